@@ -1,0 +1,1 @@
+"""Subcommands of the ``parksteer`` command line, one module per group."""

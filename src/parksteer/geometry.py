@@ -1,0 +1,130 @@
+"""Steer-axis geometry (Appendix A, reconstructed) and the lifting torque, equation (A1).
+
+Axes are fixed in the car body: x forward, y to the right, z down, origin on the
+centreline at height datum z = 0. For each side the king-pin axis passes through the
+upper point O = (-trail, +-y1, z1) and points downward along
+``R_y(castor) R_x(+-kpi) e_z``; the sign of the king-pin rotation makes the axis lean
+outboard at its foot on both sides (left: +kpi about x, right: -kpi). The wheel centre
+C = (0, +-y2, z2) lies on the axis in side view because the trail equals
+(z2 - z1) tan(castor). A steer angle ``delta`` rotates the wheel about that axis; positive
+``delta`` turns both wheels to the right (a right-hand rotation about the downward axis).
+
+Everything here is kinematics of a rigid body on a fixed axis: it is used by equation
+(A1), by Fig. A3 and as the single source of axis geometry for the multibody model.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .parameters import Parameters
+
+SIDES = ("left", "right")
+
+
+def _rot_x(a: float) -> np.ndarray:
+    c, s = np.cos(a), np.sin(a)
+    return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
+
+
+def _rot_y(a: float) -> np.ndarray:
+    c, s = np.cos(a), np.sin(a)
+    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
+
+
+@dataclass(frozen=True)
+class SteerAxis:
+    """One side's king-pin axis and wheel centre, in body axes (m)."""
+
+    side: str
+    top: np.ndarray  # O, the upper king-pin point
+    axis_frame: np.ndarray  # columns: X2, Y2, Z2 (Z2 = unit axis direction, downward)
+    wheel_centre: np.ndarray  # C at zero steer
+    wheel_radius_m: float
+
+    @property
+    def direction(self) -> np.ndarray:
+        return self.axis_frame[:, 2]
+
+    @property
+    def foot(self) -> np.ndarray:
+        """A: the foot of the perpendicular from C onto the axis."""
+        oc = self.wheel_centre - self.top
+        return self.top + np.dot(oc, self.direction) * self.direction
+
+    @property
+    def offset_d_m(self) -> float:
+        """d: perpendicular distance from the wheel centre to the steer axis."""
+        return float(np.linalg.norm(self.wheel_centre - self.foot))
+
+    def ground_intercept(self) -> np.ndarray:
+        """Where the axis meets the ground plane (z = ground)."""
+        ground_z = self.wheel_centre[2] + self.wheel_radius_m
+        t = (ground_z - self.top[2]) / self.direction[2]
+        return self.top + t * self.direction
+
+    def scrub_radius_m(self) -> float:
+        """Lateral distance at the ground from the axis intercept to the contact centre, outboard positive."""
+        outboard = -1.0 if self.side == "left" else 1.0
+        return float(outboard * (self.wheel_centre[1] - self.ground_intercept()[1]))
+
+    def rotation(self, steer_rad: float) -> np.ndarray:
+        """Rotation matrix (body axes) of the wheel about this axis by `steer_rad`."""
+        k = self.direction
+        kx = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
+        return np.eye(3) + np.sin(steer_rad) * kx + (1.0 - np.cos(steer_rad)) * (kx @ kx)
+
+    def wheel_centre_at(self, steer_rad: float) -> np.ndarray:
+        """C' : the wheel centre after steering by `steer_rad` (Rodrigues rotation about the axis)."""
+        a = self.foot
+        return a + self.rotation(steer_rad) @ (self.wheel_centre - a)
+
+    def wheel_drop_m(self, steer_rad: float | np.ndarray) -> np.ndarray | float:
+        """Downward displacement of the wheel centre (and contact point) relative to the body, from zero steer."""
+        steer = np.atleast_1d(np.asarray(steer_rad, dtype=float))
+        z0 = self.wheel_centre[2]
+        drop = np.array([self.wheel_centre_at(s)[2] - z0 for s in steer])
+        return drop if np.ndim(steer_rad) else float(drop[0])
+
+
+def steer_axis(params: Parameters, case: str, side: str) -> SteerAxis:
+    """The king-pin axis of `side` for a Table B1 `case` (spacers move only the wheel centre)."""
+    if side not in SIDES:
+        raise ValueError(f"side must be one of {SIDES}, got {side!r}")
+    g = params.sections["geometry"]
+    c = params.case(case)
+    sign = -1.0 if side == "left" else 1.0  # y of the left side is negative
+    kpi = g["kingpin_inclination"] * (1.0 if side == "left" else -1.0)
+    frame = _rot_y(g["castor_angle"]) @ _rot_x(kpi)
+    top = np.array([-g["mechanical_trail"], sign * g["kingpin_top_y"], g["kingpin_top_z"]])
+    centre = np.array([0.0, sign * c["wheel_centre_y"], g["wheel_centre_z"]])
+    return SteerAxis(side, top, frame, centre, g["ground_z"] - g["wheel_centre_z"])
+
+
+def overall_steering_ratio(params: Parameters) -> float:
+    """G: handwheel angle per road-wheel steer angle (186.47 / 8.3682 = 22.28)."""
+    s = params.sections["steering"]
+    return s["handwheel_to_rack_ratio"] / s["roadwheel_to_rack_ratio"]
+
+
+def lifting_torque_a1(params: Parameters, case: str, steer_rad: float | np.ndarray) -> np.ndarray | float:
+    """Equation (A1): handwheel torque (N m) from lifting the fixed body against the static wheel loads.
+
+    tau = d {(W_r - W_l) sin(castor) cos(delta) + (W_r + W_l) cos(castor) sin(kpi) sin(delta)} / G,
+    with d the perpendicular wheel-centre-to-axis distance and delta the road-wheel steer angle.
+    """
+    g = params.sections["geometry"]
+    c = params.case(case)
+    d = steer_axis(params, case, "left").offset_d_m
+    eps, chi = g["castor_angle"], g["kingpin_inclination"]
+    wl, wr = c["load_left"], c["load_right"]
+    delta = np.asarray(steer_rad, dtype=float)
+    tau = d * ((wr - wl) * np.sin(eps) * np.cos(delta) + (wr + wl) * np.cos(eps) * np.sin(chi) * np.sin(delta))
+    return tau / overall_steering_ratio(params)
+
+
+def lock_steer_angle(params: Parameters) -> float:
+    """Road-wheel steer angle at full lock (rad)."""
+    return params["input.handwheel_lock_angle"] / overall_steering_ratio(params)

@@ -1,0 +1,117 @@
+"""Deterministic, atomic writing of result tables (CSV) and summaries (JSON).
+
+Every output is written to a temporary file beside its target and renamed into place,
+so a failure never leaves a half-written file. Numbers are formatted with a fixed
+number of significant digits so that the same inputs give the same bytes, and so that
+a last-bit difference between platforms does not change a checksum.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import tempfile
+from collections.abc import Mapping, Sequence
+from contextlib import contextmanager
+from pathlib import Path
+from typing import Any, Iterator
+
+import numpy as np
+
+SIGNIFICANT_DIGITS = 7
+
+
+def format_number(x: float, digits: int = SIGNIFICANT_DIGITS) -> str:
+    """Format a float with `digits` significant digits; -0 becomes 0."""
+    x = float(x)
+    if not math.isfinite(x):
+        return "nan" if math.isnan(x) else ("inf" if x > 0 else "-inf")
+    s = f"{x:.{digits}g}"
+    return "0" if s in ("-0", "0") or float(s) == 0.0 else s
+
+
+@contextmanager
+def atomic_path(path: str | Path) -> Iterator[Path]:
+    """Yield a temporary path beside `path`; rename it onto `path` only on success."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    os.close(fd)
+    try:
+        yield Path(tmp)
+        os.replace(tmp, path)
+    finally:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+
+
+def write_csv(
+    path: str | Path,
+    columns: Mapping[str, Sequence[Any] | np.ndarray],
+    header: Mapping[str, Any] | None = None,
+    digits: int = SIGNIFICANT_DIGITS,
+) -> None:
+    """Write named columns as CSV, with optional leading ``# key: value`` lines."""
+    names = list(columns)
+    data = [np.asarray(columns[n]) for n in names]
+    lengths = {len(c) for c in data}
+    if len(lengths) > 1:
+        raise ValueError(f"{path}: columns have different lengths {sorted(lengths)}")
+    lines = [f"# {k}: {v}" for k, v in (header or {}).items()]
+    lines.append(",".join(names))
+    for row in zip(*data):
+        cells = []
+        for v in row:
+            if isinstance(v, (str, np.str_)):
+                cells.append(str(v))
+            else:
+                cells.append(format_number(v, digits))
+        lines.append(",".join(cells))
+    with atomic_path(path) as tmp:
+        tmp.write_text("\n".join(lines) + "\n", encoding="utf-8")
+
+
+def read_csv(path: str | Path) -> tuple[dict[str, np.ndarray], dict[str, str]]:
+    """Read a CSV written by :func:`write_csv`: numeric columns and the ``# key: value`` header."""
+    header: dict[str, str] = {}
+    rows: list[list[str]] = []
+    names: list[str] | None = None
+    for line in Path(path).read_text(encoding="utf-8").splitlines():
+        if line.startswith("#"):
+            key, _, value = line[1:].partition(":")
+            header[key.strip()] = value.strip()
+        elif names is None:
+            names = line.split(",")
+        elif line.strip():
+            rows.append(line.split(","))
+    if names is None:
+        raise ValueError(f"{path}: no header row")
+    cols: dict[str, np.ndarray] = {}
+    for i, n in enumerate(names):
+        raw = [r[i] for r in rows]
+        try:
+            cols[n] = np.array([float(v) for v in raw])
+        except ValueError:
+            cols[n] = np.array(raw, dtype=object)
+    return cols, header
+
+
+def _clean(obj: Any, digits: int) -> Any:
+    if isinstance(obj, Mapping):
+        return {str(k): _clean(v, digits) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple, np.ndarray)):
+        return [_clean(v, digits) for v in obj]
+    if isinstance(obj, (bool, np.bool_)):
+        return bool(obj)
+    if isinstance(obj, (int, np.integer)):
+        return int(obj)
+    if isinstance(obj, (float, np.floating)):
+        return float(format_number(obj, digits)) if math.isfinite(obj) else None
+    return obj
+
+
+def write_json(path: str | Path, obj: Any, digits: int = SIGNIFICANT_DIGITS) -> None:
+    """Write JSON with sorted keys and rounded floats (non-finite numbers become null)."""
+    with atomic_path(path) as tmp:
+        tmp.write_text(json.dumps(_clean(obj, digits), indent=2, sort_keys=True) + "\n", encoding="utf-8")

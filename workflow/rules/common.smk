@@ -1,0 +1,25 @@
+from pathlib import Path
+
+# Shared names. FIGURES maps each figure or table target to the files it writes;
+# these are the files checksummed in figures/SHA256SUMS.
+PARAMETERS = config["parameters"]
+
+FIGURES = {
+    "table1": ["figures/table1.csv"],
+    "fig3": ["figures/fig3.svg", "figures/fig3.csv"],
+    "fig4": ["figures/fig4.svg", "figures/fig4.csv"],
+    "figA3": ["figures/figA3.svg", "figures/figA3.csv"],
+}
+
+
+def all_figure_files():
+    return [f for files in FIGURES.values() for f in files]
+
+
+def all_number_files():
+    """The key numbers of each figure or table (results/<target>.json), which the paper quotes."""
+    return [f"results/{name}.json" for name in FIGURES]
+
+
+def paper_sources():
+    return sorted(str(p) for p in Path("paper").glob("*.typ"))

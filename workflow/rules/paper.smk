@@ -1,0 +1,17 @@
+# The reproduction article: every number it quotes is read from results/*.json and figures/*.csv.
+
+
+rule paper:
+    input:
+        source=paper_sources(),
+        parameters=PARAMETERS,
+        figures=all_figure_files(),
+        numbers=all_number_files(),
+    output:
+        pdf="paper/parksteer.pdf",
+    log:
+        "logs/paper.log",
+    conda:
+        "../envs/parksteer.yaml"
+    script:
+        "../scripts/paper.py"
