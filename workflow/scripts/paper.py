@@ -2,7 +2,8 @@
 import sys
 
 from parksteer.paper import build
+from parksteer.rules import rule_log
 
-sys.stderr = open(snakemake.log[0], "w")
-pages = build("paper/parksteer.typ", snakemake.output.pdf, root=".")
-print(f"{snakemake.output.pdf}: {pages} pages", file=sys.stderr)
+with rule_log(snakemake):
+    pages = build("paper/parksteer.typ", snakemake.output.pdf, root=".")
+    print(f"{snakemake.output.pdf}: {pages} pages", file=sys.stderr)

@@ -1,0 +1,228 @@
+"""The parameter file: the shipped file is valid and self-consistent, and every kind of defect is refused with
+a one-line error naming the file and the key, by the loader, the command line and the pipeline alike."""
+
+from __future__ import annotations
+
+import json
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from parksteer.parameters import DEFAULT_PATH, ParameterError, load_parameters
+
+BIN = Path(sys.executable).parent
+TABLE_B1_CASES = ["unladen", "part_laden", "offset_12_7mm", "offset_44_5mm", "offset_68_5mm"]
+
+
+def _edit(text: str, old: str, new: str, after: str | None = None) -> str:
+    """Replace the first `old` (after the line `after`, when given); fail if it is not there."""
+    start = 0 if after is None else text.index(after + "\n")
+    at = text.index(old, start)
+    return text[:at] + new + text[at + len(old) :]
+
+
+# defect: (text to replace, replacement, section header it follows or None, dotted key the message must name)
+DEFECTS = {
+    "unknown key": (
+        "[geometry]\n",
+        '[geometry]\nbump_steer_gain = { value = 0.1, unit = "rad/m", source = "choice" }\n',
+        None,
+        "geometry.bump_steer_gain",
+    ),
+    "missing key": (
+        'castor_angle = { value = 0.0108, unit = "rad", source = "Appendix B, epsilon" }\n',
+        "",
+        None,
+        "geometry.castor_angle",
+    ),
+    "missing value field": ("castor_angle = { value = 0.0108, ", "castor_angle = { ", None, "geometry.castor_angle"),
+    "empty source": ('source = "Appendix B, p (car model)"', 'source = ""', None, "tyre.tyre_pressure"),
+    "wrong unit": (
+        'tyre_pressure = { value = 122500.0, unit = "Pa"',
+        'tyre_pressure = { value = 1.225, unit = "bar"',
+        None,
+        "tyre.tyre_pressure",
+    ),
+    "angle in degrees": (
+        'kingpin_inclination = { value = 0.219, unit = "rad"',
+        'kingpin_inclination = { value = 12.5, unit = "deg"',
+        None,
+        "geometry.kingpin_inclination",
+    ),
+    "negative chassis mass": (
+        "chassis_mass = { value = 468.4",
+        "chassis_mass = { value = -468.4",
+        "[cases.offset_44_5mm]",
+        "cases.offset_44_5mm.chassis_mass",
+    ),
+    "negative assembly mass": (
+        "steering_assembly_mass = { value = 40.0",
+        "steering_assembly_mass = { value = -40.0",
+        None,
+        "steering.steering_assembly_mass",
+    ),
+    "negative stiffness": (
+        "radial_stiffness = { value = 160000.0",
+        "radial_stiffness = { value = -160000.0",
+        None,
+        "tyre.radial_stiffness",
+    ),
+    "zero stiffness": (
+        "column_torsional_stiffness = { value = 1000.0",
+        "column_torsional_stiffness = { value = 0.0",
+        None,
+        "steering.column_torsional_stiffness",
+    ),
+    "negative pressure": (
+        "tyre_pressure = { value = 122500.0",
+        "tyre_pressure = { value = -122500.0",
+        None,
+        "tyre.tyre_pressure",
+    ),
+    "negative load": (
+        "load_left = { value = 3065.0",
+        "load_left = { value = -3065.0",
+        "[cases.part_laden]",
+        "cases.part_laden.load_left",
+    ),
+    "number as text": (
+        "friction_coefficient = { value = 0.666",
+        'friction_coefficient = { value = "0.666"',
+        None,
+        "tyre.friction_coefficient",
+    ),
+    "text in a list": ("loads = { value = [2000.0, 2600.0", 'loads = { value = [2000.0, "2.6 kN"', None, "rig.loads"),
+    "boolean": (
+        "hooke_joint_angle = { value = 0.45",
+        "hooke_joint_angle = { value = true",
+        None,
+        "steering.hooke_joint_angle",
+    ),
+    # An added case must carry every Table B1 entry; the first one it lacks is named.
+    "incomplete case": (
+        "[cases.offset_68_5mm]\n",
+        '[cases.fully_laden]\nchassis_mass = { value = 600.0, unit = "kg", source = "choice" }\n\n'
+        "[cases.offset_68_5mm]\n",
+        None,
+        "cases.fully_laden.chassis_cg_y",
+    ),
+}
+
+
+def _write_defective(tmp_path: Path, defect: str) -> tuple[Path, str]:
+    old, new, after, key = DEFECTS[defect]
+    text = _edit(DEFAULT_PATH.read_text(encoding="utf-8"), old, new, after)
+    path = tmp_path / "bad_parameters.toml"
+    path.write_text(text, encoding="utf-8")
+    return path, key
+
+
+def _assert_one_line_naming(message: str, path: Path, key: str) -> None:
+    assert "\n" not in message.strip()
+    assert str(path) in message
+    assert key in message
+
+
+def test_shipped_file_loads(params):
+    """The shipped file passes the schema and holds the five Table B1 cases in the paper's order."""
+    assert params.path == DEFAULT_PATH
+    assert params.case_names == TABLE_B1_CASES
+    assert params.source("tyre.friction_coefficient").startswith("Appendix B")
+
+
+def test_spacer_cases_move_the_wheel_centre_by_the_spacer(params):
+    """Table B1: a spacer of thickness s moves the wheel centre outboard by s, y2 = 0.73 m + s, and the three
+    spacer cases are the three spacers listed for Fig. A3 (12.7, 44.5, 68.5 mm)."""
+    standard_y_m = params.case("unladen")["wheel_centre_y"]
+    spacer_cases = [name for name in params.case_names if params.case(name)["extra_offset"] > 0.0]
+    assert [params.case(name)["extra_offset"] for name in spacer_cases] == list(params["spacers.extra_offsets"])
+    assert list(params["spacers.extra_offsets"]) == [0.0127, 0.0445, 0.0685]
+    for name in spacer_cases:
+        case = params.case(name)
+        assert case["wheel_centre_y"] == pytest.approx(standard_y_m + case["extra_offset"], abs=1e-12)
+
+
+@pytest.mark.parametrize("defect", sorted(DEFECTS))
+def test_defect_is_refused_with_one_line_naming_file_and_key(tmp_path, defect):
+    """Each kind of defect (unknown or missing key, missing field, wrong unit, non-physical sign, non-number)
+    is refused with a ParameterError whose message is one line naming the file and the dotted key."""
+    path, key = _write_defective(tmp_path, defect)
+    with pytest.raises(ParameterError) as info:
+        load_parameters(path)
+    _assert_one_line_naming(str(info.value), path, key)
+
+
+def test_unknown_case_name_is_refused(params):
+    """Asking for a case the file does not define is a user error naming the file and the case, on one line."""
+    with pytest.raises(ParameterError) as info:
+        params.case("fully_laden")
+    _assert_one_line_naming(str(info.value), params.path, "fully_laden")
+
+
+def test_missing_file_is_refused(tmp_path):
+    """A parameter file that does not exist is a one-line user error naming it."""
+    path = tmp_path / "absent.toml"
+    with pytest.raises(ParameterError) as info:
+        load_parameters(path)
+    _assert_one_line_naming(str(info.value), path, "cannot read")
+
+
+def _run(args: list[str], cwd: Path | None = None) -> subprocess.CompletedProcess:
+    return subprocess.run(args, cwd=cwd, capture_output=True, text=True, timeout=300)
+
+
+def test_check_params_accepts_shipped_file():
+    """`parksteer check-params` on the shipped file exits 0 and reports the cases."""
+    result = _run([str(BIN / "parksteer"), "check-params"])
+    assert result.returncode == 0, result.stderr
+    assert "unladen" in result.stdout
+    assert result.stderr == ""
+
+
+def test_check_params_refuses_bad_file(tmp_path):
+    """`parksteer check-params bad.toml` exits with status 2 and prints exactly one line on stderr naming the
+    file and the key, nothing on stdout."""
+    path, key = _write_defective(tmp_path, "wrong unit")
+    result = _run([str(BIN / "parksteer"), "check-params", str(path)])
+    assert result.returncode == 2
+    assert result.stdout == ""
+    lines = result.stderr.splitlines()
+    assert len(lines) == 1
+    _assert_one_line_naming(lines[0], path, key)
+
+
+FIGA3_OUTPUTS = ("figures/figA3.svg", "figures/figA3.csv", "results/figA3.json")
+
+
+@pytest.mark.slow
+def test_pipeline_refuses_bad_file_without_output(repo_root, tmp_path):
+    """End to end: `snakemake figA3` with a defective parameter file fails, its job log holds the one-line
+    ParameterError naming file and key, and no figure file is left behind; the same workflow copy with the
+    shipped file then builds Fig. A3 (so the absence is the refusal, not a broken rule)."""
+    workdir = tmp_path / "workflow_copy"
+    workdir.mkdir()
+    shutil.copy(repo_root / "Snakefile", workdir / "Snakefile")
+    shutil.copytree(repo_root / "workflow", workdir / "workflow")
+    shutil.copytree(repo_root / "data", workdir / "data")
+    bad_path, key = _write_defective(tmp_path, "angle in degrees")
+    snakemake = [str(BIN / "snakemake"), "--cores", "1", "--directory", str(workdir)]
+    snakemake += ["--snakefile", str(workdir / "Snakefile")]
+
+    bad = _run([*snakemake, "figA3", "--config", f"parameters={bad_path}"])
+    assert bad.returncode != 0
+    assert (workdir / "logs" / "figA3.log").exists(), bad.stderr[-2000:]
+    log_lines = [line for line in (workdir / "logs" / "figA3.log").read_text().splitlines() if line.strip()]
+    assert len(log_lines) == 1, log_lines
+    _assert_one_line_naming(log_lines[0], bad_path, key)
+    for output in FIGA3_OUTPUTS:
+        assert not (workdir / output).exists(), output
+
+    good = _run([*snakemake, "figA3"])
+    assert good.returncode == 0, good.stderr[-2000:]
+    for output in FIGA3_OUTPUTS:
+        assert (workdir / output).stat().st_size > 0, output
+    summary = json.loads((workdir / "results" / "figA3.json").read_text())
+    assert round(summary["cases"]["unladen"]["torque_at_right_lock_Nm"], 1) == 1.7

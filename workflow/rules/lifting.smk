@@ -1,0 +1,16 @@
+# Appendix A: the handwheel torque from lifting the body, equation (A1), for the standard car and spacers.
+
+
+rule figA3:
+    input:
+        parameters=PARAMETERS,
+    output:
+        svg="figures/figA3.svg",
+        csv="figures/figA3.csv",
+        json="results/figA3.json",
+    log:
+        "logs/figA3.log",
+    conda:
+        "../envs/parksteer.yaml"
+    script:
+        "../scripts/figA3.py"

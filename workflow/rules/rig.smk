@@ -1,0 +1,47 @@
+# Section 2, the static tyre rig: Table 1 recomputed, Fig. 3 (torque against pressure, equations (1)
+# and (2)) and Fig. 4 (torque against pin offset, wheel free to roll and braked).
+
+
+rule table1:
+    input:
+        parameters=PARAMETERS,
+        printed="data/table1_printed.csv",
+    output:
+        csv="figures/table1.csv",
+        json="results/table1.json",
+    log:
+        "logs/table1.log",
+    conda:
+        "../envs/parksteer.yaml"
+    script:
+        "../scripts/table1.py"
+
+
+rule fig3:
+    input:
+        parameters=PARAMETERS,
+    output:
+        svg="figures/fig3.svg",
+        csv="figures/fig3.csv",
+        json="results/fig3.json",
+    log:
+        "logs/fig3.log",
+    conda:
+        "../envs/parksteer.yaml"
+    script:
+        "../scripts/fig3.py"
+
+
+rule fig4:
+    input:
+        parameters=PARAMETERS,
+    output:
+        svg="figures/fig4.svg",
+        csv="figures/fig4.csv",
+        json="results/fig4.json",
+    log:
+        "logs/fig4.log",
+    conda:
+        "../envs/parksteer.yaml"
+    script:
+        "../scripts/fig4.py"
