@@ -111,6 +111,24 @@ SCHEMA: dict[str, dict[str, Spec]] = {
     "spacers": {
         "extra_offsets": _pos("m", is_list=True),
     },
+    "synthetic": {
+        "sample_rate": _pos("Hz"),
+        "logger_bits": Spec("1", lower=1.0, upper=24.0, lower_inclusive=True),
+        "full_scale_handwheel_angle": _pos("rad"),
+        "full_scale_rack": _pos("m"),
+        "full_scale_torque": _pos("N m"),
+        "full_scale_load": _pos("N"),
+        "noise_handwheel_angle": _nonneg("rad"),
+        "noise_rack": _nonneg("m"),
+        "noise_torque": _nonneg("N m"),
+        "noise_load": _nonneg("N"),
+        "logger_seed": _nonneg("1"),
+        "hand_speed_variation": _nonneg("1", upper=0.9),
+        "hand_components": _nonneg("1", upper=20.0),
+        "hand_frequency_range": _pos("Hz", is_list=True),
+        "hand_knots_per_stroke": _pos("1", upper=8.0),
+        "hand_seed": _nonneg("1"),
+    },
 }
 
 CASE_SCHEMA: dict[str, Spec] = {
