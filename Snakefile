@@ -16,6 +16,7 @@ validate(config, "workflow/schemas/config.schema.yaml")
 include: "workflow/rules/common.smk"
 include: "workflow/rules/rig.smk"
 include: "workflow/rules/lifting.smk"
+include: "workflow/rules/model.smk"
 include: "workflow/rules/paper.smk"
 include: "workflow/rules/checks.smk"
 

@@ -17,6 +17,7 @@ from .errors import UsageError
 # Modules that add subcommands, in the order they appear in --help.
 COMMAND_MODULES = [
     "parksteer.commands.pipeline",
+    "parksteer.commands.model",
 ]
 
 
@@ -33,9 +34,27 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+# Options whose value may start with "-" (an effects spec such as "-rack_friction,+hooke_joint").
+DASH_VALUE_OPTIONS = ("--effects",)
+
+
+def _join_dash_values(argv: list[str]) -> list[str]:
+    """Rewrite ``--effects -x`` as ``--effects=-x`` so argparse does not read the spec as an option."""
+    out: list[str] = []
+    i = 0
+    while i < len(argv):
+        if argv[i] in DASH_VALUE_OPTIONS and i + 1 < len(argv) and argv[i + 1].startswith("-"):
+            out.append(f"{argv[i]}={argv[i + 1]}")
+            i += 2
+        else:
+            out.append(argv[i])
+            i += 1
+    return out
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
-    args = parser.parse_args(argv)
+    args = parser.parse_args(_join_dash_values(sys.argv[1:] if argv is None else list(argv)))
     try:
         return int(args.func(args) or 0)
     except UsageError as exc:

@@ -69,6 +69,7 @@ SCHEMA: dict[str, dict[str, Spec]] = {
         "steering_assembly_inertia_x": _pos("kg m^2"),
         "steering_assembly_inertia_y": _pos("kg m^2"),
         "steering_assembly_inertia_z": _pos("kg m^2"),
+        "rack_axis_z": _any("m"),
         "friction_smoothing": _pos("s/m"),
     },
     "geometry": {

@@ -9,6 +9,12 @@ FIGURES = {
     "fig3": ["figures/fig3.svg", "figures/fig3.csv"],
     "fig4": ["figures/fig4.svg", "figures/fig4.csv"],
     "figA3": ["figures/figA3.svg", "figures/figA3.csv"],
+    "fig12": ["figures/fig12.svg", "figures/fig12.csv"],
+    "fig13": ["figures/fig13.svg", "figures/fig13.csv"],
+    "fig14": ["figures/fig14.svg", "figures/fig14.csv"],
+    "fig15": ["figures/fig15.svg", "figures/fig15.csv"],
+    "fig16": ["figures/fig16.svg", "figures/fig16.csv"],
+    "figContrib": ["figures/figContrib.svg", "figures/figContrib.csv"],
 }
 
 

@@ -1,0 +1,151 @@
+"""Benchmark of the multibody model (not a test): medians of repeated timings.
+
+    python benchmarks/bench_model.py OUT.json [--repeats 7]
+
+Times: one 18 s cycle of the nominal case (compiled C + odeint/LSODA with the analytic
+Jacobian, cache warm); all the simulations of Figs. 12-16 and the contribution figure;
+derivation + code generation + compilation of the default model (into a scratch cache);
+and a baseline in the same run: the same sympy equations through plain ``lambdify`` and
+``solve_ivp(Radau)`` (finite-difference Jacobian) at the same tolerances. Prints a table
+and writes the numbers as JSON.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import platform
+import statistics
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+
+def _median_time(function, repeats: int) -> tuple[float, list[float]]:
+    times = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        function()
+        times.append(time.perf_counter() - start)
+    return statistics.median(times), times
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("out", help="JSON file for the results")
+    parser.add_argument("--repeats", type=int, default=7, help="repeats of the fast timings (default 7)")
+    parser.add_argument("--derive-repeats", type=int, default=3, help="repeats of the derivation (default 3)")
+    parser.add_argument("--baseline-repeats", type=int, default=3, help="repeats of the baseline (default 3)")
+    args = parser.parse_args(argv)
+
+    import sympy as sp
+    from scipy.integrate import solve_ivp
+
+    from parksteer.figures.model import all_simulations, run_simulation
+    from parksteer.model.compiled import build_entry
+    from parksteer.model.components import resolve_effects
+    from parksteer.model.derive import derive
+    from parksteer.model.simulate import RTOL, _atol, prepare, simulate, static_state
+    from parksteer.parameters import load_parameters
+    from parksteer.tables import write_json
+
+    params = load_parameters()
+    effects = resolve_effects(None)
+    runs = all_simulations()
+    for case, variant in runs:  # warm the cache (derives any missing model once)
+        run_simulation(params, case, variant)
+
+    cycle_s, cycle_all = _median_time(lambda: simulate("unladen", params=params), args.repeats)
+    figures_s, figures_all = _median_time(
+        lambda: [run_simulation(params, c, v) for c, v in runs], max(3, args.repeats // 2))
+
+    derive_totals, derive_parts = [], []
+    for _ in range(args.derive_repeats):
+        with tempfile.TemporaryDirectory() as scratch:
+            start = time.perf_counter()
+            info = build_entry(effects, Path(scratch) / "entry")
+            derive_totals.append(time.perf_counter() - start)
+            derive_parts.append(info["timings_s"])
+    derive_s = statistics.median(derive_totals)
+
+    # Baseline: plain lambdify of the same equations, solve_ivp Radau, same tolerances and outputs.
+    run = prepare("unladen", effects=effects, params=params)
+    derivation = derive(effects)
+    space, plain = derivation.space, derivation.plain_symbols()
+    n = run.model.n_q
+    q = [plain[x] for x in space.q]
+    u = [plain[x] for x in space.u]
+    symbols = [space.parameter_symbols[k] for k in run.model.info["parameters"]]
+    p_model = run.p[: len(symbols)]
+    profile = run.profile
+    y0 = static_state(run)
+    t_out = np.round(np.arange(0.0, 18.0 + 0.005, 0.01), 12)
+    fast_torque = simulate("unladen", params=params).columns["handwheel_torque_Nm"]
+
+    def time_baseline(cse: bool, repeats: int) -> dict:
+        start = time.perf_counter()
+        arguments = [q, u, symbols, space.handwheel_angle, space.handwheel_rate]
+        mass = sp.lambdify(arguments, derivation.mass_matrix.xreplace(plain), "numpy", cse=cse)
+        forcing = sp.lambdify(arguments, derivation.forcing.xreplace(plain), "numpy", cse=cse)
+        lambdify_s = time.perf_counter() - start
+
+        def rhs(t, y):
+            angle, rate = profile.angle_rate(t)
+            hw = (angle[0], rate[0])
+            a = np.linalg.solve(mass(y[:n], y[n:], p_model, *hw), np.ravel(forcing(y[:n], y[n:], p_model, *hw)))
+            return np.concatenate([y[n:], a])
+
+        solutions = []
+
+        def baseline():
+            solutions.append(solve_ivp(rhs, (0.0, 18.0), y0, method="Radau", rtol=RTOL, atol=_atol(run.model),
+                                       t_eval=t_out))
+
+        median, every = _median_time(baseline, repeats)
+        sol = solutions[-1]
+        torque = run.model.evaluate_outputs(sol.t, sol.y.T, run.p)["column_torque_Nm"]
+        return {"median": median, "all": every, "lambdify_s": lambdify_s, "rhs_evaluations": int(sol.nfev),
+                "jacobian_evaluations": int(sol.njev),
+                "max_torque_difference_to_fast_path_Nm": float(np.max(np.abs(torque - fast_torque)))}
+
+    plain_baseline = time_baseline(False, args.baseline_repeats)
+    cse_baseline = time_baseline(True, args.baseline_repeats)
+    baseline_s = plain_baseline["median"]
+
+    results = {
+        "machine": {"python": sys.version.split()[0], "platform": platform.platform(), "cpus": os.cpu_count()},
+        "repeats": {"fast": args.repeats, "derive": args.derive_repeats, "baseline": args.baseline_repeats},
+        "one_cycle_s": {"median": cycle_s, "all": cycle_all, "target": 0.05},
+        "figure_simulations_s": {"median": figures_s, "all": figures_all, "count": len(runs)},
+        "derive_codegen_compile_s": {"median": derive_s, "all": derive_totals, "target": 15.0,
+                                     "parts_of_last": derive_parts[-1]},
+        "baseline_lambdify_radau_s": plain_baseline,
+        "baseline_lambdify_cse_radau_s": cse_baseline,
+        "speedup_one_cycle_vs_baseline": baseline_s / cycle_s,
+        "speedup_one_cycle_vs_cse_baseline": cse_baseline["median"] / cycle_s,
+        "tolerances": {"rtol": RTOL, "atol": _atol(run.model).tolist()},
+    }
+    write_json(args.out, results)
+    rows = [
+        ("one 18 s cycle (compiled, odeint)", cycle_s),
+        (f"all figure simulations ({len(runs)})", figures_s),
+        ("derivation + codegen + compile", derive_s),
+        ("baseline: lambdify + Radau, one cycle", baseline_s),
+        ("baseline: lambdify(cse=True) + Radau, one cycle", cse_baseline["median"]),
+    ]
+    width = max(len(r[0]) for r in rows)
+    print(f"{'timing (median)':<{width}}  seconds")
+    for label, value in rows:
+        print(f"{label:<{width}}  {value:9.4f}")
+    print(f"{'speed-up of one cycle over the baseline':<{width}}  {baseline_s / cycle_s:9.1f}x")
+    print(f"{'speed-up over the cse baseline':<{width}}  {cse_baseline['median'] / cycle_s:9.1f}x")
+    print(f"{'baseline vs fast path, max torque difference':<{width}}  "
+          f"{plain_baseline['max_torque_difference_to_fast_path_Nm']:9.4f} N m")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,324 @@
+"""Figs. 12-16 and the contribution figure: the multibody model's cycle (paper section 4).
+
+Each simulation of the figures is one CSV, results/sim/<case>__<variant>.csv, written by
+:func:`write_simulation`; the figures read those files, so figures that share a run share
+its file. A variant is a set of effects and a surface:
+
+- full: the paper's five effects, tyres on the ground;
+- no_rack_friction, no_tyre_friction, no_friction: Fig. 14's ablations (effects switched off);
+- air_bearing: the five effects, tyres on air bearings (no tyre-to-ground friction), Fig. 16.
+
+The key numbers of each figure (plateau torque, torque near lock, drop at a reversal, the
+shares of the mechanisms, the offset sensitivity) go to results/<figure>.json.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ..geometry import steer_axis
+from ..parameters import Parameters, load_parameters
+from ..plotting import COLOURS, new_figure, save_svg
+from ..tables import read_csv, write_csv, write_json
+
+# variant -> (effects spec, surface)
+VARIANTS: dict[str, tuple[str | None, str]] = {
+    "full": (None, "ground"),
+    "no_rack_friction": ("-rack_friction", "ground"),
+    "no_tyre_friction": ("-tyre_friction", "ground"),
+    "no_friction": ("-rack_friction,-tyre_friction", "ground"),
+    "air_bearing": (None, "air_bearing"),
+}
+# The compiled model each variant needs (air bearings change a parameter, not the model).
+VARIANT_MODEL = {"full": "full", "no_rack_friction": "no_rack_friction", "no_tyre_friction": "no_tyre_friction",
+                 "no_friction": "no_friction", "air_bearing": "full"}
+MODEL_EFFECTS = {name: VARIANTS[name][0] for name in ("full", "no_rack_friction", "no_tyre_friction", "no_friction")}
+
+OFFSET_CASES = ("unladen", "offset_12_7mm", "offset_44_5mm", "offset_68_5mm")
+# figure -> the (case, variant) runs it plots, in legend order
+FIGURE_RUNS: dict[str, list[tuple[str, str]]] = {
+    "fig12": [("unladen", "full"), ("part_laden", "full")],
+    "fig13": [("unladen", "full"), ("part_laden", "full")],
+    "fig14": [("unladen", "full"), ("unladen", "no_rack_friction"), ("unladen", "no_tyre_friction"),
+              ("unladen", "no_friction")],
+    "fig15": [(case, "full") for case in OFFSET_CASES],
+    "fig16": [(case, "air_bearing") for case in OFFSET_CASES],
+    "figContrib": [("unladen", "full")],
+}
+# The plateau: the first steer towards right lock, rack between these positions (m), after the carcass wind-up
+PLATEAU_RACK_M = (0.02, 0.06)
+
+VARIANT_LABELS = {
+    "full": "full model",
+    "no_rack_friction": "(a) no rack friction",
+    "no_tyre_friction": "(b) no tyre friction",
+    "no_friction": "(c) no rack or tyre friction (lifting remains)",
+    "air_bearing": "air bearings",
+}
+EFFECT_LABELS = {
+    "tyre_friction": "tyre friction",
+    "rack_friction": "rack friction",
+    "lifting": "lifting",
+    "carcass_compliance": "carcass compliance",
+    "hooke_joint": "Hooke joint",
+    "inertia": "inertia",
+}
+
+
+def simulation_path(case: str, variant: str, directory: str | Path = "results/sim") -> Path:
+    return Path(directory) / f"{case}__{variant}.csv"
+
+
+def all_simulations() -> list[tuple[str, str]]:
+    """Every (case, variant) run of the figures, once each."""
+    seen: dict[tuple[str, str], None] = {}
+    for runs in FIGURE_RUNS.values():
+        for run in runs:
+            seen[run] = None
+    return list(seen)
+
+
+def run_simulation(params: Parameters, case: str, variant: str):
+    from ..model.simulate import simulate
+
+    effects, surface = VARIANTS[variant]
+    return simulate(case, effects=effects, surface=surface, params=params)
+
+
+def write_simulation(parameters_path: str | Path, case: str, variant: str, csv_path: str | Path) -> None:
+    """Simulate one (case, variant) run of the figures and write its CSV."""
+    if variant not in VARIANTS:
+        raise ValueError(f"unknown variant {variant!r} (known: {', '.join(VARIANTS)})")
+    result = run_simulation(load_parameters(parameters_path), case, variant)
+    result.header["variant"] = variant
+    result.write_csv(csv_path)
+
+
+def derive_model(name: str, manifest_path: str | Path) -> None:
+    """Build the cached compiled model of one of MODEL_EFFECTS and write its manifest."""
+    from ..cli import main
+
+    status = main(["derive", *(["--effects=" + MODEL_EFFECTS[name]] if MODEL_EFFECTS[name] else []),
+                   "--out", str(manifest_path)])
+    if status:
+        raise RuntimeError(f"derive {name} failed")
+
+
+# -- key numbers --------------------------------------------------------------------------
+def _times(params: Parameters) -> dict[str, float]:
+    t_right = params["input.time_to_right_lock"]
+    t_left = t_right + params["input.time_right_to_left_lock"]
+    return {"right_lock": t_right, "left_lock": t_left, "half_rounding": params["input.reversal_rounding_time"] / 2}
+
+
+def _at(columns: dict, name: str, t_s: float) -> float:
+    return float(np.interp(t_s, columns["time_s"], columns[name]))
+
+
+def plateau_mask(columns: dict, params: Parameters) -> np.ndarray:
+    t_right = _times(params)["right_lock"]
+    rack = columns["rack_m"]
+    return (columns["time_s"] < t_right) & (rack >= PLATEAU_RACK_M[0]) & (rack <= PLATEAU_RACK_M[1])
+
+
+def cycle_summary(columns: dict, params: Parameters) -> dict:
+    """Key numbers of one cycle: plateau, near lock, reversal drops, peak, loads, contribution shares."""
+    t = _times(params)
+    before_right = t["right_lock"] - t["half_rounding"]
+    after_right = t["right_lock"] + t["half_rounding"]
+    before_left = t["left_lock"] - t["half_rounding"]
+    after_left = t["left_lock"] + t["half_rounding"]
+    torque = columns["handwheel_torque_Nm"]
+    plateau = plateau_mask(columns, params)
+    out = {
+        "plateau_torque_Nm": float(np.mean(torque[plateau])),
+        "plateau_rack_range_m": list(PLATEAU_RACK_M),
+        "torque_near_right_lock_Nm": _at(columns, "handwheel_torque_Nm", before_right),
+        "rack_near_right_lock_m": _at(columns, "rack_m", before_right),
+        "torque_near_left_lock_Nm": _at(columns, "handwheel_torque_Nm", before_left),
+        "drop_at_right_lock_reversal_Nm": _at(columns, "handwheel_torque_Nm", before_right)
+        - _at(columns, "handwheel_torque_Nm", after_right),
+        "rise_at_left_lock_reversal_Nm": _at(columns, "handwheel_torque_Nm", after_left)
+        - _at(columns, "handwheel_torque_Nm", before_left),
+        "peak_torque_Nm": float(np.max(np.abs(torque))),
+        "max_rack_m": float(np.max(columns["rack_m"])),
+        "min_rack_m": float(np.min(columns["rack_m"])),
+        "load_left_range_N": [float(np.min(columns["load_left_N"])), float(np.max(columns["load_left_N"]))],
+        "load_right_range_N": [float(np.min(columns["load_right_N"])), float(np.max(columns["load_right_N"]))],
+        "load_left_near_right_lock_N": _at(columns, "load_left_N", before_right),
+        "load_right_near_right_lock_N": _at(columns, "load_right_N", before_right),
+    }
+    shares = {}
+    for name in columns:
+        if name.startswith("contrib_") and name.endswith("_Nm"):
+            effect = name[len("contrib_"):-len("_Nm")]
+            shares[effect] = {
+                "plateau_Nm": float(np.mean(columns[name][plateau])),
+                "near_right_lock_Nm": _at(columns, name, before_right),
+            }
+    out["contributions"] = shares
+    return out
+
+
+# -- figures ------------------------------------------------------------------------------
+def _label(params: Parameters, case: str, variant: str) -> str:
+    c = params.case(case)
+    if case == "part_laden":
+        name = "part laden"
+    elif c["extra_offset"] > 0:
+        name = f"{1000 * c['extra_offset']:.1f} mm spacer"
+    else:
+        name = "unladen (nominal)"
+    if case in OFFSET_CASES:
+        name += f", d = {1000 * steer_axis(params, case, 'left').offset_d_m:.1f} mm"
+    return name if variant in ("full", "air_bearing") else VARIANT_LABELS[variant]
+
+
+def _run_key(case: str, variant: str) -> str:
+    return f"{case}__{variant}"
+
+
+def _torque_against_rack(params, runs, data, title, ylabel="handwheel torque (N m)"):
+    fig, ax = new_figure(6.5, 4.2)
+    for colour, (case, variant) in zip(COLOURS, runs):
+        c = data[(case, variant)]
+        ax.plot(1000 * c["rack_m"], c["handwheel_torque_Nm"], color=colour, label=_label(params, case, variant))
+    ax.axhline(0.0, color="0.5", linewidth=0.6)
+    ax.axvline(0.0, color="0.5", linewidth=0.6)
+    ax.set_xlabel("rack displacement (mm), positive steering right")
+    ax.set_ylabel(ylabel)
+    ax.set_title(title, fontsize=9)
+    ax.legend(loc="upper left", fontsize=8)
+    fig.tight_layout()
+    return fig
+
+
+def _loads_against_rack(params, runs, data):
+    fig, ax = new_figure(6.5, 4.2)
+    for colour, (case, variant) in zip(COLOURS, runs):
+        c = data[(case, variant)]
+        label = _label(params, case, variant)
+        ax.plot(1000 * c["rack_m"], c["load_left_N"], color=colour, label=f"left wheel, {label}")
+        ax.plot(1000 * c["rack_m"], c["load_right_N"], color=colour, linestyle="--", label=f"right wheel, {label}")
+    ax.set_xlabel("rack displacement (mm), positive steering right")
+    ax.set_ylabel("road wheel load (N)")
+    ax.set_title("Fig. 13: wheel loads against rack displacement (model)", fontsize=9)
+    ax.legend(loc="center left", fontsize=7)
+    fig.tight_layout()
+    return fig
+
+
+def _contributions_over_time(params, c):
+    fig, (top, bottom) = new_figure(6.5, 5.5, nrows=2, sharex=True)
+    t = c["time_s"]
+    present = [n for n in ("tyre_friction", "rack_friction", "lifting", "carcass_compliance", "hooke_joint", "inertia")
+               if f"contrib_{n}_Nm" in c]
+    # The Hooke joint and the carcass apply no force to the rack: the joint scales every share, the carcass passes
+    # the tyre moment on. Their zero bands are left out of the stack and named in a note.
+    names = [n for n in present if np.max(np.abs(c[f"contrib_{n}_Nm"])) > 1e-9]
+    silent = [EFFECT_LABELS[n] for n in present if n not in names]
+    series = [c[f"contrib_{n}_Nm"] for n in names]
+    positive = np.zeros_like(t)
+    negative = np.zeros_like(t)
+    for colour, name, values in zip(COLOURS, names, series):
+        up = np.clip(values, 0, None)
+        down = np.clip(values, None, 0)
+        top.fill_between(t, positive, positive + up, color=colour, linewidth=0, label=EFFECT_LABELS[name])
+        top.fill_between(t, negative, negative + down, color=colour, linewidth=0)
+        positive += up
+        negative += down
+    top.plot(t, c["handwheel_torque_Nm"], color="k", linewidth=0.9, label="handwheel torque")
+    top.set_ylabel("torque at the handwheel (N m)")
+    top.set_title("Contributions of the mechanisms to the handwheel torque (nominal case)", fontsize=9)
+    top.legend(loc="lower left", fontsize=7, ncol=2)
+    if silent:
+        top.text(0.99, 0.02, "no direct share: " + ", ".join(silent), transform=top.transAxes, ha="right",
+                 va="bottom", fontsize=7, color="0.3")
+    bottom.plot(t, 1000 * c["rack_m"], color=COLOURS[0])
+    bottom.set_ylabel("rack (mm)")
+    bottom.set_xlabel("time (s)")
+    fig.tight_layout()
+    return fig
+
+
+def _figure_columns(name: str, params: Parameters, data: dict) -> dict:
+    """The plotted data of one figure, on the runs' shared time base."""
+    runs = FIGURE_RUNS[name]
+    first = data[runs[0]]
+    cols: dict[str, np.ndarray] = {"time_s": first["time_s"]}
+    for case, variant in runs:
+        c = data[(case, variant)]
+        key = _run_key(case, variant)
+        cols[f"rack_{key}_mm"] = 1000 * c["rack_m"]
+        if name == "fig13":
+            cols[f"load_left_{key}_N"] = c["load_left_N"]
+            cols[f"load_right_{key}_N"] = c["load_right_N"]
+        elif name == "figContrib":
+            cols["handwheel_torque_Nm"] = c["handwheel_torque_Nm"]
+            for col in c:
+                if col.startswith("contrib_"):
+                    cols[col] = c[col]
+        else:
+            cols[f"torque_{key}_Nm"] = c["handwheel_torque_Nm"]
+    return cols
+
+
+def _summary(name: str, params: Parameters, data: dict) -> dict:
+    runs = FIGURE_RUNS[name]
+    summaries = {_run_key(case, variant): cycle_summary(data[(case, variant)], params) for case, variant in runs}
+    out: dict = {"figure": name, "runs": summaries, "plateau_rack_range_m": list(PLATEAU_RACK_M)}
+    if name == "fig14":
+        plateau = {variant: summaries[_run_key("unladen", variant)]["plateau_torque_Nm"] for _, variant in runs}
+        out["plateau_torque_Nm"] = plateau
+        out["tyre_friction_share_from_ablation_Nm"] = plateau["full"] - plateau["no_tyre_friction"]
+        out["rack_friction_share_from_ablation_Nm"] = plateau["full"] - plateau["no_rack_friction"]
+        out["lifting_alone_plateau_Nm"] = plateau["no_friction"]
+    if name in ("fig15", "fig16"):
+        offsets = np.array([params.case(case)["extra_offset"] for case, _ in runs])
+        plateau = np.array([summaries[_run_key(c, v)]["plateau_torque_Nm"] for c, v in runs])
+        near_lock = np.array([summaries[_run_key(c, v)]["torque_near_right_lock_Nm"] for c, v in runs])
+        out["extra_offset_m"] = offsets.tolist()
+        out["offset_d_m"] = [steer_axis(params, c, "left").offset_d_m for c, _ in runs]
+        out["plateau_torque_Nm"] = plateau.tolist()
+        out["torque_near_right_lock_Nm"] = near_lock.tolist()
+        out["plateau_sensitivity_Nm_per_m_offset"] = float(np.polyfit(offsets, plateau, 1)[0])
+        out["near_lock_sensitivity_Nm_per_m_offset"] = float(np.polyfit(offsets, near_lock, 1)[0])
+        out["largest_plateau_change_relative"] = float((plateau.max() - plateau.min()) / plateau[0])
+    if name in ("fig12", "fig13"):
+        out["plateau_torque_Nm"] = {k: s["plateau_torque_Nm"] for k, s in summaries.items()}
+    return out
+
+
+PLOTTERS = {
+    "fig12": lambda p, d: _torque_against_rack(
+        p, FIGURE_RUNS["fig12"], d, "Fig. 12: handwheel torque against rack displacement (model)"),
+    "fig13": lambda p, d: _loads_against_rack(p, FIGURE_RUNS["fig13"], d),
+    "fig14": lambda p, d: _torque_against_rack(
+        p, FIGURE_RUNS["fig14"], d, "Fig. 14: mechanisms omitted in turn (unladen)"),
+    "fig15": lambda p, d: _torque_against_rack(
+        p, FIGURE_RUNS["fig15"], d, "Fig. 15: wheel offset varied by spacers, tyres on the ground"),
+    "fig16": lambda p, d: _torque_against_rack(
+        p, FIGURE_RUNS["fig16"], d, "Fig. 16: wheel offset varied by spacers, tyres on air bearings"),
+    "figContrib": lambda p, d: _contributions_over_time(p, d[("unladen", "full")]),
+}
+
+
+def make_model_figure(name: str, parameters_path: str | Path, simulation_csvs: list[str | Path],
+                      svg_path: str | Path, csv_path: str | Path, json_path: str | Path) -> None:
+    """Write one figure's SVG, plotted data and key numbers from its simulation CSVs (in FIGURE_RUNS order)."""
+    params = load_parameters(parameters_path)
+    runs = FIGURE_RUNS[name]
+    if len(simulation_csvs) != len(runs):
+        raise ValueError(f"{name}: expected {len(runs)} simulation files, got {len(simulation_csvs)}")
+    data = {run: read_csv(path)[0] for run, path in zip(runs, simulation_csvs)}
+    header = {
+        "figure": f"{name}: multibody model (section 4)",
+        "runs": ", ".join(_run_key(c, v) for c, v in runs),
+        "units": "time in s, rack in mm, torque at the handwheel in N m, loads in N",
+    }
+    fig = PLOTTERS[name](params, data)
+    write_csv(csv_path, _figure_columns(name, params, data), header)
+    write_json(json_path, _summary(name, params, data))
+    save_svg(fig, svg_path)

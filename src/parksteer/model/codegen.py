@@ -1,0 +1,304 @@
+"""C code for one derived model: mass matrix, forcing, analytic Jacobian, outputs.
+
+The generated file has two parts: functions written from the sympy expressions (after
+common-subexpression elimination) and a fixed runtime (handwheel input, Cholesky solve of
+the symmetric positive definite mass matrix, right-hand side, Jacobian, batched outputs).
+Every parameter is read from the vector ``p`` at run time.
+
+The Jacobian of y' = (u, M^-1 f) is assembled from generated partial derivatives:
+d(M^-1 f)/dq = M^-1 (df/dq - d(M a)/dq |a fixed), d(M^-1 f)/du = M^-1 df/du, a = M^-1 f.
+"""
+
+from __future__ import annotations
+
+import time
+
+import sympy as sp
+from sympy.printing.c import C99CodePrinter
+
+from .derive import Derivation
+
+# The handwheel input is a piecewise-quadratic table in p: count, then (t0, angle0, rate0, accel) per piece.
+MAX_INPUT_PIECES = 24
+INPUT_FIELDS = 4
+
+
+class _Printer(C99CodePrinter):
+    """C99 printer that writes small integer powers as products (pow() is slow)."""
+
+    def _print_Pow(self, expr):
+        base, exp = expr.as_base_exp()
+        if exp.is_Integer and 2 <= abs(int(exp)) <= 4:
+            b = self.parenthesize(base, 100)
+            prod = "*".join([b] * abs(int(exp)))
+            return f"({prod})" if exp > 0 else f"(1.0/({prod}))"
+        if exp == sp.Rational(1, 2):
+            return f"sqrt({self._print(base)})"
+        if exp == sp.Rational(3, 2):
+            b = self._print(base)
+            return f"(({b})*sqrt({b}))"
+        return super()._print_Pow(expr)
+
+
+def _c_block(assignments: list[tuple[str, sp.Expr]], printer: _Printer) -> list[str]:
+    """Lines assigning each target, sharing common subexpressions."""
+    exprs = [e for _, e in assignments]
+    replacements, reduced = sp.cse(exprs, symbols=sp.numbered_symbols("x"), order="none")
+    lines = [f"    const double {sym} = {printer.doprint(val)};" for sym, val in replacements]
+    lines += [f"    {target} = {printer.doprint(val)};" for (target, _), val in zip(assignments, reduced)]
+    return lines
+
+
+def _function(name: str, args: str, assignments, printer) -> str:
+    body = "\n".join(_c_block(assignments, printer))
+    return f"static void {name}({args})\n{{\n{body}\n}}\n"
+
+
+def generate(derivation: Derivation) -> tuple[str, dict]:
+    """C source of the model and its description (state names, parameter order, output names)."""
+    timings = {}
+    start = time.perf_counter()
+    space = derivation.space
+    n = len(space.coordinates)
+    printer = _Printer()
+    plain = derivation.plain_symbols()
+    for i, name in enumerate(derivation.parameter_names):
+        plain[space.parameter_symbols[name]] = sp.Symbol(f"p[{i}]", real=True)
+    plain[space.handwheel_angle] = sp.Symbol("th", real=True)
+    plain[space.handwheel_rate] = sp.Symbol("thd", real=True)
+
+    def c(expr):
+        return sp.sympify(expr).xreplace(plain)
+
+    q = [plain[x] for x in space.q]
+    u = [plain[x] for x in space.u]
+    a = [sp.Symbol(f"a[{i}]", real=True) for i in range(n)]
+    M = derivation.mass_matrix.xreplace(plain)
+    F = derivation.forcing.xreplace(plain)
+    F_nocol = (derivation.forcing_inertia + sum(derivation.generalized_forces.values(), sp.zeros(n, 1))).xreplace(plain)
+    bcol = derivation.column_direction.xreplace(plain)
+
+    mf = [(f"M[{i * n + j}]", M[i, j]) for i in range(n) for j in range(i, n)]
+    mf += [(f"F[{i}]", F[i]) for i in range(n)]
+    Ma = M * sp.Matrix(a)
+    jac = []
+    for i in range(n):
+        for j in range(n):
+            jac.append((f"dFdq[{i * n + j}]", sp.diff(F[i], q[j]) - sp.diff(Ma[i], q[j])))
+            jac.append((f"dFdu[{i * n + j}]", sp.diff(F[i], u[j])))
+    drive = [(f"M[{i * n + j}]", M[i, j]) for i in range(n) for j in range(i, n)]
+    drive += [(f"F[{i}]", F_nocol[i]) for i in range(n)] + [(f"b[{i}]", bcol[i]) for i in range(n)]
+    timings["diff_s"] = time.perf_counter() - start
+
+    dcol = c(space.column_angle_per_rack)
+    rack = space.coordinates.index(next(cc for cc in space.coordinates if cc.name == "rack"))
+    outputs: list[tuple[str, sp.Expr]] = [
+        ("column_angle_rad", c(space.column_angle)),
+        ("column_angle_per_rack_rad_per_m", dcol),
+        ("column_torque_Nm", c(space.column_torque)),
+        ("load_left_N", c(space.wheel_load["left"])),
+        ("load_right_N", c(space.wheel_load["right"])),
+        ("steer_left_rad", c(space.steer_angle["left"])),
+        ("steer_right_rad", c(space.steer_angle["right"])),
+        ("ring_yaw_rate_left_rad_s", c(space.ring_frame["left"].ang_vel_in(space.N).dot(space.N.z))),
+        ("ring_yaw_rate_right_rad_s", c(space.ring_frame["right"].ang_vel_in(space.N).dot(space.N.z))),
+    ]
+    for name in derivation.effects:
+        outputs.append((f"contrib_{name}_Nm", -derivation.generalized_forces[name][rack].xreplace(plain) / dcol))
+    inertia_row = sum(M[rack, j] * a[j] for j in range(n))
+    outputs.append((
+        "contrib_inertia_Nm",
+        (inertia_row - derivation.forcing_inertia[rack].xreplace(plain)
+         - derivation.generalized_forces["core"][rack].xreplace(plain)) / dcol,
+    ))
+    outputs += [
+        ("kinetic_energy_J", c(space.kinetic_energy())),
+        ("potential_energy_J", c(derivation.potential_energy)),
+        ("column_energy_J", c(space.column_potential_energy())),
+    ]
+    out_assign = [(f"out[{i}]", e) for i, (_, e) in enumerate(outputs)]
+
+    start = time.perf_counter()
+    args_mf = "const double *q, const double *u, const double *p, double th, double thd, double *M, double *F"
+    parts = [
+        _function("eval_mf", args_mf, mf, printer),
+        _function(
+            "eval_jac",
+            "const double *q, const double *u, const double *a, const double *p, double th, double thd, "
+            "double *dFdq, double *dFdu",
+            jac, printer,
+        ),
+        _function("eval_drive", "const double *q, const double *u, const double *p, double *M, double *F, double *b",
+                  drive, printer),
+        _function(
+            "eval_outputs",
+            "const double *q, const double *u, const double *a, const double *p, double th, double thd, double *out",
+            out_assign, printer,
+        ),
+    ]
+    timings["cse_print_s"] = time.perf_counter() - start
+    n_params = len(derivation.parameter_names)
+    info = {
+        "effects": list(derivation.effects),
+        "coordinates": derivation.coordinate_names,
+        "coordinate_units": derivation.coordinate_units,
+        "coordinate_owners": [cc.owner for cc in space.coordinates],
+        "parameters": derivation.parameter_names,
+        "input_offset": n_params,
+        "max_input_pieces": MAX_INPUT_PIECES,
+        "n_parameter_vector": n_params + 1 + INPUT_FIELDS * MAX_INPUT_PIECES,
+        "outputs": [name for name, _ in outputs],
+        "rack_index": rack,
+    }
+    header = (
+        "/* Generated by parksteer.model.codegen from the sympy derivation; do not edit. */\n"
+        "#include <math.h>\n#include <string.h>\n\n"
+        f"#define NQ {n}\n#define NY {2 * n}\n#define NOUT {len(outputs)}\n"
+        f"#define INPUT_OFFSET {n_params}\n#define MAX_PIECES {MAX_INPUT_PIECES}\n\n"
+    )
+    return header + "\n".join(parts) + RUNTIME, {**info, "codegen_timings_s": timings}
+
+
+RUNTIME = r"""
+/* ---- fixed runtime ---------------------------------------------------------------- */
+
+int ps_nq(void) { return NQ; }
+int ps_nout(void) { return NOUT; }
+
+/* Handwheel angle and rate from the piecewise-quadratic table in p (constant outside it). */
+void ps_handwheel(double t, const double *p, double *th, double *thd)
+{
+    const double *tab = p + INPUT_OFFSET;
+    int n = (int)tab[0], k = 0;
+    if (n < 1) { *th = 0.0; *thd = 0.0; return; }
+    while (k + 1 < n && t >= tab[1 + 4 * (k + 1)]) k++;
+    const double *piece = tab + 1 + 4 * k;
+    double dt = t - piece[0];
+    if (dt < 0.0) { *th = piece[1]; *thd = 0.0; return; }
+    *th = piece[1] + piece[2] * dt + 0.5 * piece[3] * dt * dt;
+    *thd = piece[2] + piece[3] * dt;
+}
+
+static void fill_lower(double *M)
+{
+    for (int i = 0; i < NQ; i++)
+        for (int j = 0; j < i; j++) M[i * NQ + j] = M[j * NQ + i];
+}
+
+/* In-place Cholesky factor (lower) of the symmetric positive definite M; 0 on success. */
+static int cholesky(double *M)
+{
+    for (int j = 0; j < NQ; j++) {
+        double d = M[j * NQ + j];
+        for (int k = 0; k < j; k++) d -= M[j * NQ + k] * M[j * NQ + k];
+        if (!(d > 0.0)) return -1;
+        d = sqrt(d);
+        M[j * NQ + j] = d;
+        for (int i = j + 1; i < NQ; i++) {
+            double s = M[i * NQ + j];
+            for (int k = 0; k < j; k++) s -= M[i * NQ + k] * M[j * NQ + k];
+            M[i * NQ + j] = s / d;
+        }
+    }
+    return 0;
+}
+
+/* Solve L L^T x = b for `nrhs` right-hand sides stored as columns of b (row-major, stride ld). */
+static void chol_solve(const double *L, double *b, int nrhs, int ld)
+{
+    for (int c = 0; c < nrhs; c++) {
+        for (int i = 0; i < NQ; i++) {
+            double s = b[i * ld + c];
+            for (int k = 0; k < i; k++) s -= L[i * NQ + k] * b[k * ld + c];
+            b[i * ld + c] = s / L[i * NQ + i];
+        }
+        for (int i = NQ - 1; i >= 0; i--) {
+            double s = b[i * ld + c];
+            for (int k = i + 1; k < NQ; k++) s -= L[k * NQ + i] * b[k * ld + c];
+            b[i * ld + c] = s / L[i * NQ + i];
+        }
+    }
+}
+
+/* Accelerations a = M^-1 F at state y and handwheel (th, thd); leaves the factor in L. */
+static int accelerations(const double *y, const double *p, double th, double thd, double *L, double *a)
+{
+    eval_mf(y, y + NQ, p, th, thd, L, a);
+    fill_lower(L);
+    if (cholesky(L)) return -1;
+    chol_solve(L, a, 1, 1);
+    return 0;
+}
+
+int ps_rhs(double t, const double *y, const double *p, double *ydot)
+{
+    double th, thd, L[NQ * NQ];
+    ps_handwheel(t, p, &th, &thd);
+    memcpy(ydot, y + NQ, NQ * sizeof(double));
+    return accelerations(y, p, th, thd, L, ydot + NQ);
+}
+
+/* Jacobian d(ydot)/dy, row-major NY x NY. */
+int ps_jac(double t, const double *y, const double *p, double *J)
+{
+    double th, thd, L[NQ * NQ], a[NQ], dFdq[NQ * NQ], dFdu[NQ * NQ], rhs[NQ * 2 * NQ];
+    ps_handwheel(t, p, &th, &thd);
+    if (accelerations(y, p, th, thd, L, a)) return -1;
+    eval_jac(y, y + NQ, a, p, th, thd, dFdq, dFdu);
+    for (int i = 0; i < NQ; i++)
+        for (int j = 0; j < NQ; j++) {
+            rhs[i * 2 * NQ + j] = dFdq[i * NQ + j];
+            rhs[i * 2 * NQ + NQ + j] = dFdu[i * NQ + j];
+        }
+    chol_solve(L, rhs, 2 * NQ, 2 * NQ);
+    memset(J, 0, NY * NY * sizeof(double));
+    for (int i = 0; i < NQ; i++) {
+        J[i * NY + NQ + i] = 1.0;
+        for (int j = 0; j < NY; j++) J[(NQ + i) * NY + j] = rhs[i * 2 * NQ + j];
+    }
+    return 0;
+}
+
+/* Forcing F (full, at the handwheel input of time t) for static solves. */
+void ps_forcing(double t, const double *y, const double *p, double *F)
+{
+    double th, thd, M[NQ * NQ];
+    ps_handwheel(t, p, &th, &thd);
+    eval_mf(y, y + NQ, p, th, thd, M, F);
+}
+
+/* Partial derivatives of F (a = 0) for static solves: dF/dq, row-major. */
+void ps_forcing_dq(double t, const double *y, const double *p, double *dFdq)
+{
+    double th, thd, a[NQ], dFdu[NQ * NQ];
+    memset(a, 0, sizeof a);
+    ps_handwheel(t, p, &th, &thd);
+    eval_jac(y, y + NQ, a, p, th, thd, dFdq, dFdu);
+}
+
+/* For a prescribed rack: mass matrix (full), forcing without the column, column direction b. */
+void ps_drive(const double *y, const double *p, double *M, double *F, double *b)
+{
+    eval_drive(y, y + NQ, p, M, F, b);
+    fill_lower(M);
+}
+
+/* Outputs at n samples: handwheel-driven (a computed here) when acc is NULL, else given a and (th, thd). */
+int ps_outputs(int n, const double *t, const double *y, const double *acc, const double *hw, const double *p,
+               double *out)
+{
+    for (int k = 0; k < n; k++) {
+        const double *yk = y + k * NY;
+        double th, thd, L[NQ * NQ], a[NQ];
+        if (acc) {
+            th = hw[2 * k]; thd = hw[2 * k + 1];
+            memcpy(a, acc + k * NQ, sizeof a);
+        } else {
+            ps_handwheel(t[k], p, &th, &thd);
+            if (accelerations(yk, p, th, thd, L, a)) return -1;
+        }
+        eval_outputs(yk, yk + NQ, a, p, th, thd, out + k * NOUT);
+    }
+    return 0;
+}
+"""

@@ -1,0 +1,125 @@
+"""Equations of motion by Kane's method (sympy.physics.mechanics), with per-effect generalized forces.
+
+KanesMethod gives the mass matrix and the inertia terms of the forcing; the generalized
+active forces are formed here, group by group, from each load's partial velocities:
+for a force F at point P, Q_r = dv_P/du_r . F; for a torque T on frame A,
+Q_r = dw_A/du_r . T. So the forcing is
+
+    M(q) u' = f_inertia(q, u) + Q_core + sum over effects Q_effect + b(q) T_column
+
+and each effect's generalized force on the rack, mapped to the handwheel through
+d(theta_c)/d(rack), is that effect's share of the handwheel torque.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import sympy as sp
+import sympy.physics.mechanics as me
+
+from .components import Effect
+from .system import INPUT_NAMES, SIDES, ModelSpace
+
+
+@dataclass
+class Derivation:
+    """Symbolic equations of one effect set, in terms of q, u, the parameters and the handwheel input."""
+
+    effects: tuple[str, ...]
+    space: ModelSpace
+    coordinate_names: list[str]
+    coordinate_units: list[str]
+    parameter_names: list[str]
+    mass_matrix: sp.Matrix
+    forcing_inertia: sp.Matrix
+    generalized_forces: dict[str, sp.Matrix]  # "core" and one per effect
+    column_direction: sp.Matrix  # generalized force of a unit column torque
+    potential_energy: Any
+    timings_s: dict[str, float] = field(default_factory=dict)
+
+    @property
+    def forcing(self) -> sp.Matrix:
+        total = self.forcing_inertia + self.column_direction * self.space.column_torque
+        for q in self.generalized_forces.values():
+            total += q
+        return total
+
+    def plain_symbols(self) -> dict:
+        """Map q(t), u(t) to plain symbols q_i, u_i (for lambdify/codegen); the inverse is not needed."""
+        mapping = {}
+        for i, c in enumerate(self.space.coordinates):
+            mapping[c.q] = sp.Symbol(f"q[{i}]", real=True)
+            mapping[c.u] = sp.Symbol(f"u[{i}]", real=True)
+        return mapping
+
+
+def generalized_forces(loads, speeds, frame) -> sp.Matrix:
+    """Q_r = sum over loads of (partial velocity or partial angular velocity wrt u_r) . (force or torque)."""
+    out = sp.zeros(len(speeds), 1)
+    for where, vector in loads:
+        velocity = where.ang_vel_in(frame) if isinstance(where, me.ReferenceFrame) else where.vel(frame)
+        for r, speed in enumerate(speeds):
+            partial = velocity.diff(speed, frame)
+            if partial != 0:
+                out[r] += partial.dot(vector)
+    return out
+
+
+def build_space(effects: list[Effect], speeds_as_qdot: bool = False) -> ModelSpace:
+    """Configure and build the system for `effects` (the hooks run in the order given).
+
+    With `speeds_as_qdot` every speed is written as dq/dt instead of a speed symbol u (for
+    LagrangesMethod, which takes partial velocities with respect to dq/dt).
+    """
+    space = ModelSpace(tuple(e.name for e in effects), speeds_as_qdot=speeds_as_qdot)
+    for effect in effects:
+        for spec in effect.parameters:
+            space.p(effect, spec.name)
+    for effect in effects:
+        effect.configure(space)
+    space.build()
+    return space
+
+
+def derive(effects: list[Effect]) -> Derivation:
+    """Kane's equations and the per-effect generalized forces for the given effects."""
+    import time
+
+    timings = {}
+    start = time.perf_counter()
+    space = build_space(effects)
+    q, u = space.q, space.u
+    kane = me.KanesMethod(space.N, q_ind=q, u_ind=u, kd_eqs=[qi.diff(space.t) - ui for qi, ui in zip(q, u)])
+    kane.kanes_equations(space.bodies, [])
+    mass_matrix = kane.mass_matrix
+    forcing_inertia = kane.forcing
+    timings["kane_s"] = time.perf_counter() - start
+
+    start = time.perf_counter()
+    forces = {"core": generalized_forces(space.core_loads(), u, space.N)}
+    for effect in effects:
+        forces[effect.name] = generalized_forces(effect.loads(space), u, space.N)
+    unit_torque = sp.Symbol("unit_column_torque")
+    column_loads = [(where, vector.subs(space.column_torque, unit_torque)) for where, vector in space.column_loads()]
+    column = generalized_forces(column_loads, u, space.N).xreplace({unit_torque: 1})
+    potential = space.core_potential_energy() + sum(e.potential_energy(space) for e in effects)
+    timings["forces_s"] = time.perf_counter() - start
+
+    return Derivation(
+        effects=tuple(e.name for e in effects),
+        space=space,
+        coordinate_names=[c.name for c in space.coordinates],
+        coordinate_units=[c.unit for c in space.coordinates],
+        parameter_names=list(space.parameter_symbols),
+        mass_matrix=mass_matrix,
+        forcing_inertia=forcing_inertia,
+        generalized_forces=forces,
+        column_direction=column,
+        potential_energy=potential,
+        timings_s=timings,
+    )
+
+
+__all__ = ["Derivation", "derive", "build_space", "generalized_forces", "INPUT_NAMES", "SIDES"]

@@ -1,0 +1,301 @@
+"""Simulate the steering model: the paper's handwheel cycle, or a prescribed rack travel.
+
+The fast path integrates y' = (u, M^-1 f) with scipy's odeint (LSODA, which loops in
+Fortran) and the compiled analytic Jacobian; each call of the right-hand side is one call
+into the generated C. With a prescribed rack (a measurement's rack_m against time), the
+rack is not a state: its position, speed and acceleration come from a cubic spline, and
+each step solves the Kane equations M u' = f + b T for the other accelerations and the
+column torque T together; the column twist (handwheel minus column angle) then follows
+from c dtwist/dt + k twist = T.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from scipy.integrate import odeint, solve_ivp
+
+from ..errors import UsageError
+from ..parameters import Parameters, load_parameters
+from ..tables import write_csv
+from .compiled import CompiledModel, load_model
+from .components import Effect, discover_effects, resolve_effects
+from .inputs import HandwheelProfile, RackDrive, rack_drive_from_csv, sawtooth_profile
+from .values import RunValues, parameter_vector, resolve_values
+
+# Integrator tolerances: relative, and absolute per unit of each coordinate (m or rad) and its rate.
+# The column damping turns rack-speed error into handwheel torque at c * G^2 (about 37,000 N m per m/s), so
+# the speeds need tight absolute tolerances: with these the nominal cycle's torque is within 0.002 N m of a
+# run at rtol 1e-11, atol 1e-13.
+RTOL = 1e-7
+ATOL_Q = {"m": 1e-10, "rad": 1e-9}
+ATOL_U = {"m": 1e-8, "rad": 1e-7}
+ROLL_NEUTRAL_KEY = "derived.roll_spring_neutral"
+
+
+@dataclass
+class SimulationResult:
+    """Output columns (numpy arrays, SI units in the names) and a header describing the run."""
+
+    columns: dict[str, np.ndarray]
+    header: dict[str, str]
+    states: np.ndarray = field(repr=False)
+    parameter_vector: np.ndarray = field(repr=False)
+    model: CompiledModel = field(repr=False)
+    values: RunValues = field(repr=False)
+
+    def write_csv(self, path: str | Path) -> None:
+        write_csv(path, self.columns, self.header)
+
+    @property
+    def contribution_names(self) -> list[str]:
+        return [k for k in self.columns if k.startswith("contrib_")]
+
+
+@dataclass
+class PreparedRun:
+    """A model with its parameter vector, ready to integrate (reusable for several integrations)."""
+
+    model: CompiledModel
+    effects: list[Effect]
+    values: RunValues
+    p: np.ndarray
+    profile: object
+
+    def parameter_index(self, key: str) -> int:
+        return self.model.info["parameters"].index(key)
+
+
+def prepare(case: str, effects=None, overrides: dict | None = None, surface: str = "ground",
+            params: Parameters | None = None, handwheel: HandwheelProfile | None = None) -> PreparedRun:
+    """Resolve effects and values, load (or derive) the compiled model, and balance its static state.
+
+    `handwheel` is the prescribed handwheel angle (default: the paper's saw tooth from the input section).
+    """
+    params = params if params is not None else load_parameters()
+    chosen = resolve_effects(effects)
+    values = resolve_values(params, case, chosen, overrides, surface, all_effects=discover_effects())
+    model = load_model(chosen)
+    profile = handwheel if handwheel is not None else sawtooth_profile(values.params)
+    p = parameter_vector(model.info["parameters"], values, profile.table(model.info["max_input_pieces"]))
+    run = PreparedRun(model, chosen, values, p, profile)
+    balance_roll_spring(run)
+    return run
+
+
+def balance_roll_spring(run: PreparedRun) -> None:
+    """Choose the roll spring's neutral angle so that the zero-steer state carries the Table B1 loads.
+
+    With the tyre springs' free lengths set from the Table B1 loads, the body is in vertical
+    equilibrium at zero bounce and roll; the roll spring (standing for the rear axle's
+    stiffness) takes whatever moment the tyres do not, so its neutral angle is set to
+    cancel the roll residual there. The moment is linear in the neutral angle.
+    """
+    model, p = run.model, run.p
+    roll = model.index("roll")
+    i_neutral = run.parameter_index(ROLL_NEUTRAL_KEY)
+    stiffness = p[run.parameter_index("vehicle.chassis_roll_stiffness")]
+    p[i_neutral] = 0.0
+    residual = model.forcing(0.0, np.zeros(2 * model.n_q), p)[roll]
+    p[i_neutral] = -residual / stiffness
+
+
+def static_state(run: PreparedRun, fixed: dict[str, float] | None = None, t_s: float = 0.0) -> np.ndarray:
+    """The static equilibrium (u = 0) at the handwheel input of time `t_s`, with `fixed` coordinates held.
+
+    Newton's method on f(q) = 0 with the generated df/dq.
+    """
+    model, p = run.model, run.p
+    n = model.n_q
+    fixed = fixed or {}
+    free = [i for i, name in enumerate(model.coordinates) if name not in fixed]
+    y = np.zeros(2 * n)
+    for name, value in fixed.items():
+        y[model.index(name)] = value
+    for _ in range(50):
+        residual = model.forcing(t_s, y, p)[free]
+        jac = model.forcing_dq(t_s, y, p)[np.ix_(free, free)]
+        step = np.linalg.solve(jac, -residual)
+        y[free] += step
+        if np.max(np.abs(step)) < 1e-14:
+            break
+    return y
+
+
+def _atol(model: CompiledModel) -> np.ndarray:
+    units = model.info["coordinate_units"]
+    return np.array([ATOL_Q[u] for u in units] + [ATOL_U[u] for u in units])
+
+
+def integrate(run: PreparedRun, t_out: np.ndarray, y0: np.ndarray | None = None, rtol: float = RTOL,
+              atol: np.ndarray | None = None) -> np.ndarray:
+    """States at `t_out` (odeint/LSODA with the compiled Jacobian), from `y0` or the static state."""
+    model, p = run.model, run.p
+    n_y = 2 * model.n_q
+    y0 = static_state(run) if y0 is None else np.asarray(y0, dtype=float)
+    lib = model.lib
+    rhs_c, jac_c = lib.ps_rhs, lib.ps_jac
+    p_ptr = p.ctypes.data
+    ydot = np.empty(n_y)
+    ydot_ptr = ydot.ctypes.data
+    jac = np.empty((n_y, n_y))
+    jac_ptr = jac.ctypes.data
+
+    def rhs(y, t):
+        rhs_c(t, y.ctypes.data, p_ptr, ydot_ptr)
+        return ydot
+
+    def dfun(y, t):
+        jac_c(t, y.ctypes.data, p_ptr, jac_ptr)
+        return jac
+
+    corners = np.array([piece[0] for piece in run.profile.pieces])
+    states, info = odeint(rhs, y0, t_out, Dfun=dfun, rtol=rtol, atol=_atol(model) if atol is None else atol,
+                          mxstep=200000, full_output=True, tcrit=corners)
+    if info["message"] != "Integration successful.":
+        raise RuntimeError(f"integration failed: {info['message']}")
+    return states
+
+
+def _columns(run: PreparedRun, t: np.ndarray, states: np.ndarray, outputs: dict, handwheel: np.ndarray
+             ) -> dict[str, np.ndarray]:
+    model = run.model
+    n = model.n_q
+    cols = {
+        "time_s": t,
+        "handwheel_angle_rad": handwheel[:, 0],
+        "rack_m": states[:, model.index("rack")],
+        "handwheel_torque_Nm": outputs["column_torque_Nm"],
+        "load_left_N": outputs["load_left_N"],
+        "load_right_N": outputs["load_right_N"],
+    }
+    for effect in model.effects:
+        cols[f"contrib_{effect}_Nm"] = outputs[f"contrib_{effect}_Nm"]
+    cols["contrib_inertia_Nm"] = outputs["contrib_inertia_Nm"]
+    cols["handwheel_rate_rad_s"] = handwheel[:, 1]
+    cols["column_angle_rad"] = outputs["column_angle_rad"]
+    cols["steer_left_rad"] = outputs["steer_left_rad"]
+    cols["steer_right_rad"] = outputs["steer_right_rad"]
+    for i, name in enumerate(model.coordinates):
+        if name != "rack":
+            unit = model.info["coordinate_units"][i]
+            cols[f"{name}_{unit}"] = states[:, i]
+    cols["rack_speed_m_s"] = states[:, n + model.index("rack")]
+    return cols
+
+
+def _header(run: PreparedRun, drive: str) -> dict[str, str]:
+    header = {
+        "model": "parksteer multibody steering model (Sharp & Granger section 4)",
+        "case": run.values.case,
+        "surface": run.values.surface,
+        "components": ", ".join(run.model.effects) or "none",
+        "drive": drive,
+        "model_key": run.model.directory.name,
+        "derived.roll_spring_neutral": f"{run.p[run.parameter_index(ROLL_NEUTRAL_KEY)]:.10g} rad",
+        "units": "SI; torques at the handwheel in N m; contributions sum to handwheel_torque_Nm",
+    }
+    header.update(run.values.header(run.effects))
+    return header
+
+
+def simulate(case: str, effects=None, overrides: dict | None = None, surface: str = "ground",
+             rack_drive: RackDrive | str | Path | None = None, params: Parameters | None = None,
+             t_end_s: float | None = None, output_dt_s: float = 0.01, rtol: float = RTOL,
+             handwheel: HandwheelProfile | None = None) -> SimulationResult:
+    """Simulate `case` (a Table B1 case) with the chosen effects.
+
+    effects: None (the paper's five), an effects spec string ("-rack_friction,+hooke_joint")
+    or a list of names/Effect instances. overrides: {"owner.name": value}. surface: "ground"
+    or "air_bearing" (no tyre-to-ground friction, vertical support kept). rack_drive: a
+    RackDrive or a CSV with time_s and rack_m columns (then the rack is prescribed and the
+    handwheel torque is solved for). handwheel: a HandwheelProfile to drive instead of the paper's saw
+    tooth (the run ends with the profile unless t_end_s is given). Returns the output columns at
+    `output_dt_s` spacing.
+    """
+    if not (output_dt_s > 0):
+        raise UsageError(f"output_dt_s must be positive, got {output_dt_s}")
+    run = prepare(case, effects, overrides, surface, params, handwheel)
+    if rack_drive is not None:
+        drive = rack_drive if isinstance(rack_drive, RackDrive) else rack_drive_from_csv(rack_drive)
+        return _simulate_rack_drive(run, drive, t_end_s, output_dt_s, rtol,
+                                    label=str(rack_drive) if not isinstance(rack_drive, RackDrive) else "rack")
+    t_end = run.profile.end_time_s if t_end_s is None else float(t_end_s)
+    if not (t_end > 0):
+        raise UsageError(f"t_end_s must be positive, got {t_end}")
+    t = np.round(np.arange(0.0, t_end + 0.5 * output_dt_s, output_dt_s), 12)
+    states = integrate(run, t, rtol=rtol)
+    outputs = run.model.evaluate_outputs(t, states, run.p)
+    samples = np.column_stack(run.profile.angle_rate(t))
+    columns = _columns(run, t, states, outputs, samples)
+    drive = "handwheel saw tooth (section 4)" if handwheel is None else "prescribed handwheel profile"
+    return SimulationResult(columns, _header(run, drive), states, run.p, run.model, run.values)
+
+
+def _simulate_rack_drive(run: PreparedRun, drive: RackDrive, t_end_s, output_dt_s, rtol, label
+                         ) -> SimulationResult:
+    model, p = run.model, run.p
+    n = model.n_q
+    rack = model.index("rack")
+    others = [i for i in range(n) if i != rack]
+    k_col = p[run.parameter_index("steering.column_torsional_stiffness")]
+    c_col = p[run.parameter_index("steering.column_torsional_damping")]
+    t0 = drive.start_s
+    t_end = drive.end_s if t_end_s is None else min(float(t_end_s), drive.end_s)
+
+    def full_state(t, z):
+        r, rd, rdd = drive.position_speed_accel(t)
+        y = np.zeros(2 * n)
+        y[others] = z[: n - 1]
+        y[[n + i for i in others]] = z[n - 1 : 2 * n - 2]
+        y[rack], y[n + rack] = r, rd
+        return y, rdd
+
+    def solve(y, rdd):
+        M, F, b = model.drive_parts(y, p)
+        A = np.column_stack([M[:, others], -b])
+        x = np.linalg.solve(A, F - M[:, rack] * rdd)
+        a = np.empty(n)
+        a[others], a[rack] = x[:-1], rdd
+        return a, x[-1]
+
+    def twist_rate(torque, twist):
+        return (torque - k_col * twist) / c_col if c_col > 0 else 0.0
+
+    def rhs(t, z):
+        y, rdd = full_state(t, z)
+        a, torque = solve(y, rdd)
+        return np.concatenate([z[n - 1 : 2 * n - 2], a[others], [twist_rate(torque, z[-1])]])
+
+    r0 = float(drive.position_speed_accel(t0)[0])
+    y_static = static_state(run, fixed={"rack": r0})
+    _, torque0 = solve(np.concatenate([y_static[:n], np.zeros(n)]), 0.0)
+    z0 = np.concatenate([y_static[others], np.zeros(n - 1), [torque0 / k_col]])
+    t = np.round(np.arange(t0, t_end + 0.5 * output_dt_s, output_dt_s), 12)
+    atol = np.concatenate([_atol(model)[others], _atol(model)[[n + i for i in others]], [1e-7]])
+    sol = solve_ivp(rhs, (t0, t[-1]), z0, method="LSODA", t_eval=t, rtol=rtol, atol=atol)
+    if not sol.success:
+        raise RuntimeError(f"integration failed: {sol.message}")
+    states, accels, handwheel = np.empty((len(t), 2 * n)), np.empty((len(t), n)), np.empty((len(t), 2))
+    for k, tk in enumerate(t):
+        y, rdd = full_state(tk, sol.y[:, k])
+        a, torque = solve(y, rdd)
+        states[k], accels[k] = y, a
+        twist = sol.y[-1, k] if c_col > 0 else torque / k_col
+        handwheel[k] = (twist, twist_rate(torque, twist))  # column angle added below
+    column = model.evaluate_outputs(t, states, p, accels, np.zeros((len(t), 2)))
+    handwheel[:, 0] += column["column_angle_rad"]
+    handwheel[:, 1] += column["column_angle_per_rack_rad_per_m"] * states[:, n + rack]
+    outputs = model.evaluate_outputs(t, states, p, accels, handwheel)
+    columns = _columns(run, t, states, outputs, handwheel)
+    return SimulationResult(columns, _header(run, f"prescribed rack from {label}"), states, p, model, run.values)
+
+
+def with_overrides(params: Parameters, section: str, **values) -> Parameters:
+    """A copy of `params` with entries of one section replaced (a convenience for studies and tests)."""
+    sections = {k: dict(v) for k, v in params.sections.items()}
+    sections[section].update(values)
+    return dataclasses.replace(params, sections=sections)

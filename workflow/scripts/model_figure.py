@@ -1,0 +1,13 @@
+# Thin rule script for fig12-fig16 and figContrib: the logic is parksteer.figures.model.make_model_figure.
+from parksteer.figures.model import make_model_figure
+from parksteer.rules import rule_log
+
+with rule_log(snakemake):
+    make_model_figure(
+        snakemake.rule,
+        snakemake.input.parameters,
+        list(snakemake.input.sims),
+        snakemake.output.svg,
+        snakemake.output.csv,
+        snakemake.output.json,
+    )
