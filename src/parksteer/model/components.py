@@ -12,8 +12,9 @@ places, so that adding one never needs an edit of the core:
   (entries separated by ``os.pathsep``).
 
 An effect may add generalized coordinates, replace the steer functions of the linkage
-or the column-to-pinion map, move where vertical loads act, and contribute loads (forces
-on points, torques on frames) and potential energy; see :class:`parksteer.model.system.ModelSpace`.
+or the column-to-pinion map, make the column's spring act on a deflection of its twist, move
+where vertical loads act, add bodies, and contribute loads (forces on points, torques on frames)
+and potential energy; see :class:`parksteer.model.system.ModelSpace`.
 Every parameter value is a runtime input of the generated code, so changing one never
 re-derives or recompiles. An effect beyond the paper should have a strength parameter
 whose default means absent, so that it can be present at strength 0 and its sensitivity
@@ -87,6 +88,10 @@ class Effect:
 
     def configure(self, model: ModelSpace) -> None:
         """Before the kinematics are built: add coordinates, replace steer/column maps, move load points."""
+
+    def bodies(self, model: ModelSpace) -> list[Any]:
+        """After the kinematics are built: extra rigid bodies or particles, e.g. on coordinates this effect added."""
+        return []
 
     def loads(self, model: ModelSpace) -> list[tuple[Any, Any]]:
         """(Point, force Vector) and (ReferenceFrame, torque Vector) pairs acting on the core system."""

@@ -80,6 +80,8 @@ def build_space(effects: list[Effect], speeds_as_qdot: bool = False) -> ModelSpa
     for effect in effects:
         effect.configure(space)
     space.build()
+    for effect in effects:
+        space.bodies += effect.bodies(space)
     return space
 
 

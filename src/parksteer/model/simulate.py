@@ -118,7 +118,8 @@ def static_state(run: PreparedRun, fixed: dict[str, float] | None = None, t_s: f
     for _ in range(50):
         residual = model.forcing(t_s, y, p)[free]
         jac = model.forcing_dq(t_s, y, p)[np.ix_(free, free)]
-        step = np.linalg.solve(jac, -residual)
+        # least squares: a coordinate with neither stiffness nor load (an effect at strength 0) stays put
+        step = np.linalg.lstsq(jac, -residual, rcond=None)[0]
         y[free] += step
         if np.max(np.abs(step)) < 1e-14:
             break
@@ -280,16 +281,20 @@ def _simulate_rack_drive(run: PreparedRun, drive: RackDrive, t_end_s, output_dt_
     if not sol.success:
         raise RuntimeError(f"integration failed: {sol.message}")
     states, accels, handwheel = np.empty((len(t), 2 * n)), np.empty((len(t), n)), np.empty((len(t), 2))
+    torques = np.empty(len(t))
     for k, tk in enumerate(t):
         y, rdd = full_state(tk, sol.y[:, k])
         a, torque = solve(y, rdd)
-        states[k], accels[k] = y, a
+        states[k], accels[k], torques[k] = y, a, torque
         twist = sol.y[-1, k] if c_col > 0 else torque / k_col
         handwheel[k] = (twist, twist_rate(torque, twist))  # column angle added below
     column = model.evaluate_outputs(t, states, p, accels, np.zeros((len(t), 2)))
     handwheel[:, 0] += column["column_angle_rad"]
     handwheel[:, 1] += column["column_angle_per_rack_rad_per_m"] * states[:, n + rack]
     outputs = model.evaluate_outputs(t, states, p, accels, handwheel)
+    # The solved torque: the handwheel above is rebuilt with the linear column law, so under a column deflection
+    # (ModelSpace.set_column_deflection, e.g. lash) the torque recomputed from it would be wrong.
+    outputs["column_torque_Nm"] = torques
     columns = _columns(run, t, states, outputs, handwheel)
     return SimulationResult(columns, _header(run, f"prescribed rack from {label}"), states, p, model, run.values)
 

@@ -103,6 +103,7 @@ class ModelSpace:
     coordinates: list[Coordinate] = field(default_factory=list)
     steer_function: Callable[[ModelSpace, str], Any] | None = None
     column_map: Callable[[ModelSpace, Any], Any] | None = None
+    column_deflection: Callable[[ModelSpace, Any], Any] | None = None
     contact_follows_steer: bool = False
     ring_twist: dict[str, Any] = field(default_factory=dict)
     speeds_as_qdot: bool = False  # write every speed as dq/dt (for an independent Lagrange derivation)
@@ -160,6 +161,16 @@ class ModelSpace:
     def set_column_map(self, function: Callable[[ModelSpace, Any], Any]) -> None:
         """Replace the column-to-pinion map: function(model, pinion_angle) -> column angle theta_c."""
         self.column_map = function
+
+    def set_column_deflection(self, function: Callable[[ModelSpace, Any], Any]) -> None:
+        """Make the column's spring and damper act on a deflection g(twist) instead of the twist itself.
+
+        function(model, twist) -> g, an expression in the symbol `twist` (handwheel minus column
+        angle). The column torque is then the generalized force of the spring energy k g^2 / 2 and
+        the damper dissipation c (dg/dt)^2 / 2 on the twist: (k g + c g' dtwist/dt) g'. A dead
+        band g (lash) makes the column carry no torque until the band is taken up.
+        """
+        self.column_deflection = function
 
     def set_ring_twist(self, side: str, angle) -> None:
         """Let the tread ring of `side` turn by `angle` about the steer axis relative to its wheel."""
@@ -234,9 +245,18 @@ class ModelSpace:
         self.column_frame = column_frame
         k_col = self.core("steering.column_torsional_stiffness")
         c_col = self.core("steering.column_torsional_damping")
-        self.column_torque = k_col * (self.handwheel_angle - self.column_angle) + c_col * (
-            self.handwheel_rate - self.column_rate
-        )
+        if self.column_deflection is None:
+            self.column_torque = k_col * (self.handwheel_angle - self.column_angle) + c_col * (
+                self.handwheel_rate - self.column_rate
+            )
+            self.column_spring_deflection = self.handwheel_angle - self.column_angle
+        else:
+            twist = sp.Dummy("twist")
+            law = sp.sympify(self.column_deflection(self, twist))
+            at_twist = {twist: self.handwheel_angle - self.column_angle}
+            deflection, slope = law.xreplace(at_twist), sp.diff(law, twist).xreplace(at_twist)
+            self.column_torque = (k_col * deflection + c_col * slope * (self.handwheel_rate - self.column_rate)) * slope
+            self.column_spring_deflection = deflection
 
         self.steer_angle, self.axis_frame, self.steer_frame, self.ring_frame = {}, {}, {}, {}
         self.axis_foot, self.wheel_centre, self.wheel_centre_unsteered = {}, {}, {}
@@ -344,7 +364,7 @@ class ModelSpace:
         return energy
 
     def column_potential_energy(self):
-        return self.core("steering.column_torsional_stiffness") * (self.handwheel_angle - self.column_angle) ** 2 / 2
+        return self.core("steering.column_torsional_stiffness") * self.column_spring_deflection ** 2 / 2
 
     def kinetic_energy(self):
         return sum(b.kinetic_energy(self.N) for b in self.bodies).xreplace(self.qd_to_u)

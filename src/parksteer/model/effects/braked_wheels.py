@@ -1,0 +1,100 @@
+"""Braked front wheels: the contact patch cannot roll, so it also slides sideways about the steer axis.
+
+With the wheel free to roll (the paper's model), steering about an axis that meets the
+ground at a lateral distance e from the patch centre (the scrub offset) only carries the patch
+centre along the wheel's rolling direction, which rolling takes up: the tread slides in pure
+spin and the friction moment is equation (2) whatever e (section 2, Table 1). A braked wheel
+cannot roll, so the whole patch slides rigidly about the axis intercept, each element
+perpendicular to its radius from there: the moment about the axis is the rig's braked pin
+torque (parksteer.rig.braked_pin_torque_Nm),
+
+    T_braked(e) = mu p Integral |r - e| dA = M_spin f(e / R),   f(0) = 1,  f -> 3 e / (2 R) for e >> R,
+
+over the uniform-pressure disc of radius R (pi R^2 p = W), scaled like equation (2). This
+effect adds the excess, s M(W) (f(e / R) - 1), to each tread ring's friction moment with the
+same tanh of the ring's yaw rate (s: the brake fraction, 0 = rolling freely, 1 = locked).
+It is a lumped equivalent: the net sliding force that goes with the moment is not applied.
+
+f is evaluated from its series: for e <= R, 1 + 3k^2/4 - 3k^4/64 - k^6/256 - 15k^8/16384
+- 21k^10/65536 (k = e/R, within 0.02 % of the elliptic closed form), for e > R the far-field
+series 3k/2 (1 + 1/(8k^2) + 1/(192k^4) + 1/(1024k^6)) (within 0.05 %). The offset e is the
+scrub offset, the lateral distance at the ground from the king-pin axis's intercept to the
+contact centre at zero steer (5.8 mm for the standard car, 6.9, 38.7 and 62.7 mm with the
+spacers). The fore-aft part of the intercept's offset (the castor's trail at the ground,
+3.2 mm) makes even a rolling wheel's patch slide sideways, braked or not; the paper's model
+leaves it out, and to leading order ((3/4)(e/R)^2) it does not change the braked excess.
+Needs the tyre_friction effect (its friction law and parameters); without it this effect adds
+nothing.
+"""
+
+from __future__ import annotations
+
+import sympy as sp
+
+from ..components import Effect, EffectParameter
+from ..system import SIDES
+from .tyre_friction import EFFECT as TYRE_FRICTION
+
+# f(k) - 1 inside the patch, as a polynomial in m = k^2 (series of the elliptic closed form)
+_INSIDE_COEFFICIENTS = (sp.Rational(3, 4), -sp.Rational(3, 64), -sp.Rational(1, 256), -sp.Rational(15, 16384),
+                        -sp.Rational(21, 65536))
+# f(k) / (3 k / 2) outside the patch, as a polynomial in 1 / k^2 (far-field series of the same integral)
+_OUTSIDE_COEFFICIENTS = (1, sp.Rational(1, 8), sp.Rational(1, 192), sp.Rational(1, 1024))
+
+
+def braked_excess_ratio(k_squared):
+    """f(k) - 1: the braked pin torque over the spin torque, minus one, at (scrub offset / patch radius)^2."""
+    inside = sum(c * k_squared ** (i + 1) for i, c in enumerate(_INSIDE_COEFFICIENTS))
+    k = sp.sqrt(k_squared)
+    outside = sp.Rational(3, 2) * k * sum(c / k_squared**i for i, c in enumerate(_OUTSIDE_COEFFICIENTS)) - 1
+    return sp.Piecewise((inside, k_squared <= 1), (outside, True))
+
+
+class BrakedWheels(Effect):
+    name = "braked_wheels"
+    description = (
+        "Wheels held by the brakes: the patch slides rigidly about the steer axis's ground intercept, adding "
+        "s M(W) (f(scrub offset / patch radius) - 1) to each tread's friction moment (rig theory); 0 = free to roll"
+    )
+    in_default_set = False
+    parameters = (
+        EffectParameter(
+            "brake_fraction", "1", 0.0, 1.0,
+            "candidate: share of the braked (non-rolling) excess moment, 0 = wheels free to roll as in the paper "
+            "(absent), 1 = wheels locked (parking brake on the front wheels, or a front-drive car in gear with "
+            "both wheels held)",
+            default=0.0,
+        ),
+    )
+
+    def scrub_offset_squared(self, model, side):
+        """Square of the lateral distance from the axis's ground intercept to the contact centre, zero steer."""
+        d = lambda name: model.d(f"{side}.{name}")  # noqa: E731
+        foot_y, foot_z = d("foot_y"), d("foot_z")
+        axis_y, axis_z = d("axis_frame_12"), d("axis_frame_22")  # the axis direction (third column), body y and z
+        centre_y = foot_y + sum(d(f"axis_frame_1{j}") * d(f"centre_in_axis_{c}") for j, c in enumerate("xyz"))
+        centre_z = foot_z + sum(d(f"axis_frame_2{j}") * d(f"centre_in_axis_{c}") for j, c in enumerate("xyz"))
+        along = (centre_z + model.d("wheel_radius") - foot_z) / axis_z  # down the axis from its foot to the ground
+        return (centre_y - foot_y - along * axis_y) ** 2
+
+    def loads(self, model):
+        if TYRE_FRICTION.name not in model.effect_names:
+            return []
+        fraction = model.p(self, "brake_fraction")
+        pressure = model.p(TYRE_FRICTION, "tyre_pressure")
+        beta = model.p(TYRE_FRICTION, "smoothing")
+        grip = model.d("surface_grip")
+        out = []
+        for side in SIDES:
+            load = model.wheel_load[side]
+            patch_radius_squared = sp.Piecewise((load, load > 0), (0, True)) / (sp.pi * pressure)
+            # a wheel off the ground has no patch (and no moment: moment_limit is 0 there)
+            k_squared = self.scrub_offset_squared(model, side) / sp.Max(patch_radius_squared, sp.Float(1e-12))
+            excess = fraction * TYRE_FRICTION.moment_limit(model, load) * braked_excess_ratio(k_squared)
+            ring = model.ring_frame[side]
+            yaw_rate = ring.ang_vel_in(model.N).dot(model.N.z)
+            out.append((ring, -grip * excess * sp.tanh(beta * yaw_rate) * model.N.z))
+        return out
+
+
+EFFECT = BrakedWheels()
