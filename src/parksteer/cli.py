@@ -18,6 +18,7 @@ from .errors import UsageError
 COMMAND_MODULES = [
     "parksteer.commands.pipeline",
     "parksteer.commands.model",
+    "parksteer.commands.sweep",
 ]
 
 

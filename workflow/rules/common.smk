@@ -15,6 +15,7 @@ FIGURES = {
     "fig15": ["figures/fig15.svg", "figures/fig15.csv"],
     "fig16": ["figures/fig16.svg", "figures/fig16.csv"],
     "figContrib": ["figures/figContrib.svg", "figures/figContrib.csv"],
+    "sweep_design": ["figures/sweep_design.svg", "figures/sweep_design.csv"],
 }
 
 

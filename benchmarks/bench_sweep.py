@@ -1,0 +1,220 @@
+"""Sweep cost: wall time of 25, 50, 100 and 200 points on 2 cores, and how it grows with the number of points.
+
+Two ways of running the same point code (parksteer.sweep.run.simulate_point):
+
+* snakemake: the pipeline's rules in a scratch working directory (symlinks to the repository's data,
+  src and workflow, with the benchmark's sweep in place of workflow/sweeps/design.yaml), one job per
+  point, `--cores 2`; the derivation rule runs first and is timed apart;
+* inprocess: a pool of 2 worker processes calling simulate_point directly, each loading the compiled
+  model once (the floor under any scheduler's overhead).
+
+For each it reports the wall time per size (the median of --repeats runs, all runs kept), the cost per point and
+a linear fit (slope, intercept, R^2) of the medians.
+No point may derive the model: in the pool a derivation raises; around the Snakemake runs the model
+cache's entries are compared before and after, and every point records the same model key.
+
+    python benchmarks/bench_sweep.py results/bench_sweep.json [--sizes 25 50 100 200] [--mode both] [--repeats 3]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import multiprocessing
+import os
+import platform
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+REPO = Path(__file__).resolve().parents[1]
+SNAKEMAKE = Path(sys.executable).with_name("snakemake")
+LOADS_PER_PRESSURE = 5
+
+
+def declaration(n_points: int) -> str:
+    """A sweep of exactly n_points: n/5 tyre pressures x 5 front axle loads around the test car."""
+    if n_points % LOADS_PER_PRESSURE:
+        raise SystemExit(f"sizes must be multiples of {LOADS_PER_PRESSURE}")
+    return (
+        f"name: bench{n_points}\n"
+        "base_case: unladen\n"
+        "axes:\n"
+        f"  tyre.tyre_pressure: {{start: 120000, stop: 300000, num: {n_points // LOADS_PER_PRESSURE}}}\n"
+        f"  design.front_axle_load: {{start: 5000, stop: 9000, num: {LOADS_PER_PRESSURE}}}\n"
+    )
+
+
+def linear_fit(sizes, seconds) -> dict:
+    x, y = np.asarray(sizes, dtype=float), np.asarray(seconds, dtype=float)
+    slope, intercept = np.polyfit(x, y, 1)
+    residual = y - (slope * x + intercept)
+    r2 = 1.0 - float(np.sum(residual**2) / np.sum((y - y.mean()) ** 2))
+    return {"slope_s_per_point": float(slope), "intercept_s": float(intercept), "r_squared": r2}
+
+
+def cache_snapshot() -> dict[str, float]:
+    from parksteer.model.compiled import cache_root
+
+    root = cache_root()
+    return {p.parent.name: p.stat().st_mtime for p in root.glob("*/model.so")} if root.is_dir() else {}
+
+
+# ---------------------------------------------------------------------------- in process
+
+
+def _forbid_derivation():
+    import parksteer.model.compiled as compiled
+
+    def refuse(*args, **kwargs):
+        raise RuntimeError("a sweep point tried to derive the model")
+
+    compiled.build_entry = refuse
+
+
+def _run_spec(spec):
+    from parksteer.parameters import load_parameters
+    from parksteer.sweep.run import simulate_point
+
+    record = simulate_point(spec, load_parameters())
+    return record["model_key"]
+
+
+def bench_inprocess(sizes, cores, repeats) -> dict:
+    from parksteer.parameters import load_parameters
+    from parksteer.sweep import load_sweep
+
+    params = load_parameters()
+    rows = []
+    with tempfile.TemporaryDirectory() as scratch:
+        for n in sizes:
+            path = Path(scratch) / f"bench{n}.yaml"
+            path.write_text(declaration(n), encoding="utf-8")
+            sweep = load_sweep(path, params)
+            specs = [sweep.point_spec(i) for i in sweep.point_ids]
+            walls, keys = [], set()
+            for _ in range(repeats):
+                start = time.perf_counter()
+                with multiprocessing.get_context("fork").Pool(cores, initializer=_forbid_derivation) as pool:
+                    keys.update(pool.map(_run_spec, specs, chunksize=1))
+                walls.append(time.perf_counter() - start)
+            wall = float(np.median(walls))
+            rows.append({"points": n, "wall_s": wall, "per_point_s": wall / n, "runs_s": walls,
+                         "model_keys": sorted(keys)})
+            print(f"inprocess {n:4d} points: {wall:7.2f} s ({1000 * wall / n:.1f} ms per point)", flush=True)
+    return {"rows": rows, "fit": linear_fit([r["points"] for r in rows], [r["wall_s"] for r in rows]),
+            "derivations": 0, "note": "a derivation in a worker raises, so a completed run derived nothing"}
+
+
+# ---------------------------------------------------------------------------- snakemake
+
+
+def _workdir(scratch: Path, n: int) -> tuple[Path, Path]:
+    """A working directory that sees the repository, with the benchmark's sweep as the default sweep."""
+    work = scratch / f"work{n}"
+    (work / "workflow" / "sweeps").mkdir(parents=True)
+    for name in ("data", "src", "paper"):
+        (work / name).symlink_to(REPO / name)
+    for child in (REPO / "workflow").iterdir():
+        if child.name != "sweeps":
+            (work / "workflow" / child.name).symlink_to(child)
+    (work / "workflow" / "sweeps" / "design.yaml").write_text(declaration(n), encoding="utf-8")
+    main = (REPO / "Snakefile").read_text(encoding="utf-8")
+    lines = [f'include: "{REPO / "Snakefile"}"']
+    lines += [f'include: "{REPO / "workflow" / "rules" / r}"' for r in ("model.smk", "sweep.smk") if r not in main]
+    snakefile = scratch / f"Snakefile{n}"
+    snakefile.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    return work, snakefile
+
+
+def _snakemake(snakefile: Path, work: Path, cores: int, targets: list[str]) -> float:
+    cmd = [str(SNAKEMAKE), *targets, "--snakefile", str(snakefile), "--directory", str(work), "--cores", str(cores),
+           "--quiet", "all"]
+    start = time.perf_counter()
+    done = subprocess.run(cmd, capture_output=True, text=True)
+    wall = time.perf_counter() - start
+    if done.returncode:
+        logs = sorted((work / ".snakemake" / "log").glob("*.log"))
+        detail = logs[-1].read_text(encoding="utf-8")[-3000:] if logs else done.stderr[-3000:]
+        raise SystemExit(f"snakemake failed ({' '.join(cmd)}):\n{detail}")
+    return wall
+
+
+def bench_snakemake(sizes, cores, repeats) -> dict:
+    from parksteer.parameters import load_parameters
+    from parksteer.sweep import load_sweep
+
+    params = load_parameters()
+    rows = []
+    with tempfile.TemporaryDirectory() as scratch:
+        for n in sizes:
+            work, snakefile = _workdir(Path(scratch), n)
+            sweep = load_sweep(work / "workflow" / "sweeps" / "design.yaml", params)
+            derive_s = _snakemake(snakefile, work, cores, ["results/model/derived_full.json"])
+            points = [f"results/sweeps/{sweep.name}/points/{i}.json" for i in sweep.point_ids]
+            before = cache_snapshot()
+            walls = []
+            for repeat in range(repeats):
+                for p in points if repeat else []:
+                    (work / p).unlink()
+                walls.append(_snakemake(snakefile, work, cores, points))
+            after = cache_snapshot()
+            points_s = float(np.median(walls))
+            keys = {json.loads((work / p).read_text())["model_key"] for p in points}
+            # The entry the points used existed before they ran and was not rebuilt by them (other entries may
+            # come and go with unrelated work on the machine).
+            cache_unchanged = all(k in before and after.get(k) == before[k] for k in keys)
+            gather_s = _snakemake(snakefile, work, cores, [f"sweep_{sweep.name}"])
+            rows.append({"points": n, "wall_s": points_s, "per_point_s": points_s / n, "runs_s": walls,
+                         "derive_rule_s": derive_s, "gather_s": gather_s, "model_keys": sorted(keys),
+                         "cache_unchanged_by_points": cache_unchanged})
+            print(f"snakemake {n:4d} points: {points_s:7.2f} s ({points_s / n:.3f} s per point; derive rule "
+                  f"{derive_s:.1f} s, gather {gather_s:.1f} s)", flush=True)
+    return {"rows": rows, "fit": linear_fit([r["points"] for r in rows], [r["wall_s"] for r in rows]),
+            "cache_unchanged": all(r["cache_unchanged_by_points"] for r in rows),
+            "note": "wall_s is the point jobs alone (median of runs_s); the derive rule ran first (derive_rule_s) "
+                    "and the model entry the points used was compared before and after them"}
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("out", help="JSON file for the results")
+    parser.add_argument("--sizes", type=int, nargs="+", default=[25, 50, 100, 200])
+    parser.add_argument("--mode", choices=("snakemake", "inprocess", "both"), default="both")
+    parser.add_argument("--cores", type=int, default=2)
+    parser.add_argument("--repeats", type=int, default=1, help="runs per size; the median is fitted")
+    args = parser.parse_args(argv)
+    os.chdir(REPO)
+    from parksteer.model.compiled import ensure_entry
+    from parksteer.model.components import resolve_effects
+
+    ensure_entry(resolve_effects(None))  # the one derivation, before any timing
+    result = {"sizes": args.sizes, "cores": args.cores, "repeats": args.repeats, "machine": platform.platform(),
+              "cpu_count": os.cpu_count(), "python": platform.python_version(),
+              "load_average_at_start": os.getloadavg()}
+    if args.mode in ("inprocess", "both"):
+        result["inprocess"] = bench_inprocess(args.sizes, args.cores, args.repeats)
+    if args.mode in ("snakemake", "both"):
+        result["snakemake"] = bench_snakemake(args.sizes, args.cores, args.repeats)
+    result["load_average_at_end"] = os.getloadavg()
+    for mode in ("inprocess", "snakemake"):
+        if mode in result:
+            fit = result[mode]["fit"]
+            print(f"{mode}: {fit['slope_s_per_point'] * 1000:.1f} ms per point, intercept {fit['intercept_s']:.2f} s, "
+                  f"R^2 {fit['r_squared']:.4f}")
+    Path(args.out).parent.mkdir(parents=True, exist_ok=True)
+    Path(args.out).write_text(json.dumps(result, indent=2) + "\n", encoding="utf-8")
+    one_key_per_size = all(len(r["model_keys"]) == 1 for mode in ("inprocess", "snakemake") if mode in result
+                           for r in result[mode]["rows"])
+    if not one_key_per_size or not result.get("snakemake", {}).get("cache_unchanged", True):
+        print("error: the model was derived during the sweep", file=sys.stderr)
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

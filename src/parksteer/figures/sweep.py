@@ -1,0 +1,184 @@
+"""A design sweep's table, key numbers and torque maps (figures/sweep_<name>.*, results/sweep_<name>.json).
+
+Top row: the map quantity over the map's x and y axes, one panel per value of the panel
+axis, the other axes held; the assistance threshold drawn as a contour and the test car's
+design point marked. Bottom row: the plateau torque against each swept key with every
+other key at the design point, wheels free to roll (solid) and braked (dashed: simulated
+with the sweep's braked effect, or estimated by rig theory, as the sweep declares).
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+from ..parameters import Parameters, load_parameters
+from ..plotting import COLOURS, new_figure, save_svg
+from ..sweep.aggregate import (
+    axis_values,
+    design_values,
+    matching,
+    point_quantity,
+    read_points,
+    summarize,
+    sweep_table,
+)
+from ..sweep.declaration import Sweep, SweepError, load_sweep, parameter_bounds
+from ..tables import write_csv, write_json
+
+# How each SI unit is shown on an axis: (factor, label).
+DISPLAY_UNITS = {"Pa": (1.0e-5, "bar"), "N": (1.0e-3, "kN"), "m": (1.0e3, "mm"), "rad": (180.0 / math.pi, "deg"),
+                 "1": (1.0, "")}
+LABELS = {"design.front_axle_load": "front axle load", "design.extra_offset": "spacer offset",
+          "design.steering_ratio": "overall steering ratio", "design.castor_angle": "castor angle",
+          "tyre.tyre_pressure": "tyre pressure", "geometry.kingpin_inclination": "king-pin inclination"}
+QUANTITY_LABELS = {"peak_torque_Nm": "peak handwheel torque", "plateau_torque_Nm": "plateau torque",
+                   "lock_torque_Nm": "torque at lock", "reversal_drop_Nm": "drop at reversal",
+                   "plateau_torque_braked_Nm": "plateau torque, wheels braked",
+                   "peak_torque_braked_Nm": "peak torque, wheels braked"}
+CONTOUR_STEP_NM = 2.0
+MAX_MAP_PANELS = 4
+
+
+def display(key: str) -> tuple[float, str]:
+    """(factor, axis label) to show values of `key`."""
+    unit = parameter_bounds(key)[3]
+    factor, shown = DISPLAY_UNITS.get(unit, (1.0, unit))
+    label = LABELS.get(key, key.partition(".")[2].replace("_", " "))
+    return factor, f"{label} ({shown})" if shown else label
+
+
+def _format_value(key: str, value: float) -> str:
+    factor, label = display(key)
+    unit = label[label.rfind("(") + 1: -1] if label.endswith(")") else ""
+    return f"{value * factor:.4g}{' ' + unit if unit else ''}"
+
+
+def _draw_map(ax, sweep: Sweep, records: list[dict], fixed: dict, levels, threshold, mark_design, design):
+    spec = sweep.map
+    fx, xlabel = display(spec.x)
+    fy, ylabel = display(spec.y)
+    sel = matching(records, fixed)
+    xs = np.array([r["values"][spec.x] for r in sel]) * fx
+    ys = np.array([r["values"][spec.y] for r in sel]) * fy
+    qs = np.array([point_quantity(r, spec.quantity) for r in sel])
+    ux, uy = np.unique(xs), np.unique(ys)
+    filled = None
+    if len(ux) >= 2 and len(uy) >= 2 and len(sel) == len(ux) * len(uy):
+        grid = np.full((len(uy), len(ux)), np.nan)
+        for x, y, q in zip(xs, ys, qs):
+            grid[np.searchsorted(uy, y), np.searchsorted(ux, x)] = q
+        filled = ax.contourf(ux, uy, grid, levels=levels, cmap="viridis", extend="both")
+        if threshold is not None and np.nanmin(grid) < threshold < np.nanmax(grid):
+            line = ax.contour(ux, uy, grid, levels=[threshold], colors="white", linewidths=1.8, linestyles="--")
+            ax.clabel(line, fmt=lambda v: f"{v:.1f} N m", fontsize=7)
+    elif len(sel) >= 3:
+        filled = ax.tricontourf(xs, ys, qs, levels=levels, cmap="viridis", extend="both")
+    ax.scatter(xs, ys, s=6, color="black", zorder=3, label="sweep points")
+    if mark_design:
+        ax.plot(design[spec.x]["base"] * fx, design[spec.y]["base"] * fy, marker="*", markersize=13,
+                color=COLOURS[4], markeredgecolor="black", linestyle="none", zorder=5, clip_on=False,
+                label="test car")
+        ax.legend(loc="lower right", fontsize=7, handlelength=1.0, framealpha=0.8, frameon=True)
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.grid(False)
+    return filled
+
+
+def _draw_sensitivity(ax, sweep: Sweep, records: list[dict], key: str, design: dict):
+    factor, label = display(key)
+    held = {k: d["nearest"] for k, d in design.items() if k != key}
+    line = sorted(matching(records, held), key=lambda r: r["values"][key])
+    xs = np.array([r["values"][key] for r in line]) * factor
+    ax.plot(xs, [point_quantity(r, "plateau_torque_Nm") for r in line], marker="o", markersize=3,
+            color=COLOURS[0], label="free to roll")
+    braked = [point_quantity(r, "plateau_torque_braked_Nm") for r in line]
+    if not all(math.isnan(b) for b in braked):
+        ax.plot(xs, braked, marker="s", markersize=3, linestyle="--", color=COLOURS[1], label="braked")
+    ax.axvline(design[key]["base"] * factor, color="grey", linewidth=0.8, linestyle=":")
+    ax.set_xlabel(label)
+
+
+def plot_sweep(sweep: Sweep, params: Parameters, records: list[dict], out_svg: str | Path) -> None:
+    design = design_values(sweep, params, records)
+    keys = sweep.keys
+    spec = sweep.map
+    panels = (axis_values(sweep, records, spec.panels) if spec and spec.panels else [None])[:MAX_MAP_PANELS]
+    n_top = len(panels) if spec else 0
+    n_bottom = len(keys)
+    ncols = max(n_top, n_bottom, 1)
+    fig, ax0 = new_figure(max(2.2 * ncols, 6.0), 6.4 if n_top else 3.2)
+    ax0.remove()
+    grid = fig.add_gridspec(2 if n_top else 1, n_top * n_bottom if n_top else n_bottom, hspace=0.45, wspace=0.6)
+    threshold = sweep.assistance.torque_Nm if sweep.assistance else None
+    if n_top:
+        qs = np.array([point_quantity(r, spec.quantity) for r in records])
+        low = CONTOUR_STEP_NM * math.floor(np.nanmin(qs) / CONTOUR_STEP_NM)
+        high = CONTOUR_STEP_NM * math.ceil(np.nanmax(qs) / CONTOUR_STEP_NM)
+        levels = np.arange(low, high + CONTOUR_STEP_NM / 2, CONTOUR_STEP_NM)
+        held = {k: spec.hold.get(k, d["nearest"]) for k, d in design.items() if k not in (spec.x, spec.y, spec.panels)}
+        design_panel = design[spec.panels]["nearest"] if spec.panels else None
+        filled = None
+        top_axes = []
+        for i, panel in enumerate(panels):
+            ax = fig.add_subplot(grid[0, i * n_bottom:(i + 1) * n_bottom])
+            top_axes.append(ax)
+            fixed = dict(held, **({spec.panels: panel} if spec.panels else {}))
+            on_design = all(design[k]["nearest"] == v for k, v in held.items())
+            drawn = _draw_map(ax, sweep, records, fixed, levels, threshold,
+                              on_design and panel == design_panel, design)
+            filled = drawn or filled
+            if spec.panels:
+                ax.set_title(f"{display(spec.panels)[1].split(' (')[0]} {_format_value(spec.panels, panel)}",
+                             fontsize=9)
+        if filled is not None:
+            bar = fig.colorbar(filled, ax=top_axes, shrink=0.9)
+            bar.set_label(f"{QUANTITY_LABELS[spec.quantity]} (N m)")
+        for ax in top_axes[1:]:
+            ax.set_ylabel("")
+            ax.tick_params(labelleft=False)
+        held_text = ", ".join(f"{display(k)[1].split(' (')[0]} {_format_value(k, v)}" for k, v in held.items())
+        fig.suptitle(f"{QUANTITY_LABELS[spec.quantity]}" + (f"; held: {held_text}" if held_text else ""),
+                     fontsize=9)
+    row = 1 if n_top else 0
+    span = n_top if n_top else 1
+    for j, key in enumerate(keys):
+        ax = fig.add_subplot(grid[row, j * span:(j + 1) * span])
+        _draw_sensitivity(ax, sweep, records, key, design)
+        if j == 0:
+            ax.set_ylabel("plateau torque (N m)")
+            ax.legend(fontsize=7)
+            ax.set_title("others at the test car's values", fontsize=8, loc="left")
+    save_svg(fig, out_svg)
+
+
+def make_sweep_figure(sweep_path: str | Path, parameters: Parameters | str | Path, point_paths, out_svg: str | Path,
+                      out_csv: str | Path, out_json: str | Path, full: bool = False) -> dict:
+    """Write the sweep's table (CSV), its key numbers (JSON) and its torque maps (SVG); return the numbers."""
+    params = parameters if isinstance(parameters, Parameters) else load_parameters(parameters)
+    sweep = load_sweep(sweep_path, params, full=full)
+    records = read_points(point_paths, sweep)
+    found = {r["point"] for r in records}
+    if found != set(sweep.point_ids):
+        missing = sorted(set(sweep.point_ids) - found) or sorted(found - set(sweep.point_ids))
+        raise SweepError(f"{sweep.path}: point files do not match the sweep (first difference: {missing[0]})")
+    threshold = sweep.assistance.torque_Nm if sweep.assistance else None
+    header = {
+        "sweep": f"{sweep.name} ({len(records)} points{', full' if sweep.full else ''}) from {sweep.path}",
+        "description": sweep.description,
+        "model": f"case {sweep.base_case}, effects {', '.join(records[0]['effects'])}, surface {sweep.surface}",
+        "merits": "see parksteer.sweep.merit: plateau = mean over the sliding part of the right-going stroke, "
+                  "whole Hooke-joint ripple periods; shares are of the plateau",
+        "braked": records[0]["braked"]["method"],
+    }
+    if threshold is not None:
+        header["assistance threshold"] = (f"{threshold:g} N m = {sweep.assistance.rim_force_N:g} N x "
+                                          f"{sweep.assistance.rim_radius_m:g} m; needs_assistance = peak above it")
+    write_csv(out_csv, sweep_table(sweep, records, threshold), header)
+    summary = summarize(sweep, params, records)
+    write_json(out_json, summary)
+    plot_sweep(sweep, params, records, out_svg)
+    return summary

@@ -1,0 +1,579 @@
+"""Sweep declarations: a YAML file naming a base case, the effects and the design axes of a study.
+
+A declaration (SI units throughout)::
+
+    name: design                    # outputs: results/sweeps/design/, figures/sweep_design.*
+    description: one paragraph
+    base_case: unladen              # a Table B1 case of the parameter file
+    effects: null                   # an effects spec as for `parksteer simulate` (null: the paper's five)
+    surface: ground                 # or air_bearing
+    axes:                           # the full factorial, first axis slowest
+      tyre.tyre_pressure: [122500, 180000, 240000, 300000]
+      design.front_axle_load: {start: 5000, stop: 9000, num: 3}
+    full_axes: {...}                # optional: replaces `axes` when the pipeline asks for the full sweep
+    points:                         # instead of axes: a declared list of points
+      - {tyre.tyre_pressure: 200000, design.extra_offset: 0.02}
+    map: {x: KEY, y: KEY, panels: KEY, hold: {KEY: VALUE}, quantity: peak_torque_Nm}
+    braked: braked_wheels           # compare with the wheels braked: an effect with a brake_fraction
+                                    # parameter (simulated at its maximum), rig_theory, or none (default)
+    assistance:                     # the torque above which the car needs power assistance
+      rim_force: {value: 150, unit: N, source: "..."}
+      rim_radius: {value: 0.19, unit: m, source: "..."}
+
+An axis key is any model parameter `simulate` accepts as an override (``tyre.tyre_pressure``,
+``case.chassis_mass``, ``rack_friction.friction_force``, ...) or a design variable
+(``design.*``, see DESIGN_VARIABLES) that changes several of them together so that the
+model stays consistent (statics of the wheel loads, the axis through the wheel centre).
+Every problem is one line naming the file and the key (:class:`SweepError`).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import itertools
+import json
+import math
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import yaml
+
+from ..errors import UsageError
+from ..parameters import CASE_SCHEMA, SCHEMA, Parameters, Spec
+
+# Figures of merit a map can show (written by parksteer.sweep.merit for every point).
+MAP_QUANTITIES = (
+    "peak_torque_Nm",
+    "plateau_torque_Nm",
+    "lock_torque_Nm",
+    "reversal_drop_Nm",
+    "plateau_torque_braked_Nm",
+    "peak_torque_braked_Nm",
+)
+SURFACES = ("ground", "air_bearing")
+TOP_LEVEL_KEYS = {"name", "description", "base_case", "effects", "surface", "axes", "full_axes", "points", "map",
+                  "assistance", "braked"}
+# How a point compares its wheels braked: not at all, the post-hoc rig-theory estimate, or (any other value) a
+# second simulation with that effect added at the top of its brake_fraction range.
+BRAKED_NONE, BRAKED_RIG_THEORY = "none", "rig_theory"
+BRAKE_PARAMETER = "brake_fraction"
+# Sections of the parameter file that the model reads (rig and spacers feed only the rig figures).
+MODEL_SECTIONS = ("vehicle", "steering", "geometry", "tyre", "input")
+# Grid values are rounded to this many significant digits so that linspace noise never changes a point id.
+GRID_DIGITS = 12
+ID_HEX_DIGITS = 10
+
+
+class SweepError(UsageError):
+    """A sweep declaration that cannot be run; the message is one line naming the file and the key."""
+
+
+@dataclass(frozen=True)
+class DesignVariable:
+    """A design quantity that sets several model parameters together."""
+
+    name: str
+    unit: str
+    minimum: float
+    maximum: float
+    description: str
+    replaces: tuple[str, ...]  # the model parameters it sets (an axis may not name them as well)
+
+
+DESIGN_VARIABLES: dict[str, DesignVariable] = {
+    v.name: v
+    for v in (
+        DesignVariable(
+            "front_axle_load", "N", 1000.0, 30000.0,
+            "total static load on the front wheels; the chassis mass follows (W/g minus the unsprung mass), "
+            "the chassis keeps its lateral mass-centre position and the left/right split follows from statics",
+            ("case.chassis_mass", "case.load_left", "case.load_right"),
+        ),
+        DesignVariable(
+            "extra_offset", "m", 0.0, 0.2,
+            "wheel spacer thickness: each wheel centre moves outboard by it (the paper's spacers); the "
+            "left/right loads are re-split by statics about the wider track",
+            ("case.wheel_centre_y", "case.extra_offset", "case.load_left", "case.load_right"),
+        ),
+        DesignVariable(
+            "steering_ratio", "1", 5.0, 60.0,
+            "overall steering ratio G, handwheel angle per road-wheel angle: the handwheel-to-rack ratio "
+            "becomes G times the road-wheel-to-rack ratio, and the handwheel lock angle scales with G so that "
+            "the rack travel and the road-wheel lock stay those of the base car",
+            ("steering.handwheel_to_rack_ratio", "input.handwheel_lock_angle"),
+        ),
+        DesignVariable(
+            "castor_angle", "rad", -0.3, 0.3,
+            "castor angle, with the mechanical trail (z2 - z1) tan(castor) that keeps the steer axis through "
+            "the wheel centre in side view, as in the paper's model",
+            ("geometry.castor_angle", "geometry.mechanical_trail"),
+        ),
+    )
+}
+
+
+@dataclass(frozen=True)
+class SweepPoint:
+    """One point of a sweep: its position in the expansion, its id and its axis values (SI).
+
+    The id hashes only what the point simulates (case, effects, surface, values), not its position, so that
+    extending an axis or reordering the declaration leaves every existing point's id, and its result, valid.
+    """
+
+    index: int
+    id: str
+    values: dict[str, float]
+
+
+@dataclass(frozen=True)
+class MapSpec:
+    """Which two axes a torque map spans, one panel per value of `panels`, the other axes held."""
+
+    x: str
+    y: str
+    panels: str | None
+    hold: dict[str, float]
+    quantity: str
+
+
+@dataclass(frozen=True)
+class AssistanceThreshold:
+    """The handwheel torque above which a design is taken to need power assistance: rim force x rim radius."""
+
+    rim_force_N: float
+    rim_radius_m: float
+    rim_force_source: str
+    rim_radius_source: str
+
+    @property
+    def torque_Nm(self) -> float:
+        return self.rim_force_N * self.rim_radius_m
+
+
+@dataclass(frozen=True)
+class Sweep:
+    """A validated, expanded sweep declaration."""
+
+    path: Path
+    name: str
+    description: str
+    base_case: str
+    effects: str | None
+    surface: str
+    axes: dict[str, tuple[float, ...]]  # empty for a declared list of points
+    points: tuple[SweepPoint, ...]
+    map: MapSpec | None
+    assistance: AssistanceThreshold | None
+    full: bool
+    braked: str = BRAKED_NONE
+    braked_effects: tuple[str, ...] | None = None  # the effect set of the braked run (an effect method only)
+    _by_id: dict[str, SweepPoint] = field(default_factory=dict, repr=False, compare=False)
+
+    def __post_init__(self):
+        self._by_id.update({p.id: p for p in self.points})
+
+    @property
+    def model_sets(self) -> dict[str, Any]:
+        """The effect sets whose compiled models the points need: "free" (as declared) and "braked" if simulated."""
+        sets: dict[str, Any] = {"free": self.effects}
+        if self.braked_effects is not None:
+            sets["braked"] = list(self.braked_effects)
+        return sets
+
+    @property
+    def point_ids(self) -> list[str]:
+        return [p.id for p in self.points]
+
+    @property
+    def keys(self) -> list[str]:
+        """Every parameter key that varies, in declaration order."""
+        if self.axes:
+            return list(self.axes)
+        seen: dict[str, None] = {}
+        for p in self.points:
+            seen.update(dict.fromkeys(p.values))
+        return list(seen)
+
+    def point(self, point_id: str) -> SweepPoint:
+        try:
+            return self._by_id[point_id]
+        except KeyError:
+            raise SweepError(f"{self.path}: no point {point_id!r} in sweep {self.name}") from None
+
+    def point_spec(self, point_id: str) -> dict[str, Any]:
+        """Everything a point job needs, as plain data (Snakemake passes it as a rule parameter).
+
+        It holds nothing that depends on the point's position in the sweep, so a job reruns only when what it
+        simulates changes.
+        """
+        point = self.point(point_id)
+        return {
+            "sweep": self.name,
+            "point": point.id,
+            "case": self.base_case,
+            "effects": self.effects,
+            "surface": self.surface,
+            "braked": self.braked,
+            "braked_effects": list(self.braked_effects) if self.braked_effects is not None else None,
+            "values": dict(point.values),
+        }
+
+
+# ---------------------------------------------------------------------------- parameter keys
+
+
+def _spec_bounds(spec: Spec) -> tuple[float, float, bool]:
+    return spec.lower, spec.upper, spec.lower_inclusive
+
+
+def parameter_bounds(key: str) -> tuple[float, float, bool, str]:
+    """(lower, upper, lower_inclusive, unit) of a sweepable key; raise KeyError for an unknown key."""
+    owner, _, name = key.partition(".")
+    if not name:
+        raise KeyError(key)
+    if owner == "design":
+        v = DESIGN_VARIABLES[name]
+        return v.minimum, v.maximum, True, v.unit
+    if owner == "case":
+        spec = CASE_SCHEMA[name]
+        return (*_spec_bounds(spec), spec.unit)
+    if owner in MODEL_SECTIONS:
+        if name in SCHEMA[owner]:
+            spec = SCHEMA[owner][name]
+            if spec.is_list:
+                raise KeyError(key)
+            return (*_spec_bounds(spec), spec.unit)
+        from ..model.values import MODEL_PARAMETERS  # model-only parameters, not in the file's schema
+
+        p = MODEL_PARAMETERS[key]
+        return p.minimum, p.maximum, True, p.unit
+    from ..model.components import discover_effects  # imports the effects (and sympy) only when needed
+
+    effect = discover_effects()[owner]
+    for p in effect.parameters:
+        if p.name == name:
+            return p.minimum, p.maximum, True, p.unit
+    raise KeyError(key)
+
+
+def _check_key(where: str, key: Any) -> str:
+    if not isinstance(key, str) or "." not in key:
+        raise SweepError(f"{where}: {key!r} is not a parameter key (OWNER.NAME, e.g. tyre.tyre_pressure)")
+    try:
+        parameter_bounds(key)
+    except KeyError:
+        raise SweepError(
+            f"{where}: unknown parameter {key!r} (a model parameter as for `parksteer simulate --set`, "
+            f"or design.{{{', '.join(DESIGN_VARIABLES)}}})"
+        ) from None
+    return key
+
+
+def _number(where: str, value: Any) -> float:
+    if isinstance(value, str):  # YAML 1.1 reads 1.2e5 (no dot) as a string
+        try:
+            value = float(value)
+        except ValueError:
+            pass
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise SweepError(f"{where}: {value!r} is not a number")
+    value = float(value)
+    if not math.isfinite(value):
+        raise SweepError(f"{where}: {value} is not finite")
+    return value
+
+
+def _check_value(where: str, key: str, value: float) -> float:
+    lower, upper, inclusive, unit = parameter_bounds(key)
+    below = value < lower if inclusive else value <= lower
+    if below or value > upper:
+        bracket = "[" if inclusive else "("
+        shown = f"{value:g}" if unit == "1" else f"{value:g} {unit}"
+        raise SweepError(f"{where}: {shown} is out of bounds {bracket}{lower:g}, {upper:g}]")
+    return value
+
+
+def _round(value: float) -> float:
+    return float(f"{value:.{GRID_DIGITS}g}")
+
+
+def _axis_values(where: str, key: str, raw: Any) -> tuple[float, ...]:
+    """A list of numbers, or a grid {start, stop, num} (num evenly spaced values, both ends included)."""
+    if isinstance(raw, dict):
+        unknown = sorted(set(raw) - {"start", "stop", "num"})
+        if unknown:
+            raise SweepError(f"{where}.{unknown[0]}: unknown grid field (use start, stop, num)")
+        missing = [k for k in ("start", "stop", "num") if k not in raw]
+        if missing:
+            raise SweepError(f"{where}: grid needs {missing[0]}")
+        start, stop = _number(f"{where}.start", raw["start"]), _number(f"{where}.stop", raw["stop"])
+        num = raw["num"]
+        if isinstance(num, bool) or not isinstance(num, int) or num < 1:
+            raise SweepError(f"{where}.num: {num!r} is not a positive integer")
+        if num == 1 and start != stop:
+            raise SweepError(f"{where}.num: 1 value cannot span {start:g} to {stop:g}")
+        values = [_round(v) for v in np.linspace(start, stop, num)]
+    elif isinstance(raw, list):
+        if not raw:
+            raise SweepError(f"{where}: empty axis")
+        values = [_round(_number(f"{where}[{i}]", v)) for i, v in enumerate(raw)]
+    elif raw is None:
+        raise SweepError(f"{where}: empty axis")
+    else:
+        values = [_round(_number(where, raw))]
+    if len(set(values)) != len(values):
+        raise SweepError(f"{where}: repeated value")
+    for i, v in enumerate(values):
+        _check_value(f"{where}[{i}]", key, v)
+    return tuple(values)
+
+
+def _check_conflicts(where: str, keys: list[str]) -> None:
+    for key in keys:
+        owner, _, name = key.partition(".")
+        if owner != "design":
+            continue
+        for other in DESIGN_VARIABLES[name].replaces:
+            if other in keys:
+                raise SweepError(f"{where}: {key} sets {other}; sweep one of them, not both")
+
+
+# ---------------------------------------------------------------------------- ids and expansion
+
+
+def point_id(case: str, effects: str | None, surface: str, values: dict[str, float]) -> str:
+    """A hash of what the point simulates: the same on every run and machine, whatever the point's position."""
+    canonical = json.dumps(
+        {"case": case, "effects": effects, "surface": surface,
+         "values": {k: format(v, f".{GRID_DIGITS}g") for k, v in values.items()}},
+        sort_keys=True,
+    )
+    return hashlib.sha256(canonical.encode()).hexdigest()[:ID_HEX_DIGITS]
+
+
+def _expand(axes: dict[str, tuple[float, ...]]) -> list[dict[str, float]]:
+    keys = list(axes)
+    return [dict(zip(keys, combo)) for combo in itertools.product(*(axes[k] for k in keys))]
+
+
+# ---------------------------------------------------------------------------- loading
+
+
+def _read(path: Path) -> dict:
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise SweepError(f"{path}: cannot read ({exc.strerror})") from None
+    try:
+        doc = yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        first = str(exc).splitlines()[0] if str(exc) else "syntax error"
+        raise SweepError(f"{path}: not valid YAML ({first})") from None
+    if not isinstance(doc, dict):
+        raise SweepError(f"{path}: expected a mapping of sweep fields")
+    return doc
+
+
+def _axes(path: Path, field_name: str, raw: Any) -> dict[str, tuple[float, ...]]:
+    where = f"{path}: {field_name}"
+    if not isinstance(raw, dict) or not raw:
+        raise SweepError(f"{where}: expected a mapping of parameter keys to values")
+    axes = {}
+    for key, values in raw.items():
+        _check_key(where, key)
+        axes[key] = _axis_values(f"{where}.{key}", key, values)
+    _check_conflicts(where, list(axes))
+    return axes
+
+
+def _points(path: Path, raw: Any) -> list[dict[str, float]]:
+    where = f"{path}: points"
+    if not isinstance(raw, list) or not raw:
+        raise SweepError(f"{where}: expected a non-empty list of points")
+    out = []
+    for i, entry in enumerate(raw):
+        if not isinstance(entry, dict) or not entry:
+            raise SweepError(f"{where}[{i}]: expected a mapping of parameter keys to values")
+        values = {}
+        for key, value in entry.items():
+            _check_key(f"{where}[{i}]", key)
+            values[key] = _check_value(f"{where}[{i}].{key}", key, _round(_number(f"{where}[{i}].{key}", value)))
+        _check_conflicts(f"{where}[{i}]", list(values))
+        out.append(values)
+    seen = set()
+    for i, values in enumerate(out):
+        frozen = tuple(sorted(values.items()))
+        if frozen in seen:
+            raise SweepError(f"{where}[{i}]: repeated point")
+        seen.add(frozen)
+    return out
+
+
+def _threshold(path: Path, raw: Any) -> AssistanceThreshold:
+    where = f"{path}: assistance"
+    if not isinstance(raw, dict):
+        raise SweepError(f"{where}: expected rim_force and rim_radius")
+    unknown = sorted(set(raw) - {"rim_force", "rim_radius"})
+    if unknown:
+        raise SweepError(f"{where}.{unknown[0]}: unknown field (use rim_force, rim_radius)")
+    out = {}
+    for name, unit in (("rim_force", "N"), ("rim_radius", "m")):
+        entry = raw.get(name)
+        if not isinstance(entry, dict) or set(entry) != {"value", "unit", "source"}:
+            raise SweepError(f"{where}.{name}: expected {{value, unit, source}}")
+        if entry["unit"] != unit:
+            raise SweepError(f"{where}.{name}: unit {entry['unit']!r} where {unit!r} is required")
+        if not isinstance(entry["source"], str) or not entry["source"].strip():
+            raise SweepError(f"{where}.{name}: source must be a non-empty string")
+        value = _number(f"{where}.{name}.value", entry["value"])
+        if value <= 0:
+            raise SweepError(f"{where}.{name}.value: {value:g} {unit} must be positive")
+        out[name] = (value, entry["source"].strip())
+    return AssistanceThreshold(out["rim_force"][0], out["rim_radius"][0], out["rim_force"][1], out["rim_radius"][1])
+
+
+def _map(path: Path, raw: Any, keys: list[str], axes: dict[str, tuple[float, ...]], points) -> MapSpec:
+    where = f"{path}: map"
+    if not isinstance(raw, dict):
+        raise SweepError(f"{where}: expected a mapping with x, y and quantity")
+    unknown = sorted(set(raw) - {"x", "y", "panels", "hold", "quantity"})
+    if unknown:
+        raise SweepError(f"{where}.{unknown[0]}: unknown field (use x, y, panels, hold, quantity)")
+    for name in ("x", "y", "quantity"):
+        if name not in raw:
+            raise SweepError(f"{where}: needs {name}")
+    for name in ("x", "y", "panels"):
+        key = raw.get(name)
+        if key is not None and key not in keys:
+            raise SweepError(f"{where}.{name}: {key!r} is not a key of this sweep")
+    used = [raw["x"], raw["y"]] + ([raw["panels"]] if raw.get("panels") else [])
+    if len(set(used)) != len(used):
+        raise SweepError(f"{where}: x, y and panels must be different keys")
+    if raw["quantity"] not in MAP_QUANTITIES:
+        raise SweepError(f"{where}.quantity: {raw['quantity']!r} is not one of {', '.join(MAP_QUANTITIES)}")
+    hold_raw = raw.get("hold") or {}
+    if not isinstance(hold_raw, dict):
+        raise SweepError(f"{where}.hold: expected a mapping of keys to values")
+    hold = {}
+    for key, value in hold_raw.items():
+        if key not in keys or key in used:
+            raise SweepError(f"{where}.hold.{key}: not a key of this sweep outside x, y and panels")
+        value = _round(_number(f"{where}.hold.{key}", value))
+        available = axes[key] if axes else sorted({p[key] for p in points if key in p})
+        if value not in available:
+            raise SweepError(f"{where}.hold.{key}: {value:g} is not a value of this sweep")
+        hold[key] = value
+    return MapSpec(raw["x"], raw["y"], raw.get("panels"), hold, raw["quantity"])
+
+
+def _check_model_consistency(path: Path, params: Parameters, case: str, effects: str | None,
+                             values_list: list[dict[str, float]]) -> None:
+    """Effect parameters belong to an effect of the sweep's model; derived case values are physical."""
+    from .design import point_overrides
+
+    owners = {k.partition(".")[0] for v in values_list for k in v}
+    effect_owners = owners - set(MODEL_SECTIONS) - {"case", "design"}
+    if effect_owners:
+        from ..model.components import resolve_effects
+
+        chosen = {e.name for e in resolve_effects(effects)}
+        for owner in sorted(effect_owners):
+            if owner not in chosen:
+                raise SweepError(f"{path}: {owner}: effect is not in this sweep's model "
+                                 f"(effects: {effects or 'default'})")
+    for i, values in enumerate(values_list):
+        try:
+            derived = point_overrides(params, case, values)
+        except SweepError as exc:
+            raise SweepError(f"{path}: point {i}: {exc}") from None
+        for key, value in derived.items():
+            if key in values:
+                continue  # checked with its axis
+            owner, _, name = key.partition(".")
+            spec = CASE_SCHEMA[name] if owner == "case" else SCHEMA[owner][name]
+            lower, upper, inclusive = _spec_bounds(spec)
+            if (value < lower if inclusive else value <= lower) or value > upper:
+                raise SweepError(f"{path}: point {i}: derived {key} = {value:g} {spec.unit} is out of bounds")
+
+
+def _braked(path: Path, raw: Any, effects: str | None, surface: str) -> tuple[str, tuple[str, ...] | None]:
+    """The braked-wheel comparison: none, rig_theory, or an effect with a brake_fraction parameter."""
+    where = f"{path}: braked"
+    if not isinstance(raw, str) or not raw:
+        raise SweepError(f"{where}: expected {BRAKED_NONE}, {BRAKED_RIG_THEORY} or an effect name")
+    if raw == BRAKED_NONE:
+        return raw, None
+    if surface != "ground":
+        raise SweepError(f"{where}: braked wheels are compared on the ground only (surface is {surface})")
+    from ..model.components import discover_effects, resolve_effects
+
+    chosen = [e.name for e in resolve_effects(effects)]
+    if "tyre_friction" not in chosen:
+        raise SweepError(f"{where}: needs tyre_friction in the model, or there is no patch to drag")
+    if raw == BRAKED_RIG_THEORY:
+        return raw, None
+    registry = discover_effects()
+    if raw not in registry:
+        raise SweepError(f"{where}: {raw!r} is neither {BRAKED_NONE}, {BRAKED_RIG_THEORY} nor an effect "
+                         f"(known: {', '.join(sorted(registry))})")
+    if raw in chosen:
+        raise SweepError(f"{where}: effect {raw} is already in the free-rolling model")
+    if BRAKE_PARAMETER not in {p.name for p in registry[raw].parameters}:
+        raise SweepError(f"{where}: effect {raw} has no {BRAKE_PARAMETER} parameter")
+    return raw, tuple(sorted(chosen + [raw]))
+
+
+def load_sweep(path: str | Path, params: Parameters, full: bool = False) -> Sweep:
+    """Read, validate and expand a sweep declaration against the parameter file `params`.
+
+    full: use `full_axes` (the large version of the study) instead of `axes`.
+    """
+    path = Path(path)
+    doc = _read(path)
+    unknown = sorted(set(doc) - TOP_LEVEL_KEYS)
+    if unknown:
+        raise SweepError(f"{path}: {unknown[0]}: unknown field (known: {', '.join(sorted(TOP_LEVEL_KEYS))})")
+    name = doc.get("name")
+    if not isinstance(name, str) or not re.fullmatch(r"[a-z][a-z0-9_]*", name):
+        raise SweepError(f"{path}: name: {name!r} must be lower-case letters, digits and _ (it names files)")
+    base_case = doc.get("base_case")
+    if base_case not in params.cases:
+        raise SweepError(f"{path}: base_case: {base_case!r} is not a case of {params.path} "
+                         f"(known: {', '.join(params.case_names)})")
+    effects = doc.get("effects")
+    if effects is not None and not isinstance(effects, str):
+        raise SweepError(f"{path}: effects: expected an effects spec string or null")
+    surface = doc.get("surface", "ground")
+    if surface not in SURFACES:
+        raise SweepError(f"{path}: surface: {surface!r} is not one of {', '.join(SURFACES)}")
+    description = doc.get("description") or ""
+    if not isinstance(description, str):
+        raise SweepError(f"{path}: description: expected text")
+
+    if ("axes" in doc) == ("points" in doc):
+        raise SweepError(f"{path}: declare either axes (a full factorial) or points (a list), not both or neither")
+    if "points" in doc:
+        if full:
+            raise SweepError(f"{path}: full_axes: the full sweep needs axes; this sweep declares points")
+        axes: dict[str, tuple[float, ...]] = {}
+        values_list = _points(path, doc["points"])
+    else:
+        field_name = "full_axes" if full else "axes"
+        if full and "full_axes" not in doc:
+            raise SweepError(f"{path}: full_axes: the full sweep was asked for but is not declared")
+        axes = _axes(path, field_name, doc[field_name])
+        values_list = _expand(axes)
+    if "full_axes" in doc and not full:
+        _axes(path, "full_axes", doc["full_axes"])  # validate the other half of the file as well
+
+    _check_model_consistency(path, params, base_case, effects, values_list)
+    points = tuple(SweepPoint(i, point_id(base_case, effects, surface, v), v) for i, v in enumerate(values_list))
+    keys = list(axes) if axes else list(dict.fromkeys(k for v in values_list for k in v))
+    spec_map = _map(path, doc["map"], keys, axes, values_list) if doc.get("map") is not None else None
+    threshold = _threshold(path, doc["assistance"]) if doc.get("assistance") is not None else None
+    braked, braked_effects = _braked(path, doc.get("braked", BRAKED_NONE), effects, surface)
+    return Sweep(path, name, description.strip(), base_case, effects, surface, axes, points, spec_map, threshold,
+                 full, braked, braked_effects)

@@ -1,0 +1,84 @@
+"""The sweep's table, key numbers and torque maps: reproducible files whose numbers carry the physics."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from parksteer.figures.sweep import make_sweep_figure
+from parksteer.sweep import SweepError, load_sweep
+from parksteer.sweep.run import run_point
+from parksteer.tables import read_csv
+
+SMALL = """
+name: small
+base_case: unladen
+axes:
+  tyre.tyre_pressure: [122500, 245000]
+  design.front_axle_load: [5576, 8500]
+  design.extra_offset: [0.0, 0.0685]
+braked: rig_theory
+map: {x: tyre.tyre_pressure, y: design.front_axle_load, hold: {design.extra_offset: 0.0}, quantity: peak_torque_Nm}
+assistance:
+  rim_force: {value: 150, unit: N, source: "test: UN ECE R79 M1 intact steering"}
+  rim_radius: {value: 0.19, unit: m, source: "test: typical rim"}
+"""
+
+
+@pytest.fixture(scope="module")
+def small_sweep(params, tmp_path_factory):
+    """Eight points of the multibody model, run through the point job's own code path."""
+    root = tmp_path_factory.mktemp("sweep")
+    declaration = root / "small.yaml"
+    declaration.write_text(SMALL, encoding="utf-8")
+    sweep = load_sweep(declaration, params)
+    points = []
+    for point_id in sweep.point_ids:
+        points.append(root / f"{point_id}.json")
+        run_point(sweep.point_spec(point_id), params.path, points[-1])
+    return root, declaration, points
+
+
+def test_outputs_are_reproducible_and_complete(params, small_sweep):
+    """Made twice, the SVG and CSV are byte-identical; the table has one row per point with the figures of
+    merit, the mechanism shares (summing to one) and the assistance flag of each design."""
+    root, declaration, points = small_sweep
+    for tag in ("a", "b"):
+        make_sweep_figure(declaration, params, points, root / f"{tag}.svg", root / f"{tag}.csv", root / f"{tag}.json")
+    assert (root / "a.svg").read_bytes() == (root / "b.svg").read_bytes()
+    assert (root / "a.csv").read_bytes() == (root / "b.csv").read_bytes()
+    columns, header = read_csv(root / "a.csv")
+    assert len(columns["point"]) == 8
+    shares = sum(columns[c] for c in columns if c.startswith("share_"))
+    np.testing.assert_allclose(shares, 1.0, atol=1e-5)
+    np.testing.assert_array_equal(columns["needs_assistance"], (columns["peak_torque_Nm"] > 28.5).astype(float))
+    assert "28.5 N m" in header["assistance threshold"]
+
+
+def test_summary_answers_the_design_questions(params, small_sweep):
+    """At the test car the map finds the Table B1 point; doubling the pressure lowers the plateau; the spacer
+    changes the free-rolling plateau only through lifting (under 10 %) but raises the braked one (rig-theory
+    estimate) by far more; heavier and softer designs are the ones above the assistance threshold."""
+    root, declaration, points = small_sweep
+    summary = make_sweep_figure(declaration, params, points, root / "s.svg", root / "s.csv", root / "s.json")
+    assert json.loads((root / "s.json").read_text())["n_points"] == 8
+    design = summary["design_point"]
+    assert design["on_design"] and design["values"]["design.front_axle_load"] == 5576.0
+    pressure = summary["sensitivity"]["tyre.tyre_pressure"]
+    assert pressure["ratio_plateau_torque_Nm"] < 0.8
+    offset = summary["sensitivity"]["design.extra_offset"]
+    assert 0.0 < offset["ratio_plateau_torque_Nm"] - 1.0 < 0.10
+    assert offset["ratio_plateau_torque_braked_Nm"] - 1.0 > 2.0 * (offset["ratio_plateau_torque_Nm"] - 1.0)
+    above = summary["assistance"]["points_above"]
+    assert above and all(p["values"]["design.front_axle_load"] == 8500.0 for p in above)
+    assert all(p["values"]["tyre.tyre_pressure"] == 122500.0 for p in above)
+
+
+def test_point_files_must_match_the_declaration(params, small_sweep):
+    """Gathering fewer point files than the sweep declares is refused with one line, not a partial map."""
+    root, declaration, points = small_sweep
+    with pytest.raises(SweepError, match="do not match"):
+        make_sweep_figure(declaration, params, points[:-1], root / "x.svg", root / "x.csv", root / "x.json")
+    assert not (root / "x.svg").exists()

@@ -1,0 +1,439 @@
+"""Design sweeps: declaration and expansion, design variables, figures of merit, physics of a tiny grid,
+the point job's no-derivation guarantee and the SLURM profile's dry run."""
+
+from __future__ import annotations
+
+import math
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from parksteer.errors import UsageError
+from parksteer.geometry import lock_steer_angle, steer_axis
+from parksteer.model.simulate import with_overrides
+from parksteer.sweep import SweepError, load_sweep
+from parksteer.sweep.aggregate import threshold_crossings
+from parksteer.sweep.design import point_overrides
+from parksteer.sweep.merit import figures_of_merit
+from parksteer.sweep.run import simulate_point
+
+EXAMPLE = "workflow/sweeps/design.yaml"
+
+
+def _write(tmp_path: Path, text: str, name: str = "s.yaml") -> Path:
+    path = tmp_path / name
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+GRID = """
+name: grid
+base_case: unladen
+axes:
+  tyre.tyre_pressure: {start: 120000, stop: 300000, num: 3}
+  design.front_axle_load: [5576, 7000]
+  rack_friction.friction_force: [500, 730]
+"""
+
+
+# ---------------------------------------------------------------------------- declaration
+
+
+def test_grid_is_the_full_factorial_with_stable_ids(tmp_path, params):
+    """A 3 x 2 x 2 grid gives 12 points, first axis slowest; the ids hash what each point simulates, so they
+    are identical when the file is read again and when the axes are declared in another order, and extending
+    an axis adds points without changing the ids of the existing ones."""
+    sweep = load_sweep(_write(tmp_path, GRID), params)
+    assert len(sweep.points) == 12
+    assert [p.values["tyre.tyre_pressure"] for p in sweep.points[:4]] == [120000.0] * 4
+    assert [p.values["rack_friction.friction_force"] for p in sweep.points[:2]] == [500.0, 730.0]
+    assert sweep.points[5].values == {"tyre.tyre_pressure": 210000.0, "design.front_axle_load": 5576.0,
+                                      "rack_friction.friction_force": 730.0}
+    ids = sweep.point_ids
+    assert len(set(ids)) == 12 and all(len(i) == 10 and int(i, 16) >= 0 for i in ids)
+    assert load_sweep(_write(tmp_path, GRID, "again.yaml"), params).point_ids == ids
+    reordered = GRID.replace("  tyre.tyre_pressure: {start: 120000, stop: 300000, num: 3}\n", "") + \
+        "  tyre.tyre_pressure: [120000, 210000, 300000]\n"
+    assert set(load_sweep(_write(tmp_path, reordered, "r.yaml"), params).point_ids) == set(ids)
+    extended = GRID.replace("[500, 730]", "[500, 600, 730]")
+    assert set(ids) < set(load_sweep(_write(tmp_path, extended, "e.yaml"), params).point_ids)
+
+
+def test_full_switch_and_declared_points(tmp_path, params):
+    """The shipped example has 48 points and a 240-point full version; a declared list runs exactly its points."""
+    example = load_sweep(EXAMPLE, params)
+    assert len(example.points) == 48
+    assert len(load_sweep(EXAMPLE, params, full=True).points) == 240
+    listed = load_sweep(_write(tmp_path, """
+name: listed
+base_case: unladen
+points:
+  - {tyre.tyre_pressure: 150000}
+  - {tyre.tyre_pressure: 250000, design.extra_offset: 0.02}
+"""), params)
+    assert [p.values for p in listed.points] == [{"tyre.tyre_pressure": 150000.0},
+                                                {"tyre.tyre_pressure": 250000.0, "design.extra_offset": 0.02}]
+
+
+@pytest.mark.parametrize("body, key", [
+    ("axes: {tyre.tyre_presure: [2.0e+5]}", "tyre.tyre_presure"),
+    ("axes: {tyre.tyre_pressure: [2.0e+5, -1]}", "axes.tyre.tyre_pressure[1]"),
+    ("axes: {tyre.tyre_pressure: []}", "axes.tyre.tyre_pressure"),
+    ("axes: {tyre.tyre_pressure: {start: 1.0e+5, stop: 2.0e+5, num: 0}}", "axes.tyre.tyre_pressure.num"),
+    ("axes: {design.front_axle_load: [6000], case.load_left: [3000]}", "case.load_left"),
+    ("axes: {design.steering_ratio: [500]}", "axes.design.steering_ratio[0]"),
+    ("axes: {design.front_axle_load: [1500], vehicle.unsprung_mass: [200]}", "design.front_axle_load"),
+    ("effects: '-rack_friction'\naxes: {rack_friction.friction_force: [500]}", "rack_friction"),
+    ("axes: {tyre.tyre_pressure: [2.0e+5]}\ncolour: blue", "colour"),
+    ("axes: {tyre.tyre_pressure: [2.0e+5]}\nbraked: handbrake", "braked"),
+    ("axes: {tyre.tyre_pressure: [2.0e+5]}\nsurface: air_bearing\nbraked: braked_wheels", "braked"),
+    ("axes: {tyre.tyre_pressure: [2.0e+5]}\neffects: '-tyre_friction'\nbraked: rig_theory", "braked"),
+    ("axes: {tyre.tyre_pressure: [2.0e+5]}\nmap: {x: tyre.tyre_pressure, y: case.chassis_mass, quantity: "
+     "peak_torque_Nm}", "map.y"),
+])
+def test_invalid_declarations_fail_with_one_line_naming_file_and_key(tmp_path, params, body, key):
+    """Unknown parameter, out-of-bounds value, empty axis, bad grid, conflicting keys, an effect not in the model,
+    an unknown field, a braked comparison that cannot be made, a map over a key that is not swept: each is one
+    line naming the file and the key."""
+    path = _write(tmp_path, f"name: bad\nbase_case: unladen\n{body}\n")
+    with pytest.raises(SweepError) as info:
+        load_sweep(path, params)
+    message = str(info.value)
+    assert "\n" not in message and message.startswith(str(path)) and key in message
+
+
+# ---------------------------------------------------------------------------- design variables
+
+
+@pytest.mark.parametrize("case", ["offset_12_7mm", "offset_44_5mm", "offset_68_5mm"])
+def test_offset_and_load_statics_reproduce_table_b1(params, case):
+    """Moving the wheels out by a spacer with the chassis's mass and lateral mass centre kept re-splits the
+    loads by statics exactly as the paper's Table B1 lists them for its three spacers (within 0.5 N, the
+    table's rounding plus the 0.1 N the notes found for the statics)."""
+    table = params.case(case)
+    total = params.case("unladen")["load_left"] + params.case("unladen")["load_right"]
+    overrides = point_overrides(params, "unladen", {"design.extra_offset": table["extra_offset"],
+                                                    "design.front_axle_load": total})
+    assert overrides["case.wheel_centre_y"] == pytest.approx(table["wheel_centre_y"], abs=1e-9)
+    assert overrides["case.load_left"] == pytest.approx(table["load_left"], abs=0.5)
+    assert overrides["case.load_right"] == pytest.approx(table["load_right"], abs=0.5)
+    assert overrides["case.chassis_mass"] == pytest.approx(table["chassis_mass"], abs=0.01)
+
+
+def test_ratio_keeps_road_wheel_lock_and_castor_keeps_axis_through_wheel_centre(params):
+    """A quicker rack leaves the road-wheel lock angle unchanged (the rack travel is the car's), and a new
+    castor angle comes with the trail that keeps the steer axis through the wheel centre in side view."""
+    overrides = point_overrides(params, "unladen", {"design.steering_ratio": 15.0, "design.castor_angle": 0.1})
+    sections = {}
+    for key, value in overrides.items():
+        section, _, name = key.partition(".")
+        sections.setdefault(section, {})[name] = value
+    changed = params
+    for section, values in sections.items():
+        changed = with_overrides(changed, section, **values)
+    assert changed["steering.handwheel_to_rack_ratio"] / changed["steering.roadwheel_to_rack_ratio"] == \
+        pytest.approx(15.0)
+    assert lock_steer_angle(changed) == pytest.approx(lock_steer_angle(params), rel=1e-12)
+    axis = steer_axis(changed, "unladen", "left")
+    along = (axis.wheel_centre[2] - axis.top[2]) / axis.direction[2]
+    assert (axis.top + along * axis.direction)[0] == pytest.approx(axis.wheel_centre[0], abs=1e-12)
+
+
+# ---------------------------------------------------------------------------- figures of merit
+
+RACK_SHARE = 4.0  # N m
+TYRE_LIMIT = 11.0  # N m, reached after the carcass wind-up
+WIND_UP_M = 0.02
+COLUMN_PER_RACK = 186.47
+STEER_PER_RACK = 8.3682
+
+
+def synthetic_cycle(ripple_Nm=0.0, ripple_phase=0.0, tread_slides=True, dt=0.001):
+    """A right-going stroke to lock and the start of the return, built from the paper's mechanisms.
+
+    Rack speed ramps to 15 mm/s in 0.02 s, cruises, stops at lock at t = 4.5 s and returns. The rack friction
+    share is +-RACK_SHARE (reversing with the rack speed); the tyre share rises linearly over WIND_UP_M of rack
+    (the tread stuck, the carcass twisting) to TYRE_LIMIT and stays there while the tread slides; after the
+    reversal the carcass unwinds at the same rate. A ripple of period pi in column angle stands for the Hooke
+    joint. So the plateau is RACK_SHARE + TYRE_LIMIT, the drop at reversal 2 RACK_SHARE.
+    """
+    t = np.arange(0.0, 5.5 + dt / 2, dt)
+    v0, ramp = 0.015, 0.02
+    speed = np.where(t < 4.5, v0 * np.clip(np.minimum(t, 4.5 - t) / ramp, 0, 1),
+                     -v0 * np.clip((t - 4.5) / ramp, 0, 1))
+    rack = np.concatenate([[0.0], np.cumsum((speed[1:] + speed[:-1]) / 2 * dt)])
+    lock = rack.max()
+    steer = STEER_PER_RACK * rack
+    column = COLUMN_PER_RACK * rack
+    rack_part = RACK_SHARE * np.tanh(speed / 1e-4)
+    going = t <= 4.5
+    tyre_part = np.where(going, TYRE_LIMIT * np.minimum(rack / WIND_UP_M, 1.0),
+                         TYRE_LIMIT * (1.0 - 2.0 * np.minimum((lock - rack) / WIND_UP_M, 1.0)))
+    ripple = ripple_Nm * np.sin(2.0 * column + ripple_phase)
+    twist_stuck = -steer  # the tread does not turn: ring angle steer + twist stays zero
+    twist = np.where(going & (rack > WIND_UP_M) & tread_slides, -STEER_PER_RACK * WIND_UP_M, twist_stuck)
+    twist = np.where(going, twist, twist[going][-1])
+    return {
+        "time_s": t, "rack_m": rack, "handwheel_torque_Nm": rack_part + tyre_part + ripple,
+        "column_angle_rad": column, "steer_left_rad": steer, "steer_right_rad": steer,
+        "twist_left_rad": twist, "twist_right_rad": twist,
+        "contrib_rack_friction_Nm": rack_part, "contrib_tyre_friction_Nm": tyre_part, "contrib_ripple_Nm": ripple,
+    }
+
+
+@pytest.mark.parametrize("phase", [0.0, 1.0, 2.5])
+def test_plateau_and_shares_of_a_synthetic_cycle_average_out_the_ripple(phase):
+    """Plateau = rack share + sliding tyre moment; the shares are their fractions and the Hooke-type ripple's
+    share vanishes, whatever its phase, because the window holds whole ripple periods; sliding is found where
+    the carcass stops twisting (at the wind-up travel)."""
+    merits = figures_of_merit(synthetic_cycle(ripple_Nm=1.5, ripple_phase=phase))
+    plateau = RACK_SHARE + TYRE_LIMIT
+    assert merits["plateau_torque_Nm"] == pytest.approx(plateau, abs=0.02)
+    assert merits["share_contrib_rack_friction_Nm"] == pytest.approx(RACK_SHARE / plateau, abs=0.002)
+    assert merits["share_contrib_tyre_friction_Nm"] == pytest.approx(TYRE_LIMIT / plateau, abs=0.002)
+    assert abs(merits["share_contrib_ripple_Nm"]) < 0.002
+    assert merits["sliding_start_rack_m"] == pytest.approx(WIND_UP_M, abs=0.0002)
+    assert merits["peak_torque_Nm"] == pytest.approx(plateau + 1.5, abs=0.01)
+
+
+def test_lock_torque_and_reversal_drop_of_a_synthetic_cycle():
+    """Arriving at lock the torque is rack share + tyre limit; on reversal it drops by twice the rack share
+    (the friction reverses) plus the carcass unwinding over the rack's travel to half its return speed
+    (0.04 mm here, so at most 2 * 11 N m * 0.04 / 20 = 0.05 N m)."""
+    merits = figures_of_merit(synthetic_cycle())
+    assert merits["lock_torque_Nm"] == pytest.approx(RACK_SHARE + TYRE_LIMIT, abs=1e-6)
+    assert merits["reversal_drop_Nm"] == pytest.approx(2 * RACK_SHARE, abs=0.05)
+    assert merits["reversal_rack_travel_m"] < 1e-4
+
+
+def test_no_plateau_when_the_tread_never_slides():
+    """If the carcass twists all the way to lock (the tread never slides) there is no plateau to quote."""
+    merits = figures_of_merit(synthetic_cycle(tread_slides=False))
+    assert math.isnan(merits["plateau_torque_Nm"]) and merits["sliding_fraction"] == 0.0
+
+
+def test_threshold_crossing_is_interpolated_along_the_map_axis(tmp_path, params):
+    """With the peak torque linear in front load (10 N m + 3 N m per kN), the load at which it reaches the
+    28.5 N m threshold is (28.5 - 10) / 3 kN, at every pressure."""
+    sweep = load_sweep(_write(tmp_path, """
+name: lin
+base_case: unladen
+axes:
+  tyre.tyre_pressure: [150000, 250000]
+  design.front_axle_load: [5000, 6000, 7000]
+map: {x: tyre.tyre_pressure, y: design.front_axle_load, quantity: peak_torque_Nm}
+"""), params)
+    records = [{"point": p.id, "values": p.values,
+                "merits": {"peak_torque_Nm": 10.0 + 3.0e-3 * p.values["design.front_axle_load"]}}
+               for p in sweep.points]
+    design = {k: {"nearest": v} for k, v in sweep.points[0].values.items()}
+    crossings = threshold_crossings(sweep, records, design, "peak_torque_Nm", 28.5)
+    assert [c["x"] for c in crossings] == [150000.0, 250000.0]
+    for c in crossings:
+        assert c["crossing_y"] == pytest.approx((28.5 - 10.0) / 3.0e-3, rel=1e-12)
+
+
+# ---------------------------------------------------------------------------- physics of a tiny grid
+
+
+@pytest.fixture(scope="module")
+def tiny_grid(params):
+    """Four points of the multibody model: two pressures x two front axle loads, the rest the test car."""
+    out = {}
+    for pressure in (122500.0, 245000.0):
+        for load in (5576.0, 8000.0):
+            spec = {"sweep": "tiny", "point": "x", "case": "unladen", "effects": None,
+                    "surface": "ground", "values": {"tyre.tyre_pressure": pressure, "design.front_axle_load": load}}
+            out[pressure, load] = simulate_point(spec, params)["merits"]
+    return out
+
+
+def _tyre_share(merits):
+    return merits["plateau_torque_Nm"] * merits["share_contrib_tyre_friction_Nm"]
+
+
+def test_plateau_falls_with_pressure_as_equation_2(tiny_grid):
+    """Doubling the pressure lowers the plateau, and its tyre share by (1/2)^n with n = 0.78 (equation (2)),
+    within 1 %: the sliding tread carries the moment limit at its instantaneous load, and lifting moves the
+    loads by well under 1 % between the two runs' windows; the rack share does not depend on pressure."""
+    for load in (5576.0, 8000.0):
+        low, high = tiny_grid[122500.0, load], tiny_grid[245000.0, load]
+        assert high["plateau_torque_Nm"] < low["plateau_torque_Nm"]
+        assert _tyre_share(high) / _tyre_share(low) == pytest.approx(0.5**0.78, rel=0.01)
+
+
+def test_plateau_tyre_share_rises_with_load_as_w_to_the_1_5(tiny_grid):
+    """The tyre share of the plateau grows as W^1.5 with the front axle load (equations (1), (2)), within 1 %
+    for the reason above; the total grows more slowly because the rack friction share (F / 186.47 rad/m,
+    about 3.9 N m) does not depend on load."""
+    for pressure in (122500.0, 245000.0):
+        light, heavy = tiny_grid[pressure, 5576.0], tiny_grid[pressure, 8000.0]
+        assert _tyre_share(heavy) / _tyre_share(light) == pytest.approx((8000.0 / 5576.0) ** 1.5, rel=0.01)
+        total_ratio = heavy["plateau_torque_Nm"] / light["plateau_torque_Nm"]
+        assert 1.0 < total_ratio < (8000.0 / 5576.0) ** 1.5
+        rack = [m["plateau_torque_Nm"] * m["share_contrib_rack_friction_Nm"] for m in (light, heavy)]
+        assert rack == pytest.approx([730.0 / 186.47] * 2, rel=0.01)
+
+
+def test_plateau_scales_inversely_with_steering_ratio(params):
+    """Through lossless gearing the handwheel carries the road-side resistance divided by the overall ratio:
+    plateau x G is the same for G = 16 and 30 within 2 % (the Hooke-joint ripple is averaged over whole
+    periods, the column damping adds only c * rate, under 0.1 N m at these rates)."""
+    products = []
+    for ratio in (16.0, 30.0):
+        spec = {"sweep": "tiny", "point": "x", "case": "unladen", "effects": None,
+                "surface": "ground", "values": {"design.steering_ratio": ratio}}
+        products.append(simulate_point(spec, params)["merits"]["plateau_torque_Nm"] * ratio)
+    assert products[0] == pytest.approx(products[1], rel=0.02)
+
+
+def test_braked_wheels_effect_agrees_with_rig_theory_and_matters_only_with_offset(params):
+    """Held wheels drag the patch about the axis's ground point: with the 68.5 mm spacer (62.7 mm at the ground,
+    about 0.75 patch radii) the simulated braked_wheels effect raises the tyre's plateau share by the same factor
+    as the rig theory applied after the fact (within 1 %: the effect's series for the patch integral and its
+    lateral-only offset), and the plateau by over 25 %; with the standard wheels (5.8 mm) by under 1 %."""
+    plateaus = {}
+    for offset in (0.0, 0.0685):
+        spec = {"sweep": "tiny", "point": "x", "case": "unladen", "effects": None, "surface": "ground",
+                "values": {"design.extra_offset": offset}, "braked": "braked_wheels",
+                "braked_effects": sorted(["braked_wheels", "carcass_compliance", "hooke_joint", "lifting",
+                                          "rack_friction", "tyre_friction"])}
+        record = simulate_point(spec, params)
+        braked = record["braked"]
+        assert braked["factor"] == pytest.approx(braked["rig_theory_factor"], rel=0.01)
+        plateaus[offset] = record["merits"]["plateau_torque_Nm"], braked["plateau_torque_Nm"]
+    free, held = plateaus[0.0]
+    assert held / free == pytest.approx(1.0, abs=0.01)
+    free, held = plateaus[0.0685]
+    assert held / free > 1.25
+
+
+def test_point_job_never_derives(params, tmp_path, monkeypatch):
+    """A point whose model is not in the cache fails with one line and writes nothing, instead of deriving."""
+    from parksteer.sweep.run import run_point
+
+    monkeypatch.setenv("PARKSTEER_MODEL_CACHE", str(tmp_path / "empty_cache"))
+    spec = {"sweep": "t", "point": "0000000000", "case": "unladen", "effects": None,
+            "surface": "ground", "values": {"tyre.tyre_pressure": 200000.0}}
+    out = tmp_path / "point.json"
+    with pytest.raises(UsageError, match="never derives") as info:
+        run_point(spec, params.path, out)
+    assert "\n" not in str(info.value) and not out.exists()
+    assert not (tmp_path / "empty_cache").exists()
+
+
+# ---------------------------------------------------------------------------- cluster profile
+
+
+def _snakefile_with_sweep(repo_root: Path, tmp_path: Path) -> Path:
+    """The repository's Snakefile, with the model and sweep rules included if it does not include them yet."""
+    main = (repo_root / "Snakefile").read_text(encoding="utf-8")
+    lines = [f'include: "{repo_root / "Snakefile"}"']
+    for rules in ("model.smk", "sweep.smk"):
+        if rules not in main:
+            lines.append(f'include: "{repo_root / "workflow" / "rules" / rules}"')
+    path = tmp_path / "Snakefile"
+    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    return path
+
+
+def test_slurm_profile_dry_run_lists_the_point_jobs_and_their_resources(repo_root, tmp_path):
+    """A dry run with workflow/profiles/slurm plans the example sweep as 48 point jobs bundled into two SLURM
+    group jobs (25 + 23 points), each point asking for the profile's partition, account, memory and runtime.
+
+    What this shows and what it does not: Snakemake needs the plugin installed to accept `executor: slurm`,
+    but a dry run never hands jobs to it (the plugin's maintainers say so, snakemake-executor-plugin-slurm
+    issue 312): no sbatch, sinfo or sacct is called, which the fake sbatch on PATH below verifies. So the
+    partition and account placeholders and the submission itself are only exercised on a real cluster.
+    """
+    pytest.importorskip("snakemake_executor_plugin_slurm", reason="the SLURM executor plugin is a test-only extra")
+    fake_bin = tmp_path / "bin"
+    fake_bin.mkdir()
+    called = tmp_path / "sbatch_called"
+    for tool in ("sbatch", "sinfo", "sacct", "squeue"):
+        script = fake_bin / tool
+        script.write_text(f"#!/bin/sh\necho {tool} >> {called}\nexit 1\n", encoding="utf-8")
+        script.chmod(0o755)
+    env = dict(os.environ, PATH=f"{fake_bin}{os.pathsep}{os.environ['PATH']}")
+    snakemake = Path(sys.executable).with_name("snakemake")
+    done = subprocess.run(
+        [str(snakemake), "--snakefile", str(_snakefile_with_sweep(repo_root, tmp_path)), "--directory",
+         str(repo_root), "--profile", "workflow/profiles/slurm", "--dry-run", "--forceall", "sweep_design"],
+        capture_output=True, text=True, env=env, timeout=120,
+    )
+    out = done.stdout + done.stderr
+    assert done.returncode == 0, out[-2000:]
+    assert "Using profile workflow/profiles/slurm" in out
+    stats = {line.split()[0]: int(line.split()[1]) for line in out.splitlines()
+             if len(line.split()) == 2 and line.split()[1].isdigit()}
+    assert stats["sweep_point"] == 48 and stats["sweep_design"] == 1
+    assert out.count("Group job sweep_points") == 2
+    point_resources = [line for line in out.splitlines() if "resources:" in line and "runtime=5" in line]
+    assert len(point_resources) == 48
+    assert all("slurm_partition=your_partition" in r and "slurm_account=your_account" in r and "mem_mb=1000" in r
+               for r in point_resources)
+    assert not called.exists()
+
+
+def test_slurm_submission_with_stand_in_tools_requests_bounded_group_jobs(repo_root, tmp_path):
+    """Submitting for real, against stand-ins for sbatch, sacct and friends that only record their arguments,
+    the example sweep goes to SLURM as two group jobs of 25 and 23 points, each asking for 4 cores, 4 GB and
+    5 minutes per layer of 4 points (35 and 30 min), on the profile's partition and account.
+
+    This exercises the plugin's own submission code, which a dry run does not; the stand-in sbatch runs
+    nothing, so no point is computed and Snakemake is stopped once both submissions are recorded.
+    """
+    pytest.importorskip("snakemake_executor_plugin_slurm", reason="the SLURM executor plugin is a test-only extra")
+    work = tmp_path / "work"
+    (work / "workflow").mkdir(parents=True)
+    for name in ("data", "src", "paper"):
+        (work / name).symlink_to(repo_root / name)
+    for child in (repo_root / "workflow").iterdir():
+        (work / "workflow" / child.name).symlink_to(child)
+    parksteer = Path(sys.executable).with_name("parksteer")
+    # The model manifests the point jobs wait for (the pipeline's full model and the sweep's braked-wheel model),
+    # made here so that the first submissions are the points.
+    for effects, manifest in ((None, "results/model/derived_full.json"),
+                              ("+braked_wheels", "results/sweeps/design/model_braked.json")):
+        subprocess.run([str(parksteer), "derive", *([f"--effects={effects}"] if effects else []),
+                        "--out", str(work / manifest)], check=True, capture_output=True, cwd=repo_root, timeout=600)
+    fake_bin, calls = tmp_path / "bin", tmp_path / "calls"
+    fake_bin.mkdir()
+    (fake_bin / "sbatch").write_text(f'#!/bin/sh\necho "$@" >> {calls}.sbatch\necho 4242\n', encoding="utf-8")
+    for tool in ("sinfo", "sacct", "squeue", "scancel", "sacctmgr", "sshare"):
+        (fake_bin / tool).write_text(f'#!/bin/sh\necho "$@" >> {calls}.{tool}\nexit 0\n', encoding="utf-8")
+    for tool in fake_bin.iterdir():
+        tool.chmod(0o755)
+    env = dict(os.environ, PATH=f"{fake_bin}{os.pathsep}{os.environ['PATH']}")
+    snakemake = Path(sys.executable).with_name("snakemake")
+    process = subprocess.Popen(
+        [str(snakemake), "sweep_design", "--snakefile", str(_snakefile_with_sweep(repo_root, tmp_path)),
+         "--directory", str(work), "--profile", str(repo_root / "workflow" / "profiles" / "slurm")],
+        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, env=env, text=True,
+        start_new_session=True,  # its own process group, so every child dies with it below
+    )
+    submissions: list[str] = []
+    try:
+        deadline = time.monotonic() + 90
+        while time.monotonic() < deadline and process.poll() is None:
+            sbatch_log = Path(f"{calls}.sbatch")
+            submissions = sbatch_log.read_text().splitlines() if sbatch_log.exists() else []
+            if len(submissions) >= 2:
+                break
+            time.sleep(0.5)
+    finally:
+        os.killpg(process.pid, signal.SIGKILL)
+        output = process.communicate(timeout=30)[0]
+    assert len(submissions) == 2, output[-3000:]
+    for line in submissions:
+        assert "-p your_partition" in line and "-A your_account" in line
+        assert "--cpus-per-task=4" in line and "--mem 4000" in line
+        assert "sweep_point" in line
+    assert sorted(line.split(" -t ")[1].split()[0] for line in submissions) == ["30", "35"]
+    assert sorted(line.count("sweep_point:") for line in submissions) == [23, 25]
