@@ -13,6 +13,15 @@ configfile: "workflow/config.yaml"
 validate(config, "workflow/schemas/config.schema.yaml")
 
 
+# A defective parameter file is refused before any job runs, with one line naming the file and the key.
+from parksteer.parameters import ParameterError, load_parameters
+
+try:
+    load_parameters(config["parameters"])
+except ParameterError as error:
+    sys.exit(f"parksteer: error: {error}")
+
+
 include: "workflow/rules/common.smk"
 include: "workflow/rules/rig.smk"
 include: "workflow/rules/lifting.smk"

@@ -7,6 +7,9 @@ import json
 import numpy as np
 import pytest
 
+from parksteer.model.compiled import ensure_entry
+from parksteer.model.components import resolve_effects
+
 from parksteer.figures.sweep import make_sweep_figure
 from parksteer.sweep import SweepError, load_sweep
 from parksteer.sweep.run import run_point
@@ -34,6 +37,8 @@ def small_sweep(params, tmp_path_factory):
     declaration = root / "small.yaml"
     declaration.write_text(SMALL, encoding="utf-8")
     sweep = load_sweep(declaration, params)
+    for effects in sweep.model_sets.values():  # what derive_model / sweep_model provide in the pipeline
+        ensure_entry(resolve_effects(effects))
     points = []
     for point_id in sweep.point_ids:
         points.append(root / f"{point_id}.json")
