@@ -19,6 +19,7 @@ COMMAND_MODULES = [
     "parksteer.commands.pipeline",
     "parksteer.commands.model",
     "parksteer.commands.sweep",
+    "parksteer.commands.measure",
 ]
 
 

@@ -15,7 +15,7 @@ from ..tables import write_json
 def register(sub) -> None:
     p = sub.add_parser("simulate", help="simulate the steering model for one case and write its time history (CSV)")
     p.add_argument("--case", required=True, help="a Table B1 case of the parameter file, e.g. unladen")
-    p.add_argument("--effects", default=None, help="effects spec, e.g. --effects=-rack_friction,+hooke_joint (write it with =; default: the paper's five)")
+    p.add_argument("--effects", default=None, help="effects spec, e.g. --effects=-rack_friction,+hooke_joint (default: the paper's five)")
     p.add_argument("--set", dest="overrides", action="append", default=[], metavar="OWNER.PARAM=VALUE",
                    help="override a parameter of an effect or of a parameter-file section (repeatable)")
     p.add_argument("--surface", choices=("ground", "air_bearing"), default="ground")

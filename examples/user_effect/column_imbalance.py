@@ -1,0 +1,58 @@
+"""A user-defined effect: an out-of-balance mass on the steering column (example, not part of the library).
+
+A mass m whose centre sits a distance e off the axis of an inclined column shaft (a heavy
+universal-joint yoke, a column-lock collar fitted off centre) is lifted and lowered once per
+column turn. Its weight, resolved across the column inclined by lambda from the horizontal,
+gives the column a torque -m g e sin(lambda) sin(theta_c - phase) about its axis, with
+theta_c the column angle: a ripple once per turn, distinct from the Hooke joint's, which
+comes twice per turn and scales with the torque carried. The strength m g e sin(lambda), in
+N m, is 0 when the column is balanced.
+
+The file is one module defining ``EFFECT``; nothing in the package refers to it. Join it to
+the model with an effects spec, or name it in the environment::
+
+    parksteer compare run.csv --effects=+examples/user_effect/column_imbalance.py
+    PARKSTEER_EFFECT_MODULES=examples/user_effect/column_imbalance.py parksteer diagnose run.csv --json
+
+or, from an installed package, with an entry point in its pyproject.toml::
+
+    [project.entry-points."parksteer.effects"]
+    column_imbalance = "my_package.column_imbalance:EFFECT"
+"""
+
+from __future__ import annotations
+
+import math
+
+import sympy as sp
+
+from parksteer.model.components import Effect, EffectParameter
+
+
+class ColumnImbalance(Effect):
+    name = "column_imbalance"
+    description = "Out-of-balance mass on the inclined column: torque -T_u sin(column angle - phase), once per turn"
+    in_default_set = False
+    parameters = (
+        EffectParameter("strength", "N m", 0.0, 20.0,
+                        "example: m g e sin(lambda); 0.2 kg at 30 mm on a column inclined 25 deg gives 0.025 N m "
+                        "per 100 g, so a few tenths of a N m for a heavy yoke",
+                        default=0.0),
+        EffectParameter("phase", "rad", -math.pi, math.pi,
+                        "example: column angle at which the mass passes its highest point", default=0.0),
+    )
+
+    def _angle(self, model):
+        return model.column_angle - model.p(self, "phase")
+
+    def loads(self, model):
+        torque = -model.p(self, "strength") * sp.sin(self._angle(model))
+        # The mass turns with the column; the column bearings in the body take the reaction.
+        return [(model.column_frame, torque * model.B.y), (model.B, -torque * model.B.y)]
+
+    def potential_energy(self, model):
+        # V = T_u (1 - cos(theta)), so that -dV/dtheta is the torque above.
+        return model.p(self, "strength") * (1 - sp.cos(self._angle(model)))
+
+
+EFFECT = ColumnImbalance()

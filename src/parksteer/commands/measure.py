@@ -1,0 +1,108 @@
+"""``parksteer compare`` and ``parksteer diagnose``: the model against measurement files."""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+from ..errors import UsageError
+from ..parameters import DEFAULT_PATH, load_parameters
+
+
+def _common(p) -> None:
+    p.add_argument("files", nargs="+", metavar="FILE.csv", help="measurement files (format: data/measurements/README.md)")
+    p.add_argument("--case", default=None, help="Table B1 case for every file (default: each file's own)")
+    p.add_argument("--effects", default=None,
+                   help="effects spec of the model, e.g. --effects=+column_friction or --effects=+path/to/effect.py "
+                        "(a leading - needs no =; default: the paper's five)")
+    p.add_argument("--parameters", default=str(DEFAULT_PATH), help="parameter file (default: data/parameters.toml)")
+    p.add_argument("--json", action="store_true", help="print the result as JSON on stdout")
+    p.add_argument("--plot", default=None, metavar="OUT.svg", help="write a figure")
+
+
+def register(sub) -> None:
+    p = sub.add_parser("compare", help="replay measured rack motion through the model; error by phase and noise floor")
+    _common(p)
+    p.add_argument("--set", dest="overrides", action="append", default=[], metavar="EFFECT.PARAM=VALUE",
+                   help="override a parameter of an effect or of a parameter-file section (repeatable)")
+    p.set_defaults(func=_compare)
+
+    p = sub.add_parser("diagnose", help="calibrate the model, rank the candidate effects it lacks, give a verdict")
+    _common(p)
+    p.add_argument("--report", default=None, metavar="OUT.md", help="write a readable report (markdown)")
+    p.set_defaults(func=_diagnose)
+
+
+def _check_outputs(args) -> None:
+    for option in ("plot", "report"):
+        value = getattr(args, option, None)
+        if value is not None:
+            parent = Path(value).resolve().parent
+            if not parent.is_dir():
+                raise UsageError(f"--{option} {value}: folder {parent} does not exist")
+    if getattr(args, "plot", None) is not None and not args.plot.endswith(".svg"):
+        raise UsageError(f"--plot {args.plot}: the figure is written as SVG; name it .svg")
+
+
+def _print_json(result: dict) -> None:
+    json.dump(result, sys.stdout, indent=1, allow_nan=False)
+    sys.stdout.write("\n")
+
+
+def _compare(args) -> int:
+    from ..diagnose.compare import compare_files
+    from ..diagnose.problem import load_files
+    from ..model.components import resolve_effects
+    from ..model.values import parse_overrides
+
+    _check_outputs(args)
+    overrides = parse_overrides(args.overrides)
+    params = load_parameters(args.parameters)
+    effects = resolve_effects(args.effects)
+    files = load_files(args.files, params, args.case)
+    result = compare_files(files, params, effects, overrides)
+    summary = result.as_dict()
+    if args.plot:
+        from ..figures.diagnose import compare_figure
+
+        compare_figure(result, args.plot)
+    if args.json:
+        _print_json(summary)
+    else:
+        for f in summary["files"]:
+            print(f"{f['file']} ({f['case']}, {f['surface']}): RMS {f['overall']['rms']:.3f} N m, "
+                  f"peak {f['overall']['peak']:.3f} N m, weighted RMS {f['weighted_rms_Nm']:.3f} N m, "
+                  f"noise floor {f['noise_floor']['total_rms']:.3f} N m")
+            for phase, stats in f["by_phase"].items():
+                print(f"  {phase:<13} RMS {stats['rms']:.3f} N m over {stats['samples']} samples")
+    return 0
+
+
+def _diagnose(args) -> int:
+    from ..diagnose.problem import load_files
+    from ..diagnose.report import diagnosis_dict, markdown_report, write_markdown
+    from ..diagnose.select import diagnose
+    from ..model.components import resolve_effects
+
+    _check_outputs(args)
+    if not (args.json or args.report or args.plot):
+        raise UsageError("say where the result goes: --json, --report OUT.md and/or --plot OUT.svg")
+    params = load_parameters(args.parameters)
+    effects = resolve_effects(args.effects)
+    files = load_files(args.files, params, args.case)
+    diagnosis = diagnose(files, params, effects)
+    result = diagnosis_dict(diagnosis)
+    if args.plot:
+        from ..figures.diagnose import diagnosis_figure
+
+        diagnosis_figure(diagnosis, args.plot)
+    if args.report:
+        figure = None
+        if args.plot:
+            figure = str(Path(args.plot).resolve().relative_to(Path(args.report).resolve().parent)) \
+                if Path(args.plot).resolve().is_relative_to(Path(args.report).resolve().parent) else args.plot
+        write_markdown(args.report, markdown_report(result, figure))
+    if args.json:
+        _print_json(result)
+    return 0

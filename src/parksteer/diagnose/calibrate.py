@@ -1,0 +1,253 @@
+"""Weighted nonlinear least squares of model parameters against measurement files.
+
+Before any candidate effect is considered, the base model's uncertain parameters (the tyre
+friction coefficient, the rack friction force, the carcass torsional stiffness) are fitted
+to all files at once (:func:`calibrate`), so that a wrong value of one of them is not taken
+for a missing effect. The same fitter refits a candidate's strength together with them
+(:mod:`parksteer.diagnose.select`).
+
+Method: Levenberg-Marquardt on the weighted residuals r_i = (measured - model) / sigma_i
+(:mod:`parksteer.diagnose.problem`). Positive physical parameters are fitted as the
+logarithm of their ratio to the model's default (so they stay positive and a step is a
+relative change); a candidate's strength is fitted as it stands, within its bounds. The
+Jacobian starts from finite differences (one replay per parameter and file) and is then
+updated by Broyden's rank-one formula from each step's actual change, so an iteration costs
+one replay per file. The fit has converged when the full Gauss-Newton step is below a
+fraction of every parameter's standard error; it is recomputed by finite differences at the end if the parameters
+have moved far since, because the confidence intervals and the projections of the
+candidates' signatures rely on it. Confidence intervals are 95 % intervals from the
+Jacobian, ``cov = s^2 (J^T J)^-1`` with s^2 the residual variance, inflated by (1 + rho) / (1 -
+rho) for the lag-1 autocorrelation rho of the residuals (their effective sample size is
+smaller than their count).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..model.components import Effect
+from . import settings
+from .problem import Problem, lag1_autocorrelation
+
+Z95 = 1.959964  # two-sided 95 % quantile of the standard normal
+
+
+@dataclass(frozen=True)
+class FitParameter:
+    """One fitted parameter: key ("effect.param"), transform ("log" of value / reference, or "linear")."""
+
+    key: str
+    transform: str
+    reference: float  # log: the value at theta = 0; linear: unused
+    lower: float  # bounds on the value
+    upper: float
+    step: float  # finite-difference step in theta
+
+    def value(self, theta: float) -> float:
+        raw = self.reference * math.exp(theta) if self.transform == "log" else theta
+        return min(max(raw, self.lower), self.upper)
+
+    def theta(self, value: float) -> float:
+        return math.log(value / self.reference) if self.transform == "log" else value
+
+    def theta_bounds(self) -> tuple[float, float]:
+        if self.transform == "log":
+            return math.log(self.lower / self.reference), math.log(self.upper / self.reference)
+        return self.lower, self.upper
+
+
+@dataclass
+class Fit:
+    """A fitted model: values, predictions, weighted residuals, Jacobian and the fit's statistics."""
+
+    effects: list[Effect]
+    parameters: list[FitParameter]
+    theta: np.ndarray
+    fixed: dict[str, float]
+    predictions: list[np.ndarray]
+    weighted: np.ndarray
+    jacobian: np.ndarray  # d(model / sigma) / d(theta), one row per sample
+    iterations: int
+    evaluations: int
+    history: list[float] = field(default_factory=list)  # weighted RSS after each accepted step
+
+    @property
+    def rss(self) -> float:
+        return float(np.sum(self.weighted**2))
+
+    @property
+    def values(self) -> dict[str, float]:
+        return {p.key: p.value(t) for p, t in zip(self.parameters, self.theta)}
+
+    @property
+    def overrides(self) -> dict[str, float]:
+        return {**self.fixed, **self.values}
+
+    def rho(self, problem: Problem) -> float:
+        return lag1_autocorrelation(problem, self.weighted)
+
+    def intervals(self, problem: Problem) -> dict[str, dict]:
+        """Value, standard error and 95 % interval of each parameter (in its own unit)."""
+        if not self.parameters:
+            return {}
+        n, k = self.weighted.size, len(self.parameters)
+        rho = min(max(self.rho(problem), 0.0), 0.95)
+        variance = self.rss / max(n - k, 1) * (1.0 + rho) / (1.0 - rho)
+        try:
+            covariance = variance * np.linalg.inv(self.jacobian.T @ self.jacobian)
+        except np.linalg.LinAlgError:
+            covariance = np.full((k, k), np.inf)
+        out = {}
+        for i, (p, t) in enumerate(zip(self.parameters, self.theta)):
+            se = math.sqrt(max(covariance[i, i], 0.0))
+            low, high = p.value(t - Z95 * se), p.value(t + Z95 * se)
+            if p.transform == "linear":
+                low, high = t - Z95 * se, t + Z95 * se  # the interval itself may cross a bound
+            out[p.key] = {"value": p.value(t), "ci95": [low, high],
+                          "standard_error": (p.value(t) * se if p.transform == "log" else se)}
+        return out
+
+
+def _predict(problem: Problem, effects: list[Effect], parameters: list[FitParameter], theta: np.ndarray,
+             fixed: dict[str, float]) -> tuple[list[np.ndarray], np.ndarray]:
+    overrides = {**fixed, **{p.key: p.value(t) for p, t in zip(parameters, theta)}}
+    predictions = problem.predict(effects, overrides)
+    return predictions, problem.weighted(predictions)
+
+
+def finite_difference_jacobian(problem: Problem, effects: list[Effect], parameters: list[FitParameter],
+                               theta: np.ndarray, fixed: dict[str, float], predictions: list[np.ndarray]
+                               ) -> np.ndarray:
+    """d(model / sigma)/d(theta) by forward differences (a backward step at an upper bound)."""
+    base = problem.scale(predictions)
+    columns = []
+    for i, p in enumerate(parameters):
+        step = p.step
+        if theta[i] + step > p.theta_bounds()[1]:
+            step = -step
+        shifted = theta.copy()
+        shifted[i] += step
+        moved, _ = _predict(problem, effects, parameters, shifted, fixed)
+        columns.append((problem.scale(moved) - base) / step)
+    return np.column_stack(columns) if columns else np.zeros((base.size, 0))
+
+
+def least_squares(problem: Problem, effects: list[Effect], parameters: list[FitParameter], theta0: np.ndarray,
+                  fixed: dict[str, float] | None = None, jacobian: np.ndarray | None = None,
+                  max_iterations: int = settings.CALIBRATION_MAX_ITERATIONS,
+                  tolerance: float = settings.CALIBRATION_TOLERANCE) -> Fit:
+    """Levenberg-Marquardt with Broyden updates (see the module docstring); `jacobian` may seed it."""
+    fixed = dict(fixed or {})
+    start_evaluations = problem.evaluations
+    lower = np.array([p.theta_bounds()[0] for p in parameters])
+    upper = np.array([p.theta_bounds()[1] for p in parameters])
+    theta = np.clip(np.asarray(theta0, dtype=float), lower, upper)
+    predictions, r = _predict(problem, effects, parameters, theta, fixed)
+    rss = float(r @ r)
+    history = [rss]
+    if not parameters:
+        return Fit(effects, parameters, theta, fixed, predictions, r, np.zeros((r.size, 0)), 0, 0, history)
+    J = jacobian.copy() if jacobian is not None else finite_difference_jacobian(
+        problem, effects, parameters, theta, fixed, predictions)
+    theta_at_jacobian = theta.copy()
+    damping = 1e-3
+    iterations = 0
+    failures = 0
+    while iterations < max_iterations:
+        JTJ = J.T @ J
+        scale = np.diag(JTJ).copy()
+        scale[scale <= 0] = 1.0
+        # Converged when the full Gauss-Newton step (kept within the bounds) is a small fraction of every
+        # parameter's standard error: a further step could not change the answer within its own uncertainty.
+        # (A test on the change of the sum of squares stops too early in a long, narrow valley, where two
+        # parameters trade against each other, e.g. a rack damping against the rack friction.)
+        se = np.full(len(theta), np.inf)
+        try:
+            newton = np.clip(theta + np.linalg.solve(JTJ, J.T @ r), lower, upper) - theta
+            se = np.sqrt(np.maximum(np.diag(np.linalg.inv(JTJ)), 0.0) * rss / max(r.size - len(theta), 1))
+            if np.all(np.abs(newton) <= tolerance * se):
+                break
+        except np.linalg.LinAlgError:
+            pass
+        iterations += 1
+        step = np.linalg.solve(JTJ + damping * np.diag(scale), J.T @ r)
+        trial = np.clip(theta + step, lower, upper)
+        step = trial - theta
+        if not np.any(step):
+            break
+        trial_predictions, trial_r = _predict(problem, effects, parameters, trial, fixed)
+        trial_rss = float(trial_r @ trial_r)
+        predicted = rss - float(np.sum((r - J @ step) ** 2))
+        # Broyden: the actual change of model / sigma is r - trial_r. A step much smaller than the standard
+        # errors moves the model by little more than the integrator's own noise: it would corrupt J.
+        if np.any(np.abs(step) > se):
+            J += np.outer((r - trial_r) - J @ step, step) / float(step @ step)
+        if trial_rss < rss:
+            poor = predicted > 0 and (rss - trial_rss) < 0.25 * predicted
+            theta, predictions, r, rss = trial, trial_predictions, trial_r, trial_rss
+            history.append(rss)
+            damping = max(damping / 3.0, 1e-7)
+            failures = 0
+            if poor:  # the linear model promised much more than the step gave: renew it
+                J = finite_difference_jacobian(problem, effects, parameters, theta, fixed, predictions)
+                theta_at_jacobian = theta.copy()
+        else:
+            damping *= 4.0
+            failures += 1
+            if failures == 2:  # the updated Jacobian misleads: start again from finite differences
+                J = finite_difference_jacobian(problem, effects, parameters, theta, fixed, predictions)
+                theta_at_jacobian = theta.copy()
+            elif failures > 3:
+                break
+    if np.max(np.abs(theta - theta_at_jacobian)) > settings.JACOBIAN_REFRESH_THETA:
+        J = finite_difference_jacobian(problem, effects, parameters, theta, fixed, predictions)
+    return Fit(effects, parameters, theta, fixed, predictions, r, J, iterations,
+               problem.evaluations - start_evaluations, history)
+
+
+def log_parameter(problem: Problem, effects: list[Effect], key: str) -> FitParameter:
+    """A positive parameter fitted as log(value / default), within CALIBRATION_RANGE_FACTOR of the default."""
+    owner, _, name = key.partition(".")
+    effect = next(e for e in effects if e.name == owner)
+    spec = effect.parameter(name)
+    default = problem.replay(effects, 0).value(key)
+    factor = settings.CALIBRATION_RANGE_FACTOR
+    return FitParameter(key, "log", default, max(spec.minimum, default / factor), min(spec.maximum, default * factor),
+                        settings.CALIBRATION_RELATIVE_STEP)
+
+
+def linear_parameter(effects: list[Effect], key: str, step: float) -> FitParameter:
+    """A parameter fitted as it stands (a candidate's strength), within its bounds and never below zero."""
+    owner, _, name = key.partition(".")
+    spec = next(e for e in effects if e.name == owner).parameter(name)
+    return FitParameter(key, "linear", 1.0, max(spec.minimum, 0.0), spec.maximum, step)
+
+
+def calibration_parameters(problem: Problem, effects: list[Effect],
+                           keys: tuple[str, ...] = settings.CALIBRATED_PARAMETERS,
+                           strengths: dict[str, float] | None = None) -> list[FitParameter]:
+    """The calibrated parameters the model has (an effect left out of the model leaves its keys out).
+
+    `strengths` adds effects' strengths, fitted linearly, with their finite-difference steps.
+    """
+    names = {e.name for e in effects}
+    out = [log_parameter(problem, effects, key) for key in keys if key.partition(".")[0] in names]
+    out += [linear_parameter(effects, key, step) for key, step in (strengths or {}).items()]
+    return out
+
+
+def calibrate(problem: Problem, effects: list[Effect], fixed: dict[str, float] | None = None,
+              keys: tuple[str, ...] = settings.CALIBRATED_PARAMETERS, strengths: dict[str, float] | None = None,
+              start: dict[str, float] | None = None) -> Fit:
+    """Fit the base model's uncertain parameters (and any `strengths`) to all files.
+
+    From the model's defaults, or from the values in `start` where it has them.
+    """
+    parameters = calibration_parameters(problem, effects, keys, strengths)
+    start = start or {}
+    theta0 = np.array([p.theta(start[p.key]) if p.key in start else (0.0 if p.transform == "log" else p.lower)
+                       for p in parameters])
+    return least_squares(problem, effects, parameters, theta0, fixed)

@@ -1,0 +1,178 @@
+"""Candidate effects: which ones can be tested, their signatures, and the score test that ranks them.
+
+A candidate is any registered effect (:mod:`parksteer.model.components`: the package's
+modules, entry points, configured files) that is not in the model, and that has a strength:
+the parameter whose default value means the effect is absent. It is the parameter named
+``strength`` if there is one, else the only parameter whose default is zero and whose range
+starts at zero. An effect without one (e.g. the paper's own mechanisms, when left out of the
+model) cannot be added at a fitted size, so it is listed as not testable.
+
+Signature: the change of the replayed torque per unit strength, taken from the model with
+the candidate at strength zero to the model at a probe strength. The probe is scaled (one or
+two extra replays) so that it changes the torque by a few noise floors RMS: well above the
+integrator's noise and still in the nearly linear range. In the weighted units of the
+residuals it is the column ``w`` of a Jacobian. A candidate that even at its largest
+strength moves the replayed torque by less than a tenth of a noise floor is unobservable in
+these data as replayed (a lash between pinion and rack is: with the rack's motion given, the
+torque the rack needs does not depend on the play the hand turned through before it moved;
+the play shows against the handwheel angle instead). It scores zero and is listed as such.
+
+Score test (Rao): at the calibrated base model, with weighted residual ``r`` and the
+calibrated parameters' sensitivities ``J``, the part of ``w`` that a change of those
+parameters could also produce is projected out, ``w~ = (I - J (J^T J)^-1 J^T) w``. Then
+``u = w~ . r`` is the score; the linear estimate of the strength is ``u / |w~|^2`` and the
+weighted sum of squares it removes is ``u^2 / |w~|^2``. The statistic
+``u^2 / (|w~|^2 s^2)``, with s^2 the residual variance per sample, is chi-square with one
+degree of freedom when the candidate is absent. Strengths are physical sizes that cannot be
+negative: a candidate whose score asks for a negative strength scores zero.
+``|w~| / |w|`` is how much of the signature survives the projection: near zero, the
+candidate is confounded with the calibrated parameters (these data cannot tell it from a
+change of them), and it is reported so.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..model.components import Effect, EffectParameter, discover_effects
+from . import settings
+from .calibrate import Fit
+from .problem import Problem
+
+STRENGTH_NAME = "strength"
+
+
+def strength_parameter(effect: Effect) -> EffectParameter | None:
+    """The parameter whose default means absent: 'strength', else the only zero-default parameter from zero."""
+    named = [p for p in effect.parameters if p.name == STRENGTH_NAME]
+    if named:
+        return named[0]
+    zero = [p for p in effect.parameters if p.default == 0.0 and p.file_key is None and p.minimum == 0.0]
+    return zero[0] if len(zero) == 1 else None
+
+
+def candidate_effects(model_effects: list[Effect], registry: dict[str, Effect] | None = None
+                      ) -> tuple[list[Effect], list[str]]:
+    """(testable candidates, names of registered effects outside the model that have no strength)."""
+    registry = registry if registry is not None else discover_effects()
+    in_model = {e.name for e in model_effects}
+    testable, untestable = [], []
+    for name in sorted(registry):
+        if name in in_model:
+            continue
+        (testable if strength_parameter(registry[name]) is not None else untestable).append(name)
+    return [registry[n] for n in testable], untestable
+
+
+@dataclass
+class Signature:
+    """A candidate's sensitivity at the calibrated base model."""
+
+    effect: Effect
+    key: str  # "effect.strength"
+    probe: float  # strength at which it was taken
+    zero: list[np.ndarray]  # torque with the candidate at strength zero, per file
+    probed: list[np.ndarray]  # torque at the probe strength, per file
+    weighted: np.ndarray  # d(model / sigma) / d(strength)
+    rms_change_Nm: float  # plain RMS torque change at the probe
+    model: list[Effect]  # the base effects with the candidate
+    observable: bool = True  # False: even its largest strength barely moves the replayed torque
+
+
+def _rms_change(a: list[np.ndarray], b: list[np.ndarray]) -> float:
+    diff = np.concatenate([x - y for x, y in zip(a, b)])
+    return float(np.sqrt(np.mean(diff**2)))
+
+
+def probe_signature(problem: Problem, base_effects: list[Effect], candidate: Effect, overrides: dict[str, float],
+                    target_Nm: float) -> Signature:
+    """The candidate's signature at a probe strength that changes the torque by about `target_Nm` RMS."""
+    spec = strength_parameter(candidate)
+    key = f"{candidate.name}.{spec.name}"
+    effects = sorted([*base_effects, candidate], key=lambda e: e.name)
+    zero = problem.predict(effects, {**overrides, key: 0.0})
+    strength = max(spec.maximum * settings.PROBE_START_FRACTION, 1e-12)
+    probed, change = None, 0.0
+    for _ in range(settings.PROBE_MAX_TRIES):
+        probed = problem.predict(effects, {**overrides, key: strength})
+        change = _rms_change(probed, zero)
+        if change > 0.0 and 0.5 <= change / target_Nm <= 2.0:
+            break
+        factor = target_Nm / change if change > 0.0 else 100.0
+        new_strength = min(spec.maximum, strength * factor)
+        if new_strength == strength:
+            break
+        strength = new_strength
+    weighted = problem.scale([p - z for p, z in zip(probed, zero)]) / strength
+    observable = change >= settings.UNOBSERVABLE_NOISE_FLOORS * target_Nm / settings.PROBE_EFFECT_NOISE_FLOORS
+    return Signature(candidate, key, strength, zero, probed, weighted, change, effects, observable)
+
+
+@dataclass(frozen=True)
+class Score:
+    """The score test of one candidate at the calibrated base model (module docstring)."""
+
+    effect: str
+    statistic: float  # chi-square(1) under the candidate's absence; 0 if it asks for a negative strength
+    linear_strength: float  # u / |w~|^2
+    removed_rss: float  # u^2 / |w~|^2 (0 if the strength would be negative)
+    identifiable_fraction: float  # |w~| / |w|
+    confounded_with: str | None  # the calibrated parameter whose sensitivity is closest to the signature
+
+
+def score(signature: Signature, calibration: Fit) -> Score:
+    if not signature.observable:
+        return Score(signature.effect.name, 0.0, 0.0, 0.0, 0.0, None)
+    w = signature.weighted
+    r = calibration.weighted
+    J = calibration.jacobian
+    if J.shape[1]:
+        projected = w - J @ np.linalg.lstsq(J, w, rcond=None)[0]
+        cosines = [abs(float(w @ J[:, i])) / (np.linalg.norm(w) * np.linalg.norm(J[:, i]) + 1e-300)
+                   for i in range(J.shape[1])]
+        closest = calibration.parameters[int(np.argmax(cosines))].key
+    else:
+        projected, closest = w, None
+    norm2 = float(projected @ projected)
+    full = float(np.linalg.norm(w))
+    fraction = min(math.sqrt(norm2) / full, 1.0) if full > 0 else 0.0
+    u = float(projected @ r)
+    if norm2 <= 0.0:
+        return Score(signature.effect.name, 0.0, 0.0, 0.0, fraction, closest)
+    variance = float(r @ r) / r.size
+    allowed_negative = strength_parameter(signature.effect).minimum < 0.0
+    removed = u * u / norm2 if (u > 0 or allowed_negative) else 0.0
+    return Score(signature.effect.name, removed / variance, u / norm2, removed, fraction, closest)
+
+
+def ensure_candidate_models(effects=None, extra: tuple[str, ...] = ()) -> list[dict]:
+    """Derive (once; the cache keeps them) the base model and the base model with each candidate.
+
+    `extra` names effect modules outside the registry (files or dotted names) to prepare as well.
+    Deriving them up front, in one job, spares the parallel diagnoses of a pipeline from
+    deriving the same model side by side.
+    """
+    from ..model.compiled import ensure_entry, model_key
+    from ..model.components import load_effect_module, resolve_effects
+
+    base = resolve_effects(effects)
+    registry = discover_effects()
+    for ref in extra:
+        effect = load_effect_module(ref)
+        registry[effect.name] = effect
+    testable, _ = candidate_effects(base, registry)
+    manifest = []
+    for chosen in [base] + [sorted([*base, c], key=lambda e: e.name) for c in testable]:
+        ensure_entry(chosen)
+        manifest.append({"effects": [e.name for e in chosen], "key": model_key(chosen)})
+    return manifest
+
+
+def write_candidate_models(path, extra: tuple[str, ...] = ()) -> None:
+    """Derive the candidate models (:func:`ensure_candidate_models`) and write their keys as JSON."""
+    from ..tables import write_json
+
+    write_json(path, {"models": ensure_candidate_models(None, extra)})

@@ -1,0 +1,77 @@
+"""The error ladder: the error as the model grows one step at a time, down to the noise floor.
+
+Rungs: the paper's model at its own parameter values; the same model with its uncertain
+parameters calibrated to the files; then, while the diagnosis names a missing effect, the
+model with that effect added (its strength fitted with the calibrated parameters). After
+each addition the ladder stops if the weighted error has reached the floor (within
+``ADEQUATE_RMS_FACTOR``); otherwise the grown model is diagnosed again (its added strengths
+calibrated with the base parameters), up to ``LADDER_MAX_STEPS`` additions.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from ..model.components import Effect, resolve_effects
+from ..parameters import Parameters
+from . import settings
+from .problem import FileData
+from .select import Diagnosis, diagnose
+
+
+@dataclass
+class Ladder:
+    rungs: list[dict]
+    diagnoses: list[Diagnosis]
+    noise_floor_Nm: float
+    attainable_floor_Nm: float
+
+    def as_dict(self) -> dict:
+        return {"rungs": self.rungs, "noise_floor_Nm": self.noise_floor_Nm,
+                "attainable_floor_Nm": self.attainable_floor_Nm}
+
+
+def _rung(label: str, effects: list[Effect], statistics: dict, parameters: dict[str, float]) -> dict:
+    return {
+        "label": label,
+        "effects": [e.name for e in effects],
+        "rms_Nm": statistics["rms_Nm"],
+        "weighted_rms_Nm": statistics["weighted_rms_Nm"],
+        "peak_Nm": statistics["peak_Nm"],
+        "weighted_rms_over_noise_floor": statistics["weighted_rms_Nm"] / statistics["noise_floor_Nm"],
+        "parameters": dict(sorted(parameters.items())),
+    }
+
+
+def error_ladder(files: list[FileData], params: Parameters, effects=None, first: Diagnosis | None = None,
+                 max_steps: int = settings.LADDER_MAX_STEPS) -> Ladder:
+    """Rungs from the paper's model to the model with every effect the diagnoses name (module docstring).
+
+    `first` is a diagnosis of the same files and model already made (it is not repeated).
+    """
+    base = resolve_effects(effects) if not (isinstance(effects, list) and effects
+                                             and isinstance(effects[0], Effect)) else effects
+    diagnosis = first if first is not None else diagnose(files, params, base)
+    nominal = diagnosis.statistics(diagnosis.nominal_predictions)
+    calibrated = diagnosis.statistics(diagnosis.calibration.predictions)
+    rungs = [
+        _rung("paper's model", base, nominal, {}),
+        _rung("calibrated", base, calibrated, diagnosis.calibration.values),
+    ]
+    diagnoses = [diagnosis]
+    strengths: dict[str, float] = {}
+    model = list(base)
+    for _ in range(max_steps):
+        if diagnosis.verdict != "missing":
+            break
+        best = diagnosis.best
+        fit = best.refit
+        statistics = diagnosis.statistics(fit.predictions)
+        model = list(best.signature.model)
+        strengths[best.signature.key] = best.signature.probe
+        rungs.append(_rung(f"+ {best.name}", model, statistics, fit.values))
+        if statistics["weighted_rms_Nm"] <= settings.ADEQUATE_RMS_FACTOR * statistics["noise_floor_Nm"]:
+            break
+        diagnosis = diagnose(files, params, model, strengths=dict(strengths), start=fit.values)
+        diagnoses.append(diagnosis)
+    return Ladder(rungs, diagnoses, calibrated["noise_floor_Nm"], calibrated["attainable_floor_Nm"])

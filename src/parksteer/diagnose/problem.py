@@ -1,0 +1,240 @@
+"""The data of a comparison or a diagnosis: measurement files, their smoothed racks, noise and weights.
+
+Each file (:class:`FileData`) carries what its residuals need: the measured torque, the
+phases of its cycle (:mod:`parksteer.measure.phases`), its noise floor
+(:mod:`parksteer.measure.metrics`: quantisation step / sqrt(12) combined with the analog
+noise estimated from the data) and, once :meth:`Problem.estimate_replay_uncertainty` has
+run, the replay's own uncertainty at every sample.
+
+The replay uncertainty is found by propagation, not assumed: the smoothed rack is one
+spline among many the rack data allow equally well. When the file states its logger (the
+rack's full scale and bits), the smoothed rack is logged again (analog noise, rounding to
+the converter's levels) and smoothed again, a few times
+(:meth:`parksteer.diagnose.replay.SmoothedRack.relogged`, a parametric bootstrap of the
+whole logging and smoothing); otherwise splines are drawn from the least-squares
+distribution of the coefficients, as if the rack noise were white
+(:meth:`parksteer.diagnose.replay.SmoothedRack.perturbed`). Replaying them and taking the
+spread of the torque at each sample gives how far the replay alone can be off there. It is tiny on the
+plateaus and large at a reversal, where the rack friction flips within about a millimetre
+per second of zero speed, so the turning time the data allow decides which sample carries
+the torque drop. Each sample then has an attainable error ``sigma_i = sqrt(noise_floor^2 +
+delta_i^2)``; residuals are weighted by it (``(measured - model) / sigma_i``), so a fit
+listens to the samples the replay can predict, and a perfect model has weighted residuals
+of unit variance.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from scipy.ndimage import maximum_filter1d
+
+from ..errors import UsageError
+from ..measure.io import Measurement, read_measurement
+from ..measure.metrics import NoiseFloor, noise_floor
+from ..measure.phases import CyclePhases, find_phases
+from ..model.components import Effect
+from ..parameters import Parameters
+from . import settings
+from .replay import Replay, SmoothedRack, smooth_rack
+
+TORQUE = "handwheel_torque_Nm"
+
+
+@dataclass(eq=False)
+class FileData:
+    """One measurement file, ready to be replayed."""
+
+    label: str
+    measurement: Measurement
+    case: str
+    surface: str
+    rack: SmoothedRack
+    phases: CyclePhases
+    noise: NoiseFloor
+    replay_uncertainty_Nm: np.ndarray | None = None
+
+    @property
+    def time_s(self) -> np.ndarray:
+        return self.measurement.time_s
+
+    @property
+    def rack_m(self) -> np.ndarray:
+        return self.measurement.rack_m
+
+    @property
+    def torque_Nm(self) -> np.ndarray:
+        return self.measurement.handwheel_torque_Nm
+
+    @property
+    def n(self) -> int:
+        return self.measurement.n_samples
+
+    @property
+    def sigma_Nm(self) -> np.ndarray:
+        """Attainable error at each sample: noise floor combined with the replay uncertainty (if estimated)."""
+        delta = self.replay_uncertainty_Nm if self.replay_uncertainty_Nm is not None else np.zeros(self.n)
+        return np.sqrt(self.noise.total_rms**2 + delta**2)
+
+
+def prepare_file(measurement: Measurement, case: str | None = None, label: str | None = None) -> FileData:
+    """Smooth the rack, find the phases and the noise floor of one measurement."""
+    case = case or measurement.case
+    if TORQUE not in measurement.columns:
+        raise UsageError(f"{measurement.path}: no column {TORQUE!r}")
+    label = label or (measurement.path.name if measurement.path is not None else "measurement")
+    rack = smooth_rack(measurement.time_s, measurement.rack_m)
+    phases = find_phases(measurement.time_s, measurement.rack_m, measurement.handwheel_torque_Nm,
+                         surface=measurement.surface)
+    floor = noise_floor(measurement.handwheel_torque_Nm, measurement.quantisation_step(TORQUE))
+    return FileData(label, measurement, case, measurement.surface, rack, phases, floor)
+
+
+def load_files(paths: list[str | Path], params: Parameters, case: str | None = None) -> list[FileData]:
+    """Read, validate and prepare measurement files; `case` replaces the case every file names."""
+    if not paths:
+        raise UsageError("no measurement file given")
+    if case is not None:
+        params.case(case)  # one-line error for an unknown case
+    files = []
+    for path in paths:
+        measurement = read_measurement(path, params)
+        chosen = case or measurement.case
+        stated = measurement.extra_offset_m
+        if stated is not None and abs(stated - params.case(chosen)["extra_offset"]) > 5e-4:
+            raise UsageError(
+                f"{path}: extra_offset_m = {stated:g} m but case {chosen} has "
+                f"{params.case(chosen)['extra_offset']:g} m; name the matching case (--case)"
+            )
+        files.append(prepare_file(measurement, chosen))
+    return files
+
+
+def effect_key(effects: list[Effect]) -> tuple[str, ...]:
+    return tuple(sorted(e.name for e in effects))
+
+
+@dataclass(eq=False)
+class Problem:
+    """Files and the models to replay them with; caches one :class:`Replay` per effect set and file."""
+
+    files: list[FileData]
+    params: Parameters
+    _replays: dict = field(default_factory=dict, repr=False)
+
+    def replay(self, effects: list[Effect], index: int) -> Replay:
+        key = (effect_key(effects), index)
+        if key not in self._replays:
+            f = self.files[index]
+            self._replays[key] = Replay(list(effects), f.case, f.surface, self.params, f.rack, f.time_s)
+        return self._replays[key]
+
+    @property
+    def evaluations(self) -> int:
+        return sum(r.evaluations for r in self._replays.values())
+
+    @property
+    def n(self) -> int:
+        return sum(f.n for f in self.files)
+
+    def predict(self, effects: list[Effect], overrides: dict[str, float] | None = None) -> list[np.ndarray]:
+        """Model torque at every file's samples (one array per file)."""
+        return [self.replay(effects, i).torque(overrides) for i in range(len(self.files))]
+
+    def weighted(self, predictions: list[np.ndarray]) -> np.ndarray:
+        """Weighted residuals (measured - model) / sigma_i of all files, concatenated."""
+        return np.concatenate([(f.torque_Nm - m) / f.sigma_Nm for f, m in zip(self.files, predictions)])
+
+    def scale(self, values: list[np.ndarray]) -> np.ndarray:
+        """Model differences divided by sigma_i, concatenated (the weighted units of a sensitivity)."""
+        return np.concatenate([v / f.sigma_Nm for f, v in zip(self.files, values)])
+
+    def estimate_replay_uncertainty(self, effects: list[Effect], overrides: dict[str, float] | None = None,
+                                    draws: int = settings.REPLAY_ENSEMBLE_DRAWS,
+                                    seed: int = settings.REPLAY_ENSEMBLE_SEED, keep_larger: bool = False) -> None:
+        """Set each file's replay uncertainty: spread of replays of racks the data allow (module docstring).
+
+        The spread is widened by one sample either side (a running maximum), since a torque
+        drop the draws place on one sample may fall on its neighbour. With `keep_larger`, each
+        sample keeps the larger of this and the uncertainty already estimated.
+        """
+        rng = np.random.default_rng(seed)
+        for i, f in enumerate(self.files):
+            base = self.replay(effects, i)
+            logger = rack_logger(f.measurement)
+            runs = []
+            for _ in range(draws):
+                if logger is not None:
+                    rack = f.rack.relogged(f.time_s, *logger, rng)
+                else:
+                    rack = f.rack.perturbed(rng)
+                other = Replay(list(effects), f.case, f.surface, self.params, rack, f.time_s)
+                runs.append(other.torque(overrides))
+            base.evaluations += draws
+            spread = maximum_filter1d(np.std(np.array(runs), axis=0, ddof=1), size=3, mode="nearest")
+            if keep_larger and f.replay_uncertainty_Nm is not None:
+                spread = np.maximum(spread, f.replay_uncertainty_Nm)
+            f.replay_uncertainty_Nm = spread
+
+
+def rack_logger(measurement: Measurement) -> tuple[float, int, float] | None:
+    """(full scale, bits, analog noise RMS) of the rack channel, if the file states its logger; else None.
+
+    The analog part is the rack's noise (from its second differences) less the rounding's
+    step / sqrt(12), root sum of squares, as :func:`parksteer.measure.metrics.noise_floor` splits it.
+    """
+    full_scale = measurement.full_scale("rack_m")
+    if full_scale is None or "bits" not in measurement.metadata:
+        return None
+    floor = noise_floor(measurement.rack_m, measurement.quantisation_step("rack_m"))
+    return full_scale, int(measurement.metadata["bits"]), floor.analog_rms
+
+
+def fit_statistics(problem: Problem, predictions: list[np.ndarray]) -> dict:
+    """Plain and weighted RMS, the noise floor and the attainable floor over all files.
+
+    ``weighted_rms_Nm`` is sqrt(mean(r_i^2 floor_f^2)) with r_i the weighted residual and
+    floor_f the file's noise floor: it equals the noise floor for a perfect model, and
+    sqrt(floor^2 + e^2) for a model off by e where the replay is certain.
+    """
+    residual = np.concatenate([f.torque_Nm - m for f, m in zip(problem.files, predictions)])
+    weighted = problem.weighted(predictions)
+    floors = np.concatenate([np.full(f.n, f.noise.total_rms) for f in problem.files])
+    attainable = np.concatenate([f.sigma_Nm for f in problem.files])
+    floor = float(np.sqrt(np.mean(floors**2)))
+    return {
+        "rms_Nm": float(np.sqrt(np.mean(residual**2))),
+        "peak_Nm": float(np.max(np.abs(residual))),
+        "weighted_rms_Nm": float(np.sqrt(np.mean((weighted * floors) ** 2))),
+        "noise_floor_Nm": floor,
+        "attainable_floor_Nm": float(np.sqrt(np.mean(attainable**2))),
+        "weighted_rss": float(np.sum(weighted**2)),
+        "samples": int(residual.size),
+    }
+
+
+def lag1_autocorrelation(problem: Problem, weighted: np.ndarray) -> float:
+    """Lag-1 autocorrelation of the weighted residuals, pooled over files (pairs within a file only)."""
+    num = den = 0.0
+    start = 0
+    for f in problem.files:
+        r = weighted[start : start + f.n]
+        r = r - r.mean()
+        num += float(np.sum(r[1:] * r[:-1]))
+        den += float(np.sum(r * r))
+        start += f.n
+    return num / den if den > 0 else 0.0
+
+
+def effective_samples(n: int, rho: float) -> float:
+    """n (1 - rho) / (1 + rho) for AR(1)-like residuals, rho clipped to [0, 0.95]."""
+    rho = min(max(rho, 0.0), 0.95)
+    return max(n * (1.0 - rho) / (1.0 + rho), 2.0)
+
+
+def information_criterion(weighted_rss: float, n: int, n_eff: float, parameters: int) -> float:
+    """BIC over the effective sample size: n_eff ln(RSS / n) + k ln(n_eff)."""
+    return n_eff * math.log(max(weighted_rss, 1e-300) / n) + parameters * math.log(n_eff)

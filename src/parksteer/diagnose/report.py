@@ -1,0 +1,220 @@
+"""A diagnosis as JSON (documented by workflow/schemas/diagnosis.schema.json), as markdown, and as a figure."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+from ..tables import atomic_path
+from . import settings
+from .select import Candidate, Diagnosis
+
+SCHEMA_ID = "parksteer.diagnosis/1"
+SCHEMA_PATH = Path(__file__).resolve().parents[3] / "workflow" / "schemas" / "diagnosis.schema.json"
+
+
+def _finite(x: float | None) -> float | None:
+    return None if x is None or not math.isfinite(x) else float(x)
+
+
+def candidate_predictions(diagnosis: Diagnosis, candidate: Candidate) -> list[np.ndarray]:
+    """The candidate's fitted model (refit), or its linear estimate at the calibrated parameters."""
+    if candidate.refit is not None:
+        return candidate.refit.predictions
+    sig = candidate.signature
+    strength = max(candidate.score.linear_strength, 0.0)
+    return [m + strength * (p - z) / sig.probe
+            for m, p, z in zip(diagnosis.calibration.predictions, sig.probed, sig.zero)]
+
+
+def _ranking_entry(diagnosis: Diagnosis, candidate: Candidate, before: dict) -> dict:
+    after = diagnosis.statistics(candidate_predictions(diagnosis, candidate))
+    if candidate.refit is None:
+        # the linear estimate: the sum of squares the score test says the strength removes
+        rss = diagnosis.calibration.rss - candidate.score.removed_rss
+        after["weighted_rms_Nm"] = before["weighted_rms_Nm"] * math.sqrt(max(rss, 0.0) / diagnosis.calibration.rss)
+    excess = diagnosis.calibration.rss - diagnosis.problem.n
+    removed = diagnosis.calibration.rss - candidate.rss_after(diagnosis.calibration.rss)
+    if candidate.refit is not None:
+        parameters = candidate.refit.intervals(diagnosis.problem)
+    else:
+        parameters = {candidate.signature.key: {"value": max(candidate.score.linear_strength, 0.0), "ci95": None,
+                                                "standard_error": None}}
+    return {
+        "effect": candidate.name,
+        "strength_parameter": candidate.signature.key,
+        "score": candidate.score.statistic,
+        "linear_strength": candidate.score.linear_strength,
+        "identifiable_fraction": candidate.score.identifiable_fraction,
+        "confounded_with": candidate.score.confounded_with,
+        "probe_strength": candidate.signature.probe,
+        "probe_rms_change_Nm": candidate.signature.rms_change_Nm,
+        "refitted": candidate.refit is not None,
+        "delta_bic": _finite(candidate.delta_bic),
+        "parameters": parameters,
+        "rms_before_Nm": before["rms_Nm"],
+        "rms_after_Nm": after["rms_Nm"],
+        "weighted_rms_before_Nm": before["weighted_rms_Nm"],
+        "weighted_rms_after_Nm": after["weighted_rms_Nm"],
+        "explained_fraction": _finite(removed / excess) if excess > 0 else None,
+    }
+
+
+def diagnosis_dict(diagnosis: Diagnosis) -> dict:
+    """The JSON of a diagnosis (see workflow/schemas/diagnosis.schema.json)."""
+    problem = diagnosis.problem
+    nominal = diagnosis.statistics(diagnosis.nominal_predictions)
+    calibrated = diagnosis.statistics(diagnosis.calibration.predictions)
+    with_effect = None
+    if diagnosis.verdict == "missing":
+        with_effect = diagnosis.statistics(diagnosis.best.refit.predictions)
+    defaults = {p.key: p.reference for p in diagnosis.calibration.parameters}
+    calibrated_parameters = {
+        key: {**entry, "default": defaults[key]} for key, entry in diagnosis.calibration.intervals(problem).items()
+    }
+    files = []
+    for f in problem.files:
+        delta = f.replay_uncertainty_Nm
+        files.append({
+            "file": f.label,
+            "case": f.case,
+            "surface": f.surface,
+            "samples": f.n,
+            "noise_floor": f.noise.as_dict(),
+            "replay_uncertainty_rms_Nm": float(np.sqrt(np.mean(delta**2))) if delta is not None else 0.0,
+            "rack_smoothing": f.rack.summary(),
+        })
+    return {
+        "schema": SCHEMA_ID,
+        "verdict": diagnosis.verdict,
+        "effect": diagnosis.effect,
+        "indistinguishable": [
+            {
+                "effect": s.effect,
+                "delta_bic": s.delta_bic,
+                "separating_measurement": {
+                    "case": s.case,
+                    "surface": s.surface,
+                    "predicted_difference_rms_Nm": s.predicted_difference_rms_Nm,
+                    "over_noise_floor": s.over_noise_floor,
+                },
+                "conditions": s.conditions,
+            }
+            for s in diagnosis.indistinguishable
+        ],
+        "confounded": [
+            {"effect": c.name, "confounded_with": c.score.confounded_with,
+             "identifiable_fraction": c.score.identifiable_fraction}
+            for c in diagnosis.confounded
+        ],
+        "ranking": [_ranking_entry(diagnosis, c, calibrated) for c in diagnosis.ranked],
+        "untestable": diagnosis.untestable,
+        "unobservable": diagnosis.unobservable,
+        "noise_floor_Nm": calibrated["noise_floor_Nm"],
+        "attainable_floor_Nm": calibrated["attainable_floor_Nm"],
+        "calibrated": calibrated_parameters,
+        "model": {"effects": [e.name for e in diagnosis.base_effects]},
+        "files": files,
+        "statistics": {"nominal": nominal, "calibrated": calibrated, "with_effect": with_effect},
+        "selection": {
+            "criterion": "BIC over the effective sample size: n_eff ln(RSS/n) + k ln(n_eff)",
+            "samples": problem.n,
+            "effective_samples": diagnosis.n_eff,
+            "lag1_autocorrelation": diagnosis.rho,
+            "calibrated_weighted_rms_over_noise_floor": math.sqrt(diagnosis.calibration.rss / problem.n),
+            "explained_fraction": _finite(diagnosis.explained_fraction),
+            "thresholds": {
+                "adequate_rms_factor": settings.ADEQUATE_RMS_FACTOR,
+                "bic_missing": settings.BIC_MISSING_THRESHOLD,
+                "explained_fraction_missing": settings.EXPLAINED_FRACTION_MISSING,
+                "bic_indistinguishable": settings.BIC_INDISTINGUISHABLE,
+                "confounded_fraction": settings.CONFOUNDED_FRACTION,
+            },
+        },
+        "cost": {"replays": problem.evaluations, "timings_s": diagnosis.timings_s},
+    }
+
+
+def _n(x, digits: int = 3) -> str:
+    if x is None:
+        return "-"
+    return f"{x:.{digits}g}" if abs(x) < 1e4 else f"{x:.3e}"
+
+
+def markdown_report(result: dict, figure: str | None = None) -> str:
+    """A readable report of the JSON of a diagnosis."""
+    lines = ["# Diagnosis: model against measurement", ""]
+    verdict = result["verdict"]
+    floor = result["noise_floor_Nm"]
+    stats = result["statistics"]
+    if verdict == "missing":
+        lines.append(f"**Verdict: missing effect `{result['effect']}`.** Adding it takes the weighted RMS error from "
+                     f"{_n(stats['calibrated']['weighted_rms_Nm'])} N m to {_n(stats['with_effect']['weighted_rms_Nm'])} "
+                     f"N m, against a noise floor of {_n(floor)} N m.")
+    elif verdict == "adequate":
+        lines.append(f"**Verdict: adequate.** With its calibrated parameters the model's weighted RMS error "
+                     f"({_n(stats['calibrated']['weighted_rms_Nm'])} N m) is at the noise floor ({_n(floor)} N m); "
+                     "these data show no missing effect.")
+    else:
+        lines.append(f"**Verdict: unexplained.** The calibrated model leaves a structured error (weighted RMS "
+                     f"{_n(stats['calibrated']['weighted_rms_Nm'])} N m against a noise floor of {_n(floor)} N m) "
+                     "that no candidate removes for the most part. Something outside the candidate library is at "
+                     "work (or in the measurement): look at the residual below.")
+    lines += ["", "## Files", "", "| file | case | surface | samples | noise floor (N m) | replay uncertainty RMS (N m) "
+              "| rack knot spacing (s) |", "|---|---|---|---|---|---|---|"]
+    for f in result["files"]:
+        lines.append(f"| {f['file']} | {f['case']} | {f['surface']} | {f['samples']} | "
+                     f"{_n(f['noise_floor']['total_rms'])} | {_n(f['replay_uncertainty_rms_Nm'])} | "
+                     f"{_n(f['rack_smoothing']['knot_spacing_s'])} |")
+    lines += ["", "## Error", "", "| model | RMS (N m) | weighted RMS (N m) | peak (N m) |", "|---|---|---|---|"]
+    for label, key in (("nominal parameters", "nominal"), ("calibrated", "calibrated"),
+                       (f"with {result['effect']}", "with_effect")):
+        s = stats.get(key)
+        if s:
+            lines.append(f"| {label} | {_n(s['rms_Nm'])} | {_n(s['weighted_rms_Nm'])} | {_n(s['peak_Nm'])} |")
+    lines += ["", f"Noise floor {_n(floor)} N m; attainable floor with the replay's uncertainty "
+              f"{_n(result['attainable_floor_Nm'])} N m. The weighted RMS counts each sample by its attainable "
+              "error, so it is the noise floor for a perfect model; the plain RMS also holds the few samples at "
+              "reversals where the rack data cannot fix the instant the rack friction turns over.", ""]
+    lines += ["## Calibrated parameters", "", "| parameter | default | fitted | 95 % interval |", "|---|---|---|---|"]
+    for key, entry in result["calibrated"].items():
+        ci = entry["ci95"]
+        lines.append(f"| {key} | {_n(entry['default'], 4)} | {_n(entry['value'], 4)} | "
+                     f"{_n(ci[0], 4)} to {_n(ci[1], 4)} |")
+    lines += ["", "## Candidates", "", "| candidate | score | ΔBIC | fitted strength | weighted RMS after (N m) | "
+              "identifiable fraction |", "|---|---|---|---|---|---|"]
+    for c in result["ranking"]:
+        strength = c["parameters"][c["strength_parameter"]]
+        ci = strength.get("ci95")
+        fitted = _n(strength["value"]) + (f" ({_n(ci[0])} to {_n(ci[1])})" if ci else " (linear estimate)")
+        lines.append(f"| {c['effect']} | {_n(c['score'])} | {_n(c['delta_bic'])} | {fitted} | "
+                     f"{_n(c['weighted_rms_after_Nm'])} | {_n(c['identifiable_fraction'], 2)} |")
+    if result["indistinguishable"]:
+        lines += ["", "## Indistinguishable by these data", ""]
+        for s in result["indistinguishable"]:
+            m = s["separating_measurement"]
+            lines.append(f"- `{s['effect']}` (ΔBIC {_n(s['delta_bic'])}): measure the `{m['case']}` case on "
+                         f"`{m['surface'].replace('_', ' ')}`, where the two fitted models differ by "
+                         f"{_n(m['predicted_difference_rms_Nm'])} N m RMS ({_n(m['over_noise_floor'])} noise floors).")
+    if result["confounded"]:
+        lines += ["", "## Confounded with the calibrated parameters", ""]
+        for c in result["confounded"]:
+            lines.append(f"- `{c['effect']}`: only {_n(100 * c['identifiable_fraction'], 2)} % of its signature "
+                         f"is not also made by `{c['confounded_with']}`; these data cannot tell it from a change of "
+                         "that parameter.")
+    if result["unobservable"]:
+        lines += ["", f"Unobservable in these data as replayed (even the largest strength moves the replayed torque "
+                  f"by less than a tenth of the noise floor): {', '.join(result['unobservable'])}."]
+    if result["untestable"]:
+        lines += ["", f"Not testable (no strength parameter): {', '.join(result['untestable'])}."]
+    if figure:
+        lines += ["", f"![diagnosis]({figure})"]
+    lines += ["", f"Cost: {result['cost']['replays']} replays."]
+    return "\n".join(lines) + "\n"
+
+
+def write_markdown(path: str | Path, text: str) -> None:
+    with atomic_path(path) as tmp:
+        tmp.write_text(text, encoding="utf-8")

@@ -1,0 +1,261 @@
+"""Diagnose: calibrate, rank the candidates, refit the best, choose, and say what would separate them.
+
+The steps (:func:`diagnose`):
+
+1. replay the files through the base model at its default parameters, and estimate each
+   sample's replay uncertainty (:mod:`parksteer.diagnose.problem`);
+2. calibrate the base model's uncertain parameters (:mod:`parksteer.diagnose.calibrate`);
+3. for every candidate not in the model, its signature and score test at the calibrated model
+   (:mod:`parksteer.diagnose.candidates`);
+4. refit the best-scored few in the full nonlinear model (calibrated parameters and the
+   candidate's strength together);
+5. compare by an information criterion over the effective sample size:
+   ``BIC = n_eff ln(RSS / n) + k ln(n_eff)``, with ``n_eff = n (1 - rho) / (1 + rho)`` and rho
+   the lag-1 autocorrelation of the best model's weighted residuals (neighbouring samples of
+   a smooth misfit are not independent evidence);
+6. the verdict:
+
+   - ``missing``: the best candidate lowers the BIC by more than ``BIC_MISSING_THRESHOLD``
+     and, with it, the error is at the floor (weighted RMS within ``ADEQUATE_RMS_FACTOR`` of
+     the noise floor) or it removes at least ``EXPLAINED_FRACTION_MISSING`` of the weighted
+     sum of squares above the floor (a perfect model leaves a weighted sum of squares equal
+     to the number of samples). This is tested first: a small effect that the calibration
+     has mostly absorbed can leave the error near the floor and still be strongly evidenced
+     by its shape;
+   - ``adequate``: otherwise, when no candidate is strongly evidenced and the calibrated base
+     model's weighted error is at the floor;
+   - ``unexplained``: the residual is structured (or a candidate is evidenced but leaves most
+     of it), and no candidate removes most of it.
+
+   When a candidate is strongly evidenced, the replay uncertainty is estimated again with its
+   fitted model, each sample keeps the larger of the two, and the comparison is repeated with
+   these weights: a candidate can sharpen the torque exactly where the rack data are least
+   certain (a breakaway peak at a reversal), and a comparison weighted by the base model's
+   uncertainty alone would count the replay's timing errors there against it.
+
+7. candidates within ``BIC_INDISTINGUISHABLE`` of the best are ``indistinguishable`` by these
+   data; for each, both fitted models are replayed (on the first file's rack) under every
+   condition the data do not cover (the other load cases and spacers, on the ground and on
+   air bearings), and the condition where they differ most, relative to the noise floor, is
+   named as the measurement that would separate them.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..model.components import Effect, discover_effects, resolve_effects
+from ..model.values import SURFACES
+from ..parameters import Parameters
+from . import settings
+from .calibrate import Fit, FitParameter, calibrate, least_squares
+from .candidates import Score, Signature, candidate_effects, probe_signature, score, strength_parameter
+from .problem import FileData, Problem, effective_samples, fit_statistics, lag1_autocorrelation
+from .replay import Replay
+
+VERDICTS = ("missing", "adequate", "unexplained")
+
+
+@dataclass
+class Candidate:
+    """One candidate's signature, score and (for the best few) refit."""
+
+    signature: Signature
+    score: Score
+    refit: Fit | None = None
+    delta_bic: float | None = None
+
+    @property
+    def name(self) -> str:
+        return self.signature.effect.name
+
+    def rss_after(self, base_rss: float) -> float:
+        return self.refit.rss if self.refit is not None else base_rss - self.score.removed_rss
+
+
+@dataclass
+class Separation:
+    """Where two fitted models differ most, among the conditions the data do not cover."""
+
+    effect: str
+    delta_bic: float
+    case: str
+    surface: str
+    predicted_difference_rms_Nm: float
+    over_noise_floor: float
+    conditions: list[dict]
+
+
+@dataclass
+class Diagnosis:
+    """Everything :func:`diagnose` found (turned into JSON by :mod:`parksteer.diagnose.report`)."""
+
+    problem: Problem
+    base_effects: list[Effect]
+    nominal_predictions: list[np.ndarray]
+    calibration: Fit
+    candidates: list[Candidate]
+    untestable: list[str]
+    verdict: str
+    best: Candidate | None
+    indistinguishable: list[Separation]
+    n_eff: float
+    rho: float
+    explained_fraction: float | None
+    timings_s: dict[str, float] = field(default_factory=dict)
+
+    @property
+    def effect(self) -> str | None:
+        return self.best.name if self.verdict == "missing" and self.best is not None else None
+
+    @property
+    def ranked(self) -> list[Candidate]:
+        refitted = sorted((c for c in self.candidates if c.refit is not None), key=lambda c: -(c.delta_bic or 0.0))
+        others = sorted((c for c in self.candidates if c.refit is None), key=lambda c: -c.score.statistic)
+        return refitted + others
+
+    @property
+    def confounded(self) -> list[Candidate]:
+        return [c for c in self.candidates
+                if c.signature.observable and c.score.identifiable_fraction < settings.CONFOUNDED_FRACTION]
+
+    @property
+    def unobservable(self) -> list[str]:
+        return [c.name for c in self.candidates if not c.signature.observable]
+
+    def statistics(self, predictions: list[np.ndarray]) -> dict:
+        return fit_statistics(self.problem, predictions)
+
+
+def refit(problem: Problem, calibration: Fit, signature: Signature, start_strength: float) -> Fit:
+    """The calibrated parameters and the candidate's strength fitted together in the full model."""
+    spec = strength_parameter(signature.effect)
+    strength = FitParameter(signature.key, "linear", 1.0, max(spec.minimum, 0.0), spec.maximum, signature.probe)
+    parameters = [*calibration.parameters, strength]
+    theta0 = np.concatenate([calibration.theta, [min(max(start_strength, strength.lower), strength.upper)]])
+    seed = np.column_stack([calibration.jacobian, signature.weighted])
+    return least_squares(problem, signature.model, parameters, theta0, calibration.fixed, jacobian=seed,
+                         max_iterations=settings.REFIT_MAX_ITERATIONS)
+
+
+def _compare_refits(problem: Problem, calibration: Fit, refitted: list[Candidate]):
+    """(best candidate, effective sample size, rho): each refit's BIC gain over the calibrated base model."""
+    best_fit = min((c.refit for c in refitted), key=lambda f: f.rss, default=calibration)
+    rho = lag1_autocorrelation(problem, best_fit.weighted)
+    n_eff = effective_samples(problem.n, rho)
+    for c in refitted:
+        c.delta_bic = n_eff * math.log(calibration.rss / c.refit.rss) - math.log(n_eff)
+    return max(refitted, key=lambda c: c.delta_bic, default=None), n_eff, rho
+
+
+def reweigh(problem: Problem, fit: Fit, sigma_before: list[np.ndarray]) -> None:
+    """Recompute a fit's weighted residuals and Jacobian after the files' attainable errors changed."""
+    fit.weighted = problem.weighted(fit.predictions)
+    ratio = np.concatenate([old / f.sigma_Nm for old, f in zip(sigma_before, problem.files)])
+    fit.jacobian = fit.jacobian * ratio[:, None]
+
+
+def conditions_not_covered(problem: Problem) -> list[tuple[str, str]]:
+    covered = {(f.case, f.surface) for f in problem.files}
+    return [(c, s) for c in problem.params.case_names for s in SURFACES if (c, s) not in covered]
+
+
+def separation(problem: Problem, best: Candidate, other: Candidate) -> Separation:
+    """Replay both fitted models on the first file's rack under each uncovered condition (module docstring)."""
+    f = problem.files[0]
+    rows = []
+    for case, surface in conditions_not_covered(problem):
+        predicted = []
+        for candidate in (best, other):
+            replay = Replay(candidate.signature.model, case, surface, problem.params, f.rack, f.time_s)
+            predicted.append(replay.torque(candidate.refit.overrides))
+        difference = float(np.sqrt(np.mean((predicted[0] - predicted[1]) ** 2)))
+        rows.append({"case": case, "surface": surface, "predicted_difference_rms_Nm": difference,
+                     "over_noise_floor": difference / f.noise.total_rms})
+    top = max(rows, key=lambda r: r["over_noise_floor"])
+    return Separation(other.name, float(other.delta_bic), top["case"], top["surface"],
+                      top["predicted_difference_rms_Nm"], top["over_noise_floor"], rows)
+
+
+def diagnose(files: list[FileData], params: Parameters, effects=None, registry: dict[str, Effect] | None = None,
+             strengths: dict[str, float] | None = None, start: dict[str, float] | None = None) -> Diagnosis:
+    """Calibrate, rank every candidate outside the model, refit the best, give the verdict (module docstring).
+
+    `strengths` ({"effect.param": finite-difference step}) are strengths of effects already
+    added to the model, calibrated with the base parameters (from `start`, e.g. an earlier fit).
+    """
+    clock = time.perf_counter()
+    timings: dict[str, float] = {}
+
+    def lap(name: str) -> None:
+        nonlocal clock
+        now = time.perf_counter()
+        timings[name] = now - clock
+        clock = now
+
+    registry = registry if registry is not None else discover_effects()
+    base = effects if isinstance(effects, list) and all(isinstance(e, Effect) for e in effects) \
+        else resolve_effects(effects)
+    problem = Problem(files, params)
+    nominal = problem.predict(base, {})
+    problem.estimate_replay_uncertainty(base, start or {})
+    lap("nominal_and_replay_uncertainty")
+
+    calibration = calibrate(problem, base, strengths=strengths, start=start)
+    lap("calibration")
+
+    testable, untestable = candidate_effects(base, registry)
+    floor = fit_statistics(problem, calibration.predictions)["noise_floor_Nm"]
+    candidates = []
+    for effect in testable:
+        signature = probe_signature(problem, base, effect, calibration.overrides,
+                                    settings.PROBE_EFFECT_NOISE_FLOORS * floor)
+        candidates.append(Candidate(signature, score(signature, calibration)))
+    lap("signatures_and_scores")
+
+    hopeful = sorted((c for c in candidates if c.score.removed_rss > 0.0), key=lambda c: -c.score.statistic)
+    for candidate in hopeful[: settings.REFIT_COUNT]:
+        candidate.refit = refit(problem, calibration, candidate.signature, candidate.score.linear_strength)
+    lap("refits")
+
+    refitted = [c for c in candidates if c.refit is not None]
+    best, n_eff, rho = _compare_refits(problem, calibration, refitted)
+    if best is not None and best.delta_bic > settings.BIC_MISSING_THRESHOLD:
+        # The replay's uncertainty was estimated with the base model; with the candidate, the torque may turn
+        # more sharply where the rack data are least certain (a breakaway peak at each reversal). Weigh every
+        # model by the larger of the two uncertainties and compare again.
+        before = [f.sigma_Nm for f in problem.files]
+        problem.estimate_replay_uncertainty(best.signature.model, best.refit.overrides, keep_larger=True)
+        for fit in [calibration] + [c.refit for c in refitted]:
+            reweigh(problem, fit, before)
+        best, n_eff, rho = _compare_refits(problem, calibration, refitted)
+    lap("selection")
+
+    n = problem.n
+    base_rss = calibration.rss
+    base_ratio = math.sqrt(base_rss / n)
+    excess = base_rss - n
+    explained = (base_rss - best.refit.rss) / excess if (best is not None and excess > 0) else None
+    after_ratio = math.sqrt(best.refit.rss / n) if best is not None else None
+    if (best is not None and best.delta_bic > settings.BIC_MISSING_THRESHOLD
+            and (after_ratio <= settings.ADEQUATE_RMS_FACTOR
+                 or (explained is not None and explained >= settings.EXPLAINED_FRACTION_MISSING))):
+        verdict = "missing"
+    elif base_ratio <= settings.ADEQUATE_RMS_FACTOR and not (
+            best is not None and best.delta_bic > settings.BIC_MISSING_THRESHOLD):
+        verdict = "adequate"
+    else:
+        verdict = "unexplained"
+
+    separations = []
+    if verdict == "missing":
+        for c in refitted:
+            if c is not best and c.delta_bic >= best.delta_bic - settings.BIC_INDISTINGUISHABLE:
+                separations.append(separation(problem, best, c))
+    lap("separation")
+    return Diagnosis(problem, base, nominal, calibration, candidates, untestable, verdict, best, separations,
+                     n_eff, rho, explained, timings)

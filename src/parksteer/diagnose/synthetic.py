@@ -1,0 +1,351 @@
+"""Synthetic measurements with something hidden in them: the car data set and the benchmark's data sets.
+
+Every file is made the way a car test would be: the driver's hand turns the wheel through
+the paper's cycle with an irregular speed (:func:`parksteer.measure.degrade.irregular_hand_profile`);
+the model is driven by that handwheel angle (:func:`parksteer.model.simulate.simulate` with
+``handwheel``: the column twists, the rack follows), so the data come from the other drive
+mode than the rack replay that analyses them; the logger then samples, adds noise and
+quantises every channel (:func:`parksteer.measure.degrade.synthetic_measurement`, the
+settings of the parameter file's ``[synthetic]`` section). What is hidden is one of:
+
+- a candidate effect of the library at a strength that changes the torque by a given number
+  of converter steps RMS (found by bisection on the strength, :func:`strength_for_rms`);
+- nothing (a null);
+- a disturbance no candidate models (:class:`Disturbance`): a drift of the torque sensor's
+  zero, a ripple from a damaged pinion tooth, a lag of the torque channel behind the rack,
+  or an effect from outside the library (the example's out-of-balance column).
+
+The base parameters of every data set are perturbed within stated ranges, so that a
+diagnosis must calibrate them first. What is hidden is recorded in a separate truth
+dictionary, never in the files: their metadata say only ``synthetic: true`` and the
+logger's and the hand's settings.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import UsageError
+from ..measure.degrade import HandProfile, irregular_hand_profile, quantisation_step, synthetic_measurement
+from ..measure.example import example_hand, example_logger
+from ..measure.io import OPTIONAL_COLUMNS, REQUIRED_COLUMNS, Measurement
+from ..model.components import discover_effects, load_effect_module
+from ..model.simulate import simulate
+from ..parameters import Parameters
+from . import settings
+from .candidates import strength_parameter
+
+RECORDED = [name for name in REQUIRED_COLUMNS + OPTIONAL_COLUMNS if name != "time_s"]
+CLEAN_OUTPUT_DT_S = 0.005
+REPO_ROOT = Path(__file__).resolve().parents[3]
+USER_EFFECT_PATH = REPO_ROOT / "examples" / "user_effect" / "column_imbalance.py"
+DISTURBANCES = ("torque_drift", "gear_tooth", "channel_lag", "column_imbalance")
+RANGE_HEADROOM = 0.1  # a logger range leaves at least this fraction of headroom over the signal's peak
+RANGE_STEP_FRACTION = 0.2  # ranges go up in steps of this fraction of the parameter file's range
+
+
+def torque_step_Nm(params: Parameters) -> float:
+    """The torque channel's converter step of the synthetic logger."""
+    logger = example_logger(params)
+    return quantisation_step(logger.full_scale["handwheel_torque_Nm"], logger.bits)
+
+
+def hand(params: Parameters, seed: int) -> HandProfile:
+    """The irregular hand of the synthetic measurements, with its own seed."""
+    variation = dataclasses.replace(example_hand(params), seed=int(seed))
+    return irregular_hand_profile(params, variation, output_dt_s=0.01)
+
+
+def clean_run(params: Parameters, case: str, surface: str, hand_profile: HandProfile, effects=None,
+              overrides: dict[str, float] | None = None) -> dict[str, np.ndarray]:
+    """The model's clean columns (time_s and every recorded channel) for a hand-driven cycle."""
+    result = simulate(case, effects=effects, overrides=overrides, surface=surface, params=params,
+                      handwheel=hand_profile.handwheel_profile(), output_dt_s=CLEAN_OUTPUT_DT_S)
+    columns = {"time_s": np.asarray(result.columns["time_s"])}
+    columns.update({name: np.asarray(result.columns[name]) for name in RECORDED})
+    return columns
+
+
+@dataclass(frozen=True)
+class Disturbance:
+    """Something outside the candidate library, added to a clean run before it is logged.
+
+    kind ``torque_drift``: the torque sensor's zero drifts linearly from 0 to ``size`` N m
+    over the record (a thermal drift after zeroing at the start).
+    kind ``gear_tooth``: a damaged pinion tooth gives a transmission error that repeats once
+    per pinion turn, x_rack = x + A sin(G x + phase), with G the handwheel-to-rack ratio (one
+    turn every 2 pi / G of rack, 34 mm); by virtual work the handwheel torque is scaled by
+    dx_rack/dx = 1 + A G cos(G x + phase). ``size`` is A in m. Both the logged rack and the torque
+    carry it.
+    kind ``channel_lag``: the torque channel lags the rack by ``size`` s (a filter or a
+    multiplexer in the logger).
+    kind ``column_imbalance``: the out-of-balance column of examples/user_effect (an effect
+    the library does not have), ``size`` its strength in N m; applied in the model itself.
+    """
+
+    kind: str
+    size: float
+    phase: float = 0.0
+
+    def __post_init__(self):
+        if self.kind not in DISTURBANCES:
+            raise UsageError(f"unknown disturbance {self.kind!r} (known: {', '.join(DISTURBANCES)})")
+
+    def effects_and_overrides(self) -> tuple[str | None, dict[str, float]]:
+        if self.kind == "column_imbalance":
+            return f"+{USER_EFFECT_PATH}", {"column_imbalance.strength": self.size, "column_imbalance.phase": self.phase}
+        return None, {}
+
+    def apply(self, params: Parameters, columns: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+        out = dict(columns)
+        t, torque = columns["time_s"], columns["handwheel_torque_Nm"]
+        if self.kind == "torque_drift":
+            out["handwheel_torque_Nm"] = torque + self.size * (t - t[0]) / (t[-1] - t[0])
+        elif self.kind == "gear_tooth":
+            ratio = params["steering.handwheel_to_rack_ratio"]
+            angle = ratio * columns["rack_m"] + self.phase
+            out["rack_m"] = columns["rack_m"] + self.size * np.sin(angle)
+            out["handwheel_torque_Nm"] = torque * (1.0 + self.size * ratio * np.cos(angle))
+        elif self.kind == "channel_lag":
+            out["handwheel_torque_Nm"] = np.interp(t - self.size, t, torque)
+        return out
+
+    def with_size(self, size: float) -> Disturbance:
+        return dataclasses.replace(self, size=float(size))
+
+
+def rms_difference(a: np.ndarray, b: np.ndarray) -> float:
+    return float(np.sqrt(np.mean((np.asarray(a) - np.asarray(b)) ** 2)))
+
+
+def strength_for_rms(torque_of, target_Nm: float, start: float, upper: float) -> float:
+    """The size s (from 0 up) at which RMS(torque_of(s) - torque_of(0)) = target, by bracketing and bisection.
+
+    The bracket grows from `start` by factors of 4 up to `upper`; then bisection in the
+    logarithm of s until the RMS change is within BENCHMARK_BISECTION_TOLERANCE of the target.
+    If even `upper` changes the torque by less than the target, `upper` is returned (the
+    caller records the change it actually makes).
+    """
+    reference = torque_of(0.0)
+
+    def change(s: float) -> float:
+        return rms_difference(torque_of(s), reference)
+
+    low, high = 0.0, float(min(start, upper))
+    while change(high) < target_Nm:
+        if high >= upper:
+            return upper
+        low, high = high, min(high * 4.0, upper)
+    for _ in range(settings.BENCHMARK_BISECTION_ITERATIONS):
+        middle = math.sqrt(low * high) if low > 0 else high / 4.0
+        value = change(middle)
+        if abs(value - target_Nm) <= settings.BENCHMARK_BISECTION_TOLERANCE * target_Nm:
+            return middle
+        low, high = (middle, high) if value < target_Nm else (low, middle)
+    return math.sqrt(low * high) if low > 0 else high
+
+
+@dataclass
+class DatasetSpec:
+    """One synthetic data set: its files, what is hidden, at what size, and the base perturbation."""
+
+    name: str
+    seed: int
+    files: tuple[tuple[str, str], ...]
+    kind: str  # "candidate", "null" or "outside"
+    hidden: str | None = None  # a candidate's name, or a disturbance's kind
+    steps: float | None = None  # hidden size as converter steps of torque RMS (on the first file)
+    base_overrides: dict[str, float] = field(default_factory=dict)
+    phase: float | None = None  # of a disturbance (rad); None draws it from the seed
+    strength: float | None = None  # a hidden candidate's strength as it stands (instead of `steps`)
+
+
+def perturbed_base(params: Parameters, seed: int) -> dict[str, float]:
+    """Base-parameter overrides, each its default times 1 + U(-p, p) (BENCHMARK_PERTURBATION), seeded."""
+    registry = discover_effects()
+    rng = np.random.default_rng(seed)
+    out = {}
+    for key, fraction in sorted(settings.BENCHMARK_PERTURBATION.items()):
+        owner, _, name = key.partition(".")
+        default = registry[owner].parameter(name).default_value(params)
+        out[key] = default * (1.0 + rng.uniform(-fraction, fraction))
+    return out
+
+
+@dataclass
+class Dataset:
+    """The measurements of one data set and the truth about them (kept apart from the files)."""
+
+    spec: DatasetSpec
+    measurements: list[Measurement]
+    truth: dict
+
+
+def _logged(params: Parameters, columns: dict[str, np.ndarray], case: str, surface: str, seed: int,
+            hand_profile: HandProfile) -> Measurement:
+    """Log a clean run with the synthetic logger; a channel whose peak needs more range gets the next range up.
+
+    As an engineer would set the logger: the range stays the parameter file's unless the signal
+    comes within 10 % of it; then it is raised to the next multiple of RANGE_STEP_FRACTION of it
+    that leaves 10 % headroom (the converter step grows with it, and the file's metadata say so).
+    """
+    logger = dataclasses.replace(example_logger(params), seed=int(seed))
+    full_scale = dict(logger.full_scale)
+    for name, scale in logger.full_scale.items():
+        peak = float(np.max(np.abs(columns[name]))) if name in columns else 0.0
+        if peak > (1.0 - RANGE_HEADROOM) * scale:
+            unit = RANGE_STEP_FRACTION * scale
+            full_scale[name] = unit * math.ceil(peak / (1.0 - RANGE_HEADROOM) / unit)
+    logger = dataclasses.replace(logger, full_scale=full_scale)
+    return synthetic_measurement(columns["time_s"], {k: v for k, v in columns.items() if k != "time_s"}, logger,
+                                 case=case, surface=surface, source="synthetic: parksteer.diagnose.synthetic",
+                                 extra_metadata=dict(hand_profile.metadata))
+
+
+def make_dataset(params: Parameters, spec: DatasetSpec) -> Dataset:
+    """Simulate, hide, and log every file of `spec`; the truth names what is hidden and its size.
+
+    The size is set so that the hidden thing changes the clean torque by ``spec.steps``
+    converter steps RMS over all the data set's files together (a candidate whose largest
+    strength changes it by less is hidden at that strength), or is ``spec.strength`` as it
+    stands; the truth records the steps it actually makes.
+    """
+    step = torque_step_Nm(params)
+    target = None if spec.steps is None else spec.steps * step
+    hands = [hand(params, spec.seed * 100 + i) for i in range(len(spec.files))]
+    base = dict(spec.base_overrides)
+
+    def torques(effects, overrides, disturbance=None):
+        out = []
+        for (case, surface), hand_profile in zip(spec.files, hands):
+            columns = clean_run(params, case, surface, hand_profile, effects, overrides)
+            if disturbance is not None:
+                columns = disturbance.apply(params, columns)
+            out.append(columns["handwheel_torque_Nm"])
+        return np.concatenate(out)
+
+    effects, overrides, disturbance, strength_key, strength = None, dict(base), None, None, None
+    if spec.kind == "candidate":
+        effect = discover_effects()[spec.hidden]
+        strength_key = f"{effect.name}.{strength_parameter(effect).name}"
+        effects = f"+{effect.name}"
+        upper = strength_parameter(effect).maximum
+        if spec.strength is not None:
+            strength = float(spec.strength)
+        else:
+            strength = strength_for_rms(lambda s: torques(effects, {**base, strength_key: s}), target, upper * 1e-3,
+                                        upper)
+        overrides[strength_key] = strength
+    elif spec.kind == "outside":
+        phase = spec.phase if spec.phase is not None else float(np.random.default_rng(spec.seed).uniform(-np.pi, np.pi))
+        disturbance = Disturbance(spec.hidden, 0.0, phase=phase)
+        strength = _disturbance_size(params, disturbance, target, torques, base)
+        disturbance = disturbance.with_size(strength)
+        effects, extra = disturbance.effects_and_overrides()
+        overrides.update(extra)
+        strength_key = f"{spec.hidden}.size"
+    steps = None
+    if spec.kind != "null":
+        hidden = torques(effects, overrides, disturbance)
+        steps = rms_difference(hidden, torques(None, base)) / step
+    measurements = []
+    for i, ((case, surface), hand_profile) in enumerate(zip(spec.files, hands)):
+        columns = clean_run(params, case, surface, hand_profile, effects, overrides)
+        if disturbance is not None:
+            columns = disturbance.apply(params, columns)
+        measurements.append(_logged(params, columns, case, surface, spec.seed * 100 + 50 + i, hand_profile))
+    truth = {
+        "name": spec.name,
+        "kind": spec.kind,
+        "hidden": spec.hidden,
+        "steps_requested": spec.steps,
+        "steps": steps,
+        "torque_step_Nm": step,
+        "strength_key": strength_key,
+        "strength": strength,
+        "phase": None if disturbance is None else disturbance.phase,
+        "base_overrides": spec.base_overrides,
+        "files": [{"case": c, "surface": s} for c, s in spec.files],
+        "seed": spec.seed,
+    }
+    return Dataset(spec, measurements, truth)
+
+
+def _disturbance_size(params: Parameters, disturbance: Disturbance, target: float, torques,
+                      base: dict[str, float]) -> float:
+    """The size of a disturbance that changes the data set's torque by `target` N m RMS (all files together)."""
+    if disturbance.kind == "column_imbalance":
+        effects = f"+{USER_EFFECT_PATH}"
+        upper = load_effect_module(str(USER_EFFECT_PATH)).parameter("strength").maximum
+        return strength_for_rms(
+            lambda s: torques(effects, {**base, "column_imbalance.strength": s, "column_imbalance.phase": disturbance.phase}),
+            target, upper * 1e-3, upper)
+    if disturbance.kind == "torque_drift":
+        # RMS of a ramp from 0 to a over each record: a / sqrt(3)
+        return target * math.sqrt(3.0)
+    if disturbance.kind == "gear_tooth":
+        # the torque change is A * (T G cos(G x + phase)): linear in A
+        unit = torques(None, base, disturbance.with_size(1e-6)) - torques(None, base)
+        return 1e-6 * target / float(np.sqrt(np.mean(unit**2)))
+    return strength_for_rms(lambda s: torques(None, base, disturbance.with_size(s)), target, 0.001,
+                            settings.BENCHMARK_MAX_LAG_S)
+
+
+# ----------------------------------------------------------------------------- the benchmark's data sets
+def benchmark_specs(params: Parameters, registry=None) -> list[DatasetSpec]:
+    """Every data set of the benchmark: each candidate at each strength, nulls, disturbances outside the library."""
+    registry = registry if registry is not None else discover_effects()
+    candidates = sorted(name for name, e in registry.items()
+                        if not e.in_default_set and strength_parameter(e) is not None)
+    specs: list[DatasetSpec] = []
+
+    def add(kind, hidden, steps):
+        index = len(specs)
+        seed = settings.BENCHMARK_SEED + index
+        label = "null" if kind == "null" else f"{hidden}_{steps:g}".replace(".", "p")
+        name = f"b{index:02d}_{label}"
+        specs.append(DatasetSpec(name, seed, settings.BENCHMARK_FILES, kind, hidden, steps,
+                                 perturbed_base(params, seed)))
+
+    for name in candidates:
+        for steps in settings.BENCHMARK_STEPS:
+            add("candidate", name, steps)
+    for _ in range(settings.BENCHMARK_NULLS):
+        add("null", None, None)
+    for kind in DISTURBANCES:
+        for steps in settings.BENCHMARK_DISTURBANCE_STEPS:
+            add("outside", kind, steps)
+    return specs
+
+
+# ------------------------------------------------------------------------------------ the car data set
+def car_dataset(params: Parameters) -> Dataset:
+    """The stand-in for the paper's car tests: every case on the ground and on air bearings, ONE effect hidden."""
+    spec = DatasetSpec("car", settings.CAR_SEED, settings.CAR_FILES, "candidate", settings.CAR_HIDDEN_EFFECT, None,
+                       perturbed_base(params, settings.CAR_SEED), strength=settings.CAR_HIDDEN_STRENGTH)
+    return make_dataset(params, spec)
+
+
+def file_name(case: str, surface: str) -> str:
+    return f"{case}__{surface}.csv"
+
+
+def write_car_dataset(parameters_path: str | Path, paths: list[str | Path], truth_path: str | Path) -> None:
+    """Write the car data set's files (named case__surface.csv, in CAR_FILES order) and, apart, its truth."""
+    from ..measure.io import write_measurement
+    from ..parameters import load_parameters
+    from ..tables import write_json
+
+    params = load_parameters(parameters_path)
+    dataset = car_dataset(params)
+    expected = [file_name(c, s) for c, s in settings.CAR_FILES]
+    if [Path(p).name for p in paths] != expected:
+        raise UsageError(f"car data set: output files must be named {', '.join(expected)}")
+    for path, measurement in zip(paths, dataset.measurements):
+        write_measurement(path, measurement, params)
+    write_json(truth_path, dataset.truth)

@@ -1,0 +1,73 @@
+"""Scoring the hidden-effect benchmark: confusion matrix and rates from truths and diagnoses."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from parksteer.diagnose.benchmark import aggregate, outcome
+
+
+def _diagnosis(verdict, effect=None, group=(), after=None):
+    stats = {"rms_Nm": 0.3, "peak_Nm": 1.0, "weighted_rms_Nm": 0.3, "noise_floor_Nm": 0.16,
+             "attainable_floor_Nm": 0.17, "weighted_rss": 1.0, "samples": 10}
+    return {
+        "verdict": verdict, "effect": effect, "noise_floor_Nm": 0.16,
+        "indistinguishable": [{"effect": g} for g in group],
+        "statistics": {"calibrated": stats, "with_effect": None if after is None else {**stats, "weighted_rms_Nm": after}},
+        "cost": {"replays": 100, "wall_s": 5.0},
+    }
+
+
+def _truth(name, kind, hidden=None, steps=None):
+    actual = None if steps is None else steps * 0.98  # a bisection lands within its tolerance of the request
+    return {"name": name, "kind": kind, "hidden": hidden, "steps_requested": steps, "steps": actual}
+
+
+CASES = [
+    (_truth("b0", "candidate", "rack_damping", 2.0), _diagnosis("missing", "rack_damping", after=0.17)),
+    (_truth("b1", "candidate", "rack_damping", 1.0), _diagnosis("adequate")),
+    (_truth("b2", "candidate", "kingpin_friction", 2.0), _diagnosis("missing", "column_friction", ("kingpin_friction",),
+                                                                     after=0.18)),
+    (_truth("b3", "candidate", "kingpin_friction", 5.0), _diagnosis("missing", "column_friction", after=0.2)),
+    (_truth("b4", "null"), _diagnosis("adequate")),
+    (_truth("b5", "null"), _diagnosis("missing", "rack_lash", after=0.16)),
+    (_truth("b6", "outside", "channel_lag", 3.0), _diagnosis("unexplained")),
+    (_truth("b7", "outside", "torque_drift", 3.0), _diagnosis("missing", "rack_damping", after=0.3)),
+]
+
+
+@pytest.fixture
+def scored(tmp_path):
+    truths, results = [], []
+    for truth, result in CASES:
+        t, d = tmp_path / f"{truth['name']}.truth.json", tmp_path / f"{truth['name']}.diagnosis.json"
+        t.write_text(json.dumps(truth)), d.write_text(json.dumps(result))
+        truths.append(t), results.append(d)
+    return aggregate(truths, results)
+
+
+def test_named_first_and_in_group_are_counted_separately():
+    """A hidden effect named first counts for both rates; one only inside the indistinguishable group counts for the
+    second; a wrong name outside the group counts for neither."""
+    assert outcome(*CASES[0])["named_first"] and outcome(*CASES[0])["named_or_group"]
+    assert not outcome(*CASES[2])["named_first"] and outcome(*CASES[2])["named_or_group"]
+    assert not outcome(*CASES[3])["named_or_group"]
+
+
+def test_rates_and_confusion_matrix(scored):
+    """At 2 steps or more (as asked for, though the bisection lands a little short): 2 of 3 found (one inside a
+    group); 1 of 2 nulls a false alarm; 1 of 2 disturbances outside the library called unexplained; each data set
+    counted once in the confusion matrix."""
+    rows, summary = scored
+    assert summary["named_or_group_at_2_steps"] == pytest.approx(2 / 3)
+    assert summary["named_first_at_2_steps"] == pytest.approx(1 / 3)
+    assert summary["false_alarm_rate"] == 0.5
+    assert summary["outside_unexplained"] == 0.5
+    assert summary["by_steps"]["1"]["named_first"] == 0.0
+    assert sum(sum(v.values()) for v in summary["confusion"].values()) == len(CASES)
+    assert summary["confusion"]["kingpin_friction"] == {"column_friction": 2}
+    assert summary["confusion"]["outside: torque_drift"] == {"rack_damping": 1}
+    # RMS after adding, over the successes only: 0.17 / 0.16 and 0.18 / 0.16
+    assert summary["rms_after_over_noise_floor"]["max"] == pytest.approx(0.18 / 0.16)

@@ -1,0 +1,6 @@
+# Thin rule script: the logic is parksteer.diagnose.synthetic.write_car_dataset.
+from parksteer.diagnose.synthetic import write_car_dataset
+from parksteer.rules import rule_log
+
+with rule_log(snakemake):
+    write_car_dataset(snakemake.input.parameters, list(snakemake.output.files), snakemake.output.truth)
