@@ -27,6 +27,7 @@ include: "workflow/rules/rig.smk"
 include: "workflow/rules/lifting.smk"
 include: "workflow/rules/model.smk"
 include: "workflow/rules/sweep.smk"
+include: "workflow/rules/diagnose.smk"
 include: "workflow/rules/paper.smk"
 include: "workflow/rules/checks.smk"
 

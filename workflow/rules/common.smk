@@ -16,6 +16,9 @@ FIGURES = {
     "fig16": ["figures/fig16.svg", "figures/fig16.csv"],
     "figContrib": ["figures/figContrib.svg", "figures/figContrib.csv"],
     "sweep_design": ["figures/sweep_design.svg", "figures/sweep_design.csv"],
+    "diag_compare": ["figures/diag_compare.svg", "figures/diag_compare.csv"],
+    "diag_ladder": ["figures/diag_ladder.svg", "figures/diag_ladder.csv"],
+    "diag_benchmark": ["figures/diag_benchmark.svg", "figures/diag_benchmark.csv"],
 }
 
 
