@@ -71,3 +71,23 @@ def test_rates_and_confusion_matrix(scored):
     assert summary["confusion"]["outside: torque_drift"] == {"rack_damping": 1}
     # RMS after adding, over the successes only: 0.17 / 0.16 and 0.18 / 0.16
     assert summary["rms_after_over_noise_floor"]["max"] == pytest.approx(0.18 / 0.16)
+
+
+def test_benchmark_figure_data_is_the_same_whatever_the_timings(tmp_path):
+    """Figure data is checksummed, so it must not change from run to run: two benchmarks that differ only in the
+    wall-clock time of each diagnosis give byte-identical figure data (timings stay in the JSON summary)."""
+    from parksteer.diagnose.benchmark import make_benchmark_figure
+
+    csv_bytes = []
+    for run, wall_s in enumerate((5.0, 9.5)):
+        folder = tmp_path / f"run{run}"
+        folder.mkdir()
+        truths, results = [], []
+        for truth, result in CASES:
+            t, d = folder / f"{truth['name']}.truth.json", folder / f"{truth['name']}.diagnosis.json"
+            t.write_text(json.dumps(truth))
+            d.write_text(json.dumps({**result, "cost": {"replays": 100, "wall_s": wall_s}}))
+            truths.append(t), results.append(d)
+        make_benchmark_figure(truths, results, folder / "b.svg", folder / "b.csv", folder / "b.json")
+        csv_bytes.append((folder / "b.csv").read_bytes())
+    assert csv_bytes[0] == csv_bytes[1]
