@@ -14,3 +14,12 @@ def first_ramp(result, rack_from_m: float = 0.02, rack_to_m: float = 0.06):
 
 def plateau_mean(result, column: str = "handwheel_torque_Nm") -> float:
     return float(np.mean(result.columns[column][first_ramp(result)]))
+
+# Every friction and damper of the paper's model off (for energy balances).
+DISSIPATION_OFF = {
+    "rack_friction.friction_force": 0.0,
+    "carcass_compliance.torsional_damping": 0.0,
+    "steering.column_torsional_damping": 0.0,
+    "tyre.radial_damping": 0.0,
+    "vehicle.chassis_roll_damping": 0.0,
+}

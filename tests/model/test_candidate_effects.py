@@ -21,7 +21,7 @@ from parksteer.model.inputs import rack_drive_from_arrays
 from parksteer.model.simulate import simulate
 from parksteer.rig import pin_torques_Nm
 
-from model_helpers import first_ramp, plateau_mean
+from model_helpers import DISSIPATION_OFF, first_ramp, plateau_mean
 
 # candidate -> (strength parameter, a strength well inside its typical range)
 CANDIDATES = {
@@ -337,15 +337,6 @@ def test_prescribed_rack_torque_does_not_see_the_lash(params):
     total = sum(with_lash[name] for name in with_lash if name.startswith("contrib_"))
     assert np.max(np.abs(total - with_lash["handwheel_torque_Nm"])) < 1e-9 * np.max(np.abs(total))
     assert np.max(np.abs(total)) > 10.0
-
-
-DISSIPATION_OFF = {
-    "rack_friction.friction_force": 0.0,
-    "carcass_compliance.torsional_damping": 0.0,
-    "steering.column_torsional_damping": 0.0,
-    "tyre.radial_damping": 0.0,
-    "vehicle.chassis_roll_damping": 0.0,
-}
 
 
 @pytest.mark.parametrize("name", ["ackermann", "brush_patch", "rack_lash"])

@@ -5,16 +5,9 @@ from __future__ import annotations
 import numpy as np
 from scipy.integrate import cumulative_trapezoid
 
+from model_helpers import DISSIPATION_OFF
+
 from parksteer.model.simulate import simulate
-
-DISSIPATION_OFF = {
-    "rack_friction.friction_force": 0.0,
-    "carcass_compliance.torsional_damping": 0.0,
-    "steering.column_torsional_damping": 0.0,
-    "tyre.radial_damping": 0.0,
-    "vehicle.chassis_roll_damping": 0.0,
-}
-
 
 def test_work_at_handwheel_equals_energy_change_without_dissipation(params):
     """With every friction and damper off (air bearings: no tyre friction), the work done at the handwheel,

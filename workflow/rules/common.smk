@@ -1,8 +1,12 @@
+import glob
 from pathlib import Path
 
 # Shared names. FIGURES maps each figure or table target to the files it writes;
 # these are the files checksummed in figures/SHA256SUMS.
 PARAMETERS = config["parameters"]
+
+# The model's source: a change here re-derives the compiled models (and only a change here).
+MODEL_SOURCES = sorted(glob.glob("src/parksteer/model/**/*.py", recursive=True))
 
 FIGURES = {
     "table1": ["figures/table1.csv"],

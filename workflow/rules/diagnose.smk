@@ -3,13 +3,11 @@
 # for the paper's car tests (its truth kept in a separate file); diag_compare and the case_study notebook walk it;
 # diag_ladder plots the error as the model grows; diag_bench_case diagnoses one synthetic data set of the
 # hidden-effect benchmark (one job each, so they run in parallel) and diag_benchmark scores them all.
-import glob
-
 from parksteer.diagnose import settings as DIAG
 from parksteer.diagnose.benchmark import case_names as _bench_case_names
 from parksteer.diagnose.synthetic import file_name as _diag_file_name
 
-DIAG_MODEL_SOURCES = sorted(glob.glob("src/parksteer/model/**/*.py", recursive=True)) + [
+DIAG_MODEL_SOURCES = MODEL_SOURCES + [
     "examples/user_effect/column_imbalance.py"
 ]
 DIAG_CAR_FILES = [f"results/diagnose/car/{_diag_file_name(c, s)}" for c, s in DIAG.CAR_FILES]

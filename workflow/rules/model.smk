@@ -1,11 +1,8 @@
 # Section 4: the multibody steering model. derive_model builds the compiled model of one effect set
 # (cached under results/model, keyed by the model's source); simulate_model writes one run of the
 # figures; fig12-fig16 and figContrib plot them.
-import glob
-
 from parksteer.figures.model import FIGURE_RUNS, MODEL_EFFECTS, VARIANT_MODEL, VARIANTS
 
-MODEL_SOURCES = sorted(glob.glob("src/parksteer/model/**/*.py", recursive=True))
 
 
 MODEL_FIGURE_INPUTS = {

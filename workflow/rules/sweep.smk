@@ -3,8 +3,6 @@
 # with --cores N and unchanged on a cluster (workflow/profiles/slurm). Each point job reads the compiled model
 # from the cache (rule derive_model, or sweep_model for an effect set of its own, such as the braked-wheel
 # run) and never derives; sweep_<name> gathers the table, the key numbers and the torque maps.
-import glob
-
 from parksteer.figures.model import MODEL_EFFECTS
 from parksteer.parameters import load_parameters
 from parksteer.sweep import load_sweep
@@ -14,7 +12,6 @@ SWEEP = load_sweep(
     load_parameters(PARAMETERS),
     full=bool(config.get("sweep_full", False)),
 )
-SWEEP_MODEL_SOURCES = sorted(glob.glob("src/parksteer/model/**/*.py", recursive=True))
 SWEEP_POINT_FILES = expand(
     "results/sweeps/{sweep}/points/{point}.json", sweep=SWEEP.name, point=SWEEP.point_ids
 )
@@ -33,7 +30,7 @@ SWEEP_MODEL_MANIFESTS = {
 
 rule sweep_model:
     input:
-        sources=SWEEP_MODEL_SOURCES,
+        sources=MODEL_SOURCES,
     output:
         manifest="results/sweeps/{sweep}/model_{variant}.json",
     params:
