@@ -11,7 +11,7 @@ Times, with the compiled models already in the cache (derived first, untimed):
 - the same with a candidate hidden (rack stiction at 3.5 converter steps RMS): a ``missing``
   verdict costs more (refits that converge further, a second replay-uncertainty estimate).
 
-The data are synthetic (parksteer.diagnose.synthetic), base parameters moved off the
+The data are synthetic (parksteer.synthetic.datasets), base parameters moved off the
 parameter file's values, so that the calibration has work to do. Prints a table and writes
 the numbers as JSON.
 """
@@ -36,8 +36,8 @@ def main(argv: list[str] | None = None) -> int:
     from parksteer.diagnose.compare import compare_files
     from parksteer.diagnose.problem import Problem, prepare_file
     from parksteer.diagnose.select import diagnose
-    from parksteer.diagnose.synthetic import DatasetSpec, make_dataset, perturbed_base
-    from parksteer.model.components import discover_effects, resolve_effects
+    from parksteer.synthetic.datasets import DatasetSpec, make_dataset, perturbed_base
+    from parksteer.model.symbolic.components import discover_effects, resolve_effects
     from parksteer.parameters import load_parameters
     from parksteer.tables import write_json
 

@@ -45,10 +45,10 @@ def main(argv: list[str] | None = None) -> int:
     from scipy.integrate import solve_ivp
 
     from parksteer.figures.model import all_simulations, run_simulation
-    from parksteer.model.compiled import build_entry
-    from parksteer.model.components import resolve_effects
-    from parksteer.model.derive import derive
-    from parksteer.model.simulate import RTOL, _atol, prepare, simulate, static_state
+    from parksteer.model.codegen.cache import build_entry
+    from parksteer.model.symbolic.components import resolve_effects
+    from parksteer.model.symbolic.derive import derive
+    from parksteer.model.numeric.simulate import RTOL, _atol, prepare, simulate, static_state
     from parksteer.parameters import load_parameters
     from parksteer.tables import write_json
 

@@ -3,7 +3,7 @@
 Two ways of running the same point code (parksteer.sweep.run.simulate_point):
 
 * snakemake: the pipeline's rules in a scratch working directory (symlinks to the repository's data,
-  src and workflow, with the benchmark's sweep in place of workflow/sweeps/design.yaml), one job per
+  src and workflow, with the benchmark's sweep in place of config/sweeps/design.yaml), one job per
   point, `--cores 2`; the derivation rule runs first and is timed apart;
 * inprocess: a pool of 2 worker processes calling simulate_point directly, each loading the compiled
   model once (the floor under any scheduler's overhead).
@@ -58,7 +58,7 @@ def linear_fit(sizes, seconds) -> dict:
 
 
 def cache_snapshot() -> dict[str, float]:
-    from parksteer.model.compiled import cache_root
+    from parksteer.model.codegen.cache import cache_root
 
     root = cache_root()
     return {p.parent.name: p.stat().st_mtime for p in root.glob("*/model.so")} if root.is_dir() else {}
@@ -68,7 +68,7 @@ def cache_snapshot() -> dict[str, float]:
 
 
 def _forbid_derivation():
-    import parksteer.model.compiled as compiled
+    import parksteer.model.codegen.cache as compiled
 
     def refuse(*args, **kwargs):
         raise RuntimeError("a sweep point tried to derive the model")
@@ -116,15 +116,13 @@ def bench_inprocess(sizes, cores, repeats) -> dict:
 def _workdir(scratch: Path, n: int) -> tuple[Path, Path]:
     """A working directory that sees the repository, with the benchmark's sweep as the default sweep."""
     work = scratch / f"work{n}"
-    (work / "workflow" / "sweeps").mkdir(parents=True)
-    for name in ("data", "src", "paper"):
+    (work / "config" / "sweeps").mkdir(parents=True)
+    for name in ("src", "paper", "workflow"):
         (work / name).symlink_to(REPO / name)
-    for child in (REPO / "workflow").iterdir():
-        if child.name != "sweeps":
-            (work / "workflow" / child.name).symlink_to(child)
-    (work / "workflow" / "sweeps" / "design.yaml").write_text(declaration(n), encoding="utf-8")
-    main = (REPO / "Snakefile").read_text(encoding="utf-8")
-    lines = [f'include: "{REPO / "Snakefile"}"']
+    (work / "config" / "config.yaml").symlink_to(REPO / "config" / "config.yaml")
+    (work / "config" / "sweeps" / "design.yaml").write_text(declaration(n), encoding="utf-8")
+    main = (REPO / "workflow" / "Snakefile").read_text(encoding="utf-8")
+    lines = [f'include: "{REPO / "workflow" / "Snakefile"}"']
     lines += [f'include: "{REPO / "workflow" / "rules" / r}"' for r in ("model.smk", "sweep.smk") if r not in main]
     snakefile = scratch / f"Snakefile{n}"
     snakefile.write_text("\n".join(lines) + "\n", encoding="utf-8")
@@ -189,8 +187,8 @@ def main(argv=None) -> int:
     parser.add_argument("--repeats", type=int, default=1, help="runs per size; the median is fitted")
     args = parser.parse_args(argv)
     os.chdir(REPO)
-    from parksteer.model.compiled import ensure_entry
-    from parksteer.model.components import resolve_effects
+    from parksteer.model.codegen.cache import ensure_entry
+    from parksteer.model.symbolic.components import resolve_effects
 
     ensure_entry(resolve_effects(None))  # the one derivation, before any timing
     result = {"sizes": args.sizes, "cores": args.cores, "repeats": args.repeats, "machine": platform.platform(),

@@ -204,12 +204,12 @@ def test_pipeline_refuses_bad_file_without_output(repo_root, tmp_path):
     copy with the shipped file then builds Fig. A3 (so the absence is the refusal, not a broken rule)."""
     workdir = tmp_path / "workflow_copy"
     workdir.mkdir()
-    shutil.copy(repo_root / "Snakefile", workdir / "Snakefile")
     shutil.copytree(repo_root / "workflow", workdir / "workflow")
-    shutil.copytree(repo_root / "data", workdir / "data")
+    shutil.copytree(repo_root / "config", workdir / "config")
+    (workdir / "src").symlink_to(repo_root / "src")
     bad_path, key = _write_defective(tmp_path, "angle in degrees")
     snakemake = [str(BIN / "snakemake"), "--cores", "1", "--directory", str(workdir)]
-    snakemake += ["--snakefile", str(workdir / "Snakefile")]
+    snakemake += ["--snakefile", str(workdir / "workflow" / "Snakefile")]
 
     bad = _run([*snakemake, "figA3", "--config", f"parameters={bad_path}"])
     assert bad.returncode != 0

@@ -10,10 +10,11 @@ import pytest
 from scipy.integrate import dblquad
 from scipy.optimize import brentq
 
+from parksteer.resources import data_file
 from parksteer import rig
 from parksteer.errors import UsageError
 
-PRINTED_TABLE1 = Path("data") / "table1_printed.csv"
+PRINTED_TABLE1 = data_file("table1_printed.csv")
 
 MU = 0.666
 P0_PA = 245000.0

@@ -16,14 +16,14 @@ import pytest
 
 from parksteer.errors import UsageError
 from parksteer.geometry import lock_steer_angle, steer_axis
-from parksteer.model.simulate import with_overrides
+from parksteer.model.numeric.simulate import with_overrides
 from parksteer.sweep import SweepError, load_sweep
 from parksteer.sweep.aggregate import threshold_crossings
 from parksteer.sweep.design import point_overrides
 from parksteer.sweep.merit import figures_of_merit
 from parksteer.sweep.run import simulate_point
 
-EXAMPLE = "workflow/sweeps/design.yaml"
+EXAMPLE = "config/sweeps/design.yaml"
 
 
 def _write(tmp_path: Path, text: str, name: str = "s.yaml") -> Path:
@@ -333,8 +333,8 @@ def test_point_job_never_derives(params, tmp_path, monkeypatch):
 
 def _snakefile_with_sweep(repo_root: Path, tmp_path: Path) -> Path:
     """The repository's Snakefile, with the model and sweep rules included if it does not include them yet."""
-    main = (repo_root / "Snakefile").read_text(encoding="utf-8")
-    lines = [f'include: "{repo_root / "Snakefile"}"']
+    main = (repo_root / "workflow" / "Snakefile").read_text(encoding="utf-8")
+    lines = [f'include: "{repo_root / "workflow" / "Snakefile"}"']
     for rules in ("model.smk", "sweep.smk"):
         if rules not in main:
             lines.append(f'include: "{repo_root / "workflow" / "rules" / rules}"')
@@ -392,7 +392,7 @@ def test_slurm_submission_with_stand_in_tools_requests_bounded_group_jobs(repo_r
     pytest.importorskip("snakemake_executor_plugin_slurm", reason="the SLURM executor plugin is a test-only extra")
     work = tmp_path / "work"
     (work / "workflow").mkdir(parents=True)
-    for name in ("data", "src", "paper"):
+    for name in ("config", "src", "paper"):
         (work / name).symlink_to(repo_root / name)
     for child in (repo_root / "workflow").iterdir():
         (work / "workflow" / child.name).symlink_to(child)

@@ -15,8 +15,9 @@ from pathlib import Path
 from typing import Any
 
 from .errors import UsageError
+from .resources import data_file
 
-DEFAULT_PATH = Path(__file__).resolve().parents[2] / "data" / "parameters.toml"
+DEFAULT_PATH = data_file("parameters.toml")
 
 INF = math.inf
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from parksteer.diagnose.synthetic import DatasetSpec, make_dataset
+from parksteer.synthetic.datasets import DatasetSpec, make_dataset
 from parksteer.measure.io import write_measurement
 
 ONE_FILE = (("unladen", "ground"),)

@@ -7,7 +7,7 @@ import pytest
 
 from parksteer.diagnose.calibrate import Fit, FitParameter
 from parksteer.diagnose.candidates import Signature, score, strength_parameter
-from parksteer.model.components import Effect, EffectParameter
+from parksteer.model.symbolic.components import Effect, EffectParameter
 
 
 class _Candidate(Effect):

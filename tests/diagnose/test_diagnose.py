@@ -13,8 +13,8 @@ from parksteer.diagnose.ladder import error_ladder
 from parksteer.diagnose.problem import load_files
 from parksteer.diagnose.report import SCHEMA_PATH, diagnosis_dict
 from parksteer.diagnose.select import diagnose
-from parksteer.diagnose.synthetic import USER_EFFECT_PATH
-from parksteer.model.components import MODULES_ENV, discover_effects, load_effect_module
+from parksteer.synthetic.datasets import USER_EFFECT_PATH
+from parksteer.model.symbolic.components import MODULES_ENV, discover_effects, load_effect_module
 
 # Base parameters moved off the parameter file's values, as a real car's would be: a diagnosis must calibrate them.
 OFF_NOMINAL = {"tyre_friction.friction_coefficient": 0.70, "rack_friction.friction_force": 650.0,

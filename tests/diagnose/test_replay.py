@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 
 from parksteer.diagnose.replay import Replay, smooth_rack
-from parksteer.measure.degrade import add_noise, quantise, quantisation_step
-from parksteer.model.components import resolve_effects
-from parksteer.model.inputs import rack_drive_from_arrays
-from parksteer.model.simulate import simulate
+from parksteer.synthetic.logger import add_noise, quantise, quantisation_step
+from parksteer.model.symbolic.components import resolve_effects
+from parksteer.model.numeric.inputs import rack_drive_from_arrays
+from parksteer.model.numeric.simulate import simulate
 
 FULL_SCALE_M = 0.1
 

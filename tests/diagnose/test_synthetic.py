@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from parksteer.diagnose import settings
-from parksteer.diagnose.synthetic import (
+from parksteer.synthetic.datasets import (
     DISTURBANCES,
     Disturbance,
     benchmark_specs,
@@ -14,7 +14,7 @@ from parksteer.diagnose.synthetic import (
     hand,
     torque_step_Nm,
 )
-from parksteer.model.components import discover_effects
+from parksteer.model.symbolic.components import discover_effects
 
 
 def test_hidden_imbalance_has_the_requested_rms(written, params):

@@ -8,6 +8,7 @@ import math
 import numpy as np
 import pytest
 
+from parksteer.resources import data_file
 from parksteer.errors import UsageError
 from parksteer.figures.rig import make_fig3, make_fig4, make_table1
 from parksteer.tables import read_csv
@@ -16,7 +17,7 @@ from parksteer.tables import read_csv
 def test_table1_outputs_list_exactly_the_ratio_discrepancies(params, repo_root, tmp_path):
     """Only the 60 mm and 105 mm spin/steer ratios disagree with their angle quotient, and both are explained
     by the rounding of the printed angles; the CSV carries printed and recomputed columns side by side."""
-    make_table1(params, repo_root / "data" / "table1_printed.csv", tmp_path / "t.csv", tmp_path / "t.json")
+    make_table1(params, data_file("table1_printed.csv"), tmp_path / "t.csv", tmp_path / "t.json")
     summary = json.loads((tmp_path / "t.json").read_text())
     found = [(d["offset_mm"], d["quantity"], d["explained_by_angle_rounding"]) for d in summary["disagreements"]]
     assert found == [(60.0, "spin_steer_ratio", True), (105.0, "spin_steer_ratio", True)]

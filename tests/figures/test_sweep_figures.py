@@ -7,8 +7,8 @@ import json
 import numpy as np
 import pytest
 
-from parksteer.model.compiled import ensure_entry
-from parksteer.model.components import resolve_effects
+from parksteer.model.codegen.cache import ensure_entry
+from parksteer.model.symbolic.components import resolve_effects
 
 from parksteer.figures.sweep import make_sweep_figure
 from parksteer.sweep import SweepError, load_sweep

@@ -8,16 +8,14 @@ import numpy as np
 import pytest
 
 from parksteer.errors import UsageError
-from parksteer.measure.degrade import (
-    HandVariation,
+from parksteer.synthetic.hand import HandVariation, irregular_hand_profile, sawtooth_hand_profile
+from parksteer.synthetic.logger import (
     LoggerSettings,
     add_noise,
     degrade,
-    irregular_hand_profile,
     quantisation_step,
     quantise,
     resample,
-    sawtooth_hand_profile,
     synthetic_measurement,
 )
 
@@ -167,7 +165,7 @@ def test_irregular_hand_keeps_reversal_times_and_lock_angles(params):
 
 def test_irregular_hand_drives_the_compiled_model_and_reduces_to_the_saw_tooth(params):
     """The profile fits the compiled model's input table, and with no variation it is the model's saw tooth."""
-    from parksteer.model.codegen import MAX_INPUT_PIECES
+    from parksteer.model.codegen.generate import MAX_INPUT_PIECES
 
     hand = irregular_hand_profile(params, VARIATION)
     table = hand.handwheel_profile().table(MAX_INPUT_PIECES)

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from parksteer.errors import UsageError
-from parksteer.measure.degrade import quantisation_step, quantise, resample
+from parksteer.synthetic.logger import quantisation_step, quantise, resample
 from parksteer.measure.metrics import (
     compare,
     compare_measurement,
@@ -18,9 +18,10 @@ from parksteer.measure.metrics import (
     noise_floor,
 )
 from parksteer.measure.phases import PHASES, find_phases
-from parksteer.measure.example import example_hand, example_logger
-from parksteer.measure.standin import quasi_static_cycle
-from parksteer.measure.degrade import irregular_hand_profile, synthetic_measurement
+from parksteer.synthetic.example import example_hand, example_logger
+from parksteer.synthetic.standin import quasi_static_cycle
+from parksteer.synthetic.hand import irregular_hand_profile
+from parksteer.synthetic.logger import synthetic_measurement
 
 FULL_SCALE_NM = 25.0
 

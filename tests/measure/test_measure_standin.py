@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from parksteer.measure import standin
-from parksteer.measure.degrade import sawtooth_hand_profile
+from parksteer.synthetic.hand import sawtooth_hand_profile
 
 JOINT_RAD = 0.45
 

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import pytest
 
-from parksteer.model.simulate import simulate
+from parksteer.model.numeric.simulate import simulate
 
 
 @pytest.fixture(scope="session")

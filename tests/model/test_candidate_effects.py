@@ -17,8 +17,8 @@ from scipy.integrate import cumulative_trapezoid
 
 from parksteer.cli import main
 from parksteer.geometry import steer_axis
-from parksteer.model.inputs import rack_drive_from_arrays
-from parksteer.model.simulate import simulate
+from parksteer.model.numeric.inputs import rack_drive_from_arrays
+from parksteer.model.numeric.simulate import simulate
 from parksteer.rig import pin_torques_Nm
 
 from model_helpers import DISSIPATION_OFF, first_ramp, plateau_mean

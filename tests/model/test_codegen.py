@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 import sympy as sp
 
-from parksteer.model.components import resolve_effects
-from parksteer.model.derive import derive
-from parksteer.model.simulate import prepare
+from parksteer.model.symbolic.components import resolve_effects
+from parksteer.model.symbolic.derive import derive
+from parksteer.model.numeric.simulate import prepare
 
 
 def _random_states(model, rng, count):

@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 
 from parksteer.errors import UsageError
-from parksteer.model.components import discover_effects, resolve_effects
-from parksteer.model.simulate import simulate
-from parksteer.model.values import parse_overrides
+from parksteer.model.symbolic.components import discover_effects, resolve_effects
+from parksteer.model.numeric.simulate import simulate
+from parksteer.model.numeric.values import parse_overrides
 
 PAPER_EFFECTS = ["carcass_compliance", "hooke_joint", "lifting", "rack_friction", "tyre_friction"]
 
@@ -56,7 +56,7 @@ def test_every_effect_declares_its_parameters(params):
 
 NEW_EFFECT = '''
 """Viscous damping of the rack (an effect added as one file)."""
-from parksteer.model.components import Effect, EffectParameter
+from parksteer.model.symbolic.components import Effect, EffectParameter
 
 
 class RackViscous(Effect):

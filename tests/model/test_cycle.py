@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from parksteer.model.simulate import simulate
+from parksteer.model.numeric.simulate import simulate
 
 from model_helpers import first_ramp, plateau_mean
 

@@ -7,7 +7,7 @@ from scipy.integrate import cumulative_trapezoid
 
 from model_helpers import DISSIPATION_OFF
 
-from parksteer.model.simulate import simulate
+from parksteer.model.numeric.simulate import simulate
 
 def test_work_at_handwheel_equals_energy_change_without_dissipation(params):
     """With every friction and damper off (air bearings: no tyre friction), the work done at the handwheel,

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from parksteer.model.simulate import simulate
+from parksteer.model.numeric.simulate import simulate
 
 
 def test_ripple_has_two_cycles_per_revolution_and_the_joint_amplitude(params):

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from parksteer.model.inputs import sawtooth_profile
-from parksteer.model.simulate import with_overrides
+from parksteer.model.numeric.inputs import sawtooth_profile
+from parksteer.model.numeric.simulate import with_overrides
 
 
 def test_cycle_reaches_each_lock_at_the_papers_times(params):
@@ -50,8 +50,8 @@ def test_ideal_saw_tooth_without_rounding(params):
 def test_a_given_handwheel_profile_drives_the_model(params):
     """A HandwheelProfile given to simulate replaces the saw tooth: the run follows that angle (here a steer to
     3 rad and hold) and ends with it; the header says the drive was prescribed."""
-    from parksteer.model.inputs import profile_from_rates
-    from parksteer.model.simulate import simulate
+    from parksteer.model.numeric.inputs import profile_from_rates
+    from parksteer.model.numeric.simulate import simulate
 
     profile = profile_from_rates([(0.5, 4.0), (1.0, 0.0), (0.5, -4.0), (1.0, 0.0)])  # 0.5 + 2 + 0.5 = 3 rad, hold
     result = simulate("unladen", params=params, handwheel=profile)

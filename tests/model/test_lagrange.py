@@ -6,9 +6,9 @@ import numpy as np
 import sympy as sp
 import sympy.physics.mechanics as me
 
-from parksteer.model.components import resolve_effects
-from parksteer.model.derive import build_space
-from parksteer.model.simulate import prepare
+from parksteer.model.symbolic.components import resolve_effects
+from parksteer.model.symbolic.derive import build_space
+from parksteer.model.numeric.simulate import prepare
 
 
 def test_kane_agrees_with_lagrange_at_random_states(params):

@@ -7,7 +7,7 @@ import dataclasses
 import numpy as np
 
 from parksteer.geometry import lifting_torque_a1
-from parksteer.model.simulate import simulate
+from parksteer.model.numeric.simulate import simulate
 
 ONLY_LIFTING = {"rack_friction.friction_force": 0.0, "hooke_joint.joint_angle": 0.0}
 

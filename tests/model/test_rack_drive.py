@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from parksteer.errors import UsageError
-from parksteer.model.inputs import rack_drive_from_arrays
-from parksteer.model.simulate import simulate
+from parksteer.model.numeric.inputs import rack_drive_from_arrays
+from parksteer.model.numeric.simulate import simulate
 
 
 def test_prescribed_rack_reproduces_the_handwheel_torque(params):

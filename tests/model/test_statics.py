@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from parksteer.model.simulate import prepare, static_state
+from parksteer.model.numeric.simulate import prepare, static_state
 
 
 @pytest.mark.parametrize("case", ["unladen", "part_laden", "offset_12_7mm", "offset_44_5mm", "offset_68_5mm"])

@@ -6,7 +6,7 @@ from pathlib import Path
 PARAMETERS = config["parameters"]
 
 # The model's source: a change here re-derives the compiled models (and only a change here).
-MODEL_SOURCES = sorted(glob.glob("src/parksteer/model/**/*.py", recursive=True))
+MODEL_SOURCES = sorted(glob.glob("src/parksteer/model/symbolic/**/*.py", recursive=True) + glob.glob("src/parksteer/model/codegen/**/*.py", recursive=True))
 
 FIGURES = {
     "table1": ["figures/table1.csv"],

@@ -5,10 +5,10 @@
 # hidden-effect benchmark (one job each, so they run in parallel) and diag_benchmark scores them all.
 from parksteer.diagnose import settings as DIAG
 from parksteer.diagnose.benchmark import case_names as _bench_case_names
-from parksteer.diagnose.synthetic import file_name as _diag_file_name
+from parksteer.synthetic.datasets import file_name as _diag_file_name
 
 DIAG_MODEL_SOURCES = MODEL_SOURCES + [
-    "examples/user_effect/column_imbalance.py"
+    "src/parksteer/examples/column_imbalance.py"
 ]
 DIAG_CAR_FILES = [f"results/diagnose/car/{_diag_file_name(c, s)}" for c, s in DIAG.CAR_FILES]
 DIAG_BENCH_CASES = _bench_case_names()

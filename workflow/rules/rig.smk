@@ -5,7 +5,7 @@
 rule table1:
     input:
         parameters=PARAMETERS,
-        printed="data/table1_printed.csv",
+        printed="src/parksteer/data/table1_printed.csv",
     output:
         csv="figures/table1.csv",
         json="results/table1.json",

@@ -1,4 +1,4 @@
-# Design exploration: the sweep declared in config["sweep"] (default workflow/sweeps/design.yaml; its large
+# Design exploration: the sweep declared in config["sweep"] (default config/sweeps/design.yaml; its large
 # version with config["sweep_full"]), expanded into one sweep_point job per point, so that it runs in parallel
 # with --cores N and unchanged on a cluster (workflow/profiles/slurm). Each point job reads the compiled model
 # from the cache (rule derive_model, or sweep_model for an effect set of its own, such as the braked-wheel
@@ -8,7 +8,7 @@ from parksteer.parameters import load_parameters
 from parksteer.sweep import load_sweep
 
 SWEEP = load_sweep(
-    config.get("sweep", "workflow/sweeps/design.yaml"),
+    config.get("sweep", "config/sweeps/design.yaml"),
     load_parameters(PARAMETERS),
     full=bool(config.get("sweep_full", False)),
 )

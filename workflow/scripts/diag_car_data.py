@@ -1,5 +1,5 @@
-# Thin rule script: the logic is parksteer.diagnose.synthetic.write_car_dataset.
-from parksteer.diagnose.synthetic import write_car_dataset
+# Thin rule script: the logic is parksteer.synthetic.datasets.write_car_dataset.
+from parksteer.synthetic.datasets import write_car_dataset
 from parksteer.rules import rule_log
 
 with rule_log(snakemake):

@@ -53,8 +53,8 @@ def _print_json(result: dict) -> None:
 def _compare(args) -> int:
     from ..diagnose.compare import compare_files
     from ..diagnose.problem import load_files
-    from ..model.components import resolve_effects
-    from ..model.values import parse_overrides
+    from ..model.symbolic.components import resolve_effects
+    from ..model.numeric.values import parse_overrides
 
     _check_outputs(args)
     overrides = parse_overrides(args.overrides)
@@ -83,7 +83,7 @@ def _diagnose(args) -> int:
     from ..diagnose.problem import load_files
     from ..diagnose.report import diagnosis_dict, markdown_report, write_markdown
     from ..diagnose.select import diagnose
-    from ..model.components import resolve_effects
+    from ..model.symbolic.components import resolve_effects
 
     _check_outputs(args)
     if not (args.json or args.report or args.plot):

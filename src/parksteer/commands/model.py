@@ -38,8 +38,8 @@ def register(sub) -> None:
 
 
 def _simulate(args) -> int:
-    from ..model.simulate import simulate
-    from ..model.values import parse_overrides
+    from ..model.numeric.simulate import simulate
+    from ..model.numeric.values import parse_overrides
 
     overrides = parse_overrides(args.overrides)
     if args.rack_from is not None and not Path(args.rack_from).is_file():
@@ -52,7 +52,7 @@ def _simulate(args) -> int:
 
 
 def _effects(args) -> int:
-    from ..model.components import discover_effects
+    from ..model.symbolic.components import discover_effects
 
     params = load_parameters(args.parameters)
     described = [e.describe(params) for e in discover_effects().values()]
@@ -70,8 +70,8 @@ def _effects(args) -> int:
 
 
 def _derive(args) -> int:
-    from ..model.compiled import ensure_entry, entry_path, model_key
-    from ..model.components import resolve_effects
+    from ..model.codegen.cache import ensure_entry, entry_path, model_key
+    from ..model.symbolic.components import resolve_effects
 
     effects = resolve_effects(args.effects)
     start = time.perf_counter()

@@ -1,6 +1,6 @@
 """The hidden-effect benchmark: diagnose synthetic data sets whose truth is known, and score the diagnoses.
 
-One data set (:func:`run_case`) is generated (:func:`parksteer.diagnose.synthetic.make_dataset`),
+One data set (:func:`run_case`) is generated (:func:`parksteer.synthetic.datasets.make_dataset`),
 written as measurement files, read back through the same reader a user's file goes through,
 and diagnosed; the truth is written to its own file. :func:`aggregate` then scores all of
 them:
@@ -30,7 +30,7 @@ from . import settings
 from .problem import load_files
 from .report import diagnosis_dict
 from .select import diagnose
-from .synthetic import benchmark_specs, file_name, make_dataset
+from ..synthetic.datasets import benchmark_specs, file_name, make_dataset
 
 TARGETS = {"named_or_group_at_2_steps": 0.90, "false_alarm_rate": 0.05, "outside_unexplained": 0.80,
            "rms_after_over_noise_floor": 1.2}

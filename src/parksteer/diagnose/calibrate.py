@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..model.components import Effect
+from ..model.symbolic.components import Effect
 from . import settings
 from .problem import Problem, lag1_autocorrelation
 

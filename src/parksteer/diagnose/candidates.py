@@ -1,6 +1,6 @@
 """Candidate effects: which ones can be tested, their signatures, and the score test that ranks them.
 
-A candidate is any registered effect (:mod:`parksteer.model.components`: the package's
+A candidate is any registered effect (:mod:`parksteer.model.symbolic.components`: the package's
 modules, entry points, configured files) that is not in the model, and that has a strength:
 the parameter whose default value means the effect is absent. It is the parameter named
 ``strength`` if there is one, else the only parameter whose default is zero and whose range
@@ -37,7 +37,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..model.components import Effect, EffectParameter, discover_effects
+from ..model.symbolic.components import Effect, EffectParameter, discover_effects
 from . import settings
 from .calibrate import Fit
 from .problem import Problem
@@ -155,8 +155,8 @@ def ensure_candidate_models(effects=None, extra: tuple[str, ...] = ()) -> list[d
     Deriving them up front, in one job, spares the parallel diagnoses of a pipeline from
     deriving the same model side by side.
     """
-    from ..model.compiled import ensure_entry, model_key
-    from ..model.components import load_effect_module, resolve_effects
+    from ..model.codegen.cache import ensure_entry, model_key
+    from ..model.symbolic.components import load_effect_module, resolve_effects
 
     base = resolve_effects(effects)
     registry = discover_effects()

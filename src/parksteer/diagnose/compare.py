@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..measure.metrics import Comparison, compare
-from ..model.components import Effect, resolve_effects
+from ..model.symbolic.components import Effect, resolve_effects
 from ..parameters import Parameters
 from .problem import FileData, Problem, fit_statistics
 

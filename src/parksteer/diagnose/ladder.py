@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ..model.components import Effect, resolve_effects
+from ..model.symbolic.components import Effect, resolve_effects
 from ..parameters import Parameters
 from . import settings
 from .problem import FileData

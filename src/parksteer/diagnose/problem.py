@@ -36,7 +36,7 @@ from ..errors import UsageError
 from ..measure.io import Measurement, read_measurement
 from ..measure.metrics import NoiseFloor, noise_floor
 from ..measure.phases import CyclePhases, find_phases
-from ..model.components import Effect
+from ..model.symbolic.components import Effect
 from ..parameters import Parameters
 from . import settings
 from .replay import Replay, SmoothedRack, smooth_rack

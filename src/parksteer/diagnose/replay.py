@@ -23,7 +23,7 @@ measure that uncertainty at every sample.
 The solve (:class:`Replay`): with the rack prescribed, the other coordinates are
 integrated while the column torque is found at each instant from the Kane equations,
 ``M a = F + b T`` with the rack's acceleration given (the same equations as
-:func:`parksteer.model.simulate.simulate` with ``rack_drive``). This module adds speed,
+:func:`parksteer.model.numeric.simulate.simulate` with ``rack_drive``). This module adds speed,
 not physics: the spline is evaluated from its coefficients, the column twist (which does
 not feed back on the torque) is left out, and the integrator (LSODA via odeint) gets an
 analytic Jacobian of the reduced system from the compiled model's full one. With ``h =
@@ -49,8 +49,8 @@ from scipy.interpolate import BSpline, PPoly
 
 from ..errors import UsageError
 from ..measure.metrics import estimate_noise_rms
-from ..model.components import Effect
-from ..model.simulate import ATOL_Q, ATOL_U, PreparedRun, prepare, static_state
+from ..model.symbolic.components import Effect
+from ..model.numeric.simulate import ATOL_Q, ATOL_U, PreparedRun, prepare, static_state
 from ..parameters import Parameters
 from . import settings
 
@@ -130,7 +130,7 @@ class SmoothedRack:
         or more, its rounding errors are the same from sample to sample rather than
         independent, and the turning time the data fix is correspondingly less certain.
         """
-        from ..measure.degrade import add_noise, quantise
+        from ..synthetic.logger import add_noise, quantise
 
         logged = quantise(add_noise(self.evaluate(time_s)[0], analog_rms, rng), full_scale, bits)
         return smooth_rack(time_s, logged, self.knot_spacing_s)

@@ -7,12 +7,13 @@ from pathlib import Path
 
 import numpy as np
 
+from ..resources import data_file
 from ..tables import atomic_path
 from . import settings
 from .select import Candidate, Diagnosis
 
 SCHEMA_ID = "parksteer.diagnosis/1"
-SCHEMA_PATH = Path(__file__).resolve().parents[3] / "workflow" / "schemas" / "diagnosis.schema.json"
+SCHEMA_PATH = data_file("diagnosis.schema.json")
 
 
 def _finite(x: float | None) -> float | None:

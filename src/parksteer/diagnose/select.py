@@ -48,8 +48,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..model.components import Effect, discover_effects, resolve_effects
-from ..model.values import SURFACES
+from ..model.symbolic.components import Effect, discover_effects, resolve_effects
+from ..model.numeric.values import SURFACES
 from ..parameters import Parameters
 from . import settings
 from .calibrate import Fit, FitParameter, calibrate, least_squares

@@ -36,7 +36,7 @@ RACK_REST_TEST_CHI2 = 25.0  # 1
 REPLAY_ENSEMBLE_DRAWS = 8
 REPLAY_ENSEMBLE_SEED = 271828
 # Integrator tolerances of the replay: relative, and a multiple of the model's own absolute
-# tolerances (parksteer.model.simulate). Checked against the model's tight tolerances: the
+# tolerances (parksteer.model.numeric.simulate). Checked against the model's tight tolerances: the
 # torque moves by under 1e-3 N m, a few thousandths of a converter step.
 REPLAY_RTOL = 1e-5  # 1
 REPLAY_ATOL_FACTOR = 100.0  # 1
@@ -93,7 +93,7 @@ CONFOUNDED_FRACTION = 0.3  # 1
 # --- the error ladder and the reports -------------------------------------------------------------
 LADDER_MAX_STEPS = 3  # effects added one at a time beyond the calibrated base
 
-# --- the synthetic car data set (parksteer.diagnose.synthetic) -----------------------------------
+# --- the synthetic car data set (parksteer.synthetic.datasets) -----------------------------------
 # Stand-in for the paper's car tests, with ONE hidden effect the paper's model lacks at a realistic
 # strength: breakaway friction of the rack 300 N above its kinetic friction (the candidate's
 # provenance gives 0-400 N as typical beside F = 730 N). Its name is kept out of the files' names
@@ -117,7 +117,7 @@ CAR_SEED = 1983  # the year of the Maestro road test the lock angle comes from
 # File i's hand is seeded 100 CAR_SEED + i and its logger noise 100 CAR_SEED + 50 + i; the base
 # parameters are perturbed as the benchmark's (BENCHMARK_PERTURBATION), seeded CAR_SEED.
 
-# --- the hidden-effect benchmark (parksteer.diagnose.synthetic, .benchmark) -------------------------
+# --- the hidden-effect benchmark (parksteer.synthetic.datasets, .benchmark) -------------------------
 # Strengths: the RMS torque change of the hidden effect over the data set's files, in converter
 # steps; found by bisection on the strength.
 BENCHMARK_STEPS = (1.0, 2.0, 3.5, 5.0)

@@ -81,7 +81,7 @@ def all_simulations() -> list[tuple[str, str]]:
 
 
 def run_simulation(params: Parameters, case: str, variant: str):
-    from ..model.simulate import simulate
+    from ..model.numeric.simulate import simulate
 
     effects, surface = VARIANTS[variant]
     return simulate(case, effects=effects, surface=surface, params=params)

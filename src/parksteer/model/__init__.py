@@ -6,5 +6,5 @@
   Jacobian, compilation and the on-disk cache;
 - :mod:`.values`, :mod:`.inputs`, :mod:`.simulate`: parameter vectors, drives and simulation.
 
-Use :func:`parksteer.model.simulate.simulate`, or the ``parksteer simulate`` command.
+Use :func:`parksteer.model.numeric.simulate.simulate`, or the ``parksteer simulate`` command.
 """

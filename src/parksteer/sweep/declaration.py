@@ -246,11 +246,11 @@ def parameter_bounds(key: str) -> tuple[float, float, bool, str]:
             if spec.is_list:
                 raise KeyError(key)
             return (*_spec_bounds(spec), spec.unit)
-        from ..model.values import MODEL_PARAMETERS  # model-only parameters, not in the file's schema
+        from ..model.numeric.values import MODEL_PARAMETERS  # model-only parameters, not in the file's schema
 
         p = MODEL_PARAMETERS[key]
         return p.minimum, p.maximum, True, p.unit
-    from ..model.components import discover_effects  # imports the effects (and sympy) only when needed
+    from ..model.symbolic.components import discover_effects  # imports the effects (and sympy) only when needed
 
     effect = discover_effects()[owner]
     for p in effect.parameters:
@@ -477,7 +477,7 @@ def _check_model_consistency(path: Path, params: Parameters, case: str, effects:
     owners = {k.partition(".")[0] for v in values_list for k in v}
     effect_owners = owners - set(MODEL_SECTIONS) - {"case", "design"}
     if effect_owners:
-        from ..model.components import resolve_effects
+        from ..model.symbolic.components import resolve_effects
 
         chosen = {e.name for e in resolve_effects(effects)}
         for owner in sorted(effect_owners):
@@ -508,7 +508,7 @@ def _braked(path: Path, raw: Any, effects: str | None, surface: str) -> tuple[st
         return raw, None
     if surface != "ground":
         raise SweepError(f"{where}: braked wheels are compared on the ground only (surface is {surface})")
-    from ..model.components import discover_effects, resolve_effects
+    from ..model.symbolic.components import discover_effects, resolve_effects
 
     chosen = [e.name for e in resolve_effects(effects)]
     if "tyre_friction" not in chosen:

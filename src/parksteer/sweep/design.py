@@ -100,10 +100,10 @@ def base_value(params: Parameters, case: str, key: str) -> float:
         return float(params[key])
     except KeyError:
         pass
-    from ..model.values import MODEL_PARAMETERS
+    from ..model.numeric.values import MODEL_PARAMETERS
 
     if key in MODEL_PARAMETERS:
         return MODEL_PARAMETERS[key].default_value(params)
-    from ..model.components import discover_effects
+    from ..model.symbolic.components import discover_effects
 
     return discover_effects()[owner].parameter(name).default_value(params)

@@ -35,7 +35,7 @@ BRAKED_QUANTITIES = ("plateau_torque_Nm", "peak_torque_Nm", "lock_torque_Nm")
 
 def require_cached_model(effects) -> Path:
     """The cache entry of `effects`; a one-line error if it has not been derived yet."""
-    from ..model.compiled import entry_path
+    from ..model.codegen.cache import entry_path
 
     entry = entry_path(effects)
     if not ((entry / "model.json").is_file() and (entry / "model.so").is_file()):
@@ -47,8 +47,8 @@ def require_cached_model(effects) -> Path:
 
 def simulate_point(spec: dict[str, Any], params: Parameters) -> dict[str, Any]:
     """Simulate one point (a dict as Sweep.point_spec returns) and return its record of figures of merit."""
-    from ..model.components import resolve_effects
-    from ..model.simulate import simulate
+    from ..model.symbolic.components import resolve_effects
+    from ..model.numeric.simulate import simulate
 
     effects = resolve_effects(spec["effects"])
     entry = require_cached_model(effects)
@@ -80,8 +80,8 @@ def _tyre_total(merits: dict, names: list[str]) -> float:
 
 def _braked(spec: dict[str, Any], params: Parameters, overrides: dict, free, free_merits: dict) -> dict[str, Any]:
     """The point with its wheels braked: simulated with the braked effect, or estimated by rig theory."""
-    from ..model.components import resolve_effects
-    from ..model.simulate import simulate
+    from ..model.symbolic.components import resolve_effects
+    from ..model.numeric.simulate import simulate
 
     method = spec.get("braked", BRAKED_NONE)
     case, run_params = spec["case"], free.values.params
@@ -128,8 +128,8 @@ def run_point(spec: dict[str, Any], parameters_path: str | Path, out_json: str |
 
 def derive_sweep_model(effects_spec: str | None, out_json: str | Path) -> dict[str, Any]:
     """Build (or find) the cached model of a sweep's effect set and write a manifest naming it."""
-    from ..model.compiled import ensure_entry, entry_path
-    from ..model.components import resolve_effects
+    from ..model.codegen.cache import ensure_entry, entry_path
+    from ..model.symbolic.components import resolve_effects
 
     effects = resolve_effects(effects_spec)
     existed = (entry_path(effects) / "model.json").is_file()

@@ -27,7 +27,7 @@ ring has its yaw inertia about the steer axis only (the paper gives no other com
 the others would only add a little to the roll inertia).
 
 Geometry is numeric: every position, axis direction and inertia is a parameter symbol whose
-value is computed at run time from data/parameters.toml (see :mod:`parksteer.model.values`),
+value is computed at run time from data/parameters.toml (see :mod:`parksteer.model.numeric.values`),
 so the expressions stay small and changing a value never re-derives.
 """
 

@@ -25,8 +25,8 @@ import numpy as np
 from ..geometry import lifting_torque_a1, overall_steering_ratio
 from ..parameters import Parameters
 from ..rig import limiting_torque_Nm
-from .degrade import HandProfile
-from .io import SURFACES
+from .hand import HandProfile
+from ..measure.io import SURFACES
 
 
 def hooke_speed_ratio(column_angle_rad: np.ndarray, joint_angle_rad: float, phase_rad: float) -> np.ndarray:

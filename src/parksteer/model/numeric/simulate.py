@@ -18,11 +18,11 @@ from pathlib import Path
 import numpy as np
 from scipy.integrate import odeint, solve_ivp
 
-from ..errors import UsageError
-from ..parameters import Parameters, load_parameters
-from ..tables import write_csv
+from ...errors import UsageError
+from ...parameters import Parameters, load_parameters
+from ...tables import write_csv
 from .compiled import CompiledModel, load_model
-from .components import Effect, discover_effects, resolve_effects
+from ..symbolic.components import Effect, discover_effects, resolve_effects
 from .inputs import HandwheelProfile, RackDrive, rack_drive_from_csv, sawtooth_profile
 from .values import RunValues, parameter_vector, resolve_values
 
@@ -173,7 +173,7 @@ def _columns(run: PreparedRun, t: np.ndarray, states: np.ndarray, outputs: dict,
         "load_left_N": outputs["load_left_N"],
         "load_right_N": outputs["load_right_N"],
     }
-    for effect in model.effects:
+    for effect in model.symbolic.effects:
         cols[f"contrib_{effect}_Nm"] = outputs[f"contrib_{effect}_Nm"]
     cols["contrib_inertia_Nm"] = outputs["contrib_inertia_Nm"]
     cols["handwheel_rate_rad_s"] = handwheel[:, 1]
@@ -193,7 +193,7 @@ def _header(run: PreparedRun, drive: str) -> dict[str, str]:
         "model": "parksteer multibody steering model (Sharp & Granger section 4)",
         "case": run.values.case,
         "surface": run.values.surface,
-        "components": ", ".join(run.model.effects) or "none",
+        "components": ", ".join(run.model.symbolic.effects) or "none",
         "drive": drive,
         "model_key": run.model.directory.name,
         "derived.roll_spring_neutral": f"{run.p[run.parameter_index(ROLL_NEUTRAL_KEY)]:.10g} rad",

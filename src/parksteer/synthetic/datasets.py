@@ -1,11 +1,11 @@
 """Synthetic measurements with something hidden in them: the car data set and the benchmark's data sets.
 
 Every file is made the way a car test would be: the driver's hand turns the wheel through
-the paper's cycle with an irregular speed (:func:`parksteer.measure.degrade.irregular_hand_profile`);
-the model is driven by that handwheel angle (:func:`parksteer.model.simulate.simulate` with
+the paper's cycle with an irregular speed (:func:`parksteer.synthetic.logger.irregular_hand_profile`);
+the model is driven by that handwheel angle (:func:`parksteer.model.numeric.simulate.simulate` with
 ``handwheel``: the column twists, the rack follows), so the data come from the other drive
 mode than the rack replay that analyses them; the logger then samples, adds noise and
-quantises every channel (:func:`parksteer.measure.degrade.synthetic_measurement`, the
+quantises every channel (:func:`parksteer.synthetic.logger.synthetic_measurement`, the
 settings of the parameter file's ``[synthetic]`` section). What is hidden is one of:
 
 - a candidate effect of the library at a strength that changes the torque by a given number
@@ -31,19 +31,20 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import UsageError
-from ..measure.degrade import HandProfile, irregular_hand_profile, quantisation_step, synthetic_measurement
-from ..measure.example import example_hand, example_logger
+from .hand import HandProfile, irregular_hand_profile
+from .logger import quantisation_step, synthetic_measurement
+from .example import example_hand, example_logger
 from ..measure.io import OPTIONAL_COLUMNS, REQUIRED_COLUMNS, Measurement
-from ..model.components import discover_effects, load_effect_module
-from ..model.simulate import simulate
+from ..model.symbolic.components import discover_effects, load_effect_module
+from ..model.numeric.simulate import simulate
 from ..parameters import Parameters
-from . import settings
-from .candidates import strength_parameter
+from ..resources import example_effect
+from ..diagnose import settings
+from ..diagnose.candidates import strength_parameter
 
 RECORDED = [name for name in REQUIRED_COLUMNS + OPTIONAL_COLUMNS if name != "time_s"]
 CLEAN_OUTPUT_DT_S = 0.005
-REPO_ROOT = Path(__file__).resolve().parents[3]
-USER_EFFECT_PATH = REPO_ROOT / "examples" / "user_effect" / "column_imbalance.py"
+USER_EFFECT_PATH = example_effect("column_imbalance")
 DISTURBANCES = ("torque_drift", "gear_tooth", "channel_lag", "column_imbalance")
 RANGE_HEADROOM = 0.1  # a logger range leaves at least this fraction of headroom over the signal's peak
 RANGE_STEP_FRACTION = 0.2  # ranges go up in steps of this fraction of the parameter file's range
@@ -203,7 +204,7 @@ def _logged(params: Parameters, columns: dict[str, np.ndarray], case: str, surfa
             full_scale[name] = unit * math.ceil(peak / (1.0 - RANGE_HEADROOM) / unit)
     logger = dataclasses.replace(logger, full_scale=full_scale)
     return synthetic_measurement(columns["time_s"], {k: v for k, v in columns.items() if k != "time_s"}, logger,
-                                 case=case, surface=surface, source="synthetic: parksteer.diagnose.synthetic",
+                                 case=case, surface=surface, source="synthetic: parksteer.synthetic.datasets",
                                  extra_metadata=dict(hand_profile.metadata))
 
 

@@ -17,11 +17,11 @@ import dataclasses
 import math
 import numpy as np
 
-from ..errors import UsageError
-from ..geometry import steer_axis
-from ..parameters import CASE_SCHEMA, SCHEMA, Parameters
-from .components import Effect, EffectParameter
-from .system import CORE_PARAMETERS, DERIVED, SIDES
+from ...errors import UsageError
+from ...geometry import steer_axis
+from ...parameters import CASE_SCHEMA, SCHEMA, Parameters
+from ..symbolic.components import Effect, EffectParameter
+from ..symbolic.system import CORE_PARAMETERS, DERIVED, SIDES
 
 SURFACES = {"ground": 1.0, "air_bearing": 0.0}
 
@@ -140,7 +140,7 @@ def resolve_values(params: Parameters, case: str, effects: list[Effect], overrid
 
 
 def derived_values(values: RunValues) -> dict[str, float]:
-    """Values computed from the case and the geometry, keyed as in parksteer.model.system."""
+    """Values computed from the case and the geometry, keyed as in parksteer.model.symbolic.system."""
     params, case = values.params, values.case
     c = params.case(case)
     roll_axis_z = params["vehicle.roll_axis_z"]

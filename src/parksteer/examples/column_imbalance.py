@@ -26,7 +26,7 @@ import math
 
 import sympy as sp
 
-from parksteer.model.components import Effect, EffectParameter
+from parksteer.model.symbolic.components import Effect, EffectParameter
 
 
 class ColumnImbalance(Effect):

@@ -18,8 +18,8 @@ from pathlib import Path
 import numpy as np
 from scipy.interpolate import CubicSpline
 
-from ..errors import UsageError
-from ..tables import read_csv
+from ...errors import UsageError
+from ...tables import read_csv
 
 
 @dataclass(frozen=True)

@@ -4,7 +4,7 @@ A physical mechanism of the steering model (tyre friction, rack friction, ...) i
 :class:`Effect` living in one module of its own. The registry finds effects in three
 places, so that adding one never needs an edit of the core:
 
-- every module of the package :mod:`parksteer.model.effects` that defines ``EFFECT``;
+- every module of the package :mod:`parksteer.model.symbolic.effects` that defines ``EFFECT``;
 - Python entry points in the group ``parksteer.effects`` (each loads an Effect class or
   instance);
 - a module given by name or file path in an effects spec (``+my_pkg.my_effect`` or
@@ -14,7 +14,7 @@ places, so that adding one never needs an edit of the core:
 An effect may add generalized coordinates, replace the steer functions of the linkage
 or the column-to-pinion map, make the column's spring act on a deflection of its twist, move
 where vertical loads act, add bodies, and contribute loads (forces on points, torques on frames)
-and potential energy; see :class:`parksteer.model.system.ModelSpace`.
+and potential energy; see :class:`parksteer.model.symbolic.system.ModelSpace`.
 Every parameter value is a runtime input of the generated code, so changing one never
 re-derives or recompiles. An effect beyond the paper should have a strength parameter
 whose default means absent, so that it can be present at strength 0 and its sensitivity
@@ -33,7 +33,7 @@ from importlib.metadata import entry_points
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, ClassVar
 
-from ..errors import UsageError
+from ...errors import UsageError
 
 if TYPE_CHECKING:  # pragma: no cover
     from .system import ModelSpace

@@ -1,11 +1,11 @@
 """The example measurement file, data/measurements/example_unladen.csv: a synthetic measurement.
 
-It is made from the multibody model (:func:`parksteer.model.simulate.simulate`) for the
+It is made from the multibody model (:func:`parksteer.model.numeric.simulate.simulate`) for the
 ``unladen`` case on the ground, as the paper's car test would have been logged:
 
 - the hand turns the wheel through the Section 4 cycle with its speed wandering by up to 25 %
   (:func:`example_hand`, from the parameter file); the model takes that motion as the rack displacement it produces
-  through a rigid column and the Hooke joint (:func:`parksteer.measure.standin.rack_of_hand`),
+  through a rigid column and the Hooke joint (:func:`parksteer.synthetic.standin.rack_of_hand`),
   and finds the handwheel torque, the handwheel angle (with the column twist) and the wheel
   loads that rack motion needs;
 - the logger samples at 50 Hz with 8 bits over the full scales of :func:`example_logger` (from the parameter file), with
@@ -22,8 +22,9 @@ from pathlib import Path
 import numpy as np
 
 from ..parameters import Parameters
-from .degrade import HandVariation, LoggerSettings, irregular_hand_profile, synthetic_measurement
-from .io import OPTIONAL_COLUMNS, REQUIRED_COLUMNS, Measurement, write_measurement
+from .hand import HandVariation, irregular_hand_profile
+from .logger import LoggerSettings, synthetic_measurement
+from ..measure.io import OPTIONAL_COLUMNS, REQUIRED_COLUMNS, Measurement, write_measurement
 from .standin import rack_of_hand
 
 
@@ -71,8 +72,8 @@ EXAMPLE_CASE = "unladen"
 
 def example_measurement(params: Parameters, case: str = EXAMPLE_CASE) -> Measurement:
     """The example: the model driven by the rack of an irregular hand, logged by the example logger."""
-    from ..model.inputs import rack_drive_from_arrays
-    from ..model.simulate import simulate
+    from ..model.numeric.inputs import rack_drive_from_arrays
+    from ..model.numeric.simulate import simulate
 
     hand = irregular_hand_profile(params, example_hand(params), output_dt_s=0.002)
     drive = rack_drive_from_arrays(hand.time_s, rack_of_hand(params, hand.angle_rad))
@@ -89,7 +90,7 @@ def example_measurement(params: Parameters, case: str = EXAMPLE_CASE) -> Measure
         example_logger(params),
         case=case,
         surface="ground",
-        source="synthetic: parksteer.measure.example.example_measurement",
+        source="synthetic: parksteer.synthetic.example.example_measurement",
         extra_metadata=extra,
     )
 

@@ -1,0 +1,129 @@
+"""Derive, generate, compile and cache a model: the symbolic half of the model, ready to load.
+
+A cache entry is a directory holding the generated C, the shared library and a JSON of
+the state names, parameter order and outputs. Its key is a hash of the effect set, the
+source of the model package (and of any effect module outside it) and the sympy version,
+so a change of the model's source makes a new entry and a simulation never re-derives a
+model that is already cached. The cache directory is ``$PARKSTEER_MODEL_CACHE``, else
+``results/model`` in the repository when the package runs from a checkout, else the
+user's cache directory.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import inspect
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import sympy
+
+from ...errors import UsageError
+from ..symbolic.components import Effect
+
+CACHE_ENV = "PARKSTEER_MODEL_CACHE"
+FORMAT_VERSION = "1"
+MODEL_DIR = Path(__file__).resolve().parents[1]
+# The symbolic half: what the generated code depends on. numeric/ is not hashed, so editing it never re-derives.
+SYMBOLIC_DIRS = (MODEL_DIR / "symbolic", MODEL_DIR / "codegen")
+REPO_ROOT = MODEL_DIR.parents[2]
+
+
+def cache_root() -> Path:
+    env = os.environ.get(CACHE_ENV)
+    if env:
+        return Path(env)
+    if (REPO_ROOT / "workflow" / "Snakefile").is_file() and (REPO_ROOT / "src" / "parksteer").is_dir():
+        return REPO_ROOT / "results" / "model"
+    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
+    return Path(base) / "parksteer" / "model"
+
+
+def _effect_source(effect: Effect) -> str:
+    module = sys.modules.get(type(effect).__module__)
+    path = getattr(module, "__file__", None)
+    if path and any(Path(path).resolve().is_relative_to(d) for d in SYMBOLIC_DIRS):
+        return ""  # hashed with the symbolic half
+    try:
+        return inspect.getsource(module)
+    except (OSError, TypeError):
+        return repr(type(effect))
+
+
+def model_key(effects: list[Effect]) -> str:
+    """Hash of the effect set, the symbolic half's source (symbolic/ and codegen/), external effects' source and
+    the sympy version."""
+    digest = hashlib.sha256()
+    digest.update(f"format {FORMAT_VERSION}\nsympy {sympy.__version__}\n".encode())
+    digest.update(("effects " + ",".join(e.name for e in effects) + "\n").encode())
+    for path in sorted(p for d in SYMBOLIC_DIRS for p in d.rglob("*.py")):
+        digest.update(str(path.relative_to(MODEL_DIR)).encode() + b"\0" + path.read_bytes() + b"\0")
+    for effect in effects:
+        digest.update(_effect_source(effect).encode())
+    return digest.hexdigest()[:20]
+
+
+def find_compiler() -> str:
+    for name in filter(None, (os.environ.get("CC"), "cc", "gcc", "clang")):
+        found = shutil.which(name)
+        if found:
+            return found
+    raise UsageError("no C compiler found (tried $CC, cc, gcc, clang): install one, e.g. apt-get install gcc")
+
+
+def build_entry(effects: list[Effect], directory: Path) -> dict:
+    """Derive, generate and compile the model for `effects` into `directory`; return its description."""
+    from ..symbolic.derive import derive
+    from .generate import generate
+
+    start = time.perf_counter()
+    derivation = derive(effects)
+    t_derive = time.perf_counter() - start
+    source, info = generate(derivation)
+    t_codegen = time.perf_counter() - start - t_derive
+    directory.mkdir(parents=True, exist_ok=True)
+    (directory / "model.c").write_text(source, encoding="utf-8")
+    compiler = find_compiler()
+    cmd = [compiler, "-O2", "-shared", "-fPIC", "-o", str(directory / "model.so"), str(directory / "model.c"), "-lm"]
+    done = subprocess.run(cmd, capture_output=True, text=True)
+    if done.returncode != 0:
+        first = (done.stderr.strip().splitlines() or ["unknown error"])[0]
+        raise UsageError(f"C compiler failed on the generated model: {first}")
+    t_compile = time.perf_counter() - start - t_derive - t_codegen
+    info.update({
+        "sympy_version": sympy.__version__,
+        "timings_s": {"derive": t_derive, "codegen": t_codegen, "compile": t_compile,
+                      "total": time.perf_counter() - start, **derivation.timings_s},
+    })
+    (directory / "model.json").write_text(json.dumps(info, indent=1, sort_keys=True) + "\n", encoding="utf-8")
+    return info
+
+
+def entry_path(effects: list[Effect]) -> Path:
+    return cache_root() / model_key(effects)
+
+
+def ensure_entry(effects: list[Effect]) -> Path:
+    """The cache entry of `effects`, built if missing (atomically: built aside, then renamed into place)."""
+    final = entry_path(effects)
+    if (final / "model.json").is_file() and (final / "model.so").is_file():
+        return final
+    final.parent.mkdir(parents=True, exist_ok=True)
+    scratch = Path(tempfile.mkdtemp(prefix=f".{final.name}.", dir=final.parent))
+    try:
+        build_entry(effects, scratch)
+        try:
+            os.rename(scratch, final)
+        except OSError:
+            if not (final / "model.json").is_file():  # someone else's complete entry wins
+                raise
+    finally:
+        if scratch.exists():
+            shutil.rmtree(scratch, ignore_errors=True)
+    return final

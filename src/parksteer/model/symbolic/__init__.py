@@ -1,0 +1,1 @@
+"""The symbolic half of the model: bodies, effects and Kane's equations (sympy.physics.mechanics)."""

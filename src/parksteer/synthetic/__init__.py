@@ -1,0 +1,1 @@
+"""Synthetic data: the hand, the logger, closed-form stand-ins and the data sets made from the model."""
