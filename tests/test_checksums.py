@@ -46,12 +46,14 @@ def test_refresh_writes_sha256sum_format(tmp_path):
 
 
 def test_verification_fails_when_a_figure_byte_changes(tmp_path):
-    """One flipped byte in an SVG fails verification; unchanged data is reported as a rendering-only change."""
+    """One changed digit in an SVG's drawing fails verification; unchanged data is reported as a rendering-only
+    change (a byte that breaks the XML is damage instead: see the truncation test below)."""
     files = _make_figure(tmp_path, "f", 1.0)
     refresh(tmp_path, tmp_path / "figures/SHA256SUMS", files)
     svg = tmp_path / "figures/f.svg"
     raw = bytearray(svg.read_bytes())
-    raw[-10] ^= 0x01
+    at = raw.index(b' d="M ') + len(b' d="M ')
+    raw[at] = ord("1") if raw[at] != ord("1") else ord("2")
     svg.write_bytes(bytes(raw))
     problems = verify(tmp_path, tmp_path / "figures/SHA256SUMS", files)
     assert len(problems) == 1
@@ -101,3 +103,29 @@ def test_number_formatting_absorbs_last_bit_noise(value, text):
     from parksteer.tables import format_number
 
     assert format_number(value) == text
+
+
+@pytest.mark.parametrize("victim", ["svg", "csv"])
+def test_truncated_file_is_reported_broken_not_as_a_wobble(tmp_path, victim):
+    """A figure or its data cut off mid-write (a killed job, a full disk) is damage, not a rendering wobble:
+    verify says "broken" and names the file, instead of a traceback or "only the rendering differs"."""
+    files = _make_figure(tmp_path, "f", 1.0)
+    refresh(tmp_path, tmp_path / "figures/SHA256SUMS", files)
+    path = tmp_path / f"figures/f.{victim}"
+    data = path.read_bytes()
+    path.write_bytes(data[: len(data) // 2])
+    problems = verify(tmp_path, tmp_path / "figures/SHA256SUMS", files)
+    assert len(problems) == 1, problems
+    assert problems[0].startswith(f"figures/f.{victim}: broken: "), problems[0]
+    assert "rendering" not in problems[0]
+
+
+def test_rendering_only_change_keeps_its_wording(tmp_path):
+    """The harmless case stays distinguishable: a well-formed SVG whose data is unchanged is "only the rendering
+    differs", not "broken"."""
+    files = _make_figure(tmp_path, "f", 1.0)
+    refresh(tmp_path, tmp_path / "figures/SHA256SUMS", files)
+    svg = tmp_path / "figures/f.svg"
+    svg.write_text(svg.read_text(encoding="utf-8").replace("</svg>", "<!-- other renderer --></svg>"), encoding="utf-8")
+    problems = verify(tmp_path, tmp_path / "figures/SHA256SUMS", files)
+    assert len(problems) == 1 and "only the rendering differs" in problems[0], problems

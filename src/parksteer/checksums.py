@@ -83,6 +83,39 @@ def largest_difference(new_csv: Path, reference_csv: Path) -> DataDifference | s
     return worst if worst is not None else DataDifference("-", 0, 0.0, 0.0)
 
 
+def integrity_problem(path: Path) -> str | None:
+    """Why a built figure or data file cannot be what a rule wrote (truncated, unparsable), or None if it parses.
+
+    A checksum mismatch of a file that parses is a change to explain; one of a file that does not is damage, which
+    an ordinary rebuild repairs once the file is removed.
+    """
+    path = Path(path)
+    if path.stat().st_size == 0:
+        return "empty"
+    if path.suffix == ".svg":
+        import xml.etree.ElementTree as ElementTree
+
+        try:
+            root = ElementTree.parse(path).getroot()
+        except ElementTree.ParseError as exc:
+            return f"not well-formed SVG ({exc})"
+        if not root.tag.endswith("svg"):
+            return f"root element is {root.tag!r}, not svg"
+        return None
+    if path.suffix == ".csv":
+        text = path.read_text(encoding="utf-8", errors="replace")
+        if not text.endswith("\n"):
+            return "does not end with a newline (truncated)"
+        try:
+            columns, _ = read_csv(path)
+        except (ValueError, IndexError, KeyError, UnicodeDecodeError) as exc:
+            return f"not a readable table ({type(exc).__name__}: {exc})"
+        lengths = {len(v) for v in columns.values()}
+        if len(lengths) > 1:
+            return "columns of different lengths"
+    return None
+
+
 def _data_file_for(rel: str, files: list[str]) -> str | None:
     """The CSV that holds a figure's data: itself, or the CSV with the same stem."""
     if rel.endswith(".csv"):
@@ -110,12 +143,18 @@ def verify(root: Path, sums_path: Path, expected_files: list[str]) -> list[str]:
             continue
         if sha256_of(path) == sums[rel]:
             continue
+        broken = integrity_problem(path)
+        if broken is not None:
+            problems.append(f"{rel}: broken: {broken}; delete it and rebuild (snakemake --cores 2 {rel})")
+            continue
         data = _data_file_for(rel, expected_files)
         detail = "no data file to compare"
         if data is not None:
             ref = reference / Path(data).name
             if not ref.exists():
                 detail = f"no reference copy {ref.relative_to(root) if ref.is_relative_to(root) else ref}"
+            elif data != rel and integrity_problem(root / data) is not None:
+                detail = f"its data {data} is broken: {integrity_problem(root / data)}"
             else:
                 diff = largest_difference(root / data, ref)
                 if isinstance(diff, str):

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from parksteer.measure import standin
+from parksteer.synthetic import standin
 from parksteer.synthetic.hand import sawtooth_hand_profile
 
 JOINT_RAD = 0.45
