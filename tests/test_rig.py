@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -185,13 +184,36 @@ def test_free_rolling_equilibrium_is_pure_rolling_and_flat():
 
 
 def test_pin_torques_carry_the_rig_pressure_correction(params):
-    """Both pin-offset limits are scaled by eq (2)/eq (1), so at zero offset both equal equation (2)."""
+    """The spin part of both pin-offset limits is scaled by eq (2)/eq (1), so at zero offset both equal
+    equation (2); the braked curve's drag part (braked integral minus equation (1)) is not scaled."""
     for pressure_Pa in params["rig.fig4_pressures"]:
         torques = rig.pin_torques_Nm(params, 3800.0, pressure_Pa, np.array([0.0, 0.05]))
         eq2 = float(rig.limiting_torque_Nm(params, 3800.0, pressure_Pa))
         assert torques.free_rolling_Nm[0] == pytest.approx(eq2, rel=1e-13)
         assert torques.braked_Nm[0] == pytest.approx(eq2, rel=1e-13)
         assert torques.free_rolling_Nm[1] == pytest.approx(eq2, rel=1e-13)
+        mu = params["tyre.friction_coefficient"]
+        drag = rig.braked_pin_torque_Nm(3800.0, pressure_Pa, mu, 0.05) - rig.gough_torque_Nm(3800.0, pressure_Pa, mu)
+        assert torques.braked_Nm[1] - torques.free_rolling_Nm[1] == pytest.approx(float(drag), rel=1e-12)
+
+
+def test_braked_pin_torque_never_beats_the_net_sliding_force_bound(params):
+    """Physical fact: the friction of a sliding patch can never sum to more than mu W, so the braked torque about
+    the pin is at most mu W e (the net force on the arm) plus the spin moment of the free-rolling wheel, and
+    tends to mu W e as e grows, whatever the pressure distribution (the rig's (p0/p)^(n - 0.5) acts on the spin
+    part only). At 1.5 bar, scaling the whole braked curve by 1.147 broke both, at every Fig. 4 load."""
+    mu = params["tyre.friction_coefficient"]
+    offsets_m = np.concatenate([np.linspace(0.0, 0.12, 121), [0.5, 2.0, 10.0, 50.0]])
+    for pressure_Pa in params["rig.fig4_pressures"]:
+        for load_N in params["rig.loads"]:
+            torques = rig.pin_torques_Nm(params, load_N, pressure_Pa, offsets_m)
+            bound = mu * load_N * offsets_m + torques.free_rolling_Nm
+            assert np.all(torques.braked_Nm <= bound * (1.0 + 1e-12))
+            # the departure from mu W e stays within the spin moment, so the ratio tends to 1 as 1/e
+            far = offsets_m > 0.4
+            arm = mu * load_N * offsets_m[far]
+            assert np.all(np.abs(torques.braked_Nm[far] - arm) <= torques.free_rolling_Nm[far])
+            assert abs(torques.braked_Nm[-1] / arm[-1] - 1.0) < 1e-3
 
 
 # ---------------------------------------------------------------- Table 1

@@ -164,7 +164,7 @@ def limiting_torque_Nm(params: Parameters, load_N, pressure_Pa=None):
 
 @dataclass(frozen=True)
 class PinTorques:
-    """Limiting torques about an offset pin (N m), both scaled by equation (2) / equation (1)."""
+    """Limiting torques about an offset pin (N m), with the rig's pressure correction on the spin part."""
 
     free_rolling_Nm: np.ndarray
     braked_Nm: np.ndarray
@@ -173,16 +173,20 @@ class PinTorques:
 def pin_torques_Nm(params: Parameters, load_N, pressure_Pa, offset_m) -> PinTorques:
     """Free-rolling and braked torques about a pin at `offset_m`, with the rig's pressure correction.
 
-    The uniform-pressure integrals are multiplied by (p0/p)^(n - 0.5), the ratio of
-    equation (2) to equation (1) at that pressure, so that both limits carry the same
-    empirical pressure dependence the rig measured; at e = 0 both equal equation (2).
+    The braked integral splits into the spin part, equation (1) (the patch turning about its
+    own centre), and the drag part, the braked integral minus equation (1) (the patch dragged
+    about the pin). Only the spin part carries (p0/p)^(n - 0.5), the ratio of equation (2) to
+    equation (1), which the rig measured for a patch spinning about its centre: a pressure
+    distribution changes the moment arm of the spin friction, never the net sliding force
+    mu W, so the drag part stays the uniform-pressure integral and tends to mu W e. Since
+    |r - e| <= |r| + e, the drag part never exceeds mu W e, and the braked torque never
+    exceeds mu W e plus the free-rolling torque. At e = 0 both equal equation (2).
     """
     mu = params["tyre.friction_coefficient"]
     scale = pressure_correction(pressure_Pa, params["tyre.reference_pressure"], params["tyre.pressure_index"])
-    return PinTorques(
-        free_rolling_Nm=scale * free_rolling_pin_torque_Nm(load_N, pressure_Pa, mu, offset_m),
-        braked_Nm=scale * braked_pin_torque_Nm(load_N, pressure_Pa, mu, offset_m),
-    )
+    spin_Nm = free_rolling_pin_torque_Nm(load_N, pressure_Pa, mu, offset_m)
+    drag_Nm = braked_pin_torque_Nm(load_N, pressure_Pa, mu, offset_m) - spin_Nm
+    return PinTorques(free_rolling_Nm=scale * spin_Nm, braked_Nm=scale * spin_Nm + drag_Nm)
 
 
 # ---------------------------------------------------------------- Table 1

@@ -41,7 +41,8 @@ def test_fig3_outputs_cross_at_reference_pressure_and_quote_the_correction(param
 
 def test_fig4_outputs_flat_free_rolling_and_rising_braked(params, tmp_path):
     """Free-rolling torque is the same at every offset (equation (2) at that pressure); the braked torque
-    at the largest offset is well above it; the SVG is byte-identical when made twice."""
+    at the largest offset is well above it, and never above mu W e plus the free-rolling torque (friction cannot
+    sum to more than mu W, whatever the pressure); the SVG is byte-identical when made twice."""
     make_fig4(params, tmp_path / "a.svg", tmp_path / "a.csv", tmp_path / "a.json")
     make_fig4(params, tmp_path / "b.svg", tmp_path / "b.csv", tmp_path / "b.json")
     assert (tmp_path / "a.svg").read_bytes() == (tmp_path / "b.svg").read_bytes()
@@ -58,6 +59,8 @@ def test_fig4_outputs_flat_free_rolling_and_rising_braked(params, tmp_path):
             free = columns["free_rolling_torque_Nm"][rows]
             assert np.ptp(free) == 0.0
             assert np.all(np.diff(columns["braked_torque_Nm"][rows]) > 0.0)
+            bound = params["tyre.friction_coefficient"] * w * columns["offset_m"][rows] + free
+            assert np.all(columns["braked_torque_Nm"][rows] <= bound * (1.0 + 1e-9))
     assert "(p0/p)^(n-0.5)" in summary["statement"]
 
 

@@ -1,0 +1,103 @@
+"""Visco-elastic hysteresis of the tyre carcass: a Maxwell branch beside the carcass spring (a rival).
+
+Physics. The paper's carcass is a spring k (728 N m/rad) and a damper c (25 N m s/rad) in
+parallel between each wheel and its tread ring (Kelvin-Voigt). Rubber and cord are visco-elastic:
+their stiffness is higher at fast twisting than at slow, and a loop is lost on each load cycle.
+The simplest model of that is a Maxwell branch, a spring k_m in series with a damper c_m, in
+parallel with the carcass spring (a standard linear solid): at rates well above 1/tau
+(tau = c_m / k_m) the carcass is k + k_m stiff, at rates well below it relaxes to k.
+
+Model. Each side gets one new coordinate, the angle of the branch's inner node about the steer
+axis (from the body). Wheel -- spring k_m -- node -- damper c_m -- tread ring:
+
+    spring torque k_m (node - delta),   damper torque c_m (d node/dt - d(delta + twist)/dt),
+
+with k_m = s k (s the branch's stiffness as a fraction of the carcass's, 0 = absent) and
+c_m = k_m tau. The node is massless in the ideal model; it carries (s + 0.001) 0.01 of the tread
+ring's yaw inertia so that the mass matrix stays positive definite at s = 0, where the node is
+free and carries nothing (its own time, sqrt(I / k_m), is about 2.6 ms at any s, far below the carcass's
+1.4 s wind-up in the cycle).
+Requires carcass_compliance (the twist coordinate and the tread ring).
+
+Signature against the rack: a rate-dependent stiffening of the carcass wind-up (the start and each
+reversal), relaxing with time tau; in steady sliding the twist is constant, the branch relaxes and
+the plateau is the paper's. It scales with nothing geometric: it is the same at every spacer offset,
+and with the wheel load only through how far the carcass winds up (M(W) / k). Lifting is absent at the
+reversals' first instants and grows towards lock, proportional to W and with the offset.
+Provenance: a candidate beyond the paper; s and tau are chosen (tyre relaxation times of 0.05-0.5 s).
+"""
+
+from __future__ import annotations
+
+import sympy as sp
+import sympy.physics.mechanics as me
+
+from ..components import Effect
+from ..system import SIDES, torque_between
+from .carcass_compliance import EFFECT as CARCASS
+
+NODE_INERTIA_SHARE = sp.Rational(1, 100)  # of the tread ring's yaw inertia: the branch's node is nearly massless
+INERTIA_FLOOR = sp.Rational(1, 1000)  # of the node's inertia share, so that M stays positive definite at s = 0
+
+
+class CarcassHysteresis(Effect):
+    name = "carcass_hysteresis"
+    description = (
+        "Maxwell branch (spring s k in series with a damper of relaxation time tau) beside each carcass spring; "
+        "one node coordinate per side; 0 = the paper's Kelvin-Voigt carcass (absent)"
+    )
+    in_default_set = False
+    diagnosis_candidate = False  # a rival of the paper's mechanisms, studied on its own this round
+    requires = ("carcass_compliance",)
+    uses = ("carcass_hysteresis.stiffness_fraction", "carcass_hysteresis.relaxation_time",
+            "tyre.tread_ring_yaw_inertia", *CARCASS.uses)
+
+    def configure(self, model):
+        model.state(self).node = {
+            side: model.add_coordinate(f"maxwell_{side}", "rad", owner=self.name) for side in SIDES
+        }
+
+    def bodies(self, model):
+        state = model.state(self)
+        strength = model.p("carcass_hysteresis.stiffness_fraction")
+        inertia = (strength + INERTIA_FLOOR) * NODE_INERTIA_SHARE * model.p("tyre.tread_ring_yaw_inertia")
+        state.frames = {}
+        out = []
+        for side in SIDES:
+            axis_frame = model.kinematics.axis_frame[side]
+            q, u = state.node[side]
+            frame = me.ReferenceFrame(f"maxwell_{side}")
+            frame.orient_axis(axis_frame, axis_frame.z, q)
+            frame.set_ang_vel(axis_frame, u * axis_frame.z)
+            state.frames[side] = frame
+            centre = model.kinematics.wheel_centre[side]
+            out.append(me.RigidBody(frame.name, centre, frame, 0, (inertia * me.outer(frame.z, frame.z), centre)))
+        return out
+
+    def _stiffness(self, model):
+        return model.p("carcass_hysteresis.stiffness_fraction") * model.p("tyre.carcass_torsional_stiffness")
+
+    def _spring_deflection(self, model, side):
+        q, _ = model.state(self).node[side]
+        return q - model.kinematics.steer_angle[side]
+
+    def loads(self, model):
+        k, state = model.kinematics, model.state(self)
+        stiffness = self._stiffness(model)
+        damping = stiffness * model.p("carcass_hysteresis.relaxation_time")
+        out = []
+        for side in SIDES:
+            wheel, ring, node = k.steer_frame[side], k.ring_frame[side], state.frames[side]
+            axis = k.axis_frame[side].z
+            _, u = state.node[side]
+            ring_rate = ring.ang_vel_in(k.axis_frame[side]).dot(axis)
+            spring = stiffness * self._spring_deflection(model, side)
+            out += torque_between(-spring, axis, node, wheel)
+            out += torque_between(-damping * (u - ring_rate), axis, node, ring)
+        return out
+
+    def potential_energy(self, model):
+        return sum(self._stiffness(model) * self._spring_deflection(model, side) ** 2 / 2 for side in SIDES)
+
+
+EFFECT = CarcassHysteresis()

@@ -1,0 +1,83 @@
+"""Load-dependent friction of the rack-and-pinion mesh (gear efficiency): a rival of the paper's constant rack friction.
+
+Physics. A gear mesh loses a fixed fraction of the power it transmits: tooth sliding friction
+grows with the tooth load, so the friction torque on the pinion is (1 - eta) times the torque
+it carries, opposing the pinion's rotation, where eta is the forward efficiency of the mesh
+(rack-and-pinion steering gears run at about 0.8-0.9). Unlike the paper's Coulomb rack friction
+(a constant 730 N), this friction scales with the load the steering carries: it is a fraction
+of the whole handwheel torque, larger at the tyre-friction plateau, at lock and on a laden car.
+Losses of the column's Hooke joint and bearings under load have the same form and are lumped
+into the same fraction.
+
+Model. The load the mesh carries is the force the rack needs on its road side: F = -Q, with Q the
+generalized force on the rack coordinate of every load but the column's (and this effect's): the
+tyre moments, lifting, the rack's own friction and the rest, through the linkage (at parking speed
+inertia is negligible; in quasi-static steering F times d(rack)/d(theta_c) is the column torque).
+Taking it from the road side rather than from the column torque keeps the friction an explicit
+function of the state also when the rack is prescribed and the column torque is the unknown (the
+replay of measured data). A force
+
+    F_f = (1 - eta) |F| tanh(beta * rack speed)   (to first order in 1 - eta),
+
+i.e. a torque (1 - eta) |F| / G_hr on the pinion, acts between the rack and its housing against the
+rack's motion (beta: the project's friction smoothing). |F| is smoothed as sqrt(F^2 + w^2) - w over
+a force width w, so the friction is zero at zero load and the Jacobian stays continuous. Strength:
+1 - eta, 0 = a lossless mesh (absent).
+
+Signature against the rack: a friction share in phase with the handwheel torque, (1 - eta) of
+it, of the sign of the rack speed, so it flips at each reversal and adds on every stroke
+(hysteresis), and grows with whatever raises the steering load (the wheel load through the tyre
+moment, W^1.5). Lifting instead is conservative: a function of the rack position, adding on the
+way out and returning the work on the way back, proportional to the wheel load W and growing
+with the spacer offset. Provenance: a candidate beyond the paper (textbook gear-mesh losses).
+"""
+
+from __future__ import annotations
+
+import sympy as sp
+import sympy.physics.mechanics as me
+
+from ..components import Effect
+from ..system import action_reaction
+
+
+class GearEfficiency(Effect):
+    name = "gear_efficiency"
+    description = (
+        "Friction of the rack-and-pinion mesh proportional to the load it transmits: -(1 - eta) |F_road| "
+        "tanh(beta * rack speed) on the rack; 0 = lossless (absent)"
+    )
+    in_default_set = False
+    diagnosis_candidate = False  # a rival of the paper's mechanisms, studied on its own this round
+    uses = ("gear_efficiency.inefficiency", "gear_efficiency.smoothing_force", "steering.friction_smoothing")
+
+    def road_force(self, model):
+        """The force the rack needs on its road side: minus the rack's generalized force of every load but the
+        column's (the column torque, and column-side loads, act above the mesh) and this effect's."""
+        k = model.kinematics
+        loads = list(model.core_loads())
+        for effect in model.effects:
+            if effect.name != self.name:
+                loads += effect.loads(model)
+        force = 0
+        for where, vector in loads:
+            if where is k.column_frame:
+                continue
+            velocity = where.ang_vel_in(model.N) if isinstance(where, me.ReferenceFrame) else where.vel(model.N)
+            partial = velocity.diff(model.rack_u, model.N)
+            if partial != 0:
+                force -= partial.dot(vector)
+        return force
+
+    def loads(self, model):
+        k = model.kinematics
+        road = self.road_force(model)
+        width = model.p("gear_efficiency.smoothing_force")
+        magnitude = sp.sqrt(road**2 + width**2) - width
+        force = model.p("gear_efficiency.inefficiency") * magnitude * sp.tanh(
+            model.p("steering.friction_smoothing") * model.rack_u)
+        # between rack and housing, as the rack's own friction
+        return action_reaction(k.rack_point, -force * k.B.y, k.rack_housing_point)
+
+
+EFFECT = GearEfficiency()

@@ -1,0 +1,70 @@
+"""Findings about the reconstruction, each as a test that fails on (or documents) the earlier behaviour."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from parksteer.figures.model import cycle_summary
+from parksteer.geometry import steer_axis
+from parksteer.model.numeric.simulate import simulate
+
+from model_helpers import column_angle_per_rack
+
+
+@pytest.fixture(scope="module")
+def hooke_phases(params):
+    """The paper's cycle (unladen) at Hooke joint phase 0 (the parameter file's choice) and pi/2."""
+    runs = {}
+    for phase in (0.0, math.pi / 2):
+        result = simulate("unladen", overrides={"steering.hooke_joint_phase": phase}, params=params)
+        runs[phase] = cycle_summary(result.columns, params)
+    return runs
+
+
+def test_hooke_phase_moves_the_near_lock_torque_by_its_speed_ratio(params, hooke_phases):
+    """Physical fact: the joint's speed ratio multiplies every rack-side share at the handwheel. With the lock at
+    two column turns, phase 0 puts the ratio's peak 1/cos(alpha) at the locks, pi/2 its trough cos(alpha), so the
+    near-lock torque differs by more than 2 N m (18.27 against 15.39 N m), not a ripple shifted along the cycle;
+    the ratio of the two torques follows the ratio of d(column angle)/d(rack) at the two locks (within 5 %)."""
+    at0, at90 = hooke_phases[0.0], hooke_phases[math.pi / 2]
+    assert at0["torque_near_right_lock_Nm"] - at90["torque_near_right_lock_Nm"] > 2.0
+    assert at0["torque_near_left_lock_Nm"] - at90["torque_near_left_lock_Nm"] < -2.0  # mirror image
+    # lock at two column turns: the pinion angle near lock lies close to a multiple of pi, where the ratio peaks
+    lock_pinion = params["steering.handwheel_to_rack_ratio"] * at0["rack_near_right_lock_m"]
+    assert abs(lock_pinion / math.pi - round(lock_pinion / math.pi)) < 0.15
+    speed_ratio = {phase: column_angle_per_rack(params.with_overrides({"steering.hooke_joint_phase": phase}),
+                                                at["rack_near_right_lock_m"])
+                   for phase, at in hooke_phases.items()}
+    expected = speed_ratio[math.pi / 2] / speed_ratio[0.0]
+    measured = at0["torque_near_right_lock_Nm"] / at90["torque_near_right_lock_Nm"]
+    assert expected > 1.15
+    assert measured == pytest.approx(expected, rel=0.05)
+
+
+def test_hooke_phase_source_says_what_it_moves(params):
+    """The parameter file's provenance of the phase must not call it a ripple shift (it moves the lock torque)."""
+    source = params.source("steering.hooke_joint_phase")
+    assert "only shifts the ripple" not in source
+    assert "near-lock" in source
+
+
+def test_a_car_in_gear_leaves_the_steered_pair_free_to_roll(params):
+    """Physical fact (documents the braked_wheels correction): steering turns each wheel about its own axis, and
+    pure rolling of the two patches needs wheel spins equal and opposite (the left patch centre travels forward
+    while the right travels back). An open differential with its carrier held by the gearbox allows exactly that
+    (it fixes only the mean of the two spins), so a front-drive car in gear is the free-rolling case, not braked."""
+    for case in ("unladen", "offset_68_5mm"):
+        spins = []
+        for side in ("left", "right"):
+            axis = steer_axis(params, case, side)
+            contact = axis.wheel_centre + np.array([0.0, 0.0, axis.wheel_radius_m])
+            velocity = np.cross(axis.direction, contact - axis.top)  # unit steer rate about the axis
+            spins.append(velocity[0] / axis.wheel_radius_m)  # rolling takes up the travel along x
+        left, right = spins
+        assert abs(left - right) > 0.01  # the scrub needs the wheels to turn
+        assert abs(left + right) < 1e-9 * abs(left - right)  # the held carrier (the mean) does not turn
+    source = params.source("braked_wheels.brake_fraction")
+    assert "front-drive car in gear with both wheels held" not in source
