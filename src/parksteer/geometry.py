@@ -128,3 +128,32 @@ def lifting_torque_a1(params: Parameters, case: str, steer_rad: float | np.ndarr
 def lock_steer_angle(params: Parameters) -> float:
     """Road-wheel steer angle at full lock (rad)."""
     return params["input.handwheel_lock_angle"] / overall_steering_ratio(params)
+
+
+def pinion_angle_from_column(column_angle_rad, joint_angle_rad: float, phase_rad: float) -> np.ndarray:
+    """theta_p from theta_c through the Hooke joint: tan(theta_p - phase) = tan(theta_c - phase) / cos(alpha).
+
+    The inverse of the joint's map in :mod:`parksteer.model.symbolic.effects.hooke_joint`, written in the same
+    branch-free form: with psi = theta_c - phase,
+    theta_p - theta_c = atan((1 - cos a) sin psi cos psi / (cos a cos^2 psi + sin^2 psi)), whose denominator is at
+    least cos(alpha) > 0, so the angle stays continuous over any number of turns.
+    """
+    theta_c = np.asarray(column_angle_rad, dtype=float)
+    cos_a = np.cos(joint_angle_rad)
+    psi = theta_c - phase_rad
+    s, c = np.sin(psi), np.cos(psi)
+    return theta_c + np.arctan((1.0 - cos_a) * s * c / (cos_a * c**2 + s**2))
+
+
+def rack_from_handwheel(handwheel_angle_rad, handwheel_torque_Nm, params: Parameters) -> np.ndarray:
+    """The column law: rack displacement (m) from the handwheel angle and torque.
+
+    The column twists by T / column_torsional_stiffness (its damping is left out: at parking speeds the twist
+    rate is a few hundredths of a rad/s, so the damping torque moves the rack by about 0.01 mm), the Hooke joint
+    turns the column angle into the pinion angle, and rack = theta_p / handwheel_to_rack_ratio.
+    """
+    s = params.sections["steering"]
+    column = np.asarray(handwheel_angle_rad, dtype=float) - (
+        np.asarray(handwheel_torque_Nm, dtype=float) / s["column_torsional_stiffness"])
+    pinion = pinion_angle_from_column(column, s["hooke_joint_angle"], s["hooke_joint_phase"])
+    return pinion / s["handwheel_to_rack_ratio"]

@@ -11,8 +11,12 @@ from ..parameters import DEFAULT_PATH, load_parameters
 
 
 def _common(p) -> None:
-    p.add_argument("files", nargs="+", metavar="FILE.csv", help="measurement files (format: data/measurements/README.md)")
+    p.add_argument("files", nargs="+", metavar="FILE",
+                   help="measurement files: native CSV (data/measurements/README.md), a logger's CSV or ASAM MDF")
     p.add_argument("--case", default=None, help="Table B1 case for every file (default: each file's own)")
+    p.add_argument("--surface", choices=("ground", "air_bearing"), default=None,
+                   help="the surface of files that do not state one")
+    add_import_options(p)
     p.add_argument("--effects", default=None,
                    help="effects spec of the model, e.g. --effects=+column_friction or --effects=+path/to/effect.py "
                         "(a leading - needs no =; default: the paper's five)")
@@ -21,11 +25,27 @@ def _common(p) -> None:
     p.add_argument("--plot", default=None, metavar="OUT.svg", help="write a figure")
 
 
+def add_import_options(p) -> None:
+    """--map and --map-file: how a logger's channels become the native columns (parksteer.measure.importers)."""
+    p.add_argument("--map", default=None, metavar="'SRC[unit]=COLUMN,...'",
+                   help="channel map, e.g. --map 'RackPos[mm]=rack_m,SteerTorque[N*m]=handwheel_torque_Nm,"
+                        "SWA[deg]=handwheel_angle_rad' (units converted with pint; '=-column' negates a channel)")
+    p.add_argument("--map-file", default=None, metavar="MAP.txt",
+                   help="the same channel map in a file, one 'SRC[unit]=COLUMN' per line, '#' comments")
+
+
+def channel_map_of(args):
+    """The channel map of --map and --map-file (None when neither is given)."""
+    from ..measure.importers import channel_map_from_options
+
+    return channel_map_from_options(args.map, args.map_file)
+
+
 def register(sub) -> None:
     p = sub.add_parser("compare", help="replay measured rack motion through the model; error by phase and noise floor")
     _common(p)
-    p.add_argument("--set", dest="overrides", action="append", default=[], metavar="EFFECT.PARAM=VALUE",
-                   help="override a parameter of an effect or of a parameter-file section (repeatable)")
+    p.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
+                   help="override a quantity by its key, e.g. tyre.tyre_pressure=180000 or rack_lash.lash=0.0002 (keys: `parksteer effects`, the parameter file; case.<name> for the case; repeatable)")
     p.set_defaults(func=_compare)
 
     p = sub.add_parser("diagnose", help="calibrate the model, rank the candidate effects it lacks, give a verdict")
@@ -60,7 +80,7 @@ def _compare(args) -> int:
     overrides = parse_overrides(args.overrides)
     params = load_parameters(args.parameters)
     effects = resolve_effects(args.effects)
-    files = load_files(args.files, params, args.case)
+    files = load_files(args.files, params, args.case, args.surface, channel_map_of(args))
     result = compare_files(files, params, effects, overrides)
     summary = result.as_dict()
     if args.plot:
@@ -90,7 +110,7 @@ def _diagnose(args) -> int:
         raise UsageError("say where the result goes: --json, --report OUT.md and/or --plot OUT.svg")
     params = load_parameters(args.parameters)
     effects = resolve_effects(args.effects)
-    files = load_files(args.files, params, args.case)
+    files = load_files(args.files, params, args.case, args.surface, channel_map_of(args))
     diagnosis = diagnose(files, params, effects)
     result = diagnosis_dict(diagnosis)
     if args.plot:

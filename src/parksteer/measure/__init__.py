@@ -1,13 +1,15 @@
-"""Measurements of handwheel torque against rack displacement, and their comparison with the model.
+"""Measurements of handwheel torque against rack displacement: the file format and what is read from a file.
 
 - :mod:`.io`: read, validate and write measurement files (format: data/measurements/README.md);
-- :mod:`.degrade`: turn a clean model output into a realistic measurement (8-bit logger,
-  analog noise, sampling, an irregular hand);
+- :mod:`.importers`: the one way in for every measurement, rack drive or angle record (logger exports mapped to the
+  format);
 - :mod:`.phases`: split a steering cycle into initial rise, wind-up, plateau, reversal, return;
+- :mod:`.smoothing`: a measured rack as a motion the model can follow (least-squares spline);
 - :mod:`.metrics`: residual statistics of a model against a measurement, per phase, beside the
-  noise floor the data allow;
-- :mod:`.standin`: a closed-form quasi-static cycle (not the model) for fast, independent tests;
-- :mod:`.example`: the synthetic example file data/measurements/example_unladen.csv.
+  noise floor the data allow.
+
+This package imports neither the model nor :mod:`parksteer.synthetic` (the import contract in pyproject.toml
+checks it): synthetic measurements (logger, hand, stand-ins, data sets) live in :mod:`parksteer.synthetic`.
 """
 
 from .io import Measurement, read_measurement, write_measurement

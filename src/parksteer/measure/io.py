@@ -30,6 +30,7 @@ after the header is row 1) with its line number in the file.
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -192,18 +193,19 @@ def _first_row(mask: np.ndarray) -> int:
     return int(np.argmax(mask)) + 1
 
 
-def _check_column_names(where: Path | str, names: list[str]) -> None:
-    for name in REQUIRED_COLUMNS:
+def _check_column_names(where: Path | str, names: list[str], required: tuple[str, ...] = REQUIRED_COLUMNS) -> None:
+    for name in required:
         if name not in names:
-            raise UsageError(f"{where}: missing required column {name!r} (required: {', '.join(REQUIRED_COLUMNS)})")
+            raise UsageError(f"{where}: missing required column {name!r} (required: {', '.join(required)})")
     for name in names:
         if name not in ALLOWED_COLUMNS:
             raise UsageError(f"{where}: unknown column {name!r} (allowed: {', '.join(ALLOWED_COLUMNS)})")
 
 
-def _validate_columns(where: Path | str, columns: Mapping[str, np.ndarray], line_numbers: list[int] | None) -> None:
+def _validate_columns(where: Path | str, columns: Mapping[str, np.ndarray], line_numbers: list[int] | None,
+                      required: tuple[str, ...] = REQUIRED_COLUMNS) -> None:
     names = list(columns)
-    _check_column_names(where, names)
+    _check_column_names(where, names, required)
     lengths = {len(columns[n]) for n in names}
     if len(lengths) != 1:
         raise UsageError(f"{where}: columns have different lengths {sorted(lengths)}")
@@ -254,21 +256,70 @@ def _validate_columns(where: Path | str, columns: Mapping[str, np.ndarray], line
             )
 
 
-def parse_measurement(text: str, where: Path | str, params: Parameters | None = None) -> Measurement:
-    """Parse and validate measurement text; `where` names it in error messages."""
-    if params is None:
-        params = load_parameters()
+DELIMITERS = {",": "comma", ";": "semicolon", "\t": "tab"}
+_DECIMAL_COMMA = re.compile(r"^\s*[+-]?\d*,\d+([eE][+-]?\d+)?\s*$")
+
+
+@dataclass(frozen=True)
+class Table:
+    """A delimited text table as written: metadata, header, an optional units row and the raw data cells."""
+
+    where: Path | str
+    metadata: dict[str, str]
+    header: list[str]
+    header_line: int
+    units: list[str] | None
+    rows: list[tuple[int, list[str]]]  # (line number, cells)
+    delimiter: str
+    decimal: str
+
+    @property
+    def line_numbers(self) -> list[int]:
+        return [line_no for line_no, _ in self.rows]
+
+    def column(self, j: int, name: str | None = None) -> np.ndarray:
+        """Column `j` as floats; a cell that is not a finite number is refused naming column, row and line."""
+        name = self.header[j] if name is None else name
+        values = np.empty(len(self.rows))
+        for row, (line_no, cells) in enumerate(self.rows, start=1):
+            cell = cells[j]
+            if self.decimal == ",":
+                cell = cell.replace(",", ".")
+            values[row - 1] = _parse_number(cell, f"{self.where}: column {name!r}, row {row} (line {line_no})")
+        return values
+
+
+def _split(line: str, delimiter: str) -> list[str]:
+    return [cell.strip() for cell in line.split(delimiter)]
+
+
+def _is_number(cell: str, decimal: str) -> bool:
+    try:
+        float(cell.replace(",", ".") if decimal == "," else cell)
+    except ValueError:
+        return False
+    return True
+
+
+def read_table(text: str, where: Path | str) -> Table:
+    """Split text into metadata, header, optional units row and data rows; detect the dialect.
+
+    Accepted as loggers and spreadsheets write them: a UTF-8 byte-order mark, CRLF or CR line ends, blank lines
+    anywhere, comma, semicolon or tab between cells (the one the header row uses most), a decimal comma (with a
+    semicolon or tab delimiter), and a units row right under the header (every cell not a number, e.g.
+    ``s;mm;N*m``). Each row must have as many cells as the header.
+    """
     if text.startswith("\ufeff"):  # a byte-order mark, as spreadsheets write
         text = text[1:]
     metadata: dict[str, str] = {}
-    header: list[str] | None = None
+    header_text: str | None = None
     header_line = 0
-    rows: list[tuple[int, list[str]]] = []
+    lines: list[tuple[int, str]] = []
     for line_no, line in enumerate(text.splitlines(), start=1):
         if not line.strip():
             continue
         if line.startswith("#"):
-            if header is not None:
+            if header_text is not None:
                 raise UsageError(f"{where}: line {line_no}: metadata line after the header row; move it above")
             key, colon, value = line[1:].partition(":")
             key = key.strip()
@@ -277,13 +328,16 @@ def parse_measurement(text: str, where: Path | str, params: Parameters | None = 
             if key in metadata:
                 raise UsageError(f"{where}: line {line_no}: metadata key {key!r} given twice")
             metadata[key] = value.strip()
-        elif header is None:
-            header = [name.strip() for name in line.split(",")]
-            header_line = line_no
+        elif header_text is None:
+            header_text, header_line = line, line_no
         else:
-            rows.append((line_no, line.split(",")))
-    if header is None:
+            lines.append((line_no, line))
+    if header_text is None:
         raise UsageError(f"{where}: empty file (no header row)")
+    # The header names the columns once each: the delimiter it uses most is the file's.
+    counts = {d: header_text.count(d) for d in ("\t", ";")}
+    delimiter = max(counts, key=counts.get) if max(counts.values()) > 0 else ","
+    header = _split(header_text, delimiter)
     if any(not name for name in header):
         raise UsageError(f"{where}: line {header_line}: empty column name in the header row")
     seen = set()
@@ -291,23 +345,51 @@ def parse_measurement(text: str, where: Path | str, params: Parameters | None = 
         if name in seen:
             raise UsageError(f"{where}: column {name!r} appears twice in the header row")
         seen.add(name)
-    # Name a missing or unknown column before complaining about the rows below it.
-    _check_column_names(where, header)
+    rows = [(line_no, _split(line, delimiter)) for line_no, line in lines]
+    decimal = "."
+    if delimiter != "," and any(_DECIMAL_COMMA.match(cell) for _, cells in rows[:200] for cell in cells):
+        decimal = ","
+    units = None
+    if rows and any(rows[0][1]) and not any(_is_number(cell, decimal) for cell in rows[0][1] if cell):
+        units = rows.pop(0)[1]
+        if len(units) != len(header):
+            raise UsageError(
+                f"{where}: units row (line {header_line + 1}): {len(units)} fields where the header has {len(header)}"
+            )
     if not rows:
         raise UsageError(f"{where}: no data rows after the header")
-
-    values = np.empty((len(rows), len(header)))
     for row, (line_no, cells) in enumerate(rows, start=1):
         if len(cells) != len(header):
             raise UsageError(
                 f"{where}: row {row} (line {line_no}): {len(cells)} fields where the header has {len(header)}"
             )
-        for j, cell in enumerate(cells):
-            values[row - 1, j] = _parse_number(cell, f"{where}: column {header[j]!r}, row {row} (line {line_no})")
-    columns = {name: values[:, j].copy() for j, name in enumerate(header)}
-    _validate_columns(where, columns, [line_no for line_no, _ in rows])
+    return Table(where, metadata, header, header_line, units, rows, delimiter, decimal)
+
+
+def validate_record(where: Path | str, columns: Mapping[str, np.ndarray], metadata: Mapping[str, str],
+                    params: Parameters, line_numbers: list[int] | None = None,
+                    required: tuple[str, ...] = REQUIRED_COLUMNS) -> None:
+    """Every check of the format on SI columns and metadata, whatever file they came from."""
+    _validate_columns(where, columns, line_numbers, required)
     _validate_metadata(where, metadata, params)
-    return Measurement(path=Path(where) if isinstance(where, (str, Path)) else None, columns=columns, metadata=metadata)
+
+
+def parse_measurement(text: str, where: Path | str, params: Parameters | None = None) -> Measurement:
+    """Parse and validate measurement text in the native format; `where` names it in error messages."""
+    if params is None:
+        params = load_parameters()
+    table = read_table(text, where)
+    # Name a missing or unknown column before complaining about the rows below it.
+    _check_column_names(where, table.header)
+    if table.units is not None:
+        raise UsageError(
+            f"{where}: line {table.header_line + 1}: a units row; the native format has SI units in the column "
+            "names (read logger exports through parksteer.measure.importers.load_record, or --map)"
+        )
+    columns = {name: table.column(j) for j, name in enumerate(table.header)}
+    validate_record(where, columns, table.metadata, params, table.line_numbers)
+    return Measurement(path=Path(where) if isinstance(where, (str, Path)) else None, columns=columns,
+                       metadata=table.metadata)
 
 
 def read_measurement(path: str | Path, params: Parameters | None = None) -> Measurement:
