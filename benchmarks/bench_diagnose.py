@@ -24,6 +24,7 @@ import platform
 import statistics
 import sys
 import time
+from pathlib import Path
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -32,24 +33,30 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--repeats", type=int, default=3, help="repeats of each diagnosis (default 3)")
     args = parser.parse_args(argv)
 
-    from parksteer.diagnose.candidates import ensure_candidate_models
+    from parksteer.diagnose.candidates import candidate_models
+    from parksteer.model.codegen.cache import ensure
     from parksteer.diagnose.compare import compare_files
     from parksteer.diagnose.problem import Problem, prepare_file
     from parksteer.diagnose.select import diagnose
-    from parksteer.synthetic.datasets import DatasetSpec, make_dataset, perturbed_base
+    import yaml
+
+    from parksteer.synthetic.datasets import BenchmarkDesign, DatasetSpec, make_dataset, perturbed_base
     from parksteer.model.symbolic.components import discover_effects, resolve_effects
     from parksteer.parameters import load_parameters
     from parksteer.tables import write_json
 
     params = load_parameters()
     start = time.perf_counter()
-    ensure_candidate_models()
+    for spec in candidate_models().values():
+        ensure(resolve_effects(spec))
     derive_s = time.perf_counter() - start
+    config = yaml.safe_load((Path(__file__).resolve().parents[1] / "config" / "config.yaml").read_text("utf-8"))
+    design = BenchmarkDesign.from_config(config["benchmark"])
     spec = DatasetSpec("bench", 777, (("unladen", "ground"), ("part_laden", "ground")), "null", None, None,
-                       perturbed_base(params, 777))
+                       perturbed_base(params, 777, design.perturbation))
     measurements = make_dataset(params, spec).measurements
     hidden_spec = DatasetSpec("bench_hidden", 778, spec.files, "candidate", "rack_stiction", 3.5,
-                              perturbed_base(params, 778))
+                              perturbed_base(params, 778, design.perturbation), search=design.search)
     hidden_measurements = make_dataset(params, hidden_spec).measurements
     candidates = sorted(n for n, e in discover_effects().items() if not e.in_default_set)
 

@@ -3,7 +3,9 @@
     python benchmarks/bench_model.py OUT.json [--repeats 7]
 
 Times: one 18 s cycle of the nominal case (compiled C + odeint/LSODA with the analytic
-Jacobian, cache warm); all the simulations of Figs. 12-16 and the contribution figure;
+Jacobian, cache warm); one 18 s prescribed-rack replay of data/measurements/example_unladen.csv
+(the solver of ``parksteer simulate --rack-from`` and ``parksteer compare``, on the smoothed rack;
+target 0.3 s); all the simulations of Figs. 12-16 and the contribution figure;
 derivation + code generation + compilation of the default model (into a scratch cache);
 and a baseline in the same run: the same sympy equations through plain ``lambdify`` and
 ``solve_ivp(Radau)`` (finite-difference Jacobian) at the same tolerances. Prints a table
@@ -22,6 +24,8 @@ import time
 from pathlib import Path
 
 import numpy as np
+
+REPO = Path(__file__).resolve().parents[1]
 
 
 def _median_time(function, repeats: int) -> tuple[float, list[float]]:
@@ -44,23 +48,41 @@ def main(argv: list[str] | None = None) -> int:
     import sympy as sp
     from scipy.integrate import solve_ivp
 
-    from parksteer.figures.model import all_simulations, run_simulation
+    import yaml
+
+    from parksteer.figures.model import FigureDesign, run_simulation
     from parksteer.model.codegen.cache import build_entry
     from parksteer.model.symbolic.components import resolve_effects
     from parksteer.model.symbolic.derive import derive
-    from parksteer.model.numeric.simulate import RTOL, _atol, prepare, simulate, static_state
+    from parksteer.measure.io import read_measurement
+    from parksteer.measure.smoothing import smooth_rack
+    from parksteer.model.numeric.prescribed import solve as solve_prescribed
+    from parksteer.model.numeric.simulate import _atol, prepare, simulate, static_state
+    from parksteer.model.numeric.tolerances import RTOL
     from parksteer.parameters import load_parameters
     from parksteer.tables import write_json
 
     params = load_parameters()
     effects = resolve_effects(None)
-    runs = all_simulations()
-    for case, variant in runs:  # warm the cache (derives any missing model once)
-        run_simulation(params, case, variant)
+    design = FigureDesign.from_config(yaml.safe_load((REPO / "config" / "config.yaml").read_text(encoding="utf-8")))
+    runs = [(case, design.variants[variant].effects, design.variants[variant].surface)
+            for case, variant in design.all_simulations()]
+    for case, variant_effects, surface in runs:  # warm the cache (derives any missing model once)
+        run_simulation(params, case, variant_effects, surface)
 
     cycle_s, cycle_all = _median_time(lambda: simulate("unladen", params=params), args.repeats)
+
+    measurement = read_measurement(REPO / "data" / "measurements" / "example_unladen.csv", params)
+    smoothing_s, smoothing_all = _median_time(lambda: smooth_rack(measurement.time_s, measurement.rack_m),
+                                              args.repeats)
+    rack = smooth_rack(measurement.time_s, measurement.rack_m)
+    replay_run = prepare(measurement.case, effects=effects, surface=measurement.surface, params=params)
+    replay_s, replay_all = _median_time(
+        lambda: solve_prescribed(replay_run, replay_run.p, rack, measurement.time_s), args.repeats)
+    replay_outputs_s, replay_outputs_all = _median_time(
+        lambda: solve_prescribed(replay_run, replay_run.p, rack, measurement.time_s, outputs=True), args.repeats)
     figures_s, figures_all = _median_time(
-        lambda: [run_simulation(params, c, v) for c, v in runs], max(3, args.repeats // 2))
+        lambda: [run_simulation(params, c, e, s) for c, e, s in runs], max(3, args.repeats // 2))
 
     derive_totals, derive_parts = [], []
     for _ in range(args.derive_repeats):
@@ -119,6 +141,11 @@ def main(argv: list[str] | None = None) -> int:
         "machine": {"python": sys.version.split()[0], "platform": platform.platform(), "cpus": os.cpu_count()},
         "repeats": {"fast": args.repeats, "derive": args.derive_repeats, "baseline": args.baseline_repeats},
         "one_cycle_s": {"median": cycle_s, "all": cycle_all, "target": 0.05},
+        "prescribed_rack_replay_s": {"median": replay_s, "all": replay_all, "target": 0.3,
+                                     "file": "data/measurements/example_unladen.csv"},
+        "prescribed_rack_replay_with_outputs_s": {"median": replay_outputs_s, "all": replay_outputs_all,
+                                                  "target": 0.3},
+        "rack_smoothing_s": {"median": smoothing_s, "all": smoothing_all},
         "figure_simulations_s": {"median": figures_s, "all": figures_all, "count": len(runs)},
         "derive_codegen_compile_s": {"median": derive_s, "all": derive_totals, "target": 15.0,
                                      "parts_of_last": derive_parts[-1]},
@@ -131,6 +158,9 @@ def main(argv: list[str] | None = None) -> int:
     write_json(args.out, results)
     rows = [
         ("one 18 s cycle (compiled, odeint)", cycle_s),
+        ("one 18 s prescribed-rack replay (torque)", replay_s),
+        ("the same with outputs (simulate --rack-from)", replay_outputs_s),
+        ("smoothing its rack", smoothing_s),
         (f"all figure simulations ({len(runs)})", figures_s),
         ("derivation + codegen + compile", derive_s),
         ("baseline: lambdify + Radau, one cycle", baseline_s),

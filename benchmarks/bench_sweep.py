@@ -114,19 +114,15 @@ def bench_inprocess(sizes, cores, repeats) -> dict:
 
 
 def _workdir(scratch: Path, n: int) -> tuple[Path, Path]:
-    """A working directory that sees the repository, with the benchmark's sweep as the default sweep."""
+    """A working directory that sees the repository, with the benchmark's sweep as the default sweep; its
+    workflow/Snakefile (the repository's, through the symlink)."""
     work = scratch / f"work{n}"
     (work / "config" / "sweeps").mkdir(parents=True)
     for name in ("src", "paper", "workflow"):
         (work / name).symlink_to(REPO / name)
     (work / "config" / "config.yaml").symlink_to(REPO / "config" / "config.yaml")
     (work / "config" / "sweeps" / "design.yaml").write_text(declaration(n), encoding="utf-8")
-    main = (REPO / "workflow" / "Snakefile").read_text(encoding="utf-8")
-    lines = [f'include: "{REPO / "workflow" / "Snakefile"}"']
-    lines += [f'include: "{REPO / "workflow" / "rules" / r}"' for r in ("model.smk", "sweep.smk") if r not in main]
-    snakefile = scratch / f"Snakefile{n}"
-    snakefile.write_text("\n".join(lines) + "\n", encoding="utf-8")
-    return work, snakefile
+    return work, work / "workflow" / "Snakefile"
 
 
 def _snakemake(snakefile: Path, work: Path, cores: int, targets: list[str]) -> float:
@@ -151,8 +147,8 @@ def bench_snakemake(sizes, cores, repeats) -> dict:
     with tempfile.TemporaryDirectory() as scratch:
         for n in sizes:
             work, snakefile = _workdir(Path(scratch), n)
-            sweep = load_sweep(work / "workflow" / "sweeps" / "design.yaml", params)
-            derive_s = _snakemake(snakefile, work, cores, ["results/model/derived_full.json"])
+            sweep = load_sweep(work / "config" / "sweeps" / "design.yaml", params)
+            derive_s = _snakemake(snakefile, work, cores, ["results/model/full.json"])
             points = [f"results/sweeps/{sweep.name}/points/{i}.json" for i in sweep.point_ids]
             before = cache_snapshot()
             walls = []
@@ -187,10 +183,10 @@ def main(argv=None) -> int:
     parser.add_argument("--repeats", type=int, default=1, help="runs per size; the median is fitted")
     args = parser.parse_args(argv)
     os.chdir(REPO)
-    from parksteer.model.codegen.cache import ensure_entry
+    from parksteer.model.codegen.cache import ensure
     from parksteer.model.symbolic.components import resolve_effects
 
-    ensure_entry(resolve_effects(None))  # the one derivation, before any timing
+    ensure(resolve_effects(None))  # the one derivation, before any timing
     result = {"sizes": args.sizes, "cores": args.cores, "repeats": args.repeats, "machine": platform.platform(),
               "cpu_count": os.cpu_count(), "python": platform.python_version(),
               "load_average_at_start": os.getloadavg()}

@@ -1,4 +1,5 @@
-"""Shared fixtures: the repository root and the shipped parameter file, loaded once."""
+"""Shared fixtures: the repository root, the shipped parameter file, and synthetic measurement files (made once
+per session, seeded) for the data-set and diagnosis tests."""
 
 from __future__ import annotations
 
@@ -21,3 +22,44 @@ def repo_root() -> Path:
 def params() -> Parameters:
     """The shipped data/parameters.toml, validated."""
     return load_parameters(DEFAULT_PATH)
+
+
+# Synthetic data sets: used by tests/synthetic (how they are made) and tests/diagnose (what is found in them).
+ONE_FILE = (("unladen", "ground"),)
+
+
+@pytest.fixture(scope="session")
+def benchmark_design(repo_root):
+    """The pipeline's benchmark design (config/config.yaml, section benchmark)."""
+    import yaml
+
+    from parksteer.synthetic.datasets import BenchmarkDesign
+
+    config = yaml.safe_load((repo_root / "config" / "config.yaml").read_text(encoding="utf-8"))
+    return BenchmarkDesign.from_config(config["benchmark"])
+
+
+@pytest.fixture(scope="session")
+def written(tmp_path_factory, params, benchmark_design):
+    """make(name, kind, hidden, steps, base_overrides, ...) -> (paths, truth); each data set generated once."""
+    from parksteer.measure.io import write_measurement
+    from parksteer.synthetic.datasets import DatasetSpec, make_dataset
+
+    cache = {}
+    root = tmp_path_factory.mktemp("diagnose_data")
+
+    def make(name, kind="null", hidden=None, steps=None, base_overrides=None, files=ONE_FILE, seed=4242, phase=None,
+             strength=None):
+        if name not in cache:
+            spec = DatasetSpec(name, seed, files, kind, hidden, steps, dict(base_overrides or {}), phase, strength,
+                               benchmark_design.search)
+            dataset = make_dataset(params, spec)
+            paths = []
+            for m, (case, surface) in zip(dataset.measurements, files):
+                path = root / name / f"{case}__{surface}.csv"
+                write_measurement(path, m, params)
+                paths.append(path)
+            cache[name] = (paths, dataset.truth)
+        return cache[name]
+
+    return make

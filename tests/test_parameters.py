@@ -101,6 +101,36 @@ DEFECTS = {
         None,
         "steering.hooke_joint_angle",
     ),
+    # A tyre pressure in the registry's physical range, 0.1-10 bar: 1.225 (kg/m^3, the density of air, or the
+    # pressure in bar) is refused, as every check of a value against its quantity's bounds.
+    "tyre pressure of 1.225 Pa": (
+        'tyre_pressure = { value = 122500.0, unit = "Pa"',
+        'tyre_pressure = { value = 1.225, unit = "Pa"',
+        None,
+        "tyre.tyre_pressure",
+    ),
+    "candidate strength out of bounds": ("lash = { value = 0.0,", "lash = { value = 0.5,", None, "rack_lash.lash"),
+    "candidate quantity missing": (
+        'damping = { value = 0.0, unit = "N s/m"',
+        'viscosity = { value = 0.0, unit = "N s/m"',
+        "[rack_damping]",
+        "rack_damping.viscosity",
+    ),
+    # Statics: the two wheel loads carry (chassis_mass + unsprung_mass) g, about 6.3 kN for the part-laden car's
+    # 540 kg chassis; a 29 kN wheel load cannot be.
+    "wheel load of 29 kN": (
+        "load_left = { value = 3065.0",
+        "load_left = { value = 29000.0",
+        "[cases.part_laden]",
+        "cases.part_laden.load_left",
+    ),
+    # Statics: the load difference's moment about the centreline is the chassis weight's at y_cm.
+    "mass centre against the loads": (
+        "chassis_cg_y = { value = 0.0286",
+        "chassis_cg_y = { value = 0.0386",
+        "[cases.offset_44_5mm]",
+        "cases.offset_44_5mm.chassis_cg_y",
+    ),
     # An added case must carry every Table B1 entry; the first one it lacks is named.
     "incomplete case": (
         "[cases.offset_68_5mm]\n",
@@ -155,6 +185,31 @@ def test_defect_is_refused_with_one_line_naming_file_and_key(tmp_path, defect):
     _assert_one_line_naming(str(info.value), path, key)
 
 
+def test_table_b1_loads_satisfy_the_chassis_statics_to_printing_precision(params):
+    """Table B1's wheel loads carry the front end's weight, (chassis_mass + unsprung_mass) g, to within the 1 N
+    the loads are printed to, and their difference balances the chassis weight's moment at y_cm to within the
+    0.1 mm y_cm is printed to (plus the loads' 1 N at the half track)."""
+    g, unsprung_kg = params["vehicle.gravity"], params["vehicle.unsprung_mass"]
+    for name in params.case_names:
+        c = params.case(name)
+        assert c["load_left"] + c["load_right"] == pytest.approx((c["chassis_mass"] + unsprung_kg) * g, abs=1.0)
+        implied_cg_y_m = (c["load_right"] - c["load_left"]) * c["wheel_centre_y"] / (c["chassis_mass"] * g)
+        tolerance_m = 0.05e-3 + 1.0 * c["wheel_centre_y"] / (c["chassis_mass"] * g)
+        assert implied_cg_y_m == pytest.approx(c["chassis_cg_y"], abs=tolerance_m)
+
+
+def test_a_load_sum_two_newtons_off_is_refused(tmp_path):
+    """The statics tolerance is the printing precision, not slack: moving 2 N onto one wheel of the unladen case
+    (outside the 1 N the printed loads allow) is refused naming the case's load."""
+    text = _edit(DEFAULT_PATH.read_text(encoding="utf-8"), "load_left = { value = 2698.0",
+                 "load_left = { value = 2700.0", "[cases.unladen]")
+    path = tmp_path / "off.toml"
+    path.write_text(text, encoding="utf-8")
+    with pytest.raises(ParameterError) as info:
+        load_parameters(path)
+    _assert_one_line_naming(str(info.value), path, "cases.unladen.load_left")
+
+
 def test_unknown_case_name_is_refused(params):
     """Asking for a case the file does not define is a user error naming the file and the case, on one line."""
     with pytest.raises(ParameterError) as info:
@@ -182,10 +237,12 @@ def test_check_params_accepts_shipped_file():
     assert result.stderr == ""
 
 
-def test_check_params_refuses_bad_file(tmp_path):
+@pytest.mark.parametrize("defect", ["wrong unit", "tyre pressure of 1.225 Pa", "wheel load of 29 kN"])
+def test_check_params_refuses_bad_file(tmp_path, defect):
     """`parksteer check-params bad.toml` exits with status 2 and prints exactly one line on stderr naming the
-    file and the key, nothing on stdout."""
-    path, key = _write_defective(tmp_path, "wrong unit")
+    file and the key, nothing on stdout: a wrong unit, a value outside the quantity's physical bounds (1.225 Pa
+    of tyre pressure), wheel loads that contradict the chassis statics."""
+    path, key = _write_defective(tmp_path, defect)
     result = _run([str(BIN / "parksteer"), "check-params", str(path)])
     assert result.returncode == 2
     assert result.stdout == ""

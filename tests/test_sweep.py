@@ -38,7 +38,7 @@ base_case: unladen
 axes:
   tyre.tyre_pressure: {start: 120000, stop: 300000, num: 3}
   design.front_axle_load: [5576, 7000]
-  rack_friction.friction_force: [500, 730]
+  steering.rack_friction_force: [500, 730]
 """
 
 
@@ -52,9 +52,9 @@ def test_grid_is_the_full_factorial_with_stable_ids(tmp_path, params):
     sweep = load_sweep(_write(tmp_path, GRID), params)
     assert len(sweep.points) == 12
     assert [p.values["tyre.tyre_pressure"] for p in sweep.points[:4]] == [120000.0] * 4
-    assert [p.values["rack_friction.friction_force"] for p in sweep.points[:2]] == [500.0, 730.0]
+    assert [p.values["steering.rack_friction_force"] for p in sweep.points[:2]] == [500.0, 730.0]
     assert sweep.points[5].values == {"tyre.tyre_pressure": 210000.0, "design.front_axle_load": 5576.0,
-                                      "rack_friction.friction_force": 730.0}
+                                      "steering.rack_friction_force": 730.0}
     ids = sweep.point_ids
     assert len(set(ids)) == 12 and all(len(i) == 10 and int(i, 16) >= 0 for i in ids)
     assert load_sweep(_write(tmp_path, GRID, "again.yaml"), params).point_ids == ids
@@ -89,7 +89,7 @@ points:
     ("axes: {design.front_axle_load: [6000], case.load_left: [3000]}", "case.load_left"),
     ("axes: {design.steering_ratio: [500]}", "axes.design.steering_ratio[0]"),
     ("axes: {design.front_axle_load: [1500], vehicle.unsprung_mass: [200]}", "design.front_axle_load"),
-    ("effects: '-rack_friction'\naxes: {rack_friction.friction_force: [500]}", "rack_friction"),
+    ("effects: '-rack_friction'\naxes: {rack_lash.lash: [0.0002]}", "rack_lash"),
     ("axes: {tyre.tyre_pressure: [2.0e+5]}\ncolour: blue", "colour"),
     ("axes: {tyre.tyre_pressure: [2.0e+5]}\nbraked: handbrake", "braked"),
     ("axes: {tyre.tyre_pressure: [2.0e+5]}\nsurface: air_bearing\nbraked: braked_wheels", "braked"),
@@ -266,6 +266,8 @@ def test_plateau_falls_with_pressure_as_equation_2(tiny_grid):
         low, high = tiny_grid[122500.0, load], tiny_grid[245000.0, load]
         assert high["plateau_torque_Nm"] < low["plateau_torque_Nm"]
         assert _tyre_share(high) / _tyre_share(low) == pytest.approx(0.5**0.78, rel=0.01)
+        rack = [m["plateau_torque_Nm"] * m["share_contrib_rack_friction_Nm"] for m in (low, high)]
+        assert rack[1] == pytest.approx(rack[0], rel=0.01)
 
 
 def test_plateau_tyre_share_rises_with_load_as_w_to_the_1_5(tiny_grid):
@@ -331,18 +333,6 @@ def test_point_job_never_derives(params, tmp_path, monkeypatch):
 # ---------------------------------------------------------------------------- cluster profile
 
 
-def _snakefile_with_sweep(repo_root: Path, tmp_path: Path) -> Path:
-    """The repository's Snakefile, with the model and sweep rules included if it does not include them yet."""
-    main = (repo_root / "workflow" / "Snakefile").read_text(encoding="utf-8")
-    lines = [f'include: "{repo_root / "workflow" / "Snakefile"}"']
-    for rules in ("model.smk", "sweep.smk"):
-        if rules not in main:
-            lines.append(f'include: "{repo_root / "workflow" / "rules" / rules}"')
-    path = tmp_path / "Snakefile"
-    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
-    return path
-
-
 def test_slurm_profile_dry_run_lists_the_point_jobs_and_their_resources(repo_root, tmp_path):
     """A dry run with workflow/profiles/slurm plans the example sweep as 48 point jobs bundled into two SLURM
     group jobs (25 + 23 points), each point asking for the profile's partition, account, memory and runtime.
@@ -363,7 +353,7 @@ def test_slurm_profile_dry_run_lists_the_point_jobs_and_their_resources(repo_roo
     env = dict(os.environ, PATH=f"{fake_bin}{os.pathsep}{os.environ['PATH']}")
     snakemake = Path(sys.executable).with_name("snakemake")
     done = subprocess.run(
-        [str(snakemake), "--snakefile", str(_snakefile_with_sweep(repo_root, tmp_path)), "--directory",
+        [str(snakemake), "--snakefile", str(repo_root / "workflow" / "Snakefile"), "--directory",
          str(repo_root), "--profile", "workflow/profiles/slurm", "--dry-run", "--forceall", "sweep_design"],
         capture_output=True, text=True, env=env, timeout=120,
     )
@@ -399,8 +389,8 @@ def test_slurm_submission_with_stand_in_tools_requests_bounded_group_jobs(repo_r
     parksteer = Path(sys.executable).with_name("parksteer")
     # The model manifests the point jobs wait for (the pipeline's full model and the sweep's braked-wheel model),
     # made here so that the first submissions are the points.
-    for effects, manifest in ((None, "results/model/derived_full.json"),
-                              ("+braked_wheels", "results/sweeps/design/model_braked.json")):
+    for effects, manifest in ((None, "results/model/full.json"),
+                              ("+braked_wheels", "results/model/with_braked_wheels.json")):
         subprocess.run([str(parksteer), "derive", *([f"--effects={effects}"] if effects else []),
                         "--out", str(work / manifest)], check=True, capture_output=True, cwd=repo_root, timeout=600)
     fake_bin, calls = tmp_path / "bin", tmp_path / "calls"
@@ -412,12 +402,15 @@ def test_slurm_submission_with_stand_in_tools_requests_bounded_group_jobs(repo_r
         tool.chmod(0o755)
     env = dict(os.environ, PATH=f"{fake_bin}{os.pathsep}{os.environ['PATH']}")
     snakemake = Path(sys.executable).with_name("snakemake")
-    process = subprocess.Popen(
-        [str(snakemake), "sweep_design", "--snakefile", str(_snakefile_with_sweep(repo_root, tmp_path)),
-         "--directory", str(work), "--profile", str(repo_root / "workflow" / "profiles" / "slurm")],
-        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, env=env, text=True,
-        start_new_session=True,  # its own process group, so every child dies with it below
-    )
+    # Snakemake's log goes to a file: read through a pipe only at the end, it would fill the pipe and stall.
+    log_path = tmp_path / "snakemake.log"
+    with log_path.open("w", encoding="utf-8") as log:
+        process = subprocess.Popen(
+            [str(snakemake), "sweep_design", "--snakefile", str(work / "workflow" / "Snakefile"),
+             "--directory", str(work), "--profile", str(repo_root / "workflow" / "profiles" / "slurm")],
+            stdout=log, stderr=subprocess.STDOUT, env=env, text=True,
+            start_new_session=True,  # its own process group, so every child dies with it below
+        )
     submissions: list[str] = []
     try:
         deadline = time.monotonic() + 90
@@ -429,7 +422,8 @@ def test_slurm_submission_with_stand_in_tools_requests_bounded_group_jobs(repo_r
             time.sleep(0.5)
     finally:
         os.killpg(process.pid, signal.SIGKILL)
-        output = process.communicate(timeout=30)[0]
+        process.wait(timeout=30)
+    output = log_path.read_text(encoding="utf-8")
     assert len(submissions) == 2, output[-3000:]
     for line in submissions:
         assert "-p your_partition" in line and "-A your_account" in line

@@ -1,13 +1,17 @@
-"""Load and validate the parameter file (data/parameters.toml).
+"""The registry of quantities, and the parameter file (data/parameters.toml) that gives their values.
 
-The file is human-readable TOML; every entry is ``{value, unit, source}``. The schema
-below names each key, the SI unit it must be written in and its physical bounds. Any
-unknown key, missing key, wrong unit or non-physical value is refused with a
-:class:`ParameterError` whose message is one line naming the file and the key.
+Every quantity has one key (``section.name``), one SI unit and one pair of physical bounds, listed here
+(:data:`SCHEMA`, :func:`registry`); the file gives each its value and source as ``{value, unit, source}``.
+The candidate effects' own quantities are sections of the file named after the effect. Overrides (``--set``,
+sweeps, diagnosis, the workflow's config) use the same keys, plus ``case.<name>`` for the active Table B1
+case (:meth:`Parameters.with_overrides`). Any unknown key, missing key, wrong unit, non-physical value or
+wheel loads that contradict the chassis statics are refused with a :class:`ParameterError` whose message is
+one line naming the file and the key.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import tomllib
 from dataclasses import dataclass, field
@@ -23,29 +27,82 @@ INF = math.inf
 
 
 @dataclass(frozen=True)
-class Spec:
-    """What one parameter must look like: its unit, its bounds, scalar or list."""
+class Quantity:
+    """One quantity of the pipeline: its key, SI unit and physical bounds.
 
+    ``key`` is ``section.name`` of the parameter file (``tyre.tyre_pressure``), ``case.<name>`` for a
+    value of the active Table B1 case, or ``<effect>.<name>`` for a quantity only that effect has.
+    ``default`` and ``source`` are given only by quantities declared in code (an effect from outside the
+    package); every other quantity takes its value and source from the parameter file.
+    """
+
+    key: str
     unit: str
     lower: float = 0.0
     upper: float = INF
-    is_list: bool = False
     lower_inclusive: bool = False  # most physical quantities here must be strictly positive
+    upper_inclusive: bool = True
+    is_list: bool = False
+    description: str = ""
+    default: float | None = None
+    source: str = ""
+
+    @property
+    def section(self) -> str:
+        return self.key.partition(".")[0]
+
+    @property
+    def name(self) -> str:
+        return self.key.partition(".")[2]
+
+    def bounds_text(self) -> str:
+        low = "[" if self.lower_inclusive else "("
+        high = "]" if self.upper_inclusive else ")"
+        return f"{low}{self.lower:g}, {self.upper:g}{high}"
+
+    def within(self, value: float) -> bool:
+        below = value < self.lower if self.lower_inclusive else value <= self.lower
+        above = value > self.upper if self.upper_inclusive else value >= self.upper
+        return not (below or above)
+
+    def check(self, value: Any, where: str | None = None) -> float:
+        """`value` as a float if it is a finite number within the bounds; else one-line ParameterError."""
+        where = where or self.key
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise ParameterError(f"{where}: value {value!r} is not a number")
+        value = float(value)
+        if not math.isfinite(value):
+            raise ParameterError(f"{where}: value {value} is not finite")
+        if not self.within(value):
+            raise ParameterError(
+                f"{where}: value {value:g} {self.unit} is non-physical (allowed {self.bounds_text()})"
+            )
+        return value
 
 
-def _pos(unit: str, **kw: Any) -> Spec:
-    return Spec(unit, **kw)
+def _q(unit: str, lower: float = 0.0, upper: float = INF, **kw: Any) -> dict[str, Any]:
+    return dict(unit=unit, lower=lower, upper=upper, **kw)
 
 
-def _nonneg(unit: str, **kw: Any) -> Spec:
-    return Spec(unit, lower=0.0, lower_inclusive=True, **kw)
+def _pos(unit: str, **kw: Any) -> dict[str, Any]:
+    return _q(unit, **kw)
 
 
-def _any(unit: str) -> Spec:
-    return Spec(unit, lower=-INF, upper=INF, lower_inclusive=True)
+def _nonneg(unit: str, **kw: Any) -> dict[str, Any]:
+    return _q(unit, lower_inclusive=True, **kw)
 
 
-SCHEMA: dict[str, dict[str, Spec]] = {
+def _range(unit: str, lower: float, upper: float) -> dict[str, Any]:
+    return _q(unit, lower, upper, lower_inclusive=True)
+
+
+def _any(unit: str) -> dict[str, Any]:
+    return _q(unit, -INF, INF, lower_inclusive=True)
+
+
+# Unit and physical bounds of every key of the parameter file: the one home of both. The file must hold
+# every key listed here, in the unit given here.
+_SCHEMA: dict[str, dict[str, dict[str, Any]]] = {
     "vehicle": {
         "gravity": _pos("m/s^2"),
         "unsprung_mass": _pos("kg"),
@@ -58,24 +115,24 @@ SCHEMA: dict[str, dict[str, Spec]] = {
     "steering": {
         "rack_mass": _pos("kg"),
         "rack_roll_inertia": _nonneg("kg m^2"),
-        "rack_friction_force": _nonneg("N"),
+        "rack_friction_force": _range("N", 0.0, 1.0e5),
         "handwheel_to_rack_ratio": _pos("rad/m"),
         "roadwheel_to_rack_ratio": _pos("rad/m"),
         "column_torsional_stiffness": _pos("N m/rad"),
         "column_torsional_damping": _nonneg("N m s/rad"),
-        "hooke_joint_angle": Spec("rad", lower=0.0, upper=1.2, lower_inclusive=True),
-        "hooke_joint_phase": _any("rad"),
+        "hooke_joint_angle": _range("rad", 0.0, 1.2),
+        "hooke_joint_phase": _range("rad", -10.0, 10.0),
         "steering_assembly_cg_outboard": _any("m"),
         "steering_assembly_mass": _pos("kg"),
         "steering_assembly_inertia_x": _pos("kg m^2"),
         "steering_assembly_inertia_y": _pos("kg m^2"),
         "steering_assembly_inertia_z": _pos("kg m^2"),
-        "rack_axis_z": _any("m"),
-        "friction_smoothing": _pos("s/m"),
+        "rack_axis_z": _range("m", -2.0, 2.0),
+        "friction_smoothing": _range("s/m", 1.0, 1.0e6),
     },
     "geometry": {
-        "castor_angle": Spec("rad", lower=-0.5, upper=0.5, lower_inclusive=True),
-        "kingpin_inclination": Spec("rad", lower=-0.5, upper=0.5, lower_inclusive=True),
+        "castor_angle": _range("rad", -0.5, 0.5),
+        "kingpin_inclination": _range("rad", -0.5, 0.5),
         "mechanical_trail": _any("m"),
         "kingpin_top_y": _pos("m"),
         "kingpin_top_z": _any("m"),
@@ -83,14 +140,15 @@ SCHEMA: dict[str, dict[str, Spec]] = {
         "ground_z": _any("m"),
     },
     "tyre": {
-        "tyre_pressure": _pos("Pa"),
-        "friction_coefficient": _nonneg("1", upper=3.0),
-        "reference_pressure": _pos("Pa"),
-        "pressure_index": _nonneg("1", upper=3.0),
+        # a car tyre's inflation pressure: 0.1 to 10 bar (gauge); below, the tyre is flat and equation (2) fails
+        "tyre_pressure": _range("Pa", 1.0e4, 1.0e6),
+        "friction_coefficient": _range("1", 0.0, 3.0),
+        "reference_pressure": _range("Pa", 1.0e4, 1.0e6),
+        "pressure_index": _range("1", 0.0, 3.0),
         "radial_stiffness": _pos("N/m"),
         "radial_damping": _nonneg("N s/m"),
-        "carcass_torsional_stiffness": _pos("N m/rad"),
-        "carcass_torsional_damping": _nonneg("N m s/rad"),
+        "carcass_torsional_stiffness": _range("N m/rad", 1.0, 1.0e6),
+        "carcass_torsional_damping": _range("N m s/rad", 0.0, 1.0e4),
         "tread_ring_mass": _pos("kg"),
         "tread_ring_yaw_inertia": _pos("kg m^2"),
     },
@@ -115,7 +173,7 @@ SCHEMA: dict[str, dict[str, Spec]] = {
     },
     "synthetic": {
         "sample_rate": _pos("Hz"),
-        "logger_bits": Spec("1", lower=1.0, upper=24.0, lower_inclusive=True),
+        "logger_bits": _range("1", 1.0, 24.0),
         "full_scale_handwheel_angle": _pos("rad"),
         "full_scale_rack": _pos("m"),
         "full_scale_torque": _pos("N m"),
@@ -125,15 +183,49 @@ SCHEMA: dict[str, dict[str, Spec]] = {
         "noise_torque": _nonneg("N m"),
         "noise_load": _nonneg("N"),
         "logger_seed": _nonneg("1"),
-        "hand_speed_variation": _nonneg("1", upper=0.9),
-        "hand_components": _nonneg("1", upper=20.0),
+        "hand_speed_variation": _range("1", 0.0, 0.9),
+        "hand_components": _range("1", 0.0, 20.0),
         "hand_frequency_range": _pos("Hz", is_list=True),
         "hand_knots_per_stroke": _pos("1", upper=8.0),
         "hand_seed": _nonneg("1"),
     },
+    # The candidate effects' own quantities (sections named after the effect; value 0 of a strength = absent).
+    "ackermann": {
+        "ackermann_fraction": _range("1", 0.0, 1.5),
+        "track_to_wheelbase": _range("1", 0.1, 2.0),
+    },
+    "braked_wheels": {"brake_fraction": _range("1", 0.0, 1.0)},
+    "brush_patch": {"brush_fraction": _range("1", 0.0, 1.0)},
+    "column_friction": {"friction_torque": _range("N m", 0.0, 20.0)},
+    "kingpin_friction": {"friction_radius": _range("m", 0.0, 0.05)},
+    "rack_damping": {"damping": _range("N s/m", 0.0, 1.0e5)},
+    "rack_lash": {
+        "lash": _range("m", 0.0, 0.005),
+        "smoothing_width": _range("m", 1.0e-7, 1.0e-3),
+    },
+    "rack_stiction": {
+        "breakaway_excess": _range("N", 0.0, 5000.0),
+        "stribeck_speed": _range("m/s", 1.0e-4, 0.1),
+    },
+    # Rivals of the paper's mechanisms (effects with diagnosis_candidate = False).
+    "carcass_hysteresis": {
+        "stiffness_fraction": _range("1", 0.0, 5.0),
+        "relaxation_time": _range("s", 1.0e-3, 10.0),
+    },
+    "gear_efficiency": {
+        "inefficiency": _range("1", 0.0, 0.5),
+        "smoothing_force": _range("N", 1.0e-3, 100.0),
+    },
+    "linkage_nonlinearity": {"cubic_coefficient": _range("1", 0.0, 1.0)},
+    "rolling_resistance": {"coefficient": _range("1", 0.0, 0.1)},
+    "top_mount_windup": {"stiffness": _range("N m/rad", 0.0, 1000.0)},
+    "tyre_stribeck": {
+        "breakaway_excess": _range("1", 0.0, 1.0),
+        "stribeck_rate": _range("rad/s", 1.0e-4, 1.0),
+    },
 }
 
-CASE_SCHEMA: dict[str, Spec] = {
+_CASE_SCHEMA: dict[str, dict[str, Any]] = {
     "chassis_mass": _pos("kg"),
     "chassis_cg_y": _any("m"),
     "wheel_centre_y": _pos("m"),
@@ -142,7 +234,80 @@ CASE_SCHEMA: dict[str, Spec] = {
     "extra_offset": _nonneg("m"),
 }
 
+CASE = "case"  # the override section of the active case's values (``case.load_left``)
+
+SCHEMA: dict[str, dict[str, Quantity]] = {
+    section: {name: Quantity(f"{section}.{name}", **spec) for name, spec in entries.items()}
+    for section, entries in _SCHEMA.items()
+}
+CASE_SCHEMA: dict[str, Quantity] = {name: Quantity(f"{CASE}.{name}", **spec) for name, spec in _CASE_SCHEMA.items()}
+
+# Quantities declared in code by effects from outside the package (key <effect>.<name>), joined when loaded.
+_DECLARED: dict[str, Quantity] = {}
+
+# Keys of earlier versions, each now one quantity of the file: refused with a pointer to the key.
+RENAMED: dict[str, str] = {
+    "tyre_friction.friction_coefficient": "tyre.friction_coefficient",
+    "tyre_friction.tyre_pressure": "tyre.tyre_pressure",
+    "tyre_friction.reference_pressure": "tyre.reference_pressure",
+    "tyre_friction.pressure_index": "tyre.pressure_index",
+    "tyre_friction.smoothing": "steering.friction_smoothing",
+    "rack_friction.friction_force": "steering.rack_friction_force",
+    "rack_friction.smoothing": "steering.friction_smoothing",
+    "carcass_compliance.torsional_stiffness": "tyre.carcass_torsional_stiffness",
+    "carcass_compliance.torsional_damping": "tyre.carcass_torsional_damping",
+    "hooke_joint.joint_angle": "steering.hooke_joint_angle",
+    "hooke_joint.phase": "steering.hooke_joint_phase",
+    "column_friction.smoothing": "steering.friction_smoothing",
+    "kingpin_friction.smoothing": "steering.friction_smoothing",
+    "rack_stiction.smoothing": "steering.friction_smoothing",
+}
+
+
+def registry() -> dict[str, Quantity]:
+    """Every known key: the parameter file's, ``case.*``, and those declared by loaded effects."""
+    out = {q.key: q for table in SCHEMA.values() for q in table.values()}
+    out.update({q.key: q for q in CASE_SCHEMA.values()})
+    out.update(_DECLARED)
+    return out
+
+
+def quantity(key: str) -> Quantity:
+    """The quantity of `key`; an unknown or renamed key is a one-line UsageError."""
+    found = registry().get(key)
+    if found is None:
+        raise UsageError(unknown_key_message(key))
+    return found
+
+
+def unknown_key_message(key: str) -> str:
+    if key in RENAMED:
+        return f"{key}: unknown key; this quantity is {RENAMED[key]}"
+    return f"{key}: unknown key (a key of the parameter file, case.<name>, or an effect's own quantity)"
+
+
+def declare(q: Quantity) -> Quantity:
+    """Join a quantity declared in code (an effect's own, with default and source) to the registry."""
+    if q.section in SCHEMA or q.section == CASE:
+        raise UsageError(f"{q.key}: section {q.section} belongs to the parameter file; declare {q.section}.* there")
+    if q.default is None or not q.source.strip():
+        raise UsageError(f"{q.key}: a quantity declared in code needs a default and a source")
+    known = _DECLARED.get(q.key)
+    if known is not None and known != q:
+        raise UsageError(f"{q.key}: declared twice with different unit, bounds or default")
+    q.check(q.default)
+    _DECLARED[q.key] = q
+    return q
+
 ENTRY_KEYS = {"value", "unit", "source"}
+
+# Tolerances of the statics cross-check, from the printing precision of Table B1: wheel loads are printed to
+# 1 N (so their sum is good to 1 N, two roundings of 0.5 N) and y_cm to 0.1 mm (so the chassis weight's moment
+# is good to m g 0.05 mm, plus the 1 N of the load difference at the half track). The spacer cases print loads
+# to 0.1 N; the same tolerance covers them. The shipped cases meet it with room: their sums are within 0.05 N
+# of (chassis_mass + unsprung_mass) g and the loads put y_cm within 0.03 mm of the printed value.
+LOAD_SUM_TOLERANCE_N = 1.0
+CG_Y_PRINT_TOLERANCE_M = 0.5e-4
 
 
 class ParameterError(UsageError):
@@ -159,13 +324,26 @@ class Parameters:
     sources: dict[str, str] = field(repr=False)
 
     def __getitem__(self, dotted: str) -> Any:
-        """``params["tyre.friction_coefficient"]`` or ``params["cases.unladen.load_left"]``."""
+        """``params["tyre.friction_coefficient"]`` or ``params["cases.unladen.load_left"]``.
+
+        A quantity declared in code by a loaded effect (no file entry) reads its default.
+        """
         parts = dotted.split(".")
         if parts[0] == "cases" and len(parts) == 3:
             return self.case(parts[1])[parts[2]]
-        if len(parts) != 2 or parts[0] not in self.sections or parts[1] not in self.sections[parts[0]]:
-            raise KeyError(dotted)
-        return self.sections[parts[0]][parts[1]]
+        if len(parts) == 2 and parts[0] in self.sections and parts[1] in self.sections[parts[0]]:
+            return self.sections[parts[0]][parts[1]]
+        declared = _DECLARED.get(dotted)
+        if declared is not None:
+            return declared.default
+        raise KeyError(dotted)
+
+    def value(self, key: str, case: str) -> float:
+        """The value of any registry key, ``case.<name>`` read from the case `case`."""
+        section, _, name = key.partition(".")
+        if section == CASE:
+            return self.case(case)[name]
+        return self[key]
 
     def case(self, name: str) -> dict[str, float]:
         if name not in self.cases:
@@ -174,6 +352,8 @@ class Parameters:
         return dict(self.cases[name])
 
     def source(self, dotted: str) -> str:
+        if dotted not in self.sources and dotted in _DECLARED:
+            return _DECLARED[dotted].source
         return self.sources[dotted]
 
     @property
@@ -181,8 +361,31 @@ class Parameters:
         """Case names in file order (unladen first)."""
         return list(self.cases)
 
+    def with_overrides(self, overrides: dict[str, float] | None, case: str | None = None) -> Parameters:
+        """These values with `overrides` ({key: value}) applied, each checked against its quantity's bounds.
 
-def _check_value(path: Path, key: str, spec: Spec, entry: Any) -> Any:
+        ``case.<name>`` changes the case `case` (every case when None). A list quantity cannot be overridden.
+        """
+        if not overrides:
+            return self
+        sections = {k: dict(v) for k, v in self.sections.items()}
+        cases = {k: dict(v) for k, v in self.cases.items()}
+        if case is not None:
+            self.case(case)
+        for key, value in overrides.items():
+            q = quantity(key)
+            if q.is_list:
+                raise UsageError(f"{key}: a list; it cannot be overridden by one value")
+            value = q.check(value, where=key)
+            if q.section == CASE:
+                for name in ([case] if case is not None else list(cases)):
+                    cases[name][q.name] = value
+            else:
+                sections.setdefault(q.section, {})[q.name] = value
+        return dataclasses.replace(self, sections=sections, cases=cases)
+
+
+def _check_value(path: Path, key: str, spec: Quantity, entry: Any) -> Any:
     where = f"{path}: {key}"
     if not isinstance(entry, dict):
         raise ParameterError(f"{where}: expected {{value, unit, source}}, got {type(entry).__name__}")
@@ -197,32 +400,22 @@ def _check_value(path: Path, key: str, spec: Spec, entry: Any) -> Any:
     if not isinstance(entry["source"], str) or not entry["source"].strip():
         raise ParameterError(f"{where}: source must be a non-empty string")
     raw = entry["value"]
-    values = raw if spec.is_list else [raw]
-    if spec.is_list and (not isinstance(raw, list) or not raw):
-        raise ParameterError(f"{where}: expected a non-empty list of numbers")
-    out = []
-    for v in values:
-        if isinstance(v, bool) or not isinstance(v, (int, float)):
-            raise ParameterError(f"{where}: value {v!r} is not a number")
-        v = float(v)
-        if not math.isfinite(v):
-            raise ParameterError(f"{where}: value {v} is not finite")
-        below = v < spec.lower if spec.lower_inclusive else v <= spec.lower
-        if below or v > spec.upper:
-            low = "[" if spec.lower_inclusive else "("
-            raise ParameterError(
-                f"{where}: value {v:g} {spec.unit} is non-physical (allowed {low}{spec.lower:g}, {spec.upper:g}])"
-            )
-        out.append(v)
-    return tuple(out) if spec.is_list else out[0]
+    if spec.is_list:
+        if not isinstance(raw, list) or not raw:
+            raise ParameterError(f"{where}: expected a non-empty list of numbers")
+        return tuple(spec.check(v, where) for v in raw)
+    return spec.check(raw, where)
 
 
-def _check_table(path: Path, prefix: str, table: Any, schema: dict[str, Spec], sources: dict[str, str]) -> dict[str, Any]:
+def _check_table(path: Path, prefix: str, table: Any, schema: dict[str, Quantity], sources: dict[str, str]
+                 ) -> dict[str, Any]:
     if not isinstance(table, dict):
         raise ParameterError(f"{path}: {prefix}: expected a table")
     unknown = sorted(table.keys() - schema.keys())
     if unknown:
-        raise ParameterError(f"{path}: {prefix}.{unknown[0]}: unknown key")
+        key = f"{prefix}.{unknown[0]}"
+        hint = f"; this quantity is {RENAMED[key]}" if key in RENAMED else ""
+        raise ParameterError(f"{path}: {key}: unknown key{hint}")
     missing = [k for k in schema if k not in table]
     if missing:
         raise ParameterError(f"{path}: {prefix}.{missing[0]}: missing value")
@@ -231,6 +424,30 @@ def _check_table(path: Path, prefix: str, table: Any, schema: dict[str, Spec], s
         out[key] = _check_value(path, f"{prefix}.{key}", spec, table[key])
         sources[f"{prefix}.{key}"] = table[key]["source"]
     return out
+
+
+def _check_statics(path: Path, sections: dict[str, dict[str, Any]], cases: dict[str, dict[str, float]]) -> None:
+    """Each case's wheel loads carry the car's front-end weight and balance the chassis's lateral moment."""
+    g = sections["vehicle"]["gravity"]
+    unsprung_kg = sections["vehicle"]["unsprung_mass"]
+    for name, c in cases.items():
+        weight_N = (c["chassis_mass"] + unsprung_kg) * g
+        total_N = c["load_left"] + c["load_right"]
+        if abs(total_N - weight_N) > LOAD_SUM_TOLERANCE_N:
+            raise ParameterError(
+                f"{path}: cases.{name}.load_left: wheel loads sum to {total_N:.1f} N, but (chassis_mass + "
+                f"vehicle.unsprung_mass) g is {weight_N:.1f} N (tolerance {LOAD_SUM_TOLERANCE_N:g} N)"
+            )
+        # Moments about the centreline: the unsprung parts are symmetric, the chassis weight acts at y_cm.
+        moment_Nm = (c["load_right"] - c["load_left"]) * c["wheel_centre_y"]
+        chassis_Nm = c["chassis_mass"] * g * c["chassis_cg_y"]
+        tolerance_Nm = LOAD_SUM_TOLERANCE_N * c["wheel_centre_y"] + c["chassis_mass"] * g * CG_Y_PRINT_TOLERANCE_M
+        if abs(moment_Nm - chassis_Nm) > tolerance_Nm:
+            implied_mm = 1000.0 * moment_Nm / (c["chassis_mass"] * g)
+            raise ParameterError(
+                f"{path}: cases.{name}.chassis_cg_y: {1000.0 * c['chassis_cg_y']:.1f} mm, but the wheel loads put "
+                f"the chassis mass centre at {implied_mm:.1f} mm"
+            )
 
 
 def load_parameters(path: str | Path = DEFAULT_PATH) -> Parameters:
@@ -260,4 +477,5 @@ def load_parameters(path: str | Path = DEFAULT_PATH) -> Parameters:
     if not isinstance(cases_doc, dict) or not cases_doc:
         raise ParameterError(f"{path}: cases: missing section")
     cases = {name: _check_table(path, f"cases.{name}", table, CASE_SCHEMA, sources) for name, table in cases_doc.items()}
+    _check_statics(path, sections, cases)
     return Parameters(path=path, sections=sections, cases=cases, sources=sources)

@@ -76,7 +76,7 @@ def test_rates_and_confusion_matrix(scored):
 def test_benchmark_figure_data_is_the_same_whatever_the_timings(tmp_path):
     """Figure data is checksummed, so it must not change from run to run: two benchmarks that differ only in the
     wall-clock time of each diagnosis give byte-identical figure data (timings stay in the JSON summary)."""
-    from parksteer.diagnose.benchmark import make_benchmark_figure
+    from parksteer.figures.diagnose import make_benchmark_figure
 
     csv_bytes = []
     for run, wall_s in enumerate((5.0, 9.5)):

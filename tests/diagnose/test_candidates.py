@@ -7,25 +7,33 @@ import pytest
 
 from parksteer.diagnose.calibrate import Fit, FitParameter
 from parksteer.diagnose.candidates import Signature, score, strength_parameter
-from parksteer.model.symbolic.components import Effect, EffectParameter
+from parksteer.model.symbolic.components import Effect
+from parksteer.parameters import Quantity
+
+
+def _declared(effect: str, name: str, unit: str, lower: float, upper: float, default: float) -> Quantity:
+    return Quantity(f"{effect}.{name}", unit, lower, upper, lower_inclusive=True, default=default, source="test")
 
 
 class _Candidate(Effect):
     name = "toy_candidate"
     in_default_set = False
-    parameters = (EffectParameter("strength", "N", 0.0, 1e3, "test", default=0.0),)
+    quantities = (_declared("toy_candidate", "strength", "N", 0.0, 1e3, 0.0),)
+    uses = tuple(q.key for q in quantities)
 
 
 class _TwoZeroDefaults(Effect):
     name = "toy_ambiguous"
-    parameters = (EffectParameter("a", "N", 0.0, 1.0, "test", default=0.0),
-                  EffectParameter("b", "N", 0.0, 1.0, "test", default=0.0))
+    quantities = (_declared("toy_ambiguous", "a", "N", 0.0, 1.0, 0.0),
+                  _declared("toy_ambiguous", "b", "N", 0.0, 1.0, 0.0))
+    uses = tuple(q.key for q in quantities)
 
 
 class _OneZeroDefault(Effect):
     name = "toy_single"
-    parameters = (EffectParameter("speed", "m/s", 1e-4, 1.0, "test", default=1e-3),
-                  EffectParameter("force", "N", 0.0, 1.0, "test", default=0.0))
+    quantities = (_declared("toy_single", "speed", "m/s", 1e-4, 1.0, 1e-3),
+                  _declared("toy_single", "force", "N", 0.0, 1.0, 0.0))
+    uses = tuple(q.key for q in quantities)
 
 
 def _fit(J: np.ndarray, r: np.ndarray) -> Fit:

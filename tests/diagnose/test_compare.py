@@ -38,7 +38,7 @@ def test_a_wrong_rack_friction_shows_as_a_sign_switching_offset(own_data, params
     residual on the plateau of each stroke is -1.07 N m times the stroke's direction (within the Hooke joint's
     +-11 % speed ratio)."""
     result = compare_files(load_files(own_data, params), params,
-                           overrides={"rack_friction.friction_force": params["steering.rack_friction_force"] + 200})
+                           overrides={"steering.rack_friction_force": params["steering.rack_friction_force"] + 200})
     f, model = result.files[0], result.predictions[0]
     expected = 200.0 / params["steering.handwheel_to_rack_ratio"]
     for stroke in f.phases.strokes:
@@ -64,8 +64,8 @@ def test_compare_command_writes_json_and_figure(own_data, tmp_path, capsys):
     [
         ["--case", "no_such_case"],
         ["--effects=+no_such_effect"],
-        ["--set", "rack_friction.no_such=1"],
-        ["--set", "rack_friction.friction_force=-5"],
+        ["--set", "steering.no_such=1"],
+        ["--set", "steering.rack_friction_force=-5"],
         ["--set", "friction_force=5"],
     ],
 )

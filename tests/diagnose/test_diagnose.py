@@ -17,8 +17,8 @@ from parksteer.synthetic.datasets import USER_EFFECT_PATH
 from parksteer.model.symbolic.components import MODULES_ENV, discover_effects, load_effect_module
 
 # Base parameters moved off the parameter file's values, as a real car's would be: a diagnosis must calibrate them.
-OFF_NOMINAL = {"tyre_friction.friction_coefficient": 0.70, "rack_friction.friction_force": 650.0,
-               "carcass_compliance.torsional_stiffness": 800.0}
+OFF_NOMINAL = {"tyre.friction_coefficient": 0.70, "steering.rack_friction_force": 650.0,
+               "tyre.carcass_torsional_stiffness": 800.0}
 
 
 @pytest.fixture(scope="module")
@@ -69,7 +69,7 @@ def test_a_hidden_library_candidate_is_named_with_its_strength(written, params):
     assert diagnosis.verdict == "missing" and diagnosis.effect == "rack_stiction"
     values = diagnosis.best.refit.values
     assert values["rack_stiction.breakaway_excess"] == pytest.approx(400.0, rel=0.10)
-    assert values["rack_friction.friction_force"] == pytest.approx(OFF_NOMINAL["rack_friction.friction_force"],
+    assert values["steering.rack_friction_force"] == pytest.approx(OFF_NOMINAL["steering.rack_friction_force"],
                                                                   rel=0.03)
 
 
@@ -79,8 +79,8 @@ def test_nothing_hidden_is_adequate_once_calibrated(null_diagnosis):
     not mistaken for a missing effect)."""
     assert null_diagnosis.verdict == "adequate"
     assert null_diagnosis.effect is None
-    force = null_diagnosis.calibration.values["rack_friction.friction_force"]
-    assert force == pytest.approx(OFF_NOMINAL["rack_friction.friction_force"], rel=0.03)
+    force = null_diagnosis.calibration.values["steering.rack_friction_force"]
+    assert force == pytest.approx(OFF_NOMINAL["steering.rack_friction_force"], rel=0.03)
 
 
 def test_a_disturbance_outside_the_library_is_unexplained(drift_diagnosis):

@@ -1,15 +1,17 @@
-"""Smoothing a logged rack and replaying it through the model."""
+"""Smoothing a logged rack (parksteer.measure.smoothing) and replaying it through the model (Replay)."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from parksteer.diagnose.replay import Replay, smooth_rack
-from parksteer.synthetic.logger import add_noise, quantise, quantisation_step
+from parksteer.diagnose.problem import relogged_rack
+from parksteer.diagnose.replay import _DIRECT, Replay
+from parksteer.measure.smoothing import smooth_rack
+from parksteer.model.numeric.prescribed import solve
+from parksteer.model.numeric.simulate import prepare
 from parksteer.model.symbolic.components import resolve_effects
-from parksteer.model.numeric.inputs import rack_drive_from_arrays
-from parksteer.model.numeric.simulate import simulate
+from parksteer.synthetic.logger import add_noise, quantise, quantisation_step
 
 FULL_SCALE_M = 0.1
 
@@ -75,29 +77,42 @@ def test_drawn_racks_scatter_as_the_data_allow():
     assert 0.1 * rack.noise_rms_m < np.median(spread) < rack.noise_rms_m
 
 
-def test_fast_replay_agrees_with_the_models_prescribed_rack_solve(params):
-    """The replay integrates the same equations as simulate(rack_drive=...) (only faster): on the same rack the two
-    torques agree to a few thousandths of a N m, far below a converter step (0.2 N m), reversals included."""
-    t, logged, _ = _logged_rack(4, True)
+def test_relogged_racks_scatter_about_the_smoothed_one():
+    """A rack logged again through the same 8-bit logger and smoothed again stays within a converter step of the
+    smoothed rack, keeps its knot spacing, and differs from it (the logger's noise is drawn again)."""
+    t, logged, _ = _logged_rack(6, True)
     rack = smooth_rack(t, logged)
-    fine = np.arange(t[0], t[-1] + 1e-9, 0.005)
-    drive = rack_drive_from_arrays(fine, rack.evaluate(fine)[0])
-    reference = simulate("unladen", params=params, rack_drive=drive, output_dt_s=0.02)
-    replay = Replay(resolve_effects(None), "unladen", "ground", params, rack, t)
-    torque = replay.torque()
-    expected = np.interp(t, reference.columns["time_s"], reference.columns["handwheel_torque_Nm"])
-    assert np.max(np.abs(torque - expected)) < 0.005
-    assert np.sqrt(np.mean((torque - expected) ** 2)) < 0.002
+    again = relogged_rack(rack, t, FULL_SCALE_M, 8, 0.0002, np.random.default_rng(1))
+    difference = again.evaluate(t)[0] - rack.evaluate(t)[0]
+    assert again.knot_spacing_s == rack.knot_spacing_s
+    assert 0.0 < np.sqrt(np.mean(difference**2)) < quantisation_step(FULL_SCALE_M)
 
 
-def test_an_effect_parameter_override_changes_the_torque_by_its_physical_share(params):
+def test_an_override_set_in_the_vector_replays_as_a_prepared_run(params):
+    """Bookkeeping of Replay.parameter_vector: an override that only enters the equations is written into the
+    vector, one that shapes the preparation (a case value) prepares the run again; either way the torque is the
+    one of a run prepared with that override."""
+    t, logged, _ = _logged_rack(7, True)
+    rack = smooth_rack(t, logged)
+    effects = resolve_effects(None)
+    replay = Replay(effects, "unladen", "ground", params, rack, t)
+    for key, value in (("steering.rack_friction_force", params["steering.rack_friction_force"] + 150.0),
+                       ("case.load_left", params.case("unladen")["load_left"] + 100.0)):
+        run = prepare("unladen", effects, {key: value}, "ground", params)
+        expected = solve(run, run.p, rack, t).torque_Nm
+        assert np.max(np.abs(replay.torque({key: value}) - expected)) < 1e-9, key
+    model = replay.parameter_vector()[0].model.directory.name
+    assert _DIRECT[(model, "steering.rack_friction_force")] and not _DIRECT[(model, "case.load_left")]
+
+
+def test_a_rack_friction_override_changes_the_torque_by_its_physical_share(params):
     """Raising the rack friction force by 100 N raises the sliding torque by 100 N / 186.47 rad/m = 0.54 N m
     at the handwheel (times the Hooke joint's speed ratio, 0.90 to 1.11)."""
     t, logged, _ = _logged_rack(5, True)
     rack = smooth_rack(t, logged)
     replay = Replay(resolve_effects(None), "unladen", "ground", params, rack, t)
     base = replay.torque()
-    more = replay.torque({"rack_friction.friction_force": params["steering.rack_friction_force"] + 100.0})
+    more = replay.torque({"steering.rack_friction_force": params["steering.rack_friction_force"] + 100.0})
     speed = rack.evaluate(t)[1]
     sliding = np.abs(speed) > 0.008
     share = (more - base)[sliding] * np.sign(speed[sliding])

@@ -48,7 +48,10 @@ def small_sweep(params, tmp_path_factory):
 
 def test_outputs_are_reproducible_and_complete(params, small_sweep):
     """Made twice, the SVG and CSV are byte-identical; the table has one row per point with the figures of
-    merit, the mechanism shares (summing to one) and the assistance flag of each design."""
+    merit, the mechanism shares and the assistance flag of each design. The shares summing to one is bookkeeping
+    (the inertia share is the residual, so the contributions add up to the torque by construction): it checks
+    that no mechanism's column is lost on the way to the table. The shares' physics (equation (2) in pressure and
+    load, rack friction over the ratio) is tested in tests/test_sweep.py."""
     root, declaration, points = small_sweep
     for tag in ("a", "b"):
         make_sweep_figure(declaration, params, points, root / f"{tag}.svg", root / f"{tag}.csv", root / f"{tag}.json")
@@ -57,7 +60,7 @@ def test_outputs_are_reproducible_and_complete(params, small_sweep):
     columns, header = read_csv(root / "a.csv")
     assert len(columns["point"]) == 8
     shares = sum(columns[c] for c in columns if c.startswith("share_"))
-    np.testing.assert_allclose(shares, 1.0, atol=1e-5)
+    np.testing.assert_allclose(shares, 1.0, atol=1e-5, err_msg="bookkeeping: a mechanism's share column is missing")
     np.testing.assert_array_equal(columns["needs_assistance"], (columns["peak_torque_Nm"] > 28.5).astype(float))
     assert "28.5 N m" in header["assistance threshold"]
 

@@ -15,10 +15,19 @@ def first_ramp(result, rack_from_m: float = 0.02, rack_to_m: float = 0.06):
 def plateau_mean(result, column: str = "handwheel_torque_Nm") -> float:
     return float(np.mean(result.columns[column][first_ramp(result)]))
 
+
+def column_angle_per_rack(params, rack_m):
+    """d(column angle)/d(rack) through the Hooke joint, from tan(theta_c - phase) = cos(a) tan(theta_p - phase):
+    G_hr cos(a) / (cos^2 psi + cos^2(a) sin^2 psi), psi = G_hr rack - phase (the joint's speed ratio)."""
+    ratio = params["steering.handwheel_to_rack_ratio"]
+    a = params["steering.hooke_joint_angle"]
+    psi = ratio * np.asarray(rack_m) - params["steering.hooke_joint_phase"]
+    return ratio * np.cos(a) / (np.cos(psi) ** 2 + np.cos(a) ** 2 * np.sin(psi) ** 2)
+
 # Every friction and damper of the paper's model off (for energy balances).
 DISSIPATION_OFF = {
-    "rack_friction.friction_force": 0.0,
-    "carcass_compliance.torsional_damping": 0.0,
+    "steering.rack_friction_force": 0.0,
+    "tyre.carcass_torsional_damping": 0.0,
     "steering.column_torsional_damping": 0.0,
     "tyre.radial_damping": 0.0,
     "vehicle.chassis_roll_damping": 0.0,

@@ -15,9 +15,11 @@ from parksteer.tables import read_csv
     [
         ["--case", "no_such_case"],
         ["--case", "unladen", "--effects=-no_such_effect"],
-        ["--case", "unladen", "--set", "rack_friction.no_such=1"],
-        ["--case", "unladen", "--set", "rack_friction.friction_force=-5"],
-        ["--case", "unladen", "--set", "rack_friction.friction_force"],
+        ["--case", "unladen", "--set", "steering.no_such=1"],
+        ["--case", "unladen", "--set", "tyre_friction.tyre_pressure=200000"],
+        ["--case", "unladen", "--set", "rack_lash.lash=0.0002"],
+        ["--case", "unladen", "--set", "steering.rack_friction_force=-5"],
+        ["--case", "unladen", "--set", "steering.rack_friction_force"],
         ["--case", "unladen", "--surface", "ice"],
         ["--case", "unladen", "--rack-from", "no_such_file.csv"],
     ],
@@ -56,7 +58,7 @@ def test_simulate_writes_the_documented_columns_and_header(tmp_path):
     header naming the case, surface, components and every parameter with its unit."""
     out = tmp_path / "sim.csv"
     assert main(["simulate", "--case", "part_laden", "--effects=-hooke_joint", "--surface", "air_bearing",
-                 "--set", "rack_friction.friction_force=500", "--out", str(out)]) == 0
+                 "--set", "steering.rack_friction_force=500", "--out", str(out)]) == 0
     columns, header = read_csv(out)
     for name in ("time_s", "handwheel_angle_rad", "rack_m", "handwheel_torque_Nm", "load_left_N", "load_right_N",
                  "contrib_tyre_friction_Nm", "contrib_rack_friction_Nm", "contrib_lifting_Nm",
@@ -64,15 +66,31 @@ def test_simulate_writes_the_documented_columns_and_header(tmp_path):
         assert name in columns
     assert "contrib_hooke_joint_Nm" not in columns
     assert header["case"] == "part_laden" and header["surface"] == "air_bearing"
-    assert header["param.rack_friction.friction_force"] == "500 N"
+    assert header["param.steering.rack_friction_force"] == "500 N"
     assert header["param.tyre.radial_stiffness"] == "160000 N/m"
     assert abs(columns["time_s"][-1] - 18.0) < 1e-9
 
 
 def test_effects_json_lists_parameters(capsys):
-    """`parksteer effects --json` lists every effect with name, description and parameters (unit, default, bounds)."""
+    """`parksteer effects --json` lists every effect with name, description, slot, needs and the quantities it
+    uses by key (unit, default, bounds, source), the values of the parameter file."""
     assert main(["effects", "--json"]) == 0
     listed = {e["name"]: e for e in json.loads(capsys.readouterr().out)}
     assert {"tyre_friction", "rack_friction", "carcass_compliance", "lifting", "hooke_joint"} <= set(listed)
-    friction = {p["name"]: p for p in listed["rack_friction"]["parameters"]}
-    assert friction["friction_force"]["default"] == 730.0 and friction["friction_force"]["unit"] == "N"
+    friction = {p["key"]: p for p in listed["rack_friction"]["parameters"]}
+    force = friction["steering.rack_friction_force"]
+    assert force["default"] == 730.0 and force["unit"] == "N" and force["source"] == "Appendix B, F"
+    assert listed["brush_patch"]["requires"] == ["carcass_compliance", "tyre_friction"]
+    assert listed["hooke_joint"]["replaces"] == "column_map"
+
+
+def test_renamed_key_is_refused_naming_the_key(tmp_path, capsys):
+    """A key of an earlier version (tyre_friction.tyre_pressure, once a second name of the file's tyre pressure)
+    is refused in one line that names the one key of the quantity, tyre.tyre_pressure; nothing is written."""
+    out = tmp_path / "out.csv"
+    assert main(["simulate", "--case", "unladen", "--set", "tyre_friction.tyre_pressure=200000",
+                 "--out", str(out)]) == 2
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert len(lines) == 1
+    assert "tyre_friction.tyre_pressure" in lines[0] and "this quantity is tyre.tyre_pressure" in lines[0]
+    assert not out.exists()

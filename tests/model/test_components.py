@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 from parksteer.errors import UsageError
-from parksteer.model.symbolic.components import discover_effects, resolve_effects
+from parksteer.model.symbolic.components import Effect, discover_effects, resolve_effects
+from parksteer.model.symbolic.derive import build_space
 from parksteer.model.numeric.simulate import simulate
 from parksteer.model.numeric.values import parse_overrides
 
@@ -33,41 +34,97 @@ def test_spec_adds_and_removes_from_the_default_set():
 
 
 def test_overrides_are_checked():
-    """--set items must be OWNER.PARAM=number; unknown parameters and values out of bounds are refused."""
-    assert parse_overrides(["rack_friction.friction_force=500"]) == {"rack_friction.friction_force": 500.0}
-    for bad in (["rack_friction.friction_force"], ["friction_force=1"], ["rack_friction.friction_force=abc"]):
+    """--set items must be SECTION.NAME=number; unknown keys, keys of an effect not in the model and values
+    outside the quantity's physical bounds are refused."""
+    assert parse_overrides(["steering.rack_friction_force=500"]) == {"steering.rack_friction_force": 500.0}
+    for bad in (["steering.rack_friction_force"], ["friction_force=1"], ["steering.rack_friction_force=abc"]):
         with pytest.raises(UsageError):
             parse_overrides(bad)
-    for bad in ({"rack_friction.friction_force": -1.0}, {"rack_friction.bogus": 1.0}, {"nobody.x": 1.0},
-                {"steering.rack_mass": 0.0}):
+    for bad in ({"steering.rack_friction_force": -1.0}, {"steering.bogus": 1.0}, {"nobody.x": 1.0},
+                {"steering.rack_mass": 0.0}, {"tyre.tyre_pressure": 1.225}, {"rack_lash.lash": 1e-4},
+                {"rack_friction.friction_force": 500.0}):
         with pytest.raises(UsageError):
             simulate("unladen", overrides=bad, t_end_s=0.1)
 
 
 def test_every_effect_declares_its_parameters(params):
-    """Each effect has a description and parameters with SI unit, bounds containing the default, and a source."""
+    """Each effect has a description and uses quantities of the registry, each with SI unit, bounds containing
+    the file's value, and a source; a candidate's own quantities are a section of the file named after it."""
     for effect in discover_effects().values():
         described = effect.describe(params)
         assert described["description"]
         for p in described["parameters"]:
             assert p["unit"] and p["source"]
             assert p["min"] <= p["default"] <= p["max"]
+        for key in effect.own_keys():
+            assert key in params.sources, key
+    assert discover_effects()["rack_lash"].own_keys() == ("rack_lash.lash", "rack_lash.smoothing_width")
+
+
+class _Linkage(Effect):
+    name = "linkage_test"
+    description = "a second steer function"
+    in_default_set = False
+    replaces = "steer_function"
+
+
+def test_two_effects_filling_one_slot_are_refused_in_one_line():
+    """Ackermann's linkage and a second linkage both fill the steer_function slot: resolving the set is refused in
+    one line naming both and the slot, instead of the later one silently replacing the earlier."""
+    with pytest.raises(UsageError) as info:
+        resolve_effects([*resolve_effects("+ackermann"), _Linkage()])
+    message = str(info.value)
+    assert "\n" not in message
+    assert "ackermann" in message and "linkage_test" in message and "steer_function" in message
+
+
+def test_a_missing_dependency_is_refused_in_one_line():
+    """brush_patch requires carcass_compliance and tyre_friction: without one, resolving the set is refused in one
+    line naming it (the effect once silently added nothing)."""
+    with pytest.raises(UsageError) as info:
+        resolve_effects("-carcass_compliance,+brush_patch")
+    message = str(info.value)
+    assert "\n" not in message and "brush_patch requires carcass_compliance" in message
+    with pytest.raises(UsageError, match="braked_wheels requires tyre_friction"):
+        resolve_effects("-tyre_friction,+braked_wheels")
+
+
+def test_building_two_models_leaves_no_state_on_the_effects():
+    """Two models built in one process with different effect sets: the coordinates each effect adds live on its
+    model (model.state(effect)), so the effect singletons keep no per-build attributes and each model keeps
+    its own annuli and twists."""
+    effects = discover_effects()
+    before = {name: dict(vars(e)) for name, e in effects.items()}
+    with_brush = build_space(resolve_effects("+brush_patch"))
+    plain = build_space(resolve_effects(None))
+    assert {name: dict(vars(e)) for name, e in effects.items()} == before == {name: {} for name in effects}
+    brush, carcass = effects["brush_patch"], effects["carcass_compliance"]
+    assert len(with_brush.state(brush).annulus["left"]) == 2
+    assert not vars(plain.state(brush))
+    twist_a, twist_b = with_brush.state(carcass).twist["left"][0], plain.state(carcass).twist["left"][0]
+    assert twist_a in with_brush.q and twist_b in plain.q
+    assert [c.name for c in plain.coordinates] == ["rack", "bounce", "roll", "twist_left", "twist_right"]
 
 
 NEW_EFFECT = '''
 """Viscous damping of the rack (an effect added as one file)."""
-from parksteer.model.symbolic.components import Effect, EffectParameter
+from parksteer.model.symbolic.components import Effect
+from parksteer.model.symbolic.system import action_reaction
+from parksteer.parameters import Quantity
 
 
 class RackViscous(Effect):
     name = "rack_viscous_test"
     description = "viscous force on the rack, -c * rack speed"
     in_default_set = False
-    parameters = (EffectParameter("damping", "N s/m", 0.0, 1e6, "test", default=0.0),)
+    quantities = (Quantity("rack_viscous_test.damping", "N s/m", 0.0, 1e6, lower_inclusive=True, default=0.0,
+                           source="test"),)
+    uses = ("rack_viscous_test.damping",)
 
     def loads(self, model):
-        force = model.p(self, "damping") * model.rack_u
-        return [(model.rack_point, -force * model.B.y), (model.rack_housing_point, force * model.B.y)]
+        k = model.kinematics
+        force = model.p("rack_viscous_test.damping") * model.rack_u
+        return action_reaction(k.rack_point, -force * k.B.y, k.rack_housing_point)
 
 
 EFFECT = RackViscous()

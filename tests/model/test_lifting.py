@@ -9,7 +9,7 @@ import numpy as np
 from parksteer.geometry import lifting_torque_a1
 from parksteer.model.numeric.simulate import simulate
 
-ONLY_LIFTING = {"rack_friction.friction_force": 0.0, "hooke_joint.joint_angle": 0.0}
+ONLY_LIFTING = {"steering.rack_friction_force": 0.0, "steering.hooke_joint_angle": 0.0}
 
 
 def test_handwheel_torque_equals_equation_a1_with_the_acting_loads(params):

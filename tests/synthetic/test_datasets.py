@@ -5,7 +5,6 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from parksteer.diagnose import settings
 from parksteer.synthetic.datasets import (
     DISTURBANCES,
     Disturbance,
@@ -77,20 +76,18 @@ def test_a_lagging_torque_channel_shows_the_reversal_drop_late(params):
     assert drop_lagged - drop_clean == pytest.approx(0.1, abs=0.01)
 
 
-def test_the_benchmark_covers_every_candidate_nulls_and_disturbances(params):
+def test_the_benchmark_covers_every_candidate_nulls_and_disturbances(params, benchmark_design):
     """At least 40 data sets: every candidate of the registry at every strength, the nulls, and every disturbance
     outside the library at each size; all seeds distinct; base perturbations within their stated ranges."""
-    specs = benchmark_specs(params)
+    specs = benchmark_specs(params, benchmark_design)
     registry = discover_effects()
-    candidates = sorted(n for n, e in registry.items() if not e.in_default_set)
+    candidates = sorted(n for n, e in registry.items() if not e.in_default_set and e.diagnosis_candidate)
     assert len(specs) >= 40
     for name in candidates:
-        assert sorted(s.steps for s in specs if s.hidden == name) == sorted(settings.BENCHMARK_STEPS)
-    assert sum(s.kind == "null" for s in specs) == settings.BENCHMARK_NULLS
+        assert sorted(s.steps for s in specs if s.hidden == name) == sorted(benchmark_design.steps)
+    assert sum(s.kind == "null" for s in specs) == benchmark_design.nulls
     assert {s.hidden for s in specs if s.kind == "outside"} == set(DISTURBANCES)
     assert len({s.seed for s in specs}) == len(specs)
     for s in specs:
         for key, value in s.base_overrides.items():
-            owner, _, name = key.partition(".")
-            default = registry[owner].parameter(name).default_value(params)
-            assert abs(value / default - 1.0) <= settings.BENCHMARK_PERTURBATION[key]
+            assert abs(value / params[key] - 1.0) <= benchmark_design.perturbation[key]

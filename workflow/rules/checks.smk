@@ -11,6 +11,8 @@ rule verify:
         "results/checksums_verified.txt",
     log:
         "logs/verify.log",
+    benchmark:
+        benchmark_file("verify")
     conda:
         "../envs/parksteer.yaml"
     shell:
@@ -24,6 +26,8 @@ rule refresh_checksums:
         "results/checksums_refreshed.txt",
     log:
         "logs/refresh_checksums.log",
+    benchmark:
+        benchmark_file("refresh_checksums")
     conda:
         "../envs/parksteer.yaml"
     shell:

@@ -1,12 +1,11 @@
-import glob
+import ast
+import os
+from functools import lru_cache
 from pathlib import Path
 
 # Shared names. FIGURES maps each figure or table target to the files it writes;
 # these are the files checksummed in figures/SHA256SUMS.
 PARAMETERS = config["parameters"]
-
-# The model's source: a change here re-derives the compiled models (and only a change here).
-MODEL_SOURCES = sorted(glob.glob("src/parksteer/model/symbolic/**/*.py", recursive=True) + glob.glob("src/parksteer/model/codegen/**/*.py", recursive=True))
 
 FIGURES = {
     "table1": ["figures/table1.csv"],
@@ -37,3 +36,109 @@ def all_number_files():
 
 def paper_sources():
     return sorted(str(p) for p in Path("paper").glob("*.typ"))
+
+
+# --- exact rebuilds: each rule's inputs include the package modules its script runs -------------------------
+# The modules a script imports, found statically (every `import` and `from ... import`, also inside functions),
+# then the modules those import, and so on; importing parksteer.a.b also runs parksteer/__init__.py and
+# parksteer/a/__init__.py. A changed module then reruns exactly the rules that can run it.
+WORKFLOW_DIR = Path(workflow.current_basedir).parent  # this file is workflow/rules/common.smk
+SCRIPTS_DIR = WORKFLOW_DIR / "scripts"
+PACKAGE_DIR = WORKFLOW_DIR.parent / "src" / "parksteer"
+# Imports no `import` statement shows: the effect registry loads every module of model/symbolic/effects.
+DYNAMIC_IMPORTS = {
+    "parksteer.model.symbolic.components": tuple(
+        f"parksteer.model.symbolic.effects.{p.stem}"
+        for p in sorted((PACKAGE_DIR / "model" / "symbolic" / "effects").glob("*.py"))
+        if p.stem != "__init__"
+    ),
+}
+
+
+def _module_file(name):
+    """The source file of module `name` in this checkout's package, or None (not parksteer's, or not a module)."""
+    parts = name.split(".")
+    if parts[0] != "parksteer":
+        return None
+    base = PACKAGE_DIR.joinpath(*parts[1:])
+    for candidate in (base / "__init__.py", base.with_suffix(".py")):
+        if candidate.is_file():
+            return candidate
+    return None
+
+
+def _imported_names(path, module):
+    """Every module name an import statement of `path` (module `module`, or None for a script) may load."""
+    package = module if path.name == "__init__.py" else (module or "").rpartition(".")[0]
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"), filename=str(path))):
+        if isinstance(node, ast.Import):
+            yield from (alias.name for alias in node.names)
+        elif isinstance(node, ast.ImportFrom):
+            if node.level:
+                anchor = package.split(".")[: len(package.split(".")) - node.level + 1]
+                target = ".".join(anchor + ([node.module] if node.module else []))
+            else:
+                target = node.module
+            yield target
+            yield from (f"{target}.{alias.name}" for alias in node.names)  # `from pkg import submodule`
+
+
+@lru_cache(maxsize=None)
+def _closure(path, module):
+    """The modules loaded by running `path` (as module `module`, None for a script), by name."""
+    seen, todo = set(), [(Path(path), module)]
+    while todo:
+        source, name = todo.pop()
+        for imported in _imported_names(source, name):
+            parts = imported.split(".")
+            for depth in range(1, len(parts) + 1):
+                prefix = ".".join(parts[:depth])
+                for loaded in (prefix, *DYNAMIC_IMPORTS.get(prefix, ())):
+                    found = _module_file(loaded)
+                    if found is not None and loaded not in seen:
+                        seen.add(loaded)
+                        todo.append((found, loaded))
+    return frozenset(seen)
+
+
+def file_sources(path):
+    """The package files a Python file outside the package (a notebook in percent format) loads."""
+    return sorted(os.path.relpath(_module_file(n)) for n in _closure(Path(path).resolve(), None))
+
+
+def script_sources(script):
+    """The package files a rule script (workflow/scripts/<script>.py) loads, relative to the working directory."""
+    return file_sources(SCRIPTS_DIR / f"{script}.py")
+
+
+def benchmark_file(rule, *wildcards):
+    """The rule's benchmark file under results/benchmarks/<rule>/ (one per wildcard combination)."""
+    stem = "__".join(f"{{{w}}}" for w in wildcards) or rule
+    return f"results/benchmarks/{rule}/{stem}.tsv"
+
+
+# --- compiled models: every named effect set the pipeline needs, derived once by rule derive ----------------
+MODEL_SETS = {}  # name -> effects spec
+_MODEL_NAMES = {}  # the resolved effect names -> the name first registered for them
+
+
+def model_manifest(name, spec):
+    """Register the effect set `spec` as `name` (or under the name of an identical set registered before) and
+    return the path of its manifest, results/model/<name>.json, which rule derive writes."""
+    from parksteer.model.symbolic.components import resolve_effects
+
+    effects = tuple(e.name for e in resolve_effects(spec))
+    name = _MODEL_NAMES.setdefault(effects, name)
+    MODEL_SETS.setdefault(name, spec)
+    return f"results/model/{name}.json"
+
+
+def effect_files(spec):
+    """The effect modules outside the package that an effects spec names (``+path/to/effect.py``)."""
+    items = spec if isinstance(spec, (list, tuple)) else (spec or "").split(",")
+    return [item.strip().lstrip("+") for item in items if item.strip().endswith(".py")]
+
+
+def figure_runs(wildcards):
+    """The (case, variant) runs of the model figure `wildcards.figure` (config["model_figures"])."""
+    return FIGURE_DESIGN.figures[wildcards.figure]

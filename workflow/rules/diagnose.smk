@@ -1,42 +1,41 @@
 # Model against measurement: compare, diagnose, add the missing effect, watch the error fall.
-# diag_models derives the base model with each candidate effect once; diag_car_data makes the synthetic stand-in
-# for the paper's car tests (its truth kept in a separate file); diag_compare and the case_study notebook walk it;
-# diag_ladder plots the error as the model grows; diag_bench_case diagnoses one synthetic data set of the
-# hidden-effect benchmark (one job each, so they run in parallel) and diag_benchmark scores them all.
-from parksteer.diagnose import settings as DIAG
+# diag_car_data makes the synthetic stand-in for the paper's car tests (config["car"]; its truth kept in a separate
+# file); diag_compare and the case_study notebook walk it; diag_ladder plots the error as the model grows;
+# diag_bench_case diagnoses one synthetic data set of the hidden-effect benchmark (config["benchmark"]; one job
+# each, so they run in parallel) and diag_benchmark scores them all. Every model a diagnosis replays (the base
+# model and the base model with each candidate, the example user effect among them) is derived by rule derive
+# before any of these runs.
 from parksteer.diagnose.benchmark import case_names as _bench_case_names
-from parksteer.synthetic.datasets import file_name as _diag_file_name
+from parksteer.diagnose.candidates import candidate_models
+from parksteer.parameters import load_parameters as _load_parameters
+from parksteer.synthetic.datasets import BenchmarkDesign, CarDesign, file_name as _diag_file_name
 
-DIAG_MODEL_SOURCES = MODEL_SOURCES + [
-    "src/parksteer/examples/column_imbalance.py"
+DIAG_USER_EFFECT = os.path.relpath(PACKAGE_DIR / "examples" / "column_imbalance.py")
+DIAG_MODELS = [
+    model_manifest(name, spec) for name, spec in candidate_models(None, (DIAG_USER_EFFECT,)).items()
 ]
-DIAG_CAR_FILES = [f"results/diagnose/car/{_diag_file_name(c, s)}" for c, s in DIAG.CAR_FILES]
-DIAG_BENCH_CASES = _bench_case_names()
-DIAG_BENCH_FILES = [_diag_file_name(c, s) for c, s in DIAG.BENCHMARK_FILES]
-
-
-rule diag_models:
-    input:
-        sources=DIAG_MODEL_SOURCES,
-    output:
-        manifest="results/diagnose/models.json",
-    log:
-        "logs/diag_models.log",
-    conda:
-        "../envs/parksteer.yaml"
-    script:
-        "../scripts/diag_models.py"
+DIAG_CAR = CarDesign.from_config(config["car"], config["benchmark"]["perturbation"])
+DIAG_BENCH = BenchmarkDesign.from_config(config["benchmark"])
+DIAG_CAR_FILES = [f"results/diagnose/car/{_diag_file_name(c, s)}" for c, s in DIAG_CAR.files]
+DIAG_BENCH_CASES = _bench_case_names(DIAG_BENCH, _load_parameters(PARAMETERS))
+DIAG_BENCH_FILES = [_diag_file_name(c, s) for c, s in DIAG_BENCH.files]
 
 
 rule diag_car_data:
     input:
         parameters=PARAMETERS,
-        models="results/diagnose/models.json",
+        models=DIAG_MODELS,
+        code=script_sources("diag_car_data"),
     output:
         files=DIAG_CAR_FILES,
         truth="results/diagnose/car_truth.json",
+    params:
+        car=config["car"],
+        perturbation=config["benchmark"]["perturbation"],
     log:
         "logs/diag_car_data.log",
+    benchmark:
+        benchmark_file("diag_car_data")
     conda:
         "../envs/parksteer.yaml"
     script:
@@ -47,30 +46,38 @@ rule diag_compare:
     input:
         parameters=PARAMETERS,
         files=DIAG_CAR_FILES,
+        code=script_sources("diag_compare"),
     output:
         svg="figures/diag_compare.svg",
         csv="figures/diag_compare.csv",
         json="results/diag_compare.json",
     log:
         "logs/diag_compare.log",
+    benchmark:
+        benchmark_file("diag_compare")
     conda:
         "../envs/parksteer.yaml"
     script:
         "../scripts/diag_compare.py"
 
 
+# Snakemake's `notebook:` directive is not used: it runs only .ipynb (JSON) notebooks, not this jupytext
+# percent-format .py one, and it keeps the executed notebook as a log, never as an output.
 rule case_study:
     input:
         notebook="workflow/notebooks/case_study.py",
         parameters=PARAMETERS,
         files=DIAG_CAR_FILES,
         truth="results/diagnose/car_truth.json",
+        code=sorted(set(script_sources("diag_case_study") + file_sources("workflow/notebooks/case_study.py"))),
     output:
         notebook="results/case_study.ipynb",
         json="results/case_study.json",
         residuals="results/case_study_residuals.csv",
     log:
         "logs/case_study.log",
+    benchmark:
+        benchmark_file("case_study")
     conda:
         "../envs/parksteer.yaml"
     script:
@@ -81,12 +88,15 @@ rule diag_ladder:
     input:
         study="results/case_study.json",
         residuals="results/case_study_residuals.csv",
+        code=script_sources("diag_ladder"),
     output:
         svg="figures/diag_ladder.svg",
         csv="figures/diag_ladder.csv",
         json="results/diag_ladder.json",
     log:
         "logs/diag_ladder.log",
+    benchmark:
+        benchmark_file("diag_ladder")
     conda:
         "../envs/parksteer.yaml"
     script:
@@ -96,15 +106,20 @@ rule diag_ladder:
 rule diag_bench_case:
     input:
         parameters=PARAMETERS,
-        models="results/diagnose/models.json",
+        models=DIAG_MODELS,
+        code=script_sources("diag_bench_case"),
     output:
         files=[f"results/diagnose/benchmark/{{name}}/{name}" for name in DIAG_BENCH_FILES],
         truth="results/diagnose/benchmark/{name}.truth.json",
         diagnosis="results/diagnose/benchmark/{name}.diagnosis.json",
+    params:
+        design=config["benchmark"],
     wildcard_constraints:
         name="|".join(DIAG_BENCH_CASES) if DIAG_BENCH_CASES else "none",
     log:
         "logs/diag_bench_case/{name}.log",
+    benchmark:
+        benchmark_file("diag_bench_case", "name")
     conda:
         "../envs/parksteer.yaml"
     script:
@@ -115,12 +130,17 @@ rule diag_benchmark:
     input:
         truths=expand("results/diagnose/benchmark/{name}.truth.json", name=DIAG_BENCH_CASES),
         diagnoses=expand("results/diagnose/benchmark/{name}.diagnosis.json", name=DIAG_BENCH_CASES),
+        code=script_sources("diag_benchmark"),
     output:
         svg="figures/diag_benchmark.svg",
         csv="figures/diag_benchmark.csv",
         json="results/diag_benchmark.json",
+    params:
+        design=config["benchmark"],
     log:
         "logs/diag_benchmark.log",
+    benchmark:
+        benchmark_file("diag_benchmark")
     conda:
         "../envs/parksteer.yaml"
     script:

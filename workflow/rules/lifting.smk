@@ -4,12 +4,15 @@
 rule figA3:
     input:
         parameters=PARAMETERS,
+        code=script_sources("figA3"),
     output:
         svg="figures/figA3.svg",
         csv="figures/figA3.csv",
         json="results/figA3.json",
     log:
         "logs/figA3.log",
+    benchmark:
+        benchmark_file("figA3")
     conda:
         "../envs/parksteer.yaml"
     script:

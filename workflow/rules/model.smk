@@ -1,138 +1,66 @@
-# Section 4: the multibody steering model. derive_model builds the compiled model of one effect set
-# (cached under results/model, keyed by the model's source); simulate_model writes one run of the
-# figures; fig12-fig16 and figContrib plot them.
-from parksteer.figures.model import FIGURE_RUNS, MODEL_EFFECTS, VARIANT_MODEL, VARIANTS
+# Section 4: the multibody steering model. simulate_model writes one run of the figures (a case and a variant of
+# config["variants"]) with the compiled model rule derive builds; model_figure plots the runs of one figure of
+# config["model_figures"] (fig12-fig16, figContrib), each also a named target (`snakemake fig12`).
+from parksteer.figures.model import FigureDesign
 
-
-
-MODEL_FIGURE_INPUTS = {
-    name: [f"results/sim/{case}__{variant}.csv" for case, variant in runs] for name, runs in FIGURE_RUNS.items()
-}
-
-
-rule derive_model:
-    input:
-        sources=MODEL_SOURCES,
-    output:
-        manifest="results/model/derived_{model}.json",
-    wildcard_constraints:
-        model="|".join(MODEL_EFFECTS),
-    log:
-        "logs/derive_model/{model}.log",
-    conda:
-        "../envs/parksteer.yaml"
-    script:
-        "../scripts/derive_model.py"
+FIGURE_DESIGN = FigureDesign.from_config(config)
+VARIANT_MANIFESTS = {name: model_manifest(v.model, v.effects) for name, v in FIGURE_DESIGN.variants.items()}
 
 
 rule simulate_model:
     input:
         parameters=PARAMETERS,
-        model=lambda w: f"results/model/derived_{VARIANT_MODEL[w.variant]}.json",
+        model=lambda w: VARIANT_MANIFESTS[w.variant],
+        code=script_sources("simulate_model"),
     output:
         csv="results/sim/{case}__{variant}.csv",
+    params:
+        effects=lambda w: FIGURE_DESIGN.variants[w.variant].effects,
+        surface=lambda w: FIGURE_DESIGN.variants[w.variant].surface,
     wildcard_constraints:
         case="[a-z0-9_]+?",
-        variant="|".join(VARIANTS),
+        variant="|".join(FIGURE_DESIGN.variants),
     log:
         "logs/simulate_model/{case}__{variant}.log",
+    benchmark:
+        benchmark_file("simulate_model", "case", "variant")
     conda:
         "../envs/parksteer.yaml"
     script:
         "../scripts/simulate_model.py"
 
 
-rule fig12:
+rule model_figure:
     input:
         parameters=PARAMETERS,
-        sims=MODEL_FIGURE_INPUTS["fig12"],
+        sims=lambda w: [f"results/sim/{case}__{variant}.csv" for case, variant in figure_runs(w)],
+        code=script_sources("model_figure"),
     output:
-        svg="figures/fig12.svg",
-        csv="figures/fig12.csv",
-        json="results/fig12.json",
+        svg="figures/{figure}.svg",
+        csv="figures/{figure}.csv",
+        json="results/{figure}.json",
+    params:
+        runs=lambda w: [list(run) for run in figure_runs(w)],
+        labels=lambda w: {
+            v: FIGURE_DESIGN.variants[v].label for _, v in figure_runs(w) if FIGURE_DESIGN.variants[v].label
+        },
+    wildcard_constraints:
+        figure="|".join(FIGURE_DESIGN.figures),
     log:
-        "logs/fig12.log",
+        "logs/model_figure/{figure}.log",
+    benchmark:
+        benchmark_file("model_figure", "figure")
     conda:
         "../envs/parksteer.yaml"
     script:
         "../scripts/model_figure.py"
 
 
-rule fig13:
-    input:
-        parameters=PARAMETERS,
-        sims=MODEL_FIGURE_INPUTS["fig13"],
-    output:
-        svg="figures/fig13.svg",
-        csv="figures/fig13.csv",
-        json="results/fig13.json",
-    log:
-        "logs/fig13.log",
-    conda:
-        "../envs/parksteer.yaml"
-    script:
-        "../scripts/model_figure.py"
+for _figure in FIGURE_DESIGN.figures:
 
-
-rule fig14:
-    input:
-        parameters=PARAMETERS,
-        sims=MODEL_FIGURE_INPUTS["fig14"],
-    output:
-        svg="figures/fig14.svg",
-        csv="figures/fig14.csv",
-        json="results/fig14.json",
-    log:
-        "logs/fig14.log",
-    conda:
-        "../envs/parksteer.yaml"
-    script:
-        "../scripts/model_figure.py"
-
-
-rule fig15:
-    input:
-        parameters=PARAMETERS,
-        sims=MODEL_FIGURE_INPUTS["fig15"],
-    output:
-        svg="figures/fig15.svg",
-        csv="figures/fig15.csv",
-        json="results/fig15.json",
-    log:
-        "logs/fig15.log",
-    conda:
-        "../envs/parksteer.yaml"
-    script:
-        "../scripts/model_figure.py"
-
-
-rule fig16:
-    input:
-        parameters=PARAMETERS,
-        sims=MODEL_FIGURE_INPUTS["fig16"],
-    output:
-        svg="figures/fig16.svg",
-        csv="figures/fig16.csv",
-        json="results/fig16.json",
-    log:
-        "logs/fig16.log",
-    conda:
-        "../envs/parksteer.yaml"
-    script:
-        "../scripts/model_figure.py"
-
-
-rule figContrib:
-    input:
-        parameters=PARAMETERS,
-        sims=MODEL_FIGURE_INPUTS["figContrib"],
-    output:
-        svg="figures/figContrib.svg",
-        csv="figures/figContrib.csv",
-        json="results/figContrib.json",
-    log:
-        "logs/figContrib.log",
-    conda:
-        "../envs/parksteer.yaml"
-    script:
-        "../scripts/model_figure.py"
+    rule:
+        name:
+            _figure
+        input:
+            FIGURES[_figure],
+        localrule: True

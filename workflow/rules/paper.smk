@@ -7,10 +7,13 @@ rule paper:
         parameters=PARAMETERS,
         figures=all_figure_files(),
         numbers=all_number_files(),
+        code=script_sources("paper"),
     output:
         pdf="paper/parksteer.pdf",
     log:
         "logs/paper.log",
+    benchmark:
+        benchmark_file("paper")
     conda:
         "../envs/parksteer.yaml"
     script:

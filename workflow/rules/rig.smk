@@ -6,11 +6,14 @@ rule table1:
     input:
         parameters=PARAMETERS,
         printed="src/parksteer/data/table1_printed.csv",
+        code=script_sources("table1"),
     output:
         csv="figures/table1.csv",
         json="results/table1.json",
     log:
         "logs/table1.log",
+    benchmark:
+        benchmark_file("table1")
     conda:
         "../envs/parksteer.yaml"
     script:
@@ -20,12 +23,15 @@ rule table1:
 rule fig3:
     input:
         parameters=PARAMETERS,
+        code=script_sources("fig3"),
     output:
         svg="figures/fig3.svg",
         csv="figures/fig3.csv",
         json="results/fig3.json",
     log:
         "logs/fig3.log",
+    benchmark:
+        benchmark_file("fig3")
     conda:
         "../envs/parksteer.yaml"
     script:
@@ -35,12 +41,15 @@ rule fig3:
 rule fig4:
     input:
         parameters=PARAMETERS,
+        code=script_sources("fig4"),
     output:
         svg="figures/fig4.svg",
         csv="figures/fig4.csv",
         json="results/fig4.json",
     log:
         "logs/fig4.log",
+    benchmark:
+        benchmark_file("fig4")
     conda:
         "../envs/parksteer.yaml"
     script:

@@ -1,7 +1,9 @@
-# Thin rule script: the logic is parksteer.diagnose.benchmark.make_benchmark_figure.
-from parksteer.diagnose.benchmark import make_benchmark_figure
+# Thin rule script: the logic is parksteer.figures.diagnose.make_benchmark_figure.
+from parksteer.figures.diagnose import make_benchmark_figure
 from parksteer.rules import rule_log
+from parksteer.synthetic.datasets import BenchmarkDesign
 
 with rule_log(snakemake):
     make_benchmark_figure(list(snakemake.input.truths), list(snakemake.input.diagnoses), snakemake.output.svg,
-                          snakemake.output.csv, snakemake.output.json)
+                          snakemake.output.csv, snakemake.output.json,
+                          BenchmarkDesign.from_config(snakemake.params.design))

@@ -1,6 +1,7 @@
 # Thin rule script: the logic is parksteer.synthetic.datasets.write_car_dataset.
-from parksteer.synthetic.datasets import write_car_dataset
 from parksteer.rules import rule_log
+from parksteer.synthetic.datasets import CarDesign, write_car_dataset
 
 with rule_log(snakemake):
-    write_car_dataset(snakemake.input.parameters, list(snakemake.output.files), snakemake.output.truth)
+    design = CarDesign.from_config(snakemake.params.car, snakemake.params.perturbation)
+    write_car_dataset(snakemake.input.parameters, design, list(snakemake.output.files), snakemake.output.truth)

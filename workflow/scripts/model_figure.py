@@ -4,7 +4,9 @@ from parksteer.rules import rule_log
 
 with rule_log(snakemake):
     make_model_figure(
-        snakemake.rule,
+        snakemake.wildcards.figure,
+        snakemake.params.runs,
+        snakemake.params.labels,
         snakemake.input.parameters,
         list(snakemake.input.sims),
         snakemake.output.svg,

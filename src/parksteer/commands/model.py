@@ -10,23 +10,34 @@ from pathlib import Path
 from ..errors import UsageError
 from ..parameters import DEFAULT_PATH, load_parameters
 from ..tables import write_json
+from .measure import add_import_options, channel_map_of
 
 
 def register(sub) -> None:
     p = sub.add_parser("simulate", help="simulate the steering model for one case and write its time history (CSV)")
-    p.add_argument("--case", required=True, help="a Table B1 case of the parameter file, e.g. unladen")
+    p.add_argument("--case", default=None,
+                   help="a Table B1 case of the parameter file, e.g. unladen (with --rack-from: default the file's case)")
     p.add_argument("--effects", default=None, help="effects spec, e.g. --effects=-rack_friction,+hooke_joint (default: the paper's five)")
-    p.add_argument("--set", dest="overrides", action="append", default=[], metavar="OWNER.PARAM=VALUE",
-                   help="override a parameter of an effect or of a parameter-file section (repeatable)")
-    p.add_argument("--surface", choices=("ground", "air_bearing"), default="ground")
+    p.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
+                   help="override a quantity by its key, e.g. tyre.tyre_pressure=180000 or rack_lash.lash=0.0002 (keys: `parksteer effects`, the parameter file; case.<name> for the case; repeatable)")
+    p.add_argument("--surface", choices=("ground", "air_bearing"), default=None,
+                   help="default ground (with --rack-from: the file's surface)")
     p.add_argument("--rack-from", default=None, metavar="FILE.csv",
-                   help="prescribe the rack from a CSV with time_s and rack_m columns; solve for the handwheel torque")
+                   help="prescribe the rack of a measurement file (data/measurements/README.md) and solve for the "
+                        "handwheel torque; the measured rack is smoothed as `parksteer compare` smooths it (a "
+                        "least-squares spline within the rack's noise, a knot at each reversal)")
+    p.add_argument("--raw-rack", action="store_true",
+                   help="with --rack-from: replay the raw rack samples through an interpolating cubic spline instead "
+                        "of smoothing them; a logged rack's converter steps then become spikes of rack speed and "
+                        "acceleration that flip the rack friction (several N m wrong on 8-bit data), which is why "
+                        "smoothing is the default")
+    add_import_options(p)
     p.add_argument("--parameters", default=str(DEFAULT_PATH), help="parameter file (default: data/parameters.toml)")
     p.add_argument("--output-dt", type=float, default=0.01, help="output spacing, s (default 0.01)")
     p.add_argument("--out", required=True, help="output CSV")
     p.set_defaults(func=_simulate)
 
-    p = sub.add_parser("effects", help="list the model's effects (components) and their parameters")
+    p = sub.add_parser("effects", help="list the model's effects, their slots and needs, and the quantities each uses")
     p.add_argument("--json", action="store_true", help="print JSON instead of a table")
     p.add_argument("--parameters", default=str(DEFAULT_PATH))
     p.set_defaults(func=_effects)
@@ -42,13 +53,41 @@ def _simulate(args) -> int:
     from ..model.numeric.values import parse_overrides
 
     overrides = parse_overrides(args.overrides)
-    if args.rack_from is not None and not Path(args.rack_from).is_file():
+    if args.raw_rack and args.rack_from is None:
+        raise UsageError("--raw-rack needs --rack-from FILE")
+    if args.rack_from is not None and not Path(args.rack_from).exists():
         raise UsageError(f"--rack-from {args.rack_from}: no such file")
+    if args.rack_from is None and args.case is None:
+        raise UsageError("--case is required (or --rack-from FILE, whose metadata names the case)")
     params = load_parameters(args.parameters)
-    result = simulate(args.case, effects=args.effects, overrides=overrides, surface=args.surface,
-                      rack_drive=args.rack_from, params=params, output_dt_s=args.output_dt)
+    case, surface, rack, drive = args.case, args.surface or "ground", None, None
+    if args.rack_from is not None:
+        case, surface, rack, drive = _measured_rack(args.rack_from, params, args.raw_rack,
+                                                    channel_map_of(args), args.case,
+                                                    args.surface or "ground")  # a drive needs no surface
+        case, surface = args.case or case, args.surface or surface
+    result = simulate(case, effects=args.effects, overrides=overrides, surface=surface,
+                      rack_drive=rack, params=params, output_dt_s=args.output_dt)
+    if drive is not None:
+        result.header["drive"] = drive
     result.write_csv(args.out)
     return 0
+
+
+def _measured_rack(path: str, params, raw: bool, channel_map=None, case=None, surface=None):
+    """(case, surface, rack motion, description) of a measurement file's rack: smoothed as compare does, or raw."""
+    from ..measure.importers import load_rack_drive
+    from ..measure.smoothing import interpolate_rack, smooth_rack
+
+    measurement = load_rack_drive(path, channel_map, case=case, surface=surface, params=params)
+    if raw:
+        rack = interpolate_rack(measurement.time_s, measurement.rack_m)
+        drive = f"prescribed rack from {path}: the raw samples through an interpolating cubic spline"
+    else:
+        rack = smooth_rack(measurement.time_s, measurement.rack_m)
+        drive = (f"prescribed rack from {path}: smoothed by a least-squares cubic spline, knots "
+                 f"{rack.knot_spacing_s:.3g} s apart, fit RMS {rack.fit_rms_m:.3g} m (parksteer.measure.smoothing)")
+    return measurement.case, measurement.surface, rack, drive
 
 
 def _effects(args) -> int:
@@ -63,31 +102,25 @@ def _effects(args) -> int:
     for d in described:
         mark = "*" if d["in_default_set"] else " "
         print(f"{mark} {d['name']}: {d['description']}")
+        needs = [f"fills {d['replaces']}"] if d["replaces"] else []
+        needs += [f"requires {', '.join(d['requires'])}"] if d["requires"] else []
+        if needs:
+            print(f"      ({'; '.join(needs)})")
         for par in d["parameters"]:
-            print(f"      {par['name']} = {par['default']:g} {par['unit']}  [{par['min']:g}, {par['max']:g}]")
+            print(f"      {par['key']} = {par['default']:g} {par['unit']}  [{par['min']:g}, {par['max']:g}]")
     print("(* in the default set)")
     return 0
 
 
 def _derive(args) -> int:
-    from ..model.codegen.cache import ensure_entry, entry_path, model_key
+    from ..model.codegen.cache import ensure
     from ..model.symbolic.components import resolve_effects
 
-    effects = resolve_effects(args.effects)
     start = time.perf_counter()
-    existed = (entry_path(effects) / "model.json").is_file()
-    directory = ensure_entry(effects)
-    info = json.loads((directory / "model.json").read_text(encoding="utf-8"))
-    manifest = {
-        "effects": [e.name for e in effects],
-        "key": model_key(effects),
-        "directory": str(directory),
-        "coordinates": info["coordinates"],
-        "n_parameters": len(info["parameters"]),
-        "derivation_timings_s": info["timings_s"],
-    }
+    manifest = ensure(resolve_effects(args.effects))
     if args.out:
         write_json(args.out, manifest)
     elapsed = time.perf_counter() - start
-    print(f"{'cached' if existed else 'derived'} {','.join(manifest['effects']) or 'none'} -> {directory} ({elapsed:.1f} s)")
+    print(f"{'derived' if manifest['built_now'] else 'cached'} {','.join(manifest['effects']) or 'none'} -> "
+          f"{manifest['directory']} ({elapsed:.1f} s)")
     return 0

@@ -12,6 +12,9 @@ them:
 - the false-alarm rate on the nulls (a ``missing`` verdict where nothing is hidden);
 - the fraction of the disturbances outside the library called ``unexplained``;
 - the weighted RMS error after adding the named effect, divided by the noise floor.
+
+The benchmark's design (strengths, files, perturbation, seeds) is a
+:class:`parksteer.synthetic.datasets.BenchmarkDesign`, from the pipeline's configuration.
 """
 
 from __future__ import annotations
@@ -25,26 +28,25 @@ import numpy as np
 from ..errors import UsageError
 from ..measure.io import write_measurement
 from ..parameters import Parameters, load_parameters
-from ..tables import write_csv, write_json
-from . import settings
+from ..synthetic.datasets import BenchmarkDesign, benchmark_specs, file_name, make_dataset
+from ..tables import write_json
 from .problem import load_files
 from .report import diagnosis_dict
 from .select import diagnose
-from ..synthetic.datasets import benchmark_specs, file_name, make_dataset
 
 TARGETS = {"named_or_group_at_2_steps": 0.90, "false_alarm_rate": 0.05, "outside_unexplained": 0.80,
            "rms_after_over_noise_floor": 1.2}
 
 
-def case_names(params: Parameters | None = None) -> list[str]:
-    return [s.name for s in benchmark_specs(params or load_parameters())]
+def case_names(design: BenchmarkDesign, params: Parameters | None = None) -> list[str]:
+    return [s.name for s in benchmark_specs(params or load_parameters(), design)]
 
 
-def run_case(parameters_path: str | Path, name: str, folder: str | Path, truth_path: str | Path,
-             diagnosis_path: str | Path) -> dict:
+def run_case(parameters_path: str | Path, design: BenchmarkDesign, name: str, folder: str | Path,
+             truth_path: str | Path, diagnosis_path: str | Path) -> dict:
     """Generate data set `name`, write its files into `folder`, diagnose them from the files, write truth and result."""
     params = load_parameters(parameters_path)
-    specs = {s.name: s for s in benchmark_specs(params)}
+    specs = {s.name: s for s in benchmark_specs(params, design)}
     if name not in specs:
         raise UsageError(f"unknown benchmark data set {name!r}")
     start = time.perf_counter()
@@ -102,8 +104,9 @@ def _fraction(values) -> float | None:
     return float(np.mean(values)) if values else None
 
 
-def aggregate(truth_paths: list[str | Path], diagnosis_paths: list[str | Path]) -> tuple[list[dict], dict]:
-    """(one outcome per data set, the summary numbers)."""
+def aggregate(truth_paths: list[str | Path], diagnosis_paths: list[str | Path],
+              design: BenchmarkDesign | None = None) -> tuple[list[dict], dict]:
+    """(one outcome per data set, the summary numbers, with the design they were made with if given)."""
     rows = []
     for t_path, d_path in zip(sorted(map(str, truth_paths)), sorted(map(str, diagnosis_paths))):
         truth = json.loads(Path(t_path).read_text(encoding="utf-8"))
@@ -158,11 +161,11 @@ def aggregate(truth_paths: list[str | Path], diagnosis_paths: list[str | Path]) 
         },
         "confusion": confusion,
         "targets": TARGETS,
-        "settings": {
-            "steps": list(settings.BENCHMARK_STEPS),
-            "files": [list(f) for f in settings.BENCHMARK_FILES],
-            "perturbation": settings.BENCHMARK_PERTURBATION,
-            "seed": settings.BENCHMARK_SEED,
+        "settings": None if design is None else {
+            "steps": list(design.steps),
+            "files": [list(f) for f in design.files],
+            "perturbation": design.perturbation,
+            "seed": design.seed,
         },
         "cost": {
             "replays_median": float(np.median([r["replays"] for r in rows])) if rows else None,
@@ -170,18 +173,3 @@ def aggregate(truth_paths: list[str | Path], diagnosis_paths: list[str | Path]) 
         },
     }
     return rows, summary
-
-
-def make_benchmark_figure(truth_paths, diagnosis_paths, svg: str | Path, csv: str | Path, json_path: str | Path
-                          ) -> dict:
-    """figures/diag_benchmark.svg (confusion matrix, accuracy against strength), its CSV, results JSON."""
-    from ..figures.diagnose import benchmark_figure
-
-    rows, summary = aggregate(truth_paths, diagnosis_paths)
-    benchmark_figure(rows, summary, svg)
-    # Timings differ from run to run; they stay in the JSON summary, out of the checksummed figure data.
-    columns = {key: [r[key] for r in rows] for key in rows[0] if key not in TIMING_FIELDS} if rows else {}
-    write_csv(csv, columns, {"figure": "diag_benchmark: one row per synthetic data set",
-                             "steps": "hidden size as converter steps of torque RMS on the unladen ground file"})
-    write_json(json_path, summary)
-    return summary

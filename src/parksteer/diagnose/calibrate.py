@@ -29,7 +29,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..model.symbolic.components import Effect
-from . import settings
+from ..parameters import quantity
+from .settings import DEFAULT_SETTINGS, DiagnosisSettings
 from .problem import Problem, lag1_autocorrelation
 
 Z95 = 1.959964  # two-sided 95 % quantile of the standard normal
@@ -137,9 +138,14 @@ def finite_difference_jacobian(problem: Problem, effects: list[Effect], paramete
 
 def least_squares(problem: Problem, effects: list[Effect], parameters: list[FitParameter], theta0: np.ndarray,
                   fixed: dict[str, float] | None = None, jacobian: np.ndarray | None = None,
-                  max_iterations: int = settings.CALIBRATION_MAX_ITERATIONS,
-                  tolerance: float = settings.CALIBRATION_TOLERANCE) -> Fit:
-    """Levenberg-Marquardt with Broyden updates (see the module docstring); `jacobian` may seed it."""
+                  max_iterations: int | None = None, tolerance: float | None = None,
+                  settings: DiagnosisSettings = DEFAULT_SETTINGS) -> Fit:
+    """Levenberg-Marquardt with Broyden updates (see the module docstring); `jacobian` may seed it.
+
+    `max_iterations` and `tolerance` default to the calibration's (`settings`).
+    """
+    max_iterations = settings.calibration_max_iterations if max_iterations is None else max_iterations
+    tolerance = settings.calibration_tolerance if tolerance is None else tolerance
     fixed = dict(fixed or {})
     start_evaluations = problem.evaluations
     lower = np.array([p.theta_bounds()[0] for p in parameters])
@@ -202,52 +208,51 @@ def least_squares(problem: Problem, effects: list[Effect], parameters: list[FitP
                 theta_at_jacobian = theta.copy()
             elif failures > 3:
                 break
-    if np.max(np.abs(theta - theta_at_jacobian)) > settings.JACOBIAN_REFRESH_THETA:
+    if np.max(np.abs(theta - theta_at_jacobian)) > settings.jacobian_refresh_theta:
         J = finite_difference_jacobian(problem, effects, parameters, theta, fixed, predictions)
     return Fit(effects, parameters, theta, fixed, predictions, r, J, iterations,
                problem.evaluations - start_evaluations, history)
 
 
-def log_parameter(problem: Problem, effects: list[Effect], key: str) -> FitParameter:
-    """A positive parameter fitted as log(value / default), within CALIBRATION_RANGE_FACTOR of the default."""
-    owner, _, name = key.partition(".")
-    effect = next(e for e in effects if e.name == owner)
-    spec = effect.parameter(name)
+def log_parameter(problem: Problem, effects: list[Effect], key: str,
+                  settings: DiagnosisSettings = DEFAULT_SETTINGS) -> FitParameter:
+    """A positive parameter fitted as log(value / default), within calibration_range_factor of the default."""
+    spec = quantity(key)
     default = problem.replay(effects, 0).value(key)
-    factor = settings.CALIBRATION_RANGE_FACTOR
-    return FitParameter(key, "log", default, max(spec.minimum, default / factor), min(spec.maximum, default * factor),
-                        settings.CALIBRATION_RELATIVE_STEP)
+    factor = settings.calibration_range_factor
+    return FitParameter(key, "log", default, max(spec.lower, default / factor), min(spec.upper, default * factor),
+                        settings.calibration_relative_step)
 
 
 def linear_parameter(effects: list[Effect], key: str, step: float) -> FitParameter:
     """A parameter fitted as it stands (a candidate's strength), within its bounds and never below zero."""
-    owner, _, name = key.partition(".")
-    spec = next(e for e in effects if e.name == owner).parameter(name)
-    return FitParameter(key, "linear", 1.0, max(spec.minimum, 0.0), spec.maximum, step)
+    spec = quantity(key)
+    return FitParameter(key, "linear", 1.0, max(spec.lower, 0.0), spec.upper, step)
 
 
 def calibration_parameters(problem: Problem, effects: list[Effect],
-                           keys: tuple[str, ...] = settings.CALIBRATED_PARAMETERS,
-                           strengths: dict[str, float] | None = None) -> list[FitParameter]:
+                           keys: tuple[str, ...] | None = None, strengths: dict[str, float] | None = None,
+                           settings: DiagnosisSettings = DEFAULT_SETTINGS) -> list[FitParameter]:
     """The calibrated parameters the model has (an effect left out of the model leaves its keys out).
 
     `strengths` adds effects' strengths, fitted linearly, with their finite-difference steps.
     """
-    names = {e.name for e in effects}
-    out = [log_parameter(problem, effects, key) for key in keys if key.partition(".")[0] in names]
+    used = {k for e in effects for k in e.uses}
+    keys = settings.calibrated_parameters if keys is None else keys
+    out = [log_parameter(problem, effects, key, settings) for key in keys if key in used]
     out += [linear_parameter(effects, key, step) for key, step in (strengths or {}).items()]
     return out
 
 
 def calibrate(problem: Problem, effects: list[Effect], fixed: dict[str, float] | None = None,
-              keys: tuple[str, ...] = settings.CALIBRATED_PARAMETERS, strengths: dict[str, float] | None = None,
-              start: dict[str, float] | None = None) -> Fit:
+              keys: tuple[str, ...] | None = None, strengths: dict[str, float] | None = None,
+              start: dict[str, float] | None = None, settings: DiagnosisSettings = DEFAULT_SETTINGS) -> Fit:
     """Fit the base model's uncertain parameters (and any `strengths`) to all files.
 
     From the model's defaults, or from the values in `start` where it has them.
     """
-    parameters = calibration_parameters(problem, effects, keys, strengths)
+    parameters = calibration_parameters(problem, effects, keys, strengths, settings)
     start = start or {}
     theta0 = np.array([p.theta(start[p.key]) if p.key in start else (0.0 if p.transform == "log" else p.lower)
                        for p in parameters])
-    return least_squares(problem, effects, parameters, theta0, fixed)
+    return least_squares(problem, effects, parameters, theta0, fixed, settings=settings)

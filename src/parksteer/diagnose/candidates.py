@@ -37,22 +37,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..model.symbolic.components import Effect, EffectParameter, discover_effects
-from . import settings
+from ..model.symbolic.components import Effect, discover_effects, strength_parameter
+from .settings import DEFAULT_SETTINGS, DiagnosisSettings
 from .calibrate import Fit
 from .problem import Problem
-
-STRENGTH_NAME = "strength"
-
-
-def strength_parameter(effect: Effect) -> EffectParameter | None:
-    """The parameter whose default means absent: 'strength', else the only zero-default parameter from zero."""
-    named = [p for p in effect.parameters if p.name == STRENGTH_NAME]
-    if named:
-        return named[0]
-    zero = [p for p in effect.parameters if p.default == 0.0 and p.file_key is None and p.minimum == 0.0]
-    return zero[0] if len(zero) == 1 else None
-
 
 def candidate_effects(model_effects: list[Effect], registry: dict[str, Effect] | None = None
                       ) -> tuple[list[Effect], list[str]]:
@@ -61,7 +49,7 @@ def candidate_effects(model_effects: list[Effect], registry: dict[str, Effect] |
     in_model = {e.name for e in model_effects}
     testable, untestable = [], []
     for name in sorted(registry):
-        if name in in_model:
+        if name in in_model or not registry[name].diagnosis_candidate:
             continue
         (testable if strength_parameter(registry[name]) is not None else untestable).append(name)
     return [registry[n] for n in testable], untestable
@@ -88,26 +76,26 @@ def _rms_change(a: list[np.ndarray], b: list[np.ndarray]) -> float:
 
 
 def probe_signature(problem: Problem, base_effects: list[Effect], candidate: Effect, overrides: dict[str, float],
-                    target_Nm: float) -> Signature:
+                    target_Nm: float, settings: DiagnosisSettings = DEFAULT_SETTINGS) -> Signature:
     """The candidate's signature at a probe strength that changes the torque by about `target_Nm` RMS."""
     spec = strength_parameter(candidate)
     key = f"{candidate.name}.{spec.name}"
     effects = sorted([*base_effects, candidate], key=lambda e: e.name)
     zero = problem.predict(effects, {**overrides, key: 0.0})
-    strength = max(spec.maximum * settings.PROBE_START_FRACTION, 1e-12)
+    strength = max(spec.upper * settings.probe_start_fraction, 1e-12)
     probed, change = None, 0.0
-    for _ in range(settings.PROBE_MAX_TRIES):
+    for _ in range(settings.probe_max_tries):
         probed = problem.predict(effects, {**overrides, key: strength})
         change = _rms_change(probed, zero)
         if change > 0.0 and 0.5 <= change / target_Nm <= 2.0:
             break
         factor = target_Nm / change if change > 0.0 else 100.0
-        new_strength = min(spec.maximum, strength * factor)
+        new_strength = min(spec.upper, strength * factor)
         if new_strength == strength:
             break
         strength = new_strength
     weighted = problem.scale([p - z for p, z in zip(probed, zero)]) / strength
-    observable = change >= settings.UNOBSERVABLE_NOISE_FLOORS * target_Nm / settings.PROBE_EFFECT_NOISE_FLOORS
+    observable = change >= settings.unobservable_noise_floors * target_Nm / settings.probe_effect_noise_floors
     return Signature(candidate, key, strength, zero, probed, weighted, change, effects, observable)
 
 
@@ -143,36 +131,30 @@ def score(signature: Signature, calibration: Fit) -> Score:
     if norm2 <= 0.0:
         return Score(signature.effect.name, 0.0, 0.0, 0.0, fraction, closest)
     variance = float(r @ r) / r.size
-    allowed_negative = strength_parameter(signature.effect).minimum < 0.0
+    allowed_negative = strength_parameter(signature.effect).lower < 0.0
     removed = u * u / norm2 if (u > 0 or allowed_negative) else 0.0
     return Score(signature.effect.name, removed / variance, u / norm2, removed, fraction, closest)
 
 
-def ensure_candidate_models(effects=None, extra: tuple[str, ...] = ()) -> list[dict]:
-    """Derive (once; the cache keeps them) the base model and the base model with each candidate.
+def candidate_models(effects: str | None = None, extra: tuple[str, ...] = ()) -> dict[str, str | None]:
+    """Every effect set a diagnosis of the model `effects` replays, by name, as effects specs: ``base`` and
+    ``with_<candidate>`` for each testable candidate.
 
-    `extra` names effect modules outside the registry (files or dotted names) to prepare as well.
-    Deriving them up front, in one job, spares the parallel diagnoses of a pipeline from
-    deriving the same model side by side.
+    `extra` names effect modules outside the registry (files or dotted names) to include as candidates. The
+    pipeline derives each set once (:func:`parksteer.model.codegen.cache.ensure`, one job per set) before any
+    diagnosis runs, which spares the parallel diagnoses from deriving the same model side by side.
     """
-    from ..model.codegen.cache import ensure_entry, model_key
     from ..model.symbolic.components import load_effect_module, resolve_effects
 
     base = resolve_effects(effects)
     registry = discover_effects()
+    refs = {name: name for name in registry}
     for ref in extra:
         effect = load_effect_module(ref)
         registry[effect.name] = effect
+        refs[effect.name] = str(ref)
     testable, _ = candidate_effects(base, registry)
-    manifest = []
-    for chosen in [base] + [sorted([*base, c], key=lambda e: e.name) for c in testable]:
-        ensure_entry(chosen)
-        manifest.append({"effects": [e.name for e in chosen], "key": model_key(chosen)})
-    return manifest
-
-
-def write_candidate_models(path, extra: tuple[str, ...] = ()) -> None:
-    """Derive the candidate models (:func:`ensure_candidate_models`) and write their keys as JSON."""
-    from ..tables import write_json
-
-    write_json(path, {"models": ensure_candidate_models(None, extra)})
+    sets: dict[str, str | None] = {"base": effects}
+    for candidate in testable:
+        sets[f"with_{candidate.name}"] = ",".join(filter(None, [effects, f"+{refs[candidate.name]}"]))
+    return sets

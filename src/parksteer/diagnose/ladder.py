@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 from ..model.symbolic.components import Effect, resolve_effects
 from ..parameters import Parameters
-from . import settings
+from .settings import DEFAULT_SETTINGS, DiagnosisSettings
 from .problem import FileData
 from .select import Diagnosis, diagnose
 
@@ -44,14 +44,16 @@ def _rung(label: str, effects: list[Effect], statistics: dict, parameters: dict[
 
 
 def error_ladder(files: list[FileData], params: Parameters, effects=None, first: Diagnosis | None = None,
-                 max_steps: int = settings.LADDER_MAX_STEPS) -> Ladder:
+                 settings: DiagnosisSettings | None = None) -> Ladder:
     """Rungs from the paper's model to the model with every effect the diagnoses name (module docstring).
 
-    `first` is a diagnosis of the same files and model already made (it is not repeated).
+    `first` is a diagnosis of the same files and model already made (it is not repeated); the ladder uses its
+    settings, else `settings` (by default the documented ones).
     """
+    settings = settings or (first.settings if first is not None else DEFAULT_SETTINGS)
     base = resolve_effects(effects) if not (isinstance(effects, list) and effects
                                              and isinstance(effects[0], Effect)) else effects
-    diagnosis = first if first is not None else diagnose(files, params, base)
+    diagnosis = first if first is not None else diagnose(files, params, base, settings=settings)
     nominal = diagnosis.statistics(diagnosis.nominal_predictions)
     calibrated = diagnosis.statistics(diagnosis.calibration.predictions)
     rungs = [
@@ -61,7 +63,7 @@ def error_ladder(files: list[FileData], params: Parameters, effects=None, first:
     diagnoses = [diagnosis]
     strengths: dict[str, float] = {}
     model = list(base)
-    for _ in range(max_steps):
+    for _ in range(settings.ladder_max_steps):
         if diagnosis.verdict != "missing":
             break
         best = diagnosis.best
@@ -70,8 +72,8 @@ def error_ladder(files: list[FileData], params: Parameters, effects=None, first:
         model = list(best.signature.model)
         strengths[best.signature.key] = best.signature.probe
         rungs.append(_rung(f"+ {best.name}", model, statistics, fit.values))
-        if statistics["weighted_rms_Nm"] <= settings.ADEQUATE_RMS_FACTOR * statistics["noise_floor_Nm"]:
+        if statistics["weighted_rms_Nm"] <= settings.adequate_rms_factor * statistics["noise_floor_Nm"]:
             break
-        diagnosis = diagnose(files, params, model, strengths=dict(strengths), start=fit.values)
+        diagnosis = diagnose(files, params, model, strengths=dict(strengths), start=fit.values, settings=settings)
         diagnoses.append(diagnosis)
     return Ladder(rungs, diagnoses, calibrated["noise_floor_Nm"], calibrated["attainable_floor_Nm"])

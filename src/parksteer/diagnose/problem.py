@@ -10,10 +10,10 @@ The replay uncertainty is found by propagation, not assumed: the smoothed rack i
 spline among many the rack data allow equally well. When the file states its logger (the
 rack's full scale and bits), the smoothed rack is logged again (analog noise, rounding to
 the converter's levels) and smoothed again, a few times
-(:meth:`parksteer.diagnose.replay.SmoothedRack.relogged`, a parametric bootstrap of the
+(:func:`relogged_rack`, a parametric bootstrap of the
 whole logging and smoothing); otherwise splines are drawn from the least-squares
 distribution of the coefficients, as if the rack noise were white
-(:meth:`parksteer.diagnose.replay.SmoothedRack.perturbed`). Replaying them and taking the
+(:meth:`parksteer.measure.smoothing.SmoothedRack.perturbed`). Replaying them and taking the
 spread of the torque at each sample gives how far the replay alone can be off there. It is tiny on the
 plateaus and large at a reversal, where the rack friction flips within about a millimetre
 per second of zero speed, so the turning time the data allow decides which sample carries
@@ -33,13 +33,16 @@ import numpy as np
 from scipy.ndimage import maximum_filter1d
 
 from ..errors import UsageError
-from ..measure.io import Measurement, read_measurement
+from ..measure.importers import load_record
+from ..measure.io import Measurement
 from ..measure.metrics import NoiseFloor, noise_floor
 from ..measure.phases import CyclePhases, find_phases
+from ..measure.smoothing import SmoothedRack, smooth_rack
 from ..model.symbolic.components import Effect
 from ..parameters import Parameters
-from . import settings
-from .replay import Replay, SmoothedRack, smooth_rack
+from ..synthetic.logger import add_noise, quantise
+from .settings import DEFAULT_SETTINGS
+from .replay import Replay
 
 TORQUE = "handwheel_torque_Nm"
 
@@ -93,15 +96,20 @@ def prepare_file(measurement: Measurement, case: str | None = None, label: str |
     return FileData(label, measurement, case, measurement.surface, rack, phases, floor)
 
 
-def load_files(paths: list[str | Path], params: Parameters, case: str | None = None) -> list[FileData]:
-    """Read, validate and prepare measurement files; `case` replaces the case every file names."""
+def load_files(paths: list[str | Path], params: Parameters, case: str | None = None, surface: str | None = None,
+               channel_map=None) -> list[FileData]:
+    """Read (through :func:`parksteer.measure.importers.load_record`), validate and prepare measurement files;
+    `case` replaces the case every file names, `surface` fills the surface a file does not state."""
     if not paths:
         raise UsageError("no measurement file given")
     if case is not None:
         params.case(case)  # one-line error for an unknown case
     files = []
     for path in paths:
-        measurement = read_measurement(path, params)
+        measurement = load_record(path, channel_map, case=case, surface=surface, params=params)
+        if surface is not None and measurement.surface != surface:
+            raise UsageError(f"{path}: the file says surface {measurement.surface!r} but --surface is {surface!r}; "
+                             "remove one")
         chosen = case or measurement.case
         stated = measurement.extra_offset_m
         if stated is not None and abs(stated - params.case(chosen)["extra_offset"]) > 5e-4:
@@ -153,8 +161,8 @@ class Problem:
         return np.concatenate([v / f.sigma_Nm for f, v in zip(self.files, values)])
 
     def estimate_replay_uncertainty(self, effects: list[Effect], overrides: dict[str, float] | None = None,
-                                    draws: int = settings.REPLAY_ENSEMBLE_DRAWS,
-                                    seed: int = settings.REPLAY_ENSEMBLE_SEED, keep_larger: bool = False) -> None:
+                                    draws: int = DEFAULT_SETTINGS.replay_ensemble_draws,
+                                    seed: int = DEFAULT_SETTINGS.replay_ensemble_seed, keep_larger: bool = False) -> None:
         """Set each file's replay uncertainty: spread of replays of racks the data allow (module docstring).
 
         The spread is widened by one sample either side (a running maximum), since a torque
@@ -168,7 +176,7 @@ class Problem:
             runs = []
             for _ in range(draws):
                 if logger is not None:
-                    rack = f.rack.relogged(f.time_s, *logger, rng)
+                    rack = relogged_rack(f.rack, f.time_s, *logger, rng)
                 else:
                     rack = f.rack.perturbed(rng)
                 other = Replay(list(effects), f.case, f.surface, self.params, rack, f.time_s)
@@ -178,6 +186,14 @@ class Problem:
             if keep_larger and f.replay_uncertainty_Nm is not None:
                 spread = np.maximum(spread, f.replay_uncertainty_Nm)
             f.replay_uncertainty_Nm = spread
+
+
+def relogged_rack(rack: SmoothedRack, time_s: np.ndarray, full_scale: float, bits: int, analog_rms: float,
+                  rng: np.random.Generator) -> SmoothedRack:
+    """A rack the logger could equally have recorded: `rack` at `time_s` with analog noise of `analog_rms`,
+    rounded to the levels of a `bits` converter over +-`full_scale`, and smoothed again
+    (:meth:`parksteer.measure.smoothing.SmoothedRack.resmoothed`)."""
+    return rack.resmoothed(time_s, lambda clean: quantise(add_noise(clean, analog_rms, rng), full_scale, bits))
 
 
 def rack_logger(measurement: Measurement) -> tuple[float, int, float] | None:

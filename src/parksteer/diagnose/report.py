@@ -9,7 +9,6 @@ import numpy as np
 
 from ..resources import data_file
 from ..tables import atomic_path
-from . import settings
 from .select import Candidate, Diagnosis
 
 SCHEMA_ID = "parksteer.diagnosis/1"
@@ -127,11 +126,11 @@ def diagnosis_dict(diagnosis: Diagnosis) -> dict:
             "calibrated_weighted_rms_over_noise_floor": math.sqrt(diagnosis.calibration.rss / problem.n),
             "explained_fraction": _finite(diagnosis.explained_fraction),
             "thresholds": {
-                "adequate_rms_factor": settings.ADEQUATE_RMS_FACTOR,
-                "bic_missing": settings.BIC_MISSING_THRESHOLD,
-                "explained_fraction_missing": settings.EXPLAINED_FRACTION_MISSING,
-                "bic_indistinguishable": settings.BIC_INDISTINGUISHABLE,
-                "confounded_fraction": settings.CONFOUNDED_FRACTION,
+                "adequate_rms_factor": diagnosis.settings.adequate_rms_factor,
+                "bic_missing": diagnosis.settings.bic_missing_threshold,
+                "explained_fraction_missing": diagnosis.settings.explained_fraction_missing,
+                "bic_indistinguishable": diagnosis.settings.bic_indistinguishable,
+                "confounded_fraction": diagnosis.settings.confounded_fraction,
             },
         },
         "cost": {"replays": problem.evaluations, "timings_s": diagnosis.timings_s},

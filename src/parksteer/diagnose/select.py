@@ -51,7 +51,7 @@ import numpy as np
 from ..model.symbolic.components import Effect, discover_effects, resolve_effects
 from ..model.numeric.values import SURFACES
 from ..parameters import Parameters
-from . import settings
+from .settings import DEFAULT_SETTINGS, DiagnosisSettings
 from .calibrate import Fit, FitParameter, calibrate, least_squares
 from .candidates import Score, Signature, candidate_effects, probe_signature, score, strength_parameter
 from .problem import FileData, Problem, effective_samples, fit_statistics, lag1_autocorrelation
@@ -107,6 +107,7 @@ class Diagnosis:
     rho: float
     explained_fraction: float | None
     timings_s: dict[str, float] = field(default_factory=dict)
+    settings: DiagnosisSettings = DEFAULT_SETTINGS
 
     @property
     def effect(self) -> str | None:
@@ -121,7 +122,7 @@ class Diagnosis:
     @property
     def confounded(self) -> list[Candidate]:
         return [c for c in self.candidates
-                if c.signature.observable and c.score.identifiable_fraction < settings.CONFOUNDED_FRACTION]
+                if c.signature.observable and c.score.identifiable_fraction < self.settings.confounded_fraction]
 
     @property
     def unobservable(self) -> list[str]:
@@ -131,15 +132,16 @@ class Diagnosis:
         return fit_statistics(self.problem, predictions)
 
 
-def refit(problem: Problem, calibration: Fit, signature: Signature, start_strength: float) -> Fit:
+def refit(problem: Problem, calibration: Fit, signature: Signature, start_strength: float,
+          settings: DiagnosisSettings = DEFAULT_SETTINGS) -> Fit:
     """The calibrated parameters and the candidate's strength fitted together in the full model."""
     spec = strength_parameter(signature.effect)
-    strength = FitParameter(signature.key, "linear", 1.0, max(spec.minimum, 0.0), spec.maximum, signature.probe)
+    strength = FitParameter(signature.key, "linear", 1.0, max(spec.lower, 0.0), spec.upper, signature.probe)
     parameters = [*calibration.parameters, strength]
     theta0 = np.concatenate([calibration.theta, [min(max(start_strength, strength.lower), strength.upper)]])
     seed = np.column_stack([calibration.jacobian, signature.weighted])
     return least_squares(problem, signature.model, parameters, theta0, calibration.fixed, jacobian=seed,
-                         max_iterations=settings.REFIT_MAX_ITERATIONS)
+                         max_iterations=settings.refit_max_iterations, settings=settings)
 
 
 def _compare_refits(problem: Problem, calibration: Fit, refitted: list[Candidate]):
@@ -182,8 +184,11 @@ def separation(problem: Problem, best: Candidate, other: Candidate) -> Separatio
 
 
 def diagnose(files: list[FileData], params: Parameters, effects=None, registry: dict[str, Effect] | None = None,
-             strengths: dict[str, float] | None = None, start: dict[str, float] | None = None) -> Diagnosis:
+             strengths: dict[str, float] | None = None, start: dict[str, float] | None = None,
+             settings: DiagnosisSettings = DEFAULT_SETTINGS) -> Diagnosis:
     """Calibrate, rank every candidate outside the model, refit the best, give the verdict (module docstring).
+
+    `settings` are the method's (:mod:`parksteer.diagnose.settings`; by default the documented ones).
 
     `strengths` ({"effect.param": finite-difference step}) are strengths of effects already
     added to the model, calibrated with the base parameters (from `start`, e.g. an earlier fit).
@@ -202,10 +207,11 @@ def diagnose(files: list[FileData], params: Parameters, effects=None, registry: 
         else resolve_effects(effects)
     problem = Problem(files, params)
     nominal = problem.predict(base, {})
-    problem.estimate_replay_uncertainty(base, start or {})
+    problem.estimate_replay_uncertainty(base, start or {}, settings.replay_ensemble_draws,
+                                        settings.replay_ensemble_seed)
     lap("nominal_and_replay_uncertainty")
 
-    calibration = calibrate(problem, base, strengths=strengths, start=start)
+    calibration = calibrate(problem, base, strengths=strengths, start=start, settings=settings)
     lap("calibration")
 
     testable, untestable = candidate_effects(base, registry)
@@ -213,23 +219,26 @@ def diagnose(files: list[FileData], params: Parameters, effects=None, registry: 
     candidates = []
     for effect in testable:
         signature = probe_signature(problem, base, effect, calibration.overrides,
-                                    settings.PROBE_EFFECT_NOISE_FLOORS * floor)
+                                    settings.probe_effect_noise_floors * floor, settings)
         candidates.append(Candidate(signature, score(signature, calibration)))
     lap("signatures_and_scores")
 
     hopeful = sorted((c for c in candidates if c.score.removed_rss > 0.0), key=lambda c: -c.score.statistic)
-    for candidate in hopeful[: settings.REFIT_COUNT]:
-        candidate.refit = refit(problem, calibration, candidate.signature, candidate.score.linear_strength)
+    for candidate in hopeful[: settings.refit_count]:
+        candidate.refit = refit(problem, calibration, candidate.signature, candidate.score.linear_strength,
+                                settings)
     lap("refits")
 
     refitted = [c for c in candidates if c.refit is not None]
     best, n_eff, rho = _compare_refits(problem, calibration, refitted)
-    if best is not None and best.delta_bic > settings.BIC_MISSING_THRESHOLD:
+    if best is not None and best.delta_bic > settings.bic_missing_threshold:
         # The replay's uncertainty was estimated with the base model; with the candidate, the torque may turn
         # more sharply where the rack data are least certain (a breakaway peak at each reversal). Weigh every
         # model by the larger of the two uncertainties and compare again.
         before = [f.sigma_Nm for f in problem.files]
-        problem.estimate_replay_uncertainty(best.signature.model, best.refit.overrides, keep_larger=True)
+        problem.estimate_replay_uncertainty(best.signature.model, best.refit.overrides,
+                                            settings.replay_ensemble_draws, settings.replay_ensemble_seed,
+                                            keep_larger=True)
         for fit in [calibration] + [c.refit for c in refitted]:
             reweigh(problem, fit, before)
         best, n_eff, rho = _compare_refits(problem, calibration, refitted)
@@ -241,12 +250,12 @@ def diagnose(files: list[FileData], params: Parameters, effects=None, registry: 
     excess = base_rss - n
     explained = (base_rss - best.refit.rss) / excess if (best is not None and excess > 0) else None
     after_ratio = math.sqrt(best.refit.rss / n) if best is not None else None
-    if (best is not None and best.delta_bic > settings.BIC_MISSING_THRESHOLD
-            and (after_ratio <= settings.ADEQUATE_RMS_FACTOR
-                 or (explained is not None and explained >= settings.EXPLAINED_FRACTION_MISSING))):
+    if (best is not None and best.delta_bic > settings.bic_missing_threshold
+            and (after_ratio <= settings.adequate_rms_factor
+                 or (explained is not None and explained >= settings.explained_fraction_missing))):
         verdict = "missing"
-    elif base_ratio <= settings.ADEQUATE_RMS_FACTOR and not (
-            best is not None and best.delta_bic > settings.BIC_MISSING_THRESHOLD):
+    elif base_ratio <= settings.adequate_rms_factor and not (
+            best is not None and best.delta_bic > settings.bic_missing_threshold):
         verdict = "adequate"
     else:
         verdict = "unexplained"
@@ -254,8 +263,8 @@ def diagnose(files: list[FileData], params: Parameters, effects=None, registry: 
     separations = []
     if verdict == "missing":
         for c in refitted:
-            if c is not best and c.delta_bic >= best.delta_bic - settings.BIC_INDISTINGUISHABLE:
+            if c is not best and c.delta_bic >= best.delta_bic - settings.bic_indistinguishable:
                 separations.append(separation(problem, best, c))
     lap("separation")
     return Diagnosis(problem, base, nominal, calibration, candidates, untestable, verdict, best, separations,
-                     n_eff, rho, explained, timings)
+                     n_eff, rho, explained, timings, settings)

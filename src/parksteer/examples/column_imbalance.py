@@ -26,33 +26,38 @@ import math
 
 import sympy as sp
 
-from parksteer.model.symbolic.components import Effect, EffectParameter
+from parksteer.model.symbolic.components import Effect
+from parksteer.model.symbolic.system import torque_between
+from parksteer.parameters import Quantity
 
 
 class ColumnImbalance(Effect):
     name = "column_imbalance"
     description = "Out-of-balance mass on the inclined column: torque -T_u sin(column angle - phase), once per turn"
     in_default_set = False
-    parameters = (
-        EffectParameter("strength", "N m", 0.0, 20.0,
-                        "example: m g e sin(lambda); 0.2 kg at 30 mm on a column inclined 25 deg gives 0.025 N m "
-                        "per 100 g, so a few tenths of a N m for a heavy yoke",
-                        default=0.0),
-        EffectParameter("phase", "rad", -math.pi, math.pi,
-                        "example: column angle at which the mass passes its highest point", default=0.0),
+    # Quantities only this effect has, declared here (an effect from outside the package has no section of the
+    # parameter file): they join the registry when the effect is loaded.
+    quantities = (
+        Quantity("column_imbalance.strength", "N m", 0.0, 20.0, lower_inclusive=True, default=0.0,
+                 source="example: m g e sin(lambda); 0.2 kg at 30 mm on a column inclined 25 deg gives 0.025 N m "
+                        "per 100 g, so a few tenths of a N m for a heavy yoke"),
+        Quantity("column_imbalance.phase", "rad", -math.pi, math.pi, lower_inclusive=True, default=0.0,
+                 source="example: column angle at which the mass passes its highest point"),
     )
+    uses = tuple(q.key for q in quantities)
 
     def _angle(self, model):
-        return model.column_angle - model.p(self, "phase")
+        return model.kinematics.column_angle - model.p("column_imbalance.phase")
 
     def loads(self, model):
-        torque = -model.p(self, "strength") * sp.sin(self._angle(model))
+        k = model.kinematics
+        torque = -model.p("column_imbalance.strength") * sp.sin(self._angle(model))
         # The mass turns with the column; the column bearings in the body take the reaction.
-        return [(model.column_frame, torque * model.B.y), (model.B, -torque * model.B.y)]
+        return torque_between(torque, k.B.y, k.column_frame, k.B)
 
     def potential_energy(self, model):
         # V = T_u (1 - cos(theta)), so that -dV/dtheta is the torque above.
-        return model.p(self, "strength") * (1 - sp.cos(self._angle(model)))
+        return model.p("column_imbalance.strength") * (1 - sp.cos(self._angle(model)))
 
 
 EFFECT = ColumnImbalance()

@@ -230,3 +230,19 @@ def benchmark_figure(rows: list[dict], summary: dict, path: str | Path) -> None:
     ax.legend(fontsize=7, loc="lower right")
     fig.tight_layout()
     save_svg(fig, path)
+
+
+def make_benchmark_figure(truth_paths, diagnosis_paths, svg: str | Path, csv: str | Path, json_path: str | Path,
+                          design=None) -> dict:
+    """figures/diag_benchmark.svg (confusion matrix, accuracy against strength), its CSV, results JSON."""
+    from ..diagnose.benchmark import TIMING_FIELDS, aggregate
+    from ..tables import write_csv, write_json
+
+    rows, summary = aggregate(truth_paths, diagnosis_paths, design)
+    benchmark_figure(rows, summary, svg)
+    # Timings differ from run to run; they stay in the JSON summary, out of the checksummed figure data.
+    columns = {key: [r[key] for r in rows] for key in rows[0] if key not in TIMING_FIELDS} if rows else {}
+    write_csv(csv, columns, {"figure": "diag_benchmark: one row per synthetic data set",
+                             "steps": "hidden size as converter steps of torque RMS on the unladen ground file"})
+    write_json(json_path, summary)
+    return summary

@@ -2,7 +2,9 @@
 
 Each simulation of the figures is one CSV, results/sim/<case>__<variant>.csv, written by
 :func:`write_simulation`; the figures read those files, so figures that share a run share
-its file. A variant is a set of effects and a surface:
+its file. A variant is a set of effects and a surface; the variants and each figure's runs
+are the pipeline's configuration (config/config.yaml: ``models``, ``variants``,
+``model_figures``), read by :meth:`FigureDesign.from_config`:
 
 - full: the paper's five effects, tyres on the ground;
 - no_rack_friction, no_tyre_friction, no_friction: Fig. 14's ablations (effects switched off);
@@ -14,49 +16,63 @@ shares of the mechanisms, the offset sensitivity) go to results/<figure>.json.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from ..errors import UsageError
 from ..geometry import steer_axis
 from ..parameters import Parameters, load_parameters
 from ..plotting import COLOURS, new_figure, save_svg
 from ..tables import read_csv, write_csv, write_json
 
-# variant -> (effects spec, surface)
-VARIANTS: dict[str, tuple[str | None, str]] = {
-    "full": (None, "ground"),
-    "no_rack_friction": ("-rack_friction", "ground"),
-    "no_tyre_friction": ("-tyre_friction", "ground"),
-    "no_friction": ("-rack_friction,-tyre_friction", "ground"),
-    "air_bearing": (None, "air_bearing"),
-}
-# The compiled model each variant needs (air bearings change a parameter, not the model).
-VARIANT_MODEL = {"full": "full", "no_rack_friction": "no_rack_friction", "no_tyre_friction": "no_tyre_friction",
-                 "no_friction": "no_friction", "air_bearing": "full"}
-MODEL_EFFECTS = {name: VARIANTS[name][0] for name in ("full", "no_rack_friction", "no_tyre_friction", "no_friction")}
+Run = tuple[str, str]  # (case, variant)
+
+
+@dataclass(frozen=True)
+class Variant:
+    """A variant of the figures' runs: its compiled model (a name and an effects spec), surface and legend label
+    (None: the run is labelled by its case)."""
+
+    model: str
+    effects: str | list | None
+    surface: str
+    label: str | None = None
+
+
+@dataclass(frozen=True)
+class FigureDesign:
+    """The variants and each figure's runs (in legend order)."""
+
+    variants: dict[str, Variant]
+    figures: dict[str, tuple[Run, ...]]
+
+    @classmethod
+    def from_config(cls, config: dict) -> FigureDesign:
+        """From the configuration's ``models``, ``variants`` and ``model_figures``; a name that is not defined
+        is refused in one line naming its key."""
+        for name, v in config["variants"].items():
+            if v["model"] not in config["models"]:
+                raise UsageError(f"config variants.{name}.model: no model {v['model']!r} under models")
+        for name, runs in config["model_figures"].items():
+            for case, variant in runs:
+                if variant not in config["variants"]:
+                    raise UsageError(f"config model_figures.{name}: no variant {variant!r} under variants")
+        variants = {name: Variant(v["model"], config["models"][v["model"]], v["surface"], v.get("label"))
+                    for name, v in config["variants"].items()}
+        figures = {name: tuple((str(c), str(v)) for c, v in runs) for name, runs in config["model_figures"].items()}
+        return cls(variants, figures)
+
+    def all_simulations(self) -> list[Run]:
+        """Every (case, variant) run of the figures, once each."""
+        return list(dict.fromkeys(run for runs in self.figures.values() for run in runs))
+
 
 OFFSET_CASES = ("unladen", "offset_12_7mm", "offset_44_5mm", "offset_68_5mm")
-# figure -> the (case, variant) runs it plots, in legend order
-FIGURE_RUNS: dict[str, list[tuple[str, str]]] = {
-    "fig12": [("unladen", "full"), ("part_laden", "full")],
-    "fig13": [("unladen", "full"), ("part_laden", "full")],
-    "fig14": [("unladen", "full"), ("unladen", "no_rack_friction"), ("unladen", "no_tyre_friction"),
-              ("unladen", "no_friction")],
-    "fig15": [(case, "full") for case in OFFSET_CASES],
-    "fig16": [(case, "air_bearing") for case in OFFSET_CASES],
-    "figContrib": [("unladen", "full")],
-}
 # The plateau: the first steer towards right lock, rack between these positions (m), after the carcass wind-up
 PLATEAU_RACK_M = (0.02, 0.06)
 
-VARIANT_LABELS = {
-    "full": "full model",
-    "no_rack_friction": "(a) no rack friction",
-    "no_tyre_friction": "(b) no tyre friction",
-    "no_friction": "(c) no rack or tyre friction (lifting remains)",
-    "air_bearing": "air bearings",
-}
 EFFECT_LABELS = {
     "tyre_friction": "tyre friction",
     "rack_friction": "rack friction",
@@ -71,39 +87,18 @@ def simulation_path(case: str, variant: str, directory: str | Path = "results/si
     return Path(directory) / f"{case}__{variant}.csv"
 
 
-def all_simulations() -> list[tuple[str, str]]:
-    """Every (case, variant) run of the figures, once each."""
-    seen: dict[tuple[str, str], None] = {}
-    for runs in FIGURE_RUNS.values():
-        for run in runs:
-            seen[run] = None
-    return list(seen)
-
-
-def run_simulation(params: Parameters, case: str, variant: str):
+def run_simulation(params: Parameters, case: str, effects, surface: str):
     from ..model.numeric.simulate import simulate
 
-    effects, surface = VARIANTS[variant]
     return simulate(case, effects=effects, surface=surface, params=params)
 
 
-def write_simulation(parameters_path: str | Path, case: str, variant: str, csv_path: str | Path) -> None:
-    """Simulate one (case, variant) run of the figures and write its CSV."""
-    if variant not in VARIANTS:
-        raise ValueError(f"unknown variant {variant!r} (known: {', '.join(VARIANTS)})")
-    result = run_simulation(load_parameters(parameters_path), case, variant)
+def write_simulation(parameters_path: str | Path, case: str, variant: str, effects, surface: str,
+                     csv_path: str | Path) -> None:
+    """Simulate one (case, variant) run of the figures (the variant's effects spec and surface), write its CSV."""
+    result = run_simulation(load_parameters(parameters_path), case, effects, surface)
     result.header["variant"] = variant
     result.write_csv(csv_path)
-
-
-def derive_model(name: str, manifest_path: str | Path) -> None:
-    """Build the cached compiled model of one of MODEL_EFFECTS and write its manifest."""
-    from ..cli import main
-
-    status = main(["derive", *(["--effects=" + MODEL_EFFECTS[name]] if MODEL_EFFECTS[name] else []),
-                   "--out", str(manifest_path)])
-    if status:
-        raise RuntimeError(f"derive {name} failed")
 
 
 # -- key numbers --------------------------------------------------------------------------
@@ -163,7 +158,7 @@ def cycle_summary(columns: dict, params: Parameters) -> dict:
 
 
 # -- figures ------------------------------------------------------------------------------
-def _label(params: Parameters, case: str, variant: str) -> str:
+def _label(params: Parameters, case: str, variant: str, labels: dict[str, str]) -> str:
     c = params.case(case)
     if case == "part_laden":
         name = "part laden"
@@ -173,18 +168,18 @@ def _label(params: Parameters, case: str, variant: str) -> str:
         name = "unladen (nominal)"
     if case in OFFSET_CASES:
         name += f", d = {1000 * steer_axis(params, case, 'left').offset_d_m:.1f} mm"
-    return name if variant in ("full", "air_bearing") else VARIANT_LABELS[variant]
+    return labels.get(variant) or name
 
 
 def _run_key(case: str, variant: str) -> str:
     return f"{case}__{variant}"
 
 
-def _torque_against_rack(params, runs, data, title, ylabel="handwheel torque (N m)"):
+def _torque_against_rack(params, runs, data, labels, title, ylabel="handwheel torque (N m)"):
     fig, ax = new_figure(6.5, 4.2)
     for colour, (case, variant) in zip(COLOURS, runs):
         c = data[(case, variant)]
-        ax.plot(1000 * c["rack_m"], c["handwheel_torque_Nm"], color=colour, label=_label(params, case, variant))
+        ax.plot(1000 * c["rack_m"], c["handwheel_torque_Nm"], color=colour, label=_label(params, case, variant, labels))
     ax.axhline(0.0, color="0.5", linewidth=0.6)
     ax.axvline(0.0, color="0.5", linewidth=0.6)
     ax.set_xlabel("rack displacement (mm), positive steering right")
@@ -195,11 +190,11 @@ def _torque_against_rack(params, runs, data, title, ylabel="handwheel torque (N 
     return fig
 
 
-def _loads_against_rack(params, runs, data):
+def _loads_against_rack(params, runs, data, labels):
     fig, ax = new_figure(6.5, 4.2)
     for colour, (case, variant) in zip(COLOURS, runs):
         c = data[(case, variant)]
-        label = _label(params, case, variant)
+        label = _label(params, case, variant, labels)
         ax.plot(1000 * c["rack_m"], c["load_left_N"], color=colour, label=f"left wheel, {label}")
         ax.plot(1000 * c["rack_m"], c["load_right_N"], color=colour, linestyle="--", label=f"right wheel, {label}")
     ax.set_xlabel("rack displacement (mm), positive steering right")
@@ -243,9 +238,8 @@ def _contributions_over_time(params, c):
     return fig
 
 
-def _figure_columns(name: str, params: Parameters, data: dict) -> dict:
+def _figure_columns(name: str, runs: list[Run], data: dict) -> dict:
     """The plotted data of one figure, on the runs' shared time base."""
-    runs = FIGURE_RUNS[name]
     first = data[runs[0]]
     cols: dict[str, np.ndarray] = {"time_s": first["time_s"]}
     for case, variant in runs:
@@ -265,8 +259,7 @@ def _figure_columns(name: str, params: Parameters, data: dict) -> dict:
     return cols
 
 
-def _summary(name: str, params: Parameters, data: dict) -> dict:
-    runs = FIGURE_RUNS[name]
+def _summary(name: str, runs: list[Run], params: Parameters, data: dict) -> dict:
     summaries = {_run_key(case, variant): cycle_summary(data[(case, variant)], params) for case, variant in runs}
     out: dict = {"figure": name, "runs": summaries, "plateau_rack_range_m": list(PLATEAU_RACK_M)}
     if name == "fig14":
@@ -291,25 +284,29 @@ def _summary(name: str, params: Parameters, data: dict) -> dict:
     return out
 
 
+# figure -> plot(params, runs, data, labels)
 PLOTTERS = {
-    "fig12": lambda p, d: _torque_against_rack(
-        p, FIGURE_RUNS["fig12"], d, "Fig. 12: handwheel torque against rack displacement (model)"),
-    "fig13": lambda p, d: _loads_against_rack(p, FIGURE_RUNS["fig13"], d),
-    "fig14": lambda p, d: _torque_against_rack(
-        p, FIGURE_RUNS["fig14"], d, "Fig. 14: mechanisms omitted in turn (unladen)"),
-    "fig15": lambda p, d: _torque_against_rack(
-        p, FIGURE_RUNS["fig15"], d, "Fig. 15: wheel offset varied by spacers, tyres on the ground"),
-    "fig16": lambda p, d: _torque_against_rack(
-        p, FIGURE_RUNS["fig16"], d, "Fig. 16: wheel offset varied by spacers, tyres on air bearings"),
-    "figContrib": lambda p, d: _contributions_over_time(p, d[("unladen", "full")]),
+    "fig12": lambda p, r, d, lab: _torque_against_rack(
+        p, r, d, lab, "Fig. 12: handwheel torque against rack displacement (model)"),
+    "fig13": lambda p, r, d, lab: _loads_against_rack(p, r, d, lab),
+    "fig14": lambda p, r, d, lab: _torque_against_rack(p, r, d, lab, "Fig. 14: mechanisms omitted in turn (unladen)"),
+    "fig15": lambda p, r, d, lab: _torque_against_rack(
+        p, r, d, lab, "Fig. 15: wheel offset varied by spacers, tyres on the ground"),
+    "fig16": lambda p, r, d, lab: _torque_against_rack(
+        p, r, d, lab, "Fig. 16: wheel offset varied by spacers, tyres on air bearings"),
+    "figContrib": lambda p, r, d, lab: _contributions_over_time(p, d[r[0]]),
 }
 
 
-def make_model_figure(name: str, parameters_path: str | Path, simulation_csvs: list[str | Path],
-                      svg_path: str | Path, csv_path: str | Path, json_path: str | Path) -> None:
-    """Write one figure's SVG, plotted data and key numbers from its simulation CSVs (in FIGURE_RUNS order)."""
+def make_model_figure(name: str, runs: list[Run], labels: dict[str, str], parameters_path: str | Path,
+                      simulation_csvs: list[str | Path], svg_path: str | Path, csv_path: str | Path,
+                      json_path: str | Path) -> None:
+    """Write one figure's SVG, plotted data and key numbers from its simulation CSVs (one per run, in order).
+
+    `labels` maps a variant to its legend label (a variant without one is labelled by its case).
+    """
     params = load_parameters(parameters_path)
-    runs = FIGURE_RUNS[name]
+    runs = [(str(case), str(variant)) for case, variant in runs]
     if len(simulation_csvs) != len(runs):
         raise ValueError(f"{name}: expected {len(runs)} simulation files, got {len(simulation_csvs)}")
     data = {run: read_csv(path)[0] for run, path in zip(runs, simulation_csvs)}
@@ -318,7 +315,7 @@ def make_model_figure(name: str, parameters_path: str | Path, simulation_csvs: l
         "runs": ", ".join(_run_key(c, v) for c, v in runs),
         "units": "time in s, rack in mm, torque at the handwheel in N m, loads in N",
     }
-    fig = PLOTTERS[name](params, data)
-    write_csv(csv_path, _figure_columns(name, params, data), header)
-    write_json(json_path, _summary(name, params, data))
+    fig = PLOTTERS[name](params, runs, data, dict(labels))
+    write_csv(csv_path, _figure_columns(name, runs, data), header)
+    write_json(json_path, _summary(name, runs, params, data))
     save_svg(fig, svg_path)

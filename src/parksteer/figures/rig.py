@@ -27,9 +27,11 @@ BRAKED_RISE_QUOTED = 0.10
 BRAKED_RISE_KEY = f"offset_for_{round(100 * BRAKED_RISE_QUOTED)}_percent_braked_rise_m"
 
 SCALING_STATEMENT = (
-    "Both pin-offset curves are the uniform-pressure Coulomb integrals multiplied by "
-    "(p0/p)^(n-0.5), the ratio of equation (2) to equation (1) at that pressure, so that they "
-    "carry the rig's empirical pressure correction; at zero offset both equal equation (2)."
+    "The rig's pressure correction (p0/p)^(n-0.5), the ratio of equation (2) to equation (1) at that "
+    "pressure, multiplies the spin part only: the free-rolling curve and the braked curve's equation (1) "
+    "part; the braked curve's drag part (the uniform-pressure integral minus equation (1), the patch dragged "
+    "about the pin) is not scaled, since a pressure distribution cannot raise the net sliding force above "
+    "mu W, so the braked torque tends to mu W e; at zero offset both equal equation (2)."
 )
 
 
@@ -261,8 +263,8 @@ def braked_rise_offset_m(
         return float(rig.pin_torques_Nm(params, load_N, pressure_Pa, offset_m).braked_Nm) / free - 1.0 - rise
 
     radius_m = float(rig.patch_radius_m(load_N, pressure_Pa))
-    # braked >= mu W e (triangle inequality on the integral) and free = (2/3) mu W R,
-    # so at e = (1 + rise) R the excess is already positive
+    # braked >= mu W e + (c - 1) (2/3) mu W R (triangle inequality on the drag part, c the pressure
+    # correction) and free = c (2/3) mu W R, so at e = (1 + rise) R the excess is positive for c < 1.5
     return brentq(excess, 0.0, (1.0 + rise) * radius_m, xtol=1e-9)
 
 

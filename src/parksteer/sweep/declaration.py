@@ -21,7 +21,7 @@ A declaration (SI units throughout)::
       rim_radius: {value: 0.19, unit: m, source: "..."}
 
 An axis key is any model parameter `simulate` accepts as an override (``tyre.tyre_pressure``,
-``case.chassis_mass``, ``rack_friction.friction_force``, ...) or a design variable
+``case.chassis_mass``, ``steering.rack_friction_force``, ...) or a design variable
 (``design.*``, see DESIGN_VARIABLES) that changes several of them together so that the
 model stays consistent (statics of the wheel loads, the axis through the wheel centre).
 Every problem is one line naming the file and the key (:class:`SweepError`).
@@ -41,8 +41,8 @@ from typing import Any
 import numpy as np
 import yaml
 
-from ..errors import UsageError
-from ..parameters import CASE_SCHEMA, SCHEMA, Parameters, Spec
+from ..parameters import Parameters, quantity, registry
+from .design import SweepError, point_overrides
 
 # Figures of merit a map can show (written by parksteer.sweep.merit for every point).
 MAP_QUANTITIES = (
@@ -65,10 +65,6 @@ MODEL_SECTIONS = ("vehicle", "steering", "geometry", "tyre", "input")
 # Grid values are rounded to this many significant digits so that linspace noise never changes a point id.
 GRID_DIGITS = 12
 ID_HEX_DIGITS = 10
-
-
-class SweepError(UsageError):
-    """A sweep declaration that cannot be run; the message is one line naming the file and the key."""
 
 
 @dataclass(frozen=True)
@@ -225,38 +221,21 @@ class Sweep:
 # ---------------------------------------------------------------------------- parameter keys
 
 
-def _spec_bounds(spec: Spec) -> tuple[float, float, bool]:
-    return spec.lower, spec.upper, spec.lower_inclusive
-
-
 def parameter_bounds(key: str) -> tuple[float, float, bool, str]:
-    """(lower, upper, lower_inclusive, unit) of a sweepable key; raise KeyError for an unknown key."""
+    """(lower, upper, lower_inclusive, unit) of a sweepable key; raise KeyError for an unknown key.
+
+    A model quantity's bounds are its registry's (:mod:`parksteer.parameters`); a design variable's are its own.
+    """
     owner, _, name = key.partition(".")
     if not name:
         raise KeyError(key)
     if owner == "design":
         v = DESIGN_VARIABLES[name]
         return v.minimum, v.maximum, True, v.unit
-    if owner == "case":
-        spec = CASE_SCHEMA[name]
-        return (*_spec_bounds(spec), spec.unit)
-    if owner in MODEL_SECTIONS:
-        if name in SCHEMA[owner]:
-            spec = SCHEMA[owner][name]
-            if spec.is_list:
-                raise KeyError(key)
-            return (*_spec_bounds(spec), spec.unit)
-        from ..model.numeric.values import MODEL_PARAMETERS  # model-only parameters, not in the file's schema
-
-        p = MODEL_PARAMETERS[key]
-        return p.minimum, p.maximum, True, p.unit
-    from ..model.symbolic.components import discover_effects  # imports the effects (and sympy) only when needed
-
-    effect = discover_effects()[owner]
-    for p in effect.parameters:
-        if p.name == name:
-            return p.minimum, p.maximum, True, p.unit
-    raise KeyError(key)
+    q = registry().get(key)
+    if q is None or q.is_list:
+        raise KeyError(key)
+    return q.lower, q.upper, q.lower_inclusive, q.unit
 
 
 def _check_key(where: str, key: Any) -> str:
@@ -472,8 +451,6 @@ def _map(path: Path, raw: Any, keys: list[str], axes: dict[str, tuple[float, ...
 def _check_model_consistency(path: Path, params: Parameters, case: str, effects: str | None,
                              values_list: list[dict[str, float]]) -> None:
     """Effect parameters belong to an effect of the sweep's model; derived case values are physical."""
-    from .design import point_overrides
-
     owners = {k.partition(".")[0] for v in values_list for k in v}
     effect_owners = owners - set(MODEL_SECTIONS) - {"case", "design"}
     if effect_owners:
@@ -492,11 +469,10 @@ def _check_model_consistency(path: Path, params: Parameters, case: str, effects:
         for key, value in derived.items():
             if key in values:
                 continue  # checked with its axis
-            owner, _, name = key.partition(".")
-            spec = CASE_SCHEMA[name] if owner == "case" else SCHEMA[owner][name]
-            lower, upper, inclusive = _spec_bounds(spec)
-            if (value < lower if inclusive else value <= lower) or value > upper:
-                raise SweepError(f"{path}: point {i}: derived {key} = {value:g} {spec.unit} is out of bounds")
+            q = quantity(key)
+            if not q.within(value):
+                raise SweepError(f"{path}: point {i}: derived {key} = {value:g} {q.unit} is out of bounds "
+                                 f"{q.bounds_text()}")
 
 
 def _braked(path: Path, raw: Any, effects: str | None, surface: str) -> tuple[str, tuple[str, ...] | None]:
@@ -515,13 +491,13 @@ def _braked(path: Path, raw: Any, effects: str | None, surface: str) -> tuple[st
         raise SweepError(f"{where}: needs tyre_friction in the model, or there is no patch to drag")
     if raw == BRAKED_RIG_THEORY:
         return raw, None
-    registry = discover_effects()
-    if raw not in registry:
+    found = discover_effects()
+    if raw not in found:
         raise SweepError(f"{where}: {raw!r} is neither {BRAKED_NONE}, {BRAKED_RIG_THEORY} nor an effect "
-                         f"(known: {', '.join(sorted(registry))})")
+                         f"(known: {', '.join(sorted(found))})")
     if raw in chosen:
         raise SweepError(f"{where}: effect {raw} is already in the free-rolling model")
-    if BRAKE_PARAMETER not in {p.name for p in registry[raw].parameters}:
+    if f"{raw}.{BRAKE_PARAMETER}" not in found[raw].uses:
         raise SweepError(f"{where}: effect {raw} has no {BRAKE_PARAMETER} parameter")
     return raw, tuple(sorted(chosen + [raw]))
 

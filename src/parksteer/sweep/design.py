@@ -1,6 +1,6 @@
 """From a sweep point's values to the overrides `simulate` takes, and the base car's value of each key.
 
-Direct keys (``tyre.tyre_pressure``, ``case.chassis_mass``, ``rack_friction.friction_force``)
+Direct keys (``tyre.tyre_pressure``, ``case.chassis_mass``, ``steering.rack_friction_force``)
 pass through unchanged. Design variables set several parameters together so that the
 model stays consistent with how the base car was built:
 
@@ -21,8 +21,12 @@ from __future__ import annotations
 
 import math
 
+from ..errors import UsageError
 from ..parameters import Parameters
-from .declaration import SweepError
+
+
+class SweepError(UsageError):
+    """A sweep declaration that cannot be run; the message is one line naming the file and the key."""
 
 
 def _effective(params: Parameters, case: str, values: dict[str, float]):
@@ -96,14 +100,4 @@ def base_value(params: Parameters, case: str, key: str) -> float:
         raise KeyError(key)
     if owner == "case":
         return c[name]
-    try:
-        return float(params[key])
-    except KeyError:
-        pass
-    from ..model.numeric.values import MODEL_PARAMETERS
-
-    if key in MODEL_PARAMETERS:
-        return MODEL_PARAMETERS[key].default_value(params)
-    from ..model.symbolic.components import discover_effects
-
-    return discover_effects()[owner].parameter(name).default_value(params)
+    return float(params[key])

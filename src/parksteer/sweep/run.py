@@ -19,7 +19,7 @@ from typing import Any
 
 from ..errors import UsageError
 from ..geometry import steer_axis
-from ..parameters import Parameters, load_parameters
+from ..parameters import Parameters, load_parameters, quantity
 from ..tables import write_json
 from .declaration import BRAKE_PARAMETER, BRAKED_NONE, BRAKED_RIG_THEORY, SweepError
 from .design import point_overrides
@@ -88,7 +88,7 @@ def _braked(spec: dict[str, Any], params: Parameters, overrides: dict, free, fre
     if method == BRAKED_NONE:
         return {"method": "none", "factor": math.nan, "ground_offset_m": math.nan,
                 **{q: math.nan for q in BRAKED_QUANTITIES}}
-    pressure = free.values.effect_values["tyre_friction"]["tyre_pressure"]
+    pressure = free.values.value("tyre.tyre_pressure")
     factor = braked_factor(run_params, case, pressure)
     estimate = figures_of_merit(braked_columns(free.columns, factor))
     if method == BRAKED_RIG_THEORY:
@@ -97,8 +97,7 @@ def _braked(spec: dict[str, Any], params: Parameters, overrides: dict, free, fre
                 **{q: estimate[q] for q in BRAKED_QUANTITIES}}
     effects = resolve_effects(spec["braked_effects"])
     entry = require_cached_model(effects)
-    effect = next(e for e in effects if e.name == method)
-    locked = effect.parameter(BRAKE_PARAMETER).maximum
+    locked = quantity(f"{method}.{BRAKE_PARAMETER}").upper
     run = simulate(case, effects=effects, overrides={**overrides, f"{method}.{BRAKE_PARAMETER}": locked},
                    surface=spec["surface"], params=params)
     braked = figures_of_merit(run.columns)
@@ -124,17 +123,3 @@ def run_point(spec: dict[str, Any], parameters_path: str | Path, out_json: str |
     print(f"point {spec['point']}: {time.perf_counter() - start:.3f} s, values {json.dumps(spec['values'])}",
           file=sys.stderr)
     return record
-
-
-def derive_sweep_model(effects_spec: str | None, out_json: str | Path) -> dict[str, Any]:
-    """Build (or find) the cached model of a sweep's effect set and write a manifest naming it."""
-    from ..model.codegen.cache import ensure_entry, entry_path
-    from ..model.symbolic.components import resolve_effects
-
-    effects = resolve_effects(effects_spec)
-    existed = (entry_path(effects) / "model.json").is_file()
-    entry = ensure_entry(effects)
-    manifest = {"effects": [e.name for e in effects], "effects_spec": effects_spec, "model_key": entry.name,
-                "directory": str(entry), "derived_now": not existed}
-    write_json(out_json, manifest)
-    return manifest

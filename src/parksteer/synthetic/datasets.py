@@ -19,6 +19,10 @@ The base parameters of every data set are perturbed within stated ranges, so tha
 diagnosis must calibrate them first. What is hidden is recorded in a separate truth
 dictionary, never in the files: their metadata say only ``synthetic: true`` and the
 logger's and the hand's settings.
+
+The experiment design (what is hidden in the car data set, the benchmark's strengths, files,
+perturbations and seeds) is the pipeline's configuration (``config/config.yaml``, sections
+``car`` and ``benchmark``), given here as :class:`CarDesign` and :class:`BenchmarkDesign`.
 """
 
 from __future__ import annotations
@@ -39,8 +43,7 @@ from ..model.symbolic.components import discover_effects, load_effect_module
 from ..model.numeric.simulate import simulate
 from ..parameters import Parameters
 from ..resources import example_effect
-from ..diagnose import settings
-from ..diagnose.candidates import strength_parameter
+from ..model.symbolic.components import strength_parameter
 
 RECORDED = [name for name in REQUIRED_COLUMNS + OPTIONAL_COLUMNS if name != "time_s"]
 CLEAN_OUTPUT_DT_S = 0.005
@@ -124,11 +127,21 @@ def rms_difference(a: np.ndarray, b: np.ndarray) -> float:
     return float(np.sqrt(np.mean((np.asarray(a) - np.asarray(b)) ** 2)))
 
 
-def strength_for_rms(torque_of, target_Nm: float, start: float, upper: float) -> float:
+@dataclass(frozen=True)
+class SizeSearch:
+    """How the size of a hidden thing is found: bisection iterations, accepted relative error of the RMS change,
+    and the largest lag of the torque channel searched (s)."""
+
+    iterations: int
+    tolerance: float
+    max_lag_s: float
+
+
+def strength_for_rms(torque_of, target_Nm: float, start: float, upper: float, search: SizeSearch) -> float:
     """The size s (from 0 up) at which RMS(torque_of(s) - torque_of(0)) = target, by bracketing and bisection.
 
     The bracket grows from `start` by factors of 4 up to `upper`; then bisection in the
-    logarithm of s until the RMS change is within BENCHMARK_BISECTION_TOLERANCE of the target.
+    logarithm of s until the RMS change is within ``search.tolerance`` of the target.
     If even `upper` changes the torque by less than the target, `upper` is returned (the
     caller records the change it actually makes).
     """
@@ -142,10 +155,10 @@ def strength_for_rms(torque_of, target_Nm: float, start: float, upper: float) ->
         if high >= upper:
             return upper
         low, high = high, min(high * 4.0, upper)
-    for _ in range(settings.BENCHMARK_BISECTION_ITERATIONS):
+    for _ in range(search.iterations):
         middle = math.sqrt(low * high) if low > 0 else high / 4.0
         value = change(middle)
-        if abs(value - target_Nm) <= settings.BENCHMARK_BISECTION_TOLERANCE * target_Nm:
+        if abs(value - target_Nm) <= search.tolerance * target_Nm:
             return middle
         low, high = (middle, high) if value < target_Nm else (low, middle)
     return math.sqrt(low * high) if low > 0 else high
@@ -164,17 +177,59 @@ class DatasetSpec:
     base_overrides: dict[str, float] = field(default_factory=dict)
     phase: float | None = None  # of a disturbance (rad); None draws it from the seed
     strength: float | None = None  # a hidden candidate's strength as it stands (instead of `steps`)
+    search: SizeSearch | None = None  # how a size given in `steps` is found (needed when `steps` is)
 
 
-def perturbed_base(params: Parameters, seed: int) -> dict[str, float]:
-    """Base-parameter overrides, each its default times 1 + U(-p, p) (BENCHMARK_PERTURBATION), seeded."""
-    registry = discover_effects()
+@dataclass(frozen=True)
+class BenchmarkDesign:
+    """The hidden-effect benchmark's design (config/config.yaml, section ``benchmark``, where each value's reason
+    is): strengths in converter steps, the files of each data set, the base perturbation (fractions by key), the
+    number of nulls, the seed of data set 0, the disturbances' sizes, and the size search."""
+
+    steps: tuple[float, ...]
+    files: tuple[tuple[str, str], ...]
+    perturbation: dict[str, float]
+    nulls: int
+    seed: int
+    disturbance_steps: tuple[float, ...]
+    search: SizeSearch
+
+    @classmethod
+    def from_config(cls, section: dict) -> BenchmarkDesign:
+        return cls(tuple(float(s) for s in section["steps"]), _files(section["files"]),
+                   {str(k): float(v) for k, v in section["perturbation"].items()}, int(section["nulls"]),
+                   int(section["seed"]), tuple(float(s) for s in section["disturbance_steps"]),
+                   SizeSearch(int(section["bisection_iterations"]), float(section["bisection_tolerance"]),
+                              float(section["max_lag_s"])))
+
+
+@dataclass(frozen=True)
+class CarDesign:
+    """The synthetic car data set's design (config/config.yaml, section ``car``): the one hidden effect and its
+    strength, the files (case, surface) in order, the seed, and the base perturbation (the benchmark's)."""
+
+    hidden_effect: str
+    hidden_strength: float
+    files: tuple[tuple[str, str], ...]
+    seed: int
+    perturbation: dict[str, float]
+
+    @classmethod
+    def from_config(cls, section: dict, perturbation: dict) -> CarDesign:
+        return cls(str(section["hidden_effect"]), float(section["hidden_strength"]), _files(section["files"]),
+                   int(section["seed"]), {str(k): float(v) for k, v in perturbation.items()})
+
+
+def _files(pairs) -> tuple[tuple[str, str], ...]:
+    return tuple((str(case), str(surface)) for case, surface in pairs)
+
+
+def perturbed_base(params: Parameters, seed: int, perturbation: dict[str, float]) -> dict[str, float]:
+    """Base-parameter overrides, each its default times 1 + U(-p, p) (`perturbation`: p by key), seeded."""
     rng = np.random.default_rng(seed)
     out = {}
-    for key, fraction in sorted(settings.BENCHMARK_PERTURBATION.items()):
-        owner, _, name = key.partition(".")
-        default = registry[owner].parameter(name).default_value(params)
-        out[key] = default * (1.0 + rng.uniform(-fraction, fraction))
+    for key, fraction in sorted(perturbation.items()):
+        out[key] = float(params[key]) * (1.0 + rng.uniform(-fraction, fraction))
     return out
 
 
@@ -218,6 +273,8 @@ def make_dataset(params: Parameters, spec: DatasetSpec) -> Dataset:
     """
     step = torque_step_Nm(params)
     target = None if spec.steps is None else spec.steps * step
+    if target is not None and spec.search is None:
+        raise UsageError(f"data set {spec.name}: a size in converter steps needs a size search (DatasetSpec.search)")
     hands = [hand(params, spec.seed * 100 + i) for i in range(len(spec.files))]
     base = dict(spec.base_overrides)
 
@@ -233,19 +290,19 @@ def make_dataset(params: Parameters, spec: DatasetSpec) -> Dataset:
     effects, overrides, disturbance, strength_key, strength = None, dict(base), None, None, None
     if spec.kind == "candidate":
         effect = discover_effects()[spec.hidden]
-        strength_key = f"{effect.name}.{strength_parameter(effect).name}"
+        strength_key = strength_parameter(effect, params).key
         effects = f"+{effect.name}"
-        upper = strength_parameter(effect).maximum
+        upper = strength_parameter(effect, params).upper
         if spec.strength is not None:
             strength = float(spec.strength)
         else:
             strength = strength_for_rms(lambda s: torques(effects, {**base, strength_key: s}), target, upper * 1e-3,
-                                        upper)
+                                        upper, spec.search)
         overrides[strength_key] = strength
     elif spec.kind == "outside":
         phase = spec.phase if spec.phase is not None else float(np.random.default_rng(spec.seed).uniform(-np.pi, np.pi))
         disturbance = Disturbance(spec.hidden, 0.0, phase=phase)
-        strength = _disturbance_size(params, disturbance, target, torques, base)
+        strength = _disturbance_size(params, disturbance, target, torques, base, spec.search)
         disturbance = disturbance.with_size(strength)
         effects, extra = disturbance.effects_and_overrides()
         overrides.update(extra)
@@ -278,14 +335,14 @@ def make_dataset(params: Parameters, spec: DatasetSpec) -> Dataset:
 
 
 def _disturbance_size(params: Parameters, disturbance: Disturbance, target: float, torques,
-                      base: dict[str, float]) -> float:
+                      base: dict[str, float], search: SizeSearch) -> float:
     """The size of a disturbance that changes the data set's torque by `target` N m RMS (all files together)."""
     if disturbance.kind == "column_imbalance":
         effects = f"+{USER_EFFECT_PATH}"
-        upper = load_effect_module(str(USER_EFFECT_PATH)).parameter("strength").maximum
+        upper = strength_parameter(load_effect_module(str(USER_EFFECT_PATH)), params).upper
         return strength_for_rms(
             lambda s: torques(effects, {**base, "column_imbalance.strength": s, "column_imbalance.phase": disturbance.phase}),
-            target, upper * 1e-3, upper)
+            target, upper * 1e-3, upper, search)
     if disturbance.kind == "torque_drift":
         # RMS of a ramp from 0 to a over each record: a / sqrt(3)
         return target * math.sqrt(3.0)
@@ -294,41 +351,41 @@ def _disturbance_size(params: Parameters, disturbance: Disturbance, target: floa
         unit = torques(None, base, disturbance.with_size(1e-6)) - torques(None, base)
         return 1e-6 * target / float(np.sqrt(np.mean(unit**2)))
     return strength_for_rms(lambda s: torques(None, base, disturbance.with_size(s)), target, 0.001,
-                            settings.BENCHMARK_MAX_LAG_S)
+                            search.max_lag_s, search)
 
 
 # ----------------------------------------------------------------------------- the benchmark's data sets
-def benchmark_specs(params: Parameters, registry=None) -> list[DatasetSpec]:
+def benchmark_specs(params: Parameters, design: BenchmarkDesign, registry=None) -> list[DatasetSpec]:
     """Every data set of the benchmark: each candidate at each strength, nulls, disturbances outside the library."""
     registry = registry if registry is not None else discover_effects()
     candidates = sorted(name for name, e in registry.items()
-                        if not e.in_default_set and strength_parameter(e) is not None)
+                        if not e.in_default_set and e.diagnosis_candidate and strength_parameter(e, params) is not None)
     specs: list[DatasetSpec] = []
 
     def add(kind, hidden, steps):
         index = len(specs)
-        seed = settings.BENCHMARK_SEED + index
+        seed = design.seed + index
         label = "null" if kind == "null" else f"{hidden}_{steps:g}".replace(".", "p")
         name = f"b{index:02d}_{label}"
-        specs.append(DatasetSpec(name, seed, settings.BENCHMARK_FILES, kind, hidden, steps,
-                                 perturbed_base(params, seed)))
+        specs.append(DatasetSpec(name, seed, design.files, kind, hidden, steps,
+                                 perturbed_base(params, seed, design.perturbation), search=design.search))
 
     for name in candidates:
-        for steps in settings.BENCHMARK_STEPS:
+        for steps in design.steps:
             add("candidate", name, steps)
-    for _ in range(settings.BENCHMARK_NULLS):
+    for _ in range(design.nulls):
         add("null", None, None)
     for kind in DISTURBANCES:
-        for steps in settings.BENCHMARK_DISTURBANCE_STEPS:
+        for steps in design.disturbance_steps:
             add("outside", kind, steps)
     return specs
 
 
 # ------------------------------------------------------------------------------------ the car data set
-def car_dataset(params: Parameters) -> Dataset:
+def car_dataset(params: Parameters, design: CarDesign) -> Dataset:
     """The stand-in for the paper's car tests: every case on the ground and on air bearings, ONE effect hidden."""
-    spec = DatasetSpec("car", settings.CAR_SEED, settings.CAR_FILES, "candidate", settings.CAR_HIDDEN_EFFECT, None,
-                       perturbed_base(params, settings.CAR_SEED), strength=settings.CAR_HIDDEN_STRENGTH)
+    spec = DatasetSpec("car", design.seed, design.files, "candidate", design.hidden_effect, None,
+                       perturbed_base(params, design.seed, design.perturbation), strength=design.hidden_strength)
     return make_dataset(params, spec)
 
 
@@ -336,15 +393,16 @@ def file_name(case: str, surface: str) -> str:
     return f"{case}__{surface}.csv"
 
 
-def write_car_dataset(parameters_path: str | Path, paths: list[str | Path], truth_path: str | Path) -> None:
-    """Write the car data set's files (named case__surface.csv, in CAR_FILES order) and, apart, its truth."""
+def write_car_dataset(parameters_path: str | Path, design: CarDesign, paths: list[str | Path],
+                      truth_path: str | Path) -> None:
+    """Write the car data set's files (named case__surface.csv, in the design's order) and, apart, its truth."""
     from ..measure.io import write_measurement
     from ..parameters import load_parameters
     from ..tables import write_json
 
     params = load_parameters(parameters_path)
-    dataset = car_dataset(params)
-    expected = [file_name(c, s) for c, s in settings.CAR_FILES]
+    dataset = car_dataset(params, design)
+    expected = [file_name(c, s) for c, s in design.files]
     if [Path(p).name for p in paths] != expected:
         raise UsageError(f"car data set: output files must be named {', '.join(expected)}")
     for path, measurement in zip(paths, dataset.measurements):

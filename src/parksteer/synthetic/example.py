@@ -25,6 +25,7 @@ from ..parameters import Parameters
 from .hand import HandVariation, irregular_hand_profile
 from .logger import LoggerSettings, synthetic_measurement
 from ..measure.io import OPTIONAL_COLUMNS, REQUIRED_COLUMNS, Measurement, write_measurement
+from ..measure.smoothing import interpolate_rack
 from .standin import rack_of_hand
 
 
@@ -72,11 +73,11 @@ EXAMPLE_CASE = "unladen"
 
 def example_measurement(params: Parameters, case: str = EXAMPLE_CASE) -> Measurement:
     """The example: the model driven by the rack of an irregular hand, logged by the example logger."""
-    from ..model.numeric.inputs import rack_drive_from_arrays
     from ..model.numeric.simulate import simulate
 
     hand = irregular_hand_profile(params, example_hand(params), output_dt_s=0.002)
-    drive = rack_drive_from_arrays(hand.time_s, rack_of_hand(params, hand.angle_rad))
+    # the hand's motion is smooth and finely sampled: a spline through its samples is the motion itself
+    drive = interpolate_rack(hand.time_s, rack_of_hand(params, hand.angle_rad))
     result = simulate(case, surface="ground", rack_drive=drive, params=params, output_dt_s=0.01)
     kept = [name for name in REQUIRED_COLUMNS + OPTIONAL_COLUMNS if name != "time_s"]
     clean = {name: np.asarray(result.columns[name]) for name in kept}

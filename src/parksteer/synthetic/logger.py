@@ -30,7 +30,6 @@ from typing import Any
 import numpy as np
 
 from ..errors import UsageError
-from ..parameters import Parameters
 from ..measure.io import ALLOWED_COLUMNS, Measurement, metadata_text
 
 LITECORDER_BITS = 8  # Section 3: "digitized via an 8-bit ... converter"

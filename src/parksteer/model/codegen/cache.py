@@ -6,7 +6,7 @@ source of the model package (and of any effect module outside it) and the sympy 
 so a change of the model's source makes a new entry and a simulation never re-derives a
 model that is already cached. The cache directory is ``$PARKSTEER_MODEL_CACHE``, else
 ``results/model`` in the repository when the package runs from a checkout, else the
-user's cache directory.
+user's cache directory. :func:`ensure` is the one way to get a model built and described.
 """
 
 from __future__ import annotations
@@ -20,6 +20,7 @@ import subprocess
 import sys
 import tempfile
 import time
+from importlib import metadata
 from pathlib import Path
 
 import sympy
@@ -32,15 +33,32 @@ FORMAT_VERSION = "1"
 MODEL_DIR = Path(__file__).resolve().parents[1]
 # The symbolic half: what the generated code depends on. numeric/ is not hashed, so editing it never re-derives.
 SYMBOLIC_DIRS = (MODEL_DIR / "symbolic", MODEL_DIR / "codegen")
-REPO_ROOT = MODEL_DIR.parents[2]
+
+
+def _checkout_root() -> Path | None:
+    """The repository the package runs from (editable install, or src/ on the path); None when installed."""
+    package = MODEL_DIR.parent
+    try:
+        dist = metadata.distribution("parksteer")
+    except metadata.PackageNotFoundError:
+        dist = None
+    # An installed wheel's files sit where its metadata says: never a checkout, wherever the environment is.
+    if dist is not None and Path(str(dist.locate_file("parksteer"))).resolve() == package:
+        return None
+    root = package.parents[1]
+    if package.parent.name == "src" and (root / "workflow" / "Snakefile").is_file():
+        return root
+    return None
 
 
 def cache_root() -> Path:
+    """$PARKSTEER_MODEL_CACHE, else results/model of the checkout the package runs from, else the user cache."""
     env = os.environ.get(CACHE_ENV)
     if env:
         return Path(env)
-    if (REPO_ROOT / "workflow" / "Snakefile").is_file() and (REPO_ROOT / "src" / "parksteer").is_dir():
-        return REPO_ROOT / "results" / "model"
+    root = _checkout_root()
+    if root is not None:
+        return root / "results" / "model"
     base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
     return Path(base) / "parksteer" / "model"
 
@@ -127,3 +145,25 @@ def ensure_entry(effects: list[Effect]) -> Path:
         if scratch.exists():
             shutil.rmtree(scratch, ignore_errors=True)
     return final
+
+
+def ensure(effects: list[Effect]) -> dict:
+    """Build (or find) the compiled model of `effects` and return its manifest.
+
+    The one derive path: ``parksteer derive`` and the pipeline's derive rule both call it. The
+    manifest names the effects, the cache key and entry directory, the generalised coordinates,
+    the number of run-time parameters, and the derivation's timings (of the build that made the
+    entry, possibly earlier) with ``built_now`` saying whether this call built it.
+    """
+    existed = (entry_path(effects) / "model.json").is_file()
+    directory = ensure_entry(effects)
+    info = json.loads((directory / "model.json").read_text(encoding="utf-8"))
+    return {
+        "effects": [e.name for e in effects],
+        "key": directory.name,
+        "directory": str(directory),
+        "coordinates": info["coordinates"],
+        "n_parameters": len(info["parameters"]),
+        "timings_s": info["timings_s"],
+        "built_now": not existed,
+    }

@@ -90,18 +90,18 @@ def generate(derivation: Derivation) -> tuple[str, dict]:
     drive += [(f"F[{i}]", F_nocol[i]) for i in range(n)] + [(f"b[{i}]", bcol[i]) for i in range(n)]
     timings["diff_s"] = time.perf_counter() - start
 
-    dcol = c(space.column_angle_per_rack)
+    dcol = c(space.kinematics.column_angle_per_rack)
     rack = space.coordinates.index(next(cc for cc in space.coordinates if cc.name == "rack"))
     outputs: list[tuple[str, sp.Expr]] = [
-        ("column_angle_rad", c(space.column_angle)),
+        ("column_angle_rad", c(space.kinematics.column_angle)),
         ("column_angle_per_rack_rad_per_m", dcol),
-        ("column_torque_Nm", c(space.column_torque)),
-        ("load_left_N", c(space.wheel_load["left"])),
-        ("load_right_N", c(space.wheel_load["right"])),
-        ("steer_left_rad", c(space.steer_angle["left"])),
-        ("steer_right_rad", c(space.steer_angle["right"])),
-        ("ring_yaw_rate_left_rad_s", c(space.ring_frame["left"].ang_vel_in(space.N).dot(space.N.z))),
-        ("ring_yaw_rate_right_rad_s", c(space.ring_frame["right"].ang_vel_in(space.N).dot(space.N.z))),
+        ("column_torque_Nm", c(space.kinematics.column_torque)),
+        ("load_left_N", c(space.kinematics.wheel_load["left"])),
+        ("load_right_N", c(space.kinematics.wheel_load["right"])),
+        ("steer_left_rad", c(space.kinematics.steer_angle["left"])),
+        ("steer_right_rad", c(space.kinematics.steer_angle["right"])),
+        ("ring_yaw_rate_left_rad_s", c(space.kinematics.ring_frame["left"].ang_vel_in(space.N).dot(space.N.z))),
+        ("ring_yaw_rate_right_rad_s", c(space.kinematics.ring_frame["right"].ang_vel_in(space.N).dot(space.N.z))),
     ]
     for name in derivation.effects:
         outputs.append((f"contrib_{name}_Nm", -derivation.generalized_forces[name][rack].xreplace(plain) / dcol))

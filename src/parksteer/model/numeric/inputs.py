@@ -1,4 +1,4 @@
-"""Drives of the model: the prescribed handwheel angle (paper section 4) or a prescribed rack travel.
+"""The handwheel drive of the model: the prescribed handwheel angle (paper section 4).
 
 The paper's input is a saw tooth of handwheel angle: straight ahead to full right lock in
 4.5 s, to full left lock 9 s later, back to straight ahead at 18 s. Its corners are rounded
@@ -7,19 +7,17 @@ changes linearly (constant angular acceleration), so the handwheel stops exactly
 lock at the corner time and the start and stop are from and to rest. An ideal saw tooth
 changes the rate instantly, and against the 200 N m s/rad column damping that gives a
 torque spike of about 1 kN m that no measurement shows. The constant rates are raised a
-little so that each lock is still reached at the paper's times.
+little so that each lock is still reached at the paper's times. A prescribed rack travel is any rack
+motion (:mod:`parksteer.model.numeric.prescribed`).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
-from scipy.interpolate import CubicSpline
 
 from ...errors import UsageError
-from ...tables import read_csv
 
 
 @dataclass(frozen=True)
@@ -96,39 +94,3 @@ def sawtooth_profile(params) -> HandwheelProfile:
         angle += travel_rad
     pieces.append((t, angle, 0.0, 0.0))
     return HandwheelProfile(tuple(pieces))
-
-
-@dataclass(frozen=True)
-class RackDrive:
-    """A prescribed rack displacement: a cubic spline through measured (time, rack) samples."""
-
-    spline: CubicSpline
-    start_s: float
-    end_s: float
-
-    def position_speed_accel(self, t_s):
-        t = np.clip(np.asarray(t_s, dtype=float), self.start_s, self.end_s)
-        return self.spline(t), self.spline(t, 1), self.spline(t, 2)
-
-
-def rack_drive_from_arrays(time_s, rack_m) -> RackDrive:
-    time_s = np.asarray(time_s, dtype=float)
-    rack_m = np.asarray(rack_m, dtype=float)
-    if time_s.ndim != 1 or len(time_s) < 4 or len(time_s) != len(rack_m):
-        raise UsageError("rack drive: needs at least 4 samples of time_s and rack_m")
-    if not (np.all(np.isfinite(time_s)) and np.all(np.isfinite(rack_m))) or np.any(np.diff(time_s) <= 0):
-        raise UsageError("rack drive: time_s must be finite and strictly increasing, rack_m finite")
-    # Clamped ends: the rack starts and ends at rest.
-    return RackDrive(CubicSpline(time_s, rack_m), float(time_s[0]), float(time_s[-1]))
-
-
-def rack_drive_from_csv(path: str | Path) -> RackDrive:
-    """Read a measurement's time_s and rack_m columns (a CSV as written by parksteer.tables.write_csv)."""
-    try:
-        columns, _ = read_csv(path)
-    except (OSError, ValueError, UnicodeDecodeError, IndexError) as exc:
-        raise UsageError(f"{path}: cannot read rack drive ({exc})") from None
-    for name in ("time_s", "rack_m"):
-        if name not in columns or columns[name].dtype == object:
-            raise UsageError(f"{path}: needs a numeric column {name!r}")
-    return rack_drive_from_arrays(columns["time_s"], columns["rack_m"])

@@ -1,12 +1,10 @@
 """Simulate the steering model: the paper's handwheel cycle, or a prescribed rack travel.
 
-The fast path integrates y' = (u, M^-1 f) with scipy's odeint (LSODA, which loops in
-Fortran) and the compiled analytic Jacobian; each call of the right-hand side is one call
-into the generated C. With a prescribed rack (a measurement's rack_m against time), the
-rack is not a state: its position, speed and acceleration come from a cubic spline, and
-each step solves the Kane equations M u' = f + b T for the other accelerations and the
-column torque T together; the column twist (handwheel minus column angle) then follows
-from c dtwist/dt + k twist = T.
+With the handwheel prescribed, the model integrates y' = (u, M^-1 f) with scipy's odeint
+(LSODA, which loops in Fortran) and the compiled analytic Jacobian; each call of the
+right-hand side is one call into the generated C. With a prescribed rack (a rack motion, such
+as a measurement's rack smoothed by :func:`parksteer.measure.smoothing.smooth_rack`), the
+handwheel torque is solved for by :func:`parksteer.model.numeric.prescribed.solve`.
 """
 
 from __future__ import annotations
@@ -16,23 +14,19 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-from scipy.integrate import odeint, solve_ivp
+from scipy.integrate import odeint
 
 from ...errors import UsageError
 from ...parameters import Parameters, load_parameters
 from ...tables import write_csv
 from .compiled import CompiledModel, load_model
 from ..symbolic.components import Effect, discover_effects, resolve_effects
-from .inputs import HandwheelProfile, RackDrive, rack_drive_from_csv, sawtooth_profile
+from .inputs import HandwheelProfile, sawtooth_profile
+from .prescribed import RackMotion, solve as solve_prescribed
+from .statics import static_state
+from .tolerances import PRESCRIBED_RTOL, RTOL, absolute_tolerances
 from .values import RunValues, parameter_vector, resolve_values
 
-# Integrator tolerances: relative, and absolute per unit of each coordinate (m or rad) and its rate.
-# The column damping turns rack-speed error into handwheel torque at c * G^2 (about 37,000 N m per m/s), so
-# the speeds need tight absolute tolerances: with these the nominal cycle's torque is within 0.002 N m of a
-# run at rtol 1e-11, atol 1e-13.
-RTOL = 1e-7
-ATOL_Q = {"m": 1e-10, "rad": 1e-9}
-ATOL_U = {"m": 1e-8, "rad": 1e-7}
 ROLL_NEUTRAL_KEY = "derived.roll_spring_neutral"
 
 
@@ -103,32 +97,8 @@ def balance_roll_spring(run: PreparedRun) -> None:
     p[i_neutral] = -residual / stiffness
 
 
-def static_state(run: PreparedRun, fixed: dict[str, float] | None = None, t_s: float = 0.0) -> np.ndarray:
-    """The static equilibrium (u = 0) at the handwheel input of time `t_s`, with `fixed` coordinates held.
-
-    Newton's method on f(q) = 0 with the generated df/dq.
-    """
-    model, p = run.model, run.p
-    n = model.n_q
-    fixed = fixed or {}
-    free = [i for i, name in enumerate(model.coordinates) if name not in fixed]
-    y = np.zeros(2 * n)
-    for name, value in fixed.items():
-        y[model.index(name)] = value
-    for _ in range(50):
-        residual = model.forcing(t_s, y, p)[free]
-        jac = model.forcing_dq(t_s, y, p)[np.ix_(free, free)]
-        # least squares: a coordinate with neither stiffness nor load (an effect at strength 0) stays put
-        step = np.linalg.lstsq(jac, -residual, rcond=None)[0]
-        y[free] += step
-        if np.max(np.abs(step)) < 1e-14:
-            break
-    return y
-
-
 def _atol(model: CompiledModel) -> np.ndarray:
-    units = model.info["coordinate_units"]
-    return np.array([ATOL_Q[u] for u in units] + [ATOL_U[u] for u in units])
+    return absolute_tolerances(model.info["coordinate_units"])
 
 
 def integrate(run: PreparedRun, t_out: np.ndarray, y0: np.ndarray | None = None, rtol: float = RTOL,
@@ -173,7 +143,7 @@ def _columns(run: PreparedRun, t: np.ndarray, states: np.ndarray, outputs: dict,
         "load_left_N": outputs["load_left_N"],
         "load_right_N": outputs["load_right_N"],
     }
-    for effect in model.symbolic.effects:
+    for effect in model.effects:
         cols[f"contrib_{effect}_Nm"] = outputs[f"contrib_{effect}_Nm"]
     cols["contrib_inertia_Nm"] = outputs["contrib_inertia_Nm"]
     cols["handwheel_rate_rad_s"] = handwheel[:, 1]
@@ -193,7 +163,7 @@ def _header(run: PreparedRun, drive: str) -> dict[str, str]:
         "model": "parksteer multibody steering model (Sharp & Granger section 4)",
         "case": run.values.case,
         "surface": run.values.surface,
-        "components": ", ".join(run.model.symbolic.effects) or "none",
+        "components": ", ".join(run.model.effects) or "none",
         "drive": drive,
         "model_key": run.model.directory.name,
         "derived.roll_spring_neutral": f"{run.p[run.parameter_index(ROLL_NEUTRAL_KEY)]:.10g} rad",
@@ -204,26 +174,27 @@ def _header(run: PreparedRun, drive: str) -> dict[str, str]:
 
 
 def simulate(case: str, effects=None, overrides: dict | None = None, surface: str = "ground",
-             rack_drive: RackDrive | str | Path | None = None, params: Parameters | None = None,
-             t_end_s: float | None = None, output_dt_s: float = 0.01, rtol: float = RTOL,
+             rack_drive: RackMotion | None = None, params: Parameters | None = None,
+             t_end_s: float | None = None, output_dt_s: float = 0.01, rtol: float | None = None,
              handwheel: HandwheelProfile | None = None) -> SimulationResult:
     """Simulate `case` (a Table B1 case) with the chosen effects.
 
     effects: None (the paper's five), an effects spec string ("-rack_friction,+hooke_joint")
-    or a list of names/Effect instances. overrides: {"owner.name": value}. surface: "ground"
-    or "air_bearing" (no tyre-to-ground friction, vertical support kept). rack_drive: a
-    RackDrive or a CSV with time_s and rack_m columns (then the rack is prescribed and the
-    handwheel torque is solved for). handwheel: a HandwheelProfile to drive instead of the paper's saw
-    tooth (the run ends with the profile unless t_end_s is given). Returns the output columns at
-    `output_dt_s` spacing.
+    or a list of names/Effect instances. overrides: {key: value} (quantity keys, as --set). surface: "ground"
+    or "air_bearing" (no tyre-to-ground friction, vertical support kept). rack_drive: a rack
+    motion (:class:`parksteer.model.numeric.prescribed.RackMotion`, e.g. a
+    :class:`parksteer.measure.smoothing.RackSpline`); then the rack is prescribed from its start to
+    its end (or t_end_s) and the handwheel torque is solved for. handwheel: a HandwheelProfile to
+    drive instead of the paper's saw tooth (the run ends with the profile unless t_end_s is given).
+    rtol: the integrator's relative tolerance (default: RTOL, or PRESCRIBED_RTOL with a rack drive;
+    parksteer.model.numeric.tolerances). Returns the output columns at `output_dt_s` spacing.
     """
     if not (output_dt_s > 0):
         raise UsageError(f"output_dt_s must be positive, got {output_dt_s}")
     run = prepare(case, effects, overrides, surface, params, handwheel)
     if rack_drive is not None:
-        drive = rack_drive if isinstance(rack_drive, RackDrive) else rack_drive_from_csv(rack_drive)
-        return _simulate_rack_drive(run, drive, t_end_s, output_dt_s, rtol,
-                                    label=str(rack_drive) if not isinstance(rack_drive, RackDrive) else "rack")
+        return _simulate_rack_drive(run, rack_drive, t_end_s, output_dt_s, PRESCRIBED_RTOL if rtol is None else rtol)
+    rtol = RTOL if rtol is None else rtol
     t_end = run.profile.end_time_s if t_end_s is None else float(t_end_s)
     if not (t_end > 0):
         raise UsageError(f"t_end_s must be positive, got {t_end}")
@@ -236,67 +207,17 @@ def simulate(case: str, effects=None, overrides: dict | None = None, surface: st
     return SimulationResult(columns, _header(run, drive), states, run.p, run.model, run.values)
 
 
-def _simulate_rack_drive(run: PreparedRun, drive: RackDrive, t_end_s, output_dt_s, rtol, label
+def _simulate_rack_drive(run: PreparedRun, rack: RackMotion, t_end_s, output_dt_s: float, rtol: float
                          ) -> SimulationResult:
-    model, p = run.model, run.p
-    n = model.n_q
-    rack = model.index("rack")
-    others = [i for i in range(n) if i != rack]
-    k_col = p[run.parameter_index("steering.column_torsional_stiffness")]
-    c_col = p[run.parameter_index("steering.column_torsional_damping")]
-    t0 = drive.start_s
-    t_end = drive.end_s if t_end_s is None else min(float(t_end_s), drive.end_s)
-
-    def full_state(t, z):
-        r, rd, rdd = drive.position_speed_accel(t)
-        y = np.zeros(2 * n)
-        y[others] = z[: n - 1]
-        y[[n + i for i in others]] = z[n - 1 : 2 * n - 2]
-        y[rack], y[n + rack] = r, rd
-        return y, rdd
-
-    def solve(y, rdd):
-        M, F, b = model.drive_parts(y, p)
-        A = np.column_stack([M[:, others], -b])
-        x = np.linalg.solve(A, F - M[:, rack] * rdd)
-        a = np.empty(n)
-        a[others], a[rack] = x[:-1], rdd
-        return a, x[-1]
-
-    def twist_rate(torque, twist):
-        return (torque - k_col * twist) / c_col if c_col > 0 else 0.0
-
-    def rhs(t, z):
-        y, rdd = full_state(t, z)
-        a, torque = solve(y, rdd)
-        return np.concatenate([z[n - 1 : 2 * n - 2], a[others], [twist_rate(torque, z[-1])]])
-
-    r0 = float(drive.position_speed_accel(t0)[0])
-    y_static = static_state(run, fixed={"rack": r0})
-    _, torque0 = solve(np.concatenate([y_static[:n], np.zeros(n)]), 0.0)
-    z0 = np.concatenate([y_static[others], np.zeros(n - 1), [torque0 / k_col]])
+    t0 = float(rack.start_s)
+    t_end = float(rack.end_s) if t_end_s is None else min(float(t_end_s), float(rack.end_s))
     t = np.round(np.arange(t0, t_end + 0.5 * output_dt_s, output_dt_s), 12)
-    atol = np.concatenate([_atol(model)[others], _atol(model)[[n + i for i in others]], [1e-7]])
-    sol = solve_ivp(rhs, (t0, t[-1]), z0, method="LSODA", t_eval=t, rtol=rtol, atol=atol)
-    if not sol.success:
-        raise RuntimeError(f"integration failed: {sol.message}")
-    states, accels, handwheel = np.empty((len(t), 2 * n)), np.empty((len(t), n)), np.empty((len(t), 2))
-    torques = np.empty(len(t))
-    for k, tk in enumerate(t):
-        y, rdd = full_state(tk, sol.y[:, k])
-        a, torque = solve(y, rdd)
-        states[k], accels[k], torques[k] = y, a, torque
-        twist = sol.y[-1, k] if c_col > 0 else torque / k_col
-        handwheel[k] = (twist, twist_rate(torque, twist))  # column angle added below
-    column = model.evaluate_outputs(t, states, p, accels, np.zeros((len(t), 2)))
-    handwheel[:, 0] += column["column_angle_rad"]
-    handwheel[:, 1] += column["column_angle_per_rack_rad_per_m"] * states[:, n + rack]
-    outputs = model.evaluate_outputs(t, states, p, accels, handwheel)
-    # The solved torque: the handwheel above is rebuilt with the linear column law, so under a column deflection
-    # (ModelSpace.set_column_deflection, e.g. lash) the torque recomputed from it would be wrong.
-    outputs["column_torque_Nm"] = torques
-    columns = _columns(run, t, states, outputs, handwheel)
-    return SimulationResult(columns, _header(run, f"prescribed rack from {label}"), states, p, model, run.values)
+    t = t[t <= rack.end_s]
+    if len(t) < 2:
+        raise UsageError(f"rack drive: the run from {t0:g} s to {t_end:g} s holds fewer than two outputs")
+    solution = solve_prescribed(run, run.p, rack, t, rtol=rtol, outputs=True)
+    columns = _columns(run, t, solution.states, solution.outputs, solution.handwheel)
+    return SimulationResult(columns, _header(run, "prescribed rack"), solution.states, run.p, run.model, run.values)
 
 
 def with_overrides(params: Parameters, section: str, **values) -> Parameters:

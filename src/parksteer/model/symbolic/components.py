@@ -11,12 +11,14 @@ places, so that adding one never needs an edit of the core:
   ``+path/to/effect.py``) or in the environment variable ``PARKSTEER_EFFECT_MODULES``
   (entries separated by ``os.pathsep``).
 
-An effect may add generalized coordinates, replace the steer functions of the linkage
-or the column-to-pinion map, make the column's spring act on a deflection of its twist, move
-where vertical loads act, add bodies, and contribute loads (forces on points, torques on frames)
-and potential energy; see :class:`parksteer.model.symbolic.system.ModelSpace`.
-Every parameter value is a runtime input of the generated code, so changing one never
-re-derives or recompiles. An effect beyond the paper should have a strength parameter
+An effect may add generalized coordinates, fill one slot of the core (the linkage's steer
+function, the column-to-pinion map, the column spring's deflection law, the tread ring's twist,
+where vertical loads act; :data:`parksteer.model.symbolic.system.SLOTS`), add bodies, and
+contribute loads (forces on points, torques on frames) and potential energy; see
+:class:`parksteer.model.symbolic.system.ModelSpace`. It names the effects it requires; a set
+in which two effects fill one slot, or one lacks an effect it requires, is refused.
+Every quantity's value is a runtime input of the generated code, so changing one never
+re-derives or recompiles. An effect beyond the paper should have a strength quantity
 whose default means absent, so that it can be present at strength 0 and its sensitivity
 taken numerically.
 """
@@ -28,12 +30,15 @@ import importlib.util
 import inspect
 import os
 import pkgutil
-from dataclasses import dataclass
+from functools import lru_cache
 from importlib.metadata import entry_points
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, ClassVar
 
 from ...errors import UsageError
+from ...parameters import DEFAULT_PATH, Quantity, declare, load_parameters, registry, unknown_key_message
+
+from .system import SLOTS
 
 if TYPE_CHECKING:  # pragma: no cover
     from .system import ModelSpace
@@ -41,91 +46,83 @@ if TYPE_CHECKING:  # pragma: no cover
 ENTRY_POINT_GROUP = "parksteer.effects"
 MODULES_ENV = "PARKSTEER_EFFECT_MODULES"
 
-
-@dataclass(frozen=True)
-class EffectParameter:
-    """One parameter of an effect: SI unit, bounds and where its default comes from.
-
-    ``file_key`` names the entry of data/parameters.toml that supplies the default (the
-    paper's value or the project's documented choice); ``default`` is used only when the
-    file has no such entry (a parameter that exists only for the model, e.g. a strength).
-    """
-
-    name: str
-    unit: str
-    minimum: float
-    maximum: float
-    source: str
-    default: float | None = None
-    file_key: str | None = None
-
-    def default_value(self, params) -> float:
-        if self.file_key is not None:
-            try:
-                return float(params[self.file_key])
-            except KeyError:
-                pass
-        if self.default is None:
-            raise UsageError(f"parameter {self.name}: no default and no entry {self.file_key!r} in the parameter file")
-        return float(self.default)
-
-    def check(self, owner: str, value: float) -> float:
-        value = float(value)
-        if not (self.minimum <= value <= self.maximum):
-            raise UsageError(
-                f"{owner}.{self.name} = {value:g} {self.unit} is out of bounds [{self.minimum:g}, {self.maximum:g}]"
-            )
-        return value
-
-
 class Effect:
-    """A physical mechanism of the model. Subclasses set the class attributes and override hooks."""
+    """A physical mechanism of the model. Subclasses set the class attributes and override hooks.
+
+    ``uses`` lists every quantity key the effect reads (``tyre.tyre_pressure``, ``rack_lash.lash``); the
+    package's effects find their own quantities in the parameter file, under a section named after the
+    effect. An effect from outside the package declares its own in ``quantities`` (key ``<name>.<quantity>``,
+    with unit, bounds, default and source); they join the registry when the effect is loaded.
+    ``requires`` names the effects it needs; ``replaces`` names the slot it fills (see :data:`SLOTS`).
+    Per-build state lives on the model being built (``model.state(self)``), never on the effect.
+    """
 
     name: ClassVar[str] = ""
     description: ClassVar[str] = ""
-    parameters: ClassVar[tuple[EffectParameter, ...]] = ()
+    uses: ClassVar[tuple[str, ...]] = ()
+    quantities: ClassVar[tuple[Quantity, ...]] = ()
+    requires: ClassVar[tuple[str, ...]] = ()
+    replaces: ClassVar[str | None] = None
     in_default_set: ClassVar[bool] = True  # the paper's five are; candidate mechanisms are not
+    # False keeps an effect out of the diagnosis' candidates (rivals of the paper's mechanisms, studied alone)
+    diagnosis_candidate: ClassVar[bool] = True
 
     def configure(self, model: ModelSpace) -> None:
-        """Before the kinematics are built: add coordinates, replace steer/column maps, move load points."""
+        """Before the kinematics are built: add coordinates (keep them in ``model.state(self)``)."""
 
     def bodies(self, model: ModelSpace) -> list[Any]:
         """After the kinematics are built: extra rigid bodies or particles, e.g. on coordinates this effect added."""
         return []
 
-    def loads(self, model: ModelSpace) -> list[tuple[Any, Any]]:
-        """(Point, force Vector) and (ReferenceFrame, torque Vector) pairs acting on the core system."""
+    def loads(self, model: ModelSpace) -> list[Any]:
+        """Forces on points and torques on frames (``Force``, ``Torque``) acting on the core system."""
         return []
 
     def potential_energy(self, model: ModelSpace):
         """Potential energy (J) of the conservative part of this effect's loads (for the energy balance)."""
         return 0
 
-    def parameter(self, name: str) -> EffectParameter:
-        for spec in self.parameters:
-            if spec.name == name:
-                return spec
-        known = ", ".join(s.name for s in self.parameters) or "none"
-        raise UsageError(f"effect {self.name} has no parameter {name!r} (known: {known})")
+    def own_keys(self) -> tuple[str, ...]:
+        """The keys of the quantities only this effect has (its section of the parameter file, or declared)."""
+        return tuple(k for k in self.uses if k.partition(".")[0] == self.name)
 
     def describe(self, params) -> dict:
-        """Name, description and parameters with their defaults (for ``parksteer effects --json``)."""
+        """Name, description, slot, needs and quantities with their values (for ``parksteer effects --json``)."""
+        table = registry()
         return {
             "name": self.name,
             "description": self.description,
             "in_default_set": self.in_default_set,
+            "requires": list(self.requires),
+            "replaces": self.replaces,
             "parameters": [
                 {
-                    "name": s.name,
-                    "unit": s.unit,
-                    "default": s.default_value(params),
-                    "min": s.minimum,
-                    "max": s.maximum,
-                    "source": s.source,
+                    "key": key,
+                    "unit": table[key].unit,
+                    "default": float(params[key]),
+                    "min": table[key].lower,
+                    "max": table[key].upper,
+                    "source": params.source(key),
                 }
-                for s in self.parameters
+                for key in self.uses
             ],
         }
+
+
+def _register_quantities(effect: Effect, where: str) -> Effect:
+    """Join the effect's declared quantities to the registry and check every key it uses is known."""
+    for q in effect.quantities:
+        if q.section != effect.name:
+            raise UsageError(f"{where}: quantity {q.key} must be named {effect.name}.<name>")
+        declare(q)
+    if effect.replaces is not None and effect.replaces not in SLOTS:
+        raise UsageError(f"{where}: effect {effect.name} replaces unknown slot {effect.replaces!r} "
+                         f"(slots: {', '.join(SLOTS)})")
+    table = registry()
+    for key in effect.uses:
+        if key not in table:
+            raise UsageError(f"{where}: effect {effect.name} uses {unknown_key_message(key)}")
+    return effect
 
 
 def _effect_of(obj: Any, where: str) -> Effect:
@@ -133,7 +130,7 @@ def _effect_of(obj: Any, where: str) -> Effect:
         obj = obj()
     if not isinstance(obj, Effect) or not obj.name:
         raise UsageError(f"{where}: does not define an Effect with a name")
-    return obj
+    return _register_quantities(obj, where)
 
 
 def _effect_of_module(module: Any, where: str) -> Effect:
@@ -182,6 +179,31 @@ def discover_effects() -> dict[str, Effect]:
     return found
 
 
+STRENGTH_NAME = "strength"
+
+
+@lru_cache(maxsize=1)
+def _shipped_parameters():
+    return load_parameters(DEFAULT_PATH)
+
+
+def strength_parameter(effect: Effect, params=None) -> Quantity | None:
+    """The quantity whose default means absent: ``<effect>.strength``, else the only own quantity of value 0
+    whose lower bound is 0 (in `params`, by default the shipped parameter file).
+
+    A candidate effect (off by default) is added to a model at a fitted or chosen size through it.
+    """
+    params = params if params is not None else _shipped_parameters()
+    declared = {q.key: q for q in effect.quantities}
+    table = registry()
+    own = [declared.get(k) or table[k] for k in effect.own_keys()]
+    named = [q for q in own if q.name == STRENGTH_NAME]
+    if named:
+        return named[0]
+    zero = [q for q in own if (q.default if q.key in declared else float(params[q.key])) == 0.0 and q.lower == 0.0]
+    return zero[0] if len(zero) == 1 else None
+
+
 def default_effect_names(registry: dict[str, Effect] | None = None) -> list[str]:
     registry = registry if registry is not None else discover_effects()
     return [name for name, e in registry.items() if e.in_default_set]
@@ -194,11 +216,32 @@ def resolve_effects(spec: str | list | tuple | None = None) -> list[Effect]:
     (each ``+name``/``-name`` edits the default set; a bare list ``"a,b"`` without signs
     names the set exactly; ``none`` is the empty set), or a list of names or Effect instances.
     """
+    return _checked(_chosen(spec), spec)
+
+
+def _checked(effects: list[Effect], spec) -> list[Effect]:
+    """Refuse a set in which two effects fill one slot or an effect lacks one it requires."""
+    where = f"effects {spec!r}" if isinstance(spec, str) else "effects"
+    names = {e.name for e in effects}
+    filled: dict[str, str] = {}
+    for effect in effects:
+        missing = [n for n in effect.requires if n not in names]
+        if missing:
+            raise UsageError(f"{where}: {effect.name} requires {', '.join(missing)} (add +{missing[0]})")
+        if effect.replaces is not None:
+            if effect.replaces in filled:
+                raise UsageError(f"{where}: {filled[effect.replaces]} and {effect.name} both fill the slot "
+                                 f"{effect.replaces}; choose one")
+            filled[effect.replaces] = effect.name
+    return effects
+
+
+def _chosen(spec) -> list[Effect]:
     registry = discover_effects()
     if isinstance(spec, (list, tuple)):
         chosen: dict[str, Effect] = {}
         for item in spec:
-            effect = item if isinstance(item, Effect) else _lookup(registry, str(item))
+            effect = _register_quantities(item, item.name) if isinstance(item, Effect) else _lookup(registry, str(item))
             chosen[effect.name] = effect
         return [chosen[n] for n in sorted(chosen)]
     text = (spec or "").strip()

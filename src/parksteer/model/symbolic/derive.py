@@ -41,7 +41,7 @@ class Derivation:
 
     @property
     def forcing(self) -> sp.Matrix:
-        total = self.forcing_inertia + self.column_direction * self.space.column_torque
+        total = self.forcing_inertia + self.column_direction * self.space.kinematics.column_torque
         for q in self.generalized_forces.values():
             total += q
         return total
@@ -73,10 +73,7 @@ def build_space(effects: list[Effect], speeds_as_qdot: bool = False) -> ModelSpa
     With `speeds_as_qdot` every speed is written as dq/dt instead of a speed symbol u (for
     LagrangesMethod, which takes partial velocities with respect to dq/dt).
     """
-    space = ModelSpace(tuple(e.name for e in effects), speeds_as_qdot=speeds_as_qdot)
-    for effect in effects:
-        for spec in effect.parameters:
-            space.p(effect, spec.name)
+    space = ModelSpace(effects, speeds_as_qdot=speeds_as_qdot)
     for effect in effects:
         effect.configure(space)
     space.build()
@@ -104,7 +101,8 @@ def derive(effects: list[Effect]) -> Derivation:
     for effect in effects:
         forces[effect.name] = generalized_forces(effect.loads(space), u, space.N)
     unit_torque = sp.Symbol("unit_column_torque")
-    column_loads = [(where, vector.subs(space.column_torque, unit_torque)) for where, vector in space.column_loads()]
+    column_torque = space.kinematics.column_torque
+    column_loads = [(where, vector.subs(column_torque, unit_torque)) for where, vector in space.column_loads()]
     column = generalized_forces(column_loads, u, space.N).xreplace({unit_torque: 1})
     potential = space.core_potential_energy() + sum(e.potential_energy(space) for e in effects)
     timings["forces_s"] = time.perf_counter() - start

@@ -26,6 +26,11 @@ about axes parallel to the body axes at zero steer, turning with the wheel; each
 ring has its yaw inertia about the steer axis only (the paper gives no other component, and
 the others would only add a little to the roll inertia).
 
+Effects fill slots of this system (``Effect.replaces``, :data:`SLOTS`): the linkage's steer function,
+the column-to-pinion map, the column spring's deflection law, the tread ring's twist, the points where
+vertical loads act. They read the built kinematics through :class:`Kinematics` (``model.kinematics``),
+the declared fields effects may use, and keep per-build state in ``model.state(effect)``.
+
 Geometry is numeric: every position, axis direction and inertia is a parameter symbol whose
 value is computed at run time from data/parameters.toml (see :mod:`parksteer.model.numeric.values`),
 so the expressions stay small and changing a value never re-derives.
@@ -34,7 +39,8 @@ so the expressions stay small and changing a value never re-derives.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, Callable
+from types import SimpleNamespace
+from typing import Any
 
 import sympy as sp
 import sympy.physics.mechanics as me
@@ -42,23 +48,34 @@ import sympy.physics.mechanics as me
 SIDES = ("left", "right")
 DERIVED = "derived"
 
-# Core parameters: (section, name) of data/parameters.toml that enter the equations.
-CORE_PARAMETERS: tuple[tuple[str, str], ...] = (
-    ("vehicle", "gravity"),
-    ("vehicle", "chassis_roll_inertia"),
-    ("vehicle", "chassis_roll_stiffness"),
-    ("vehicle", "chassis_roll_damping"),
-    ("steering", "rack_mass"),
-    ("steering", "rack_roll_inertia"),
-    ("steering", "handwheel_to_rack_ratio"),
-    ("steering", "roadwheel_to_rack_ratio"),
-    ("steering", "column_torsional_stiffness"),
-    ("steering", "column_torsional_damping"),
-    ("steering", "steering_assembly_mass"),
-    ("tyre", "radial_stiffness"),
-    ("tyre", "radial_damping"),
-    ("tyre", "tread_ring_mass"),
-    ("tyre", "tread_ring_yaw_inertia"),
+# The slots of the core an effect may fill (``Effect.replaces``), each with the method the effect defines to
+# fill it. At most one effect fills a slot (refused when the effect set is resolved); an empty slot keeps the
+# paper's law.
+SLOTS: dict[str, str] = {
+    "steer_function": "steer_angle",  # (model, side) -> road-wheel steer angle, an expression in model.rack_q
+    "column_map": "column_angle",  # (model, pinion angle) -> column angle theta_c
+    "column_deflection": "deflection",  # (model, twist) -> the deflection g(twist) the column spring acts on
+    "ring_twist": "ring_twist",  # (model, side) -> angle of the tread ring about the steer axis from its wheel
+    "load_points": "",  # filled: vertical loads act where the steer geometry puts them (the effect moves them)
+}
+
+# Quantities of the parameter file that enter the core's equations.
+CORE_PARAMETERS: tuple[str, ...] = (
+    "vehicle.gravity",
+    "vehicle.chassis_roll_inertia",
+    "vehicle.chassis_roll_stiffness",
+    "vehicle.chassis_roll_damping",
+    "steering.rack_mass",
+    "steering.rack_roll_inertia",
+    "steering.handwheel_to_rack_ratio",
+    "steering.roadwheel_to_rack_ratio",
+    "steering.column_torsional_stiffness",
+    "steering.column_torsional_damping",
+    "steering.steering_assembly_mass",
+    "tyre.radial_stiffness",
+    "tyre.radial_damping",
+    "tyre.tread_ring_mass",
+    "tyre.tread_ring_yaw_inertia",
 )
 
 # Values computed at run time from the case and the geometry (see values.derived_values).
@@ -94,53 +111,138 @@ class Coordinate:
     owner: str
 
 
+Weight = tuple[me.Point, Any, "me.Point | None"]  # (true point, mass, chassis-fixed twin at zero steer or None)
+
+
 @dataclass
-class ModelSpace:
-    """The symbolic system under construction, handed to each effect's hooks."""
+class Kinematics:
+    """The built system: the fields an effect's ``bodies``, ``loads`` and ``potential_energy`` may use.
 
-    effect_names: tuple[str, ...]
-    parameter_symbols: dict[str, sp.Symbol] = field(default_factory=dict)
-    coordinates: list[Coordinate] = field(default_factory=list)
-    steer_function: Callable[[ModelSpace, str], Any] | None = None
-    column_map: Callable[[ModelSpace, Any], Any] | None = None
-    column_deflection: Callable[[ModelSpace, Any], Any] | None = None
-    contact_follows_steer: bool = False
+    Per-side fields are dicts keyed by ``"left"``/``"right"``. Frames: ``B`` the chassis, ``column_frame``
+    turned by the column angle about B.y, per side ``axis_frame`` (fixed in B, z along the king-pin axis),
+    ``steer_frame`` (the steering assembly, turned about it by the steer angle) and ``ring_frame`` (the tread
+    ring; the steer frame unless the ring_twist slot is filled). Points: ``rack_point`` (rack mass centre)
+    and ``rack_housing_point`` (the body point under it), per side ``axis_foot`` (A), ``wheel_centre`` (C),
+    ``contact_point`` (P) and ``assembly_cg`` (G), each with its chassis-fixed ``*_unsteered`` twin.
+    """
+
+    B: me.ReferenceFrame
+    roll_centre: me.Point
+    rack_point: me.Point
+    rack_housing_point: me.Point
+    pinion_angle: Any
+    column_angle: Any
+    column_angle_per_rack: Any
+    column_rate: Any
+    column_frame: me.ReferenceFrame
+    column_torque: Any
+    column_spring_deflection: Any
+    weights: list[Weight]
+    qd_to_u: dict
+    steer_angle: dict[str, Any] = field(default_factory=dict)
     ring_twist: dict[str, Any] = field(default_factory=dict)
-    speeds_as_qdot: bool = False  # write every speed as dq/dt (for an independent Lagrange derivation)
-    built: bool = False
+    axis_frame: dict[str, me.ReferenceFrame] = field(default_factory=dict)
+    steer_frame: dict[str, me.ReferenceFrame] = field(default_factory=dict)
+    ring_frame: dict[str, me.ReferenceFrame] = field(default_factory=dict)
+    axis_foot: dict[str, me.Point] = field(default_factory=dict)
+    wheel_centre: dict[str, me.Point] = field(default_factory=dict)
+    wheel_centre_unsteered: dict[str, me.Point] = field(default_factory=dict)
+    contact_point: dict[str, me.Point] = field(default_factory=dict)
+    contact_point_unsteered: dict[str, me.Point] = field(default_factory=dict)
+    assembly_cg: dict[str, me.Point] = field(default_factory=dict)
+    assembly_cg_unsteered: dict[str, me.Point] = field(default_factory=dict)
+    wheel_load: dict[str, Any] = field(default_factory=dict)
+    tyre_deflection: dict[str, Any] = field(default_factory=dict)
 
-    def __post_init__(self):
+
+def action_reaction(point: me.Point, force, reaction_point: me.Point) -> list[me.Force]:
+    """A force on `point` and its reaction on `reaction_point` (sympy's apply_force(..., reaction_point))."""
+    return [me.Force(point, force), me.Force(reaction_point, -force)]
+
+
+def torque_between(torque, axis, target_frame: me.ReferenceFrame, reaction_frame: me.ReferenceFrame
+                   ) -> list[me.Torque]:
+    """`torque` about `axis` on `target_frame`, reacted on `reaction_frame` (a sympy TorqueActuator)."""
+    return me.TorqueActuator(torque, axis, target_frame, reaction_frame).to_loads()
+
+
+class ModelSpace:
+    """The symbolic system under construction, handed to each effect's hooks.
+
+    Before the build (``Effect.configure``): the rack coordinate ``rack_q``/``rack_u``, the time ``t``, the
+    ground frame ``N`` and ``origin``, ``add_coordinate``, and the parameter symbols ``p(key)`` (a key the
+    model's effects use) and ``d(name)`` (a value derived from the case and geometry). After it:
+    ``kinematics`` (:class:`Kinematics`).
+    """
+
+    def __init__(self, effects=(), speeds_as_qdot: bool = False):
+        self.effects = tuple(effects)
+        self.speeds_as_qdot = speeds_as_qdot  # write every speed as dq/dt (for an independent Lagrange derivation)
+        self.parameter_symbols: dict[str, sp.Symbol] = {}
+        self.coordinates: list[Coordinate] = []
+        self.bodies: list[Any] = []
+        self._states: dict[str, SimpleNamespace] = {}
+        self._kinematics: Kinematics | None = None
+        self.slots: dict[str, Any] = {}
+        for effect in self.effects:
+            if effect.replaces is not None:
+                if effect.replaces in self.slots:  # resolve_effects refuses this first, with the user's spec
+                    raise ValueError(f"{self.slots[effect.replaces].name} and {effect.name} both fill "
+                                     f"{effect.replaces}")
+                self.slots[effect.replaces] = effect
         self.t = me.dynamicsymbols._t
         self.N = me.ReferenceFrame("N")
         self.origin = me.Point("O")
         self.origin.set_vel(self.N, 0)
-        for section, name in CORE_PARAMETERS:
-            self.symbol(f"{section}.{name}")
+        for key in CORE_PARAMETERS:
+            self._symbol(key)
         for name in DERIVED_SCALARS:
-            self.symbol(f"{DERIVED}.{name}")
+            self._symbol(f"{DERIVED}.{name}")
         for side in SIDES:
             for name in DERIVED_PER_SIDE:
-                self.symbol(f"{DERIVED}.{side}.{name}")
+                self._symbol(f"{DERIVED}.{side}.{name}")
+        for effect in self.effects:
+            for key in effect.uses:
+                self._symbol(key)
         self.handwheel_angle, self.handwheel_rate = sp.symbols("handwheel_angle handwheel_rate")
         self.rack_q, self.rack_u = self.add_coordinate("rack", "m", owner="core")
         self.bounce_q, self.bounce_u = self.add_coordinate("bounce", "m", owner="core")
         self.roll_q, self.roll_u = self.add_coordinate("roll", "rad", owner="core")
 
+    @property
+    def effect_names(self) -> tuple[str, ...]:
+        return tuple(e.name for e in self.effects)
+
+    @property
+    def built(self) -> bool:
+        return self._kinematics is not None
+
+    @property
+    def kinematics(self) -> Kinematics:
+        if self._kinematics is None:
+            raise RuntimeError("the kinematics exist after the build (use them in bodies, loads, potential_energy)")
+        return self._kinematics
+
+    def state(self, effect) -> SimpleNamespace:
+        """The per-build state of `effect` (coordinates it added, frames it made): one namespace per effect."""
+        return self._states.setdefault(effect.name, SimpleNamespace())
+
     # -- parameters and coordinates ------------------------------------------------------
-    def symbol(self, key: str) -> sp.Symbol:
-        """The symbol of parameter `key` ("section.name", "effect.name" or "derived..."), created once."""
+    def _symbol(self, key: str) -> sp.Symbol:
         if key not in self.parameter_symbols:
             self.parameter_symbols[key] = sp.Symbol(key.replace(".", "__"), real=True)
         return self.parameter_symbols[key]
 
-    def p(self, effect, name: str) -> sp.Symbol:
-        """Symbol of parameter `name` of `effect` (an Effect or its name); checks it is declared."""
-        from .components import Effect
+    def p(self, key: str) -> sp.Symbol:
+        """The symbol of quantity `key`: a core quantity or one an effect of this model uses."""
+        try:
+            return self.parameter_symbols[key]
+        except KeyError:
+            raise KeyError(f"{key}: not a quantity of this model (list it in the effect's uses)") from None
 
-        if isinstance(effect, Effect):
-            effect.parameter(name)
-            effect = effect.name
-        return self.symbol(f"{effect}.{name}")
+    def d(self, key: str) -> sp.Symbol:
+        """The symbol of a value derived from the case and the geometry (``derived.<key>``)."""
+        return self.parameter_symbols[f"{DERIVED}.{key}"]
 
     def add_coordinate(self, name: str, unit: str, owner: str) -> tuple[Any, Any]:
         """A new generalized coordinate and its speed (Kane: u = dq/dt); only before the build."""
@@ -154,27 +256,15 @@ class ModelSpace:
         self.coordinates.append(Coordinate(name, unit, q, u, owner))
         return q, u
 
-    def set_steer_function(self, function: Callable[[ModelSpace, str], Any]) -> None:
-        """Replace the linkage: function(model, side) -> road-wheel steer angle as an expression in model.rack_q."""
-        self.steer_function = function
+    def _slot(self, slot: str):
+        """The method of the effect filling `slot`, or None for the paper's law."""
+        effect = self.slots.get(slot)
+        return None if effect is None else getattr(effect, SLOTS[slot])
 
-    def set_column_map(self, function: Callable[[ModelSpace, Any], Any]) -> None:
-        """Replace the column-to-pinion map: function(model, pinion_angle) -> column angle theta_c."""
-        self.column_map = function
-
-    def set_column_deflection(self, function: Callable[[ModelSpace, Any], Any]) -> None:
-        """Make the column's spring and damper act on a deflection g(twist) instead of the twist itself.
-
-        function(model, twist) -> g, an expression in the symbol `twist` (handwheel minus column
-        angle). The column torque is then the generalized force of the spring energy k g^2 / 2 and
-        the damper dissipation c (dg/dt)^2 / 2 on the twist: (k g + c g' dtwist/dt) g'. A dead
-        band g (lash) makes the column carry no torque until the band is taken up.
-        """
-        self.column_deflection = function
-
-    def set_ring_twist(self, side: str, angle) -> None:
-        """Let the tread ring of `side` turn by `angle` about the steer axis relative to its wheel."""
-        self.ring_twist[side] = angle
+    @property
+    def lifts(self) -> bool:
+        """Whether the vertical loads act where the steer geometry puts them (the load_points slot is filled)."""
+        return "load_points" in self.slots
 
     @property
     def q(self) -> list:
@@ -184,91 +274,87 @@ class ModelSpace:
     def u(self) -> list:
         return [c.u for c in self.coordinates]
 
-    def d(self, key: str) -> sp.Symbol:
-        return self.symbol(f"{DERIVED}.{key}")
-
-    def core(self, key: str) -> sp.Symbol:
-        return self.symbol(key)
-
     # -- kinematics ------------------------------------------------------------------------
     def build(self) -> None:
         """Frames, points and bodies, after every effect has configured the space."""
         N, O = self.N, self.origin
         qd_to_u = {c.q.diff(self.t): c.u for c in self.coordinates}
-        self.qd_to_u = qd_to_u
 
         B = me.ReferenceFrame("B")
         B.orient_axis(N, N.x, self.roll_q)
         B.set_ang_vel(N, self.roll_u * N.x)
-        self.B = B
         roll_centre = O.locatenew("roll_centre", (self.d("roll_axis_z") + self.bounce_q) * N.z)
         roll_centre.set_vel(N, self.bounce_u * N.z)
-        self.roll_centre = roll_centre
 
         def body_point(name: str, x, y, z_below_roll_axis) -> me.Point:
             point = roll_centre.locatenew(name, x * B.x + y * B.y + z_below_roll_axis * B.z)
             point.v2pt_theory(roll_centre, N, B)
             return point
 
-        self.body_point = body_point
+        self._body_point = body_point
         chassis_cg = body_point("chassis_cg", 0, self.d("chassis_cg_y"), self.d("chassis_cg_z_below_roll_axis"))
         chassis = me.RigidBody(
             "chassis", chassis_cg, B, self.d("chassis_mass"),
-            (self.core("vehicle.chassis_roll_inertia") * me.outer(B.x, B.x), chassis_cg),
+            (self.p("vehicle.chassis_roll_inertia") * me.outer(B.x, B.x), chassis_cg),
         )
         rack_point = body_point("rack", 0, self.rack_q, self.d("rack_z_below_roll_axis"))
         rack_point.set_vel(N, (rack_point.pos_from(O).dt(N)).xreplace(qd_to_u))
-        self.rack_point = rack_point
         # The point of the rack housing (chassis) under the rack's mass centre: internal forces between
         # rack and housing act on both, so they roll the body only through their moment, never net.
-        self.rack_housing_point = body_point("rack_housing", 0, self.rack_q, self.d("rack_z_below_roll_axis"))
+        rack_housing_point = body_point("rack_housing", 0, self.rack_q, self.d("rack_z_below_roll_axis"))
         rack = me.RigidBody(
-            "rack", rack_point, B, self.core("steering.rack_mass"),
-            (self.core("steering.rack_roll_inertia") * me.outer(B.y, B.y), rack_point),
+            "rack", rack_point, B, self.p("steering.rack_mass"),
+            (self.p("steering.rack_roll_inertia") * me.outer(B.y, B.y), rack_point),
         )
         self.bodies = [chassis, rack]
-        self.weights: list[tuple[me.Point, Any, me.Point | None]] = [
+        weights: list[Weight] = [
             (chassis_cg, self.d("chassis_mass"), None),
-            (rack_point, self.core("steering.rack_mass"), None),
+            (rack_point, self.p("steering.rack_mass"), None),
         ]
 
-        steer = self.steer_function or _linear_linkage
-        pinion = self.core("steering.handwheel_to_rack_ratio") * self.rack_q
-        self.pinion_angle = pinion
-        self.column_angle = (self.column_map or (lambda model, p: p))(self, pinion)
-        self.column_angle_per_rack = sp.diff(self.column_angle, self.rack_q)
+        steer = self._slot("steer_function") or _linear_linkage
+        pinion = self.p("steering.handwheel_to_rack_ratio") * self.rack_q
+        column_angle = (self._slot("column_map") or (lambda model, p: p))(self, pinion)
+        column_angle_per_rack = sp.diff(column_angle, self.rack_q)
         # the total rate, so that a map may also depend on a coordinate an effect adds (e.g. lash)
-        self.column_rate = self.column_angle.diff(self.t).xreplace(qd_to_u)
+        column_rate = column_angle.diff(self.t).xreplace(qd_to_u)
         column_frame = me.ReferenceFrame("column")
-        column_frame.orient_axis(B, B.y, self.column_angle)
-        column_frame.set_ang_vel(B, self.column_rate * B.y)
-        self.column_frame = column_frame
-        k_col = self.core("steering.column_torsional_stiffness")
-        c_col = self.core("steering.column_torsional_damping")
-        if self.column_deflection is None:
-            self.column_torque = k_col * (self.handwheel_angle - self.column_angle) + c_col * (
-                self.handwheel_rate - self.column_rate
+        column_frame.orient_axis(B, B.y, column_angle)
+        column_frame.set_ang_vel(B, column_rate * B.y)
+        k_col = self.p("steering.column_torsional_stiffness")
+        c_col = self.p("steering.column_torsional_damping")
+        column_deflection = self._slot("column_deflection")
+        if column_deflection is None:
+            column_torque = k_col * (self.handwheel_angle - column_angle) + c_col * (
+                self.handwheel_rate - column_rate
             )
-            self.column_spring_deflection = self.handwheel_angle - self.column_angle
+            spring_deflection = self.handwheel_angle - column_angle
         else:
+            # The column's spring and damper act on a deflection g(twist) of the twist (handwheel minus column
+            # angle): the column torque is the generalized force of the spring energy k g^2 / 2 and the damper
+            # dissipation c (dg/dt)^2 / 2 on the twist, (k g + c g' dtwist/dt) g'.
             twist = sp.Dummy("twist")
-            law = sp.sympify(self.column_deflection(self, twist))
-            at_twist = {twist: self.handwheel_angle - self.column_angle}
+            law = sp.sympify(column_deflection(self, twist))
+            at_twist = {twist: self.handwheel_angle - column_angle}
             deflection, slope = law.xreplace(at_twist), sp.diff(law, twist).xreplace(at_twist)
-            self.column_torque = (k_col * deflection + c_col * slope * (self.handwheel_rate - self.column_rate)) * slope
-            self.column_spring_deflection = deflection
+            column_torque = (k_col * deflection + c_col * slope * (self.handwheel_rate - column_rate)) * slope
+            spring_deflection = deflection
 
-        self.steer_angle, self.axis_frame, self.steer_frame, self.ring_frame = {}, {}, {}, {}
-        self.axis_foot, self.wheel_centre, self.wheel_centre_unsteered = {}, {}, {}
-        self.contact_point, self.contact_point_unsteered, self.wheel_load = {}, {}, {}
-        self.tyre_deflection = {}
-        self.assembly_cg, self.assembly_cg_unsteered = {}, {}
+        self._kinematics = Kinematics(
+            B=B, roll_centre=roll_centre, rack_point=rack_point, rack_housing_point=rack_housing_point,
+            pinion_angle=pinion, column_angle=column_angle, column_angle_per_rack=column_angle_per_rack,
+            column_rate=column_rate, column_frame=column_frame, column_torque=column_torque,
+            column_spring_deflection=spring_deflection, weights=weights, qd_to_u=qd_to_u,
+        )
+        ring_twist = self._slot("ring_twist")
         for side in SIDES:
-            self._build_side(side, steer(self, side))
-        self.built = True
+            twist = None if ring_twist is None else ring_twist(self, side)
+            self._build_side(side, steer(self, side), twist)
 
-    def _build_side(self, side: str, delta) -> None:
-        N, B, O = self.N, self.B, self.origin
+    def _build_side(self, side: str, delta, twist) -> None:
+        N, O = self.N, self.origin
+        k = self._kinematics
+        B, body_point = k.B, self._body_point
         ds = lambda name: self.d(f"{side}.{name}")  # noqa: E731
         roll_axis_z = self.d("roll_axis_z")
         K = me.ReferenceFrame(f"K_{side}")
@@ -278,14 +364,14 @@ class ModelSpace:
         S.orient_axis(K, K.z, delta)
         delta_rate = sp.diff(delta, self.rack_q) * self.rack_u
         S.set_ang_vel(K, delta_rate * K.z)
-        twist = self.ring_twist.get(side)
         if twist is None:
             R = S
         else:
             R = me.ReferenceFrame(f"R_{side}")
             R.orient_axis(S, S.z, twist)
-            R.set_ang_vel(S, twist.diff(self.t).xreplace(self.qd_to_u) * S.z)
-        foot = self.body_point(f"A_{side}", ds("foot_x"), ds("foot_y"), ds("foot_z") - roll_axis_z)
+            R.set_ang_vel(S, twist.diff(self.t).xreplace(k.qd_to_u) * S.z)
+            k.ring_twist[side] = twist
+        foot = body_point(f"A_{side}", ds("foot_x"), ds("foot_y"), ds("foot_z") - roll_axis_z)
 
         def steered(name: str, prefix: str) -> tuple[me.Point, me.Point]:
             """A point fixed in S given in axis-frame components, and its chassis-fixed twin at zero steer."""
@@ -308,68 +394,71 @@ class ModelSpace:
         for (i, j), key in zip(((0, 0), (1, 1), (2, 2), (0, 1), (1, 2), (2, 0)), ("xx", "yy", "zz", "xy", "yz", "zx")):
             inertia[i, j] = inertia[j, i] = ds(f"assembly_inertia_{key}")
         assembly = me.RigidBody(
-            f"steering_assembly_{side}", cg, S, self.core("steering.steering_assembly_mass"),
+            f"steering_assembly_{side}", cg, S, self.p("steering.steering_assembly_mass"),
             (me.inertia(S, inertia[0, 0], inertia[1, 1], inertia[2, 2], inertia[0, 1], inertia[1, 2], inertia[2, 0]), cg),
         )
         ring = me.RigidBody(
-            f"tread_ring_{side}", centre, R, self.core("tyre.tread_ring_mass"),
-            (self.core("tyre.tread_ring_yaw_inertia") * me.outer(R.z, R.z), centre),
+            f"tread_ring_{side}", centre, R, self.p("tyre.tread_ring_mass"),
+            (self.p("tyre.tread_ring_yaw_inertia") * me.outer(R.z, R.z), centre),
         )
         self.bodies += [assembly, ring]
-        self.weights += [
-            (cg, self.core("steering.steering_assembly_mass"), cg0),
-            (centre, self.core("tyre.tread_ring_mass"), centre0),
+        k.weights += [
+            (cg, self.p("steering.steering_assembly_mass"), cg0),
+            (centre, self.p("tyre.tread_ring_mass"), centre0),
         ]
 
-        where = contact if self.contact_follows_steer else contact0
+        where = contact if self.lifts else contact0  # the tyre deflection follows the steered contact height
         deflection = where.pos_from(O).dot(N.z) - self.d("ground_z") + ds("static_tyre_deflection")
         deflection_rate = where.vel(N).dot(N.z)
-        self.tyre_deflection[side] = deflection
-        load = self.core("tyre.radial_stiffness") * deflection + self.core("tyre.radial_damping") * deflection_rate
-        self.steer_angle[side] = delta
-        self.axis_frame[side], self.steer_frame[side], self.ring_frame[side] = K, S, R
-        self.axis_foot[side] = foot
-        self.wheel_centre[side], self.wheel_centre_unsteered[side] = centre, centre0
-        self.contact_point[side], self.contact_point_unsteered[side] = contact, contact0
-        self.assembly_cg[side], self.assembly_cg_unsteered[side] = cg, cg0
-        self.wheel_load[side] = load
+        k.tyre_deflection[side] = deflection
+        load = self.p("tyre.radial_stiffness") * deflection + self.p("tyre.radial_damping") * deflection_rate
+        k.steer_angle[side] = delta
+        k.axis_frame[side], k.steer_frame[side], k.ring_frame[side] = K, S, R
+        k.axis_foot[side] = foot
+        k.wheel_centre[side], k.wheel_centre_unsteered[side] = centre, centre0
+        k.contact_point[side], k.contact_point_unsteered[side] = contact, contact0
+        k.assembly_cg[side], k.assembly_cg_unsteered[side] = cg, cg0
+        k.wheel_load[side] = load
 
     # -- core loads and energy ------------------------------------------------------------
-    def core_loads(self) -> list[tuple[Any, Any]]:
+    def core_loads(self) -> list[Any]:
         """Gravity, tyre vertical springs and dampers, chassis roll spring and damper."""
-        N, B = self.N, self.B
-        g = self.core("vehicle.gravity")
+        N, k = self.N, self.kinematics
+        g = self.p("vehicle.gravity")
         loads = []
-        for point, mass, unsteered in self.weights:
-            loads.append((unsteered or point, mass * g * N.z))
+        for point, mass, unsteered in k.weights:
+            loads.append(me.Force(unsteered or point, mass * g * N.z))
         for side in SIDES:
-            loads.append((self.contact_point_unsteered[side], -self.wheel_load[side] * N.z))
-        k, c = self.core("vehicle.chassis_roll_stiffness"), self.core("vehicle.chassis_roll_damping")
-        loads.append((B, -(k * (self.roll_q - self.d("roll_spring_neutral")) + c * self.roll_u) * N.x))
+            loads.append(me.Force(k.contact_point_unsteered[side], -k.wheel_load[side] * N.z))
+        stiffness, damping = self.p("vehicle.chassis_roll_stiffness"), self.p("vehicle.chassis_roll_damping")
+        roll_torque = -(stiffness * (self.roll_q - self.d("roll_spring_neutral")) + damping * self.roll_u)
+        loads.append(me.Torque(k.B, roll_torque * N.x))
         return loads
 
-    def column_loads(self) -> list[tuple[Any, Any]]:
+    def column_loads(self) -> list[Any]:
         """The column torque on the pinion (through the massless frame turned by theta_c); the driver who
         applies it sits in the body, which takes the reaction."""
-        return [(self.column_frame, self.column_torque * self.B.y), (self.B, -self.column_torque * self.B.y)]
+        k = self.kinematics
+        return torque_between(k.column_torque, k.B.y, k.column_frame, k.B)
 
     def core_potential_energy(self):
         """Gravity (at the points where the core applies the weights), tyre and roll springs."""
-        g = self.core("vehicle.gravity")
+        k = self.kinematics
+        g = self.p("vehicle.gravity")
         energy = sum(mass * g * (unsteered or point).pos_from(self.origin).dot(self.N.z) * -1
-                     for point, mass, unsteered in self.weights)
+                     for point, mass, unsteered in k.weights)
         for side in SIDES:
-            energy += self.core("tyre.radial_stiffness") * self.tyre_deflection[side] ** 2 / 2
-        energy += self.core("vehicle.chassis_roll_stiffness") * (self.roll_q - self.d("roll_spring_neutral")) ** 2 / 2
+            energy += self.p("tyre.radial_stiffness") * k.tyre_deflection[side] ** 2 / 2
+        energy += self.p("vehicle.chassis_roll_stiffness") * (self.roll_q - self.d("roll_spring_neutral")) ** 2 / 2
         return energy
 
     def column_potential_energy(self):
-        return self.core("steering.column_torsional_stiffness") * self.column_spring_deflection ** 2 / 2
+        return self.p("steering.column_torsional_stiffness") * self.kinematics.column_spring_deflection ** 2 / 2
 
     def kinetic_energy(self):
-        return sum(b.kinetic_energy(self.N) for b in self.bodies).xreplace(self.qd_to_u)
+        return sum(b.kinetic_energy(self.N) for b in self.bodies).xreplace(self.kinematics.qd_to_u)
 
 
 def _linear_linkage(model: ModelSpace, side: str):
     """The paper's linkage: both road wheels steer by roadwheel_to_rack_ratio * rack (positive: to the right)."""
-    return model.core("steering.roadwheel_to_rack_ratio") * model.rack_q
+    return model.p("steering.roadwheel_to_rack_ratio") * model.rack_q

@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import sympy as sp
 
-from ..components import Effect, EffectParameter
+from ..components import Effect
 
 SIDE_SIGN = {"left": -1, "right": 1}  # the right wheel is the inner one in a right turn (positive rack)
 
@@ -36,27 +36,12 @@ class Ackermann(Effect):
         "wheelbase) / 2, delta_m = roadwheel_to_rack_ratio * rack; 0 = the paper's parallel linkage"
     )
     in_default_set = False
-    parameters = (
-        EffectParameter(
-            "ackermann_fraction", "1", 0.0, 1.5,
-            "candidate: fraction of the ideal Ackermann toe-out on turns; road cars typically have a partial "
-            "Ackermann, roughly 0.3-1; 0 = the paper's equal steer angles (absent)",
-            default=0.0,
-        ),
-        EffectParameter(
-            "track_to_wheelbase", "1", 0.1, 2.0,
-            "candidate: Austin Maestro front track 1.46 m (twice Table B1 y2) over wheelbase 2.507 m "
-            "(manufacturer's data), 0.582",
-            default=0.582,
-        ),
-    )
-
-    def configure(self, model):
-        model.set_steer_function(self.steer_angle)
+    uses = ("steering.roadwheel_to_rack_ratio", "ackermann.ackermann_fraction", "ackermann.track_to_wheelbase")
+    replaces = "steer_function"
 
     def steer_angle(self, model, side):
-        reference = model.core("steering.roadwheel_to_rack_ratio") * model.rack_q
-        shift = model.p(self, "ackermann_fraction") * model.p(self, "track_to_wheelbase") / 2
+        reference = model.p("steering.roadwheel_to_rack_ratio") * model.rack_q
+        shift = model.p("ackermann.ackermann_fraction") * model.p("ackermann.track_to_wheelbase") / 2
         return sp.atan2(sp.sin(reference), sp.cos(reference) - SIDE_SIGN[side] * shift * sp.sin(reference))
 
 

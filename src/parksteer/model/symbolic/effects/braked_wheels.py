@@ -14,6 +14,14 @@ over the uniform-pressure disc of radius R (pi R^2 p = W), scaled like equation 
 effect adds the excess, s M(W) (f(e / R) - 1), to each tread ring's friction moment with the
 same tanh of the ring's yaw rate (s: the brake fraction, 0 = rolling freely, 1 = locked).
 It is a lumped equivalent: the net sliding force that goes with the moment is not applied.
+The excess carries equation (2)'s pressure correction (p0/p)^(n - 1/2) through M(W) as a whole; the
+rig's Fig. 4 (parksteer.rig.pin_torques_Nm) scales the spin part only, which gives the excess
+M_1(W) (f - 1) with M_1 equation (1), smaller by that factor (1.21 at the car's 1.225 bar).
+
+Only brakes hold the wheels. A front-drive car in gear is not braked in this sense: its open
+differential, with the carrier held by the gearbox, still lets the two wheels turn in opposite
+senses, and steering a mirror-image pair needs exactly that (each patch centre travels round its
+axis the opposite way along its rolling direction), so in gear the front wheels roll freely.
 
 f is evaluated from its series: for e <= R, 1 + 3k^2/4 - 3k^4/64 - k^6/256 - 15k^8/16384
 - 21k^10/65536 (k = e/R, within 0.02 % of the elliptic closed form), for e > R the far-field
@@ -23,15 +31,15 @@ contact centre at zero steer (5.8 mm for the standard car, 6.9, 38.7 and 62.7 mm
 spacers). The fore-aft part of the intercept's offset (the castor's trail at the ground,
 3.2 mm) makes even a rolling wheel's patch slide sideways, braked or not; the paper's model
 leaves it out, and to leading order ((3/4)(e/R)^2) it does not change the braked excess.
-Needs the tyre_friction effect (its friction law and parameters); without it this effect adds
-nothing.
+Requires the tyre_friction effect (its friction law and quantities).
 """
 
 from __future__ import annotations
 
 import sympy as sp
+import sympy.physics.mechanics as me
 
-from ..components import Effect, EffectParameter
+from ..components import Effect
 from ..system import SIDES
 from .tyre_friction import EFFECT as TYRE_FRICTION
 
@@ -57,15 +65,8 @@ class BrakedWheels(Effect):
         "s M(W) (f(scrub offset / patch radius) - 1) to each tread's friction moment (rig theory); 0 = free to roll"
     )
     in_default_set = False
-    parameters = (
-        EffectParameter(
-            "brake_fraction", "1", 0.0, 1.0,
-            "candidate: share of the braked (non-rolling) excess moment, 0 = wheels free to roll as in the paper "
-            "(absent), 1 = wheels locked (parking brake on the front wheels, or a front-drive car in gear with "
-            "both wheels held)",
-            default=0.0,
-        ),
-    )
+    uses = ("braked_wheels.brake_fraction", *TYRE_FRICTION.uses)
+    requires = ("tyre_friction",)
 
     def scrub_offset_squared(self, model, side):
         """Square of the lateral distance from the axis's ground intercept to the contact centre, zero steer."""
@@ -78,22 +79,21 @@ class BrakedWheels(Effect):
         return (centre_y - foot_y - along * axis_y) ** 2
 
     def loads(self, model):
-        if TYRE_FRICTION.name not in model.effect_names:
-            return []
-        fraction = model.p(self, "brake_fraction")
-        pressure = model.p(TYRE_FRICTION, "tyre_pressure")
-        beta = model.p(TYRE_FRICTION, "smoothing")
+        k = model.kinematics
+        fraction = model.p("braked_wheels.brake_fraction")
+        pressure = model.p("tyre.tyre_pressure")
+        beta = model.p("steering.friction_smoothing")
         grip = model.d("surface_grip")
         out = []
         for side in SIDES:
-            load = model.wheel_load[side]
+            load = k.wheel_load[side]
             patch_radius_squared = sp.Piecewise((load, load > 0), (0, True)) / (sp.pi * pressure)
             # a wheel off the ground has no patch (and no moment: moment_limit is 0 there)
             k_squared = self.scrub_offset_squared(model, side) / sp.Max(patch_radius_squared, sp.Float(1e-12))
             excess = fraction * TYRE_FRICTION.moment_limit(model, load) * braked_excess_ratio(k_squared)
-            ring = model.ring_frame[side]
+            ring = k.ring_frame[side]
             yaw_rate = ring.ang_vel_in(model.N).dot(model.N.z)
-            out.append((ring, -grip * excess * sp.tanh(beta * yaw_rate) * model.N.z))
+            out.append(me.Torque(ring, -grip * excess * sp.tanh(beta * yaw_rate) * model.N.z))
         return out
 
 

@@ -24,8 +24,7 @@ coordinates (their yaw about the steer axis, from the body), each with the sprin
 and friction shares and the yaw inertia share w_j of the tread ring. The strength s blends:
 the removed shares and the inner annuli's springs, dampers, frictions and inertias are all
 scaled by s (the inertias by s + 0.001, which keeps the mass matrix positive definite at s = 0,
-where the annuli are free and carry nothing). Needs carcass_compliance and tyre_friction;
-without either it adds nothing.
+where the annuli are free and carry nothing). Requires carcass_compliance and tyre_friction.
 """
 
 from __future__ import annotations
@@ -33,8 +32,8 @@ from __future__ import annotations
 import sympy as sp
 import sympy.physics.mechanics as me
 
-from ..components import Effect, EffectParameter
-from ..system import SIDES
+from ..components import Effect
+from ..system import SIDES, torque_between
 from .carcass_compliance import EFFECT as CARCASS
 from .tyre_friction import EFFECT as TYRE_FRICTION
 
@@ -56,32 +55,20 @@ class BrushPatch(Effect):
         "from the rim inwards and the wind-up knee rounds off below the same plateau; s blends lumped to brush"
     )
     in_default_set = False
-    parameters = (
-        EffectParameter(
-            "brush_fraction", "1", 0.0, 1.0,
-            "candidate: blend of the brush law (1) into the paper's lumped spring and Coulomb slider (0, absent); "
-            "the brush shape follows from uniform pressure (the paper's patch) and uniform bristle stiffness",
-            default=0.0,
-        ),
-    )
-
-    def active(self, model) -> bool:
-        return CARCASS.name in model.effect_names and TYRE_FRICTION.name in model.effect_names
+    requires = ("carcass_compliance", "tyre_friction")
+    uses = ("brush_patch.brush_fraction", "tyre.tread_ring_yaw_inertia", *CARCASS.uses, *TYRE_FRICTION.uses)
 
     def configure(self, model):
-        self.annulus = {}
-        if not self.active(model):
-            return
-        for side in SIDES:
-            self.annulus[side] = [
-                model.add_coordinate(f"annulus{j}_{side}", "rad", owner=self.name) for j in range(1, ANNULI)
-            ]
+        model.state(self).annulus = {
+            side: [model.add_coordinate(f"annulus{j}_{side}", "rad", owner=self.name) for j in range(1, ANNULI)]
+            for side in SIDES
+        }
 
     def _frames(self, model, side):
         """The inner annuli's frames: each turned about the steer axis from the body-fixed axis frame."""
-        axis_frame = model.axis_frame[side]
+        axis_frame = model.kinematics.axis_frame[side]
         frames = []
-        for j, (q, u) in enumerate(self.annulus[side], start=1):
+        for j, (q, u) in enumerate(model.state(self).annulus[side], start=1):
             frame = me.ReferenceFrame(f"annulus{j}_{side}")
             frame.orient_axis(axis_frame, axis_frame.z, q)
             frame.set_ang_vel(axis_frame, u * axis_frame.z)
@@ -89,69 +76,67 @@ class BrushPatch(Effect):
         return frames
 
     def bodies(self, model):
-        if not self.active(model):
-            return []
-        strength = model.p(self, "brush_fraction")
-        ring_inertia = model.core("tyre.tread_ring_yaw_inertia")
+        state = model.state(self)
+        strength = model.p("brush_patch.brush_fraction")
+        ring_inertia = model.p("tyre.tread_ring_yaw_inertia")
         shares = annulus_shares()
-        self.frames = {}
+        state.frames = {}
         out = []
         for side in SIDES:
-            self.frames[side] = self._frames(model, side)
-            centre = model.wheel_centre[side]
-            for (stiffness_share, _), frame in zip(shares, self.frames[side]):
+            state.frames[side] = self._frames(model, side)
+            centre = model.kinematics.wheel_centre[side]
+            for (stiffness_share, _), frame in zip(shares, state.frames[side]):
                 inertia = (strength + INERTIA_FLOOR) * stiffness_share * ring_inertia
                 out.append(me.RigidBody(frame.name, centre, frame, 0, (inertia * me.outer(frame.z, frame.z), centre)))
         return out
 
     def _relative(self, model, side, q, u):
         """Angle and rate of an annulus relative to its wheel (both about the steer axis)."""
-        wheel = model.steer_angle[side]
+        wheel = model.kinematics.steer_angle[side]
         return q - wheel, u - sp.diff(wheel, model.rack_q) * model.rack_u
 
     def loads(self, model):
-        if not self.active(model):
-            return []
-        strength = model.p(self, "brush_fraction")
-        k, c = model.p(CARCASS, "torsional_stiffness"), model.p(CARCASS, "torsional_damping")
-        beta = model.p(TYRE_FRICTION, "smoothing")
+        k, state = model.kinematics, model.state(self)
+        strength = model.p("brush_patch.brush_fraction")
+        stiffness, damping = model.p("tyre.carcass_torsional_stiffness"), model.p("tyre.carcass_torsional_damping")
+        beta = model.p("steering.friction_smoothing")
         grip = model.d("surface_grip")
         shares = annulus_shares()
         rim_stiffness, rim_friction = shares[-1]
         out = []
         for side in SIDES:
-            wheel, ring = model.steer_frame[side], model.ring_frame[side]
+            wheel, ring = k.steer_frame[side], k.ring_frame[side]
             axis = wheel.z
-            moment_limit = grip * TYRE_FRICTION.moment_limit(model, model.wheel_load[side])
+            moment_limit = grip * TYRE_FRICTION.moment_limit(model, k.wheel_load[side])
             # The tread ring becomes the rim annulus: take the other annuli's shares off its spring and slider.
-            twist = model.ring_twist[side]
-            twist_rate = twist.diff(model.t).xreplace(model.qd_to_u)
-            spring_off = strength * (1 - rim_stiffness) * (k * twist + c * twist_rate)
-            out += [(ring, spring_off * axis), (wheel, -spring_off * axis)]
+            twist = k.ring_twist[side]
+            twist_rate = twist.diff(model.t).xreplace(k.qd_to_u)
+            spring_off = strength * (1 - rim_stiffness) * (stiffness * twist + damping * twist_rate)
+            out += torque_between(spring_off, axis, ring, wheel)
             ring_yaw = ring.ang_vel_in(model.N).dot(model.N.z)
             friction_off = strength * (1 - rim_friction) * moment_limit * sp.tanh(beta * ring_yaw)
-            out.append((ring, friction_off * model.N.z))
-            for (stiffness_share, friction_share), frame, (q, u) in zip(shares, self.frames[side], self.annulus[side]):
+            out.append(me.Torque(ring, friction_off * model.N.z))
+            for (stiffness_share, friction_share), frame, (q, u) in zip(shares, state.frames[side],
+                                                                        state.annulus[side]):
                 angle, rate = self._relative(model, side, q, u)
-                spring = strength * stiffness_share * (k * angle + c * rate)
-                out += [(frame, -spring * axis), (wheel, spring * axis)]
+                spring = strength * stiffness_share * (stiffness * angle + damping * rate)
+                out += torque_between(-spring, axis, frame, wheel)
                 yaw = frame.ang_vel_in(model.N).dot(model.N.z)
                 friction = strength * friction_share * moment_limit * sp.tanh(beta * yaw)
-                out.append((frame, -friction * model.N.z))
+                out.append(me.Torque(frame, -friction * model.N.z))
         return out
 
     def potential_energy(self, model):
-        if not self.active(model):
-            return 0
-        strength = model.p(self, "brush_fraction")
-        k = model.p(CARCASS, "torsional_stiffness")
+        k, state = model.kinematics, model.state(self)
+        strength = model.p("brush_patch.brush_fraction")
+        stiffness = model.p("tyre.carcass_torsional_stiffness")
         shares = annulus_shares()
         energy = 0
         for side in SIDES:
-            energy -= strength * (1 - shares[-1][0]) * k * model.ring_twist[side] ** 2 / 2
-            for (stiffness_share, _), (q, u) in zip(shares, self.annulus[side]):
+            energy -= strength * (1 - shares[-1][0]) * stiffness * k.ring_twist[side] ** 2 / 2
+            for (stiffness_share, _), (q, u) in zip(shares, state.annulus[side]):
                 angle, _ = self._relative(model, side, q, u)
-                energy += strength * stiffness_share * k * angle**2 / 2
+                energy += strength * stiffness_share * stiffness * angle**2 / 2
         return energy
 
 

@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-from ..components import Effect, EffectParameter
-from ..system import SIDES
+from ..components import Effect
+from ..system import SIDES, torque_between
 
 
 class CarcassCompliance(Effect):
@@ -12,34 +12,33 @@ class CarcassCompliance(Effect):
         "Tread ring joined to its wheel by the sidewall's torsional stiffness and damping; adds one twist "
         "coordinate per side (without it the ring is rigid to the wheel)"
     )
-    parameters = (
-        EffectParameter("torsional_stiffness", "N m/rad", 1.0, 1.0e6, "Appendix B",
-                        file_key="tyre.carcass_torsional_stiffness"),
-        EffectParameter("torsional_damping", "N m s/rad", 0.0, 1.0e4, "Appendix B",
-                        file_key="tyre.carcass_torsional_damping"),
-    )
+    uses = ("tyre.carcass_torsional_stiffness", "tyre.carcass_torsional_damping")
+    replaces = "ring_twist"
 
     def configure(self, model):
-        self.twist = {}
-        for side in SIDES:
-            q, u = model.add_coordinate(f"twist_{side}", "rad", owner=self.name)
-            model.set_ring_twist(side, q)
-            self.twist[side] = (q, u)
+        model.state(self).twist = {
+            side: model.add_coordinate(f"twist_{side}", "rad", owner=self.name) for side in SIDES
+        }
+
+    def ring_twist(self, model, side):
+        return model.state(self).twist[side][0]
 
     def _torque(self, model, side):
-        q, u = self.twist[side]
-        return model.p(self, "torsional_stiffness") * q + model.p(self, "torsional_damping") * u
+        q, u = model.state(self).twist[side]
+        return model.p("tyre.carcass_torsional_stiffness") * q + model.p("tyre.carcass_torsional_damping") * u
 
     def loads(self, model):
+        k = model.kinematics
         out = []
         for side in SIDES:
-            axis = model.steer_frame[side].z
-            torque = self._torque(model, side)
-            out += [(model.ring_frame[side], -torque * axis), (model.steer_frame[side], torque * axis)]
+            # The sidewall between the tread ring and its wheel: equal and opposite about the steer axis.
+            out += torque_between(-self._torque(model, side), k.steer_frame[side].z, k.ring_frame[side],
+                                  k.steer_frame[side])
         return out
 
     def potential_energy(self, model):
-        return sum(model.p(self, "torsional_stiffness") * self.twist[s][0] ** 2 / 2 for s in SIDES)
+        twist = model.state(self).twist
+        return sum(model.p("tyre.carcass_torsional_stiffness") * twist[s][0] ** 2 / 2 for s in SIDES)
 
 
 EFFECT = CarcassCompliance()

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import sympy as sp
 
-from ..components import Effect, EffectParameter
+from ..components import Effect
 
 
 class HookeJoint(Effect):
@@ -13,14 +13,8 @@ class HookeJoint(Effect):
         "Non-constant-velocity joint from column to pinion: tan(theta_p - phase) = tan(theta_c - phase) / cos(alpha), "
         "so the torque ripples twice per column revolution"
     )
-    parameters = (
-        EffectParameter("joint_angle", "rad", 0.0, 1.2, "Appendix B", file_key="steering.hooke_joint_angle"),
-        EffectParameter("phase", "rad", -10.0, 10.0, "choice, see data/parameters.toml",
-                        file_key="steering.hooke_joint_phase"),
-    )
-
-    def configure(self, model):
-        model.set_column_map(self.column_angle)
+    uses = ("steering.hooke_joint_angle", "steering.hooke_joint_phase")
+    replaces = "column_map"
 
     def column_angle(self, model, pinion_angle):
         """theta_c from theta_p, continuous across branches.
@@ -29,8 +23,8 @@ class HookeJoint(Effect):
         theta_c - theta_p = atan((cos a - 1) sin psi cos psi / (cos^2 psi + cos a sin^2 psi)),
         whose denominator is at least cos(alpha) > 0, so no branch is ever crossed.
         """
-        cos_a = sp.cos(model.p(self, "joint_angle"))
-        psi = pinion_angle - model.p(self, "phase")
+        cos_a = sp.cos(model.p("steering.hooke_joint_angle"))
+        psi = pinion_angle - model.p("steering.hooke_joint_phase")
         s, c = sp.sin(psi), sp.cos(psi)
         return pinion_angle + sp.atan((cos_a - 1) * s * c / (c**2 + cos_a * s**2))
 

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from ..components import Effect
-from ..system import SIDES
+from ..system import SIDES, action_reaction
 
 
 class Lifting(Effect):
@@ -13,27 +13,28 @@ class Lifting(Effect):
         "so steering lifts the car (without it they act at their zero-steer points, fixed in the body)"
     )
 
-    def configure(self, model):
-        model.contact_follows_steer = True  # the tyre deflection follows the steered contact height
+    replaces = "load_points"  # the tyre deflection, too, follows the steered contact height
+    uses = ("vehicle.gravity",)
 
     def loads(self, model):
         """Move each vertical load from its chassis-fixed point (where the core applies it) to its true point."""
+        k = model.kinematics
         n_z = model.N.z
-        g = model.core("vehicle.gravity")
+        g = model.p("vehicle.gravity")
         out = []
         for side in SIDES:
-            load = model.wheel_load[side]
-            out += [(model.contact_point[side], -load * n_z), (model.contact_point_unsteered[side], load * n_z)]
-        for point, mass, unsteered in model.weights:
+            load = k.wheel_load[side]
+            out += action_reaction(k.contact_point[side], -load * n_z, k.contact_point_unsteered[side])
+        for point, mass, unsteered in k.weights:
             if unsteered is not None:
-                out += [(point, mass * g * n_z), (unsteered, -mass * g * n_z)]
+                out += action_reaction(point, mass * g * n_z, unsteered)
         return out
 
     def potential_energy(self, model):
-        g = model.core("vehicle.gravity")
+        g = model.p("vehicle.gravity")
         return sum(
             -mass * g * (point.pos_from(model.origin) - unsteered.pos_from(model.origin)).dot(model.N.z)
-            for point, mass, unsteered in model.weights
+            for point, mass, unsteered in model.kinematics.weights
             if unsteered is not None
         )
 

@@ -12,7 +12,7 @@ damper act on the deflection
     g(x) = phi(x - a) - phi(-x - a),  phi(z) = (z + sqrt(z^2 + e^2)) / 2,  a = b G, e = w G,
 
 a dead zone smoothed over the width w (the hyperbola phi is a smooth max(z, 0)); the
-column torque is (k g + c dg/dt) dg/dx (ModelSpace.set_column_deflection). No coordinate is
+column torque is (k g + c dg/dt) dg/dx (the column_deflection slot of ModelSpace). No coordinate is
 added and nothing is stiffer than the engaged column, so the integrator sees the paper's
 stiffness when the lash is taken up and a free rack while it is crossed. At b = 0, g(x) = x
 exactly and the model is the paper's.
@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import sympy as sp
 
-from ..components import Effect, EffectParameter
+from ..components import Effect
 
 
 class RackLash(Effect):
@@ -36,28 +36,12 @@ class RackLash(Effect):
         "column twist, +-b * handwheel_to_rack_ratio; 0 = absent"
     )
     in_default_set = False
-    parameters = (
-        EffectParameter(
-            "lash", "m", 0.0, 0.005,
-            "candidate: half the free play of the rack-and-pinion mesh, as rack travel; a worn or badly adjusted "
-            "rack has 0-0.5 mm (0-5.4 degrees at the handwheel through 186.47 rad/m); 0 = absent",
-            default=0.0,
-        ),
-        EffectParameter(
-            "smoothing_width", "m", 1.0e-7, 1.0e-3,
-            "candidate: rack travel over which the tooth contact takes up the load (the dead band's corners are "
-            "rounded over it); 0.01 mm keeps the corners sharp beside a lash of 0.1-0.5 mm and the residual "
-            "stiffness in the band below 0.1 % of the column's",
-            default=1.0e-5,
-        ),
-    )
-
-    def configure(self, model):
-        model.set_column_deflection(self.deflection)
+    uses = ("steering.handwheel_to_rack_ratio", "rack_lash.lash", "rack_lash.smoothing_width")
+    replaces = "column_deflection"
 
     def deflection(self, model, twist):
-        ratio = model.core("steering.handwheel_to_rack_ratio")
-        band, width = model.p(self, "lash") * ratio, model.p(self, "smoothing_width") * ratio
+        ratio = model.p("steering.handwheel_to_rack_ratio")
+        band, width = model.p("rack_lash.lash") * ratio, model.p("rack_lash.smoothing_width") * ratio
 
         def smooth_max0(z):
             return (z + sp.sqrt(z**2 + width**2)) / 2

@@ -1,0 +1,327 @@
+"""A measured rack as a motion the model can follow: position, speed and acceleration at any time.
+
+Why smooth: the rack of an 8-bit logger moves in steps of 2 full_scale / 255 (0.8 mm for a
++-0.1 m range). Replayed as it stands (through an interpolating spline, :func:`interpolate_rack`),
+every step is a jump in position, so the rack's speed and acceleration (which a prescribed-rack
+model differentiates) are spikes, and the rack friction's tanh flips at every step: the replayed
+torque is then wrong by several N m. The rack is therefore replaced by a least-squares cubic
+spline (:func:`smooth_rack`) with evenly spaced knots and one knot at each reversal. The spacing
+is the largest that still fits the rack to within its own noise (estimated, as for the torque,
+from second differences; the discrepancy principle), inside a range the cycle sets: closer knots
+follow the noise, and the spline's speed then crosses zero where the rack never reverses, which
+flips the rack friction; wider ones cannot follow the hand through a reversal. Each end of the
+record is held at rest unless the data contradict it, so that a record starting from rest gets
+no spurious starting speed.
+
+What smoothing cannot fix: near a reversal the rack speed passes through zero, and the rack
+friction force, F tanh(beta v), turns over within about 1 mm/s of it (a few hundredths of a
+second). The rack data fix the turning time only to a few hundredths of a second, so a replay is
+least certain there. :meth:`SmoothedRack.perturbed` and :meth:`SmoothedRack.resmoothed` give
+other racks the data allow as well; :mod:`parksteer.diagnose.problem` replays them to measure
+that uncertainty at every sample.
+
+Every rack here is a :class:`RackSpline` (a piecewise polynomial with ``scalar()``, ``start_s`` and
+``end_s``), the rack motion :func:`parksteer.model.numeric.prescribed.solve` takes.
+"""
+
+from __future__ import annotations
+
+import bisect
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.interpolate import BSpline, CubicSpline, PPoly
+
+from ..errors import UsageError
+from .metrics import estimate_noise_rms
+from .phases import local_linear_fit
+
+# --- smoothing settings (settings of the method, not properties of the car; each with its reason) ---------------
+# The spacing of the knots is the largest whose fit residual (per degree of freedom) is within this factor of the
+# rack's own noise (estimated from its second differences): the discrepancy principle, so the spline follows the
+# motion but not the noise or the converter's steps.
+RACK_DISCREPANCY_FACTOR = 1.05  # 1
+# Knot spacings tried, s: never closer than this many samples (a spline needs data in every interval) ...
+RACK_MIN_SAMPLES_PER_KNOT = 4  # 1
+# ... and within this range. Below 0.15 s the spline starts to follow the noise, and its speed then crosses zero
+# where the rack does not move backwards, which flips the rack friction; above 0.4 s it cannot follow a reversal
+# of the hand (the paper's cycle turns within about 0.4 s). The rack noise estimate from second differences of
+# 8-bit data is itself uncertain by a few per cent, too little to choose reliably between neighbouring spacings,
+# so the range does most of the work.
+RACK_KNOT_SPACING_RANGE_S = (0.15, 0.4)
+RACK_KNOT_SPACING_STEP = 1.15  # 1, ratio between spacings tried
+# Reversals (where the spline gets a knot) are found from the speed of a local straight-line fit over this
+# window, as parksteer.measure.phases finds strokes.
+RACK_TURN_WINDOW_S = 0.5
+# Each end of the record is held at rest unless that raises the fit's sum of squares by more than this many
+# noise variances (see _lsq_fit).
+RACK_REST_TEST_CHI2 = 25.0  # 1
+
+
+@dataclass(frozen=True, eq=False)
+class RackSpline:
+    """A rack motion as a piecewise polynomial: position (m), speed (m/s), acceleration (m/s^2) at any time.
+
+    ``breaks`` (s, increasing) and ``coefficients`` (highest power first, one column per piece,
+    as :class:`scipy.interpolate.PPoly`). Outside the record the rack is held at its end position
+    (speed and acceleration of the end sample).
+    """
+
+    breaks: np.ndarray
+    coefficients: np.ndarray
+
+    @classmethod
+    def from_ppoly(cls, pp: PPoly) -> RackSpline:
+        keep = np.diff(pp.x) > 0.0  # a spline's PPoly repeats its end knots as empty pieces
+        return cls(np.concatenate([pp.x[:-1][keep], [pp.x[-1]]]), np.asarray(pp.c[:, keep], dtype=float))
+
+    @property
+    def start_s(self) -> float:
+        return float(self.breaks[0])
+
+    @property
+    def end_s(self) -> float:
+        return float(self.breaks[-1])
+
+    def evaluate(self, t_s) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Position (m), speed (m/s) and acceleration (m/s^2) at `t_s` (held at the ends outside the record)."""
+        t = np.clip(np.asarray(t_s, dtype=float), self.start_s, self.end_s)
+        x = self.breaks
+        k = np.clip(np.searchsorted(x, t, side="right") - 1, 0, len(x) - 2)
+        h = t - x[k]
+        c = self.coefficients[:, k]
+        degree = len(self.coefficients) - 1
+        position, speed, accel = np.zeros_like(h), np.zeros_like(h), np.zeros_like(h)
+        for i in range(degree + 1):  # Horner, with the derivatives alongside
+            accel = accel * h + 2.0 * speed
+            speed = speed * h + position
+            position = position * h + c[i]
+        return position, speed, accel
+
+    def scalar(self) -> Callable[[float], tuple[float, float, float]]:
+        """A fast scalar evaluator t -> (position, speed, acceleration) for an integrator's right-hand side."""
+        x = [float(v) for v in self.breaks]
+        columns = [[float(v) for v in column] for column in self.coefficients.T]
+        last, t0, t1 = len(x) - 2, x[0], x[-1]
+
+        def at(t: float) -> tuple[float, float, float]:
+            t = t0 if t < t0 else (t1 if t > t1 else t)
+            k = min(bisect.bisect_right(x, t) - 1, last)
+            h = t - x[k]
+            position = speed = accel = 0.0
+            for c in columns[k]:
+                accel = accel * h + 2.0 * speed
+                speed = speed * h + position
+                position = position * h + c
+            return position, speed, accel
+
+        return at
+
+
+def interpolate_rack(time_s, rack_m) -> RackSpline:
+    """The cubic spline through every sample (not-a-knot ends): for samples of a smooth motion, not logged data.
+
+    On logged data it replays every converter step (see the module docstring); :func:`smooth_rack` is the
+    replay of a measurement.
+    """
+    t = np.asarray(time_s, dtype=float)
+    x = np.asarray(rack_m, dtype=float)
+    if t.ndim != 1 or len(t) < 4 or len(t) != len(x):
+        raise UsageError("rack spline: needs at least 4 samples of time_s and rack_m")
+    if not (np.all(np.isfinite(t)) and np.all(np.isfinite(x))) or np.any(np.diff(t) <= 0):
+        raise UsageError("rack spline: time_s must be finite and strictly increasing, rack_m finite")
+    return RackSpline.from_ppoly(CubicSpline(t, x))
+
+
+@dataclass(frozen=True, eq=False)
+class SmoothedRack(RackSpline):
+    """A measured rack as a least-squares cubic spline, with its fit.
+
+    ``knots`` and ``bspline`` are the least-squares B-spline; ``coefficient_covariance`` is the
+    covariance of its coefficients for white rack noise of RMS ``noise_rms_m`` (for
+    :meth:`perturbed`).
+    """
+
+    knots: np.ndarray = None
+    bspline: np.ndarray = None
+    coefficient_covariance: np.ndarray = None
+    knot_spacing_s: float = 0.0
+    fit_rms_m: float = 0.0
+    noise_rms_m: float = 0.0
+    held_at_rest: tuple[bool, bool] = (False, False)  # (start, end) of the record
+    turning_times_s: tuple[float, ...] = ()  # where the rack reverses (each has a knot)
+
+    @classmethod
+    def from_bspline(cls, knots, bspline, covariance, knot_spacing_s, fit_rms_m, noise_rms_m,
+                     held_at_rest=(False, False), turning_times_s=()) -> SmoothedRack:
+        piecewise = RackSpline.from_ppoly(PPoly.from_spline(BSpline(knots, bspline, 3, extrapolate=False)))
+        return cls(piecewise.breaks, piecewise.coefficients, knots, bspline, covariance, float(knot_spacing_s),
+                   float(fit_rms_m), float(noise_rms_m), tuple(held_at_rest), tuple(turning_times_s))
+
+    def perturbed(self, rng: np.random.Generator) -> SmoothedRack:
+        """A rack the data allow as well: coefficients drawn from their least-squares distribution."""
+        draw = rng.multivariate_normal(self.bspline, self.coefficient_covariance, method="eigh")
+        return SmoothedRack.from_bspline(self.knots, draw, self.coefficient_covariance, self.knot_spacing_s,
+                                         self.fit_rms_m, self.noise_rms_m, self.held_at_rest, self.turning_times_s)
+
+    def resmoothed(self, time_s: np.ndarray, log: Callable[[np.ndarray], np.ndarray]) -> SmoothedRack:
+        """A rack the logger could equally have recorded: this spline at `time_s`, logged by `log`, smoothed again.
+
+        `log` maps a clean rack (m) to a logged one (noise and rounding to the logger's levels;
+        see :func:`parksteer.diagnose.problem.relogged_rack`); the smoothing keeps this knot
+        spacing (and the same tests for rest at the ends). Unlike :meth:`perturbed`, this keeps
+        what makes an 8-bit rack hard near a turning point: there the rack stays within one
+        converter step for a tenth of a second or more, its rounding errors are the same from
+        sample to sample rather than independent, and the turning time the data fix is
+        correspondingly less certain.
+        """
+        return smooth_rack(time_s, log(self.evaluate(time_s)[0]), self.knot_spacing_s)
+
+    def summary(self) -> dict:
+        """The smoothing's settings and fit (for JSON)."""
+        return {
+            "knot_spacing_s": self.knot_spacing_s,
+            "fit_rms_m": self.fit_rms_m,
+            "rack_noise_rms_m": self.noise_rms_m,
+            "held_at_rest_at_start": bool(self.held_at_rest[0]),
+            "held_at_rest_at_end": bool(self.held_at_rest[1]),
+            "turning_times_s": list(self.turning_times_s),
+        }
+
+
+def _knot_vector(t: np.ndarray, spacing_s: float, turns: tuple[float, ...] = ()) -> np.ndarray:
+    """Clamped cubic knots: evenly spaced interior knots about `spacing_s` apart, and one at each turning time.
+
+    A reversal is the one place where the rack's motion changes within a few tenths of a
+    second; with a knot at the turning time the spline can decelerate into it and accelerate
+    out of it on either side, whatever the reversal's phase against the even knots. Even knots
+    closer than half a spacing to a turning time give way to it.
+    """
+    span = t[-1] - t[0]
+    pieces = max(1, int(round(span / spacing_s)))
+    interior = list(t[0] + span * np.arange(1, pieces) / pieces)
+    closest = RACK_MIN_SAMPLES_PER_KNOT * float(np.median(np.diff(t)))
+    turns = [x for x in turns if t[0] + closest < x < t[-1] - closest]
+    knots = sorted([k for k in interior if all(abs(k - x) >= 0.5 * spacing_s for x in turns)] + turns)
+    return np.concatenate([[t[0]] * 4, knots, [t[-1]] * 4])
+
+
+def turning_times(time_s: np.ndarray, rack_m: np.ndarray) -> tuple[float, ...]:
+    """Times where the rack reverses: zero crossings of its speed between steady motions of opposite sign.
+
+    The speed is a local straight-line fit over RACK_TURN_WINDOW_S (as parksteer.measure.phases
+    finds strokes); steady motion is a speed beyond a fifth of the 90th percentile of |speed|.
+    """
+    _, speed = local_linear_fit(time_s, rack_m, RACK_TURN_WINDOW_S)
+    level = 0.2 * float(np.percentile(np.abs(speed), 90))
+    moving = np.flatnonzero(np.abs(speed) > level)
+    turns = []
+    for a, b in zip(moving[:-1], moving[1:]):
+        if level > 0 and np.sign(speed[a]) != np.sign(speed[b]):
+            segment = speed[a : b + 1]
+            k = a + int(np.flatnonzero(np.sign(segment[:-1]) != np.sign(segment[1:]))[0])
+            v0, v1 = speed[k], speed[k + 1]
+            turns.append(float(time_s[k] + (time_s[k + 1] - time_s[k]) * v0 / (v0 - v1)))
+    return tuple(turns)
+
+
+def _constrained_solve(gram: np.ndarray, rhs: np.ndarray, constraints: np.ndarray):
+    """Least squares with linear equality constraints C c = 0: (coefficients, their covariance per unit variance)."""
+    inverse = np.linalg.inv(gram)
+    coefficients = inverse @ rhs
+    covariance = inverse
+    if len(constraints):
+        gc = inverse @ constraints.T
+        correction = gc @ np.linalg.inv(constraints @ gc)
+        coefficients = coefficients - correction @ (constraints @ coefficients)
+        covariance = inverse - correction @ gc.T
+    return coefficients, 0.5 * (covariance + covariance.T)
+
+
+def _lsq_fit(t: np.ndarray, x: np.ndarray, spacing_s: float, turns: tuple[float, ...] = ()):
+    """(knots, coefficients, covariance per unit variance, fit RMS) of the least-squares cubic spline.
+
+    At each end of the record the spline is held at rest (zero speed) unless the data
+    contradict it: unless holding it raises the residual sum of squares by more than
+    ``RACK_REST_TEST_CHI2`` times the noise variance (a likelihood-ratio test with one degree of
+    freedom; the bar is set well above the usual 6.6 because a spline with knots a few tenths
+    of a second apart cannot follow the hand's first 0.2 s exactly and so leans towards a
+    start speed that is not there). A record that starts or ends at rest then gets no
+    spurious end speed, which the rack friction would turn into a spurious torque and the
+    tyre carcass would remember; one cut in the middle of a stroke (15 mm/s, some fifty
+    standard errors from rest) keeps its speed. None if the spline is ill-posed.
+    """
+    knots = _knot_vector(t, spacing_s, turns)
+    design = BSpline.design_matrix(t, knots, 3).toarray()
+    gram = design.T @ design
+    try:
+        np.linalg.cholesky(gram)
+    except np.linalg.LinAlgError:  # Schoenberg-Whitney fails: an interval without data
+        return None
+    rhs = design.T @ x
+    free, _ = _constrained_solve(gram, rhs, np.zeros((0, len(rhs))))
+    rss_free = float(np.sum((design @ free - x) ** 2))
+    noise_var = max(rss_free / max(len(t) - len(rhs), 1), 1e-30)
+    speed_rows = np.array([BSpline(knots, np.eye(len(rhs))[j], 3)(np.array([t[0], t[-1]]), 1)
+                           for j in range(len(rhs))]).T
+    held, at_rest = [], []
+    for row in speed_rows:
+        trial, _ = _constrained_solve(gram, rhs, np.array(held + [row]))
+        rss = float(np.sum((design @ trial - x) ** 2))
+        at_rest.append(rss - rss_free < RACK_REST_TEST_CHI2 * noise_var)
+        if at_rest[-1]:
+            held.append(row)
+    coefficients, covariance = _constrained_solve(gram, rhs, np.array(held).reshape(len(held), len(rhs)))
+    rms = float(np.sqrt(np.mean((design @ coefficients - x) ** 2)))
+    return knots, coefficients, covariance, rms, tuple(at_rest)
+
+
+def knot_spacings(time_s: np.ndarray) -> list[float]:
+    """The knot spacings tried, s: from the finer of the range's bottom and a few samples, up to its top."""
+    dt = float(np.median(np.diff(time_s)))
+    low, high = RACK_KNOT_SPACING_RANGE_S
+    low = max(low, RACK_MIN_SAMPLES_PER_KNOT * dt)
+    count = int(math.floor(math.log(high / low) / math.log(RACK_KNOT_SPACING_STEP))) + 1
+    return [low * RACK_KNOT_SPACING_STEP**i for i in range(max(count, 1))]
+
+
+def smooth_rack(time_s, rack_m, knot_spacing_s: float | None = None) -> SmoothedRack:
+    """The measured rack as a least-squares cubic spline; the knot spacing from the data unless given.
+
+    Chosen spacing: the largest tried (:func:`knot_spacings`) whose fit RMS per degree of
+    freedom is within ``RACK_DISCREPANCY_FACTOR`` of the rack's noise RMS; if none is, the finest.
+    """
+    t = np.asarray(time_s, dtype=float)
+    x = np.asarray(rack_m, dtype=float)
+    if t.ndim != 1 or len(t) != len(x) or len(t) < 8:
+        raise UsageError("rack smoothing needs matching time and rack columns with at least 8 samples")
+    if (np.diff(t) <= 0).any():
+        raise UsageError("rack smoothing: time must be strictly increasing")
+    noise = estimate_noise_rms(x)
+    turns = turning_times(t, x)
+
+    def build(fit, spacing):
+        knots, coefficients, inverse, rms, at_rest = fit
+        return SmoothedRack.from_bspline(knots, coefficients, noise**2 * inverse, spacing, rms, noise, at_rest, turns)
+
+    if knot_spacing_s is not None:
+        if not knot_spacing_s > 0:
+            raise UsageError(f"knot spacing must be positive, got {knot_spacing_s:g} s")
+        fit = _lsq_fit(t, x, knot_spacing_s, turns)
+        if fit is None:
+            raise UsageError(f"rack smoothing: knot spacing {knot_spacing_s:g} s leaves intervals without samples")
+        return build(fit, knot_spacing_s)
+    best = None
+    for spacing in knot_spacings(t):
+        fit = _lsq_fit(t, x, spacing, turns)
+        if fit is None:
+            continue
+        # the residual of a least-squares fit with p coefficients has n - p degrees of freedom
+        unbiased = fit[3] * math.sqrt(len(t) / max(len(t) - len(fit[1]), 1))
+        if best is None or unbiased <= RACK_DISCREPANCY_FACTOR * noise:
+            best = (fit, spacing)
+    if best is None:
+        raise UsageError("rack smoothing: no knot spacing gives a well-posed spline (samples too uneven)")
+    return build(*best)

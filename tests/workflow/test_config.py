@@ -1,0 +1,50 @@
+"""The pipeline's configuration: config/config.yaml against workflow/schemas/config.schema.yaml, and the design
+checks that need more than a schema."""
+
+from __future__ import annotations
+
+import copy
+
+import pytest
+import yaml
+from snakemake.exceptions import WorkflowError
+from snakemake.utils import validate
+
+from parksteer.errors import UsageError
+from parksteer.figures.model import FigureDesign
+
+
+@pytest.fixture(scope="module")
+def config(repo_root) -> dict:
+    return yaml.safe_load((repo_root / "config" / "config.yaml").read_text(encoding="utf-8"))
+
+
+@pytest.fixture(scope="module")
+def schema(repo_root) -> str:
+    return str(repo_root / "workflow" / "schemas" / "config.schema.yaml")
+
+
+def test_the_shipped_configuration_is_valid(config, schema):
+    validate(copy.deepcopy(config), schema)
+
+
+@pytest.mark.parametrize("section, key, value", [
+    ("benchmark", "nulls", -1),  # a count
+    ("benchmark", "bisection_tolerance", 1.5),  # a relative error below 1
+    ("car", "files", [["unladen"]]),  # (case, surface) pairs
+    ("variants", "air_bearing", {"model": "full", "surface": "ice"}),  # a known surface
+    ("car", "colour", "red"),  # no unknown key
+])
+def test_a_bad_design_entry_is_refused(config, schema, section, key, value):
+    bad = copy.deepcopy(config)
+    bad[section][key] = value
+    with pytest.raises(WorkflowError):
+        validate(bad, schema)
+
+
+def test_a_figure_run_of_an_undefined_variant_is_refused_in_one_line(config):
+    bad = copy.deepcopy(config)
+    bad["model_figures"]["fig14"].append(["unladen", "no_steering"])
+    with pytest.raises(UsageError, match="model_figures.fig14") as info:
+        FigureDesign.from_config(bad)
+    assert "\n" not in str(info.value)

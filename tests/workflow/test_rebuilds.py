@@ -1,0 +1,105 @@
+"""Exact rebuilds: a rule's inputs are the package modules its script runs, so an edit reruns what it affects;
+the experiment design in config/config.yaml reaches the rules as parameters, so a changed entry does too.
+
+In a copy of the repository (its tracked and new files) every output of the pipeline is created empty and marked
+up to date (`snakemake --touch`); then a module is edited and a dry run lists the jobs Snakemake would run. No job
+runs: the DAG alone shows which rules depend on which module.
+"""
+
+from __future__ import annotations
+
+import re
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+SNAKEMAKE = Path(sys.executable).with_name("snakemake")
+
+
+def _snakemake(workdir: Path, *args: str) -> str:
+    done = subprocess.run([str(SNAKEMAKE), *args], cwd=workdir, capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, (done.stdout + done.stderr)[-3000:]
+    return done.stdout + done.stderr
+
+
+def _planned(workdir: Path, *options: str) -> dict[str, int]:
+    """Rule -> number of jobs a dry run of the default target plans."""
+    out = _snakemake(workdir, "all", "--dry-run", *options)  # the target first: --configfile takes several
+    if "Nothing to be done" in out:
+        return {}
+    stats = out[out.index("Job stats:"):]
+    return {m.group(1): int(m.group(2)) for m in re.finditer(r"^(\w+)\s+(\d+)$", stats, re.MULTILINE)
+            if m.group(1) != "total"}
+
+
+def _edit(path: Path) -> None:
+    with path.open("a", encoding="utf-8") as f:
+        f.write("\n# edited by the rebuild test\n")
+
+
+@pytest.fixture(scope="module")
+def repository_copy(repo_root, tmp_path_factory) -> Path:
+    """A copy of the repository whose every pipeline output exists and is up to date."""
+    listed = subprocess.run(["git", "ls-files", "-z", "--cached", "--others", "--exclude-standard"], cwd=repo_root,
+                            capture_output=True, text=True, check=True).stdout.split("\0")
+    work = tmp_path_factory.mktemp("rebuilds")
+    for name in filter(None, listed):
+        source = repo_root / name
+        if source.is_file():
+            (work / name).parent.mkdir(parents=True, exist_ok=True)
+            shutil.copy2(source, work / name)
+    summary = _snakemake(work, "--summary", "all")
+    for line in summary.splitlines()[1:]:
+        output = work / line.split("\t")[0]
+        output.parent.mkdir(parents=True, exist_ok=True)
+        output.touch()
+    return work
+
+
+@pytest.fixture
+def up_to_date_copy(repository_copy) -> Path:
+    """The copy, every output marked up to date (each newer than its inputs, in DAG order) before each test."""
+    _snakemake(repository_copy, "--touch", "--cores", "1", "all")
+    assert _planned(repository_copy) == {}
+    return repository_copy
+
+
+def test_a_figure_module_edit_reruns_that_figure_and_the_paper_only(up_to_date_copy):
+    """figures/lifting.py draws Fig. A3 alone: editing it plans figA3 and the paper that shows it, nothing else."""
+    _edit(up_to_date_copy / "src" / "parksteer" / "figures" / "lifting.py")
+    assert _planned(up_to_date_copy) == {"figA3": 1, "paper": 1, "all": 1}
+
+
+def test_a_numeric_model_edit_derives_nothing_and_reruns_the_simulations(up_to_date_copy):
+    """model/numeric does not key the compiled model: editing simulate.py plans every simulation again (the model
+    figures' runs, the sweep's points, the synthetic data) but no derive job."""
+    _edit(up_to_date_copy / "src" / "parksteer" / "model" / "numeric" / "simulate.py")
+    planned = _planned(up_to_date_copy)
+    assert "derive" not in planned
+    assert planned["simulate_model"] > 0 and planned["sweep_point"] > 0 and planned["diag_car_data"] == 1
+
+
+def test_a_diagnosis_setting_edit_reruns_the_diagnoses_not_the_model_figures(up_to_date_copy):
+    """diagnose/settings.py holds the diagnosis thresholds: editing it reruns the benchmark's diagnoses and the
+    case study, and leaves the compiled models, the simulations of the model figures and the sweep alone."""
+    _edit(up_to_date_copy / "src" / "parksteer" / "diagnose" / "settings.py")
+    planned = _planned(up_to_date_copy)
+    assert planned["diag_bench_case"] > 0 and planned["case_study"] == 1 and planned["diag_benchmark"] == 1
+    assert not {"derive", "simulate_model", "model_figure", "sweep_point", "fig3", "figA3"} & set(planned)
+
+
+def test_a_design_entry_reruns_what_it_affects(up_to_date_copy, tmp_path):
+    """A new seed of the synthetic car (config car.seed) plans its data set again and what reads it (comparison,
+    case study, ladder, paper), not the benchmark; a new legend label of Fig. 14's ablation plans Fig. 14 alone."""
+    seed = tmp_path / "seed.yaml"
+    seed.write_text("car:\n  seed: 1984\n", encoding="utf-8")
+    planned = _planned(up_to_date_copy, "--configfile", str(seed))
+    assert planned == {"diag_car_data": 1, "diag_compare": 1, "case_study": 1, "diag_ladder": 1, "paper": 1,
+                       "all": 1}
+    label = tmp_path / "label.yaml"
+    label.write_text("variants:\n  no_friction: {model: no_friction, surface: ground, label: lifting alone}\n",
+                     encoding="utf-8")
+    assert _planned(up_to_date_copy, "--configfile", str(label)) == {"model_figure": 1, "paper": 1, "all": 1}

@@ -1,0 +1,25 @@
+# The one derive rule: the compiled model of every named effect set the other rules registered with
+# model_manifest (the figures' models, the sweep's, the diagnosis's base model and candidates), each built or
+# found in the cache by parksteer.model.codegen.cache.ensure. Its inputs are the modules that derivation and
+# code generation run (model/symbolic, model/codegen and what they import): an edit of model/numeric derives
+# nothing. Included last, once every set is registered.
+
+
+rule derive:
+    input:
+        code=script_sources("derive"),
+        effects=lambda w: effect_files(MODEL_SETS[w.model]),
+    output:
+        manifest="results/model/{model}.json",
+    params:
+        effects=lambda w: MODEL_SETS[w.model],
+    wildcard_constraints:
+        model="|".join(MODEL_SETS),
+    log:
+        "logs/derive/{model}.log",
+    benchmark:
+        benchmark_file("derive", "model")
+    conda:
+        "../envs/parksteer.yaml"
+    script:
+        "../scripts/derive.py"
