@@ -7,7 +7,8 @@ import sys
 from pathlib import Path
 
 from ..errors import UsageError
-from ..parameters import DEFAULT_PATH, load_parameters
+from ..parameters import DEFAULT_PATH
+from .vehicle import add_vehicle_option, parameters_of
 
 
 def _common(p) -> None:
@@ -21,6 +22,7 @@ def _common(p) -> None:
                    help="effects spec of the model, e.g. --effects=+column_friction or --effects=+path/to/effect.py "
                         "(a leading - needs no =; default: the paper's five)")
     p.add_argument("--parameters", default=str(DEFAULT_PATH), help="parameter file (default: data/parameters.toml)")
+    add_vehicle_option(p)
     p.add_argument("--json", action="store_true", help="print the result as JSON on stdout")
     p.add_argument("--plot", default=None, metavar="OUT.svg", help="write a figure")
 
@@ -78,7 +80,7 @@ def _compare(args) -> int:
 
     _check_outputs(args)
     overrides = parse_overrides(args.overrides)
-    params = load_parameters(args.parameters)
+    params = parameters_of(args)
     effects = resolve_effects(args.effects)
     files = load_files(args.files, params, args.case, args.surface, channel_map_of(args))
     result = compare_files(files, params, effects, overrides)
@@ -108,7 +110,7 @@ def _diagnose(args) -> int:
     _check_outputs(args)
     if not (args.json or args.report or args.plot):
         raise UsageError("say where the result goes: --json, --report OUT.md and/or --plot OUT.svg")
-    params = load_parameters(args.parameters)
+    params = parameters_of(args)
     effects = resolve_effects(args.effects)
     files = load_files(args.files, params, args.case, args.surface, channel_map_of(args))
     diagnosis = diagnose(files, params, effects)

@@ -11,6 +11,7 @@ from ..errors import UsageError
 from ..parameters import DEFAULT_PATH, load_parameters
 from ..tables import write_json
 from .measure import add_import_options, channel_map_of
+from .vehicle import add_vehicle_option, parameters_of
 
 
 def register(sub) -> None:
@@ -33,6 +34,7 @@ def register(sub) -> None:
                         "smoothing is the default")
     add_import_options(p)
     p.add_argument("--parameters", default=str(DEFAULT_PATH), help="parameter file (default: data/parameters.toml)")
+    add_vehicle_option(p)
     p.add_argument("--output-dt", type=float, default=0.01, help="output spacing, s (default 0.01)")
     p.add_argument("--out", required=True, help="output CSV")
     p.set_defaults(func=_simulate)
@@ -59,7 +61,7 @@ def _simulate(args) -> int:
         raise UsageError(f"--rack-from {args.rack_from}: no such file")
     if args.rack_from is None and args.case is None:
         raise UsageError("--case is required (or --rack-from FILE, whose metadata names the case)")
-    params = load_parameters(args.parameters)
+    params = parameters_of(args)
     case, surface, rack, drive = args.case, args.surface or "ground", None, None
     if args.rack_from is not None:
         case, surface, rack, drive = _measured_rack(args.rack_from, params, args.raw_rack,
