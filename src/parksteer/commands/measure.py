@@ -53,11 +53,13 @@ def register(sub) -> None:
     p = sub.add_parser("diagnose", help="calibrate the model, rank the candidate effects it lacks, give a verdict")
     _common(p)
     p.add_argument("--report", default=None, metavar="OUT.md", help="write a readable report (markdown)")
+    p.add_argument("--html", default=None, metavar="OUT.html",
+                   help="write one self-contained HTML page: overlay, residual by phase, fitted values, ranking")
     p.set_defaults(func=_diagnose)
 
 
 def _check_outputs(args) -> None:
-    for option in ("plot", "report"):
+    for option in ("plot", "report", "html"):
         value = getattr(args, option, None)
         if value is not None:
             parent = Path(value).resolve().parent
@@ -108,8 +110,8 @@ def _diagnose(args) -> int:
     from ..model.symbolic.components import resolve_effects
 
     _check_outputs(args)
-    if not (args.json or args.report or args.plot):
-        raise UsageError("say where the result goes: --json, --report OUT.md and/or --plot OUT.svg")
+    if not (args.json or args.report or args.plot or args.html):
+        raise UsageError("say where the result goes: --json, --report OUT.md, --html OUT.html and/or --plot OUT.svg")
     params = parameters_of(args)
     effects = resolve_effects(args.effects)
     files = load_files(args.files, params, args.case, args.surface, channel_map_of(args))
@@ -125,6 +127,29 @@ def _diagnose(args) -> int:
             figure = str(Path(args.plot).resolve().relative_to(Path(args.report).resolve().parent)) \
                 if Path(args.plot).resolve().is_relative_to(Path(args.report).resolve().parent) else args.plot
         write_markdown(args.report, markdown_report(result, figure))
+    if args.html:
+        _write_html(args.html, diagnosis, result)
     if args.json:
         _print_json(result)
     return 0
+
+
+def _write_html(path: str, diagnosis, result: dict) -> None:
+    """The diagnosis as one self-contained HTML page (parksteer.diagnose.report.html_report)."""
+    import tempfile
+
+    from ..diagnose.report import html_report, phase_residuals, write_markdown
+    from ..figures.diagnose import diagnosis_figure, phase_residual_figure
+
+    phases = phase_residuals(diagnosis)
+    with tempfile.TemporaryDirectory() as tmp:
+        diagnosis_figure(diagnosis, Path(tmp) / "diagnosis.svg")
+        phase_residual_figure(phases, Path(tmp) / "phases.svg")
+        figures = [
+            ("Measured handwheel torque and the calibrated model (with the best candidate) against rack, their "
+             "residual, and the weighted RMS error with each candidate (first file).",
+             (Path(tmp) / "diagnosis.svg").read_text(encoding="utf-8")),
+            ("RMS residual by phase of the cycle over all files, against the noise floor.",
+             (Path(tmp) / "phases.svg").read_text(encoding="utf-8")),
+        ]
+    write_markdown(path, html_report(result, figures, phases))

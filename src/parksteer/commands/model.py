@@ -59,9 +59,11 @@ def _simulate(args) -> int:
         raise UsageError("--raw-rack needs --rack-from FILE")
     if args.rack_from is not None and not Path(args.rack_from).exists():
         raise UsageError(f"--rack-from {args.rack_from}: no such file")
-    if args.rack_from is None and args.case is None:
-        raise UsageError("--case is required (or --rack-from FILE, whose metadata names the case)")
     params = parameters_of(args)
+    if args.rack_from is None and args.case is None:
+        if args.vehicle is None or len(params.case_names) != 1:
+            raise UsageError("--case is required (or --rack-from FILE, whose metadata names the case)")
+        args.case = params.case_names[0]  # a vehicle file with one load case
     case, surface, rack, drive = args.case, args.surface or "ground", None, None
     if args.rack_from is not None:
         case, surface, rack, drive = _measured_rack(args.rack_from, params, args.raw_rack,
