@@ -179,3 +179,19 @@ def test_vehicle_option_reaches_the_commands():
 
             args = build_parser().parse_args([*command, "--vehicle", "no_such.toml"])
             parameters_of(args)
+
+
+def test_simulate_runs_the_vehicle_not_the_paper_car(tmp_path):
+    """simulate --vehicle (no --case: the file's only load case) drives the handwheel to that car's lock, 2.85
+    turns lock to lock = 2.85 pi rad each way, not the paper car's 4 pi, and starts from the file's wheel loads."""
+    import numpy as np
+
+    out = tmp_path / "polo.csv"
+    assert main(["simulate", "--vehicle", str(VEHICLES / "polo_vi.toml"), "--out", str(out)]) == 0
+    header = [l for l in out.read_text().splitlines() if l.startswith("#")]
+    assert "# case: kerb" in header
+    data = np.genfromtxt(out, delimiter=",", names=True, skip_header=len(header))
+    assert np.max(np.abs(data["handwheel_angle_rad"])) == pytest.approx(2.85 * math.pi, rel=1e-3)
+    car = load_vehicle(VEHICLES / "polo_vi.toml").case("kerb")
+    assert data["load_left_N"][0] == pytest.approx(car["load_left"], abs=1.0)
+    assert data["load_right_N"][0] == pytest.approx(car["load_right"], abs=1.0)
