@@ -83,15 +83,17 @@ def test_page_is_self_contained_and_parses(report):
 
 
 def test_page_holds_the_figures_and_the_numbers(report):
-    """Two inline figures (overlay with residual and ranking; residual by phase), the verdict, the residual by
-    phase, every calibrated parameter with its interval and every ranked candidate of the same diagnosis's JSON."""
+    """Three inline figures (overlay with residual and ranking; residual by phase; error ladder), the verdict, the
+    residual by phase, the ladder down to the hidden effect, every calibrated parameter with its interval and every
+    ranked candidate of the same diagnosis's JSON."""
     path, result = report
     page = _Page()
     page.feed(path.read_text(encoding="utf-8"))
     text = " ".join(page.text)
-    assert page.tags.count("svg") == 2 and page.tags.count("figure") == 2
+    assert page.tags.count("svg") == 3 and page.tags.count("figure") == 3
     assert f"Verdict: {result['verdict']}" in text
     assert "Residual by phase" in text and "plateau" in text
+    assert "Error ladder" in text and "paper's model" in text and "+ rack_stiction" in text
     for key in result["calibrated"]:
         assert key in text
     assert text.count(" to ") >= len(result["calibrated"])

@@ -1,4 +1,4 @@
-# Your own car: a vehicle's study (compare, diagnose, figures, report) from a folder of its measurement files,
+# Your own car: a vehicle's study (compare, diagnose with its ladder, figures, report) from its measurement files,
 # written under its own name (results/vehicles/<vehicle>/, figures/vehicles/<vehicle>/), never into the
 # reproduction's checksummed outputs and never part of `all`:
 #   snakemake --cores 2 vehicle_study --config vehicle=polo_vi                          (synthetic measurements)

@@ -128,28 +128,33 @@ def _diagnose(args) -> int:
                 if Path(args.plot).resolve().is_relative_to(Path(args.report).resolve().parent) else args.plot
         write_markdown(args.report, markdown_report(result, figure))
     if args.html:
-        _write_html(args.html, diagnosis, result)
+        _write_html(args.html, diagnosis, result, files, params)
     if args.json:
         _print_json(result)
     return 0
 
 
-def _write_html(path: str, diagnosis, result: dict) -> None:
-    """The diagnosis as one self-contained HTML page (parksteer.diagnose.report.html_report)."""
+def _write_html(path: str, diagnosis, result: dict, files, params) -> None:
+    """The diagnosis and its error ladder as one self-contained HTML page (parksteer.diagnose.report.html_report)."""
     import tempfile
 
+    from ..diagnose.ladder import error_ladder
     from ..diagnose.report import html_report, phase_residuals, write_markdown
-    from ..figures.diagnose import diagnosis_figure, phase_residual_figure
+    from ..figures.diagnose import diagnosis_figure, ladder_figure, phase_residual_figure
 
     phases = phase_residuals(diagnosis)
+    ladder = error_ladder(files, params, list(diagnosis.base_effects), first=diagnosis)
+    captions = {
+        "diagnosis": "Measured handwheel torque and the calibrated model (with the best candidate) against rack, "
+                     "their residual, and the weighted RMS error with each candidate (first file).",
+        "phases": "RMS residual by phase of the cycle over all files, against the noise floor.",
+        "ladder": "The error ladder: the paper's model, calibrated, then with each effect the diagnoses name, down "
+                  "to the noise floor.",
+    }
     with tempfile.TemporaryDirectory() as tmp:
         diagnosis_figure(diagnosis, Path(tmp) / "diagnosis.svg")
         phase_residual_figure(phases, Path(tmp) / "phases.svg")
-        figures = [
-            ("Measured handwheel torque and the calibrated model (with the best candidate) against rack, their "
-             "residual, and the weighted RMS error with each candidate (first file).",
-             (Path(tmp) / "diagnosis.svg").read_text(encoding="utf-8")),
-            ("RMS residual by phase of the cycle over all files, against the noise floor.",
-             (Path(tmp) / "phases.svg").read_text(encoding="utf-8")),
-        ]
-    write_markdown(path, html_report(result, figures, phases))
+        ladder_figure(ladder.rungs, ladder.noise_floor_Nm, ladder.attainable_floor_Nm, Path(tmp) / "ladder.svg")
+        figures = [(caption, (Path(tmp) / f"{name}.svg").read_text(encoding="utf-8"))
+                   for name, caption in captions.items()]
+    write_markdown(path, html_report(result, figures, phases, ladder.as_dict()))

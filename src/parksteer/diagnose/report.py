@@ -276,9 +276,11 @@ def _table(head: list[str], rows: list[list]) -> list[str]:
     return out + ["</table>"]
 
 
-def html_report(result: dict, figures: list[tuple[str, str]], phases: list[dict], title: str | None = None) -> str:
+def html_report(result: dict, figures: list[tuple[str, str]], phases: list[dict], ladder: dict | None = None,
+                title: str | None = None) -> str:
     """One self-contained page: the verdict, the files, the figures (`(caption, svg text)`, inlined), the residual
-    by phase (`phases`, from :func:`phase_residuals`), the fitted values with their 95 % intervals, the ranking."""
+    by phase (`phases`, from :func:`phase_residuals`), the error ladder (:meth:`parksteer.diagnose.ladder.Ladder.
+    as_dict`), the fitted values with their 95 % intervals, the ranking."""
     title = title or "Diagnosis: model against measurement"
     stats, floor = result["statistics"], result["noise_floor_Nm"]
     verdict = result["verdict"]
@@ -308,6 +310,13 @@ def html_report(result: dict, figures: list[tuple[str, str]], phases: list[dict]
     out += _table(head + ["noise floor (N m)"],
                   [[r["file"], r["phase"].replace("_", " "), r["samples"], _n(r["calibrated_rms_Nm"])]
                    + ([_n(r["with_effect_rms_Nm"])] if effect else []) + [_n(r["noise_floor_Nm"])] for r in phases])
+    if ladder is not None:
+        out.append("<h2>Error ladder</h2>")
+        out += _table(["rung", "effects", "RMS (N m)", "weighted RMS (N m)", "weighted RMS / noise floor"],
+                      [[r["label"], ", ".join(r["effects"]), _n(r["rms_Nm"]), _n(r["weighted_rms_Nm"]),
+                        _n(r["weighted_rms_over_noise_floor"])] for r in ladder["rungs"]])
+        out.append(f"<p>Noise floor {html.escape(_n(ladder['noise_floor_Nm']))} N m; with the replay's uncertainty "
+                   f"{html.escape(_n(ladder['attainable_floor_Nm']))} N m.</p>")
     out.append("<h2>Fitted values</h2>")
     rows = [[key, _n(e["default"], 4), _n(e["value"], 4), f"{_n(e['ci95'][0], 4)} to {_n(e['ci95'][1], 4)}"]
             for key, e in result["calibrated"].items()]
