@@ -22,6 +22,7 @@ COMMAND_MODULES = [
     "parksteer.commands.model",
     "parksteer.commands.sweep",
     "parksteer.commands.measure",
+    "parksteer.commands.vehicle",
 ]
 
 

@@ -479,3 +479,9 @@ def load_parameters(path: str | Path = DEFAULT_PATH) -> Parameters:
     cases = {name: _check_table(path, f"cases.{name}", table, CASE_SCHEMA, sources) for name, table in cases_doc.items()}
     _check_statics(path, sections, cases)
     return Parameters(path=path, sections=sections, cases=cases, sources=sources)
+
+
+# The checks by name, for other files made of the same entries (a vehicle file, parksteer.vehicle).
+check_entry = _check_value
+check_table = _check_table
+check_statics = _check_statics

@@ -7,7 +7,8 @@ import sys
 from pathlib import Path
 
 from ..errors import UsageError
-from ..parameters import DEFAULT_PATH, load_parameters
+from ..parameters import DEFAULT_PATH
+from .vehicle import add_vehicle_option, parameters_of
 
 
 def _common(p) -> None:
@@ -21,6 +22,7 @@ def _common(p) -> None:
                    help="effects spec of the model, e.g. --effects=+column_friction or --effects=+path/to/effect.py "
                         "(a leading - needs no =; default: the paper's five)")
     p.add_argument("--parameters", default=str(DEFAULT_PATH), help="parameter file (default: data/parameters.toml)")
+    add_vehicle_option(p)
     p.add_argument("--json", action="store_true", help="print the result as JSON on stdout")
     p.add_argument("--plot", default=None, metavar="OUT.svg", help="write a figure")
 
@@ -51,11 +53,13 @@ def register(sub) -> None:
     p = sub.add_parser("diagnose", help="calibrate the model, rank the candidate effects it lacks, give a verdict")
     _common(p)
     p.add_argument("--report", default=None, metavar="OUT.md", help="write a readable report (markdown)")
+    p.add_argument("--html", default=None, metavar="OUT.html",
+                   help="write one self-contained HTML page: overlay, residual by phase, fitted values, ranking")
     p.set_defaults(func=_diagnose)
 
 
 def _check_outputs(args) -> None:
-    for option in ("plot", "report"):
+    for option in ("plot", "report", "html"):
         value = getattr(args, option, None)
         if value is not None:
             parent = Path(value).resolve().parent
@@ -78,7 +82,7 @@ def _compare(args) -> int:
 
     _check_outputs(args)
     overrides = parse_overrides(args.overrides)
-    params = load_parameters(args.parameters)
+    params = parameters_of(args)
     effects = resolve_effects(args.effects)
     files = load_files(args.files, params, args.case, args.surface, channel_map_of(args))
     result = compare_files(files, params, effects, overrides)
@@ -106,9 +110,9 @@ def _diagnose(args) -> int:
     from ..model.symbolic.components import resolve_effects
 
     _check_outputs(args)
-    if not (args.json or args.report or args.plot):
-        raise UsageError("say where the result goes: --json, --report OUT.md and/or --plot OUT.svg")
-    params = load_parameters(args.parameters)
+    if not (args.json or args.report or args.plot or args.html):
+        raise UsageError("say where the result goes: --json, --report OUT.md, --html OUT.html and/or --plot OUT.svg")
+    params = parameters_of(args)
     effects = resolve_effects(args.effects)
     files = load_files(args.files, params, args.case, args.surface, channel_map_of(args))
     diagnosis = diagnose(files, params, effects)
@@ -123,6 +127,34 @@ def _diagnose(args) -> int:
             figure = str(Path(args.plot).resolve().relative_to(Path(args.report).resolve().parent)) \
                 if Path(args.plot).resolve().is_relative_to(Path(args.report).resolve().parent) else args.plot
         write_markdown(args.report, markdown_report(result, figure))
+    if args.html:
+        _write_html(args.html, diagnosis, result, files, params)
     if args.json:
         _print_json(result)
     return 0
+
+
+def _write_html(path: str, diagnosis, result: dict, files, params) -> None:
+    """The diagnosis and its error ladder as one self-contained HTML page (parksteer.diagnose.report.html_report)."""
+    import tempfile
+
+    from ..diagnose.ladder import error_ladder
+    from ..diagnose.report import html_report, phase_residuals, write_markdown
+    from ..figures.diagnose import diagnosis_figure, ladder_figure, phase_residual_figure
+
+    phases = phase_residuals(diagnosis)
+    ladder = error_ladder(files, params, list(diagnosis.base_effects), first=diagnosis)
+    captions = {
+        "diagnosis": "Measured handwheel torque and the calibrated model (with the best candidate) against rack, "
+                     "their residual, and the weighted RMS error with each candidate (first file).",
+        "phases": "RMS residual by phase of the cycle over all files, against the noise floor.",
+        "ladder": "The error ladder: the paper's model, calibrated, then with each effect the diagnoses name, down "
+                  "to the noise floor.",
+    }
+    with tempfile.TemporaryDirectory() as tmp:
+        diagnosis_figure(diagnosis, Path(tmp) / "diagnosis.svg")
+        phase_residual_figure(phases, Path(tmp) / "phases.svg")
+        ladder_figure(ladder.rungs, ladder.noise_floor_Nm, ladder.attainable_floor_Nm, Path(tmp) / "ladder.svg")
+        figures = [(caption, (Path(tmp) / f"{name}.svg").read_text(encoding="utf-8"))
+                   for name, caption in captions.items()]
+    write_markdown(path, html_report(result, figures, phases, ladder.as_dict()))

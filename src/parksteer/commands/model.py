@@ -11,6 +11,7 @@ from ..errors import UsageError
 from ..parameters import DEFAULT_PATH, load_parameters
 from ..tables import write_json
 from .measure import add_import_options, channel_map_of
+from .vehicle import add_vehicle_option, parameters_of
 
 
 def register(sub) -> None:
@@ -33,6 +34,7 @@ def register(sub) -> None:
                         "smoothing is the default")
     add_import_options(p)
     p.add_argument("--parameters", default=str(DEFAULT_PATH), help="parameter file (default: data/parameters.toml)")
+    add_vehicle_option(p)
     p.add_argument("--output-dt", type=float, default=0.01, help="output spacing, s (default 0.01)")
     p.add_argument("--out", required=True, help="output CSV")
     p.set_defaults(func=_simulate)
@@ -57,9 +59,11 @@ def _simulate(args) -> int:
         raise UsageError("--raw-rack needs --rack-from FILE")
     if args.rack_from is not None and not Path(args.rack_from).exists():
         raise UsageError(f"--rack-from {args.rack_from}: no such file")
+    params = parameters_of(args)
     if args.rack_from is None and args.case is None:
-        raise UsageError("--case is required (or --rack-from FILE, whose metadata names the case)")
-    params = load_parameters(args.parameters)
+        if args.vehicle is None or len(params.case_names) != 1:
+            raise UsageError("--case is required (or --rack-from FILE, whose metadata names the case)")
+        args.case = params.case_names[0]  # a vehicle file with one load case
     case, surface, rack, drive = args.case, args.surface or "ground", None, None
     if args.rack_from is not None:
         case, surface, rack, drive = _measured_rack(args.rack_from, params, args.raw_rack,

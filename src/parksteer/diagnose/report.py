@@ -1,12 +1,16 @@
-"""A diagnosis as JSON (documented by workflow/schemas/diagnosis.schema.json), as markdown, and as a figure."""
+"""A diagnosis as JSON (documented by workflow/schemas/diagnosis.schema.json), as markdown, and as one
+self-contained HTML page (figures inlined as SVG, no external reference)."""
 
 from __future__ import annotations
 
+import html
 import math
+import re
 from pathlib import Path
 
 import numpy as np
 
+from ..measure.phases import PHASES
 from ..resources import data_file
 from ..tables import atomic_path
 from .select import Candidate, Diagnosis
@@ -218,3 +222,123 @@ def markdown_report(result: dict, figure: str | None = None) -> str:
 def write_markdown(path: str | Path, text: str) -> None:
     with atomic_path(path) as tmp:
         tmp.write_text(text, encoding="utf-8")
+
+
+# ------------------------------------------------------------------------------------ the HTML report
+def phase_residuals(diagnosis: Diagnosis) -> list[dict]:
+    """RMS of the residual of the calibrated model, and with the best candidate, in each phase of each file."""
+    best = candidate_predictions(diagnosis, diagnosis.best) if diagnosis.best is not None else None
+    rows = []
+    for i, f in enumerate(diagnosis.problem.files):
+        calibrated = f.torque_Nm - diagnosis.calibration.predictions[i]
+        after = f.torque_Nm - best[i] if best is not None else None
+        for phase in PHASES:
+            mask = f.phases.mask(phase)
+            if not mask.any():
+                continue
+            rows.append({
+                "file": f.label,
+                "phase": phase,
+                "samples": int(mask.sum()),
+                "calibrated_rms_Nm": float(np.sqrt(np.mean(calibrated[mask] ** 2))),
+                "with_effect_rms_Nm": float(np.sqrt(np.mean(after[mask] ** 2))) if after is not None else None,
+                "noise_floor_Nm": float(f.noise.total_rms),
+            })
+    return rows
+
+
+_SVG_START = re.compile(r"<svg[\s>]")
+_METADATA = re.compile(r"<metadata>.*?</metadata>\s*", re.DOTALL)
+
+
+def inline_svg(text: str, prefix: str) -> str:
+    """An SVG file's text as an inline element of a page that holds several: the XML declaration, the DOCTYPE
+    (which names an external DTD) and the RDF metadata (which names vocabularies by URL) dropped, so the page
+    refers to nothing outside itself, and every id prefixed with `prefix`, so two figures' ids cannot meet."""
+    match = _SVG_START.search(text)
+    if match is None:
+        raise ValueError("not an SVG document")
+    svg = _METADATA.sub("", text[match.start():])
+    svg = re.sub(r'\bid="([^"]+)"', lambda m: f'id="{prefix}{m[1]}"', svg)
+    svg = re.sub(r'href="#([^"]+)"', lambda m: f'href="#{prefix}{m[1]}"', svg)
+    return re.sub(r"url\(#([^)]+)\)", lambda m: f"url(#{prefix}{m[1]})", svg)
+
+
+_STYLE = """body{font-family:sans-serif;max-width:60em;margin:2em auto;padding:0 1em;color:#222}
+table{border-collapse:collapse;margin:1em 0}th,td{border:1px solid #bbb;padding:.25em .6em;text-align:right}
+th:first-child,td:first-child{text-align:left}figure{margin:1em 0}figure svg{max-width:100%;height:auto}
+figcaption{font-size:.9em;color:#555}.verdict{font-size:1.1em;padding:.6em;background:#f3f3f3}"""
+
+
+def _table(head: list[str], rows: list[list]) -> list[str]:
+    out = ["<table>", "<tr>" + "".join(f"<th>{html.escape(h)}</th>" for h in head) + "</tr>"]
+    out += ["<tr>" + "".join(f"<td>{html.escape(str(c))}</td>" for c in row) + "</tr>" for row in rows]
+    return out + ["</table>"]
+
+
+def html_report(result: dict, figures: list[tuple[str, str]], phases: list[dict], ladder: dict | None = None,
+                title: str | None = None) -> str:
+    """One self-contained page: the verdict, the files, the figures (`(caption, svg text)`, inlined), the residual
+    by phase (`phases`, from :func:`phase_residuals`), the error ladder (:meth:`parksteer.diagnose.ladder.Ladder.
+    as_dict`), the fitted values with their 95 % intervals, the ranking."""
+    title = title or "Diagnosis: model against measurement"
+    stats, floor = result["statistics"], result["noise_floor_Nm"]
+    verdict = result["verdict"]
+    if verdict == "missing":
+        text = (f"Verdict: missing effect {result['effect']}. Adding it takes the weighted RMS error from "
+                f"{_n(stats['calibrated']['weighted_rms_Nm'])} N m to {_n(stats['with_effect']['weighted_rms_Nm'])} "
+                f"N m, against a noise floor of {_n(floor)} N m.")
+    elif verdict == "adequate":
+        text = (f"Verdict: adequate. The calibrated model's weighted RMS error "
+                f"({_n(stats['calibrated']['weighted_rms_Nm'])} N m) is at the noise floor ({_n(floor)} N m).")
+    else:
+        text = (f"Verdict: unexplained. The calibrated model leaves a structured error (weighted RMS "
+                f"{_n(stats['calibrated']['weighted_rms_Nm'])} N m against a noise floor of {_n(floor)} N m) "
+                "that no candidate removes.")
+    out = ["<!DOCTYPE html>", '<html lang="en">', "<head>", '<meta charset="utf-8">',
+           f"<title>{html.escape(title)}</title>", f"<style>{_STYLE}</style>", "</head>", "<body>",
+           f"<h1>{html.escape(title)}</h1>", f'<p class="verdict">{html.escape(text)}</p>',
+           f"<p>Model: {html.escape(', '.join(result['model']['effects']))}.</p>", "<h2>Files</h2>"]
+    out += _table(["file", "case", "surface", "samples", "noise floor (N m)"],
+                  [[f["file"], f["case"], f["surface"], f["samples"], _n(f["noise_floor"]["total_rms"])]
+                   for f in result["files"]])
+    for k, (caption, svg) in enumerate(figures):
+        out += ["<figure>", inline_svg(svg, f"f{k}-"), f"<figcaption>{html.escape(caption)}</figcaption>", "</figure>"]
+    out.append("<h2>Residual by phase</h2>")
+    effect = result["effect"] if verdict == "missing" else None
+    head = ["file", "phase", "samples", "calibrated RMS (N m)"] + ([f"with {effect} RMS (N m)"] if effect else [])
+    out += _table(head + ["noise floor (N m)"],
+                  [[r["file"], r["phase"].replace("_", " "), r["samples"], _n(r["calibrated_rms_Nm"])]
+                   + ([_n(r["with_effect_rms_Nm"])] if effect else []) + [_n(r["noise_floor_Nm"])] for r in phases])
+    if ladder is not None:
+        out.append("<h2>Error ladder</h2>")
+        out += _table(["rung", "effects", "RMS (N m)", "weighted RMS (N m)", "weighted RMS / noise floor"],
+                      [[r["label"], ", ".join(r["effects"]), _n(r["rms_Nm"]), _n(r["weighted_rms_Nm"]),
+                        _n(r["weighted_rms_over_noise_floor"])] for r in ladder["rungs"]])
+        out.append(f"<p>Noise floor {html.escape(_n(ladder['noise_floor_Nm']))} N m; with the replay's uncertainty "
+                   f"{html.escape(_n(ladder['attainable_floor_Nm']))} N m.</p>")
+    out.append("<h2>Fitted values</h2>")
+    rows = [[key, _n(e["default"], 4), _n(e["value"], 4), f"{_n(e['ci95'][0], 4)} to {_n(e['ci95'][1], 4)}"]
+            for key, e in result["calibrated"].items()]
+    out += _table(["parameter", "default", "fitted", "95 % interval"], rows)
+    out.append("<h2>Ranking of the candidate effects</h2>")
+    rows = []
+    for c in result["ranking"]:
+        strength = c["parameters"][c["strength_parameter"]]
+        ci = strength.get("ci95")
+        rows.append([c["effect"], _n(c["score"]), _n(c["delta_bic"]),
+                     _n(strength["value"]) + (f" ({_n(ci[0])} to {_n(ci[1])})" if ci else " (linear estimate)"),
+                     _n(c["weighted_rms_after_Nm"]), _n(c["identifiable_fraction"], 2)])
+    out += _table(["candidate", "score", "ΔBIC", "fitted strength (95 % interval)", "weighted RMS after (N m)",
+                   "identifiable fraction"], rows)
+    if result["indistinguishable"]:
+        out.append("<h2>Indistinguishable by these data</h2>")
+        out += _table(["effect", "ΔBIC", "measure case", "on", "difference RMS (N m)"],
+                      [[s["effect"], _n(s["delta_bic"]), s["separating_measurement"]["case"],
+                        s["separating_measurement"]["surface"].replace("_", " "),
+                        _n(s["separating_measurement"]["predicted_difference_rms_Nm"])]
+                       for s in result["indistinguishable"]])
+    if result["unobservable"]:
+        out.append(f"<p>Unobservable in these data: {html.escape(', '.join(result['unobservable']))}.</p>")
+    out += [f"<p>Cost: {result['cost']['replays']} replays.</p>", "</body>", "</html>"]
+    return "\n".join(out) + "\n"

@@ -246,3 +246,30 @@ def make_benchmark_figure(truth_paths, diagnosis_paths, svg: str | Path, csv: st
                              "steps": "hidden size as converter steps of torque RMS on the unladen ground file"})
     write_json(json_path, summary)
     return summary
+
+
+def phase_residual_figure(rows: list[dict], path: str | Path) -> None:
+    """RMS residual by phase over all files (from :func:`parksteer.diagnose.report.phase_residuals`): the calibrated
+    model and, when the verdict names one, with the missing effect; the dotted line is the median noise floor."""
+    fig, ax = new_figure(7.0, 3.0)
+    present = [p for p in PHASES if any(r["phase"] == p for r in rows)]
+    series = [("calibrated model", "calibrated_rms_Nm")]
+    if rows and rows[0]["with_effect_rms_Nm"] is not None:
+        series.append(("with the missing effect", "with_effect_rms_Nm"))
+    x = np.arange(len(present))
+    width = 0.8 / len(series)
+    for k, (label, key) in enumerate(series):
+        pooled = []
+        for p in present:
+            chosen = [r for r in rows if r["phase"] == p]
+            n = sum(r["samples"] for r in chosen)
+            pooled.append(float(np.sqrt(sum(r["samples"] * r[key] ** 2 for r in chosen) / n)))
+        ax.bar(x + (k - (len(series) - 1) / 2) * width, pooled, width, color=COLOURS[k], label=label)
+    if rows:
+        ax.axhline(float(np.median([r["noise_floor_Nm"] for r in rows])), color="black", linestyle=":",
+                   linewidth=1.0, label="noise floor (median of the files)")
+    ax.set_xticks(x, [p.replace("_", " ") for p in present])
+    ax.set_ylabel("RMS residual (N m)")
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    save_svg(fig, path)

@@ -1,0 +1,140 @@
+"""``parksteer vehicle new`` and ``parksteer vehicle check``: a vehicle file from a car's specification."""
+
+from __future__ import annotations
+
+import math
+import re
+from pathlib import Path
+
+from ..errors import UsageError
+from ..parameters import DEFAULT_PATH, load_parameters
+
+BAR_PA = 1.0e5
+INCH_M = 0.0254
+TYRE_SIZE = re.compile(r"^\s*(\d{3})\s*/\s*(\d{2})\s*Z?R\s*(\d{2}(?:\.\d)?)\s*$", re.IGNORECASE)
+
+
+def register(sub) -> None:
+    p = sub.add_parser("vehicle", help="write or check a vehicle file (your own car)")
+    vsub = p.add_subparsers(dest="vehicle_command", required=True, parser_class=type(p))
+
+    n = vsub.add_parser("new", help="write a commented vehicle file from a car's specification, deriving the rest")
+    n.add_argument("--out", required=True, metavar="FILE.toml", help="the vehicle file to write (its stem names the car)")
+    load = n.add_mutually_exclusive_group(required=True)
+    load.add_argument("--front-axle-mass-kg", type=float, help="front axle load as a mass (kg), e.g. 780")
+    load.add_argument("--front-axle-load-N", type=float, help="front axle load (N)")
+    n.add_argument("--left-share", type=float, default=0.5,
+                   help="share of the front axle load on the left wheel (default 0.5)")
+    n.add_argument("--track-m", type=float, required=True, help="front track, wheel centre to wheel centre (m)")
+    n.add_argument("--kingpin-inclination-deg", type=float, required=True, help="king-pin inclination (degrees)")
+    n.add_argument("--castor-deg", type=float, required=True, help="castor angle (degrees)")
+    offset = n.add_mutually_exclusive_group(required=True)
+    offset.add_argument("--scrub-radius-m", type=float,
+                        help="scrub radius at the ground, contact centre outboard of the axis positive (m)")
+    offset.add_argument("--kingpin-offset-m", type=float,
+                        help="king-pin offset at wheel-centre height, wheel centre outboard of the axis positive (m)")
+    tyre = n.add_mutually_exclusive_group(required=True)
+    tyre.add_argument("--tyre-size", help="ISO size, e.g. 185/65R15 (the unloaded radius is derived from it)")
+    tyre.add_argument("--tyre-radius-m", type=float, help="tyre radius (m)")
+    n.add_argument("--tyre-pressure-bar", type=float, required=True, help="front tyre pressure, gauge (bar)")
+    n.add_argument("--steering-ratio", type=float, required=True, help="overall steering ratio (handwheel/road wheel)")
+    n.add_argument("--lock-turns", type=float, required=True, help="handwheel turns lock to lock")
+    n.add_argument("--case", default="kerb", help="name of the load case (default kerb)")
+    n.add_argument("--force", action="store_true", help="overwrite an existing file")
+    n.add_argument("--parameters", default=str(DEFAULT_PATH),
+                   help="parameter file whose car fills what a specification does not give")
+    n.set_defaults(func=_new)
+
+    c = vsub.add_parser("check", help="validate a vehicle file (registry, statics, geometry, lock)")
+    c.add_argument("path")
+    c.add_argument("--parameters", default=str(DEFAULT_PATH), help="the base parameter file")
+    c.set_defaults(func=_check)
+
+
+def tyre_radius_m(size: str) -> float:
+    """Unloaded radius of an ISO tyre size: rim / 2 + width x aspect (185/65R15: 0.1905 + 0.12025 m)."""
+    match = TYRE_SIZE.match(size)
+    if match is None:
+        raise UsageError(f"--tyre-size {size!r}: expected an ISO size such as 185/65R15")
+    width_mm, aspect_pct, rim_in = float(match[1]), float(match[2]), float(match[3])
+    return rim_in * INCH_M / 2.0 + width_mm / 1000.0 * aspect_pct / 100.0
+
+
+def specification(args, gravity: float):
+    """The :class:`parksteer.vehicle.Specification` of the command line, in SI units."""
+    from ..vehicle import Specification
+
+    load_N = args.front_axle_load_N if args.front_axle_load_N is not None else args.front_axle_mass_kg * gravity
+    radius = args.tyre_radius_m if args.tyre_radius_m is not None else tyre_radius_m(args.tyre_size)
+    chi, eps = math.radians(args.kingpin_inclination_deg), math.radians(args.castor_deg)
+    if args.scrub_radius_m is not None:
+        scrub = args.scrub_radius_m
+    else:  # the axis runs inboard by tan(kpi)/cos(castor) per unit height above the ground
+        scrub = args.kingpin_offset_m - radius * math.tan(chi) / math.cos(eps)
+    for option, value, low, high in (("--left-share", args.left_share, 0.0, 1.0),
+                                     ("--steering-ratio", args.steering_ratio, 1.0, 100.0),
+                                     ("--lock-turns", args.lock_turns, 0.1, 10.0),
+                                     ("--track-m", args.track_m, 0.5, 3.0),
+                                     ("--tyre-pressure-bar", args.tyre_pressure_bar, 0.1, 10.0)):
+        if not low < value < high:
+            raise UsageError(f"{option} {value:g}: outside ({low:g}, {high:g})")
+    sources = [("tyre_radius_m", f"derived from the tyre size {args.tyre_size}")] if args.tyre_size else []
+    if args.front_axle_mass_kg is not None:
+        sources.append(("front_axle_load_N", f"front axle mass {args.front_axle_mass_kg:g} kg x g"))
+    if args.kingpin_offset_m is not None:
+        sources.append(("scrub_radius_m", f"from the king-pin offset {args.kingpin_offset_m:g} m"))
+    return Specification(
+        front_axle_load_N=load_N, left_share=args.left_share, track_m=args.track_m, kingpin_inclination_rad=chi,
+        castor_rad=eps, scrub_radius_m=scrub, tyre_radius_m=radius,
+        tyre_pressure_Pa=args.tyre_pressure_bar * BAR_PA, steering_ratio=args.steering_ratio,
+        lock_turns=args.lock_turns, case=args.case, spec_sources=tuple(sources))
+
+
+def _new(args) -> int:
+    from ..tables import atomic_path
+    from ..vehicle import derive, template_text, vehicle_from_text, vehicle_name
+
+    out = Path(args.out)
+    if out.suffix != ".toml":
+        raise UsageError(f"--out {args.out}: a vehicle file is TOML; name it .toml")
+    if not out.resolve().parent.is_dir():
+        raise UsageError(f"--out {args.out}: folder {out.resolve().parent} does not exist")
+    if out.exists() and not args.force:
+        raise UsageError(f"--out {args.out}: exists (--force to overwrite)")
+    base = load_parameters(args.parameters)
+    spec = specification(args, base["vehicle.gravity"])
+    values = derive(spec, base)
+    text = template_text(vehicle_name(out), spec, values)
+    vehicle_from_text(text, out, base)  # checked as a vehicle file before anything is written
+    with atomic_path(out) as tmp:
+        tmp.write_text(text, encoding="utf-8")
+    print(f"{out}: vehicle {vehicle_name(out)}, case {spec.case}")
+    for d in values:
+        how = f" = {d.how}" if d.how else ""
+        print(f"  {d.key} = {d.value:.6g} {d.unit}  [{d.source}]{how}")
+    return 0
+
+
+def _check(args) -> int:
+    from ..vehicle import load_vehicle
+
+    params = load_vehicle(args.path, args.parameters)
+    print(f"{args.path}: vehicle valid; cases: {', '.join(params.case_names)}")
+    return 0
+
+
+def add_vehicle_option(p) -> None:
+    """--vehicle FILE: run on that car (its values and cases over the base parameter file)."""
+    p.add_argument("--vehicle", default=None, metavar="FILE.toml",
+                   help="a vehicle file (data/vehicles/, `parksteer vehicle new`): its car and load cases replace "
+                        "the paper's; --case names one of its cases where a file does not")
+
+
+def parameters_of(args):
+    """The parameters of a command: --parameters, with the car of --vehicle over it when given."""
+    params = load_parameters(args.parameters)
+    if getattr(args, "vehicle", None) is None:
+        return params
+    from ..vehicle import load_vehicle
+
+    return load_vehicle(args.vehicle, params)

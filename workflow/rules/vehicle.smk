@@ -1,0 +1,82 @@
+# Your own car: a vehicle's study (compare, diagnose with its ladder, figures, report) from its measurement files,
+# written under its own name (results/vehicles/<vehicle>/, figures/vehicles/<vehicle>/), never into the
+# reproduction's checksummed outputs and never part of `all`:
+#   snakemake --cores 2 vehicle_study --config vehicle=polo_vi                          (synthetic measurements)
+#   snakemake --cores 2 vehicle_study --config vehicle=my_car vehicle_data=logs/my_car vehicle_map=my_car.map
+# `vehicle` names data/vehicles/<vehicle>.toml; without `vehicle_data` the study runs on synthetic measurements
+# of that car (each load case on the ground, the first also on air bearings, config["car"]'s hidden effect).
+wildcard_constraints:
+    vehicle="[A-Za-z0-9_-]+",
+
+
+rule vehicle_synthetic_data:
+    input:
+        parameters=PARAMETERS,
+        vehicle=vehicle_file("{vehicle}"),
+        models=DIAG_MODELS,
+        code=script_sources("vehicle_data"),
+    output:
+        files=directory("results/vehicles/{vehicle}/synthetic"),
+    params:
+        runs=lambda w: vehicle_runs(w.vehicle),
+        car=config["car"],
+        perturbation=config["benchmark"]["perturbation"],
+    log:
+        "logs/vehicles/{vehicle}/synthetic_data.log",
+    benchmark:
+        benchmark_file("vehicle_synthetic_data", "vehicle")
+    conda:
+        "../envs/parksteer.yaml"
+    script:
+        "../scripts/vehicle_data.py"
+
+
+rule vehicle_compare:
+    input:
+        parameters=PARAMETERS,
+        vehicle=vehicle_file("{vehicle}"),
+        models=DIAG_MODELS,
+        files=vehicle_measurements,
+        code=script_sources("vehicle_compare"),
+    output:
+        json="results/vehicles/{vehicle}/compare.json",
+        svg="figures/vehicles/{vehicle}/compare.svg",
+    params:
+        options=vehicle_options(),
+    log:
+        "logs/vehicles/{vehicle}/compare.log",
+    benchmark:
+        benchmark_file("vehicle_compare", "vehicle")
+    conda:
+        "../envs/parksteer.yaml"
+    script:
+        "../scripts/vehicle_compare.py"
+
+
+rule vehicle_diagnose:
+    input:
+        parameters=PARAMETERS,
+        vehicle=vehicle_file("{vehicle}"),
+        models=DIAG_MODELS,
+        files=vehicle_measurements,
+        code=script_sources("vehicle_diagnose"),
+    output:
+        json="results/vehicles/{vehicle}/diagnosis.json",
+        svg="figures/vehicles/{vehicle}/diagnosis.svg",
+        md="results/vehicles/{vehicle}/report.md",
+        html="results/vehicles/{vehicle}/report.html",
+    params:
+        options=vehicle_options(),
+    log:
+        "logs/vehicles/{vehicle}/diagnose.log",
+    benchmark:
+        benchmark_file("vehicle_diagnose", "vehicle")
+    conda:
+        "../envs/parksteer.yaml"
+    script:
+        "../scripts/vehicle_diagnose.py"
+
+
+rule vehicle_study:
+    input:
+        vehicle_study_files,

@@ -1,0 +1,48 @@
+# Names the vehicle study's rules (workflow/rules/vehicle.smk) share: the vehicle file, its measurement files (a
+# folder, or synthetic ones of its load cases), the import options from the configuration, the study's files.
+from parksteer.vehicle import load_vehicle as _load_vehicle
+
+VEHICLE_SUFFIXES = (".csv", ".txt", ".mf4", ".mdf", ".dat")
+
+
+def vehicle_file(name):
+    return f"data/vehicles/{name}.toml"
+
+
+def vehicle_runs(name):
+    """(case, surface) of a vehicle's synthetic measurements: every load case on the ground, the first on air."""
+    cases = _load_vehicle(vehicle_file(name), PARAMETERS).case_names
+    return [(case, "ground") for case in cases] + [(cases[0], "air_bearing")]
+
+
+def vehicle_measurements(wildcards):
+    folder = config.get("vehicle_data")
+    if folder is None:
+        return [f"results/vehicles/{wildcards.vehicle}/synthetic"]  # a directory: the rule scripts list it
+    files = sorted(str(p) for p in Path(folder).iterdir() if p.suffix.lower() in VEHICLE_SUFFIXES)
+    if not files:
+        raise ValueError(f"vehicle_data {folder}: no measurement file ({', '.join(VEHICLE_SUFFIXES)})")
+    return files
+
+
+def vehicle_options():
+    """Import options for every file of the study: --map-file, --case, --surface from the configuration."""
+    options = []
+    for key, option in (("vehicle_map", "--map-file"), ("vehicle_case", "--case"), ("vehicle_surface", "--surface")):
+        if config.get(key) is not None:
+            options += [option, str(config[key])]
+    return options
+
+
+def vehicle_study_files(wildcards):
+    name = config.get("vehicle")
+    if name is None:
+        raise ValueError("vehicle_study needs the vehicle's name: --config vehicle=<name> (data/vehicles/<name>.toml)")
+    return [
+        f"results/vehicles/{name}/compare.json",
+        f"figures/vehicles/{name}/compare.svg",
+        f"results/vehicles/{name}/diagnosis.json",
+        f"figures/vehicles/{name}/diagnosis.svg",
+        f"results/vehicles/{name}/report.md",
+        f"results/vehicles/{name}/report.html",
+    ]
