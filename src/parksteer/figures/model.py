@@ -118,6 +118,38 @@ def plateau_mask(columns: dict, params: Parameters) -> np.ndarray:
     return (columns["time_s"] < t_right) & (rack >= PLATEAU_RACK_M[0]) & (rack <= PLATEAU_RACK_M[1])
 
 
+STEP_LEVEL = 0.99  # tanh(beta v) of the rack speed at the two ends of the rack-friction step
+
+
+def _crossing_time(t: np.ndarray, x: np.ndarray, level: float, start: int) -> float:
+    """The first time from index `start` on at which x passes `level`, linearly interpolated."""
+    above = x[start:] >= level
+    k = start + int(np.flatnonzero(above[1:] != above[0])[0])
+    return float(t[k] + (level - x[k]) * (t[k + 1] - t[k]) / (x[k + 1] - x[k]))
+
+
+def reversal_step(columns: dict, params: Parameters) -> dict:
+    """The handwheel torque step at right lock while the rack friction reverses, measured where it happens.
+
+    The rack friction is F tanh(beta v); its step is taken between the instants at which tanh(beta v) passes
+    +0.99 and -0.99 (the rack speed's zero crossing at right lock), so the carcasses' unwinding over the rounded
+    reversal stays out of it. Returns the step, its window and (when the run has rack friction) the rack friction
+    share's own step.
+    """
+    t = np.asarray(columns["time_s"], dtype=float)
+    level = np.tanh(params["steering.friction_smoothing"] * np.asarray(columns["rack_speed_m_s"], dtype=float))
+    i_lock = int(np.argmax(columns["rack_m"]))
+    start = int(np.flatnonzero((level[:i_lock] >= STEP_LEVEL))[-1])
+    t0 = _crossing_time(t, level, STEP_LEVEL, start)
+    t1 = _crossing_time(t, level, -STEP_LEVEL, start)
+    torque = np.asarray(columns["handwheel_torque_Nm"], dtype=float)
+    out = {"step_Nm": float(np.interp(t0, t, torque) - np.interp(t1, t, torque)), "window_s": [t0, t1]}
+    if "contrib_rack_friction_Nm" in columns:
+        rack = np.asarray(columns["contrib_rack_friction_Nm"], dtype=float)
+        out["rack_friction_step_Nm"] = float(np.interp(t0, t, rack) - np.interp(t1, t, rack))
+    return out
+
+
 def cycle_summary(columns: dict, params: Parameters) -> dict:
     """Key numbers of one cycle: plateau, near lock, reversal drops, peak, loads, contribution shares."""
     t = _times(params)
@@ -135,6 +167,7 @@ def cycle_summary(columns: dict, params: Parameters) -> dict:
         "torque_near_left_lock_Nm": _at(columns, "handwheel_torque_Nm", before_left),
         "drop_at_right_lock_reversal_Nm": _at(columns, "handwheel_torque_Nm", before_right)
         - _at(columns, "handwheel_torque_Nm", after_right),
+        "reversal_step_at_right_lock_Nm": reversal_step(columns, params)["step_Nm"],
         "rise_at_left_lock_reversal_Nm": _at(columns, "handwheel_torque_Nm", after_left)
         - _at(columns, "handwheel_torque_Nm", before_left),
         "peak_torque_Nm": float(np.max(np.abs(torque))),
