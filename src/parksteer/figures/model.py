@@ -208,23 +208,38 @@ def _run_key(case: str, variant: str) -> str:
     return f"{case}__{variant}"
 
 
+def until_hand_stops(columns: dict, params: Parameters) -> np.ndarray:
+    """The samples of a cycle up to the hand's stop at its end: those after the last reversal's half rounding
+    before the end where the rack still moves (|tanh(beta v)| >= 0.99) or before. At rest the smoothed friction
+    tanh(beta v) vanishes, so the torque falls (16.7 to 12.8 N m unladen) along a vertical line at rack 0 that
+    is the friction model's artefact, not a measurement; the torque-rack figures end their curves before it."""
+    t = np.asarray(columns["time_s"], dtype=float)
+    level = np.abs(np.tanh(params["steering.friction_smoothing"] * np.asarray(columns["rack_speed_m_s"])))
+    stopping = t > t[-1] - _times(params)["half_rounding"]
+    return ~(stopping & (level < STEP_LEVEL))
+
+
 def _torque_against_rack(params, runs, data, labels, title, ylabel="handwheel torque (N m)"):
     fig, ax = new_figure(6.5, 4.2)
     for colour, (case, variant) in zip(COLOURS, runs):
         c = data[(case, variant)]
-        ax.plot(1000 * c["rack_m"], c["handwheel_torque_Nm"], color=colour, label=_label(params, case, variant, labels))
+        keep = until_hand_stops(c, params)
+        ax.plot(1000 * c["rack_m"][keep], c["handwheel_torque_Nm"][keep], color=colour,
+                label=_label(params, case, variant, labels))
     ax.axhline(0.0, color="0.5", linewidth=0.6)
     ax.axvline(0.0, color="0.5", linewidth=0.6)
     ax.set_xlabel("rack displacement (mm), positive steering right")
     ax.set_ylabel(ylabel)
     ax.set_title(title, fontsize=9)
     ax.legend(loc="upper left", fontsize=8)
+    ax.text(0.99, 0.02, "curves end as the hand stops at the cycle's end (at rest the smoothed friction vanishes)",
+            transform=ax.transAxes, ha="right", va="bottom", fontsize=6.5, color="0.3")
     fig.tight_layout()
     return fig
 
 
 def _loads_against_rack(params, runs, data, labels):
-    fig, ax = new_figure(6.5, 4.2)
+    fig, ax = new_figure(6.5, 4.8)
     for colour, (case, variant) in zip(COLOURS, runs):
         c = data[(case, variant)]
         label = _label(params, case, variant, labels)
@@ -233,7 +248,8 @@ def _loads_against_rack(params, runs, data, labels):
     ax.set_xlabel("rack displacement (mm), positive steering right")
     ax.set_ylabel("road wheel load (N)")
     ax.set_title("Fig. 13: wheel loads against rack displacement (model)", fontsize=9)
-    ax.legend(loc="center left", fontsize=7)
+    # below the axes: inside, any corner covers part of a curve that spans the whole rack travel
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2, fontsize=7, frameon=False)
     fig.tight_layout()
     return fig
 
