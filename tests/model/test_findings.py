@@ -96,3 +96,27 @@ def test_fig13_legend_covers_no_curve(params):
     ax = fig.axes[0]
     legend = ax.get_legend().get_window_extent()
     assert legend.y1 < ax.get_window_extent().y0
+
+
+def _brush_twist(m):
+    """Bristle twist (in units of M / k_b) of the continuous brush disc in spin carrying the moment m M: the inverse
+    of f(x) = x up to 3/4, then 1 - (27/256) / x^3."""
+    m = np.asarray(m, dtype=float)
+    return np.where(m <= 0.75, m, np.cbrt((27.0 / 256.0) / np.maximum(1.0 - m, 1e-300)))
+
+
+def test_brush_patch_states_its_rounding_as_the_rigid_sidewall_bound():
+    """Physical fact: a sidewall spring in series with the brush (compliance fraction phi, same total compliance
+    1/k) leaves the sliding moment M and scales the knee's extra twist over the lumped law by (1 - phi); the
+    brush_patch effect, which gives all of 1/k to the bristles, is the phi = 0 limit, an upper bound on the
+    rounding. Checked on the continuous brush law, and the effect's docstring says so."""
+    from parksteer.model.symbolic.effects import brush_patch
+
+    m = np.linspace(0.0, 0.99, 200)
+    all_bristles = _brush_twist(m) - m  # phi = 0: twist k theta / M minus the lumped law's
+    for phi in (0.3, 0.7):
+        series = phi * m + (1.0 - phi) * _brush_twist(m) - m
+        assert np.allclose(series, (1.0 - phi) * all_bristles, atol=1e-12)
+        assert np.all(series <= all_bristles + 1e-12)
+    doc = brush_patch.__doc__
+    assert "series" in doc and "upper bound" in doc

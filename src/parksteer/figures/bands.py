@@ -184,12 +184,13 @@ def compute_bands(params: Parameters, simulate=None) -> dict:
 
 def band_table(bands: dict) -> dict[str, list]:
     """The band table's columns: one row per headline number, with each input's low and high."""
-    rows: dict[str, list] = {"number": [], "unit": [], "nominal": [], "band_low": [], "band_high": []}
+    rows: dict[str, list] = {"number": [], "label": [], "unit": [], "nominal": [], "band_low": [], "band_high": []}
     for name in bands["input_order"]:
         rows[f"{name}_low"] = []
         rows[f"{name}_high"] = []
     for key, label, unit in NUMBERS:
         rows["number"].append(key)
+        rows["label"].append(label.replace(",", ";"))
         rows["unit"].append(unit.replace(" ", "_"))
         rows["nominal"].append(bands["nominal"][key])
         rows["band_low"].append(bands["band"][key][0])
