@@ -101,3 +101,16 @@ def test_band_table_round_trips(bands, tmp_path):
     for name in bands["input_order"]:
         assert np.all(columns[f"{name}_low"] <= columns[f"{name}_high"])
     assert np.all(columns["band_low"] <= columns["nominal"]) and np.all(columns["nominal"] <= columns["band_high"])
+
+
+def test_tyre_moment_about_the_steer_axis_scales_the_tyre_share_alone(bands, params):
+    """Physical fact: the tread ring turns about the steer axis, so a patch moment M about the ground normal does
+    work M n_z per unit turn, about the steer axis M; moving the moment's axis raises the tyre share by 1/n_z
+    (n_z = cos(castor) cos(king-pin inclination) for a mirror-symmetric axis, 2.4 % here) and nothing else."""
+    n_z = math.cos(params["geometry.castor_angle"]) * math.cos(params["geometry.kingpin_inclination"])
+    axis = bands["inputs"]["tyre_moment_axis"]["values"]
+    nominal = bands["nominal"]
+    assert axis["tyre_share_Nm"][0] / nominal["tyre_share_Nm"] == pytest.approx(1 / n_z, rel=1e-3)
+    assert axis["rack_share_Nm"][0] == pytest.approx(nominal["rack_share_Nm"], rel=1e-9)
+    assert axis["plateau_Nm"][0] - nominal["plateau_Nm"] == pytest.approx(
+        nominal["tyre_share_Nm"] * (1 / n_z - 1), rel=2e-3)

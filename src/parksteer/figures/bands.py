@@ -10,6 +10,7 @@ and every headline number is recomputed from the simulated cycles:
 * wheel radius: the Table 1 rig tyre's 0.263 m rolling radius to the 0.30 m of the Appendix B heights
   (ground and roll axis moved together; the ground scrub changes sign between them);
 * mass centre of each steering assembly: on the king-pin axis (the choice) to the wheel centre;
+* the axis of the tyre's friction moment: the ground normal (the model) or the steer axis;
 * saw-tooth rounding: 0.2-0.8 s about the chosen 0.4 s.
 
 The headline numbers (all of the unladen car on the ground unless named otherwise):
@@ -43,6 +44,7 @@ from matplotlib.patches import Patch
 from ..geometry import lifting_torque_a1, steer_axis
 from ..parameters import Parameters, load_parameters
 from ..plotting import COLOURS, new_figure, save_svg
+from ..sweep.merit import braked_columns
 from ..tables import write_csv, write_json
 from .model import PLATEAU_RACK_M, cycle_summary, plateau_mask
 
@@ -51,11 +53,15 @@ HOOKE_PHASES = 8  # phases evaluated over a full column turn
 
 @dataclass(frozen=True)
 class BandInput:
-    """A reconstructed input and the settings (override dicts, each with a label) it is moved over."""
+    """A reconstructed input and the settings (override dicts, each with a label) it is moved over.
+
+    `tyre_moment_about_steer_axis`: instead of overrides, apply the tyre's friction moment about the steer axis
+    rather than the ground normal (:func:`tyre_moment_about_steer_axis`)."""
 
     name: str
     label: str
     settings: tuple[tuple[str, dict[str, float]], ...]
+    tyre_moment_about_steer_axis: bool = False
 
 
 def band_inputs(params: Parameters) -> tuple[BandInput, ...]:
@@ -77,6 +83,8 @@ def band_inputs(params: Parameters) -> tuple[BandInput, ...]:
                                      "vehicle.roll_axis_z": centre_z + rig_radius}),)),
         BandInput("assembly_cg", "assembly mass centre, axis to wheel centre", (
             (f"{1000 * d_m:.1f} mm", {"steering.steering_assembly_cg_outboard": d_m}),)),
+        BandInput("tyre_moment_axis", "tyre moment about the steer axis", (("steer axis", {}),),
+                  tyre_moment_about_steer_axis=True),
         BandInput("rounding", "saw-tooth rounding 0.2-0.8 s", (
             (f"{0.5 * rounding:.1f} s", {"input.reversal_rounding_time": 0.5 * rounding}),
             (f"{2.0 * rounding:.1f} s", {"input.reversal_rounding_time": 2.0 * rounding}))),
@@ -129,8 +137,21 @@ def a1_deviation(columns: dict, params: Parameters, case: str) -> dict:
     }
 
 
-def headline_numbers(params: Parameters, simulate=None) -> dict[str, float]:
-    """Every headline number (see the module docstring) for one parameter set: four simulated cycles."""
+def tyre_moment_about_steer_axis(columns: dict, params: Parameters, case: str) -> dict:
+    """The cycle with the tread's friction moment acting about the steer axis instead of the ground normal.
+
+    The model applies the patch's moment M about the ground normal; the tread ring turns about the steer axis,
+    so its generalized force is M times the axis's vertical component n_z = cos(castor) cos(king-pin
+    inclination) nearly. Where the moment acts is a reconstruction (the source says neither); about the axis the
+    tyre share is larger by 1/n_z, so the torque gains (1/n_z - 1) times the tyre share.
+    """
+    n_z = abs(float(steer_axis(params, case, "left").direction[2]))
+    return braked_columns(columns, 1.0 / n_z)
+
+
+def headline_numbers(params: Parameters, simulate=None, about_steer_axis: bool = False) -> dict[str, float]:
+    """Every headline number (see the module docstring) for one parameter set: four simulated cycles (with the
+    tyre moment about the steer axis when `about_steer_axis`)."""
     if simulate is None:
         from ..model.numeric.simulate import simulate
     run = {
@@ -138,6 +159,8 @@ def headline_numbers(params: Parameters, simulate=None) -> dict[str, float]:
         for case, surface in (("unladen", "ground"), ("unladen", "air_bearing"), ("offset_68_5mm", "ground"),
                               ("part_laden", "ground"))
     }
+    if about_steer_axis:
+        run = {key: tyre_moment_about_steer_axis(c, params, key[0]) for key, c in run.items()}
     unladen = cycle_summary(run[("unladen", "ground")], params)
     shares = unladen["contributions"]
     plateau = unladen["plateau_torque_Nm"]
@@ -173,7 +196,7 @@ def compute_bands(params: Parameters, simulate=None) -> dict:
     for item in band_inputs(params):
         values: dict[str, list[float]] = {k: [] for k in nominal}
         for _, overrides in item.settings:
-            numbers = headline_numbers(params.with_overrides(overrides), simulate)
+            numbers = headline_numbers(params.with_overrides(overrides), simulate, item.tyre_moment_about_steer_axis)
             for k, v in numbers.items():
                 values[k].append(v)
                 band[k] = [min(band[k][0], v), max(band[k][1], v)]
