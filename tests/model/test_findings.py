@@ -120,3 +120,18 @@ def test_brush_patch_states_its_rounding_as_the_rigid_sidewall_bound():
         assert np.all(series <= all_bristles + 1e-12)
     doc = brush_patch.__doc__
     assert "series" in doc and "upper bound" in doc
+
+
+def test_model_figure_titles_do_not_carry_a_figure_number_of_their_own(params):
+    """The article numbers its figures itself; a plotted title "Fig. 12: ..." under the article's "Figure 4"
+    contradicts it. The titles name the source's figure they reproduce without leading with a number."""
+    import re
+
+    from parksteer.figures.model import PLOTTERS
+
+    runs = [("unladen", "full")]
+    data = {runs[0]: simulate("unladen", params=params).columns}
+    for name, plot in PLOTTERS.items():
+        fig = plot(params, runs, data, {})
+        for ax in fig.axes:
+            assert not re.match(r"\s*Fig\.\s*\d+\s*:", ax.get_title()), (name, ax.get_title())

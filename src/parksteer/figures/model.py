@@ -247,7 +247,7 @@ def _loads_against_rack(params, runs, data, labels):
         ax.plot(1000 * c["rack_m"], c["load_right_N"], color=colour, linestyle="--", label=f"right wheel, {label}")
     ax.set_xlabel("rack displacement (mm), positive steering right")
     ax.set_ylabel("road wheel load (N)")
-    ax.set_title("Fig. 13: wheel loads against rack displacement (model)", fontsize=9)
+    ax.set_title("Wheel loads against rack displacement (model; the source's Fig. 13)", fontsize=9)
     # below the axes: inside, any corner covers part of a curve that spans the whole rack travel
     ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2, fontsize=7, frameon=False)
     fig.tight_layout()
@@ -336,13 +336,13 @@ def _summary(name: str, runs: list[Run], params: Parameters, data: dict) -> dict
 # figure -> plot(params, runs, data, labels)
 PLOTTERS = {
     "fig12": lambda p, r, d, lab: _torque_against_rack(
-        p, r, d, lab, "Fig. 12: handwheel torque against rack displacement (model)"),
+        p, r, d, lab, "Handwheel torque against rack displacement (model; the source's Fig. 12)"),
     "fig13": lambda p, r, d, lab: _loads_against_rack(p, r, d, lab),
-    "fig14": lambda p, r, d, lab: _torque_against_rack(p, r, d, lab, "Fig. 14: mechanisms omitted in turn (unladen)"),
+    "fig14": lambda p, r, d, lab: _torque_against_rack(p, r, d, lab, "Mechanisms omitted in turn, unladen (model; the source's Fig. 14)"),
     "fig15": lambda p, r, d, lab: _torque_against_rack(
-        p, r, d, lab, "Fig. 15: wheel offset varied by spacers, tyres on the ground"),
+        p, r, d, lab, "Wheel offset varied by spacers, tyres on the ground (model; the source's Fig. 15)"),
     "fig16": lambda p, r, d, lab: _torque_against_rack(
-        p, r, d, lab, "Fig. 16: wheel offset varied by spacers, tyres on air bearings"),
+        p, r, d, lab, "Wheel offset varied by spacers, tyres on air bearings (model; the source's Fig. 16)"),
     "figContrib": lambda p, r, d, lab: _contributions_over_time(p, d[r[0]]),
 }
 
