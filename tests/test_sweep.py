@@ -299,7 +299,8 @@ def test_braked_wheels_effect_agrees_with_rig_theory_and_matters_only_with_offse
     """Held wheels drag the patch about the axis's ground point: with the 68.5 mm spacer (62.7 mm at the ground,
     about 0.75 patch radii) the simulated braked_wheels effect raises the tyre's plateau share by the same factor
     as the rig theory applied after the fact (within 1 %: the effect's series for the patch integral and its
-    lateral-only offset), and the plateau by over 25 %; with the standard wheels (5.8 mm) by under 1 %."""
+    lateral-only offset), and the plateau by over 20 % (the drag part without equation (2)'s pressure correction,
+    as Fig. 4); with the standard wheels (5.8 mm) by under 1 %."""
     plateaus = {}
     for offset in (0.0, 0.0685):
         spec = {"sweep": "tiny", "point": "x", "case": "unladen", "effects": None, "surface": "ground",
@@ -313,7 +314,7 @@ def test_braked_wheels_effect_agrees_with_rig_theory_and_matters_only_with_offse
     free, held = plateaus[0.0]
     assert held / free == pytest.approx(1.0, abs=0.01)
     free, held = plateaus[0.0685]
-    assert held / free > 1.25
+    assert held / free > 1.2
 
 
 def test_point_job_never_derives(params, tmp_path, monkeypatch):

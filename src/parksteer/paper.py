@@ -9,6 +9,7 @@ depend on its inputs alone.
 from __future__ import annotations
 
 import re
+import subprocess
 from pathlib import Path
 
 import typst
@@ -18,9 +19,25 @@ from .tables import atomic_path
 FIXED_TIMESTAMP = 0  # 1970-01-01T00:00:00Z, as SOURCE_DATE_EPOCH=0
 
 
-def build(main_typ: str | Path, out_pdf: str | Path, root: str | Path = ".") -> int:
-    """Compile `main_typ` to `out_pdf`; return the page count."""
-    compiler = typst.Compiler(str(main_typ), root=str(root), ignore_system_fonts=True)
+def source_commit(root: str | Path = ".") -> str:
+    """The git commit of the checkout at `root` the article is built from, with "+ uncommitted changes" when its
+    tracked files differ from it; "unknown (not a git checkout)" outside a repository or without git."""
+    def git(*args: str) -> str:
+        return subprocess.run(["git", *args], cwd=root, capture_output=True, text=True, check=True).stdout.strip()
+
+    try:
+        commit = git("rev-parse", "HEAD")
+        dirty = git("status", "--porcelain", "--untracked-files=no")
+    except (OSError, subprocess.CalledProcessError):
+        return "unknown (not a git checkout)"
+    return commit + (" + uncommitted changes" if dirty else "")
+
+
+def build(main_typ: str | Path, out_pdf: str | Path, root: str | Path = ".", commit: str | None = None) -> int:
+    """Compile `main_typ` to `out_pdf`; return the page count. The document reads `commit` (default: the checkout's,
+    :func:`source_commit`) as ``sys.inputs.commit`` for its availability statement."""
+    commit = source_commit(root) if commit is None else commit
+    compiler = typst.Compiler(str(main_typ), root=str(root), ignore_system_fonts=True, sys_inputs={"commit": commit})
     pdf = compiler.compile(format="pdf", timestamp=FIXED_TIMESTAMP)
     with atomic_path(out_pdf) as tmp:
         tmp.write_bytes(pdf)

@@ -91,3 +91,21 @@ def test_benchmark_figure_data_is_the_same_whatever_the_timings(tmp_path):
         make_benchmark_figure(truths, results, folder / "b.svg", folder / "b.csv", folder / "b.json")
         csv_bytes.append((folder / "b.csv").read_bytes())
     assert csv_bytes[0] == csv_bytes[1]
+
+
+def test_benchmark_figure_shows_both_curves_when_they_coincide(scored, tmp_path, monkeypatch):
+    """Where every hidden candidate named was named first, the two accuracy curves carry the same numbers; the one
+    drawn underneath must stay visible beside the one on top (wider line and marks, lower in the drawing order)."""
+    import parksteer.figures.diagnose as diagnose_figures
+
+    figures = []
+    monkeypatch.setattr(diagnose_figures, "save_svg", lambda fig, path: figures.append(fig))
+    rows, summary = scored
+    for value in summary["by_steps"].values():
+        value["named_or_group"] = value["named_first"]
+    diagnose_figures.benchmark_figure(rows, summary, tmp_path / "b.svg")
+    (fig,) = figures
+    first, group = [line for line in fig.axes[1].lines if line.get_label().startswith("named")]
+    assert list(first.get_ydata()) == list(group.get_ydata())
+    assert first.get_zorder() < group.get_zorder()
+    assert first.get_linewidth() > 2 * group.get_linewidth() and first.get_markersize() > 1.5 * group.get_markersize()

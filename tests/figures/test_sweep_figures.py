@@ -90,3 +90,24 @@ def test_point_files_must_match_the_declaration(params, small_sweep):
     with pytest.raises(SweepError, match="do not match"):
         make_sweep_figure(declaration, params, points[:-1], root / "x.svg", root / "x.csv", root / "x.json")
     assert not (root / "x.svg").exists()
+
+
+def test_map_points_and_test_car_lie_inside_the_axes(params, small_sweep, monkeypatch, tmp_path):
+    """The torque map's grid points sit on its edges and the test car (1.225 bar, the lowest pressure) on one of
+    them: every sweep point and the test-car star lie strictly inside the axes limits, so none is cut in half."""
+    import parksteer.figures.sweep as sweep_figures
+
+    root, declaration, points = small_sweep
+    figures = []
+    monkeypatch.setattr(sweep_figures, "save_svg", lambda fig, path: figures.append(fig))
+    make_sweep_figure(declaration, params, points, tmp_path / "m.svg", tmp_path / "m.csv", tmp_path / "m.json")
+    (fig,) = figures
+    maps = [ax for ax in fig.axes if ax.collections and any(c.get_label() == "sweep points" for c in ax.collections)]
+    assert maps
+    for ax in maps:
+        (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()
+        shown = [c.get_offsets() for c in ax.collections if c.get_label() == "sweep points"]
+        shown += [np.column_stack(line.get_data()) for line in ax.lines if line.get_label() == "test car"]
+        xy = np.vstack(shown)
+        assert np.all((xy[:, 0] > x0) & (xy[:, 0] < x1) & (xy[:, 1] > y0) & (xy[:, 1] < y1))
+        assert any(line.get_label() == "test car" for line in ax.lines)

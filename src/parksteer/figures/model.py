@@ -118,6 +118,38 @@ def plateau_mask(columns: dict, params: Parameters) -> np.ndarray:
     return (columns["time_s"] < t_right) & (rack >= PLATEAU_RACK_M[0]) & (rack <= PLATEAU_RACK_M[1])
 
 
+STEP_LEVEL = 0.99  # tanh(beta v) of the rack speed at the two ends of the rack-friction step
+
+
+def _crossing_time(t: np.ndarray, x: np.ndarray, level: float, start: int) -> float:
+    """The first time from index `start` on at which x passes `level`, linearly interpolated."""
+    above = x[start:] >= level
+    k = start + int(np.flatnonzero(above[1:] != above[0])[0])
+    return float(t[k] + (level - x[k]) * (t[k + 1] - t[k]) / (x[k + 1] - x[k]))
+
+
+def reversal_step(columns: dict, params: Parameters) -> dict:
+    """The handwheel torque step at right lock while the rack friction reverses, measured where it happens.
+
+    The rack friction is F tanh(beta v); its step is taken between the instants at which tanh(beta v) passes
+    +0.99 and -0.99 (the rack speed's zero crossing at right lock), so the carcasses' unwinding over the rounded
+    reversal stays out of it. Returns the step, its window and (when the run has rack friction) the rack friction
+    share's own step.
+    """
+    t = np.asarray(columns["time_s"], dtype=float)
+    level = np.tanh(params["steering.friction_smoothing"] * np.asarray(columns["rack_speed_m_s"], dtype=float))
+    i_lock = int(np.argmax(columns["rack_m"]))
+    start = int(np.flatnonzero((level[:i_lock] >= STEP_LEVEL))[-1])
+    t0 = _crossing_time(t, level, STEP_LEVEL, start)
+    t1 = _crossing_time(t, level, -STEP_LEVEL, start)
+    torque = np.asarray(columns["handwheel_torque_Nm"], dtype=float)
+    out = {"step_Nm": float(np.interp(t0, t, torque) - np.interp(t1, t, torque)), "window_s": [t0, t1]}
+    if "contrib_rack_friction_Nm" in columns:
+        rack = np.asarray(columns["contrib_rack_friction_Nm"], dtype=float)
+        out["rack_friction_step_Nm"] = float(np.interp(t0, t, rack) - np.interp(t1, t, rack))
+    return out
+
+
 def cycle_summary(columns: dict, params: Parameters) -> dict:
     """Key numbers of one cycle: plateau, near lock, reversal drops, peak, loads, contribution shares."""
     t = _times(params)
@@ -135,6 +167,7 @@ def cycle_summary(columns: dict, params: Parameters) -> dict:
         "torque_near_left_lock_Nm": _at(columns, "handwheel_torque_Nm", before_left),
         "drop_at_right_lock_reversal_Nm": _at(columns, "handwheel_torque_Nm", before_right)
         - _at(columns, "handwheel_torque_Nm", after_right),
+        "reversal_step_at_right_lock_Nm": reversal_step(columns, params)["step_Nm"],
         "rise_at_left_lock_reversal_Nm": _at(columns, "handwheel_torque_Nm", after_left)
         - _at(columns, "handwheel_torque_Nm", before_left),
         "peak_torque_Nm": float(np.max(np.abs(torque))),
@@ -175,23 +208,38 @@ def _run_key(case: str, variant: str) -> str:
     return f"{case}__{variant}"
 
 
+def until_hand_stops(columns: dict, params: Parameters) -> np.ndarray:
+    """The samples of a cycle up to the hand's stop at its end: those after the last reversal's half rounding
+    before the end where the rack still moves (|tanh(beta v)| >= 0.99) or before. At rest the smoothed friction
+    tanh(beta v) vanishes, so the torque falls (16.7 to 12.8 N m unladen) along a vertical line at rack 0 that
+    is the friction model's artefact, not a measurement; the torque-rack figures end their curves before it."""
+    t = np.asarray(columns["time_s"], dtype=float)
+    level = np.abs(np.tanh(params["steering.friction_smoothing"] * np.asarray(columns["rack_speed_m_s"])))
+    stopping = t > t[-1] - _times(params)["half_rounding"]
+    return ~(stopping & (level < STEP_LEVEL))
+
+
 def _torque_against_rack(params, runs, data, labels, title, ylabel="handwheel torque (N m)"):
     fig, ax = new_figure(6.5, 4.2)
     for colour, (case, variant) in zip(COLOURS, runs):
         c = data[(case, variant)]
-        ax.plot(1000 * c["rack_m"], c["handwheel_torque_Nm"], color=colour, label=_label(params, case, variant, labels))
+        keep = until_hand_stops(c, params)
+        ax.plot(1000 * c["rack_m"][keep], c["handwheel_torque_Nm"][keep], color=colour,
+                label=_label(params, case, variant, labels))
     ax.axhline(0.0, color="0.5", linewidth=0.6)
     ax.axvline(0.0, color="0.5", linewidth=0.6)
     ax.set_xlabel("rack displacement (mm), positive steering right")
     ax.set_ylabel(ylabel)
     ax.set_title(title, fontsize=9)
     ax.legend(loc="upper left", fontsize=8)
+    ax.text(0.99, 0.02, "curves end as the hand stops at the cycle's end (at rest the smoothed friction vanishes)",
+            transform=ax.transAxes, ha="right", va="bottom", fontsize=6.5, color="0.3")
     fig.tight_layout()
     return fig
 
 
 def _loads_against_rack(params, runs, data, labels):
-    fig, ax = new_figure(6.5, 4.2)
+    fig, ax = new_figure(6.5, 4.8)
     for colour, (case, variant) in zip(COLOURS, runs):
         c = data[(case, variant)]
         label = _label(params, case, variant, labels)
@@ -199,8 +247,9 @@ def _loads_against_rack(params, runs, data, labels):
         ax.plot(1000 * c["rack_m"], c["load_right_N"], color=colour, linestyle="--", label=f"right wheel, {label}")
     ax.set_xlabel("rack displacement (mm), positive steering right")
     ax.set_ylabel("road wheel load (N)")
-    ax.set_title("Fig. 13: wheel loads against rack displacement (model)", fontsize=9)
-    ax.legend(loc="center left", fontsize=7)
+    ax.set_title("Wheel loads against rack displacement (model; the source's Fig. 13)", fontsize=9)
+    # below the axes: inside, any corner covers part of a curve that spans the whole rack travel
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2, fontsize=7, frameon=False)
     fig.tight_layout()
     return fig
 
@@ -287,13 +336,13 @@ def _summary(name: str, runs: list[Run], params: Parameters, data: dict) -> dict
 # figure -> plot(params, runs, data, labels)
 PLOTTERS = {
     "fig12": lambda p, r, d, lab: _torque_against_rack(
-        p, r, d, lab, "Fig. 12: handwheel torque against rack displacement (model)"),
+        p, r, d, lab, "Handwheel torque against rack displacement (model; the source's Fig. 12)"),
     "fig13": lambda p, r, d, lab: _loads_against_rack(p, r, d, lab),
-    "fig14": lambda p, r, d, lab: _torque_against_rack(p, r, d, lab, "Fig. 14: mechanisms omitted in turn (unladen)"),
+    "fig14": lambda p, r, d, lab: _torque_against_rack(p, r, d, lab, "Mechanisms omitted in turn, unladen (model; the source's Fig. 14)"),
     "fig15": lambda p, r, d, lab: _torque_against_rack(
-        p, r, d, lab, "Fig. 15: wheel offset varied by spacers, tyres on the ground"),
+        p, r, d, lab, "Wheel offset varied by spacers, tyres on the ground (model; the source's Fig. 15)"),
     "fig16": lambda p, r, d, lab: _torque_against_rack(
-        p, r, d, lab, "Fig. 16: wheel offset varied by spacers, tyres on air bearings"),
+        p, r, d, lab, "Wheel offset varied by spacers, tyres on air bearings (model; the source's Fig. 16)"),
     "figContrib": lambda p, r, d, lab: _contributions_over_time(p, d[r[0]]),
 }
 

@@ -40,6 +40,7 @@ QUANTITY_LABELS = {"peak_torque_Nm": "peak handwheel torque", "plateau_torque_Nm
                    "peak_torque_braked_Nm": "peak torque, wheels braked"}
 CONTOUR_STEP_NM = 2.0
 MAX_MAP_PANELS = 4
+MAP_MARGIN = 0.06  # of the plotted range, around the torque map's points and the test car
 
 
 def display(key: str) -> tuple[float, str]:
@@ -76,12 +77,20 @@ def _draw_map(ax, sweep: Sweep, records: list[dict], fixed: dict, levels, thresh
             ax.clabel(line, fmt=lambda v: f"{v:.1f} N m", fontsize=7)
     elif len(sel) >= 3:
         filled = ax.tricontourf(xs, ys, qs, levels=levels, cmap="viridis", extend="both")
-    ax.scatter(xs, ys, s=6, color="black", zorder=3, label="sweep points")
+    ax.scatter(xs, ys, s=6, color="black", zorder=3, label="sweep points", clip_on=False)
+    shown_x, shown_y = list(xs), list(ys)
     if mark_design:
-        ax.plot(design[spec.x]["base"] * fx, design[spec.y]["base"] * fy, marker="*", markersize=13,
-                color=COLOURS[4], markeredgecolor="black", linestyle="none", zorder=5, clip_on=False,
-                label="test car")
+        star = design[spec.x]["base"] * fx, design[spec.y]["base"] * fy
+        ax.plot(*star, marker="*", markersize=13, color=COLOURS[4], markeredgecolor="black", linestyle="none",
+                zorder=5, clip_on=False, label="test car")
+        shown_x.append(star[0])
+        shown_y.append(star[1])
         ax.legend(loc="lower right", fontsize=7, handlelength=1.0, framealpha=0.8, frameon=True)
+    # the grid's edge points and the test car (often on an edge) drawn whole, not cut by the axes frame
+    for values, set_limits in ((shown_x, ax.set_xlim), (shown_y, ax.set_ylim)):
+        low, high = min(values), max(values)
+        pad = MAP_MARGIN * ((high - low) or abs(high) or 1.0)
+        set_limits(low - pad, high + pad)
     ax.set_xlabel(xlabel)
     ax.set_ylabel(ylabel)
     ax.grid(False)

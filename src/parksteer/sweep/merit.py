@@ -31,7 +31,7 @@ from collections.abc import Mapping
 import numpy as np
 
 from ..geometry import steer_axis
-from ..rig import disc_distance_integral_m3, patch_radius_m
+from ..rig import disc_distance_integral_m3, patch_radius_m, pressure_correction
 
 SIDES = ("left", "right")
 MOVING_FRACTION = 0.5  # of the reference speed, for "moving", "arriving at lock" and "returning"
@@ -128,9 +128,11 @@ def braked_factor(params, case: str, pressure_Pa: float) -> float:
 
     Rig theory (parksteer.rig): a wheel free to roll needs only the spin moment of its patch,
     equation (1); a braked wheel drags the patch rigidly round the axis's ground point at
-    offset e, mu p Integral |r - e| dA. The pressure correction of equation (2) multiplies
-    both and cancels. The two wheels are weighted by their spin moments (W^1.5).
+    offset e, mu p Integral |r - e| dA. As in parksteer.rig.pin_torques_Nm, only the spin part
+    carries the pressure correction (p0/p)^(n - 1/2) of equation (2), so the drag part's share
+    f - 1 is divided by it. The two wheels are weighted by their spin moments (W^1.5).
     """
+    scale = float(pressure_correction(pressure_Pa, params["tyre.reference_pressure"], params["tyre.pressure_index"]))
     loads = {side: params.case(case)[f"load_{side}"] for side in SIDES}
     weighted = total = 0.0
     for side in SIDES:
@@ -138,7 +140,7 @@ def braked_factor(params, case: str, pressure_Pa: float) -> float:
         ratio = float(disc_distance_integral_m3(radius, ground_offset_m(params, case, side))) / (
             2.0 * math.pi * radius**3 / 3.0)
         weight = loads[side] ** 1.5
-        weighted += weight * ratio
+        weighted += weight * (1.0 + (ratio - 1.0) / scale)
         total += weight
     return weighted / total
 

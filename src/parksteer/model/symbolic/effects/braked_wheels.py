@@ -10,13 +10,14 @@ torque (parksteer.rig.braked_pin_torque_Nm),
 
     T_braked(e) = mu p Integral |r - e| dA = M_spin f(e / R),   f(0) = 1,  f -> 3 e / (2 R) for e >> R,
 
-over the uniform-pressure disc of radius R (pi R^2 p = W), scaled like equation (2). This
-effect adds the excess, s M(W) (f(e / R) - 1), to each tread ring's friction moment with the
-same tanh of the ring's yaw rate (s: the brake fraction, 0 = rolling freely, 1 = locked).
+over the uniform-pressure disc of radius R (pi R^2 p = W). This effect adds the drag part, the
+excess s M_1(W) (f(e / R) - 1) with M_1 equation (1), to each tread ring's friction moment with
+the same tanh of the ring's yaw rate (s: the brake fraction, 0 = rolling freely, 1 = locked); the
+spin part stays the tyre_friction effect's equation (2). As in the rig's Fig. 4
+(parksteer.rig.pin_torques_Nm), only the spin part carries equation (2)'s pressure correction
+(p0/p)^(n - 1/2): a pressure distribution changes the spin friction's moment arm, never the net
+sliding force mu W, so the drag part stays the uniform-pressure integral, at most mu W e.
 It is a lumped equivalent: the net sliding force that goes with the moment is not applied.
-The excess carries equation (2)'s pressure correction (p0/p)^(n - 1/2) through M(W) as a whole; the
-rig's Fig. 4 (parksteer.rig.pin_torques_Nm) scales the spin part only, which gives the excess
-M_1(W) (f - 1) with M_1 equation (1), smaller by that factor (1.21 at the car's 1.225 bar).
 
 Only brakes hold the wheels. A front-drive car in gear is not braked in this sense: its open
 differential, with the carrier held by the gearbox, still lets the two wheels turn in opposite
@@ -62,7 +63,8 @@ class BrakedWheels(Effect):
     name = "braked_wheels"
     description = (
         "Wheels held by the brakes: the patch slides rigidly about the steer axis's ground intercept, adding "
-        "s M(W) (f(scrub offset / patch radius) - 1) to each tread's friction moment (rig theory); 0 = free to roll"
+        "s M_1(W) (f(scrub offset / patch radius) - 1), M_1 equation (1), to each tread's friction moment (rig "
+        "theory, the drag part without the pressure correction); 0 = free to roll"
     )
     in_default_set = False
     uses = ("braked_wheels.brake_fraction", *TYRE_FRICTION.uses)
@@ -82,6 +84,7 @@ class BrakedWheels(Effect):
         k = model.kinematics
         fraction = model.p("braked_wheels.brake_fraction")
         pressure = model.p("tyre.tyre_pressure")
+        p0, n = model.p("tyre.reference_pressure"), model.p("tyre.pressure_index")
         beta = model.p("steering.friction_smoothing")
         grip = model.d("surface_grip")
         out = []
@@ -90,7 +93,9 @@ class BrakedWheels(Effect):
             patch_radius_squared = sp.Piecewise((load, load > 0), (0, True)) / (sp.pi * pressure)
             # a wheel off the ground has no patch (and no moment: moment_limit is 0 there)
             k_squared = self.scrub_offset_squared(model, side) / sp.Max(patch_radius_squared, sp.Float(1e-12))
-            excess = fraction * TYRE_FRICTION.moment_limit(model, load) * braked_excess_ratio(k_squared)
+            # equation (1): equation (2) without its pressure correction (p0/p)^(n - 1/2)
+            spin_uniform = TYRE_FRICTION.moment_limit(model, load) / (p0 / pressure) ** (n - sp.Rational(1, 2))
+            excess = fraction * spin_uniform * braked_excess_ratio(k_squared)
             ring = k.ring_frame[side]
             yaw_rate = ring.ang_vel_in(model.N).dot(model.N.z)
             out.append(me.Torque(ring, -grip * excess * sp.tanh(beta * yaw_rate) * model.N.z))

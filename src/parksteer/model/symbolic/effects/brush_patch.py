@@ -25,6 +25,14 @@ and friction shares and the yaw inertia share w_j of the tread ring. The strengt
 the removed shares and the inner annuli's springs, dampers, frictions and inertias are all
 scaled by s (the inertias by s + 0.001, which keeps the mass matrix positive definite at s = 0,
 where the annuli are free and carry nothing). Requires carcass_compliance and tyre_friction.
+
+Sidewall and brush: in a tyre the carcass sidewall is a spring in series with the tread bristles
+(wheel - sidewall - tread base - bristles - ground). This effect has no separate sidewall: the
+paper's whole carcass compliance 1/k is given to the bristles, so s = 1 is the series arrangement's
+limit of a rigid sidewall. With a sidewall taking a fraction phi of the compliance (1/k_s = phi/k,
+1/k_b = (1 - phi)/k, the same initial slope), the extra twist the rounded knee adds to the lumped law
+at any moment below M is (1 - phi) times this effect's, and the sliding moment is the same M: the
+rounding modelled here is an upper bound, reached when the bristles carry all the compliance.
 """
 
 from __future__ import annotations

@@ -1,0 +1,24 @@
+# Bands on the headline numbers: each number the paper quotes over the reconstructed inputs (Hooke joint phase,
+# lock angle, wheel radius, assembly mass centre, saw-tooth rounding), moved one at a time through parameter
+# overrides of the figures' compiled model (parksteer.figures.bands). Writes the band table (CSV), a tornado
+# figure (SVG) and the numbers the paper quotes (results/bands.json).
+FIGURES["bands"] = ["figures/bands.svg", "figures/bands.csv"]
+
+
+rule bands:
+    input:
+        parameters=PARAMETERS,
+        model=model_manifest("full", None),
+        code=script_sources("bands"),
+    output:
+        svg="figures/bands.svg",
+        csv="figures/bands.csv",
+        json="results/bands.json",
+    log:
+        "logs/bands.log",
+    benchmark:
+        benchmark_file("bands")
+    conda:
+        "../envs/parksteer.yaml"
+    script:
+        "../scripts/bands.py"
