@@ -17,7 +17,8 @@ in every one of these, each in a way a real test could:
   (whose full scale is left out): the diagnosis then knows the torque's step and estimates the rack's noise
   from the data.
 
-Nothing is hidden: these are the null records on which a diagnosis must say ``adequate``.
+:func:`null_variations` names one record per way of differing: with nothing hidden, a diagnosis must say
+``adequate`` on each; ``benchmarks/bench_variations.py`` hides library effects in them as well.
 """
 
 from __future__ import annotations
@@ -129,13 +130,16 @@ class VariationLogger:
 
 
 def variation_record(params: Parameters, hand: HandVariant, logger: VariationLogger, case: str = "unladen",
-                     surface: str = "ground", overrides: dict[str, float] | None = None) -> Measurement:
-    """A null record: `hand` drives the rack, the model's prescribed-rack solve gives the torque, `logger` logs both."""
+                     surface: str = "ground", overrides: dict[str, float] | None = None, effects=None) -> Measurement:
+    """A record: `hand` drives the rack, the model's prescribed-rack solve gives the torque, `logger` logs both.
+
+    With `effects` (a spec as ``parksteer simulate --effects``) and `overrides`, something is hidden in it;
+    by default nothing is (a null).
+    """
     from ..model.numeric.simulate import simulate
 
-    t_hand, angle = variation_hand(params, hand)
-    drive = interpolate_rack(t_hand, rack_of_hand(params, angle))
-    result = simulate(case, overrides=overrides, surface=surface, rack_drive=drive, params=params,
+    drive = variation_rack(params, hand)
+    result = simulate(case, effects=effects, overrides=overrides, surface=surface, rack_drive=drive, params=params,
                       output_dt_s=CLEAN_DT_S)
     t = np.asarray(result.columns["time_s"], dtype=float)
     clean = {"rack_m": np.asarray(result.columns["rack_m"]),
@@ -154,6 +158,12 @@ def variation_record(params: Parameters, hand: HandVariant, logger: VariationLog
     }
     columns = {"time_s": time_s, "rack_m": rack, "handwheel_torque_Nm": torque}
     return Measurement(path=None, columns=columns, metadata={k: metadata_text(v) for k, v in metadata.items()})
+
+
+def variation_rack(params: Parameters, hand: HandVariant):
+    """The rack the hand drives (a spline through its fine samples, the motion itself)."""
+    t_hand, angle = variation_hand(params, hand)
+    return interpolate_rack(t_hand, rack_of_hand(params, angle))
 
 
 def null_variations(seed: int = 0) -> list[tuple[str, HandVariant, VariationLogger]]:
