@@ -16,7 +16,7 @@ the parameter file's values (the benchmark's perturbation, config/config.yaml). 
 - coverage: the fraction of the 95 % intervals of the reported model (the calibrated base, or with the named
   effect when the verdict is ``missing``: its strength too) that hold the true values.
 
-The default grid (five variations, one seed, a null and rack stiction in each: ten diagnoses) takes a few
+The default grid (six variations, one seed, a null and rack stiction in each: twelve diagnoses) takes a few
 minutes on 2 cores, too long for the pipeline's DAG; ``--full`` adds seeds and hidden effects.
 Prints the table per variation and writes every record's outcome as JSON.
 """
@@ -37,6 +37,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--hidden", default="rack_stiction", help="comma-separated library effects to hide")
     parser.add_argument("--steps", type=float, default=3.5, help="hidden size, converter steps of torque RMS")
     parser.add_argument("--seeds", type=int, default=1, help="seeds per variation")
+    parser.add_argument("--only", default="", help="comma-separated variation names (default: all)")
     args = parser.parse_args(argv)
     hidden = [h for h in args.hidden.split(",") if h]
     seeds = args.seeds
@@ -84,6 +85,8 @@ def main(argv: list[str] | None = None) -> int:
     records = []
     for seed in range(seeds):
         for name, hand, logger in null_variations(seed * 10):
+            if args.only and name not in args.only.split(","):
+                continue
             base = perturbed_base(params, 9000 + seed * 10 + len(records), perturbation)
             step = quantisation_step(logger.torque_full_scale_Nm, logger.torque_bits)
             for effect in [None] + hidden:

@@ -74,3 +74,25 @@ def test_sandwich_agrees_with_white_noise_when_the_residual_is_white():
         sandwich, _ = block_sandwich(design, residual, problem, 2.0)
         ratios.append(sandwich[0, 0] / white[0, 0])
     assert 0.85 < np.mean(ratios) < 1.3
+
+
+@dataclass
+class _ReplayFile:
+    replay_draws_Nm: np.ndarray
+    sigma_Nm: np.ndarray
+
+
+def test_replay_covariance_is_the_spread_of_the_shifts_the_racks_would_cause():
+    """If each replayed rack changed the torque exactly as a parameter change a_d would (d = sigma J a_d), a fit
+    would absorb it as that change: the replay's covariance is then the sample covariance of the a_d."""
+    from parksteer.diagnose.calibrate import replay_covariance
+
+    rng = np.random.default_rng(7)
+    t = np.arange(0.0, 18.0, 0.02)
+    jacobian = np.column_stack([np.sin(2 * np.pi * t / 18.0), np.cos(2 * np.pi * t / 9.0)])
+    sigma = 0.2 + 0.1 * np.abs(np.sin(t))
+    shifts = rng.normal(size=(8, 2)) * [0.3, 0.05]
+    shifts -= shifts.mean(axis=0)
+    draws = (jacobian @ shifts.T).T * sigma
+    covariance = replay_covariance(jacobian, _Problem([_ReplayFile(draws, sigma)]))
+    assert np.allclose(covariance, np.cov(shifts.T, ddof=1), rtol=1e-9, atol=1e-12)

@@ -100,7 +100,10 @@ class Fit:
         (J^T J)^-1`` with ``g_b = J_b^T r_b`` the block's score (:func:`block_sandwich`). The
         model-based one is right only if the model is exact and the residual is noise; the
         sandwich takes the residual as it is, a structured misfit included, so its
-        intervals widen when the model class is not exact. With the sandwich the 95 % point is
+        intervals widen when the model class is not exact. Neither sees an error of the replayed
+        rack itself, which is one error for the whole record and so shifts the fit rather than
+        the residual: its share (:func:`replay_covariance`, the spread of the fitted values the
+        replay ensemble's racks would give) is added in quadrature. With the sandwich the 95 % point is
         Student's t with B - k degrees of freedom (B blocks), since the meat is estimated from B blocks.
         """
         if not self.parameters:
@@ -111,14 +114,17 @@ class Fit:
         try:
             covariance = variance * np.linalg.inv(self.jacobian.T @ self.jacobian)
             sandwich, blocks = block_sandwich(self.jacobian, self.weighted, problem, block_s)
+            replay = replay_covariance(self.jacobian, problem)
         except np.linalg.LinAlgError:
             covariance, sandwich, blocks = np.full((k, k), np.inf), np.full((k, k), np.inf), 0
+            replay = np.zeros((k, k))
         quantile = float(student_t.ppf(0.975, blocks - k)) if blocks > k else math.inf
         out = {}
         for i, (p, t) in enumerate(zip(self.parameters, self.theta)):
             model_se = math.sqrt(max(covariance[i, i], 0.0))
             sandwich_se = math.sqrt(max(sandwich[i, i], 0.0))
-            half = max(Z95 * model_se, quantile * sandwich_se)
+            # the replay's own error is common to every block (one rack for the whole record): added apart
+            half = math.hypot(max(Z95 * model_se, quantile * sandwich_se), Z95 * math.sqrt(max(replay[i, i], 0.0)))
             se = half / Z95
             low, high = p.value(t - half), p.value(t + half)
             if p.transform == "linear":
@@ -150,6 +156,20 @@ def block_sandwich(jacobian: np.ndarray, weighted: np.ndarray, problem: Problem,
         meat += np.outer(score, score)
     scale = offset / max(offset - k, 1)
     return scale * bread @ meat @ bread, offset
+
+
+def replay_covariance(jacobian: np.ndarray, problem: Problem) -> np.ndarray:
+    """Covariance of the fitted parameters from the replay's own uncertainty: each rack of the replay ensemble
+    (:meth:`parksteer.diagnose.problem.Problem.estimate_replay_uncertainty`) changes the replayed torque by its
+    deviation d from the ensemble mean, which a fit absorbs as the parameter shift (J^T J)^-1 J^T (d / sigma);
+    the covariance of these shifts over the draws. Zero when the ensemble was not run."""
+    k = jacobian.shape[1]
+    draws = [f.replay_draws_Nm for f in problem.files]
+    if any(d is None for d in draws) or len({d.shape[0] for d in draws}) != 1 or draws[0].shape[0] < 2:
+        return np.zeros((k, k))
+    deviations = np.concatenate([d / f.sigma_Nm for d, f in zip(draws, problem.files)], axis=1)
+    shifts = np.linalg.solve(jacobian.T @ jacobian, jacobian.T @ deviations.T)  # k x draws
+    return shifts @ shifts.T / (shifts.shape[1] - 1)
 
 
 def _predict(problem: Problem, effects: list[Effect], parameters: list[FitParameter], theta: np.ndarray,

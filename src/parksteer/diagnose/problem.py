@@ -62,6 +62,8 @@ class FileData:
     phases: CyclePhases
     noise: NoiseFloor
     replay_uncertainty_Nm: np.ndarray | None = None
+    # each draw's replayed torque less the draws' mean (draws x samples), from the latest estimate
+    replay_draws_Nm: np.ndarray | None = None
 
     @property
     def time_s(self) -> np.ndarray:
@@ -191,7 +193,9 @@ class Problem:
                 other = Replay(list(effects), f.case, f.surface, self.params, rack, f.time_s)
                 runs.append(other.torque(overrides))
             base.evaluations += draws
-            spread = maximum_filter1d(np.std(np.array(runs), axis=0, ddof=1), size=3, mode="nearest")
+            runs = np.array(runs)
+            f.replay_draws_Nm = runs - runs.mean(axis=0)
+            spread = maximum_filter1d(np.std(runs, axis=0, ddof=1), size=3, mode="nearest")
             if keep_larger and f.replay_uncertainty_Nm is not None:
                 spread = np.maximum(spread, f.replay_uncertainty_Nm)
             f.replay_uncertainty_Nm = spread

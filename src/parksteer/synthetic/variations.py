@@ -176,4 +176,6 @@ def null_variations(seed: int = 0) -> list[tuple[str, HandVariant, VariationLogg
         ("rate_8pc_50Hz", HandVariant(0.08, 0.3, 0.0, "rest", 0.3, seed=seed + 4), VariationLogger(50.0, 12, 8, seed=seed + 4)),
         ("rate_3pc_200Hz", HandVariant(0.03, 0.1, 0.0, "mid_stroke", cut_before_end_s=0.1, seed=seed + 5),
          VariationLogger(200.0, 12, 8, seed=seed + 5)),
+        ("rack_8bit_torque_12bit", HandVariant(0.05, 0.2, 0.6, "mid_stroke", cut_before_end_s=0.15, seed=seed + 6),
+         VariationLogger(100.0, 8, 12, rack_noise_m=2e-4, seed=seed + 6)),
     ]
