@@ -18,7 +18,8 @@ have moved far since, because the confidence intervals and the projections of th
 candidates' signatures rely on it. Confidence intervals are 95 % intervals from the
 Jacobian, ``cov = s^2 (J^T J)^-1`` with s^2 the residual variance, inflated by (1 + rho) / (1 -
 rho) for the lag-1 autocorrelation rho of the residuals (their effective sample size is
-smaller than their count).
+smaller than their count), or, where larger, from a block sandwich over segments of the cycle
+(:meth:`Fit.intervals`), which holds when the residual is a structured misfit and not noise.
 """
 
 from __future__ import annotations
@@ -27,6 +28,7 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy.stats import t as student_t
 
 from ..model.symbolic.components import Effect
 from ..parameters import quantity
@@ -90,8 +92,20 @@ class Fit:
     def rho(self, problem: Problem) -> float:
         return lag1_autocorrelation(problem, self.weighted)
 
-    def intervals(self, problem: Problem) -> dict[str, dict]:
-        """Value, standard error and 95 % interval of each parameter (in its own unit)."""
+    def intervals(self, problem: Problem, block_s: float = DEFAULT_SETTINGS.interval_block_s) -> dict[str, dict]:
+        """Value, standard error and 95 % interval of each parameter (in its own unit).
+
+        The standard error is the larger of two: the model-based one (module docstring) and a
+        block sandwich over `block_s` segments of each file, ``B/(B-k) (J^T J)^-1 (sum_b g_b g_b^T)
+        (J^T J)^-1`` with ``g_b = J_b^T r_b`` the block's score (:func:`block_sandwich`). The
+        model-based one is right only if the model is exact and the residual is noise; the
+        sandwich takes the residual as it is, a structured misfit included, so its
+        intervals widen when the model class is not exact. Neither sees an error of the replayed
+        rack itself, which is one error for the whole record and so shifts the fit rather than
+        the residual: its share (:func:`replay_covariance`, the spread of the fitted values the
+        replay ensemble's racks would give) is added in quadrature. With the sandwich the 95 % point is
+        Student's t with B - k degrees of freedom (B blocks), since the meat is estimated from B blocks.
+        """
         if not self.parameters:
             return {}
         n, k = self.weighted.size, len(self.parameters)
@@ -99,17 +113,63 @@ class Fit:
         variance = self.rss / max(n - k, 1) * (1.0 + rho) / (1.0 - rho)
         try:
             covariance = variance * np.linalg.inv(self.jacobian.T @ self.jacobian)
+            sandwich, blocks = block_sandwich(self.jacobian, self.weighted, problem, block_s)
+            replay = replay_covariance(self.jacobian, problem)
         except np.linalg.LinAlgError:
-            covariance = np.full((k, k), np.inf)
+            covariance, sandwich, blocks = np.full((k, k), np.inf), np.full((k, k), np.inf), 0
+            replay = np.zeros((k, k))
+        quantile = float(student_t.ppf(0.975, blocks - k)) if blocks > k else math.inf
         out = {}
         for i, (p, t) in enumerate(zip(self.parameters, self.theta)):
-            se = math.sqrt(max(covariance[i, i], 0.0))
-            low, high = p.value(t - Z95 * se), p.value(t + Z95 * se)
+            model_se = math.sqrt(max(covariance[i, i], 0.0))
+            sandwich_se = math.sqrt(max(sandwich[i, i], 0.0))
+            # the replay's own error is common to every block (one rack for the whole record): added apart
+            half = math.hypot(max(Z95 * model_se, quantile * sandwich_se), Z95 * math.sqrt(max(replay[i, i], 0.0)))
+            se = half / Z95
+            low, high = p.value(t - half), p.value(t + half)
             if p.transform == "linear":
-                low, high = t - Z95 * se, t + Z95 * se  # the interval itself may cross a bound
+                low, high = t - half, t + half  # the interval itself may cross a bound
             out[p.key] = {"value": p.value(t), "ci95": [low, high],
                           "standard_error": (p.value(t) * se if p.transform == "log" else se)}
         return out
+
+
+def block_sandwich(jacobian: np.ndarray, weighted: np.ndarray, problem: Problem, block_s: float
+                   ) -> tuple[np.ndarray, int]:
+    """(Block sandwich covariance of the fitted parameters, number of blocks B): residuals grouped in segments
+    of `block_s` of each file (a last segment shorter than half a block joins the one before)."""
+    ids, start, offset = [], 0, 0
+    for f in problem.files:
+        t = f.time_s - f.time_s[0]
+        count = max(int(round(t[-1] / block_s)), 1)
+        block = np.minimum((t / (t[-1] / count)).astype(int), count - 1) if t[-1] > 0 else np.zeros(f.n, dtype=int)
+        ids.append(block + offset)
+        offset += count
+        start += f.n
+    ids = np.concatenate(ids)
+    k = jacobian.shape[1]
+    bread = np.linalg.inv(jacobian.T @ jacobian)
+    meat = np.zeros((k, k))
+    for b in range(offset):
+        rows = ids == b
+        score = jacobian[rows].T @ weighted[rows]
+        meat += np.outer(score, score)
+    scale = offset / max(offset - k, 1)
+    return scale * bread @ meat @ bread, offset
+
+
+def replay_covariance(jacobian: np.ndarray, problem: Problem) -> np.ndarray:
+    """Covariance of the fitted parameters from the replay's own uncertainty: each rack of the replay ensemble
+    (:meth:`parksteer.diagnose.problem.Problem.estimate_replay_uncertainty`) changes the replayed torque by its
+    deviation d from the ensemble mean, which a fit absorbs as the parameter shift (J^T J)^-1 J^T (d / sigma);
+    the covariance of these shifts over the draws. Zero when the ensemble was not run."""
+    k = jacobian.shape[1]
+    draws = [f.replay_draws_Nm for f in problem.files]
+    if any(d is None for d in draws) or len({d.shape[0] for d in draws}) != 1 or draws[0].shape[0] < 2:
+        return np.zeros((k, k))
+    deviations = np.concatenate([d / f.sigma_Nm for d, f in zip(draws, problem.files)], axis=1)
+    shifts = np.linalg.solve(jacobian.T @ jacobian, jacobian.T @ deviations.T)  # k x draws
+    return shifts @ shifts.T / (shifts.shape[1] - 1)
 
 
 def _predict(problem: Problem, effects: list[Effect], parameters: list[FitParameter], theta: np.ndarray,

@@ -14,7 +14,10 @@ the converter's levels) and smoothed again, a few times
 whole logging and smoothing); otherwise splines are drawn from the least-squares
 distribution of the coefficients, as if the rack noise were white
 (:meth:`parksteer.measure.smoothing.SmoothedRack.perturbed`). Replaying them and taking the
-spread of the torque at each sample gives how far the replay alone can be off there. It is tiny on the
+spread of the torque at each sample gives how far the replay alone can be off there (where the
+smoothing held an end of the record or a pause of the hand at rest, every other draw leaves
+them free: a record cut while the hand is still slowing passes the smoothing's rest test, the
+edges of a pause are not sharp, and the rack friction there hangs on that choice). It is tiny on the
 plateaus and large at a reversal, where the rack friction flips within about a millimetre
 per second of zero speed, so the turning time the data allow decides which sample carries
 the torque drop. Each sample then has an attainable error ``sigma_i = sqrt(noise_floor^2 +
@@ -59,6 +62,8 @@ class FileData:
     phases: CyclePhases
     noise: NoiseFloor
     replay_uncertainty_Nm: np.ndarray | None = None
+    # each draw's replayed torque less the draws' mean (draws x samples), from the latest estimate
+    replay_draws_Nm: np.ndarray | None = None
 
     @property
     def time_s(self) -> np.ndarray:
@@ -173,27 +178,36 @@ class Problem:
         for i, f in enumerate(self.files):
             base = self.replay(effects, i)
             logger = rack_logger(f.measurement)
+            # An end held at rest may be a hand still slowing there, and a pause's edges are not sharp
+            # (smoothing.RACK_REST_TEST_CHI2, RACK_REST_MIN_S): every other draw smooths with the ends and the
+            # pauses free, so the samples there carry that doubt.
+            released = (smooth_rack(f.time_s, f.rack_m, f.rack.knot_spacing_s, hold_rest=False)
+                        if any(f.rack.held_at_rest) or f.rack.rest_intervals_s else None)
             runs = []
-            for _ in range(draws):
+            for k in range(draws):
+                source, hold = (released, False) if released is not None and k % 2 else (f.rack, True)
                 if logger is not None:
-                    rack = relogged_rack(f.rack, f.time_s, *logger, rng)
+                    rack = relogged_rack(source, f.time_s, *logger, rng, hold_rest=hold)
                 else:
-                    rack = f.rack.perturbed(rng)
+                    rack = source.perturbed(rng)
                 other = Replay(list(effects), f.case, f.surface, self.params, rack, f.time_s)
                 runs.append(other.torque(overrides))
             base.evaluations += draws
-            spread = maximum_filter1d(np.std(np.array(runs), axis=0, ddof=1), size=3, mode="nearest")
+            runs = np.array(runs)
+            f.replay_draws_Nm = runs - runs.mean(axis=0)
+            spread = maximum_filter1d(np.std(runs, axis=0, ddof=1), size=3, mode="nearest")
             if keep_larger and f.replay_uncertainty_Nm is not None:
                 spread = np.maximum(spread, f.replay_uncertainty_Nm)
             f.replay_uncertainty_Nm = spread
 
 
 def relogged_rack(rack: SmoothedRack, time_s: np.ndarray, full_scale: float, bits: int, analog_rms: float,
-                  rng: np.random.Generator) -> SmoothedRack:
+                  rng: np.random.Generator, hold_rest: bool = True) -> SmoothedRack:
     """A rack the logger could equally have recorded: `rack` at `time_s` with analog noise of `analog_rms`,
     rounded to the levels of a `bits` converter over +-`full_scale`, and smoothed again
     (:meth:`parksteer.measure.smoothing.SmoothedRack.resmoothed`)."""
-    return rack.resmoothed(time_s, lambda clean: quantise(add_noise(clean, analog_rms, rng), full_scale, bits))
+    return rack.resmoothed(time_s, lambda clean: quantise(add_noise(clean, analog_rms, rng), full_scale, bits),
+                           hold_rest)
 
 
 def rack_logger(measurement: Measurement) -> tuple[float, int, float] | None:

@@ -45,6 +45,11 @@ class DiagnosisSettings:
     # The Jacobian is recomputed by finite differences at the end of a fit when a parameter has moved
     # by more than this (in its fitted variable: 0.15 is 15 % of a log-fitted value) since it was taken.
     jacobian_refresh_theta: float = 0.15
+    # Intervals of fitted parameters: the larger of the model-based one and a block sandwich over segments of
+    # this length, s (parksteer.diagnose.calibrate.Fit.intervals). A misfit of a wrong model class keeps one sign
+    # over a stretch of a stroke (about 2 s of the 4.5 to 9 s strokes), so residuals within a segment are
+    # taken as dependent and segments as independent; an 18 s record gives 9 segments.
+    interval_block_s: float = 2.0
 
     # --- candidates, score test and selection (parksteer.diagnose.candidates, .select) ---------------------
     # A candidate's signature is taken at a probe strength giving this RMS torque change (in noise

@@ -58,6 +58,21 @@ RACK_TURN_WINDOW_S = 0.5
 # Each end of the record is held at rest unless that raises the fit's sum of squares by more than this many
 # noise variances (see _lsq_fit).
 RACK_REST_TEST_CHI2 = 25.0  # 1
+# A record cut while the hand is still slowing (about 1 mm/s, where the rack friction's tanh is already near its
+# full value) can pass that test, and holding the end at rest then drops the rack friction from the last samples
+# (3 to 5 N m): the data cannot tell. The replay's uncertainty (parksteer.diagnose.problem) therefore replays
+# racks smoothed with the ends free as well as held (smooth_rack(hold_rest=False)).
+# The same holds at the edges of a pause (RACK_REST_MIN_S below): where the hand comes to rest the rack speed
+# passes through the friction's tanh over a few hundredths of a second that the data do not fix, so the free
+# alternative there is replayed too.
+RACK_REST_SLOPE_SE = 3.0  # 1
+# A pause of the hand: a stretch of at least RACK_REST_MIN_S where a quadratic fitted to the rack over a window of
+# that length, centred on each sample, has speed and acceleration both within RACK_REST_SLOPE_SE standard errors
+# of zero. There the spline is held constant (its B-spline coefficients over the stretch equal, with a knot at
+# each end of it): left free, a spline with knots a fifth of a second apart rings after the stop (a few tenths
+# of a mm/s either way), and the rack friction flips sign with it, which the data at rest never do. The window
+# is the cycle's reversal time (about 0.4 s), so that a reversal without a pause (a parabola, not a line) fails.
+RACK_REST_MIN_S = 0.4
 
 
 @dataclass(frozen=True, eq=False)
@@ -152,21 +167,25 @@ class SmoothedRack(RackSpline):
     noise_rms_m: float = 0.0
     held_at_rest: tuple[bool, bool] = (False, False)  # (start, end) of the record
     turning_times_s: tuple[float, ...] = ()  # where the rack reverses (each has a knot)
+    rest_intervals_s: tuple[tuple[float, float], ...] = ()  # pauses of the hand, where the spline is constant
 
     @classmethod
     def from_bspline(cls, knots, bspline, covariance, knot_spacing_s, fit_rms_m, noise_rms_m,
-                     held_at_rest=(False, False), turning_times_s=()) -> SmoothedRack:
+                     held_at_rest=(False, False), turning_times_s=(), rest_intervals_s=()) -> SmoothedRack:
         piecewise = RackSpline.from_ppoly(PPoly.from_spline(BSpline(knots, bspline, 3, extrapolate=False)))
         return cls(piecewise.breaks, piecewise.coefficients, knots, bspline, covariance, float(knot_spacing_s),
-                   float(fit_rms_m), float(noise_rms_m), tuple(held_at_rest), tuple(turning_times_s))
+                   float(fit_rms_m), float(noise_rms_m), tuple(held_at_rest), tuple(turning_times_s),
+                   tuple(rest_intervals_s))
 
     def perturbed(self, rng: np.random.Generator) -> SmoothedRack:
         """A rack the data allow as well: coefficients drawn from their least-squares distribution."""
         draw = rng.multivariate_normal(self.bspline, self.coefficient_covariance, method="eigh")
         return SmoothedRack.from_bspline(self.knots, draw, self.coefficient_covariance, self.knot_spacing_s,
-                                         self.fit_rms_m, self.noise_rms_m, self.held_at_rest, self.turning_times_s)
+                                         self.fit_rms_m, self.noise_rms_m, self.held_at_rest, self.turning_times_s,
+                                         self.rest_intervals_s)
 
-    def resmoothed(self, time_s: np.ndarray, log: Callable[[np.ndarray], np.ndarray]) -> SmoothedRack:
+    def resmoothed(self, time_s: np.ndarray, log: Callable[[np.ndarray], np.ndarray],
+                   hold_rest: bool = True) -> SmoothedRack:
         """A rack the logger could equally have recorded: this spline at `time_s`, logged by `log`, smoothed again.
 
         `log` maps a clean rack (m) to a logged one (noise and rounding to the logger's levels;
@@ -177,7 +196,7 @@ class SmoothedRack(RackSpline):
         sample to sample rather than independent, and the turning time the data fix is
         correspondingly less certain.
         """
-        return smooth_rack(time_s, log(self.evaluate(time_s)[0]), self.knot_spacing_s)
+        return smooth_rack(time_s, log(self.evaluate(time_s)[0]), self.knot_spacing_s, hold_rest)
 
     def summary(self) -> dict:
         """The smoothing's settings and fit (for JSON)."""
@@ -188,10 +207,12 @@ class SmoothedRack(RackSpline):
             "held_at_rest_at_start": bool(self.held_at_rest[0]),
             "held_at_rest_at_end": bool(self.held_at_rest[1]),
             "turning_times_s": list(self.turning_times_s),
+            "rest_intervals_s": [list(r) for r in self.rest_intervals_s],
         }
 
 
-def _knot_vector(t: np.ndarray, spacing_s: float, turns: tuple[float, ...] = ()) -> np.ndarray:
+def _knot_vector(t: np.ndarray, spacing_s: float, turns: tuple[float, ...] = (),
+                 rests: tuple[tuple[float, float], ...] = ()) -> np.ndarray:
     """Clamped cubic knots: evenly spaced interior knots about `spacing_s` apart, and one at each turning time.
 
     A reversal is the one place where the rack's motion changes within a few tenths of a
@@ -203,9 +224,46 @@ def _knot_vector(t: np.ndarray, spacing_s: float, turns: tuple[float, ...] = ())
     pieces = max(1, int(round(span / spacing_s)))
     interior = list(t[0] + span * np.arange(1, pieces) / pieces)
     closest = RACK_MIN_SAMPLES_PER_KNOT * float(np.median(np.diff(t)))
+    turns = [x for x in turns if not any(a <= x <= b for a, b in rests)]  # a turn inside a pause: the pause's ends
+    turns += [x for a, b in rests for x in (a, b)]
     turns = [x for x in turns if t[0] + closest < x < t[-1] - closest]
     knots = sorted([k for k in interior if all(abs(k - x) >= 0.5 * spacing_s for x in turns)] + turns)
     return np.concatenate([[t[0]] * 4, knots, [t[-1]] * 4])
+
+
+def _window_fit(time_s: np.ndarray, rack_m: np.ndarray, noise: float, degree: int) -> tuple[np.ndarray, np.ndarray]:
+    """Least-squares polynomial of `degree` about the window's mid time: (coefficients, their standard errors)."""
+    tau = time_s - 0.5 * (time_s[0] + time_s[-1])
+    design = np.vander(tau, degree + 1, increasing=True)
+    coefficients, *_ = np.linalg.lstsq(design, rack_m, rcond=None)
+    errors = noise * np.sqrt(np.diag(np.linalg.inv(design.T @ design)))
+    return coefficients, errors
+
+
+def rest_intervals(time_s: np.ndarray, rack_m: np.ndarray, noise: float) -> tuple[tuple[float, float], ...]:
+    """Stretches (start s, end s) of at least RACK_REST_MIN_S where the rack data show it at rest (see the setting).
+
+    A window passes when the quadratic's speed and acceleration are both within the bound; a
+    stretch is a run of samples whose centred windows pass (so it starts half a window after the
+    hand has stopped, where the window no longer reaches back into the slowing hand).
+    """
+    t = np.asarray(time_s, dtype=float)
+    x = np.asarray(rack_m, dtype=float)
+    dt = float(np.median(np.diff(t)))
+    half = int(round(0.5 * RACK_REST_MIN_S / dt))
+    if noise <= 0.0 or len(t) < 2 * half + 1 or half < 2:
+        return ()
+    covered = np.zeros(len(t), dtype=bool)
+    for k in range(half, len(t) - half):
+        c, se = _window_fit(t[k - half : k + half + 1], x[k - half : k + half + 1], noise, 2)
+        if abs(c[1]) <= RACK_REST_SLOPE_SE * se[1] and abs(c[2]) <= RACK_REST_SLOPE_SE * se[2]:
+            covered[k] = True
+    edges = np.diff(np.concatenate([[0], covered.astype(int), [0]]))
+    out = []
+    for a, b in zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1) - 1):
+        if t[b] - t[a] >= RACK_REST_MIN_S:
+            out.append((float(t[a]), float(t[b])))
+    return tuple(out)
 
 
 def turning_times(time_s: np.ndarray, rack_m: np.ndarray) -> tuple[float, ...]:
@@ -234,13 +292,14 @@ def _constrained_solve(gram: np.ndarray, rhs: np.ndarray, constraints: np.ndarra
     covariance = inverse
     if len(constraints):
         gc = inverse @ constraints.T
-        correction = gc @ np.linalg.inv(constraints @ gc)
+        correction = gc @ np.linalg.pinv(constraints @ gc)  # pinv: a rest reaching an end already fixes its speed
         coefficients = coefficients - correction @ (constraints @ coefficients)
         covariance = inverse - correction @ gc.T
     return coefficients, 0.5 * (covariance + covariance.T)
 
 
-def _lsq_fit(t: np.ndarray, x: np.ndarray, spacing_s: float, turns: tuple[float, ...] = ()):
+def _lsq_fit(t: np.ndarray, x: np.ndarray, spacing_s: float, turns: tuple[float, ...] = (),
+             rests: tuple[tuple[float, float], ...] = (), hold_rest: bool = True):
     """(knots, coefficients, covariance per unit variance, fit RMS) of the least-squares cubic spline.
 
     At each end of the record the spline is held at rest (zero speed) unless the data
@@ -251,9 +310,11 @@ def _lsq_fit(t: np.ndarray, x: np.ndarray, spacing_s: float, turns: tuple[float,
     start speed that is not there). A record that starts or ends at rest then gets no
     spurious end speed, which the rack friction would turn into a spurious torque and the
     tyre carcass would remember; one cut in the middle of a stroke (15 mm/s, some fifty
-    standard errors from rest) keeps its speed. None if the spline is ill-posed.
+    standard errors from rest) keeps its speed. Without `hold_rest` no end is held (only a rest
+    reaching the end holds it). Over each of `rests` the spline is constant.
+    None if the spline is ill-posed.
     """
-    knots = _knot_vector(t, spacing_s, turns)
+    knots = _knot_vector(t, spacing_s, turns, rests)
     design = BSpline.design_matrix(t, knots, 3).toarray()
     gram = design.T @ design
     try:
@@ -261,16 +322,23 @@ def _lsq_fit(t: np.ndarray, x: np.ndarray, spacing_s: float, turns: tuple[float,
     except np.linalg.LinAlgError:  # Schoenberg-Whitney fails: an interval without data
         return None
     rhs = design.T @ x
-    free, _ = _constrained_solve(gram, rhs, np.zeros((0, len(rhs))))
+    still = []  # B-spline coefficients acting over a rest are equal: the spline is constant there
+    for a, b in rests:
+        active = [j for j in range(len(rhs)) if knots[j] < b - 1e-9 and knots[j + 4] > a + 1e-9]
+        for j, k in zip(active[:-1], active[1:]):
+            row = np.zeros(len(rhs))
+            row[j], row[k] = 1.0, -1.0
+            still.append(row)
+    free, _ = _constrained_solve(gram, rhs, np.array(still).reshape(len(still), len(rhs)))
     rss_free = float(np.sum((design @ free - x) ** 2))
     noise_var = max(rss_free / max(len(t) - len(rhs), 1), 1e-30)
     speed_rows = np.array([BSpline(knots, np.eye(len(rhs))[j], 3)(np.array([t[0], t[-1]]), 1)
                            for j in range(len(rhs))]).T
-    held, at_rest = [], []
+    held, at_rest = list(still), []
     for row in speed_rows:
         trial, _ = _constrained_solve(gram, rhs, np.array(held + [row]))
         rss = float(np.sum((design @ trial - x) ** 2))
-        at_rest.append(rss - rss_free < RACK_REST_TEST_CHI2 * noise_var)
+        at_rest.append(hold_rest and rss - rss_free < RACK_REST_TEST_CHI2 * noise_var)
         if at_rest[-1]:
             held.append(row)
     coefficients, covariance = _constrained_solve(gram, rhs, np.array(held).reshape(len(held), len(rhs)))
@@ -287,8 +355,12 @@ def knot_spacings(time_s: np.ndarray) -> list[float]:
     return [low * RACK_KNOT_SPACING_STEP**i for i in range(max(count, 1))]
 
 
-def smooth_rack(time_s, rack_m, knot_spacing_s: float | None = None) -> SmoothedRack:
+def smooth_rack(time_s, rack_m, knot_spacing_s: float | None = None, hold_rest: bool = True) -> SmoothedRack:
     """The measured rack as a least-squares cubic spline; the knot spacing from the data unless given.
+
+    With `hold_rest` (the default) each end is held at rest unless the data contradict it (:func:`_lsq_fit`) and
+    the spline is constant over every pause of the hand (:func:`rest_intervals`); without, the ends and the
+    pauses are free (the alternative the replay's uncertainty also replays).
 
     Chosen spacing: the largest tried (:func:`knot_spacings`) whose fit RMS per degree of
     freedom is within ``RACK_DISCREPANCY_FACTOR`` of the rack's noise RMS; if none is, the finest.
@@ -301,21 +373,23 @@ def smooth_rack(time_s, rack_m, knot_spacing_s: float | None = None) -> Smoothed
         raise UsageError("rack smoothing: time must be strictly increasing")
     noise = estimate_noise_rms(x)
     turns = turning_times(t, x)
+    rests = rest_intervals(t, x, noise) if hold_rest else ()
 
     def build(fit, spacing):
         knots, coefficients, inverse, rms, at_rest = fit
-        return SmoothedRack.from_bspline(knots, coefficients, noise**2 * inverse, spacing, rms, noise, at_rest, turns)
+        return SmoothedRack.from_bspline(knots, coefficients, noise**2 * inverse, spacing, rms, noise, at_rest, turns,
+                                         rests)
 
     if knot_spacing_s is not None:
         if not knot_spacing_s > 0:
             raise UsageError(f"knot spacing must be positive, got {knot_spacing_s:g} s")
-        fit = _lsq_fit(t, x, knot_spacing_s, turns)
+        fit = _lsq_fit(t, x, knot_spacing_s, turns, rests, hold_rest)
         if fit is None:
             raise UsageError(f"rack smoothing: knot spacing {knot_spacing_s:g} s leaves intervals without samples")
         return build(fit, knot_spacing_s)
     best = None
     for spacing in knot_spacings(t):
-        fit = _lsq_fit(t, x, spacing, turns)
+        fit = _lsq_fit(t, x, spacing, turns, rests, hold_rest)
         if fit is None:
             continue
         # the residual of a least-squares fit with p coefficients has n - p degrees of freedom

@@ -1,0 +1,181 @@
+"""Records made independently of the benchmark's generator: another hand, another logger, another drive.
+
+The benchmark's records (:mod:`parksteer.synthetic.datasets`) are made by the same hand model, the same
+logger and the same handwheel-driven simulation that the diagnosis was tuned on. The records here differ
+in every one of these, each in a way a real test could:
+
+- the hand (:func:`variation_hand`): the Section 4 cycle with a smooth speed variation of a few per
+  cent (the rate a smooth C2 function of time, not piecewise linear), optional pauses at rest inside a
+  stroke, and a record that either ends mid-stroke while the hand is still slowing or goes on at rest
+  for a while after the hand has stopped;
+- the drive: the rack follows the hand through a rigid column and the Hooke joint
+  (:func:`parksteer.synthetic.standin.rack_of_hand`) and the torque is the model's prescribed-rack
+  solve of that rack (as ``parksteer simulate --rack-from`` does), at a finer output spacing than any logger;
+- the logger (:class:`VariationLogger`): its own sample rate, and the rack and torque channels on
+  converters of different resolution (a 12-bit rack beside an 8-bit torque, say). A file states one
+  ``bits`` only, so it states the torque channel's logger (its full scale and bits) and not the rack's
+  (whose full scale is left out): the diagnosis then knows the torque's step and estimates the rack's noise
+  from the data.
+
+:func:`null_variations` names one record per way of differing: with nothing hidden, a diagnosis must say
+``adequate`` on each; ``benchmarks/bench_variations.py`` hides library effects in them as well.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import UsageError
+from ..measure.io import Measurement, metadata_text
+from ..measure.smoothing import interpolate_rack
+from ..parameters import Parameters
+from .logger import add_noise, quantise, resample
+from .standin import rack_of_hand
+
+# The hand's motion is sampled this finely before the rack is splined through it (s).
+HAND_DT_S = 0.002
+# The clean torque is solved at this spacing, finer than any logger here, then sampled (s).
+CLEAN_DT_S = 0.002
+
+
+@dataclass(frozen=True)
+class HandVariant:
+    """A hand through the Section 4 cycle (straight ahead, right lock, left lock, straight ahead).
+
+    ``rate_variation``: the hand's speed in each stroke's cruise is scaled by
+    ``1 + rate_variation * s(t)``, s a smooth random signal within [-1, 1] (two sinusoids of
+    ``frequency_hz`` scale). ``pause_s``: the hand rests this long in the middle of the first and
+    second strokes (0: no pause). ``end``: ``"rest"`` keeps the record going ``rest_after_s`` at rest
+    after the hand stops at straight ahead; ``"mid_stroke"`` cuts the record ``cut_before_end_s`` before
+    the hand's stop, while it is slowing (the last stroke's ramp to rest lasts ``ramp_s``).
+    """
+
+    rate_variation: float = 0.05
+    frequency_hz: float = 0.2
+    pause_s: float = 0.0
+    end: str = "rest"
+    rest_after_s: float = 1.0
+    cut_before_end_s: float = 0.15
+    ramp_s: float = 0.6
+    seed: int = 0
+
+    def __post_init__(self):
+        if not 0.0 <= self.rate_variation < 0.5:
+            raise UsageError(f"hand rate variation must be in [0, 0.5), got {self.rate_variation:g}")
+        if self.end not in ("rest", "mid_stroke"):
+            raise UsageError(f"hand end must be 'rest' or 'mid_stroke', got {self.end!r}")
+        if self.end == "mid_stroke" and not 0.0 < self.cut_before_end_s < self.ramp_s:
+            raise UsageError("a mid-stroke end must cut the record inside the last ramp to rest")
+
+
+def _smoothstep_rate(t: np.ndarray, t0: float, t1: float, ramp: float) -> np.ndarray:
+    """A rate shape rising from 0 at t0 to 1 over `ramp`, 1 in the cruise, back to 0 at t1 (C1 cosine ramps)."""
+    up = np.clip((t - t0) / ramp, 0.0, 1.0)
+    down = np.clip((t1 - t) / ramp, 0.0, 1.0)
+    shape = 0.5 - 0.5 * np.cos(np.pi * np.minimum(up, down))
+    return np.where((t > t0) & (t < t1), shape, 0.0)
+
+
+def variation_hand(params: Parameters, hand: HandVariant) -> tuple[np.ndarray, np.ndarray]:
+    """(time s, handwheel angle rad) of `hand`, sampled every HAND_DT_S from 0 to the record's end.
+
+    Each stroke covers exactly its travel (lock, -2 lock, lock): its rate is scaled so that its
+    integral does, whatever the speed variation.
+    """
+    p = params.sections["input"]
+    lock = p["handwheel_lock_angle"]
+    durations = [p["time_to_right_lock"], p["time_right_to_left_lock"], p["time_left_lock_to_centre"]]
+    travels = (lock, -2.0 * lock, lock)
+    rng = np.random.default_rng(hand.seed)
+    frequencies = hand.frequency_hz * rng.uniform(0.5, 1.5, size=2)
+    phases = rng.uniform(0.0, 2.0 * np.pi, size=2)
+    pauses = (hand.pause_s, hand.pause_s, 0.0)
+    end_hand = sum(durations) + sum(pauses)
+    end_record = end_hand + hand.rest_after_s if hand.end == "rest" else end_hand - hand.cut_before_end_s
+    t = np.arange(0.0, max(end_record, end_hand) + 0.5 * HAND_DT_S, HAND_DT_S)
+    wander = 1.0 + hand.rate_variation * 0.5 * np.sum(np.sin(2 * np.pi * frequencies * t[:, None] + phases), axis=1)
+    rate = np.zeros_like(t)
+    start = 0.0
+    for duration, travel, pause in zip(durations, travels, pauses):
+        if pause > 0.0:  # the hand slows to rest half way, rests, and goes on
+            half = 0.5 * duration
+            shape = (_smoothstep_rate(t, start, start + half, hand.ramp_s)
+                     + _smoothstep_rate(t, start + half + pause, start + duration + pause, hand.ramp_s))
+        else:
+            shape = _smoothstep_rate(t, start, start + duration, hand.ramp_s)
+        piece = shape * wander
+        area = float(np.sum(0.5 * (piece[1:] + piece[:-1]) * np.diff(t)))
+        rate += travel / area * piece
+        start += duration + pause
+    keep = t <= end_record + 1e-9
+    t, rate = t[keep], rate[keep]
+    angle = np.concatenate([[0.0], np.cumsum(0.5 * (rate[1:] + rate[:-1]) * np.diff(t))])
+    return t, angle
+
+
+@dataclass(frozen=True)
+class VariationLogger:
+    """A logger with its own sample rate and a converter per channel: rack and torque bits, full scales, noise."""
+
+    sample_rate_hz: float = 100.0
+    rack_bits: int = 12
+    torque_bits: int = 8
+    rack_full_scale_m: float = 0.1
+    torque_full_scale_Nm: float = 25.0
+    rack_noise_m: float = 2e-5
+    torque_noise_Nm: float = 0.1
+    seed: int = 0
+
+
+def variation_record(params: Parameters, hand: HandVariant, logger: VariationLogger, case: str = "unladen",
+                     surface: str = "ground", overrides: dict[str, float] | None = None, effects=None) -> Measurement:
+    """A record: `hand` drives the rack, the model's prescribed-rack solve gives the torque, `logger` logs both.
+
+    With `effects` (a spec as ``parksteer simulate --effects``) and `overrides`, something is hidden in it;
+    by default nothing is (a null).
+    """
+    from ..model.numeric.simulate import simulate
+
+    drive = variation_rack(params, hand)
+    result = simulate(case, effects=effects, overrides=overrides, surface=surface, rack_drive=drive, params=params,
+                      output_dt_s=CLEAN_DT_S)
+    t = np.asarray(result.columns["time_s"], dtype=float)
+    clean = {"rack_m": np.asarray(result.columns["rack_m"]),
+             "handwheel_torque_Nm": np.asarray(result.columns["handwheel_torque_Nm"])}
+    time_s, sampled = resample(t, clean, logger.sample_rate_hz)
+    rng = np.random.default_rng(logger.seed)
+    rack = quantise(add_noise(sampled["rack_m"], logger.rack_noise_m, rng), logger.rack_full_scale_m, logger.rack_bits)
+    torque = quantise(add_noise(sampled["handwheel_torque_Nm"], logger.torque_noise_Nm, rng),
+                      logger.torque_full_scale_Nm, logger.torque_bits)
+    metadata = {
+        "case": case, "surface": surface, "source": "synthetic: parksteer.synthetic.variations",
+        "synthetic": True, "bits": logger.torque_bits, "sample_rate_hz": float(logger.sample_rate_hz),
+        "full_scale_handwheel_torque_Nm": logger.torque_full_scale_Nm,
+        "rack_bits": logger.rack_bits, "hand_rate_variation": hand.rate_variation, "hand_pause_s": hand.pause_s,
+        "hand_end": hand.end, "hand_seed": hand.seed, "noise_seed": logger.seed,
+    }
+    columns = {"time_s": time_s, "rack_m": rack, "handwheel_torque_Nm": torque}
+    return Measurement(path=None, columns=columns, metadata={k: metadata_text(v) for k, v in metadata.items()})
+
+
+def variation_rack(params: Parameters, hand: HandVariant):
+    """The rack the hand drives (a spline through its fine samples, the motion itself)."""
+    t_hand, angle = variation_hand(params, hand)
+    return interpolate_rack(t_hand, rack_of_hand(params, angle))
+
+
+def null_variations(seed: int = 0) -> list[tuple[str, HandVariant, VariationLogger]]:
+    """A small set of independent null records' settings (name, hand, logger), one per way a record can differ."""
+    return [
+        ("rest_after_stop", HandVariant(0.05, 0.2, 0.0, "rest", 1.5, seed=seed + 1), VariationLogger(100.0, 12, 8, seed=seed + 1)),
+        ("mid_stroke_end", HandVariant(0.04, 0.25, 0.0, "mid_stroke", cut_before_end_s=0.2, seed=seed + 2),
+         VariationLogger(100.0, 12, 8, seed=seed + 2)),
+        ("pauses", HandVariant(0.06, 0.15, 0.8, "rest", 0.5, seed=seed + 3), VariationLogger(100.0, 12, 8, seed=seed + 3)),
+        ("rate_8pc_50Hz", HandVariant(0.08, 0.3, 0.0, "rest", 0.3, seed=seed + 4), VariationLogger(50.0, 12, 8, seed=seed + 4)),
+        ("rate_3pc_200Hz", HandVariant(0.03, 0.1, 0.0, "mid_stroke", cut_before_end_s=0.1, seed=seed + 5),
+         VariationLogger(200.0, 12, 8, seed=seed + 5)),
+        ("rack_8bit_torque_12bit", HandVariant(0.05, 0.2, 0.6, "mid_stroke", cut_before_end_s=0.15, seed=seed + 6),
+         VariationLogger(100.0, 8, 12, rack_noise_m=2e-4, seed=seed + 6)),
+    ]
