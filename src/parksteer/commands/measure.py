@@ -111,6 +111,10 @@ def _diagnose(args) -> int:
     params = load_parameters(args.parameters)
     effects = resolve_effects(args.effects)
     files = load_files(args.files, params, args.case, args.surface, channel_map_of(args))
+    for f in files:
+        if len(f.phases.reversal_times_s) == 0:
+            raise UsageError(f"{f.measurement.path}: column 'rack_m': the rack never reverses, so the record holds "
+                             "no reversal to calibrate the friction on; diagnose needs a cycle that turns back")
     diagnosis = diagnose(files, params, effects)
     result = diagnosis_dict(diagnosis)
     if args.plot:

@@ -28,7 +28,7 @@ import numpy as np
 from scipy.integrate import odeint
 
 from .statics import static_state
-from .tolerances import PRESCRIBED_ATOL_FACTOR, PRESCRIBED_RTOL, absolute_tolerances
+from .tolerances import PRESCRIBED_ATOL_FACTOR, PRESCRIBED_RTOL, absolute_tolerances, solver_failure
 
 # The column twist is integrated exactly for a torque linear between samples this far apart at most (s).
 # Against the column's time constant c / k (0.2 s) the twist filters the torque; at 5 ms the handwheel angle
@@ -160,7 +160,7 @@ def solve(run, p: np.ndarray, rack: RackMotion, t_out, rtol: float = PRESCRIBED_
     states, info = odeint(rhs, z0, grid, Dfun=jacobian, rtol=rtol, atol=atol, mxstep=200000, full_output=True,
                           h0=FIRST_STEP_S)
     if info["message"] != "Integration successful.":
-        raise RuntimeError(f"prescribed-rack integration failed: {info['message']}")
+        raise solver_failure("prescribed-rack integration", info, float(grid[0]))
 
     # The accelerations and the torque at every sample, solved together (the same equations as `accelerations`).
     m = len(grid)

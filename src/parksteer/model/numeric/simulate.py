@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 from scipy.integrate import odeint
 
-from ...errors import UsageError
+from ...errors import SolverError, UsageError
 from ...parameters import Parameters, load_parameters
 from ...tables import write_csv
 from .compiled import CompiledModel, load_model
@@ -24,7 +24,7 @@ from ..symbolic.components import Effect, discover_effects, resolve_effects
 from .inputs import HandwheelProfile, sawtooth_profile
 from .prescribed import RackMotion, solve as solve_prescribed
 from .statics import static_state
-from .tolerances import PRESCRIBED_RTOL, RTOL, absolute_tolerances
+from .tolerances import PRESCRIBED_RTOL, RTOL, absolute_tolerances, solver_failure
 from .values import RunValues, parameter_vector, resolve_values
 
 ROLL_NEUTRAL_KEY = "derived.roll_spring_neutral"
@@ -127,7 +127,7 @@ def integrate(run: PreparedRun, t_out: np.ndarray, y0: np.ndarray | None = None,
     states, info = odeint(rhs, y0, t_out, Dfun=dfun, rtol=rtol, atol=_atol(model) if atol is None else atol,
                           mxstep=200000, full_output=True, tcrit=corners)
     if info["message"] != "Integration successful.":
-        raise RuntimeError(f"integration failed: {info['message']}")
+        raise solver_failure("integration", info, float(t_out[0]))
     return states
 
 
@@ -192,19 +192,35 @@ def simulate(case: str, effects=None, overrides: dict | None = None, surface: st
     if not (output_dt_s > 0):
         raise UsageError(f"output_dt_s must be positive, got {output_dt_s}")
     run = prepare(case, effects, overrides, surface, params, handwheel)
-    if rack_drive is not None:
-        return _simulate_rack_drive(run, rack_drive, t_end_s, output_dt_s, PRESCRIBED_RTOL if rtol is None else rtol)
-    rtol = RTOL if rtol is None else rtol
-    t_end = run.profile.end_time_s if t_end_s is None else float(t_end_s)
-    if not (t_end > 0):
-        raise UsageError(f"t_end_s must be positive, got {t_end}")
-    t = np.round(np.arange(0.0, t_end + 0.5 * output_dt_s, output_dt_s), 12)
-    states = integrate(run, t, rtol=rtol)
+    try:
+        if rack_drive is not None:
+            return _simulate_rack_drive(run, rack_drive, t_end_s, output_dt_s,
+                                        PRESCRIBED_RTOL if rtol is None else rtol)
+        rtol = RTOL if rtol is None else rtol
+        t_end = run.profile.end_time_s if t_end_s is None else float(t_end_s)
+        if not (t_end > 0):
+            raise UsageError(f"t_end_s must be positive, got {t_end}")
+        t = np.round(np.arange(0.0, t_end + 0.5 * output_dt_s, output_dt_s), 12)
+        if len(t) < 2:
+            raise UsageError(f"output step {output_dt_s:g} s leaves fewer than two outputs in the run of {t_end:g} s; "
+                             "give a shorter --output-dt")
+        states = integrate(run, t, rtol=rtol)
+    except SolverError as exc:
+        raise SolverError(f"case {case} ({surface}), effects {','.join(e.name for e in run.effects)}, "
+                          f"{_stated_values(overrides)}: {exc}", exc.t_failed_s) from None
     outputs = run.model.evaluate_outputs(t, states, run.p)
     samples = np.column_stack(run.profile.angle_rate(t))
     columns = _columns(run, t, states, outputs, samples)
     drive = "handwheel saw tooth (section 4)" if handwheel is None else "prescribed handwheel profile"
     return SimulationResult(columns, _header(run, drive), states, run.p, run.model, run.values)
+
+
+def _stated_values(overrides: dict | None) -> str:
+    """The values a caller changed, the usual cause of a stiff run ('the parameter file's values' if none)."""
+    if not overrides:
+        return "the parameter file's values (no --set)"
+    return "values set: " + ", ".join(f"{key}={value:g}" if isinstance(value, (int, float)) else f"{key}={value}"
+                                      for key, value in overrides.items())
 
 
 def _simulate_rack_drive(run: PreparedRun, rack: RackMotion, t_end_s, output_dt_s: float, rtol: float

@@ -27,3 +27,15 @@ PRESCRIBED_ATOL_FACTOR = 100.0  # 1
 def absolute_tolerances(units: list[str], factor: float = 1.0) -> np.ndarray:
     """Absolute tolerances of the states (coordinates, then their rates) for coordinates of `units` (m or rad)."""
     return factor * np.array([ATOL_Q[u] for u in units] + [ATOL_U[u] for u in units])
+
+
+def solver_failure(what: str, info: dict, t_start_s: float) -> "SolverError":
+    """The one-line error of an odeint call that gave up: its message and the last time it reached."""
+    from ...errors import SolverError
+
+    reached = np.asarray(info.get("tcur", []), dtype=float)
+    reached = reached[np.isfinite(reached)]
+    t_failed = max(float(reached.max()), t_start_s) if reached.size else t_start_s
+    message = str(info.get("message", "unknown failure")).rstrip(".").replace("\n", " ")
+    hint = " (the output step is longer than the run?)" if "Nothing was done" in message else ""
+    return SolverError(f"{what} failed at t = {t_failed:.4g} s: {message}{hint}", t_failed)
