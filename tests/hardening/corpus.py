@@ -142,6 +142,15 @@ def _fd_path(folder: Path, text: str) -> str:
     return f"/dev/fd/{fd}"
 
 
+def _fast_text(rate_hz: float) -> str:
+    """The example cycle resampled to `rate_hz` (made at run time: 36 000 rows at 2 kHz)."""
+    meta, header, d = base_record(1)
+    meta = [m for m in meta if not m.startswith(("# bits", "# full_scale", "# sample_rate"))]
+    t = np.arange(d[0, 0], d[-1, 0], 1.0 / rate_hz)
+    data = np.column_stack([t] + [np.interp(t, d[:, 0], d[:, j]) for j in range(1, d.shape[1])])
+    return record_text(meta=meta, data=data)
+
+
 def _ramp_text() -> str:
     """The first stroke only (to the right lock, 112 samples): the rack never turns back."""
     _, _, d = base_record(2)
@@ -198,6 +207,11 @@ def odd_record_cases() -> list[Case]:
         Case("simulate:rack_from_missing", "simulate",
              lambda f: ["simulate", "--rack-from", str(f / "nope.csv"), "--out", str(f / "out.csv")], "no such file",
              ("out.csv",)),
+        Case("simulate:wheel_load_against_statics", "simulate",
+             lambda f: ["simulate", "--case", "unladen", "--set", "case.load_left=29000", "--out", str(f / "out.csv")],
+             "wheel loads sum to", ("out.csv",)),
+        Case("compare:2kHz_record", "compare", lambda f: ["compare", str(_write(f, "fast.csv", _fast_text(2000.0)))],
+             ACCEPTED),
         Case("simulate:unknown_case_option", "simulate",
              lambda f: ["simulate", "--case", "nocar", "--out", str(f / "out.csv")], "nocar", ("out.csv",)),
     ]
@@ -233,6 +247,9 @@ def parameter_cases() -> list[Case]:
         "chassis_mass_statics": (lambda: _params_text("chassis_mass = { value = 468.4,",
                                                       "chassis_mass = { value = 4684.0,"), "chassis_mass"),
         "not_utf8": (lambda: _params_text().encode("utf-8").replace(b"# parksteer", b"# p\xe4rksteer"), "UTF-8"),
+        "tyre_pressure_in_atmospheres": (lambda: _params_text("tyre_pressure = { value = 122500.0,",
+                                                              "tyre_pressure = { value = 1.225,"),
+                                         "tyre.tyre_pressure: value 1.225 Pa is non-physical"),
     }
     cases = []
     for name, (content, fragment) in variants.items():
