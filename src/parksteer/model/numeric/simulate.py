@@ -9,12 +9,14 @@ handwheel torque is solved for by :func:`parksteer.model.numeric.prescribed.solv
 
 from __future__ import annotations
 
+import warnings
+
 import dataclasses
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-from scipy.integrate import odeint
+from scipy.integrate import ODEintWarning, odeint
 
 from ...errors import SolverError, UsageError
 from ...parameters import Parameters, load_parameters
@@ -124,10 +126,12 @@ def integrate(run: PreparedRun, t_out: np.ndarray, y0: np.ndarray | None = None,
         return jac
 
     corners = np.array([piece[0] for piece in run.profile.pieces])
-    states, info = odeint(rhs, y0, t_out, Dfun=dfun, rtol=rtol, atol=_atol(model) if atol is None else atol,
-                          mxstep=200000, full_output=True, tcrit=corners)
+    with warnings.catch_warnings():  # a failure is reported below as one line, not as a warning too
+        warnings.simplefilter("ignore", ODEintWarning)
+        states, info = odeint(rhs, y0, t_out, Dfun=dfun, rtol=rtol, atol=_atol(model) if atol is None else atol,
+                              mxstep=200000, full_output=True, tcrit=corners)
     if info["message"] != "Integration successful.":
-        raise solver_failure("integration", info, float(t_out[0]))
+        raise solver_failure("integration", info, t_out)
     return states
 
 
