@@ -189,6 +189,12 @@ def odd_record_cases() -> list[Case]:
              "name it .svg", ("out.png",)),
         Case("simulate:out_is_directory", "simulate",
              lambda f: ["simulate", "--case", "unladen", "--out", str(f)], "is a directory"),
+        Case("diagnose:report_is_directory", "diagnose",
+             lambda f: ["diagnose", str(_write(f, "ok.csv", record_text())), "--report", str(f)], "is a directory"),
+        Case("compare:plot_is_directory", "compare",
+             lambda f: ["compare", str(_write(f, "ok.csv", record_text())), "--plot", str((f / "d.svg").mkdir() or
+                                                                                            f / "d.svg")],
+             "is a directory"),
         Case("simulate:output_step_longer_than_run", "simulate",
              lambda f: ["simulate", "--case", "unladen", "--output-dt", "1e6", "--out", str(f / "out.csv")],
              "fewer than two outputs", ("out.csv",)),

@@ -58,6 +58,8 @@ def _check_outputs(args) -> None:
     for option in ("plot", "report"):
         value = getattr(args, option, None)
         if value is not None:
+            if Path(value).is_dir():
+                raise UsageError(f"--{option} {value}: is a directory; name a file to write")
             parent = Path(value).resolve().parent
             if not parent.is_dir():
                 raise UsageError(f"--{option} {value}: folder {parent} does not exist")

@@ -54,6 +54,8 @@ def _simulate(args) -> int:
     from ..model.numeric.values import parse_overrides
 
     overrides = parse_overrides(args.overrides)
+    if Path(args.out).is_dir():
+        raise UsageError(f"--out {args.out}: is a directory; name a file to write")
     if args.raw_rack and args.rack_from is None:
         raise UsageError("--raw-rack needs --rack-from FILE")
     if args.rack_from is not None and not Path(args.rack_from).exists():
