@@ -308,6 +308,10 @@ ENTRY_KEYS = {"value", "unit", "source"}
 # of (chassis_mass + unsprung_mass) g and the loads put y_cm within 0.03 mm of the printed value.
 LOAD_SUM_TOLERANCE_N = 1.0
 CG_Y_PRINT_TOLERANCE_M = 0.5e-4
+# A run's overrides (--set, a sweep point) may move the loads off the printed statics a little (a study of one
+# load), but loads more than a tenth off the front-end weight are a typo or a wrong unit: the body would not be
+# in vertical equilibrium and a wheel load can come out negative. Such an override is refused.
+OVERRIDE_LOAD_FRACTION = 0.10
 
 
 class ParameterError(UsageError):
@@ -382,6 +386,20 @@ class Parameters:
                     cases[name][q.name] = value
             else:
                 sections.setdefault(q.section, {})[q.name] = value
+        statics_keys = {"vehicle.gravity", "vehicle.unsprung_mass"} | {f"{CASE}.{n}" for n in
+                                                                        ("chassis_mass", "load_left", "load_right")}
+        changed = [key for key in overrides if key in statics_keys]
+        if changed:
+            g = sections["vehicle"]["gravity"]
+            for name in ([case] if case is not None else list(cases)):
+                c = cases[name]
+                weight_N = (c["chassis_mass"] + sections["vehicle"]["unsprung_mass"]) * g
+                total_N = c["load_left"] + c["load_right"]
+                if abs(total_N - weight_N) > OVERRIDE_LOAD_FRACTION * weight_N:
+                    raise UsageError(
+                        f"{', '.join(changed)}: case {name}'s wheel loads sum to {total_N:.0f} N, but (chassis_mass + "
+                        f"vehicle.unsprung_mass) g is {weight_N:.0f} N; set the loads and the mass together"
+                    )
         return dataclasses.replace(self, sections=sections, cases=cases)
 
 
@@ -454,9 +472,14 @@ def load_parameters(path: str | Path = DEFAULT_PATH) -> Parameters:
     """Read and validate a parameter file; raise :class:`ParameterError` on any defect."""
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8")
+        raw = path.read_bytes()
     except OSError as exc:
         raise ParameterError(f"{path}: cannot read ({exc.strerror})") from None
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise ParameterError(f"{path}: not UTF-8 text (byte {exc.start})") from None
+    text = text.removeprefix("\ufeff")  # a byte-order mark, as some editors write
     try:
         doc = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:

@@ -19,6 +19,8 @@ from typing import Any, Iterator
 
 import numpy as np
 
+from .errors import UsageError
+
 SIGNIFICANT_DIGITS = 7
 
 
@@ -35,6 +37,10 @@ def format_number(x: float, digits: int = SIGNIFICANT_DIGITS) -> str:
 def atomic_path(path: str | Path) -> Iterator[Path]:
     """Yield a temporary path beside `path`; rename it onto `path` only on success."""
     path = Path(path)
+    if path.is_dir():
+        raise UsageError(f"{path}: is a directory; name a file to write")
+    if path.parent.exists() and not path.parent.is_dir():
+        raise UsageError(f"{path}: {path.parent} is a file, not a directory")
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     os.close(fd)

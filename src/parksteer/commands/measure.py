@@ -62,6 +62,8 @@ def _check_outputs(args) -> None:
     for option in ("plot", "report", "html"):
         value = getattr(args, option, None)
         if value is not None:
+            if Path(value).is_dir():
+                raise UsageError(f"--{option} {value}: is a directory; name a file to write")
             parent = Path(value).resolve().parent
             if not parent.is_dir():
                 raise UsageError(f"--{option} {value}: folder {parent} does not exist")
@@ -115,6 +117,10 @@ def _diagnose(args) -> int:
     params = parameters_of(args)
     effects = resolve_effects(args.effects)
     files = load_files(args.files, params, args.case, args.surface, channel_map_of(args))
+    for f in files:
+        if len(f.phases.reversal_times_s) == 0:
+            raise UsageError(f"{f.measurement.path}: column 'rack_m': the rack never reverses, so the record holds "
+                             "no reversal to calibrate the friction on; diagnose needs a cycle that turns back")
     diagnosis = diagnose(files, params, effects)
     result = diagnosis_dict(diagnosis)
     if args.plot:

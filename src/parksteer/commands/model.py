@@ -5,9 +5,10 @@ from __future__ import annotations
 import json
 import sys
 import time
+from contextlib import nullcontext
 from pathlib import Path
 
-from ..errors import UsageError
+from ..errors import UsageError, naming
 from ..parameters import DEFAULT_PATH, load_parameters
 from ..tables import write_json
 from .measure import add_import_options, channel_map_of
@@ -55,6 +56,8 @@ def _simulate(args) -> int:
     from ..model.numeric.values import parse_overrides
 
     overrides = parse_overrides(args.overrides)
+    if Path(args.out).is_dir():
+        raise UsageError(f"--out {args.out}: is a directory; name a file to write")
     if args.raw_rack and args.rack_from is None:
         raise UsageError("--raw-rack needs --rack-from FILE")
     if args.rack_from is not None and not Path(args.rack_from).exists():
@@ -70,8 +73,11 @@ def _simulate(args) -> int:
                                                     channel_map_of(args), args.case,
                                                     args.surface or "ground")  # a drive needs no surface
         case, surface = args.case or case, args.surface or surface
-    result = simulate(case, effects=args.effects, overrides=overrides, surface=surface,
-                      rack_drive=rack, params=params, output_dt_s=args.output_dt)
+    if not (args.output_dt > 0):
+        raise UsageError(f"--output-dt {args.output_dt:g}: the output step must be positive")
+    with naming(f"--rack-from {args.rack_from}") if args.rack_from is not None else nullcontext():
+        result = simulate(case, effects=args.effects, overrides=overrides, surface=surface,
+                          rack_drive=rack, params=params, output_dt_s=args.output_dt)
     if drive is not None:
         result.header["drive"] = drive
     result.write_csv(args.out)
@@ -84,11 +90,11 @@ def _measured_rack(path: str, params, raw: bool, channel_map=None, case=None, su
     from ..measure.smoothing import interpolate_rack, smooth_rack
 
     measurement = load_rack_drive(path, channel_map, case=case, surface=surface, params=params)
+    with naming(path):
+        rack = (interpolate_rack if raw else smooth_rack)(measurement.time_s, measurement.rack_m)
     if raw:
-        rack = interpolate_rack(measurement.time_s, measurement.rack_m)
         drive = f"prescribed rack from {path}: the raw samples through an interpolating cubic spline"
     else:
-        rack = smooth_rack(measurement.time_s, measurement.rack_m)
         drive = (f"prescribed rack from {path}: smoothed by a least-squares cubic spline, knots "
                  f"{rack.knot_spacing_s:.3g} s apart, fit RMS {rack.fit_rms_m:.3g} m (parksteer.measure.smoothing)")
     return measurement.case, measurement.surface, rack, drive

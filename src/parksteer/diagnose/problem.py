@@ -35,7 +35,7 @@ from pathlib import Path
 import numpy as np
 from scipy.ndimage import maximum_filter1d
 
-from ..errors import UsageError
+from ..errors import UsageError, naming
 from ..measure.importers import load_record
 from ..measure.io import Measurement
 from ..measure.metrics import NoiseFloor, noise_floor
@@ -122,7 +122,8 @@ def load_files(paths: list[str | Path], params: Parameters, case: str | None = N
                 f"{path}: extra_offset_m = {stated:g} m but case {chosen} has "
                 f"{params.case(chosen)['extra_offset']:g} m; name the matching case (--case)"
             )
-        files.append(prepare_file(measurement, chosen))
+        with naming(path):
+            files.append(prepare_file(measurement, chosen))
     return files
 
 

@@ -73,6 +73,13 @@ SIGN_CORRELATION_LIMIT = -0.3
 SPEED_WINDOW_S = 0.25  # rack speed from a moving average over this window (converter steps are not motion)
 
 MDF_MAGIC = (b"MDF     ", b"UnFinMF ")
+# Big and fast records. The method resolves a steering cycle's phases over windows of 0.1 s and more, and it is
+# shown to work on 50 Hz loggers (data/measurements/example_unladen.csv); 100 samples a second, twice that, carry
+# all it uses. A faster record is low-pass filtered (an FIR anti-alias filter, zero phase) and decimated to at
+# least that rate on reading, so the work downstream grows with the record's duration, not its sample rate.
+# Beyond the caps a record is refused, not read for minutes.
+METHOD_RATE_HZ = 100.0
+MAX_RECORD_BYTES = 256 * 2**20
 
 
 @dataclass(frozen=True)
@@ -476,9 +483,16 @@ def load_record(path: str | Path, channel_map: str | list[Channel] | None = None
     if isinstance(channel_map, str):
         channel_map = parse_channel_map(channel_map)
     try:
+        size = path.stat().st_size if path.is_file() else 0
+        if size > MAX_RECORD_BYTES:
+            raise UsageError(f"{path}: {size / 2**20:.0f} MiB is beyond the {MAX_RECORD_BYTES / 2**20:.0f} MiB a "
+                             f"record may have; cut it to the steering cycles or decimate it to {METHOD_RATE_HZ:g} Hz")
         raw = path.read_bytes()
     except OSError as exc:
         raise UsageError(f"{path}: cannot read ({exc.strerror})") from None
+    if len(raw) > MAX_RECORD_BYTES:
+        raise UsageError(f"{path}: more than {MAX_RECORD_BYTES / 2**20:.0f} MiB, the most a record may have; cut it "
+                         f"to the steering cycles or decimate it to {METHOD_RATE_HZ:g} Hz")
 
     line_numbers: list[int] | None = None
     if raw[:8] in MDF_MAGIC:
@@ -569,7 +583,32 @@ def load_record(path: str | Path, channel_map: str | list[Channel] | None = None
     ordered = {name: columns[name] for name in ALLOWED_COLUMNS if name in columns}
     validate_record(path, ordered, metadata, params, line_numbers, required)
     _check_signs(path, ordered, chosen, derived)
+    ordered = _decimate(path, ordered, metadata)
     return Measurement(path=path, columns=ordered, metadata=metadata)
+
+
+def _decimate(path: Path, columns: dict[str, np.ndarray], metadata: dict[str, str]) -> dict[str, np.ndarray]:
+    """A record sampled faster than METHOD_RATE_HZ, filtered (FIR anti-alias, zero phase) and decimated by the
+    largest whole factor that keeps at least that rate; a record with uneven sampling is left as it is."""
+    from scipy.signal import decimate
+
+    time_s = columns[TIME]
+    steps = np.diff(time_s)
+    dt = float(np.median(steps))
+    factor = int(1.0 / (dt * METHOD_RATE_HZ))
+    if factor < 2 or float(steps.max() - steps.min()) > 0.01 * dt or len(time_s) < 40 * factor:
+        return columns
+    out = {TIME: time_s[::factor]}
+    for name, values in columns.items():
+        if name != TIME:
+            out[name] = decimate(values, factor, ftype="fir", zero_phase=True)[: len(out[TIME])]
+    for column in list(metadata):  # a quantisation step no longer describes filtered samples
+        if column.startswith("full_scale_") or column == "bits":
+            del metadata[column]
+    metadata["decimated"] = (f"from {1.0 / dt:.6g} Hz by {factor} to {1.0 / (dt * factor):.6g} Hz with an FIR "
+                             "anti-alias filter (parksteer.measure.importers.METHOD_RATE_HZ)")
+    _note(f"{path}: note: {1.0 / dt:.6g} Hz decimated by {factor} to {1.0 / (dt * factor):.6g} Hz")
+    return out
 
 
 def load_rack_drive(path: str | Path, channel_map: str | list[Channel] | None = None, case: str | None = None,

@@ -73,6 +73,11 @@ ANGLE_LIMIT_RAD = 30.0
 LOAD_LIMIT_N = 20000.0
 LOAD_KILONEWTON_SUSPICION_N = 20.0
 EXTRA_OFFSET_LIMIT_M = 0.2
+# A steering cycle moves the rack to a lock (tens of millimetres); a rack that spans less than half a millimetre,
+# the size of the rack lash, holds no cycle to compare, smooth or replay.
+RACK_MOTION_MIN_M = 5.0e-4
+# The most data rows a record may have: an hour at 1 kHz. A longer record is refused before it is parsed.
+MAX_SAMPLES = 3_600_000
 
 
 @dataclass(frozen=True)
@@ -240,6 +245,13 @@ def _validate_columns(where: Path | str, columns: Mapping[str, np.ndarray], line
                     f"+-{limit:g} {unit}; {advice}"
                 )
 
+    if "rack_m" in columns:
+        span = float(np.ptp(columns["rack_m"]))
+        if span < RACK_MOTION_MIN_M:
+            raise UsageError(
+                f"{where}: column 'rack_m': the rack never moves (it spans {span:.3g} m, less than "
+                f"{RACK_MOTION_MIN_M:g} m), so the record holds no steering cycle"
+            )
     check_limit("rack_m", RACK_LIMIT_M, "looks like millimetres; convert to metres (a car rack travels about 0.07 m)")
     check_limit(
         "handwheel_torque_Nm",
@@ -345,6 +357,9 @@ def read_table(text: str, where: Path | str) -> Table:
         if name in seen:
             raise UsageError(f"{where}: column {name!r} appears twice in the header row")
         seen.add(name)
+    if len(lines) > MAX_SAMPLES:
+        raise UsageError(f"{where}: {len(lines)} data rows, beyond the {MAX_SAMPLES} a record may have (an hour at "
+                         "1 kHz); cut it to the steering cycles")
     rows = [(line_no, _split(line, delimiter)) for line_no, line in lines]
     decimal = "."
     if delimiter != "," and any(_DECIMAL_COMMA.match(cell) for _, cells in rows[:200] for cell in cells):

@@ -16,6 +16,7 @@ import inspect
 import json
 import os
 import shutil
+import socket
 import subprocess
 import sys
 import tempfile
@@ -33,6 +34,13 @@ FORMAT_VERSION = "1"
 MODEL_DIR = Path(__file__).resolve().parents[1]
 # The symbolic half: what the generated code depends on. numeric/ is not hashed, so editing it never re-derives.
 SYMBOLIC_DIRS = (MODEL_DIR / "symbolic", MODEL_DIR / "codegen")
+# This module stores entries and generates nothing, so its source is not part of the key.
+KEYLESS_SOURCE = Path(__file__).resolve()
+# Built files whose SHA-256 model.json records: an entry is used only if both exist and match.
+BUILT_FILES = ("model.c", "model.so")
+# A scratch directory (".<key>.<host>.<pid>.<random>") whose builder is gone is removed by the next build; one
+# from another host (a shared cache on a cluster) only once it is older than any build could take.
+STALE_SCRATCH_S = 6 * 3600.0
 
 
 def _checkout_root() -> Path | None:
@@ -80,7 +88,7 @@ def model_key(effects: list[Effect]) -> str:
     digest = hashlib.sha256()
     digest.update(f"format {FORMAT_VERSION}\nsympy {sympy.__version__}\n".encode())
     digest.update(("effects " + ",".join(e.name for e in effects) + "\n").encode())
-    for path in sorted(p for d in SYMBOLIC_DIRS for p in d.rglob("*.py")):
+    for path in sorted(p for d in SYMBOLIC_DIRS for p in d.rglob("*.py") if p != KEYLESS_SOURCE):
         digest.update(str(path.relative_to(MODEL_DIR)).encode() + b"\0" + path.read_bytes() + b"\0")
     for effect in effects:
         digest.update(_effect_source(effect).encode())
@@ -115,6 +123,7 @@ def build_entry(effects: list[Effect], directory: Path) -> dict:
         raise UsageError(f"C compiler failed on the generated model: {first}")
     t_compile = time.perf_counter() - start - t_derive - t_codegen
     info.update({
+        "sha256": {name: _sha256(directory / name) for name in BUILT_FILES},
         "sympy_version": sympy.__version__,
         "timings_s": {"derive": t_derive, "codegen": t_codegen, "compile": t_compile,
                       "total": time.perf_counter() - start, **derivation.timings_s},
@@ -127,19 +136,75 @@ def entry_path(effects: list[Effect]) -> Path:
     return cache_root() / model_key(effects)
 
 
+def _sha256(path: Path) -> str:
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+def entry_is_sound(directory: Path) -> bool:
+    """True if `directory` holds a complete entry: model.json readable, and model.c and model.so present with
+    the SHA-256 it recorded (content, not timestamps: a truncated or replaced library is not trusted)."""
+    try:
+        info = json.loads((directory / "model.json").read_text(encoding="utf-8"))
+        recorded = info["sha256"]
+        return all(_sha256(directory / name) == recorded[name] for name in BUILT_FILES)
+    except (OSError, ValueError, KeyError, TypeError):
+        return False
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
+
+
+def clean_stale_scratch(root: Path) -> list[Path]:
+    """Remove scratch directories of builds that were killed (their process is gone); return what was removed."""
+    removed = []
+    host = socket.gethostname().replace(".", "-")  # as the scratch name writes it
+    if not root.is_dir():
+        return removed
+    for path in root.iterdir():
+        parts = path.name.split(".")
+        if not (path.name.startswith(".") and len(parts) >= 5 and path.is_dir()):
+            continue
+        _, _key, owner_host, pid, *_ = parts
+        try:
+            age = time.time() - path.stat().st_mtime
+        except OSError:
+            continue
+        if not pid.isdigit():
+            continue
+        stale = (owner_host == host and not _alive(int(pid))) or age > STALE_SCRATCH_S
+        if stale:
+            shutil.rmtree(path, ignore_errors=True)
+            removed.append(path)
+    return removed
+
+
 def ensure_entry(effects: list[Effect]) -> Path:
-    """The cache entry of `effects`, built if missing (atomically: built aside, then renamed into place)."""
+    """The cache entry of `effects`, built if missing or unsound (atomically: built aside, then renamed into
+    place; a scratch directory left by a killed build is removed here)."""
     final = entry_path(effects)
-    if (final / "model.json").is_file() and (final / "model.so").is_file():
+    if entry_is_sound(final):
         return final
     final.parent.mkdir(parents=True, exist_ok=True)
-    scratch = Path(tempfile.mkdtemp(prefix=f".{final.name}.", dir=final.parent))
+    clean_stale_scratch(final.parent)
+    host = socket.gethostname().replace(".", "-")
+    scratch = Path(tempfile.mkdtemp(prefix=f".{final.name}.{host}.{os.getpid()}.", dir=final.parent))
     try:
         build_entry(effects, scratch)
+        if final.exists() and not entry_is_sound(final):  # damaged or incomplete: replaced by the new build
+            broken = Path(tempfile.mkdtemp(prefix=f".{final.name}.{host}.{os.getpid()}.", dir=final.parent))
+            os.rename(final, broken / "old")
+            shutil.rmtree(broken, ignore_errors=True)
         try:
             os.rename(scratch, final)
         except OSError:
-            if not (final / "model.json").is_file():  # someone else's complete entry wins
+            if not entry_is_sound(final):  # someone else's complete entry wins
                 raise
     finally:
         if scratch.exists():
@@ -155,7 +220,7 @@ def ensure(effects: list[Effect]) -> dict:
     the number of run-time parameters, and the derivation's timings (of the build that made the
     entry, possibly earlier) with ``built_now`` saying whether this call built it.
     """
-    existed = (entry_path(effects) / "model.json").is_file()
+    existed = entry_is_sound(entry_path(effects))
     directory = ensure_entry(effects)
     info = json.loads((directory / "model.json").read_text(encoding="utf-8"))
     return {

@@ -20,15 +20,17 @@ torque it would not pass). An 18 s replay takes a few hundredths of a second.
 
 from __future__ import annotations
 
+import warnings
+
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Protocol
 
 import numpy as np
-from scipy.integrate import odeint
+from scipy.integrate import ODEintWarning, odeint
 
 from .statics import static_state
-from .tolerances import PRESCRIBED_ATOL_FACTOR, PRESCRIBED_RTOL, absolute_tolerances
+from .tolerances import PRESCRIBED_ATOL_FACTOR, PRESCRIBED_RTOL, absolute_tolerances, solver_failure
 
 # The column twist is integrated exactly for a torque linear between samples this far apart at most (s).
 # Against the column's time constant c / k (0.2 s) the twist filters the torque; at 5 ms the handwheel angle
@@ -157,10 +159,12 @@ def solve(run, p: np.ndarray, rack: RackMotion, t_out, rtol: float = PRESCRIBED_
     # LSODA interpolates at the output times without stepping to them; with its first step fixed (it would
     # otherwise choose it from the first output interval) the refined grid of the twist changes no step.
     grid, at_out = _refined(t_out, TWIST_SAMPLE_S) if outputs else (t_out, np.arange(len(t_out)))
-    states, info = odeint(rhs, z0, grid, Dfun=jacobian, rtol=rtol, atol=atol, mxstep=200000, full_output=True,
-                          h0=FIRST_STEP_S)
+    with warnings.catch_warnings():  # a failure is reported below as one line, not as a warning too
+        warnings.simplefilter("ignore", ODEintWarning)
+        states, info = odeint(rhs, z0, grid, Dfun=jacobian, rtol=rtol, atol=atol, mxstep=200000, full_output=True,
+                              h0=FIRST_STEP_S)
     if info["message"] != "Integration successful.":
-        raise RuntimeError(f"prescribed-rack integration failed: {info['message']}")
+        raise solver_failure("prescribed-rack integration", info, grid)
 
     # The accelerations and the torque at every sample, solved together (the same equations as `accelerations`).
     m = len(grid)

@@ -9,14 +9,16 @@ handwheel torque is solved for by :func:`parksteer.model.numeric.prescribed.solv
 
 from __future__ import annotations
 
+import warnings
+
 import dataclasses
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-from scipy.integrate import odeint
+from scipy.integrate import ODEintWarning, odeint
 
-from ...errors import UsageError
+from ...errors import SolverError, UsageError
 from ...parameters import Parameters, load_parameters
 from ...tables import write_csv
 from .compiled import CompiledModel, load_model
@@ -24,7 +26,7 @@ from ..symbolic.components import Effect, discover_effects, resolve_effects
 from .inputs import HandwheelProfile, sawtooth_profile
 from .prescribed import RackMotion, solve as solve_prescribed
 from .statics import static_state
-from .tolerances import PRESCRIBED_RTOL, RTOL, absolute_tolerances
+from .tolerances import PRESCRIBED_RTOL, RTOL, absolute_tolerances, solver_failure
 from .values import RunValues, parameter_vector, resolve_values
 
 ROLL_NEUTRAL_KEY = "derived.roll_spring_neutral"
@@ -124,10 +126,12 @@ def integrate(run: PreparedRun, t_out: np.ndarray, y0: np.ndarray | None = None,
         return jac
 
     corners = np.array([piece[0] for piece in run.profile.pieces])
-    states, info = odeint(rhs, y0, t_out, Dfun=dfun, rtol=rtol, atol=_atol(model) if atol is None else atol,
-                          mxstep=200000, full_output=True, tcrit=corners)
+    with warnings.catch_warnings():  # a failure is reported below as one line, not as a warning too
+        warnings.simplefilter("ignore", ODEintWarning)
+        states, info = odeint(rhs, y0, t_out, Dfun=dfun, rtol=rtol, atol=_atol(model) if atol is None else atol,
+                              mxstep=200000, full_output=True, tcrit=corners)
     if info["message"] != "Integration successful.":
-        raise RuntimeError(f"integration failed: {info['message']}")
+        raise solver_failure("integration", info, t_out)
     return states
 
 
@@ -192,19 +196,35 @@ def simulate(case: str, effects=None, overrides: dict | None = None, surface: st
     if not (output_dt_s > 0):
         raise UsageError(f"output_dt_s must be positive, got {output_dt_s}")
     run = prepare(case, effects, overrides, surface, params, handwheel)
-    if rack_drive is not None:
-        return _simulate_rack_drive(run, rack_drive, t_end_s, output_dt_s, PRESCRIBED_RTOL if rtol is None else rtol)
-    rtol = RTOL if rtol is None else rtol
-    t_end = run.profile.end_time_s if t_end_s is None else float(t_end_s)
-    if not (t_end > 0):
-        raise UsageError(f"t_end_s must be positive, got {t_end}")
-    t = np.round(np.arange(0.0, t_end + 0.5 * output_dt_s, output_dt_s), 12)
-    states = integrate(run, t, rtol=rtol)
+    try:
+        if rack_drive is not None:
+            return _simulate_rack_drive(run, rack_drive, t_end_s, output_dt_s,
+                                        PRESCRIBED_RTOL if rtol is None else rtol)
+        rtol = RTOL if rtol is None else rtol
+        t_end = run.profile.end_time_s if t_end_s is None else float(t_end_s)
+        if not (t_end > 0):
+            raise UsageError(f"t_end_s must be positive, got {t_end}")
+        t = np.round(np.arange(0.0, t_end + 0.5 * output_dt_s, output_dt_s), 12)
+        if len(t) < 2:
+            raise UsageError(f"output step {output_dt_s:g} s leaves fewer than two outputs in the run of {t_end:g} s; "
+                             "give a shorter --output-dt")
+        states = integrate(run, t, rtol=rtol)
+    except SolverError as exc:
+        raise SolverError(f"case {case} ({surface}), effects {','.join(e.name for e in run.effects)}, "
+                          f"{_stated_values(overrides)}: {exc}", exc.t_failed_s) from None
     outputs = run.model.evaluate_outputs(t, states, run.p)
     samples = np.column_stack(run.profile.angle_rate(t))
     columns = _columns(run, t, states, outputs, samples)
     drive = "handwheel saw tooth (section 4)" if handwheel is None else "prescribed handwheel profile"
     return SimulationResult(columns, _header(run, drive), states, run.p, run.model, run.values)
+
+
+def _stated_values(overrides: dict | None) -> str:
+    """The values a caller changed, the usual cause of a stiff run ('the parameter file's values' if none)."""
+    if not overrides:
+        return "the parameter file's values (no --set)"
+    return "values set: " + ", ".join(f"{key}={value:g}" if isinstance(value, (int, float)) else f"{key}={value}"
+                                      for key, value in overrides.items())
 
 
 def _simulate_rack_drive(run: PreparedRun, rack: RackMotion, t_end_s, output_dt_s: float, rtol: float

@@ -27,3 +27,23 @@ PRESCRIBED_ATOL_FACTOR = 100.0  # 1
 def absolute_tolerances(units: list[str], factor: float = 1.0) -> np.ndarray:
     """Absolute tolerances of the states (coordinates, then their rates) for coordinates of `units` (m or rad)."""
     return factor * np.array([ATOL_Q[u] for u in units] + [ATOL_U[u] for u in units])
+
+
+def solver_failure(what: str, info: dict, t_out: np.ndarray) -> "SolverError":
+    """The one-line error of an odeint call that gave up: its message and the last time it reached.
+
+    odeint's ``tcur`` holds the time reached at each output up to the failure and undefined values after it;
+    an entry counts while it is finite, not before its output time, not decreasing, and within the run.
+    """
+    from ...errors import SolverError
+
+    t_out = np.asarray(t_out, dtype=float)
+    span = float(t_out[-1] - t_out[0])
+    t_failed = float(t_out[0])
+    for t_req, reached in zip(t_out, np.asarray(info.get("tcur", []), dtype=float)):
+        if not (np.isfinite(reached) and t_req <= reached <= t_out[-1] + span and reached >= t_failed):
+            break
+        t_failed = float(reached)
+    # odeint's words, without its guess at the cause ("Excess work done on this call (perhaps wrong Dfun type).")
+    message = str(info.get("message", "unknown failure")).split(" on this call")[0].rstrip(".").replace("\n", " ")
+    return SolverError(f"{what} failed at t = {t_failed:.4g} s: {message}", t_failed)

@@ -1,0 +1,88 @@
+"""The compiled-model cache survives a killed build and damage: a killed build's scratch directory is removed by
+the next build, and an entry whose library or source no longer matches the SHA-256 it recorded is rebuilt."""
+
+from __future__ import annotations
+
+import os
+import signal
+import socket
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from parksteer.model.codegen import cache
+from parksteer.model.symbolic.components import resolve_effects
+
+# The smallest effect set: the quickest build (a few seconds).
+SMALL = "-rack_friction,-tyre_friction"
+
+
+@pytest.fixture
+def cache_dir(tmp_path, monkeypatch):
+    monkeypatch.setenv(cache.CACHE_ENV, str(tmp_path / "model"))
+    return tmp_path / "model"
+
+
+def _dead_pid() -> int:
+    done = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True, text=True)
+    return int(done.stdout)
+
+
+def _scratch(root: Path) -> list[Path]:
+    return [p for p in root.iterdir() if p.name.startswith(".")]
+
+
+def test_killed_build_leaves_scratch_that_the_next_build_removes(cache_dir):
+    """A build killed by SIGKILL mid-way leaves its scratch directory; the next build removes it (its process is
+    gone), keeps a live builder's, and ends with one sound entry and no scratch."""
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
+    code = ("from parksteer.model.codegen.cache import ensure_entry;"
+            "from parksteer.model.symbolic.components import resolve_effects;"
+            f"ensure_entry(resolve_effects({SMALL!r}))")
+    proc = subprocess.Popen([sys.executable, "-c", code], env=env, start_new_session=True)
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline and not (cache_dir.is_dir() and _scratch(cache_dir)):
+        time.sleep(0.05)
+    os.killpg(proc.pid, signal.SIGKILL)
+    proc.wait()
+    left = _scratch(cache_dir)
+    assert left, "the build was killed before it made its scratch directory"
+    host = socket.gethostname().replace(".", "-")
+    live = cache_dir / f".{'0' * 20}.{host}.{os.getpid()}.live"  # this process is alive: never removed
+    live.mkdir()
+    entry = cache.ensure_entry(resolve_effects(SMALL))
+    assert cache.entry_is_sound(entry)
+    assert [p for p in _scratch(cache_dir) if p != live] == []
+    assert live.is_dir()
+
+
+def test_damaged_entry_is_rebuilt_and_a_dead_builders_scratch_removed(cache_dir):
+    """Truncating model.so (its timestamp newer than model.json) makes the entry unsound; the next ensure
+    rebuilds it to the recorded content. A scratch directory of a dead process on this host goes too."""
+    effects = resolve_effects(SMALL)
+    entry = cache.ensure_entry(effects)
+    good = (entry / "model.so").read_bytes()
+    (entry / "model.so").write_bytes(good[: len(good) // 2])
+    assert not cache.entry_is_sound(entry)
+    host = socket.gethostname().replace(".", "-")
+    stale = cache_dir / f".{entry.name}.{host}.{_dead_pid()}.abcd"
+    stale.mkdir()
+    (stale / "model.c").write_text("half", encoding="utf-8")
+    again = cache.ensure_entry(effects)
+    assert again == entry and cache.entry_is_sound(entry)
+    assert not stale.exists()
+    assert _scratch(cache_dir) == []
+
+
+def test_entry_without_recorded_hashes_is_not_trusted(tmp_path):
+    """An entry from before hashes were recorded, or a model.json alone, is not sound."""
+    d = tmp_path / "entry"
+    d.mkdir()
+    (d / "model.json").write_text("{}", encoding="utf-8")
+    (d / "model.so").write_bytes(b"x")
+    (d / "model.c").write_text("x", encoding="utf-8")
+    assert not cache.entry_is_sound(d)
+    assert not cache.entry_is_sound(tmp_path / "missing")

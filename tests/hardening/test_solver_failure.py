@@ -1,0 +1,65 @@
+"""An integration the solver gives up on is one line naming the case, the values set and the time it failed at,
+exit status 2, and no output written. The failure is real: the integrator is allowed only a few steps per
+output, so LSODA stops with 'Excess work done', as it does on a stiff set of values."""
+
+from __future__ import annotations
+
+import re
+
+import numpy as np
+import pytest
+from scipy.integrate import odeint as real_odeint
+
+from parksteer.cli import main
+from parksteer.model.numeric import prescribed, simulate
+from parksteer.model.numeric.tolerances import solver_failure
+
+from .corpus import _write, record_text
+
+
+def _starved(*args, **kwargs):
+    return real_odeint(*args, **{**kwargs, "mxstep": 3})
+
+
+@pytest.mark.filterwarnings("ignore::scipy.integrate.ODEintWarning")  # odeint called directly warns
+def test_solver_failure_reports_the_last_time_reached():
+    """odeint's own report of a starved stiff problem (Van der Pol, mu = 1000) becomes one line with the time
+    the integrator reached, which lies inside the requested span."""
+    def rhs(y, t):
+        return [y[1], 1000.0 * (1 - y[0] ** 2) * y[1] - y[0]]
+
+    t = np.linspace(0.0, 3000.0, 11)
+    _, info = real_odeint(rhs, [2.0, 0.0], t, mxstep=50, full_output=True)
+    assert "Excess work done" in info["message"]
+    error = solver_failure("integration", info, t)
+    assert "\n" not in str(error)
+    assert 0.0 < error.t_failed_s < 3000.0
+    assert re.search(r"failed at t = [0-9.e+-]+ s: Excess work done$", str(error))
+
+
+# A warning beside the one line would be a second line on stderr: turned into an error here, it would fail the test.
+@pytest.mark.filterwarnings("error::scipy.integrate.ODEintWarning")
+def test_simulate_names_case_values_and_time(tmp_path, capsys, monkeypatch):
+    """A saw-tooth run that the integrator abandons: exit 2, one line naming case, effects, --set values and time."""
+    monkeypatch.setattr(simulate, "odeint", _starved)
+    out = tmp_path / "out.csv"
+    status = main(["simulate", "--case", "unladen", "--set", "tyre.tyre_pressure=180000", "--out", str(out)])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert status == 2 and len(err) == 1, err
+    assert "case unladen (ground)" in err[0] and "tyre.tyre_pressure=180000" in err[0], err[0]
+    assert re.search(r"integration failed at t = [0-9.e+-]+ s: Excess work done", err[0]), err[0]
+    assert not out.exists()
+
+
+@pytest.mark.filterwarnings("error::scipy.integrate.ODEintWarning")
+def test_rack_drive_failure_names_the_file(tmp_path, capsys, monkeypatch):
+    """The same for a prescribed rack: the line names the --rack-from file as well."""
+    monkeypatch.setattr(prescribed, "odeint", _starved)
+    record = _write(tmp_path, "rec.csv", record_text())
+    out = tmp_path / "out.csv"
+    status = main(["simulate", "--rack-from", str(record), "--out", str(out)])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert status == 2 and len(err) == 1, err
+    assert f"--rack-from {record}" in err[0] and "the parameter file's values" in err[0], err[0]
+    assert "prescribed-rack integration failed at t = " in err[0], err[0]
+    assert not out.exists()
