@@ -51,7 +51,10 @@ def declaration(n_points: int) -> str:
     )
 
 
-def linear_fit(sizes, seconds) -> dict:
+def linear_fit(sizes, seconds) -> dict | None:
+    """Least-squares line through (points, seconds); None for fewer than two sizes."""
+    if len(set(sizes)) < 2:
+        return None
     x, y = np.asarray(sizes, dtype=float), np.asarray(seconds, dtype=float)
     slope, intercept = np.polyfit(x, y, 1)
     residual = y - (slope * x + intercept)
@@ -217,6 +220,8 @@ def main(argv=None) -> int:
     for mode in ("inprocess", "snakemake"):
         if mode in result:
             fit = result[mode]["fit"]
+            if fit is None:
+                continue
             print(f"{mode}: {fit['slope_s_per_point'] * 1000:.1f} ms per point, intercept {fit['intercept_s']:.2f} s, "
                   f"R^2 {fit['r_squared']:.4f}")
     Path(args.out).parent.mkdir(parents=True, exist_ok=True)
