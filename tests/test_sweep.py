@@ -182,9 +182,10 @@ def _listed(tmp_path, pressures, name):
 
 
 def test_batches_partition_the_points_and_a_new_point_reruns_only_its_batch(tmp_path, params):
-    """Every point is in exactly one batch; adding a point changes exactly one batch (the one it joins: new id,
-    old members plus it) and leaves every other batch, id and members, as it was; so does removing one. At batch
-    size 1 every point is its own batch; over 2,000 points batches average about the asked size."""
+    """Every point is in exactly one batch; adding a point (here one whose id is not a boundary) changes exactly
+    one batch (the one it joins: new id, old members plus it) and leaves every other batch, id and members, as it
+    was; removing one changes one old batch. At batch size 1 every point is its own batch; over 2,000 points
+    batches average about the asked size and none exceeds the cap."""
     pressures = list(range(100000, 500000, 2000))  # 200 points
     sweep = load_sweep(_listed(tmp_path, pressures, "a.yaml"), params)
     batches = sweep.batches(8)
@@ -193,9 +194,19 @@ def test_batches_partition_the_points_and_a_new_point_reruns_only_its_batch(tmp_
     grown = load_sweep(_listed(tmp_path, pressures + [123457], "b.yaml"), params).batches(8)
     new_id = (set(load_sweep(_listed(tmp_path, pressures + [123457], "b.yaml"), params).point_ids)
               - set(sweep.point_ids)).pop()
+    assert int(new_id, 16) % 8  # not a boundary: it joins a batch rather than splitting one
     changed_old, changed_new = set(batches) - set(grown), set(grown) - set(batches)
     assert len(changed_old) == 1 and len(changed_new) == 1
     assert set(grown[changed_new.pop()]) == set(batches[changed_old.pop()]) | {new_id}
+    from parksteer.sweep.declaration import point_id
+
+    boundary = next(q for q in range(123001, 124000, 2)
+                    if int(point_id("unladen", None, "ground", {"tyre.tyre_pressure": float(q)}), 16) % 8 == 0)
+    split = load_sweep(_listed(tmp_path, pressures + [boundary], "s.yaml"), params).batches(8)
+    old_batch, new_batches = set(batches) - set(split), set(split) - set(batches)
+    assert len(old_batch) == 1 and len(new_batches) == 2  # a boundary point splits the one batch it falls in
+    assert set().union(*(split[b] for b in new_batches)) - set(batches[old_batch.pop()]) == {
+        point_id("unladen", None, "ground", {"tyre.tyre_pressure": float(boundary)})}
     shrunk = load_sweep(_listed(tmp_path, pressures[1:], "c.yaml"), params).batches(8)
     assert len(set(batches) - set(shrunk)) == 1 and len(set(shrunk) - set(batches)) <= 1
     assert all(len(points) == 1 for points in sweep.batches(1).values()) and len(sweep.batches(1)) == 200

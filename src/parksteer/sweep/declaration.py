@@ -354,9 +354,11 @@ def batch_points(ids, batch_size: int) -> dict[str, tuple[str, ...]]:
 
     The ids are taken in sorted order and a batch ends after every id whose value is a multiple of
     `batch_size` (content-defined boundaries, as in rsync), or once it holds BATCH_CAP_FACTOR x `batch_size`
-    points. A boundary depends only on the id before it, so a new point joins one batch and leaves every other
-    batch, its id (a hash of its members) and its result as they were; removing a point likewise. Batch size 1
-    gives one batch per point.
+    points. A boundary depends only on the id before it, so a new point changes only the batch it falls in (which
+    it joins, or splits in two when its own id is a boundary) and leaves every other batch, its id (a hash of its
+    members) and its result as they were; a removed point changes only its batch (merged with the next when the
+    point ended it). The cap can shift boundaries further only in a run of over BATCH_CAP_FACTOR x `batch_size`
+    points without a natural boundary. Batch size 1 gives one batch per point.
     """
     if isinstance(batch_size, bool) or not isinstance(batch_size, int) or batch_size < 1:
         raise SweepError(f"sweep_batch_size: {batch_size!r} is not a positive integer")
