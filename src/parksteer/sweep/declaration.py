@@ -496,7 +496,10 @@ def _map(path: Path, raw: Any, keys: list[str], axes: dict[str, tuple[float, ...
 
 
 def _check_effects(path: Path, effects: str | None) -> None:
-    """The effects spec names effects that exist (resolved as `parksteer simulate --effects` would)."""
+    """The effects spec names effects that exist (resolved as `parksteer simulate --effects` would); null, the
+    paper's five, needs no check and so does not import the symbolic model (sympy)."""
+    if effects is None:
+        return
     from ..model.symbolic.components import resolve_effects
 
     try:
