@@ -1,19 +1,21 @@
-"""Sweep cost: wall time of 25, 50, 100 and 200 points on 2 cores, and how it grows with the number of points.
+"""Sweep cost: wall time of 48, 1,000 and 2,000 points on 2 cores, in process and in the DAG, and how it grows.
 
 Two ways of running the same point code (parksteer.sweep.run.simulate_point):
 
 * snakemake: the pipeline's rules in a scratch working directory (symlinks to the repository's data,
-  src and workflow, with the benchmark's sweep in place of config/sweeps/design.yaml), one job per
-  point, `--cores 2`; the derivation rule runs first and is timed apart;
+  src and workflow, with the benchmark's sweep in place of config/sweeps/design.yaml), the points in
+  sweep_batch jobs of about --batch-size points (default: config/config.yaml's sweep_batch_size), `--cores 2`;
+  the derivation rule runs first and is timed apart; the wall time includes Snakemake's own start and DAG build;
 * inprocess: a pool of 2 worker processes calling simulate_point directly, each loading the compiled
   model once (the floor under any scheduler's overhead).
 
-For each it reports the wall time per size (the median of --repeats runs, all runs kept), the cost per point and
-a linear fit (slope, intercept, R^2) of the medians.
+For each it reports the wall time per size (the median of --repeats runs, all runs kept), the cost per point, the
+ratio of the DAG's cost per point to the in-process one, and a linear fit (slope, intercept, R^2) of the medians.
 No point may derive the model: in the pool a derivation raises; around the Snakemake runs the model
 cache's entries are compared before and after, and every point records the same model key.
 
-    python benchmarks/bench_sweep.py results/bench_sweep.json [--sizes 25 50 100 200] [--mode both] [--repeats 3]
+    python benchmarks/bench_sweep.py results/bench_sweep.json [--sizes 48 1000 2000] [--mode both] [--repeats 1]
+        [--batch-size N]
 """
 
 from __future__ import annotations
@@ -33,23 +35,26 @@ import numpy as np
 
 REPO = Path(__file__).resolve().parents[1]
 SNAKEMAKE = Path(sys.executable).with_name("snakemake")
-LOADS_PER_PRESSURE = 5
 
 
 def declaration(n_points: int) -> str:
-    """A sweep of exactly n_points: n/5 tyre pressures x 5 front axle loads around the test car."""
-    if n_points % LOADS_PER_PRESSURE:
-        raise SystemExit(f"sizes must be multiples of {LOADS_PER_PRESSURE}")
+    """A sweep of exactly n_points: tyre pressures x front axle loads around the test car (5, 4, 3, 2 or 1 loads,
+    the most that divide n_points)."""
+    loads = next(k for k in (5, 4, 3, 2, 1) if n_points % k == 0)
+    load_axis = f"{{start: 5000, stop: 9000, num: {loads}}}" if loads > 1 else "[5576]"
     return (
         f"name: bench{n_points}\n"
         "base_case: unladen\n"
         "axes:\n"
-        f"  tyre.tyre_pressure: {{start: 120000, stop: 300000, num: {n_points // LOADS_PER_PRESSURE}}}\n"
-        f"  design.front_axle_load: {{start: 5000, stop: 9000, num: {LOADS_PER_PRESSURE}}}\n"
+        f"  tyre.tyre_pressure: {{start: 120000, stop: 300000, num: {n_points // loads}}}\n"
+        f"  design.front_axle_load: {load_axis}\n"
     )
 
 
-def linear_fit(sizes, seconds) -> dict:
+def linear_fit(sizes, seconds) -> dict | None:
+    """Least-squares line through (points, seconds); None for fewer than two sizes."""
+    if len(set(sizes)) < 2:
+        return None
     x, y = np.asarray(sizes, dtype=float), np.asarray(seconds, dtype=float)
     slope, intercept = np.polyfit(x, y, 1)
     residual = y - (slope * x + intercept)
@@ -125,9 +130,9 @@ def _workdir(scratch: Path, n: int) -> tuple[Path, Path]:
     return work, work / "workflow" / "Snakefile"
 
 
-def _snakemake(snakefile: Path, work: Path, cores: int, targets: list[str]) -> float:
+def _snakemake(snakefile: Path, work: Path, cores: int, targets: list[str], batch_size: int) -> float:
     cmd = [str(SNAKEMAKE), *targets, "--snakefile", str(snakefile), "--directory", str(work), "--cores", str(cores),
-           "--quiet", "all"]
+           "--config", f"sweep_batch_size={batch_size}", "--quiet", "all"]
     start = time.perf_counter()
     done = subprocess.run(cmd, capture_output=True, text=True)
     wall = time.perf_counter() - start
@@ -138,7 +143,7 @@ def _snakemake(snakefile: Path, work: Path, cores: int, targets: list[str]) -> f
     return wall
 
 
-def bench_snakemake(sizes, cores, repeats) -> dict:
+def bench_snakemake(sizes, cores, repeats, batch_size) -> dict:
     from parksteer.parameters import load_parameters
     from parksteer.sweep import load_sweep
 
@@ -148,41 +153,51 @@ def bench_snakemake(sizes, cores, repeats) -> dict:
         for n in sizes:
             work, snakefile = _workdir(Path(scratch), n)
             sweep = load_sweep(work / "config" / "sweeps" / "design.yaml", params)
-            derive_s = _snakemake(snakefile, work, cores, ["results/model/full.json"])
-            points = [f"results/sweeps/{sweep.name}/points/{i}.json" for i in sweep.point_ids]
+            derive_s = _snakemake(snakefile, work, cores, ["results/model/full.json"], batch_size)
+            batches = sweep.batches(batch_size)
+            files = [f"results/sweeps/{sweep.name}/batches/{b}.json" for b in sorted(batches)]
             before = cache_snapshot()
             walls = []
             for repeat in range(repeats):
-                for p in points if repeat else []:
-                    (work / p).unlink()
-                walls.append(_snakemake(snakefile, work, cores, points))
+                for f in files if repeat else []:
+                    (work / f).unlink()
+                walls.append(_snakemake(snakefile, work, cores, files, batch_size))
             after = cache_snapshot()
             points_s = float(np.median(walls))
-            keys = {json.loads((work / p).read_text())["model_key"] for p in points}
+            records = [r for f in files for r in json.loads((work / f).read_text())["records"]]
+            assert len(records) == n, (len(records), n)
+            keys = {r["model_key"] for r in records}
             # The entry the points used existed before they ran and was not rebuilt by them (other entries may
             # come and go with unrelated work on the machine).
             cache_unchanged = all(k in before and after.get(k) == before[k] for k in keys)
-            gather_s = _snakemake(snakefile, work, cores, [f"sweep_{sweep.name}"])
-            rows.append({"points": n, "wall_s": points_s, "per_point_s": points_s / n, "runs_s": walls,
-                         "derive_rule_s": derive_s, "gather_s": gather_s, "model_keys": sorted(keys),
-                         "cache_unchanged_by_points": cache_unchanged})
-            print(f"snakemake {n:4d} points: {points_s:7.2f} s ({points_s / n:.3f} s per point; derive rule "
-                  f"{derive_s:.1f} s, gather {gather_s:.1f} s)", flush=True)
-    return {"rows": rows, "fit": linear_fit([r["points"] for r in rows], [r["wall_s"] for r in rows]),
+            gather_s = _snakemake(snakefile, work, cores, [f"sweep_{sweep.name}"], batch_size)
+            rows.append({"points": n, "batches": len(batches), "wall_s": points_s, "per_point_s": points_s / n,
+                         "runs_s": walls, "derive_rule_s": derive_s, "gather_s": gather_s,
+                         "model_keys": sorted(keys), "cache_unchanged_by_points": cache_unchanged})
+            print(f"snakemake {n:4d} points in {len(batches)} batches: {points_s:7.2f} s ({1000 * points_s / n:.1f} "
+                  f"ms per point; derive rule {derive_s:.1f} s, gather {gather_s:.1f} s)", flush=True)
+    return {"rows": rows, "batch_size": batch_size,
+            "fit": linear_fit([r["points"] for r in rows], [r["wall_s"] for r in rows]),
             "cache_unchanged": all(r["cache_unchanged_by_points"] for r in rows),
-            "note": "wall_s is the point jobs alone (median of runs_s); the derive rule ran first (derive_rule_s) "
-                    "and the model entry the points used was compared before and after them"}
+            "note": "wall_s is the batch jobs alone, with Snakemake's start and DAG build (median of runs_s); the "
+                    "derive rule ran first (derive_rule_s) and the model entry the points used was compared before "
+                    "and after them"}
 
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("out", help="JSON file for the results")
-    parser.add_argument("--sizes", type=int, nargs="+", default=[25, 50, 100, 200])
+    parser.add_argument("--sizes", type=int, nargs="+", default=[48, 1000, 2000])
     parser.add_argument("--mode", choices=("snakemake", "inprocess", "both"), default="both")
     parser.add_argument("--cores", type=int, default=2)
     parser.add_argument("--repeats", type=int, default=1, help="runs per size; the median is fitted")
+    parser.add_argument("--batch-size", type=int, default=None,
+                        help="points per sweep_batch job (default: config/config.yaml's sweep_batch_size)")
     args = parser.parse_args(argv)
     os.chdir(REPO)
+    import yaml
+
+    batch_size = args.batch_size or yaml.safe_load((REPO / "config" / "config.yaml").read_text())["sweep_batch_size"]
     from parksteer.model.codegen.cache import ensure
     from parksteer.model.symbolic.components import resolve_effects
 
@@ -193,11 +208,20 @@ def main(argv=None) -> int:
     if args.mode in ("inprocess", "both"):
         result["inprocess"] = bench_inprocess(args.sizes, args.cores, args.repeats)
     if args.mode in ("snakemake", "both"):
-        result["snakemake"] = bench_snakemake(args.sizes, args.cores, args.repeats)
+        result["snakemake"] = bench_snakemake(args.sizes, args.cores, args.repeats, batch_size)
+    if "inprocess" in result and "snakemake" in result:
+        result["dag_over_inprocess"] = {
+            str(a["points"]): b["per_point_s"] / a["per_point_s"]
+            for a, b in zip(result["inprocess"]["rows"], result["snakemake"]["rows"])
+        }
+        for n, ratio in result["dag_over_inprocess"].items():
+            print(f"{n} points: the DAG costs {ratio:.2f} x the in-process cost per point")
     result["load_average_at_end"] = os.getloadavg()
     for mode in ("inprocess", "snakemake"):
         if mode in result:
             fit = result[mode]["fit"]
+            if fit is None:
+                continue
             print(f"{mode}: {fit['slope_s_per_point'] * 1000:.1f} ms per point, intercept {fit['intercept_s']:.2f} s, "
                   f"R^2 {fit['r_squared']:.4f}")
     Path(args.out).parent.mkdir(parents=True, exist_ok=True)

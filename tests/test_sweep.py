@@ -3,8 +3,11 @@ the point job's no-derivation guarantee and the SLURM profile's dry run."""
 
 from __future__ import annotations
 
+import hashlib
+import json
 import math
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -106,6 +109,128 @@ def test_invalid_declarations_fail_with_one_line_naming_file_and_key(tmp_path, p
         load_sweep(path, params)
     message = str(info.value)
     assert "\n" not in message and message.startswith(str(path)) and key in message
+
+
+BAR = "name: bar\nbase_case: unladen\naxes: {tyre.tyre_pressure: [1.2, 2.0]}\n"  # pressures in bar, not Pa
+
+
+@pytest.mark.parametrize("body, key", [
+    ("axes: {}", "axes"),
+    ("axes: {tyre.pressure_bar: [2.0]}", "tyre.pressure_bar"),
+    ("effects: '+no_such_effect'\naxes: {tyre.tyre_pressure: [2.0e+5]}", "no_such_effect"),
+    ("axes: {tyre.tyre_pressure: [1.2, 2.0]}", "axes.tyre.tyre_pressure[0]"),
+    ("axes: {tyre.tyre_pressure: [2.0e+5]}\nfull_axes: {design.front_axle_load: [1500], vehicle.unsprung_mass: [200]}",
+     "full_axes point 0"),
+])
+def test_declarations_the_dag_build_refuses(tmp_path, params, body, key):
+    """What `--config sweep=...` may name and the DAG build must refuse, each in one line naming the file and the
+    key: empty axes, an unknown axis, an unknown effect, a pressure given in bar (1.2 Pa is below the registry's
+    1e4 Pa), and a point of the unselected full sweep whose derived quantities are unphysical (a front axle
+    load below the unsprung weight leaves a negative chassis mass)."""
+    path = _write(tmp_path, f"name: bad\nbase_case: unladen\n{body}\n")
+    with pytest.raises(SweepError) as info:
+        load_sweep(path, params)
+    message = str(info.value)
+    assert "\n" not in message and message.startswith(str(path)) and key in message
+
+
+def test_a_missing_declaration_is_one_line(tmp_path, params):
+    """A sweep file that does not exist is refused in one line naming it."""
+    missing = tmp_path / "nowhere.yaml"
+    with pytest.raises(SweepError, match="nowhere.yaml: cannot read") as info:
+        load_sweep(missing, params)
+    assert "\n" not in str(info.value)
+
+
+def test_sweep_expand_refuses_a_pressure_in_bar_with_exit_status_2(tmp_path):
+    """`parksteer sweep expand` checks every value against the registry's bounds: exit status 2, one line on
+    stderr naming the file and the axis, nothing on stdout."""
+    path = _write(tmp_path, BAR)
+    done = subprocess.run([str(Path(sys.executable).with_name("parksteer")), "sweep", "expand", str(path)],
+                          capture_output=True, text=True, timeout=120)
+    assert done.returncode == 2 and done.stdout == ""
+    assert done.stderr.splitlines() == [f"parksteer sweep: error: {path}: axes.tyre.tyre_pressure[0]: 1.2 Pa is out "
+                                        "of bounds [10000, 1e+06]"]
+
+
+def test_the_dag_build_refuses_a_bad_sweep_in_one_line(repo_root, tmp_path):
+    """`snakemake --config sweep=bad.yaml` stops while the DAG is built: exit status 2, exactly one error line
+    naming the file and the axis, no traceback, no job started (nothing under results/ or logs/ of the
+    working directory). load_sweep's refusals above are the ones this line reports."""
+    path = _write(tmp_path, BAR)
+    work = tmp_path / "work"
+    work.mkdir()
+    for name in ("config", "src", "workflow"):
+        (work / name).symlink_to(repo_root / name)
+    done = subprocess.run([str(Path(sys.executable).with_name("snakemake")), "--cores", "1", "--directory",
+                           str(work), "--snakefile", str(repo_root / "workflow" / "Snakefile"), "sweep_design",
+                           "--config", f"sweep={path}"], capture_output=True, text=True, timeout=300)
+    out = done.stdout + done.stderr
+    assert done.returncode == 2, out[-2000:]
+    errors = [line for line in out.splitlines() if "error" in line.lower()]
+    assert errors == [f"parksteer: error: {path}: axes.tyre.tyre_pressure[0]: 1.2 Pa is out of bounds [10000, 1e+06]"]
+    assert "Traceback" not in out and "SweepError" not in out
+    assert not (work / "results").exists() and not (work / "logs").exists()
+
+
+# ---------------------------------------------------------------------------- batches
+
+
+def _listed(tmp_path, pressures, name):
+    lines = "".join(f"  - {{tyre.tyre_pressure: {p}}}\n" for p in pressures)
+    return _write(tmp_path, f"name: listed\nbase_case: unladen\npoints:\n{lines}", name)
+
+
+def test_batches_partition_the_points_and_a_new_point_reruns_only_its_batch(tmp_path, params):
+    """Every point is in exactly one batch; adding a point (here one whose id is not a boundary) changes exactly
+    one batch (the one it joins: new id, old members plus it) and leaves every other batch, id and members, as it
+    was; removing one changes one old batch. At batch size 1 every point is its own batch; over 2,000 points
+    batches average about the asked size and none exceeds the cap."""
+    pressures = list(range(100000, 500000, 2000))  # 200 points
+    sweep = load_sweep(_listed(tmp_path, pressures, "a.yaml"), params)
+    batches = sweep.batches(8)
+    members = [p for points in batches.values() for p in points]
+    assert sorted(members) == sorted(sweep.point_ids)
+    grown = load_sweep(_listed(tmp_path, pressures + [123457], "b.yaml"), params).batches(8)
+    new_id = (set(load_sweep(_listed(tmp_path, pressures + [123457], "b.yaml"), params).point_ids)
+              - set(sweep.point_ids)).pop()
+    assert int(new_id, 16) % 8  # not a boundary: it joins a batch rather than splitting one
+    changed_old, changed_new = set(batches) - set(grown), set(grown) - set(batches)
+    assert len(changed_old) == 1 and len(changed_new) == 1
+    assert set(grown[changed_new.pop()]) == set(batches[changed_old.pop()]) | {new_id}
+    from parksteer.sweep.declaration import point_id
+
+    boundary = next(q for q in range(123001, 124000, 2)
+                    if int(point_id("unladen", None, "ground", {"tyre.tyre_pressure": float(q)}), 16) % 8 == 0)
+    split = load_sweep(_listed(tmp_path, pressures + [boundary], "s.yaml"), params).batches(8)
+    old_batch, new_batches = set(batches) - set(split), set(split) - set(batches)
+    assert len(old_batch) == 1 and len(new_batches) == 2  # a boundary point splits the one batch it falls in
+    assert set().union(*(split[b] for b in new_batches)) - set(batches[old_batch.pop()]) == {
+        point_id("unladen", None, "ground", {"tyre.tyre_pressure": float(boundary)})}
+    shrunk = load_sweep(_listed(tmp_path, pressures[1:], "c.yaml"), params).batches(8)
+    assert len(set(batches) - set(shrunk)) == 1 and len(set(shrunk) - set(batches)) <= 1
+    assert all(len(points) == 1 for points in sweep.batches(1).values()) and len(sweep.batches(1)) == 200
+    ids = [hashlib.sha256(str(k).encode()).hexdigest()[:10] for k in range(2000)]  # uniform, as point ids are
+    from parksteer.sweep.declaration import batch_points
+
+    sizes = [len(points) for points in batch_points(ids, 25).values()]
+    assert sum(sizes) == 2000 and max(sizes) <= 75 and 15 <= 2000 / len(sizes) <= 40
+
+
+def test_a_batch_writes_the_records_its_points_give_alone(tmp_path, params):
+    """The batch job's records are, point for point, the records of the single-point job (same simulation, same
+    rounding): batching changes where the work runs, not its result."""
+    from parksteer.sweep.run import run_batch, run_point
+
+    sweep = load_sweep(_listed(tmp_path, [150000, 250000], "two.yaml"), params)
+    (batch_id, points), = sweep.batches(100).items()
+    out = run_batch(sweep.batch_spec(batch_id, 100), params.path, tmp_path / "batch.json")
+    saved = json.loads((tmp_path / "batch.json").read_text(encoding="utf-8"))
+    assert saved["points"] == list(points) == sorted(points) and len(saved["records"]) == 2
+    for record in saved["records"]:
+        run_point(sweep.point_spec(record["point"]), params.path, tmp_path / "point.json")
+        assert json.loads((tmp_path / "point.json").read_text(encoding="utf-8")) == record
+    assert [r["point"] for r in out["records"]] == saved["points"]
 
 
 # ---------------------------------------------------------------------------- design variables
@@ -334,9 +459,17 @@ def test_point_job_never_derives(params, tmp_path, monkeypatch):
 # ---------------------------------------------------------------------------- cluster profile
 
 
-def test_slurm_profile_dry_run_lists_the_point_jobs_and_their_resources(repo_root, tmp_path):
-    """A dry run with workflow/profiles/slurm plans the example sweep as 48 point jobs bundled into two SLURM
-    group jobs (25 + 23 points), each point asking for the profile's partition, account, memory and runtime.
+def _design_batches(repo_root, params) -> dict[str, tuple[str, ...]]:
+    """The batches of the example sweep at the configured batch size, as the pipeline forms them."""
+    import yaml
+
+    config = yaml.safe_load((repo_root / "config" / "config.yaml").read_text(encoding="utf-8"))
+    return load_sweep(repo_root / EXAMPLE, params).batches(config["sweep_batch_size"])
+
+
+def test_slurm_profile_dry_run_lists_the_batch_jobs_and_their_resources(repo_root, tmp_path, params):
+    """A dry run with workflow/profiles/slurm plans the example sweep's 48 points as its batch jobs bundled into
+    group jobs of at most 8 batches, each batch asking for the profile's partition, account, memory and runtime.
 
     What this shows and what it does not: Snakemake needs the plugin installed to accept `executor: slurm`,
     but a dry run never hands jobs to it (the plugin's maintainers say so, snakemake-executor-plugin-slurm
@@ -344,6 +477,8 @@ def test_slurm_profile_dry_run_lists_the_point_jobs_and_their_resources(repo_roo
     partition and account placeholders and the submission itself are only exercised on a real cluster.
     """
     pytest.importorskip("snakemake_executor_plugin_slurm", reason="the SLURM executor plugin is a test-only extra")
+    batches = _design_batches(repo_root, params)
+    assert sum(len(points) for points in batches.values()) == 48
     fake_bin = tmp_path / "bin"
     fake_bin.mkdir()
     called = tmp_path / "sbatch_called"
@@ -363,37 +498,40 @@ def test_slurm_profile_dry_run_lists_the_point_jobs_and_their_resources(repo_roo
     assert "Using profile workflow/profiles/slurm" in out
     stats = {line.split()[0]: int(line.split()[1]) for line in out.splitlines()
              if len(line.split()) == 2 and line.split()[1].isdigit()}
-    assert stats["sweep_point"] == 48 and stats["sweep_design"] == 1
-    assert out.count("Group job sweep_points") == 2
-    point_resources = [line for line in out.splitlines() if "resources:" in line and "runtime=5" in line]
-    assert len(point_resources) == 48
+    assert stats["sweep_batch"] == len(batches) and stats["sweep_design"] == 1
+    assert out.count("Group job sweep_batches") == math.ceil(len(batches) / 8)
+    assert set(re.findall(r"logs/sweep_batch/design/([0-9a-f]{10})\.log", out)) == set(batches)
+    batch_resources = [line for line in out.splitlines() if "resources:" in line and "runtime=10" in line]
+    assert len(batch_resources) == len(batches)
     assert all("slurm_partition=your_partition" in r and "slurm_account=your_account" in r and "mem_mb=1000" in r
-               for r in point_resources)
+               for r in batch_resources)
     assert not called.exists()
 
 
-def test_slurm_submission_with_stand_in_tools_requests_bounded_group_jobs(repo_root, tmp_path):
+def test_slurm_submission_with_stand_in_tools_requests_bounded_group_jobs(repo_root, tmp_path, params):
     """Submitting for real, against stand-ins for sbatch, sacct and friends that only record their arguments,
-    the example sweep goes to SLURM as two group jobs of 25 and 23 points, each asking for 4 cores, 4 GB and
-    5 minutes per layer of 4 points (35 and 30 min), on the profile's partition and account.
+    the example sweep goes to SLURM as group jobs of at most 8 batches, each asking for at most 4 cores and
+    4 GB (the batches run 4 at a time) and 10 minutes per layer of 4 batches, on the profile's partition and
+    account.
 
     This exercises the plugin's own submission code, which a dry run does not; the stand-in sbatch runs
-    nothing, so no point is computed and Snakemake is stopped once both submissions are recorded.
+    nothing, so no point is computed and Snakemake is stopped once every group is submitted.
     """
     pytest.importorskip("snakemake_executor_plugin_slurm", reason="the SLURM executor plugin is a test-only extra")
+    batches = _design_batches(repo_root, params)
+    groups = math.ceil(len(batches) / 8)
     work = tmp_path / "work"
     (work / "workflow").mkdir(parents=True)
     for name in ("config", "src", "paper"):
         (work / name).symlink_to(repo_root / name)
     for child in (repo_root / "workflow").iterdir():
         (work / "workflow" / child.name).symlink_to(child)
-    parksteer = Path(sys.executable).with_name("parksteer")
-    # The model manifests the point jobs wait for (the pipeline's full model and the sweep's braked-wheel model),
-    # made here so that the first submissions are the points.
-    for effects, manifest in ((None, "results/model/full.json"),
-                              ("+braked_wheels", "results/model/with_braked_wheels.json")):
-        subprocess.run([str(parksteer), "derive", *([f"--effects={effects}"] if effects else []),
-                        "--out", str(work / manifest)], check=True, capture_output=True, cwd=repo_root, timeout=600)
+    # The model manifests the batch jobs wait for (the pipeline's full model and the sweep's braked-wheel model),
+    # present and newer than their inputs, so that the first submissions are the batches. Nothing runs a point
+    # here, so their content does not matter.
+    for manifest in ("results/model/full.json", "results/model/with_braked_wheels.json"):
+        (work / manifest).parent.mkdir(parents=True, exist_ok=True)
+        (work / manifest).write_text("{}\n", encoding="utf-8")
     fake_bin, calls = tmp_path / "bin", tmp_path / "calls"
     fake_bin.mkdir()
     (fake_bin / "sbatch").write_text(f'#!/bin/sh\necho "$@" >> {calls}.sbatch\necho 4242\n', encoding="utf-8")
@@ -418,17 +556,19 @@ def test_slurm_submission_with_stand_in_tools_requests_bounded_group_jobs(repo_r
         while time.monotonic() < deadline and process.poll() is None:
             sbatch_log = Path(f"{calls}.sbatch")
             submissions = sbatch_log.read_text().splitlines() if sbatch_log.exists() else []
-            if len(submissions) >= 2:
+            if len(submissions) >= groups:
                 break
             time.sleep(0.5)
     finally:
         os.killpg(process.pid, signal.SIGKILL)
         process.wait(timeout=30)
     output = log_path.read_text(encoding="utf-8")
-    assert len(submissions) == 2, output[-3000:]
+    assert len(submissions) == groups, output[-3000:]
+    assert "derive" not in " ".join(submissions)
     for line in submissions:
+        members = line.count("sweep_batch:")
+        assert 1 <= members <= 8
         assert "-p your_partition" in line and "-A your_account" in line
-        assert "--cpus-per-task=4" in line and "--mem 4000" in line
-        assert "sweep_point" in line
-    assert sorted(line.split(" -t ")[1].split()[0] for line in submissions) == ["30", "35"]
-    assert sorted(line.count("sweep_point:") for line in submissions) == [23, 25]
+        assert f"--cpus-per-task={min(members, 4)}" in line and f"--mem {1000 * min(members, 4)}" in line
+        assert line.split(" -t ")[1].split()[0] == str(10 * math.ceil(members / 4))
+    assert sum(line.count("sweep_batch:") for line in submissions) == len(batches)

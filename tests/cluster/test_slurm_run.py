@@ -12,6 +12,7 @@ between machines, partitions and accounts that are enforced, fair-share queueing
 from __future__ import annotations
 
 import filecmp
+import json
 import os
 import re
 import shutil
@@ -32,7 +33,7 @@ PARTITION = "debug"  # tests/cluster/slurm.conf.in
 ACCOUNT = "parksteer"
 SWEEP_NAME = "slurm_check"
 # Four designs of the unladen car with the paper's five effects: one compiled model (a derive job) and four
-# points (one group job under the profile's grouping of sweep points).
+# points (in one or two batches, one group job under the profile's grouping of sweep batches).
 SWEEP = f"""\
 name: {SWEEP_NAME}
 description: Four designs of the unladen car, to compare a SLURM run with a local one.
@@ -118,7 +119,7 @@ def _job_states(jobs: list[str]) -> dict[str, str]:
 
 
 def _results(work: Path) -> list[str]:
-    """The sweep's results, relative to the work copy: every per-point record, the figure's CSV and the key
+    """The sweep's results, relative to the work copy: every batch of point records, the figure's CSV and the key
     numbers (the SVG is left out: it is a rendering of the CSV)."""
     points = sorted(str(p.relative_to(work)) for p in (work / "results" / "sweeps" / SWEEP_NAME).rglob("*")
                     if p.is_file())
@@ -145,7 +146,8 @@ def test_slurm_run_of_a_sweep_matches_the_local_run_byte_for_byte(repo_root, tmp
     states = _job_states(submitted)
     assert states == {job: "COMPLETED" for job in submitted}, states
     produced = _results(on_slurm)
-    assert len([p for p in produced if p.endswith(".json") and "/points/" in p]) >= 4, produced
+    batches = [p for p in produced if p.endswith(".json") and "/batches/" in p]
+    assert sum(len(json.loads((on_slurm / p).read_text())["records"]) for p in batches) == 4, produced
     assert produced == _results(local)
     differing = [p for p in produced if not filecmp.cmp(on_slurm / p, local / p, shallow=False)]
     assert not differing, f"differ between the SLURM and the local run: {differing}"

@@ -48,3 +48,12 @@ def test_a_figure_run_of_an_undefined_variant_is_refused_in_one_line(config):
     with pytest.raises(UsageError, match="model_figures.fig14") as info:
         FigureDesign.from_config(bad)
     assert "\n" not in str(info.value)
+
+
+@pytest.mark.parametrize("size", [0, 2.5, "50"])
+def test_a_sweep_batch_size_that_is_not_a_positive_integer_is_refused(config, schema, size):
+    """sweep_batch_size counts points per sweep_batch job: zero, a fraction or a string is refused by the schema."""
+    bad = copy.deepcopy(config)
+    bad["sweep_batch_size"] = size
+    with pytest.raises(WorkflowError):
+        validate(bad, schema)

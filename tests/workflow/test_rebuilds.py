@@ -2,12 +2,15 @@
 the experiment design in config/config.yaml reaches the rules as parameters, so a changed entry does too.
 
 In a copy of the repository (its tracked and new files) every output of the pipeline is created empty and marked
-up to date (`snakemake --touch`); then a module is edited and a dry run lists the jobs Snakemake would run. No job
-runs: the DAG alone shows which rules depend on which module.
+up to date (`snakemake --touch`), once for the module; then a module is edited and a dry run lists the jobs
+Snakemake would run. No job runs: the DAG alone shows which rules depend on which module. After each test the
+edited file gets back its bytes and its modification time, which is all a dry run's verdict depends on (a dry run
+writes no metadata), so the copy is up to date again for the next test without a second `--touch`.
 """
 
 from __future__ import annotations
 
+import os
 import re
 import shutil
 import subprocess
@@ -35,9 +38,22 @@ def _planned(workdir: Path, *options: str) -> dict[str, int]:
             if m.group(1) != "total"}
 
 
-def _edit(path: Path) -> None:
-    with path.open("a", encoding="utf-8") as f:
-        f.write("\n# edited by the rebuild test\n")
+@pytest.fixture
+def edit():
+    """edit(path) appends a comment to path; after the test every edited file is restored, bytes and mtime."""
+    saved: dict[Path, tuple[bytes, int, int]] = {}
+
+    def _edit(path: Path) -> None:
+        stat = path.stat()
+        saved.setdefault(path, (path.read_bytes(), stat.st_atime_ns, stat.st_mtime_ns))
+        with path.open("a", encoding="utf-8") as f:
+            f.write("\n# edited by the rebuild test\n")
+
+    yield _edit
+    for path, (content, atime, mtime) in saved.items():
+        path.write_bytes(content)
+        os.utime(path, ns=(atime, mtime))
+        assert path.read_bytes() == content and path.stat().st_mtime_ns == mtime
 
 
 @pytest.fixture(scope="module")
@@ -59,36 +75,37 @@ def repository_copy(repo_root, tmp_path_factory) -> Path:
     return work
 
 
-@pytest.fixture
+@pytest.fixture(scope="module")
 def up_to_date_copy(repository_copy) -> Path:
-    """The copy, every output marked up to date (each newer than its inputs, in DAG order) before each test."""
+    """The copy, every output marked up to date (each newer than its inputs, in DAG order); each test restores what
+    it edits (fixture `edit`)."""
     _snakemake(repository_copy, "--touch", "--cores", "1", "all")
     assert _planned(repository_copy) == {}
     return repository_copy
 
 
-def test_a_figure_module_edit_reruns_that_figure_and_the_paper_only(up_to_date_copy):
+def test_a_figure_module_edit_reruns_that_figure_and_the_paper_only(up_to_date_copy, edit):
     """figures/lifting.py draws Fig. A3 alone: editing it plans figA3 and the paper that shows it, nothing else."""
-    _edit(up_to_date_copy / "src" / "parksteer" / "figures" / "lifting.py")
+    edit(up_to_date_copy / "src" / "parksteer" / "figures" / "lifting.py")
     assert _planned(up_to_date_copy) == {"figA3": 1, "paper": 1, "all": 1}
 
 
-def test_a_numeric_model_edit_derives_nothing_and_reruns_the_simulations(up_to_date_copy):
+def test_a_numeric_model_edit_derives_nothing_and_reruns_the_simulations(up_to_date_copy, edit):
     """model/numeric does not key the compiled model: editing simulate.py plans every simulation again (the model
-    figures' runs, the sweep's points, the synthetic data) but no derive job."""
-    _edit(up_to_date_copy / "src" / "parksteer" / "model" / "numeric" / "simulate.py")
+    figures' runs, the sweep's batches, the synthetic data) but no derive job."""
+    edit(up_to_date_copy / "src" / "parksteer" / "model" / "numeric" / "simulate.py")
     planned = _planned(up_to_date_copy)
     assert "derive" not in planned
-    assert planned["simulate_model"] > 0 and planned["sweep_point"] > 0 and planned["diag_car_data"] == 1
+    assert planned["simulate_model"] > 0 and planned["sweep_batch"] > 0 and planned["diag_car_data"] == 1
 
 
-def test_a_diagnosis_setting_edit_reruns_the_diagnoses_not_the_model_figures(up_to_date_copy):
+def test_a_diagnosis_setting_edit_reruns_the_diagnoses_not_the_model_figures(up_to_date_copy, edit):
     """diagnose/settings.py holds the diagnosis thresholds: editing it reruns the benchmark's diagnoses and the
     case study, and leaves the compiled models, the simulations of the model figures and the sweep alone."""
-    _edit(up_to_date_copy / "src" / "parksteer" / "diagnose" / "settings.py")
+    edit(up_to_date_copy / "src" / "parksteer" / "diagnose" / "settings.py")
     planned = _planned(up_to_date_copy)
     assert planned["diag_bench_case"] > 0 and planned["case_study"] == 1 and planned["diag_benchmark"] == 1
-    assert not {"derive", "simulate_model", "model_figure", "sweep_point", "fig3", "figA3"} & set(planned)
+    assert not {"derive", "simulate_model", "model_figure", "sweep_batch", "fig3", "figA3"} & set(planned)
 
 
 def test_a_design_entry_reruns_what_it_affects(up_to_date_copy, tmp_path):

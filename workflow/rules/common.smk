@@ -55,6 +55,7 @@ DYNAMIC_IMPORTS = {
 }
 
 
+@lru_cache(maxsize=None)
 def _module_file(name):
     """The source file of module `name` in this checkout's package, or None (not parksteer's, or not a module)."""
     parts = name.split(".")
@@ -67,20 +68,24 @@ def _module_file(name):
     return None
 
 
+@lru_cache(maxsize=None)
 def _imported_names(path, module):
-    """Every module name an import statement of `path` (module `module`, or None for a script) may load."""
+    """Every module name an import statement of `path` (module `module`, or None for a script) may load; each
+    file is parsed once per Snakemake run, however many rule scripts import it."""
     package = module if path.name == "__init__.py" else (module or "").rpartition(".")[0]
+    names = []
     for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"), filename=str(path))):
         if isinstance(node, ast.Import):
-            yield from (alias.name for alias in node.names)
+            names.extend(alias.name for alias in node.names)
         elif isinstance(node, ast.ImportFrom):
             if node.level:
                 anchor = package.split(".")[: len(package.split(".")) - node.level + 1]
                 target = ".".join(anchor + ([node.module] if node.module else []))
             else:
                 target = node.module
-            yield target
-            yield from (f"{target}.{alias.name}" for alias in node.names)  # `from pkg import submodule`
+            names.append(target)
+            names.extend(f"{target}.{alias.name}" for alias in node.names)  # `from pkg import submodule`
+    return tuple(names)
 
 
 @lru_cache(maxsize=None)

@@ -1,46 +1,59 @@
 # Design exploration: the sweep declared in config["sweep"] (default config/sweeps/design.yaml; its large
-# version with config["sweep_full"]), expanded into one sweep_point job per point, so that it runs in parallel
-# with --cores N and unchanged on a cluster (workflow/profiles/slurm). Each point job reads the compiled model
-# of its effect sets ("free", and "braked" when the sweep simulates braked wheels) from the cache, where rule
-# derive puts it, and never derives; sweep_<name> gathers the table, the key numbers and the torque maps.
+# version with config["sweep_full"]), expanded into points and the points into batches of about
+# config["sweep_batch_size"] (parksteer.sweep.declaration.batch_points), one sweep_batch job per batch, so that a
+# point costs its physics rather than a process start, and the batches run in parallel with --cores N and
+# unchanged on a cluster (workflow/profiles/slurm). Each batch job reads the compiled model of its effect sets
+# ("free", and "braked" when the sweep simulates braked wheels) from the cache, where rule derive puts it, and
+# never derives; sweep_<name> gathers the table, the key numbers and the torque maps.
 from parksteer.parameters import load_parameters
+from parksteer.errors import UsageError
 from parksteer.sweep import load_sweep
+from parksteer.sweep.declaration import DEFAULT_BATCH_SIZE
 
-SWEEP = load_sweep(
-    config.get("sweep", "config/sweeps/design.yaml"),
-    load_parameters(PARAMETERS),
-    full=bool(config.get("sweep_full", False)),
+SWEEP_BATCH_SIZE = int(config.get("sweep_batch_size", DEFAULT_BATCH_SIZE))
+# A bad declaration (empty axis, unknown key or effect, a value out of its bounds, a missing file) is refused
+# here, while the DAG is built, with one line naming the file and the key.
+try:
+    SWEEP = load_sweep(
+        config.get("sweep", "config/sweeps/design.yaml"),
+        load_parameters(PARAMETERS),
+        full=bool(config.get("sweep_full", False)),
+    )
+    SWEEP_BATCHES = SWEEP.batches(SWEEP_BATCH_SIZE)
+    SWEEP_MODEL_MANIFESTS = [
+        model_manifest(f"sweep_{SWEEP.name}_{variant}", effects) for variant, effects in SWEEP.model_sets.items()
+    ]
+except UsageError as error:  # SweepError is one
+    print(f"parksteer: error: {error}", file=sys.stderr)
+    sys.exit(2)
+SWEEP_BATCH_FILES = expand(
+    "results/sweeps/{sweep}/batches/{batch}.json", sweep=SWEEP.name, batch=sorted(SWEEP_BATCHES)
 )
-SWEEP_POINT_FILES = expand(
-    "results/sweeps/{sweep}/points/{point}.json", sweep=SWEEP.name, point=SWEEP.point_ids
-)
-SWEEP_MODEL_MANIFESTS = [
-    model_manifest(f"sweep_{SWEEP.name}_{variant}", effects) for variant, effects in SWEEP.model_sets.items()
-]
 
 
-# The point's values are a parameter, not an input file, and its id hashes them: editing the declaration
-# (another axis value, a new map) runs only the points that are new, never the whole sweep again.
-rule sweep_point:
+# A batch's id hashes its points' ids and each point's id hashes what it simulates; the points' values are a
+# parameter, not an input file. Editing the declaration (another axis value, a new map) runs only the batches
+# that gained or lost a point, never the whole sweep again.
+rule sweep_batch:
     input:
         parameters=PARAMETERS,
         models=SWEEP_MODEL_MANIFESTS,
-        code=script_sources("sweep_point"),
+        code=script_sources("sweep_batch"),
     output:
-        point="results/sweeps/{sweep}/points/{point}.json",
+        batch="results/sweeps/{sweep}/batches/{batch}.json",
     params:
-        spec=lambda wildcards: SWEEP.point_spec(wildcards.point),
+        spec=lambda wildcards: SWEEP.batch_spec(wildcards.batch, SWEEP_BATCH_SIZE),
     wildcard_constraints:
         sweep=SWEEP.name,
-        point="[0-9a-f]{10}",
+        batch="[0-9a-f]{10}",
     log:
-        "logs/sweep_point/{sweep}/{point}.log",
+        "logs/sweep_batch/{sweep}/{batch}.log",
     benchmark:
-        benchmark_file("sweep_point", "sweep", "point")
+        benchmark_file("sweep_batch", "sweep", "batch")
     conda:
         "../envs/parksteer.yaml"
     script:
-        "../scripts/sweep_point.py"
+        "../scripts/sweep_batch.py"
 
 
 rule:
@@ -49,7 +62,7 @@ rule:
     input:
         sweep=str(SWEEP.path),
         parameters=PARAMETERS,
-        points=SWEEP_POINT_FILES,
+        batches=SWEEP_BATCH_FILES,
         code=script_sources("sweep_figure"),
     output:
         svg=f"figures/sweep_{SWEEP.name}.svg",

@@ -3,5 +3,5 @@ from parksteer.figures.sweep import make_sweep_figure
 from parksteer.rules import rule_log
 
 with rule_log(snakemake):
-    make_sweep_figure(snakemake.input.sweep, snakemake.input.parameters, snakemake.input.points,
+    make_sweep_figure(snakemake.input.sweep, snakemake.input.parameters, snakemake.input.batches,
                       snakemake.output.svg, snakemake.output.csv, snakemake.output.json, full=snakemake.params.full)

@@ -1,7 +1,7 @@
 """``parksteer sweep``: expand a design sweep, run one of its points, or gather its outputs.
 
-The pipeline runs a sweep as one Snakemake job per point (workflow/rules/sweep.smk); these
-subcommands give the same steps by hand, e.g. to rerun one failed point of a cluster run.
+The pipeline runs a sweep in batches of points, one Snakemake job per batch (workflow/rules/sweep.smk);
+these subcommands give the same steps by hand, e.g. to rerun one failed point of a cluster run.
 """
 
 from __future__ import annotations
@@ -33,7 +33,7 @@ def register(sub) -> None:
 
     q = actions.add_parser("gather", help="write the table, key numbers and torque maps from point JSONs")
     q.add_argument("declaration")
-    q.add_argument("points", nargs="+", help="point JSON files")
+    q.add_argument("points", nargs="+", help="point JSON files (or the pipeline's batch files)")
     q.add_argument("--svg", required=True)
     q.add_argument("--csv", required=True)
     q.add_argument("--json", required=True)

@@ -28,9 +28,13 @@ SUMMARY_MERITS = ("peak_torque_Nm", "plateau_torque_Nm", "lock_torque_Nm", "reve
 
 
 def read_points(paths, sweep: Sweep) -> list[dict[str, Any]]:
-    """Point records (JSON files written by run_point) in the sweep's order, each given its index there."""
+    """Point records (JSON files written by run_point, or batch files written by run_batch) in the sweep's order,
+    each given its index there."""
     order = {point.id: point.index for point in sweep.points}
-    records = [json.loads(Path(p).read_text(encoding="utf-8")) for p in paths]
+    records = []
+    for path in paths:
+        doc = json.loads(Path(path).read_text(encoding="utf-8"))
+        records.extend(doc["records"] if "records" in doc else [doc])  # a batch file holds its points' records
     for record in records:
         record["index"] = order.get(record["point"], -1)
     return sorted(records, key=lambda r: r["index"])

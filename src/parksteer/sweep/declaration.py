@@ -41,6 +41,7 @@ from typing import Any
 import numpy as np
 import yaml
 
+from ..errors import UsageError
 from ..parameters import Parameters, quantity, registry
 from .design import SweepError, point_overrides
 
@@ -65,6 +66,10 @@ MODEL_SECTIONS = ("vehicle", "steering", "geometry", "tyre", "input")
 # Grid values are rounded to this many significant digits so that linspace noise never changes a point id.
 GRID_DIGITS = 12
 ID_HEX_DIGITS = 10
+# Points per batch job when the configuration names none (config/config.yaml, sweep_batch_size).
+DEFAULT_BATCH_SIZE = 50
+# A batch is closed at the latest when it holds this many times the batch size.
+BATCH_CAP_FACTOR = 3
 
 
 @dataclass(frozen=True)
@@ -192,6 +197,17 @@ class Sweep:
         for p in self.points:
             seen.update(dict.fromkeys(p.values))
         return list(seen)
+
+    def batches(self, batch_size: int = DEFAULT_BATCH_SIZE) -> dict[str, tuple[str, ...]]:
+        """The points in batches of about `batch_size`, batch id -> point ids (see :func:`batch_points`)."""
+        return batch_points(self.point_ids, batch_size)
+
+    def batch_spec(self, batch_id: str, batch_size: int = DEFAULT_BATCH_SIZE) -> dict[str, Any]:
+        """Everything a batch job needs: the spec of each of its points, in id order."""
+        batches = self.batches(batch_size)
+        if batch_id not in batches:
+            raise SweepError(f"{self.path}: no batch {batch_id!r} in sweep {self.name} at batch size {batch_size}")
+        return {"sweep": self.name, "batch": batch_id, "points": [self.point_spec(i) for i in batches[batch_id]]}
 
     def point(self, point_id: str) -> SweepPoint:
         try:
@@ -333,6 +349,37 @@ def point_id(case: str, effects: str | None, surface: str, values: dict[str, flo
     return hashlib.sha256(canonical.encode()).hexdigest()[:ID_HEX_DIGITS]
 
 
+def batch_points(ids, batch_size: int) -> dict[str, tuple[str, ...]]:
+    """Group point ids into batches of about `batch_size`, batch id -> its point ids (sorted).
+
+    The ids are taken in sorted order and a batch ends after every id whose value is a multiple of
+    `batch_size` (content-defined boundaries, as in rsync), or once it holds BATCH_CAP_FACTOR x `batch_size`
+    points. A boundary depends only on the id before it, so a new point changes only the batch it falls in (which
+    it joins, or splits in two when its own id is a boundary) and leaves every other batch, its id (a hash of its
+    members) and its result as they were; a removed point changes only its batch (merged with the next when the
+    point ended it). The cap can shift boundaries further only in a run of over BATCH_CAP_FACTOR x `batch_size`
+    points without a natural boundary. Batch size 1 gives one batch per point.
+    """
+    if isinstance(batch_size, bool) or not isinstance(batch_size, int) or batch_size < 1:
+        raise SweepError(f"sweep_batch_size: {batch_size!r} is not a positive integer")
+    batches: dict[str, tuple[str, ...]] = {}
+    current: list[str] = []
+
+    def close():
+        members = tuple(current)
+        digest = hashlib.sha256(" ".join(members).encode()).hexdigest()[:ID_HEX_DIGITS]
+        batches[digest] = members
+        current.clear()
+
+    for point in sorted(ids):
+        current.append(point)
+        if int(point, 16) % batch_size == 0 or len(current) >= BATCH_CAP_FACTOR * batch_size:
+            close()
+    if current:
+        close()
+    return batches
+
+
 def _expand(axes: dict[str, tuple[float, ...]]) -> list[dict[str, float]]:
     keys = list(axes)
     return [dict(zip(keys, combo)) for combo in itertools.product(*(axes[k] for k in keys))]
@@ -448,8 +495,21 @@ def _map(path: Path, raw: Any, keys: list[str], axes: dict[str, tuple[float, ...
     return MapSpec(raw["x"], raw["y"], raw.get("panels"), hold, raw["quantity"])
 
 
+def _check_effects(path: Path, effects: str | None) -> None:
+    """The effects spec names effects that exist (resolved as `parksteer simulate --effects` would); null, the
+    paper's five, needs no check and so does not import the symbolic model (sympy)."""
+    if effects is None:
+        return
+    from ..model.symbolic.components import resolve_effects
+
+    try:
+        resolve_effects(effects)
+    except UsageError as exc:
+        raise SweepError(f"{path}: effects: {exc}") from None
+
+
 def _check_model_consistency(path: Path, params: Parameters, case: str, effects: str | None,
-                             values_list: list[dict[str, float]]) -> None:
+                             values_list: list[dict[str, float]], what: str = "point") -> None:
     """Effect parameters belong to an effect of the sweep's model; derived case values are physical."""
     owners = {k.partition(".")[0] for v in values_list for k in v}
     effect_owners = owners - set(MODEL_SECTIONS) - {"case", "design"}
@@ -465,13 +525,13 @@ def _check_model_consistency(path: Path, params: Parameters, case: str, effects:
         try:
             derived = point_overrides(params, case, values)
         except SweepError as exc:
-            raise SweepError(f"{path}: point {i}: {exc}") from None
+            raise SweepError(f"{path}: {what} {i}: {exc}") from None
         for key, value in derived.items():
             if key in values:
                 continue  # checked with its axis
             q = quantity(key)
             if not q.within(value):
-                raise SweepError(f"{path}: point {i}: derived {key} = {value:g} {q.unit} is out of bounds "
+                raise SweepError(f"{path}: {what} {i}: derived {key} = {value:g} {q.unit} is out of bounds "
                                  f"{q.bounds_text()}")
 
 
@@ -522,6 +582,7 @@ def load_sweep(path: str | Path, params: Parameters, full: bool = False) -> Swee
     effects = doc.get("effects")
     if effects is not None and not isinstance(effects, str):
         raise SweepError(f"{path}: effects: expected an effects spec string or null")
+    _check_effects(path, effects)
     surface = doc.get("surface", "ground")
     if surface not in SURFACES:
         raise SweepError(f"{path}: surface: {surface!r} is not one of {', '.join(SURFACES)}")
@@ -542,8 +603,9 @@ def load_sweep(path: str | Path, params: Parameters, full: bool = False) -> Swee
             raise SweepError(f"{path}: full_axes: the full sweep was asked for but is not declared")
         axes = _axes(path, field_name, doc[field_name])
         values_list = _expand(axes)
-    if "full_axes" in doc and not full:
-        _axes(path, "full_axes", doc["full_axes"])  # validate the other half of the file as well
+    if "full_axes" in doc and not full:  # validate the other half of the file as well, every point of it
+        _check_model_consistency(path, params, base_case, effects, _expand(_axes(path, "full_axes", doc["full_axes"])),
+                                 "full_axes point")
 
     _check_model_consistency(path, params, base_case, effects, values_list)
     points = tuple(SweepPoint(i, point_id(base_case, effects, surface, v), v) for i, v in enumerate(values_list))
