@@ -1,7 +1,7 @@
 """Build the reproduction article (paper/parksteer.typ) to PDF with Typst.
 
 The document reads every number it quotes from pipeline outputs (results/*.json,
-figures/*.csv, data/parameters.toml), so the compile root is the repository. A fixed
+figures/*.csv, src/parksteer/data/parameters.toml), so the compile root is the repository. A fixed
 creation timestamp and Typst's embedded fonts only (no system fonts) make the PDF
 depend on its inputs alone.
 """

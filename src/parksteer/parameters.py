@@ -1,4 +1,4 @@
-"""The registry of quantities, and the parameter file (data/parameters.toml) that gives their values.
+"""The registry of quantities, and the parameter file (src/parksteer/data/parameters.toml, shipped as package data) that gives their values.
 
 Every quantity has one key (``section.name``), one SI unit and one pair of physical bounds, listed here
 (:data:`SCHEMA`, :func:`registry`); the file gives each its value and source as ``{value, unit, source}``.

@@ -21,7 +21,7 @@ def _common(p) -> None:
     p.add_argument("--effects", default=None,
                    help="effects spec of the model, e.g. --effects=+column_friction or --effects=+path/to/effect.py "
                         "(a leading - needs no =; default: the paper's five)")
-    p.add_argument("--parameters", default=str(DEFAULT_PATH), help="parameter file (default: data/parameters.toml)")
+    p.add_argument("--parameters", default=str(DEFAULT_PATH), help="parameter file (default: the packaged parksteer/data/parameters.toml)")
     add_vehicle_option(p)
     p.add_argument("--json", action="store_true", help="print the result as JSON on stdout")
     p.add_argument("--plot", default=None, metavar="OUT.svg", help="write a figure")

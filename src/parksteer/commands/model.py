@@ -34,7 +34,7 @@ def register(sub) -> None:
                         "acceleration that flip the rack friction (several N m wrong on 8-bit data), which is why "
                         "smoothing is the default")
     add_import_options(p)
-    p.add_argument("--parameters", default=str(DEFAULT_PATH), help="parameter file (default: data/parameters.toml)")
+    p.add_argument("--parameters", default=str(DEFAULT_PATH), help="parameter file (default: the packaged parksteer/data/parameters.toml)")
     add_vehicle_option(p)
     p.add_argument("--output-dt", type=float, default=0.01, help="output spacing, s (default 0.01)")
     p.add_argument("--out", required=True, help="output CSV")

@@ -17,7 +17,7 @@ def register(sub) -> None:
     actions = p.add_subparsers(dest="sweep_action", required=True, parser_class=type(p))
 
     q = actions.add_parser("expand", help="validate a sweep declaration and list its points")
-    q.add_argument("declaration", help="sweep YAML, e.g. workflow/sweeps/design.yaml")
+    q.add_argument("declaration", help="sweep YAML, e.g. config/sweeps/design.yaml")
     q.add_argument("--full", action="store_true", help="the declaration's full_axes (the large sweep)")
     q.add_argument("--json", action="store_true", help="print JSON instead of one line per point")
     q.add_argument("--parameters", default=str(DEFAULT_PATH))

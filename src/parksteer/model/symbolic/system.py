@@ -32,7 +32,7 @@ vertical loads act. They read the built kinematics through :class:`Kinematics` (
 the declared fields effects may use, and keep per-build state in ``model.state(effect)``.
 
 Geometry is numeric: every position, axis direction and inertia is a parameter symbol whose
-value is computed at run time from data/parameters.toml (see :mod:`parksteer.model.numeric.values`),
+value is computed at run time from src/parksteer/data/parameters.toml (see :mod:`parksteer.model.numeric.values`),
 so the expressions stay small and changing a value never re-derives.
 """
 
