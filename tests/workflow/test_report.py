@@ -36,8 +36,8 @@ def _script_value(html: str, name: str):
 
 
 @pytest.fixture(scope="module")
-def report(repo_root, tmp_path_factory) -> tuple[list[str], dict, str]:
-    """(the inputs of rule all, the report's results by path, the report page) for a copy of the repository."""
+def repository_copy(repo_root, tmp_path_factory) -> Path:
+    """A copy of the repository (its tracked and new files)."""
     listed = subprocess.run(["git", "ls-files", "-z", "--cached", "--others", "--exclude-standard"], cwd=repo_root,
                             capture_output=True, text=True, check=True).stdout.split("\0")
     work = tmp_path_factory.mktemp("report")
@@ -46,16 +46,28 @@ def report(repo_root, tmp_path_factory) -> tuple[list[str], dict, str]:
         if source.is_file():
             (work / name).parent.mkdir(parents=True, exist_ok=True)
             shutil.copy2(source, work / name)
-    for line in _snakemake(work, "--summary", "all").splitlines()[1:]:
+    return work
+
+
+def _report(work: Path, target: str, *options: str) -> tuple[list[str], dict, str]:
+    """(the inputs of rule `target`, the report's results by path, the report page), every output of the target's
+    DAG created empty first."""
+    for line in _snakemake(work, "--summary", target, *options).splitlines()[1:]:
         output = work / line.split("\t")[0]
         output.parent.mkdir(parents=True, exist_ok=True)
         output.touch()
-    planned = _snakemake(work, "all", "--dry-run", "--forcerun", "all")
-    inputs = re.search(r"^rule all:\n\s+input: (.+)$", planned, re.MULTILINE)
+    planned = _snakemake(work, target, "--dry-run", "--forcerun", target, *options)
+    inputs = re.search(rf"^(?:local)?rule {target}:\n\s+input: (.+)$", planned, re.MULTILINE)
     assert inputs, planned[-3000:]
-    _snakemake(work, "--report", "report.html", "all")
-    html = (work / "report.html").read_text(encoding="utf-8")
+    _snakemake(work, "--report", f"{target}.html", target, *options)
+    html = (work / f"{target}.html").read_text(encoding="utf-8")
     return inputs.group(1).split(", "), _script_value(html, "results"), html
+
+
+@pytest.fixture(scope="module")
+def report(repository_copy) -> tuple[list[str], dict, str]:
+    """The report of the default target `all`."""
+    return _report(repository_copy, "all")
 
 
 def test_every_figure_and_the_article_are_in_the_report(report):
@@ -94,3 +106,15 @@ def test_each_entry_is_in_a_category_and_labelled(report):
         assert sub == Path(path).stem, (path, sub)
         assert entry["labels"] == {"figure": Path(path).stem,
                                    "file": "data (CSV)" if path.endswith(".csv") else "plot"}
+
+
+def test_a_vehicle_study_report_holds_its_figures_and_the_diagnosis_page(repository_copy):
+    """`snakemake --report ... vehicle_study --config vehicle=polo_vi` holds the study's comparison and diagnosis
+    figures and its HTML diagnosis report, filed under the vehicle, each caption naming the vehicle."""
+    targets, results, _ = _report(repository_copy, "vehicle_study", "--config", "vehicle=polo_vi")
+    shown = sorted(t for t in targets if t.endswith((".svg", ".html")))
+    assert shown == sorted(["figures/vehicles/polo_vi/compare.svg", "figures/vehicles/polo_vi/diagnosis.svg",
+                            "results/vehicles/polo_vi/report.html"])
+    assert sorted(results) == shown
+    for path, entry in results.items():
+        assert "polo_vi" in entry["caption"], path
