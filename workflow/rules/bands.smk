@@ -11,8 +11,8 @@ rule bands:
         model=model_manifest("full", None),
         code=script_sources("bands"),
     output:
-        svg="figures/bands.svg",
-        csv="figures/bands.csv",
+        svg=figure_report("figures/bands.svg", "bands"),
+        csv=figure_report("figures/bands.csv", "bands"),
         json="results/bands.json",
     log:
         "logs/bands.log",

@@ -48,8 +48,8 @@ rule diag_compare:
         files=DIAG_CAR_FILES,
         code=script_sources("diag_compare"),
     output:
-        svg="figures/diag_compare.svg",
-        csv="figures/diag_compare.csv",
+        svg=figure_report("figures/diag_compare.svg", "diagnose"),
+        csv=figure_report("figures/diag_compare.csv", "diagnose"),
         json="results/diag_compare.json",
     log:
         "logs/diag_compare.log",
@@ -90,8 +90,8 @@ rule diag_ladder:
         residuals="results/case_study_residuals.csv",
         code=script_sources("diag_ladder"),
     output:
-        svg="figures/diag_ladder.svg",
-        csv="figures/diag_ladder.csv",
+        svg=figure_report("figures/diag_ladder.svg", "diagnose"),
+        csv=figure_report("figures/diag_ladder.csv", "diagnose"),
         json="results/diag_ladder.json",
     log:
         "logs/diag_ladder.log",
@@ -132,8 +132,8 @@ rule diag_benchmark:
         diagnoses=expand("results/diagnose/benchmark/{name}.diagnosis.json", name=DIAG_BENCH_CASES),
         code=script_sources("diag_benchmark"),
     output:
-        svg="figures/diag_benchmark.svg",
-        csv="figures/diag_benchmark.csv",
+        svg=figure_report("figures/diag_benchmark.svg", "diagnose"),
+        csv=figure_report("figures/diag_benchmark.csv", "diagnose"),
         json="results/diag_benchmark.json",
     params:
         design=config["benchmark"],

@@ -6,8 +6,8 @@ rule figA3:
         parameters=PARAMETERS,
         code=script_sources("figA3"),
     output:
-        svg="figures/figA3.svg",
-        csv="figures/figA3.csv",
+        svg=figure_report("figures/figA3.svg", "lifting"),
+        csv=figure_report("figures/figA3.csv", "lifting"),
         json="results/figA3.json",
     log:
         "logs/figA3.log",

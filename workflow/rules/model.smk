@@ -36,8 +36,8 @@ rule model_figure:
         sims=lambda w: [f"results/sim/{case}__{variant}.csv" for case, variant in figure_runs(w)],
         code=script_sources("model_figure"),
     output:
-        svg="figures/{figure}.svg",
-        csv="figures/{figure}.csv",
+        svg=figure_report("figures/{figure}.svg", "model", caption="model_figure"),
+        csv=figure_report("figures/{figure}.csv", "model", caption="model_figure"),
         json="results/{figure}.json",
     params:
         runs=lambda w: [list(run) for run in figure_runs(w)],

@@ -9,7 +9,7 @@ rule paper:
         numbers=all_number_files(),
         code=script_sources("paper"),
     output:
-        pdf="paper/parksteer.pdf",
+        pdf=figure_report("paper/parksteer.pdf", "paper", caption="paper"),
     log:
         "logs/paper.log",
     benchmark:

@@ -8,7 +8,7 @@ rule table1:
         printed="src/parksteer/data/table1_printed.csv",
         code=script_sources("table1"),
     output:
-        csv="figures/table1.csv",
+        csv=figure_report("figures/table1.csv", "rig"),
         json="results/table1.json",
     log:
         "logs/table1.log",
@@ -25,8 +25,8 @@ rule fig3:
         parameters=PARAMETERS,
         code=script_sources("fig3"),
     output:
-        svg="figures/fig3.svg",
-        csv="figures/fig3.csv",
+        svg=figure_report("figures/fig3.svg", "rig"),
+        csv=figure_report("figures/fig3.csv", "rig"),
         json="results/fig3.json",
     log:
         "logs/fig3.log",
@@ -43,8 +43,8 @@ rule fig4:
         parameters=PARAMETERS,
         code=script_sources("fig4"),
     output:
-        svg="figures/fig4.svg",
-        csv="figures/fig4.csv",
+        svg=figure_report("figures/fig4.svg", "rig"),
+        csv=figure_report("figures/fig4.csv", "rig"),
         json="results/fig4.json",
     log:
         "logs/fig4.log",

@@ -65,8 +65,8 @@ rule:
         batches=SWEEP_BATCH_FILES,
         code=script_sources("sweep_figure"),
     output:
-        svg=f"figures/sweep_{SWEEP.name}.svg",
-        csv=f"figures/sweep_{SWEEP.name}.csv",
+        svg=figure_report(f"figures/sweep_{SWEEP.name}.svg", "sweep", caption="sweep"),
+        csv=figure_report(f"figures/sweep_{SWEEP.name}.csv", "sweep", caption="sweep"),
         json=f"results/sweep_{SWEEP.name}.json",
     params:
         full=SWEEP.full,

@@ -40,7 +40,7 @@ rule vehicle_compare:
         code=script_sources("vehicle_compare"),
     output:
         json="results/vehicles/{vehicle}/compare.json",
-        svg="figures/vehicles/{vehicle}/compare.svg",
+        svg=figure_report("figures/vehicles/{vehicle}/compare.svg", "vehicle", caption="vehicle_compare"),
     params:
         options=vehicle_options(),
     log:
@@ -62,9 +62,9 @@ rule vehicle_diagnose:
         code=script_sources("vehicle_diagnose"),
     output:
         json="results/vehicles/{vehicle}/diagnosis.json",
-        svg="figures/vehicles/{vehicle}/diagnosis.svg",
+        svg=figure_report("figures/vehicles/{vehicle}/diagnosis.svg", "vehicle", caption="vehicle_diagnose"),
         md="results/vehicles/{vehicle}/report.md",
-        html="results/vehicles/{vehicle}/report.html",
+        html=figure_report("results/vehicles/{vehicle}/report.html", "vehicle", caption="vehicle_report"),
     params:
         options=vehicle_options(),
     log:

@@ -5,4 +5,4 @@ from parksteer.rules import rule_log
 from parksteer.tables import write_json
 
 with rule_log(snakemake):
-    write_json(snakemake.output.manifest, ensure(resolve_effects(snakemake.params.effects)))
+    write_json(snakemake.output.manifest, ensure(resolve_effects(snakemake.params.effects), note_cached=True))

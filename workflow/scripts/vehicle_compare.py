@@ -5,6 +5,7 @@ from pathlib import Path
 
 import parksteer.commands.measure  # noqa: F401 (the command this rule runs; its imports are the rule's inputs)
 from parksteer.cli import main
+from parksteer.rules import rule_log
 
 
 def measurement_files(items):
@@ -17,8 +18,8 @@ def measurement_files(items):
     return out
 
 
-with open(snakemake.log[0], "w", encoding="utf-8") as log, contextlib.redirect_stderr(log), \
-        open(snakemake.output.json, "w", encoding="utf-8") as out, contextlib.redirect_stdout(out):
+with rule_log(snakemake), open(snakemake.output.json, "w", encoding="utf-8") as out, \
+        contextlib.redirect_stdout(out):
     status = main(["compare", *measurement_files(snakemake.input.files), "--parameters", snakemake.input.parameters,
                    "--vehicle", snakemake.input.vehicle, *snakemake.params.options,
                    "--json", "--plot", snakemake.output.svg])

@@ -10,6 +10,7 @@ from pathlib import Path
 
 from ..errors import UsageError, naming
 from ..parameters import DEFAULT_PATH, load_parameters
+from ..progress import set_quiet
 from ..tables import write_json
 from .measure import add_import_options, channel_map_of
 from .vehicle import add_vehicle_option, parameters_of
@@ -48,6 +49,8 @@ def register(sub) -> None:
     p = sub.add_parser("derive", help="derive, generate and compile the model for an effect set (cached)")
     p.add_argument("--effects", default=None, help="effects spec (default: all five)")
     p.add_argument("--out", default=None, help="also write a JSON manifest of the cache entry here")
+    p.add_argument("--quiet", action="store_true",
+                   help="no progress on stderr (derivation, code generation, compilation, their times)")
     p.set_defaults(func=_derive)
 
 
@@ -126,8 +129,9 @@ def _derive(args) -> int:
     from ..model.codegen.cache import ensure
     from ..model.symbolic.components import resolve_effects
 
+    set_quiet(args.quiet)
     start = time.perf_counter()
-    manifest = ensure(resolve_effects(args.effects))
+    manifest = ensure(resolve_effects(args.effects), note_cached=True)
     if args.out:
         write_json(args.out, manifest)
     elapsed = time.perf_counter() - start

@@ -27,6 +27,7 @@ from pathlib import Path
 import sympy
 
 from ...errors import UsageError
+from ...progress import note
 from ..symbolic.components import Effect
 
 CACHE_ENV = "PARKSTEER_MODEL_CACHE"
@@ -108,11 +109,17 @@ def build_entry(effects: list[Effect], directory: Path) -> dict:
     from ..symbolic.derive import derive
     from .generate import generate
 
+    names = ",".join(e.name for e in effects) or "none"
+    note(f"deriving the model of {names} (sympy Kane's method) ...")
     start = time.perf_counter()
     derivation = derive(effects)
     t_derive = time.perf_counter() - start
+    note(f"derived: {len(derivation.coordinate_names)} coordinates ({', '.join(derivation.coordinate_names)}), "
+         f"{len(derivation.parameter_names)} parameters, {t_derive:.1f} s "
+         f"({', '.join(f'{k} {v:.1f} s' for k, v in derivation.timings_s.items())})")
     source, info = generate(derivation)
     t_codegen = time.perf_counter() - start - t_derive
+    note(f"generated C: {source.count(chr(10))} lines, {len(source) / 1024:.0f} KiB, {t_codegen:.1f} s")
     directory.mkdir(parents=True, exist_ok=True)
     (directory / "model.c").write_text(source, encoding="utf-8")
     compiler = find_compiler()
@@ -122,6 +129,7 @@ def build_entry(effects: list[Effect], directory: Path) -> dict:
         first = (done.stderr.strip().splitlines() or ["unknown error"])[0]
         raise UsageError(f"C compiler failed on the generated model: {first}")
     t_compile = time.perf_counter() - start - t_derive - t_codegen
+    note(f"compiled with {Path(compiler).name} -O2: {t_compile:.1f} s")
     info.update({
         "sha256": {name: _sha256(directory / name) for name in BUILT_FILES},
         "sympy_version": sympy.__version__,
@@ -212,16 +220,20 @@ def ensure_entry(effects: list[Effect]) -> Path:
     return final
 
 
-def ensure(effects: list[Effect]) -> dict:
+def ensure(effects: list[Effect], note_cached: bool = False) -> dict:
     """Build (or find) the compiled model of `effects` and return its manifest.
 
     The one derive path: ``parksteer derive`` and the pipeline's derive rule both call it. The
     manifest names the effects, the cache key and entry directory, the generalised coordinates,
     the number of run-time parameters, and the derivation's timings (of the build that made the
-    entry, possibly earlier) with ``built_now`` saying whether this call built it.
+    entry, possibly earlier) with ``built_now`` saying whether this call built it. A build reports its stages on
+    stderr (:mod:`parksteer.progress`); a cache hit only with `note_cached`.
     """
     existed = entry_is_sound(entry_path(effects))
     directory = ensure_entry(effects)
+    if not existed or note_cached:
+        note(f"model of {','.join(e.name for e in effects) or 'none'}: "
+             f"{'found in' if existed else 'built into'} the cache, {directory}")
     info = json.loads((directory / "model.json").read_text(encoding="utf-8"))
     return {
         "effects": [e.name for e in effects],

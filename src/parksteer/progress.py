@@ -1,0 +1,37 @@
+"""Progress of the long steps (derivation, code generation, compilation, a rule's run) on stderr: what is being
+computed, how long it took, its key numbers. ``--quiet`` silences it; a Snakemake rule sends stderr to its log
+(:func:`parksteer.rules.rule_log`), so each rule's log holds the same lines."""
+
+from __future__ import annotations
+
+import sys
+import time
+from contextlib import contextmanager
+from typing import Iterator
+
+_quiet = False
+
+
+def set_quiet(quiet: bool) -> None:
+    """Silence (True) or restore (False) the progress lines of this process."""
+    global _quiet
+    _quiet = bool(quiet)
+
+
+def note(message: str) -> None:
+    """One progress line on the current stderr (looked up at each call: a rule redirects it to its log)."""
+    if not _quiet:
+        print(message, file=sys.stderr, flush=True)
+
+
+@contextmanager
+def step(what: str) -> Iterator[None]:
+    """Note `what` when it starts and how long it took when it ends (or that it failed)."""
+    note(f"{what} ...")
+    start = time.perf_counter()
+    try:
+        yield
+    except BaseException:
+        note(f"{what}: failed after {time.perf_counter() - start:.2f} s")
+        raise
+    note(f"{what}: {time.perf_counter() - start:.2f} s")
