@@ -28,8 +28,7 @@ from pathlib import Path
 import pytest
 
 from parksteer.checksums import integrity_problem, read_sums
-
-pytestmark = pytest.mark.slow
+from parksteer.tables import atomic_path, remove_stale_temporaries, write_json
 
 SNAKEMAKE = Path(sys.executable).with_name("snakemake")
 TARGETS = ("figA3", "fig12")
@@ -94,6 +93,7 @@ def copy(repo_root, tmp_path_factory) -> Path:
     return work
 
 
+@pytest.mark.slow
 def test_a_killed_run_is_finished_by_the_next_ordinary_run(copy):
     """SIGKILL to the process group of a running `snakemake` (and its jobs) leaves a lock and incomplete markers;
     with a temporary file of a killed writer and a scratch directory of a killed model build beside them, the
@@ -113,6 +113,7 @@ def test_a_killed_run_is_finished_by_the_next_ordinary_run(copy):
         os.killpg(run.pid, signal.SIGKILL)
         run.wait()
     assert any((copy / ".snakemake" / "locks").glob("*.lock")), "the kill left no lock: nothing was interrupted"
+    assert any(p.is_file() for p in incomplete.rglob("*")), "the kill left no job marked incomplete"
     host = socket.gethostname().replace(".", "-")
     pid = _dead_pid()
     (copy / "figures" / f".fig12.csv.{host}.{pid}.abcdefgh.tmp").write_text("time_s,torque_Nm\n0,1", "utf-8")
@@ -126,6 +127,7 @@ def test_a_killed_run_is_finished_by_the_next_ordinary_run(copy):
     assert _leftovers(copy) == []
 
 
+@pytest.mark.slow
 def test_damaged_intermediates_are_rebuilt_by_the_next_ordinary_run(copy):
     """After a finished run: a simulation truncated mid-row, the model manifest naming a cache entry that does not
     exist, a figure truncated mid-element and a sweep batch truncated mid-object are each removed, with one line
@@ -161,6 +163,7 @@ def test_damaged_intermediates_are_rebuilt_by_the_next_ordinary_run(copy):
     assert _leftovers(copy) == []
 
 
+@pytest.mark.slow
 def test_two_rebuilds_from_clean_give_the_same_bytes(copy):
     """Every figure, data file, key-number file and simulation of `figA3 fig12`, rebuilt from nothing (the compiled
     models kept; their manifests, which record build timings, rewritten), is byte for byte what the previous
@@ -182,3 +185,47 @@ def test_two_rebuilds_from_clean_give_the_same_bytes(copy):
     second = rebuild()
     assert len(first) >= 8
     assert first == second
+
+
+def test_a_killed_writers_temporary_file_is_removed_and_a_live_ones_kept(tmp_path):
+    """atomic_path names its temporary file after the writing process: the next write of the same target removes
+    one whose process has ended, and remove_stale_temporaries removes it anywhere under a folder, while a file
+    being written by a live process (this one) and files that are not temporaries are left alone."""
+    host = socket.gethostname().replace(".", "-")
+    dead = tmp_path / f".table.json.{host}.{_dead_pid()}.abcdefgh.tmp"
+    live = tmp_path / f".table.json.{host}.{os.getpid()}.abcdefgh.tmp"
+    other = tmp_path / "sub" / f".fig.svg.{host}.{_dead_pid()}.ijklmnop.tmp"
+    ordinary = tmp_path / "sub" / "notes.tmp"
+    for path in (dead, live, other, ordinary):
+        path.parent.mkdir(exist_ok=True)
+        path.write_text("partial", "utf-8")
+    write_json(tmp_path / "table.json", {"a": 1})
+    assert not dead.exists() and live.exists() and other.exists()
+    with atomic_path(tmp_path / "x.json") as tmp:
+        assert tmp.name.startswith(f".x.json.{host}.{os.getpid()}.")
+        assert remove_stale_temporaries(tmp_path) == [other]
+    assert live.exists() and ordinary.exists() and not other.exists()
+
+
+@pytest.mark.skipif(not Path("/proc/self/cwd").exists(), reason="tells running processes apart through /proc")
+def test_the_lock_of_a_running_snakemake_is_kept_and_that_of_a_dead_one_removed(tmp_path):
+    """check_outputs removes Snakemake's lock only when no Snakemake process runs in the folder: with a process
+    named snakemake running there (a renamed `sleep`), the lock stays; once it has ended, the lock goes, in one
+    line."""
+    from parksteer.outputs import check_outputs, other_snakemake_running
+
+    lock = tmp_path / ".snakemake" / "locks" / "0.output.lock"
+    lock.parent.mkdir(parents=True)
+    lock.write_text("results/x.csv\n", "utf-8")
+    (tmp_path / "snakemake").symlink_to(shutil.which("sleep"))
+    running = subprocess.Popen(["./snakemake", "60"], cwd=tmp_path)
+    try:
+        time.sleep(0.2)
+        assert other_snakemake_running(tmp_path)
+        assert check_outputs({}, tmp_path) == [] and lock.exists()
+    finally:
+        running.kill()
+        running.wait()
+    assert not other_snakemake_running(tmp_path)
+    assert check_outputs({}, tmp_path) == ["removed the lock of a Snakemake run that is no longer running"]
+    assert not lock.parent.exists()

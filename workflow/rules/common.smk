@@ -1,6 +1,5 @@
 import ast
 import os
-import shutil
 from functools import lru_cache
 from pathlib import Path
 
@@ -152,138 +151,19 @@ def figure_runs(wildcards):
 
 # --- damage and interruptions: what the next ordinary run repairs -----------------------------------------------
 # Snakemake compares timestamps only: a truncated intermediate newer than its inputs would be trusted on every
-# run. So before the DAG is built (in the main process, not in the jobs), check_outputs looks at the content of
-# what earlier runs wrote and removes what cannot be what a rule wrote. Snakemake then treats it as any missing
-# file: a missing target is built, and a missing intermediate is rebuilt as soon as a job that reads it runs (one
-# whose consumers are intact and up to date is needed by nothing, and is left missing, as Snakemake leaves a
-# temp() file). Removed are:
-#   - a CSV, SVG, JSON or PDF a rule wrote (results/, figures/, paper/) that is empty, truncated or unparsable;
-#   - a model manifest results/model/<set>.json whose cache key is not the one the set has now, or whose cache
-#     entry is missing or fails its SHA-256 check (a manifest is trusted only if what it points at is sound);
-#   - temporary files of writers that were killed (parksteer.tables.atomic_path), and scratch directories of
-#     killed model builds;
-#   - the lock of a Snakemake run that was killed (no Snakemake process runs in this folder any more).
-# Outputs a killed job left marked incomplete are rerun by `rerun-incomplete` in workflow/profiles/default.
-# `--config check_outputs=false` skips the checks (tests that stand empty placeholder files in for outputs).
-CHECKED_ROOTS = ("results", "figures", "paper")
-CHECKED_SUFFIXES = (".csv", ".svg", ".json", ".ipynb", ".pdf")
-
-
-def _content_problem(path):
-    """Why the output `path` cannot be what a rule wrote, or None."""
-    import json
-
-    from parksteer.checksums import integrity_problem
-
-    if path.suffix in (".csv", ".svg"):
-        return integrity_problem(path)
-    if path.stat().st_size == 0:
-        return "empty"
-    if path.suffix == ".pdf":
-        with path.open("rb") as f:
-            head = f.read(5)
-            f.seek(max(0, path.stat().st_size - 1024))
-            tail = f.read()
-        return None if head == b"%PDF-" and b"%%EOF" in tail else "not a complete PDF (truncated)"
-    try:
-        json.loads(path.read_text(encoding="utf-8"))
-    except (ValueError, UnicodeDecodeError) as exc:
-        return f"not readable JSON ({exc})"
-    return None
-
-
-def _manifest_problem(path, spec):
-    """Why the model manifest `path` of effect set `spec` cannot be trusted, or None."""
-    import json
-
-    from parksteer.model.codegen.cache import cache_root, entry_is_sound, model_key
-    from parksteer.model.symbolic.components import resolve_effects
-
-    try:
-        key = json.loads(path.read_text(encoding="utf-8"))["key"]
-    except (ValueError, UnicodeDecodeError, KeyError, TypeError) as exc:
-        return f"not a model manifest ({type(exc).__name__}: {exc})"
-    expected = model_key(resolve_effects(spec))
-    if key != expected:
-        return f"names cache entry {key}, but the model's sources now key it {expected}"
-    if not entry_is_sound(cache_root() / key):
-        return f"its cache entry {cache_root() / key} is missing or fails its SHA-256 check"
-    return None
-
-
-def _other_snakemake_here():
-    """True if a Snakemake process other than this one (and its parents) runs in this folder, or if that cannot be
-    told (no /proc)."""
-    proc = Path("/proc")
-    if not (proc / "self" / "cwd").exists():
-        return True
-    mine, pid = set(), os.getpid()
-    while pid > 1 and pid not in mine:  # this process and its ancestors
-        mine.add(pid)
-        try:
-            pid = int((proc / str(pid) / "stat").read_text().rpartition(")")[2].split()[1])
-        except (OSError, ValueError, IndexError):
-            break
-    here = os.path.realpath(os.getcwd())
-    for entry in proc.iterdir():
-        if not entry.name.isdigit() or int(entry.name) in mine:
-            continue
-        try:
-            argv = (entry / "cmdline").read_bytes().split(b"\0")
-        except OSError:
-            continue
-        names = [os.path.basename(a.decode(errors="replace")) for a in argv[:3]]
-        if "snakemake" not in names:
-            continue
-        try:
-            if os.path.realpath(entry / "cwd") != here:
-                continue
-        except OSError:
-            return True  # a Snakemake whose folder cannot be read: perhaps this one
-        return True
-    return False
-
-
+# run. So before the DAG is built (the Snakefile calls check_outputs in the main process, never in a job), the
+# content of what earlier runs wrote is checked, and what no job can have written is removed (damaged CSV, SVG,
+# JSON and PDF outputs, model manifests whose cache entry is missing or unsound, temporary files and scratch
+# directories of killed writers, and the lock of a killed run; parksteer.outputs says exactly what and how).
+# Snakemake then treats a removed file as any missing one: a missing target is built, a missing intermediate as
+# soon as a job that reads it runs (one whose readers are intact and up to date is needed by nothing and stays
+# missing, as a temp() file would). Outputs a killed job left marked incomplete are rerun by `rerun-incomplete`
+# in workflow/profiles/default. `--config check_outputs=False` skips the checks (for tests that stand empty
+# placeholders in for outputs).
 def check_outputs():
-    """Remove damaged outputs, untrusted model manifests, leftovers of killed writers and a dead run's lock (see
-    above); say in one line each what was removed and why."""
-    from parksteer.model.codegen.cache import cache_root, clean_stale_scratch
-    from parksteer.tables import remove_stale_temporaries
+    """Remove damaged outputs, untrusted model manifests, leftovers of killed writers and a dead run's lock
+    (parksteer.outputs.check_outputs), saying in one line each what was removed and why."""
+    from parksteer.outputs import check_outputs as check
 
-    def removed(path, why):
-        print(f"parksteer: removed {path}: {why}; it is rebuilt", file=sys.stderr)
-
-    locks = Path(".snakemake") / "locks"
-    if locks.is_dir() and any(locks.iterdir()) and not _other_snakemake_here():
-        shutil.rmtree(locks, ignore_errors=True)
-        print("parksteer: removed the lock of a Snakemake run that is no longer running", file=sys.stderr)
-    for path in remove_stale_temporaries(*CHECKED_ROOTS):
-        removed(path, "a temporary file of a killed writer")
-    for path in clean_stale_scratch(cache_root()):
-        removed(path, "a scratch directory of a killed model build")
-    model_dir = Path("results") / "model"
-    manifests = {model_dir / f"{name}.json": spec for name, spec in MODEL_SETS.items()}
-    for path in _written_files():
-        why = _content_problem(path)
-        if why is None and path in manifests:
-            why = _manifest_problem(path, manifests[path])
-        if why is not None:
-            path.unlink(missing_ok=True)
-            removed(path, why)
-
-
-def _written_files():
-    """The files rules write that check_outputs reads: results/ (but the model cache's entries, checked through
-    their manifests, and Snakemake's benchmark records), figures/*.{svg,csv} (not figures/reference, which is
-    source) and paper/*.pdf."""
-    for folder, subfolders, names in os.walk("results"):
-        if Path(folder) == Path("results"):
-            subfolders[:] = [d for d in subfolders if d != "benchmarks"]
-        if Path(folder) == Path("results") / "model":
-            subfolders.clear()
-        for name in sorted(names):
-            path = Path(folder) / name
-            if path.suffix in CHECKED_SUFFIXES and not name.startswith("."):
-                yield path
-    yield from sorted(p for p in Path("figures").glob("*") if p.suffix in (".svg", ".csv") and p.is_file())
-    yield from sorted(p for p in Path("paper").glob("*.pdf") if p.is_file())
+    for line in check(MODEL_SETS):
+        print(f"parksteer: {line}", file=sys.stderr)
