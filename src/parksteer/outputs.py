@@ -118,7 +118,8 @@ def other_snakemake_running(folder: str | Path = ".") -> bool:
 
 def written_files(root: Path) -> Iterator[Path]:
     """The files rules write under `root` that check_outputs reads: results/ (but the model cache's entries, checked
-    through their manifests, and Snakemake's benchmark records), figures/*.svg and *.csv, paper/*.pdf."""
+    through their manifests, Snakemake's benchmark records and the directory outputs results/vehicles/*/synthetic),
+    figures/*.svg and *.csv, paper/*.pdf."""
     results = root / "results"
     for folder, subfolders, names in os.walk(results):
         here = Path(folder)
@@ -126,6 +127,8 @@ def written_files(root: Path) -> Iterator[Path]:
             subfolders[:] = [d for d in subfolders if d != "benchmarks"]
         if here == results / "model":
             subfolders.clear()
+        if here.parent == results / "vehicles":  # its synthetic/ is a directory output: a removed file in it would
+            subfolders[:] = [d for d in subfolders if d != "synthetic"]  # not make Snakemake rebuild it
         subfolders.sort()
         for name in sorted(names):
             path = here / name

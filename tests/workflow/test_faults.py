@@ -229,3 +229,28 @@ def test_the_lock_of_a_running_snakemake_is_kept_and_that_of_a_dead_one_removed(
     assert not other_snakemake_running(tmp_path)
     assert check_outputs({}, tmp_path) == ["removed the lock of a Snakemake run that is no longer running"]
     assert not lock.parent.exists()
+
+
+def test_a_manifest_is_trusted_only_if_its_cache_entry_exists_and_matches(tmp_path, monkeypatch):
+    """A model manifest naming the right key is still untrusted while that entry is missing, trusted once the
+    entry holds model.c and model.so with the SHA-256 its model.json records, and untrusted again when the
+    library is replaced (content, not timestamps)."""
+    from parksteer.model.codegen.cache import CACHE_ENV, model_key
+    from parksteer.model.symbolic.components import resolve_effects
+    from parksteer.outputs import manifest_problem
+
+    monkeypatch.setenv(CACHE_ENV, str(tmp_path / "cache"))
+    key = model_key(resolve_effects(None))
+    manifest = tmp_path / "full.json"
+    manifest.write_text(json.dumps({"key": key}), "utf-8")
+    assert "is missing or fails its SHA-256 check" in manifest_problem(manifest, None)
+    entry = tmp_path / "cache" / key
+    entry.mkdir(parents=True)
+    (entry / "model.c").write_text("int f(void) { return 1; }\n", "utf-8")
+    (entry / "model.so").write_bytes(b"\x7fELF library")
+    sums = {name: _sha256(entry / name) for name in ("model.c", "model.so")}
+    (entry / "model.json").write_text(json.dumps({"sha256": sums}), "utf-8")
+    assert manifest_problem(manifest, None) is None
+    (entry / "model.so").write_bytes(b"\x7fELF replaced")
+    assert "is missing or fails its SHA-256 check" in manifest_problem(manifest, None)
+    assert "but the model's sources now key it" in manifest_problem(manifest, "-rack_friction")
