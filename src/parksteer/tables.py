@@ -8,10 +8,13 @@ a last-bit difference between platforms does not change a checksum.
 
 from __future__ import annotations
 
+import glob
 import json
 import math
 import os
+import socket
 import tempfile
+import time
 from collections.abc import Mapping, Sequence
 from contextlib import contextmanager
 from pathlib import Path
@@ -33,16 +36,78 @@ def format_number(x: float, digits: int = SIGNIFICANT_DIGITS) -> str:
     return "0" if s in ("-0", "0") or float(s) == 0.0 else s
 
 
+# A temporary file is named ".<target name>.<host>.<pid>.<random>.tmp" so that one left by a killed writer can be
+# told from one being written: remove_stale_temporaries deletes those whose process is gone (same host), or that are
+# older than any write could take (another host, on a shared file system).
+TEMPORARY_SUFFIX = ".tmp"
+STALE_TEMPORARY_S = 6 * 3600.0
+
+
+def _host() -> str:
+    return socket.gethostname().replace(".", "-")
+
+
+def _process_alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except (PermissionError, OverflowError):
+        return True
+    return True
+
+
+def _stale_temporary(path: Path, host: str, now: float) -> bool:
+    """True if `path` is a temporary file of atomic_path whose writer is gone."""
+    parts = path.name.split(".")
+    if not (path.name.startswith(".") and path.name.endswith(TEMPORARY_SUFFIX) and len(parts) >= 6):
+        return False
+    owner_host, pid = parts[-4], parts[-3]
+    if not pid.isdigit():
+        return False
+    try:
+        age = now - path.lstat().st_mtime
+    except OSError:
+        return False
+    return (owner_host == host and not _process_alive(int(pid))) or age > STALE_TEMPORARY_S
+
+
+def remove_stale_temporaries(*roots: str | Path) -> list[Path]:
+    """Remove the temporary files of atomic_path left by killed writers in `roots` (folders, searched through);
+    return what was removed. A file being written by a live process is left alone."""
+    host, now, removed = _host(), time.time(), []
+    for root in map(Path, roots):
+        if not root.is_dir():
+            continue
+        for folder, _, names in os.walk(root):
+            for name in names:
+                path = Path(folder) / name
+                if name.endswith(TEMPORARY_SUFFIX) and _stale_temporary(path, host, now):
+                    try:
+                        path.unlink()
+                    except FileNotFoundError:
+                        continue
+                    removed.append(path)
+    return removed
+
+
 @contextmanager
 def atomic_path(path: str | Path) -> Iterator[Path]:
-    """Yield a temporary path beside `path`; rename it onto `path` only on success."""
+    """Yield a temporary path beside `path`; rename it onto `path` only on success.
+
+    A temporary file of the same target left by a killed writer is removed first."""
     path = Path(path)
     if path.is_dir():
         raise UsageError(f"{path}: is a directory; name a file to write")
     if path.parent.exists() and not path.parent.is_dir():
         raise UsageError(f"{path}: {path.parent} is a file, not a directory")
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    host = _host()
+    for old in path.parent.glob(f".{glob.escape(path.name)}.*{TEMPORARY_SUFFIX}"):
+        if _stale_temporary(old, host, time.time()):
+            old.unlink(missing_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.{host}.{os.getpid()}.", suffix=TEMPORARY_SUFFIX,
+                               dir=path.parent)
     os.close(fd)
     umask = os.umask(0)
     os.umask(umask)

@@ -23,7 +23,8 @@ SNAKEMAKE = Path(sys.executable).with_name("snakemake")
 
 
 def _snakemake(workdir: Path, *args: str) -> str:
-    done = subprocess.run([str(SNAKEMAKE), *args], cwd=workdir, capture_output=True, text=True, timeout=300)
+    # The outputs here are empty placeholders, which the damage check (check_outputs) would remove: skip it.
+    done = subprocess.run([str(SNAKEMAKE), *args, "--config", "check_outputs=False"], cwd=workdir, capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, (done.stdout + done.stderr)[-3000:]
     return done.stdout + done.stderr
 

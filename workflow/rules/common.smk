@@ -147,3 +147,23 @@ def effect_files(spec):
 def figure_runs(wildcards):
     """The (case, variant) runs of the model figure `wildcards.figure` (config["model_figures"])."""
     return FIGURE_DESIGN.figures[wildcards.figure]
+
+
+# --- damage and interruptions: what the next ordinary run repairs -----------------------------------------------
+# Snakemake compares timestamps only: a truncated intermediate newer than its inputs would be trusted on every
+# run. So before the DAG is built (the Snakefile calls check_outputs in the main process, never in a job), the
+# content of what earlier runs wrote is checked, and what no job can have written is removed (damaged CSV, SVG,
+# JSON and PDF outputs, model manifests whose cache entry is missing or unsound, temporary files and scratch
+# directories of killed writers, and the lock of a killed run; parksteer.outputs says exactly what and how).
+# Snakemake then treats a removed file as any missing one: a missing target is built, a missing intermediate as
+# soon as a job that reads it runs (one whose readers are intact and up to date is needed by nothing and stays
+# missing, as a temp() file would). Outputs a killed job left marked incomplete are rerun by `rerun-incomplete`
+# in workflow/profiles/default. `--config check_outputs=False` skips the checks (for tests that stand empty
+# placeholders in for outputs).
+def check_outputs():
+    """Remove damaged outputs, untrusted model manifests, leftovers of killed writers and a dead run's lock
+    (parksteer.outputs.check_outputs), saying in one line each what was removed and why."""
+    from parksteer.outputs import check_outputs as check
+
+    for line in check(MODEL_SETS):
+        print(f"parksteer: {line}", file=sys.stderr)
