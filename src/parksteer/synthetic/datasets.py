@@ -467,6 +467,11 @@ OUTCLASS_RIVALS: dict[str, dict] = {
         "reason": "both change the map from rack travel to steer angle, and with it the road-wheel torque seen "
                   "at the handwheel towards lock",
     },
+    "rack_presliding": {
+        "closest": "rack_stiction", "related": ("column_friction", "kingpin_friction"),
+        "reason": "rack friction departing from the tanh law near each reversal; rack_stiction's excess lives at "
+                  "low speed, the bristle's in the first tenths of a millimetre of travel",
+    },
     "rolling_resistance": {
         "closest": "braked_wheels", "related": ("kingpin_friction",),
         "reason": "both are a force at the contact patch acting on the scrub radius, W |e|, against the steer "
