@@ -117,3 +117,20 @@ def test_a_small_case_runs(tmp_path):
     assert (tmp_path / "files" / "unladen__ground.csv").exists()
     row = outcome(truth, result)
     assert row["relation"] in ("closest", "related", "unrelated", "unexplained", "adequate")
+
+
+def test_config_grids():
+    """The pipeline's design: the small grid has each rival once plus the nulls; the full grid (the switch) has each
+    rival at every size; every data set has its own seed, and nothing hidden is a candidate."""
+    import yaml
+
+    config = yaml.safe_load(open("config/config.yaml", encoding="utf-8"))
+    params = load_parameters()
+    for full in (False, True):
+        section = {**config["outclass"], "full_grid": full}
+        design = OutclassDesign.from_config(section, config["benchmark"])
+        grid = section["full" if full else "small"]
+        specs = outclass_specs(params, design)
+        assert len(specs) == len(section["rivals"]) * len(grid["steps"]) + grid["nulls"]
+        assert len({s.seed for s in specs}) == len(specs)
+        assert all(s.hidden in OUTCLASS_RIVALS for s in specs if s.kind == "rival")

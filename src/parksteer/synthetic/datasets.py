@@ -23,6 +23,13 @@ logger's and the hand's settings.
 The experiment design (what is hidden in the car data set, the benchmark's strengths, files,
 perturbations and seeds) is the pipeline's configuration (``config/config.yaml``, sections
 ``car`` and ``benchmark``), given here as :class:`CarDesign` and :class:`BenchmarkDesign`.
+
+The out-of-class benchmark's records (:func:`make_outclass_dataset`, design :class:`OutclassDesign`, section
+``outclass``) are made otherwise: a rival effect that is no diagnosis candidate is hidden, the model runs at a
+tighter tolerance, and the clean columns pass a whole logger chain (:func:`chain_logged`: anti-alias filter,
+channel lag, sampling, noise, an 8-bit torque and a finer rack converter). The hand is the irregular hand above:
+the smooth hand of :mod:`parksteer.synthetic.variations` is sampled too finely to be a handwheel input of the
+compiled model (24 pieces at most), and driving the rack instead would be the diagnosis's own drive.
 """
 
 from __future__ import annotations
@@ -197,7 +204,7 @@ class DatasetSpec:
     name: str
     seed: int
     files: tuple[tuple[str, str], ...]
-    kind: str  # "candidate", "null" or "outside"
+    kind: str  # "candidate", "null" or "outside" (the out-of-class benchmark: "rival" or "null")
     hidden: str | None = None  # a candidate's name, or a disturbance's kind
     steps: float | None = None  # hidden size as converter steps of torque RMS (on the first file)
     base_overrides: dict[str, float] = field(default_factory=dict)
