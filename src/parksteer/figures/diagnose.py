@@ -296,7 +296,7 @@ def outclass_figure(rows: list[dict], path: str | Path) -> None:
     for r in rows:
         i, j = truth_labels.index(r["hidden"]), said_labels.index(r["said"])
         ax.add_patch(_cell(j, i, OUTCLASS_SHADES[r["relation"]]))
-        text = f"{r['steps_actual']:.1f} st" if r["kind"] == "rival" else ""
+        text = f"{r['steps_actual']:.1f} st" if r["kind"] == "rival" else r["relation"]
         if r["bic_margin"] is not None:
             text += f"\nΔBIC {r['bic_margin']:.0f}"
         ax.text(j, i, text, ha="center", va="center", fontsize=6)
@@ -313,7 +313,7 @@ def outclass_figure(rows: list[dict], path: str | Path) -> None:
     from matplotlib.patches import Patch
 
     shown = [k for k in ("closest", "related", "unrelated", "unexplained", "adequate")
-             if any(r["relation"] == k for r in rows)]
+             if any(r["relation"] == k for r in rows if r["kind"] == "rival")]
     ax.legend(handles=[Patch(color=OUTCLASS_SHADES[k], label=k) for k in shown], fontsize=7, loc="upper left",
               bbox_to_anchor=(1.01, 1.0))
     fig.tight_layout()
