@@ -124,7 +124,9 @@ def test_config_grids():
     rival at every size; every data set has its own seed, and nothing hidden is a candidate."""
     import yaml
 
-    config = yaml.safe_load(open("config/config.yaml", encoding="utf-8"))
+    from pathlib import Path
+
+    config = yaml.safe_load((Path(__file__).parents[2] / "config" / "config.yaml").read_text(encoding="utf-8"))
     params = load_parameters()
     for full in (False, True):
         section = {**config["outclass"], "full_grid": full}
