@@ -218,6 +218,12 @@ _SCHEMA: dict[str, dict[str, dict[str, Any]]] = {
     },
     "linkage_nonlinearity": {"cubic_coefficient": _range("1", 0.0, 1.0)},
     "rolling_resistance": {"coefficient": _range("1", 0.0, 0.1)},
+    "rack_presliding": {
+        "force": _range("N", 0.0, 2000.0),
+        "presliding_displacement": _range("m", 1.0e-6, 1.0e-2),
+        "slip_smoothing": _range("s/m", 10.0, 1.0e6),
+        "node_mass": _range("kg", 1.0e-4, 10.0),
+    },
     "top_mount_windup": {"stiffness": _range("N m/rad", 0.0, 1000.0)},
     "tyre_stribeck": {
         "breakaway_excess": _range("1", 0.0, 1.0),

@@ -4,11 +4,14 @@
 # diag_bench_case diagnoses one synthetic data set of the hidden-effect benchmark (config["benchmark"]; one job
 # each, so they run in parallel) and diag_benchmark scores them all. Every model a diagnosis replays (the base
 # model and the base model with each candidate, the example user effect among them) is derived by rule derive
-# before any of these runs.
+# before any of these runs. diag_outclass_case and diag_outclass are the out-of-class benchmark
+# (config["outclass"]): rival effects that are not candidates, hidden by a truth generator that is not the
+# diagnosis model, scored against the physically closest candidate.
 from parksteer.diagnose.benchmark import case_names as _bench_case_names
 from parksteer.diagnose.candidates import candidate_models
 from parksteer.parameters import load_parameters as _load_parameters
-from parksteer.synthetic.datasets import BenchmarkDesign, CarDesign, file_name as _diag_file_name
+from parksteer.diagnose.outclass import case_names as _outclass_case_names
+from parksteer.synthetic.datasets import BenchmarkDesign, CarDesign, OutclassDesign, file_name as _diag_file_name
 
 DIAG_USER_EFFECT = os.path.relpath(PACKAGE_DIR / "examples" / "column_imbalance.py")
 DIAG_MODELS = [
@@ -19,6 +22,12 @@ DIAG_BENCH = BenchmarkDesign.from_config(config["benchmark"])
 DIAG_CAR_FILES = [f"results/diagnose/car/{_diag_file_name(c, s)}" for c, s in DIAG_CAR.files]
 DIAG_BENCH_CASES = _bench_case_names(DIAG_BENCH, _load_parameters(PARAMETERS))
 DIAG_BENCH_FILES = [_diag_file_name(c, s) for c, s in DIAG_BENCH.files]
+DIAG_OUTCLASS = OutclassDesign.from_config(config["outclass"], config["benchmark"])
+DIAG_OUTCLASS_CASES = _outclass_case_names(DIAG_OUTCLASS, _load_parameters(PARAMETERS))
+DIAG_OUTCLASS_FILES = [_diag_file_name(c, s) for c, s in DIAG_OUTCLASS.files]
+# the truth generator's models: the base model with each rival (none of them a candidate)
+DIAG_OUTCLASS_MODELS = [model_manifest(f"with_{rival}", f"+{rival}") for rival in DIAG_OUTCLASS.rivals]
+FIGURES["diag_outclass"] = ["figures/diag_outclass.svg", "figures/diag_outclass.csv"]
 
 
 rule diag_car_data:
@@ -145,3 +154,49 @@ rule diag_benchmark:
         "../envs/parksteer.yaml"
     script:
         "../scripts/diag_benchmark.py"
+
+
+rule diag_outclass_case:
+    input:
+        parameters=PARAMETERS,
+        models=DIAG_MODELS + DIAG_OUTCLASS_MODELS,
+        code=script_sources("diag_outclass_case"),
+    output:
+        files=[f"results/diagnose/outclass/{{name}}/{name}" for name in DIAG_OUTCLASS_FILES],
+        truth="results/diagnose/outclass/{name}.truth.json",
+        diagnosis="results/diagnose/outclass/{name}.diagnosis.json",
+    params:
+        design=config["outclass"],
+        benchmark=config["benchmark"],
+    wildcard_constraints:
+        name="|".join(DIAG_OUTCLASS_CASES) if DIAG_OUTCLASS_CASES else "none",
+    log:
+        "logs/diag_outclass_case/{name}.log",
+    benchmark:
+        benchmark_file("diag_outclass_case", "name")
+    conda:
+        "../envs/parksteer.yaml"
+    script:
+        "../scripts/diag_outclass_case.py"
+
+
+rule diag_outclass:
+    input:
+        truths=expand("results/diagnose/outclass/{name}.truth.json", name=DIAG_OUTCLASS_CASES),
+        diagnoses=expand("results/diagnose/outclass/{name}.diagnosis.json", name=DIAG_OUTCLASS_CASES),
+        code=script_sources("diag_outclass"),
+    output:
+        svg="figures/diag_outclass.svg",
+        csv="figures/diag_outclass.csv",
+        json="results/diag_outclass.json",
+    params:
+        design=config["outclass"],
+        benchmark=config["benchmark"],
+    log:
+        "logs/diag_outclass.log",
+    benchmark:
+        benchmark_file("diag_outclass")
+    conda:
+        "../envs/parksteer.yaml"
+    script:
+        "../scripts/diag_outclass.py"

@@ -277,3 +277,68 @@ def phase_residual_figure(rows: list[dict], path: str | Path) -> None:
     ax.legend(fontsize=7)
     fig.tight_layout()
     save_svg(fig, path)
+
+
+OUTCLASS_SHADES = {"closest": "#4daf4a", "related": "#b8e186", "unrelated": "#e41a1c", "unexplained": "#bdbdbd",
+                   "adequate": "#ff7f00", "correct": "#4daf4a", "not adequate": "#bdbdbd", "false alarm": "#e41a1c"}
+
+
+def outclass_figure(rows: list[dict], path: str | Path) -> None:
+    """The out-of-class confusion table: each hidden rival (a row, with its physically closest candidate) against
+    what the diagnosis said (a column), the cell shaded by how the answer relates to the rival's physics and
+    labelled with the BIC margin over the runner-up when a candidate was named."""
+    truths = sorted({(r["hidden"], r["closest"]) for r in rows if r["kind"] == "rival"})
+    truth_labels = [h for h, _ in truths] + (["nothing"] if any(r["kind"] == "null" for r in rows) else [])
+    closest = dict(truths)
+    named = sorted({r["said"] for r in rows} - {"adequate", "unexplained"})
+    said_labels = named + ["adequate", "unexplained"]
+    fig, ax = new_figure(7.0, 0.45 * len(truth_labels) + 2.2)
+    for r in rows:
+        i, j = truth_labels.index(r["hidden"]), said_labels.index(r["said"])
+        ax.add_patch(_cell(j, i, OUTCLASS_SHADES[r["relation"]]))
+        text = f"{r['steps_actual']:.1f} st" if r["kind"] == "rival" else r["relation"]
+        if r["bic_margin"] is not None:
+            text += f"\nΔBIC {r['bic_margin']:.0f}"
+        ax.text(j, i, text, ha="center", va="center", fontsize=6)
+    ax.set_xlim(-0.5, len(said_labels) - 0.5)
+    ax.set_ylim(len(truth_labels) - 0.5, -0.5)
+    ax.set_xticks(np.arange(len(said_labels)), [s.replace("_", " ") for s in said_labels], rotation=45, ha="right",
+                  fontsize=7)
+    ax.set_yticks(np.arange(len(truth_labels)),
+                  [f"{h.replace('_', ' ')} ({closest[h].replace('_', ' ')})" if h in closest else h
+                   for h in truth_labels], fontsize=7)
+    ax.set_xlabel("diagnosis")
+    ax.set_ylabel("hidden rival (physically closest candidate)")
+    ax.grid(False)
+    from matplotlib.patches import Patch
+
+    shown = [k for k in ("closest", "related", "unrelated", "unexplained", "adequate")
+             if any(r["relation"] == k for r in rows if r["kind"] == "rival")]
+    ax.legend(handles=[Patch(color=OUTCLASS_SHADES[k], label=k) for k in shown], fontsize=7, loc="upper left",
+              bbox_to_anchor=(1.01, 1.0))
+    fig.tight_layout()
+    save_svg(fig, path)
+
+
+def _cell(x: float, y: float, colour: str):
+    from matplotlib.patches import Rectangle
+
+    return Rectangle((x - 0.5, y - 0.5), 1.0, 1.0, color=colour, alpha=0.8)
+
+
+def make_outclass_figure(truth_paths, diagnosis_paths, svg: str | Path, csv: str | Path, json_path: str | Path,
+                         design=None) -> dict:
+    """figures/diag_outclass.svg (the out-of-class confusion table), its CSV (one row per data set), results JSON."""
+    from ..diagnose.outclass import aggregate
+    from ..tables import write_csv, write_json
+
+    rows, summary = aggregate(truth_paths, diagnosis_paths, design)
+    outclass_figure(rows, svg)
+    # the diagnosis's wall time differs from run to run; it stays in the JSON summary, out of the figure data
+    columns = {key: [("" if r[key] is None else r[key]) for r in rows] for key in rows[0] if key != "wall_s"} \
+        if rows else {}
+    write_csv(csv, columns, {"figure": "diag_outclass: one row per out-of-class data set",
+                             "steps_actual": "hidden rival's RMS torque change in converter steps (all files)",
+                             "bic_margin": "named candidate's BIC gain over the runner-up's"})
+    write_json(json_path, summary)
+    return summary

@@ -23,6 +23,13 @@ logger's and the hand's settings.
 The experiment design (what is hidden in the car data set, the benchmark's strengths, files,
 perturbations and seeds) is the pipeline's configuration (``config/config.yaml``, sections
 ``car`` and ``benchmark``), given here as :class:`CarDesign` and :class:`BenchmarkDesign`.
+
+The out-of-class benchmark's records (:func:`make_outclass_dataset`, design :class:`OutclassDesign`, section
+``outclass``) are made otherwise: a rival effect that is no diagnosis candidate is hidden, the model runs at a
+tighter tolerance, and the clean columns pass a whole logger chain (:func:`chain_logged`: anti-alias filter,
+channel lag, sampling, noise, an 8-bit torque and a finer rack converter). The hand is the irregular hand above:
+the smooth hand of :mod:`parksteer.synthetic.variations` is sampled too finely to be a handwheel input of the
+compiled model (24 pieces at most), and driving the rack instead would be the diagnosis's own drive.
 """
 
 from __future__ import annotations
@@ -197,7 +204,7 @@ class DatasetSpec:
     name: str
     seed: int
     files: tuple[tuple[str, str], ...]
-    kind: str  # "candidate", "null" or "outside"
+    kind: str  # "candidate", "null" or "outside" (the out-of-class benchmark: "rival" or "null")
     hidden: str | None = None  # a candidate's name, or a disturbance's kind
     steps: float | None = None  # hidden size as converter steps of torque RMS (on the first file)
     base_overrides: dict[str, float] = field(default_factory=dict)
@@ -434,3 +441,220 @@ def write_car_dataset(parameters_path: str | Path, design: CarDesign, paths: lis
     for path, measurement in zip(paths, dataset.measurements):
         write_measurement(path, measurement, params)
     write_json(truth_path, dataset.truth)
+
+
+# ------------------------------------------------------------------------------ the out-of-class benchmark
+# Which library candidate is physically closest to each rival effect (one per rival, or None), the others that
+# share its physics ("related"), and why. A diagnosis that names the closest or a related candidate, or says
+# `unexplained`, has answered honestly; one that names any other candidate beyond the indistinguishable band has
+# given a confident wrong answer.
+OUTCLASS_RIVALS: dict[str, dict] = {
+    "gear_efficiency": {
+        "closest": "column_friction", "related": ("kingpin_friction", "rack_stiction"),
+        "reason": "friction in the steering transmission, reversing with the motion; the mesh's grows with the "
+                  "load it carries, the column's does not",
+    },
+    "tyre_stribeck": {
+        "closest": "brush_patch", "related": ("rack_stiction",),
+        "reason": "both reshape the tread's moment where the patch goes from sticking to sliding (start and each "
+                  "reversal); rack_stiction has the same breakaway form at the rack",
+    },
+    "carcass_hysteresis": {
+        "closest": "brush_patch", "related": ("rack_damping",),
+        "reason": "both change the tyre's wind-up at the start and each reversal and keep the sliding plateau; "
+                  "its damper makes it rate dependent, as rack_damping is",
+    },
+    "top_mount_windup": {
+        "closest": None, "related": (),
+        "reason": "an elastic centring torque about the king-pin axis; the only conservative rack-position term "
+                  "of the model is lifting, which is in the base model, not a candidate",
+    },
+    "linkage_nonlinearity": {
+        "closest": "ackermann", "related": (),
+        "reason": "both change the map from rack travel to steer angle, and with it the road-wheel torque seen "
+                  "at the handwheel towards lock",
+    },
+    "rack_presliding": {
+        "closest": "rack_stiction", "related": ("column_friction", "kingpin_friction"),
+        "reason": "rack friction departing from the tanh law near each reversal; rack_stiction's excess lives at "
+                  "low speed, the bristle's in the first tenths of a millimetre of travel",
+    },
+    "rolling_resistance": {
+        "closest": "braked_wheels", "related": ("kingpin_friction",),
+        "reason": "both are a force at the contact patch acting on the scrub radius, W |e|, against the steer "
+                  "rate; kingpin_friction is a friction moment about the same axis growing with W",
+    },
+}
+
+
+@dataclass(frozen=True)
+class ChainLogger:
+    """The whole logger chain of the out-of-class records, in the order a signal passes it.
+
+    A causal Butterworth low-pass of ``anti_alias_order`` at ``anti_alias_hz`` on every channel (the analogue
+    anti-alias filter, run from rest on the fine clean signal), a delay of the torque channel behind the rack of
+    ``torque_lag_s`` (a multiplexed converter), sampling at ``sample_rate_hz``, analog noise (the parameter
+    file's ``[synthetic]`` RMS values), and a converter per channel: the torque on ``torque_bits`` over the
+    parameter file's full scale, the rack on ``rack_bits``.
+    """
+
+    sample_rate_hz: float
+    anti_alias_hz: float
+    anti_alias_order: int
+    torque_lag_s: float
+    torque_bits: int
+    rack_bits: int
+
+    @classmethod
+    def from_config(cls, section: dict) -> ChainLogger:
+        return cls(float(section["sample_rate_hz"]), float(section["anti_alias_hz"]), int(section["anti_alias_order"]),
+                   float(section["torque_lag_s"]), int(section["torque_bits"]), int(section["rack_bits"]))
+
+
+@dataclass(frozen=True)
+class OutclassDesign:
+    """The out-of-class benchmark's design (config/config.yaml, section ``outclass``, where each value's reason
+    is): rival effects, their sizes in converter steps (the small grid, or the full one when ``full_grid``), the
+    nulls, the files, the truth integrator's relative tolerance, the logger chain and the seed. The base
+    perturbation and the size search are the in-class benchmark's."""
+
+    rivals: tuple[str, ...]
+    steps: tuple[float, ...]
+    nulls: int
+    files: tuple[tuple[str, str], ...]
+    rtol: float
+    logger: ChainLogger
+    seed: int
+    perturbation: dict[str, float]
+    search: SizeSearch
+
+    @classmethod
+    def from_config(cls, section: dict, benchmark: dict) -> OutclassDesign:
+        grid = section["full"] if section["full_grid"] else section["small"]
+        bench = BenchmarkDesign.from_config(benchmark)
+        return cls(tuple(str(r) for r in section["rivals"]), tuple(float(s) for s in grid["steps"]),
+                   int(grid["nulls"]), _files(section["files"]), float(section["rtol"]),
+                   ChainLogger.from_config(section["logger"]), int(section["seed"]), bench.perturbation, bench.search)
+
+
+def outclass_specs(params: Parameters, design: OutclassDesign, registry=None) -> list[DatasetSpec]:
+    """Every data set of the out-of-class benchmark: each rival at each size, then the nulls.
+
+    A rival must be a registered effect that is not a diagnosis candidate (so the truth is never one of the
+    forms the diagnosis fits) and must be in :data:`OUTCLASS_RIVALS` (so its answer can be judged).
+    """
+    registry = registry if registry is not None else discover_effects()
+    specs: list[DatasetSpec] = []
+    for rival in design.rivals:
+        if rival not in registry:
+            raise UsageError(f"config outclass.rivals: unknown effect {rival!r}")
+        if registry[rival].diagnosis_candidate or rival not in OUTCLASS_RIVALS:
+            raise UsageError(f"config outclass.rivals: {rival!r} is a diagnosis candidate or has no closest-candidate "
+                             "entry (parksteer.synthetic.datasets.OUTCLASS_RIVALS)")
+
+    def add(kind, hidden, steps):
+        index = len(specs)
+        seed = design.seed + index
+        label = "null" if kind == "null" else f"{hidden}_{steps:g}".replace(".", "p")
+        specs.append(DatasetSpec(f"o{index:02d}_{label}", seed, design.files, kind, hidden, steps,
+                                 perturbed_base(params, seed, design.perturbation), search=design.search))
+
+    for rival in design.rivals:
+        for steps in design.steps:
+            add("rival", rival, steps)
+    for _ in range(design.nulls):
+        add("null", None, None)
+    return specs
+
+
+def chain_logged(params: Parameters, columns: dict[str, np.ndarray], chain: ChainLogger, case: str, surface: str,
+                 seed: int, hand_profile: HandProfile) -> Measurement:
+    """Pass clean columns (time_s, rack_m, handwheel_torque_Nm on a fine even grid) through the logger chain."""
+    from scipy.signal import butter, sosfilt, sosfilt_zi
+
+    from ..measure.io import metadata_text
+    from .logger import add_noise, quantise, resample
+
+    t = np.asarray(columns["time_s"], dtype=float)
+    dt = float(t[1] - t[0])
+    sos = butter(chain.anti_alias_order, chain.anti_alias_hz, fs=1.0 / dt, output="sos")
+    filtered = {}
+    for name in ("rack_m", "handwheel_torque_Nm"):
+        x = np.asarray(columns[name], dtype=float)
+        filtered[name], _ = sosfilt(sos, x, zi=sosfilt_zi(sos) * x[0])  # from rest at the first value
+    filtered["handwheel_torque_Nm"] = np.interp(t - chain.torque_lag_s, t, filtered["handwheel_torque_Nm"])
+    time_s, sampled = resample(t, filtered, chain.sample_rate_hz)
+    s = params.sections["synthetic"]
+    rng = np.random.default_rng(seed)
+    rack_scale, torque_scale = float(s["full_scale_rack"]), float(s["full_scale_torque"])
+    peak = float(np.max(np.abs(sampled["handwheel_torque_Nm"])))
+    if peak > (1.0 - RANGE_HEADROOM) * torque_scale:  # the engineer's next range up, as _logged does
+        unit = RANGE_STEP_FRACTION * torque_scale
+        torque_scale = unit * math.ceil(peak / (1.0 - RANGE_HEADROOM) / unit)
+    rack = quantise(add_noise(sampled["rack_m"], float(s["noise_rack"]), rng), rack_scale, chain.rack_bits)
+    torque = quantise(add_noise(sampled["handwheel_torque_Nm"], float(s["noise_torque"]), rng), torque_scale,
+                      chain.torque_bits)
+    # a file states one converter (the torque's); the rack's noise is estimated from the data
+    metadata = {"case": case, "surface": surface, "source": "synthetic: parksteer.synthetic.datasets (out of class)",
+                "synthetic": True, "bits": chain.torque_bits, "sample_rate_hz": chain.sample_rate_hz,
+                "full_scale_handwheel_torque_Nm": torque_scale, "rack_bits": chain.rack_bits,
+                "anti_alias_hz": chain.anti_alias_hz, "torque_lag_s": chain.torque_lag_s, "noise_seed": int(seed)}
+    metadata.update(hand_profile.metadata)
+    return Measurement(path=None, columns={"time_s": time_s, "rack_m": rack, "handwheel_torque_Nm": torque},
+                       metadata={k: metadata_text(v) for k, v in metadata.items()})
+
+
+def chain_torque_step_Nm(params: Parameters, chain: ChainLogger) -> float:
+    """The converter step of the chain's torque channel at the parameter file's full scale."""
+    return quantisation_step(float(params.sections["synthetic"]["full_scale_torque"]), chain.torque_bits)
+
+
+def make_outclass_dataset(params: Parameters, spec: DatasetSpec, design: OutclassDesign) -> Dataset:
+    """Simulate a rival hidden in the base model, handwheel-driven at ``design.rtol``, and log it through the chain.
+
+    The rival's strength makes the clean torque change by ``spec.steps`` converter steps RMS over all files (the
+    chain's torque step; its largest strength if that falls short, the truth records the steps it makes).
+    """
+    step = chain_torque_step_Nm(params, design.logger)
+    hands = [hand(params, spec.seed * 100 + i) for i in range(len(spec.files))]
+    base = dict(spec.base_overrides)
+
+    def runs(effects, overrides):
+        return [_fine_run(params, case, surface, h, effects, overrides, design.rtol)
+                for (case, surface), h in zip(spec.files, hands)]
+
+    def torque(effects, overrides):
+        return np.concatenate([r["handwheel_torque_Nm"] for r in runs(effects, overrides)])
+
+    effects, overrides, strength_key, strength, steps = None, dict(base), None, None, None
+    if spec.kind == "rival":
+        effect = discover_effects()[spec.hidden]
+        quantity = strength_parameter(effect, params)
+        strength_key, effects = quantity.key, f"+{effect.name}"
+        strength = strength_for_rms(lambda s: torque(effects, {**base, strength_key: s}), spec.steps * step,
+                                    quantity.upper * 1e-3, quantity.upper, spec.search)
+        overrides[strength_key] = strength
+    clean = runs(effects, overrides)
+    if spec.kind == "rival":
+        steps = rms_difference(np.concatenate([r["handwheel_torque_Nm"] for r in clean]), torque(None, base)) / step
+    measurements = [chain_logged(params, columns, design.logger, case, surface, spec.seed * 100 + 50 + i, h)
+                    for i, (columns, (case, surface), h) in enumerate(zip(clean, spec.files, hands))]
+    rival = OUTCLASS_RIVALS.get(spec.hidden, {})
+    truth = {
+        "name": spec.name, "kind": spec.kind, "hidden": spec.hidden, "steps_requested": spec.steps, "steps": steps,
+        "torque_step_Nm": step, "strength_key": strength_key, "strength": strength,
+        "closest": rival.get("closest"), "related": list(rival.get("related", ())), "reason": rival.get("reason"),
+        "rtol": design.rtol, "logger": dataclasses.asdict(design.logger),
+        "base_overrides": spec.base_overrides, "files": [{"case": c, "surface": s} for c, s in spec.files],
+        "seed": spec.seed,
+    }
+    return Dataset(spec, measurements, truth)
+
+
+def _fine_run(params, case, surface, hand_profile, effects, overrides, rtol) -> dict[str, np.ndarray]:
+    result = simulate(case, effects=effects, overrides=overrides, surface=surface, params=params,
+                      handwheel=hand_profile.handwheel_profile(), output_dt_s=OUTCLASS_CLEAN_DT_S, rtol=rtol)
+    return {name: np.asarray(result.columns[name]) for name in ("time_s", "rack_m", "handwheel_torque_Nm")}
+
+
+OUTCLASS_CLEAN_DT_S = 0.001  # the truth's output spacing: the anti-alias filter runs on a signal this fine

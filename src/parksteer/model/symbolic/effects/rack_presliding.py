@@ -1,0 +1,82 @@
+"""Pre-sliding, history-dependent friction of the rack (a bristle of the Dahl kind): a rival of the tanh friction.
+
+Physics. The paper's rack friction is Coulomb, smoothed as -F tanh(beta v): a function of the rack
+speed alone, which flips sign within about 1 / beta = 1 mm/s of a reversal whatever the rack did
+before. Real sliding contacts have a pre-sliding regime: after a reversal the asperities (the
+"bristles") first deform elastically, the friction force grows with the displacement since the
+reversal over a pre-sliding distance of the order of 0.01-1 mm, and only then does the contact slide
+at the full force. The force depends on the path (the last reversal), not on the speed: Dahl's
+model, dF/dt = sigma v (1 - (F / F_c) sgn v), with initial stiffness sigma and saturation F_c.
+
+Model. One bristle between the rack and its housing: a spring k in series with a Coulomb slider of
+force F_d. A new coordinate y is the position of the bristle's root along the rack axis (from the
+housing, like the rack's): the spring acts between rack and root, -k (x - y), and the slider between
+root and housing, -F_d tanh(beta_s dy/dt). k = F_d / x_p, with x_p the pre-sliding displacement, so
+the force saturates at F_d after a rack travel of about x_p from a reversal. In the limit of a massless
+root, F = k (x - y) obeys dF/dt = k dx/dt - (k / beta_s) atanh(F / F_d): the same initial stiffness and
+saturation as Dahl's model with a sharper knee, and a slow creep at rest (time beta_s x_p), the smoothed
+slider's residue. The root carries a small mass (``node_mass``) so that the mass matrix stays regular;
+its own time sqrt(m / k) is far below the pre-sliding time. The effect adds F_d to the rack friction
+(strength F_d in N, 0 = absent: then spring and slider vanish and the root is a free, resting mass).
+
+Signature against the rack: in steady sliding the bristle has slid and carries F_d exactly, like an
+extra Coulomb friction of F_d; after each reversal the force changes sign over a rack travel of
+about 2 x_p instead of over a speed of 1 / beta, so the torque's drop at a reversal is spread over
+the first few tenths of a millimetre of travel, whatever the rack speed. Lifting is conservative and
+follows the rack position, proportional to the wheel load and growing with the offset; this friction
+depends on neither. Provenance: a rival beyond the paper (Dahl, 1968 and 1976; the elasto-plastic
+bristle of Dupont et al., 2002); F_d and x_p are chosen, not measured.
+"""
+
+from __future__ import annotations
+
+import sympy as sp
+import sympy.physics.mechanics as me
+
+from ..components import Effect
+from ..system import action_reaction
+
+
+class RackPresliding(Effect):
+    name = "rack_presliding"
+    description = (
+        "Pre-sliding rack friction: a bristle (spring F_d / x_p in series with a slider of force F_d) between "
+        "rack and housing; one root coordinate; 0 = absent"
+    )
+    in_default_set = False
+    diagnosis_candidate = False  # a rival of the paper's tanh rack friction, not a candidate
+    uses = ("rack_presliding.force", "rack_presliding.presliding_displacement", "rack_presliding.slip_smoothing",
+            "rack_presliding.node_mass")
+
+    def configure(self, model):
+        model.state(self).root = model.add_coordinate("bristle_root", "m", owner=self.name)
+
+    def bodies(self, model):
+        k, state = model.kinematics, model.state(self)
+        q, u = state.root
+        root = k.rack_housing_point.locatenew("bristle_root", (q - model.rack_q) * k.B.y)
+        root.set_vel(k.B, u * k.B.y)
+        root.v1pt_theory(k.rack_housing_point, model.N, k.B)
+        state.point = root
+        return [me.Particle("bristle_root", root, model.p("rack_presliding.node_mass"))]
+
+    def _spring_force(self, model):
+        q, _ = model.state(self).root
+        stiffness = model.p("rack_presliding.force") / model.p("rack_presliding.presliding_displacement")
+        return stiffness * (model.rack_q - q)
+
+    def loads(self, model):
+        k, state = model.kinematics, model.state(self)
+        _, u = state.root
+        spring = self._spring_force(model)
+        slider = model.p("rack_presliding.force") * sp.tanh(model.p("rack_presliding.slip_smoothing") * u)
+        return (action_reaction(k.rack_point, -spring * k.B.y, state.point)
+                + action_reaction(state.point, -slider * k.B.y, k.rack_housing_point))
+
+    def potential_energy(self, model):
+        q, _ = model.state(self).root
+        stiffness = model.p("rack_presliding.force") / model.p("rack_presliding.presliding_displacement")
+        return stiffness * (model.rack_q - q) ** 2 / 2
+
+
+EFFECT = RackPresliding()
