@@ -1,6 +1,7 @@
 """Benchmark of diagnose (not a test): wall time, replays and verdicts, against a reference source tree.
 
-    python benchmarks/bench_diagnose.py OUT.json [--repeats 3] [--reference SRC] [--workers N] [--car DIR]
+    python benchmarks/bench_diagnose.py OUT.json [--repeats 3] [--eight-repeats 1] [--reference SRC] [--workers N]
+                                                 [--car DIR]
 
 Measures, each in a fresh process per source tree and worker count, compiled models already in the cache
 (derived first, untimed):
@@ -40,7 +41,7 @@ CAR_FILES = ("unladen__ground.csv", "part_laden__ground.csv", "offset_12_7mm__gr
              "offset_68_5mm__ground.csv", "offset_68_5mm__air_bearing.csv")
 
 
-def _measure(repeats: int, workers: int, car: Path | None) -> dict:
+def _measure(repeats: int, workers: int, car: Path | None, eight_repeats: int) -> dict:
     """Every timing of the module docstring in this process (the source tree on sys.path)."""
     import inspect
 
@@ -78,9 +79,9 @@ def _measure(repeats: int, workers: int, car: Path | None) -> dict:
         compare_files([prepare_file(bench_measurements[0], label="unladen")], params)
         compare_times.append(time.perf_counter() - t0)
 
-    def timed(make_files, count_workers: int) -> dict:
+    def timed(make_files, count_workers: int, times: int = repeats) -> dict:
         walls, replays, outcomes = [], [], []
-        for _ in range(repeats):
+        for _ in range(times):
             files = make_files()
             kwargs = {"workers": count_workers} if takes_workers else {}
             t0 = time.perf_counter()
@@ -102,14 +103,15 @@ def _measure(repeats: int, workers: int, car: Path | None) -> dict:
     }
     if car is not None:
         result["one_car_file"] = timed(lambda: load_files([car / CAR_FILES[0]], params), workers)
-        result["eight_car_files"] = timed(lambda: load_files([car / f for f in CAR_FILES], params), workers)
+        result["eight_car_files"] = timed(lambda: load_files([car / f for f in CAR_FILES], params), workers,
+                                          eight_repeats)
     return result
 
 
-def _variant(src: Path, repeats: int, workers: int, car: Path | None) -> dict:
+def _variant(src: Path, repeats: int, workers: int, car: Path | None, eight_repeats: int) -> dict:
     env = {**os.environ, "PYTHONPATH": str(src)}
     command = [sys.executable, str(Path(__file__).resolve()), "-", "--emit", "--repeats", str(repeats),
-               "--workers", str(workers)] + (["--car", str(car)] if car is not None else [])
+               "--workers", str(workers), "--eight-repeats", str(eight_repeats)] + (["--car", str(car)] if car is not None else [])
     done = subprocess.run(command, env=env, capture_output=True, text=True, check=False)
     if done.returncode != 0:
         sys.exit(f"bench_diagnose: variant {src} with {workers} worker(s) failed:\n{done.stderr[-2000:]}")
@@ -128,6 +130,8 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("out", help="JSON file for the results ('-' with --emit)")
     parser.add_argument("--repeats", type=int, default=3, help="repeats of each diagnosis (default 3)")
+    parser.add_argument("--eight-repeats", type=int, default=1,
+                        help="repeats of the eight-file diagnosis (default 1: about a minute each)")
     parser.add_argument("--workers", type=int, default=None, help="workers of the parallel variant (default: CPUs)")
     parser.add_argument("--reference", default=None, metavar="SRC", help="a reference tree's src folder")
     parser.add_argument("--car", default=str(ROOT / "results" / "diagnose" / "car"), metavar="DIR",
@@ -136,7 +140,7 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     car = Path(args.car) if all((Path(args.car) / f).is_file() for f in CAR_FILES) else None
     if args.emit:
-        print(json.dumps(_measure(args.repeats, args.workers or 1, car)))
+        print(json.dumps(_measure(args.repeats, args.workers or 1, car, args.eight_repeats)))
         return 0
 
     from parksteer.diagnose.parallel import available_workers
@@ -146,9 +150,9 @@ def main(argv: list[str] | None = None) -> int:
     here = ROOT / "src"
     variants = {}
     if args.reference:
-        variants["reference"] = _variant(Path(args.reference), args.repeats, 1, car)
-    variants["one_worker"] = _variant(here, args.repeats, 1, car)
-    variants[f"{workers}_workers"] = _variant(here, args.repeats, workers, car)
+        variants["reference"] = _variant(Path(args.reference), args.repeats, 1, car, args.eight_repeats)
+    variants["one_worker"] = _variant(here, args.repeats, 1, car, args.eight_repeats)
+    variants[f"{workers}_workers"] = _variant(here, args.repeats, workers, car, args.eight_repeats)
     rows = ["replay_s_median", "compare_one_file_s_median", "bench_case", "one_car_file", "eight_car_files"]
     base_name = next(iter(variants))
     table = {}
@@ -163,7 +167,7 @@ def main(argv: list[str] | None = None) -> int:
     result = {
         "machine": {"python": sys.version.split()[0], "platform": platform.platform(), "cpus": os.cpu_count(),
                     "load_average": os.getloadavg()},
-        "repeats": args.repeats, "workers": workers, "reference": args.reference,
+        "repeats": args.repeats, "eight_repeats": args.eight_repeats, "workers": workers, "reference": args.reference,
         "targets_s": {"one_car_file": 5.0, "eight_car_files": 20.0},
         "table": table, "variants": variants,
     }
