@@ -103,6 +103,7 @@ def _measure(repeats: int, workers: int, car: Path | None, eight_repeats: int) -
     }
     if car is not None:
         result["one_car_file"] = timed(lambda: load_files([car / CAR_FILES[0]], params), workers)
+    if car is not None and eight_repeats > 0:
         result["eight_car_files"] = timed(lambda: load_files([car / f for f in CAR_FILES], params), workers,
                                           eight_repeats)
     return result
@@ -131,7 +132,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("out", help="JSON file for the results ('-' with --emit)")
     parser.add_argument("--repeats", type=int, default=3, help="repeats of each diagnosis (default 3)")
     parser.add_argument("--eight-repeats", type=int, default=1,
-                        help="repeats of the eight-file diagnosis (default 1: about a minute each)")
+                        help="repeats of the eight-file diagnosis (default 1: about a minute each; 0 leaves it out)")
     parser.add_argument("--workers", type=int, default=None, help="workers of the parallel variant (default: CPUs)")
     parser.add_argument("--reference", default=None, metavar="SRC", help="a reference tree's src folder")
     parser.add_argument("--car", default=str(ROOT / "results" / "diagnose" / "car"), metavar="DIR",
