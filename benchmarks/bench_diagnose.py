@@ -15,7 +15,7 @@ Measures, each in a fresh process per source tree and worker count, compiled mod
   (target: 5 s on 2 cores);
 - ``diagnose`` of the paper's eight car files together (target: 20 s on 2 cores).
 
-Variants: this tree with one worker and with ``--workers`` (default: the CPUs available), and, with
+Variants (each repeat a fresh process, the variants taking turns): this tree with one worker and with ``--workers`` (default: the CPUs available), and, with
 ``--reference SRC``, another tree's ``src`` (e.g. ``git worktree add /tmp/ref <commit>``; a tree whose
 ``diagnose`` has no workers runs in line). The car files are the DAG's (``snakemake --cores 1
 diag_car_data``, results/diagnose/car); without them the car rows are left out. Reports medians,
@@ -149,11 +149,31 @@ def main(argv: list[str] | None = None) -> int:
 
     workers = args.workers or available_workers()
     here = ROOT / "src"
-    variants = {}
+    plan = {}
     if args.reference:
-        variants["reference"] = _variant(Path(args.reference), args.repeats, 1, car, args.eight_repeats)
-    variants["one_worker"] = _variant(here, args.repeats, 1, car, args.eight_repeats)
-    variants[f"{workers}_workers"] = _variant(here, args.repeats, workers, car, args.eight_repeats)
+        plan["reference"] = (Path(args.reference), 1)
+    plan["one_worker"] = (here, 1)
+    plan[f"{workers}_workers"] = (here, workers)
+    # One process per variant and repeat, the variants taking turns: a change of the machine's load between
+    # variants (shared machines) falls on all of them alike.
+    variants: dict[str, dict] = {}
+    for _ in range(max(args.repeats, 1)):
+        for name, (src, count) in plan.items():
+            one = _variant(src, 1, count, car, args.eight_repeats)
+            if name not in variants:
+                variants[name] = one
+                continue
+            for row, value in one.items():
+                if isinstance(value, dict) and "wall_s" in value:
+                    merged = variants[name][row]
+                    merged["wall_s"] += value["wall_s"]
+                    merged["replays"] += value["replays"]
+                    merged["wall_s_median"] = statistics.median(merged["wall_s"])
+                    merged["same_outcome_each_repeat"] = merged.get("same_outcome_each_repeat", True) and _same(
+                        merged["outcome"], value["outcome"])
+                elif isinstance(value, float) and row.endswith("_median"):
+                    variants[name].setdefault(row + "_all", [variants[name][row]]).append(value)
+                    variants[name][row] = statistics.median(variants[name][row + "_all"])
     rows = ["replay_s_median", "compare_one_file_s_median", "bench_case", "one_car_file", "eight_car_files"]
     base_name = next(iter(variants))
     table = {}
