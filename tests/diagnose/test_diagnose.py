@@ -150,12 +150,22 @@ def test_the_user_effect_joins_compare_by_spec_and_by_environment(written, tmp_p
 
 
 def test_diagnose_command_writes_json_report_and_figure(written, tmp_path, capsys):
-    """The command's JSON validates, the markdown report states the verdict and links the figure."""
+    """The command's JSON validates, the markdown report states the verdict and links the figure; progress goes
+    to stderr, and --quiet with --jobs 2 prints nothing there and the same JSON (timings apart)."""
     paths, _ = written("null_off_nominal", kind="null", base_overrides=OFF_NOMINAL)
     report, plot = tmp_path / "report.md", tmp_path / "diagnosis.svg"
     assert main(["diagnose", str(paths[0]), "--json", "--report", str(report), "--plot", str(plot)]) == 0
-    result = json.loads(capsys.readouterr().out)
+    captured = capsys.readouterr()
+    result = json.loads(captured.out)
+    assert captured.err.splitlines()[-1].startswith(f"diagnose: verdict: {result['verdict']}")
     jsonschema.validate(result, json.loads(SCHEMA_PATH.read_text(encoding="utf-8")))
     text = report.read_text(encoding="utf-8")
     assert f"Verdict: {result['verdict']}" in text and "diagnosis.svg" in text
     assert plot.read_text(encoding="utf-8").startswith("<?xml")
+    assert main(["diagnose", str(paths[0]), "--json", "--quiet", "--jobs", "2"]) == 0
+    captured = capsys.readouterr()
+    again = json.loads(captured.out)
+    assert captured.err == ""
+    for r in (result, again):
+        r["cost"].pop("timings_s")
+    assert again == result

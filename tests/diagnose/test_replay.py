@@ -119,3 +119,20 @@ def test_a_rack_friction_override_changes_the_torque_by_its_physical_share(param
     expected = 100.0 / params["steering.handwheel_to_rack_ratio"]
     assert np.all(share > 0.85 * expected) and np.all(share < 1.16 * expected)
     assert np.mean(share) == pytest.approx(expected, rel=0.05)
+
+
+def test_a_replay_on_another_rack_shares_the_preparation_not_the_result(params):
+    """Replay.on_rack (the replay ensemble's racks): the prepared runs do not depend on the rack, so a replay made
+    from another's on a second rack gives exactly the torque of a replay prepared afresh on that rack, overrides
+    included, and a different torque from the first rack's."""
+    t, logged, _ = _logged_rack(11, True)
+    _, other_logged, _ = _logged_rack(12, True)
+    first, second = smooth_rack(t, logged), smooth_rack(t, other_logged)
+    effects = resolve_effects(None)
+    replay = Replay(effects, "unladen", "ground", params, first, t)
+    moved = {"steering.rack_friction_force": params["steering.rack_friction_force"] + 80.0}
+    shared = replay.on_rack(second)
+    fresh = Replay(effects, "unladen", "ground", params, second, t)
+    for overrides in ({}, moved):
+        assert np.array_equal(shared.torque(overrides), fresh.torque(overrides))
+    assert not np.array_equal(shared.torque(), replay.torque())

@@ -55,6 +55,9 @@ def register(sub) -> None:
     p.add_argument("--report", default=None, metavar="OUT.md", help="write a readable report (markdown)")
     p.add_argument("--html", default=None, metavar="OUT.html",
                    help="write one self-contained HTML page: overlay, residual by phase, fitted values, ranking")
+    p.add_argument("--jobs", type=int, default=None, metavar="N",
+                   help="replays run side by side on N processes (default: the CPUs available; same result)")
+    p.add_argument("--quiet", action="store_true", help="no progress lines on stderr")
     p.set_defaults(func=_diagnose)
 
 
@@ -121,7 +124,12 @@ def _diagnose(args) -> int:
         if len(f.phases.reversal_times_s) == 0:
             raise UsageError(f"{f.measurement.path}: column 'rack_m': the rack never reverses, so the record holds "
                              "no reversal to calibrate the friction on; diagnose needs a cycle that turns back")
-    diagnosis = diagnose(files, params, effects)
+    from ..diagnose.parallel import available_workers
+
+    if args.jobs is not None and args.jobs < 1:
+        raise UsageError(f"--jobs {args.jobs}: give at least 1")
+    workers = args.jobs if args.jobs is not None else available_workers()
+    diagnosis = diagnose(files, params, effects, workers=workers, quiet=args.quiet)
     result = diagnosis_dict(diagnosis)
     if args.plot:
         from ..figures.diagnose import diagnosis_figure
@@ -134,13 +142,13 @@ def _diagnose(args) -> int:
                 if Path(args.plot).resolve().is_relative_to(Path(args.report).resolve().parent) else args.plot
         write_markdown(args.report, markdown_report(result, figure))
     if args.html:
-        _write_html(args.html, diagnosis, result, files, params)
+        _write_html(args.html, diagnosis, result, files, params, workers)
     if args.json:
         _print_json(result)
     return 0
 
 
-def _write_html(path: str, diagnosis, result: dict, files, params) -> None:
+def _write_html(path: str, diagnosis, result: dict, files, params, workers: int = 1) -> None:
     """The diagnosis and its error ladder as one self-contained HTML page (parksteer.diagnose.report.html_report)."""
     import tempfile
 
@@ -149,7 +157,7 @@ def _write_html(path: str, diagnosis, result: dict, files, params) -> None:
     from ..figures.diagnose import diagnosis_figure, ladder_figure, phase_residual_figure
 
     phases = phase_residuals(diagnosis)
-    ladder = error_ladder(files, params, list(diagnosis.base_effects), first=diagnosis)
+    ladder = error_ladder(files, params, list(diagnosis.base_effects), first=diagnosis, workers=workers)
     captions = {
         "diagnosis": "Measured handwheel torque and the calibrated model (with the best candidate) against rack, "
                      "their residual, and the weighted RMS error with each candidate (first file).",

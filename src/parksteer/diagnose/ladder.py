@@ -44,16 +44,17 @@ def _rung(label: str, effects: list[Effect], statistics: dict, parameters: dict[
 
 
 def error_ladder(files: list[FileData], params: Parameters, effects=None, first: Diagnosis | None = None,
-                 settings: DiagnosisSettings | None = None) -> Ladder:
+                 settings: DiagnosisSettings | None = None, workers: int = 1) -> Ladder:
     """Rungs from the paper's model to the model with every effect the diagnoses name (module docstring).
 
     `first` is a diagnosis of the same files and model already made (it is not repeated); the ladder uses its
-    settings, else `settings` (by default the documented ones).
+    settings, else `settings` (by default the documented ones). `workers`: as for
+    :func:`parksteer.diagnose.select.diagnose`.
     """
     settings = settings or (first.settings if first is not None else DEFAULT_SETTINGS)
     base = resolve_effects(effects) if not (isinstance(effects, list) and effects
                                              and isinstance(effects[0], Effect)) else effects
-    diagnosis = first if first is not None else diagnose(files, params, base, settings=settings)
+    diagnosis = first if first is not None else diagnose(files, params, base, settings=settings, workers=workers)
     nominal = diagnosis.statistics(diagnosis.nominal_predictions)
     calibrated = diagnosis.statistics(diagnosis.calibration.predictions)
     rungs = [
@@ -74,6 +75,7 @@ def error_ladder(files: list[FileData], params: Parameters, effects=None, first:
         rungs.append(_rung(f"+ {best.name}", model, statistics, fit.values))
         if statistics["weighted_rms_Nm"] <= settings.adequate_rms_factor * statistics["noise_floor_Nm"]:
             break
-        diagnosis = diagnose(files, params, model, strengths=dict(strengths), start=fit.values, settings=settings)
+        diagnosis = diagnose(files, params, model, strengths=dict(strengths), start=fit.values, settings=settings,
+                             workers=workers)
         diagnoses.append(diagnosis)
     return Ladder(rungs, diagnoses, calibrated["noise_floor_Nm"], calibrated["attainable_floor_Nm"])

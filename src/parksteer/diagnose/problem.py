@@ -44,6 +44,7 @@ from ..measure.smoothing import SmoothedRack, smooth_rack
 from ..model.symbolic.components import Effect
 from ..parameters import Parameters
 from ..synthetic.logger import add_noise, quantise
+from .parallel import fork_map, forks, worker_pool
 from .settings import DEFAULT_SETTINGS
 from .replay import Replay
 
@@ -133,11 +134,19 @@ def effect_key(effects: list[Effect]) -> tuple[str, ...]:
 
 @dataclass(eq=False)
 class Problem:
-    """Files and the models to replay them with; caches one :class:`Replay` per effect set and file."""
+    """Files and the models to replay them with; caches one :class:`Replay` per effect set and file.
+
+    With `workers` > 1 the files of a prediction are replayed side by side, on a pool of processes
+    forked once (:mod:`parksteer.diagnose.parallel`; :meth:`close` ends it), and the draws of the
+    replay ensemble likewise: the same numbers as in line.
+    """
 
     files: list[FileData]
     params: Parameters
+    workers: int = 1
     _replays: dict = field(default_factory=dict, repr=False)
+    extra_evaluations: int = 0  # replays run in worker processes
+    _pool: object = field(default=None, repr=False)
 
     def replay(self, effects: list[Effect], index: int) -> Replay:
         key = (effect_key(effects), index)
@@ -148,7 +157,20 @@ class Problem:
 
     @property
     def evaluations(self) -> int:
-        return sum(r.evaluations for r in self._replays.values())
+        return sum(r.evaluations for r in self._replays.values()) + self.extra_evaluations
+
+    @property
+    def parallel_files(self) -> bool:
+        """Whether predictions spread their files over the workers (else the callers spread candidates)."""
+        return len(self.files) > 1 and forks(len(self.files), self.workers)
+
+    def close(self) -> None:
+        """End the worker pool, if one was started; later predictions run in line."""
+        self.workers = 1
+        if self._pool is not None:
+            self._pool.close()
+            self._pool.join()
+            self._pool = None
 
     @property
     def n(self) -> int:
@@ -156,6 +178,16 @@ class Problem:
 
     def predict(self, effects: list[Effect], overrides: dict[str, float] | None = None) -> list[np.ndarray]:
         """Model torque at every file's samples (one array per file)."""
+        if self.parallel_files:
+            if self._pool is None:
+                global _POOLED
+                _POOLED = self
+                self._pool = worker_pool(self.workers)
+            if self._pool is not None:
+                tasks = [(list(effects), i, overrides) for i in range(len(self.files))]
+                out = self._pool.map(_pooled_torque, tasks, chunksize=1)
+                self.extra_evaluations += len(tasks)
+                return out
         return [self.replay(effects, i).torque(overrides) for i in range(len(self.files))]
 
     def weighted(self, predictions: list[np.ndarray]) -> np.ndarray:
@@ -176,30 +208,41 @@ class Problem:
         sample keeps the larger of this and the uncertainty already estimated.
         """
         rng = np.random.default_rng(seed)
+        # The racks are drawn in line, in order (one random stream), then replayed side by side.
+        racks = []
         for i, f in enumerate(self.files):
             base = self.replay(effects, i)
+            base.parameter_vector(overrides)  # any run the overrides need is prepared once, here
             logger = rack_logger(f.measurement)
             # An end held at rest may be a hand still slowing there, and a pause's edges are not sharp
             # (smoothing.RACK_REST_TEST_CHI2, RACK_REST_MIN_S): every other draw smooths with the ends and the
             # pauses free, so the samples there carry that doubt.
             released = (smooth_rack(f.time_s, f.rack_m, f.rack.knot_spacing_s, hold_rest=False)
                         if any(f.rack.held_at_rest) or f.rack.rest_intervals_s else None)
-            runs = []
             for k in range(draws):
                 source, hold = (released, False) if released is not None and k % 2 else (f.rack, True)
                 if logger is not None:
                     rack = relogged_rack(source, f.time_s, *logger, rng, hold_rest=hold)
                 else:
                     rack = source.perturbed(rng)
-                other = Replay(list(effects), f.case, f.surface, self.params, rack, f.time_s)
-                runs.append(other.torque(overrides))
+                racks.append((base, rack))
             base.evaluations += draws
-            runs = np.array(runs)
+        torques = fork_map(lambda job: job[0].on_rack(job[1]).torque(overrides), racks, self.workers)
+        for i, f in enumerate(self.files):
+            runs = np.array(torques[i * draws : (i + 1) * draws])
             f.replay_draws_Nm = runs - runs.mean(axis=0)
             spread = maximum_filter1d(np.std(runs, axis=0, ddof=1), size=3, mode="nearest")
             if keep_larger and f.replay_uncertainty_Nm is not None:
                 spread = np.maximum(spread, f.replay_uncertainty_Nm)
             f.replay_uncertainty_Nm = spread
+
+
+_POOLED: Problem | None = None  # the problem a worker pool was forked from (Problem.predict)
+
+
+def _pooled_torque(task) -> np.ndarray:
+    effects, index, overrides = task
+    return _POOLED.replay(effects, index).torque(overrides)
 
 
 def relogged_rack(rack: SmoothedRack, time_s: np.ndarray, full_scale: float, bits: int, analog_rms: float,

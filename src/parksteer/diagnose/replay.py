@@ -47,11 +47,20 @@ class Replay:
     time_s: np.ndarray
     base_overrides: dict[str, float] = field(default_factory=dict)
     evaluations: int = 0
+    # prepared runs to start from (another replay's of the same model, case and surface: :meth:`on_rack`)
+    runs: dict[tuple, PreparedRun] | None = field(default=None, repr=False, compare=False)
 
     def __post_init__(self):
         self.time_s = np.asarray(self.time_s, dtype=float)
-        self._runs: dict[tuple, PreparedRun] = {}
+        self._runs: dict[tuple, PreparedRun] = dict(self.runs) if self.runs is not None else {}
+        self.runs = None
         self._base = self._prepared(self.base_overrides)
+
+    def on_rack(self, rack: SmoothedRack) -> Replay:
+        """The same model, case and surface driven by another rack, at the same times: the prepared runs
+        (which do not depend on the rack) are shared, not made again."""
+        return Replay(self.effects, self.case, self.surface, self.params, rack, self.time_s,
+                      dict(self.base_overrides), runs=self._runs)
 
     def _prepared(self, overrides: dict[str, float]) -> PreparedRun:
         key = tuple(sorted(overrides.items()))

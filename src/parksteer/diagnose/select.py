@@ -54,6 +54,7 @@ from ..parameters import Parameters
 from .settings import DEFAULT_SETTINGS, DiagnosisSettings
 from .calibrate import Fit, FitParameter, calibrate, least_squares
 from .candidates import Score, Signature, candidate_effects, probe_signature, score, strength_parameter
+from .parallel import Progress, fork_map, forks
 from .problem import FileData, Problem, effective_samples, fit_statistics, lag1_autocorrelation
 from .replay import Replay
 
@@ -183,16 +184,43 @@ def separation(problem: Problem, best: Candidate, other: Candidate) -> Separatio
                       top["predicted_difference_rms_Nm"], top["over_noise_floor"], rows)
 
 
+def _in_workers(problem: Problem, function, items: list, by_candidate: bool) -> list:
+    """`function` over `items` (candidates), spread over the workers if `by_candidate` or the predictions do
+    not spread the files; the replays the workers ran are counted."""
+    if (problem.parallel_files and not by_candidate) or not forks(len(items), problem.workers):
+        return [function(item) for item in items]
+
+    def counted(item):
+        before = problem.evaluations
+        return function(item), problem.evaluations - before
+
+    out = fork_map(counted, items, problem.workers)
+    problem.extra_evaluations += sum(evaluations for _, evaluations in out)
+    return [result for result, _ in out]
+
+
 def diagnose(files: list[FileData], params: Parameters, effects=None, registry: dict[str, Effect] | None = None,
              strengths: dict[str, float] | None = None, start: dict[str, float] | None = None,
-             settings: DiagnosisSettings = DEFAULT_SETTINGS) -> Diagnosis:
+             settings: DiagnosisSettings = DEFAULT_SETTINGS, workers: int = 1, quiet: bool = True) -> Diagnosis:
     """Calibrate, rank every candidate outside the model, refit the best, give the verdict (module docstring).
 
     `settings` are the method's (:mod:`parksteer.diagnose.settings`; by default the documented ones).
 
     `strengths` ({"effect.param": finite-difference step}) are strengths of effects already
     added to the model, calibrated with the base parameters (from `start`, e.g. an earlier fit).
+
+    `workers` > 1 replays independent runs side by side (:mod:`parksteer.diagnose.parallel`; the
+    result is the same); unless `quiet`, each step says on stderr where it is.
     """
+    problem = Problem(files, params, workers=max(int(workers), 1))
+    try:
+        return _diagnose(problem, effects, registry, strengths, start, settings, Progress(quiet))
+    finally:
+        problem.close()
+
+
+def _diagnose(problem: Problem, effects, registry, strengths, start, settings: DiagnosisSettings,
+              progress: Progress) -> Diagnosis:
     clock = time.perf_counter()
     timings: dict[str, float] = {}
 
@@ -202,31 +230,51 @@ def diagnose(files: list[FileData], params: Parameters, effects=None, registry: 
         timings[name] = now - clock
         clock = now
 
+    files = problem.files
     registry = registry if registry is not None else discover_effects()
     base = effects if isinstance(effects, list) and all(isinstance(e, Effect) for e in effects) \
         else resolve_effects(effects)
-    problem = Problem(files, params)
+    progress(f"{len(files)} file(s), {problem.n} samples, {problem.workers} worker(s): replaying the base model "
+             f"and its replay uncertainty ({settings.replay_ensemble_draws} racks per file)")
     nominal = problem.predict(base, {})
     problem.estimate_replay_uncertainty(base, start or {}, settings.replay_ensemble_draws,
                                         settings.replay_ensemble_seed)
     lap("nominal_and_replay_uncertainty")
 
+    progress("calibrating " + ", ".join(settings.calibrated_parameters))
     calibration = calibrate(problem, base, strengths=strengths, start=start, settings=settings)
     lap("calibration")
 
     testable, untestable = candidate_effects(base, registry)
     floor = fit_statistics(problem, calibration.predictions)["noise_floor_Nm"]
-    candidates = []
-    for effect in testable:
+    progress(f"ranking {len(testable)} candidates: " + ", ".join(e.name for e in testable))
+
+    # Many candidates: one worker each (its model prepared once per file). The few refits spread their files.
+    def signature_of(effect: Effect) -> Signature:
         signature = probe_signature(problem, base, effect, calibration.overrides,
                                     settings.probe_effect_noise_floors * floor, settings)
+        signature.effect, signature.model = None, None  # travel back without the effects
+        return signature
+
+    candidates = []
+    for effect, signature in zip(testable, _in_workers(problem, signature_of, testable, True)):
+        signature.effect, signature.model = effect, sorted([*base, effect], key=lambda e: e.name)
         candidates.append(Candidate(signature, score(signature, calibration)))
     lap("signatures_and_scores")
 
     hopeful = sorted((c for c in candidates if c.score.removed_rss > 0.0), key=lambda c: -c.score.statistic)
-    for candidate in hopeful[: settings.refit_count]:
-        candidate.refit = refit(problem, calibration, candidate.signature, candidate.score.linear_strength,
-                                settings)
+    chosen = hopeful[: settings.refit_count]
+    if chosen:
+        progress("refitting " + ", ".join(c.name for c in chosen))
+
+    def refit_of(candidate: Candidate) -> Fit:
+        fit = refit(problem, calibration, candidate.signature, candidate.score.linear_strength, settings)
+        fit.effects = None  # travels back without the effects
+        return fit
+
+    for candidate, fit in zip(chosen, _in_workers(problem, refit_of, chosen, False)):
+        fit.effects = candidate.signature.model
+        candidate.refit = fit
     lap("refits")
 
     refitted = [c for c in candidates if c.refit is not None]
@@ -235,6 +283,7 @@ def diagnose(files: list[FileData], params: Parameters, effects=None, registry: 
         # The replay's uncertainty was estimated with the base model; with the candidate, the torque may turn
         # more sharply where the rack data are least certain (a breakaway peak at each reversal). Weigh every
         # model by the larger of the two uncertainties and compare again.
+        progress(f"{best.name} evidenced: replay uncertainty again with it")
         before = [f.sigma_Nm for f in problem.files]
         problem.estimate_replay_uncertainty(best.signature.model, best.refit.overrides,
                                             settings.replay_ensemble_draws, settings.replay_ensemble_seed,
@@ -266,5 +315,7 @@ def diagnose(files: list[FileData], params: Parameters, effects=None, registry: 
             if c is not best and c.delta_bic >= best.delta_bic - settings.bic_indistinguishable:
                 separations.append(separation(problem, best, c))
     lap("separation")
+    progress(f"verdict: {verdict}" + (f" {best.name}" if verdict == "missing" else "")
+             + f" ({problem.evaluations} replays)")
     return Diagnosis(problem, base, nominal, calibration, candidates, untestable, verdict, best, separations,
                      n_eff, rho, explained, timings, settings)
