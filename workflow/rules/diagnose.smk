@@ -186,8 +186,8 @@ rule diag_outclass:
         diagnoses=expand("results/diagnose/outclass/{name}.diagnosis.json", name=DIAG_OUTCLASS_CASES),
         code=script_sources("diag_outclass"),
     output:
-        svg="figures/diag_outclass.svg",
-        csv="figures/diag_outclass.csv",
+        svg=figure_report("figures/diag_outclass.svg", "diagnose"),
+        csv=figure_report("figures/diag_outclass.csv", "diagnose"),
         json="results/diag_outclass.json",
     params:
         design=config["outclass"],
