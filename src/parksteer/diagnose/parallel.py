@@ -18,10 +18,10 @@ from __future__ import annotations
 
 import multiprocessing
 import os
-import sys
 import time
 from collections.abc import Callable, Sequence
 from typing import Any
+from ..progress import note
 
 _TASK: tuple[Callable[[Any], Any], Sequence[Any]] | None = None
 _IN_WORKER = False
@@ -97,5 +97,8 @@ class Progress:
     def __call__(self, message: str) -> None:
         if self.quiet:
             return
-        stream = self.stream if self.stream is not None else sys.stderr
-        print(f"diagnose: {message} ({time.perf_counter() - self.start:.1f} s)", file=stream, flush=True)
+        line = f"diagnose: {message} ({time.perf_counter() - self.start:.1f} s)"
+        if self.stream is None:
+            note(line)  # the package's one progress channel (stderr, a rule's log)
+        else:
+            print(line, file=self.stream, flush=True)
