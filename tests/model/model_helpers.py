@@ -32,3 +32,12 @@ DISSIPATION_OFF = {
     "tyre.radial_damping": 0.0,
     "vehicle.chassis_roll_damping": 0.0,
 }
+
+
+def with_effect(name: str, strength_key: str, case: str = "unladen", strength: float | None = None,
+                overrides=None, **kwargs):
+    """The paper's model plus effect `name`, at its default strength (0) or at `strength` of `name.strength_key`."""
+    from parksteer.model.numeric.simulate import simulate
+
+    chosen = {} if strength is None else {f"{name}.{strength_key}": strength}
+    return simulate(case, effects=f"+{name}", overrides={**(overrides or {}), **chosen}, **kwargs)

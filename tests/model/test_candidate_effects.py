@@ -21,7 +21,7 @@ from parksteer.measure.smoothing import interpolate_rack
 from parksteer.model.numeric.simulate import simulate
 from parksteer.rig import braked_pin_torque_Nm, free_rolling_pin_torque_Nm
 
-from model_helpers import DISSIPATION_OFF, column_angle_per_rack, first_ramp, plateau_mean
+from model_helpers import DISSIPATION_OFF, with_effect, column_angle_per_rack, first_ramp, plateau_mean
 
 # candidate -> (strength parameter, a strength well inside its typical range)
 CANDIDATES = {
@@ -39,8 +39,7 @@ PAPER_EFFECTS = {"tyre_friction", "rack_friction", "carcass_compliance", "liftin
 
 def with_candidate(name: str, case: str = "unladen", strength: float | None = None, **kwargs):
     """The paper's model plus one candidate, at its default strength (0) or at `strength`."""
-    overrides = {} if strength is None else {f"{name}.{CANDIDATES[name][0]}": strength}
-    return simulate(case, effects=f"+{name}", overrides=overrides, **kwargs)
+    return with_effect(name, CANDIDATES[name][0], case, strength, **kwargs)
 
 
 def steady(result, params, margin_s: float = 0.5):

@@ -23,7 +23,7 @@ from parksteer.model.numeric.simulate import simulate
 from parksteer.model.symbolic.components import discover_effects, resolve_effects, strength_parameter
 from parksteer.parameters import registry
 
-from model_helpers import DISSIPATION_OFF, column_angle_per_rack, first_ramp, plateau_mean
+from model_helpers import DISSIPATION_OFF, with_effect, column_angle_per_rack, first_ramp, plateau_mean
 
 # rival -> (strength quantity, a strength well inside its typical range)
 RIVALS = {
@@ -39,8 +39,7 @@ CASES = ("unladen", "part_laden", "offset_68_5mm")
 
 def with_rival(name: str, case: str = "unladen", strength: float | None = None, overrides=None, **kwargs):
     """The paper's model plus one rival, at its default strength (0) or at `strength`."""
-    chosen = {} if strength is None else {f"{name}.{RIVALS[name][0]}": strength}
-    return simulate(case, effects=f"+{name}", overrides={**(overrides or {}), **chosen}, **kwargs)
+    return with_effect(name, RIVALS[name][0], case, strength, overrides, **kwargs)
 
 
 @pytest.fixture(scope="module")
