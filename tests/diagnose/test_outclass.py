@@ -71,8 +71,9 @@ def test_logger_chain_lag_quantisation_and_dc_gain():
 def _result(verdict, effect=None, gains=(), group=()):
     stats = {"weighted_rms_Nm": 0.4, "rms_Nm": 0.4}
     return {"verdict": verdict, "effect": effect, "noise_floor_Nm": 0.16,
-            "selection": {"thresholds": {"bic_indistinguishable": 6.0}},
-            "ranking": [{"effect": f"c{i}", "delta_bic": g} for i, g in enumerate(gains)],
+            "selection": {"thresholds": {"bic_indistinguishable": 6.0, "bic_missing": 10.0}},
+            "ranking": [{"effect": f"c{i}", "delta_bic": g, "weighted_rms_after_Nm": 0.3, "explained_fraction": 0.5}
+                        for i, g in enumerate(gains)],
             "indistinguishable": [{"effect": g} for g in group],
             "statistics": {"calibrated": stats, "with_effect": stats if effect else None}, "cost": {"wall_s": 1.0}}
 
@@ -99,6 +100,17 @@ def test_scoring_follows_the_targets():
     assert not outcome(_truth(steps=3.0), _result("adequate"))["target_met"]
     assert outcome(_truth(steps=2.0), _result("adequate"))["target_met"]
     assert outcome(_truth(None, None, "null"), _result("adequate"))["relation"] == "correct"
+
+
+def test_an_unexplained_verdict_reports_the_strongly_evidenced_nearest_candidate():
+    """An unexplained verdict with a candidate above the BIC threshold (named but not the whole story) keeps that
+    candidate as the nearest, with the error it leaves; one with no strong evidence has none."""
+    row = outcome(_truth("top_mount_windup"), _result("unexplained", gains=(496.1, 20.0)))
+    assert row["said"] == "unexplained" and row["target_met"]
+    assert row["nearest"] == "c0" and row["nearest_after_over_floor"] == pytest.approx(0.3 / 0.16)
+    assert row["explained_fraction"] == 0.5
+    weak = outcome(_truth("top_mount_windup"), _result("unexplained", gains=(4.0,)))
+    assert weak["nearest"] == "none" and weak["nearest_after_over_floor"] is None
 
 
 def test_a_small_case_runs(tmp_path):

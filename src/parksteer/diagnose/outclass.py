@@ -89,6 +89,9 @@ def outcome(truth: dict, result: dict) -> dict:
     group = [s["effect"] for s in result["indistinguishable"]]
     confident_wrong = relation == "unrelated" and margin is not None and margin > band
     missed = truth["kind"] == "rival" and said == "adequate" and steps >= ADEQUATE_LIMIT_STEPS
+    # The strongly evidenced candidate an unexplained verdict still reports as the nearest form the library has.
+    top = result["ranking"][0] if result["ranking"] else None
+    evidenced = top is not None and (top["delta_bic"] or 0.0) > result["selection"]["thresholds"]["bic_missing"]
     return {
         "name": truth["name"],
         "kind": truth["kind"],
@@ -104,9 +107,11 @@ def outcome(truth: dict, result: dict) -> dict:
         "best_delta_bic": max((c["delta_bic"] for c in result["ranking"] if c["delta_bic"] is not None),
                               default=None),
         "explained_fraction": next((c.get("explained_fraction") for c in result["ranking"] if c["effect"] == named),
-                                   None) if named else None,
+                                   None) if named else (top.get("explained_fraction") if evidenced else None),
         "calibrated_over_floor": result["statistics"]["calibrated"]["weighted_rms_Nm"] / floor,
         "after_over_floor": after["weighted_rms_Nm"] / floor if after else None,
+        "nearest": top["effect"] if evidenced else "none",
+        "nearest_after_over_floor": top["weighted_rms_after_Nm"] / floor if evidenced else None,
         "confident_wrong": confident_wrong,
         "adequate_at_3_steps": missed,
         "target_met": not confident_wrong and not missed,
@@ -140,7 +145,8 @@ def aggregate(truth_paths, diagnosis_paths, design: OutclassDesign | None = None
         "target_met": all(r["target_met"] for r in rows),
         "null_adequate": sum(r["said"] == "adequate" for r in nulls),
         "cases": [{k: r[k] for k in ("name", "hidden", "steps_actual", "closest", "said", "relation", "bic_margin",
-                                     "explained_fraction", "calibrated_over_floor", "after_over_floor", "target_met")} for r in rows],
+                                     "explained_fraction", "calibrated_over_floor", "after_over_floor", "nearest",
+                                     "nearest_after_over_floor", "target_met")} for r in rows],
         "confusion": confusion,
         "closest_table": {k: {"closest": v["closest"] or "none", "related": list(v["related"]),
                               "reason": v["reason"]} for k, v in OUTCLASS_RIVALS.items()},

@@ -133,6 +133,7 @@ def diagnosis_dict(diagnosis: Diagnosis) -> dict:
                 "adequate_rms_factor": diagnosis.settings.adequate_rms_factor,
                 "bic_missing": diagnosis.settings.bic_missing_threshold,
                 "explained_fraction_missing": diagnosis.settings.explained_fraction_missing,
+                "missing_rms_ceiling": diagnosis.settings.missing_rms_ceiling,
                 "bic_indistinguishable": diagnosis.settings.bic_indistinguishable,
                 "confounded_fraction": diagnosis.settings.confounded_fraction,
             },
@@ -145,6 +146,20 @@ def _n(x, digits: int = 3) -> str:
     if x is None:
         return "-"
     return f"{x:.{digits}g}" if abs(x) < 1e4 else f"{x:.3e}"
+
+
+def _nearest(result: dict) -> str:
+    """For an unexplained verdict: the strongly evidenced candidate that was still not the whole story, if any."""
+    thresholds = result["selection"]["thresholds"]
+    top = result["ranking"][0] if result["ranking"] else None
+    if top is None or top["delta_bic"] is None or top["delta_bic"] <= thresholds["bic_missing"]:
+        return ""
+    floor = result["noise_floor_Nm"]
+    after = top["weighted_rms_after_Nm"] / floor if floor > 0 else float("nan")
+    return (f" The nearest candidate, {top['effect']}, is strongly evidenced (BIC gain {_n(top['delta_bic'])}) but "
+            f"leaves the weighted error at {_n(after)} noise floors, above the {_n(thresholds['missing_rms_ceiling'])} "
+            "that records with nothing hidden reach: it may be the closest form the library has to what is at work, "
+            "not the effect itself.")
 
 
 def markdown_report(result: dict, figure: str | None = None) -> str:
@@ -165,7 +180,7 @@ def markdown_report(result: dict, figure: str | None = None) -> str:
         lines.append(f"**Verdict: unexplained.** The calibrated model leaves a structured error (weighted RMS "
                      f"{_n(stats['calibrated']['weighted_rms_Nm'])} N m against a noise floor of {_n(floor)} N m) "
                      "that no candidate removes for the most part. Something outside the candidate library is at "
-                     "work (or in the measurement): look at the residual below.")
+                     "work (or in the measurement): look at the residual below." + _nearest(result))
     lines += ["", "## Files", "", "| file | case | surface | samples | noise floor (N m) | replay uncertainty RMS (N m) "
               "| rack knot spacing (s) |", "|---|---|---|---|---|---|---|"]
     for f in result["files"]:
@@ -294,7 +309,7 @@ def html_report(result: dict, figures: list[tuple[str, str]], phases: list[dict]
     else:
         text = (f"Verdict: unexplained. The calibrated model leaves a structured error (weighted RMS "
                 f"{_n(stats['calibrated']['weighted_rms_Nm'])} N m against a noise floor of {_n(floor)} N m) "
-                "that no candidate removes.")
+                "that no candidate removes." + _nearest(result))
     out = ["<!DOCTYPE html>", '<html lang="en">', "<head>", '<meta charset="utf-8">',
            f"<title>{html.escape(title)}</title>", f"<style>{_STYLE}</style>", "</head>", "<body>",
            f"<h1>{html.escape(title)}</h1>", f'<p class="verdict">{html.escape(text)}</p>',

@@ -15,13 +15,15 @@ The steps (:func:`diagnose`):
    a smooth misfit are not independent evidence);
 6. the verdict:
 
-   - ``missing``: the best candidate lowers the BIC by more than ``BIC_MISSING_THRESHOLD``
-     and, with it, the error is at the floor (weighted RMS within ``ADEQUATE_RMS_FACTOR`` of
-     the noise floor) or it removes at least ``EXPLAINED_FRACTION_MISSING`` of the weighted
+   - ``missing``: the best candidate lowers the BIC by more than ``bic_missing_threshold``
+     and, with it, the error is at the floor (weighted RMS within ``adequate_rms_factor`` of
+     the noise floor) or it removes at least ``explained_fraction_missing`` of the weighted
      sum of squares above the floor (a perfect model leaves a weighted sum of squares equal
-     to the number of samples). This is tested first: a small effect that the calibration
-     has mostly absorbed can leave the error near the floor and still be strongly evidenced
-     by its shape;
+     to the number of samples); either way the error with it must come within
+     ``missing_rms_ceiling`` floors, since a named effect that leaves the residual above what
+     records with nothing hidden reach is not the whole story. This is tested first: a small
+     effect that the calibration has mostly absorbed can leave the error near the floor and
+     still be strongly evidenced by its shape;
    - ``adequate``: otherwise, when no candidate is strongly evidenced and the calibrated base
      model's weighted error is at the floor;
    - ``unexplained``: the residual is structured (or a candidate is evidenced but leaves most
@@ -131,6 +133,20 @@ class Diagnosis:
 
     def statistics(self, predictions: list[np.ndarray]) -> dict:
         return fit_statistics(self.problem, predictions)
+
+
+def choose_verdict(base_ratio: float, best_delta_bic: float | None, after_ratio: float | None,
+                   explained: float | None, settings: DiagnosisSettings = DEFAULT_SETTINGS) -> str:
+    """The verdict from the calibrated base model's weighted RMS over the floor, the best refit's BIC gain, its
+    weighted RMS over the floor and the fraction of the excess it removes (module docstring, step 6)."""
+    evidenced = best_delta_bic is not None and best_delta_bic > settings.bic_missing_threshold
+    if (evidenced and after_ratio <= settings.missing_rms_ceiling
+            and (after_ratio <= settings.adequate_rms_factor
+                 or (explained is not None and explained >= settings.explained_fraction_missing))):
+        return "missing"
+    if base_ratio <= settings.adequate_rms_factor and not evidenced:
+        return "adequate"
+    return "unexplained"
 
 
 def refit(problem: Problem, calibration: Fit, signature: Signature, start_strength: float,
@@ -299,15 +315,8 @@ def _diagnose(problem: Problem, effects, registry, strengths, start, settings: D
     excess = base_rss - n
     explained = (base_rss - best.refit.rss) / excess if (best is not None and excess > 0) else None
     after_ratio = math.sqrt(best.refit.rss / n) if best is not None else None
-    if (best is not None and best.delta_bic > settings.bic_missing_threshold
-            and (after_ratio <= settings.adequate_rms_factor
-                 or (explained is not None and explained >= settings.explained_fraction_missing))):
-        verdict = "missing"
-    elif base_ratio <= settings.adequate_rms_factor and not (
-            best is not None and best.delta_bic > settings.bic_missing_threshold):
-        verdict = "adequate"
-    else:
-        verdict = "unexplained"
+    verdict = choose_verdict(base_ratio, best.delta_bic if best is not None else None, after_ratio, explained,
+                             settings)
 
     separations = []
     if verdict == "missing":

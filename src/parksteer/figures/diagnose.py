@@ -286,7 +286,8 @@ OUTCLASS_SHADES = {"closest": "#4daf4a", "related": "#b8e186", "unrelated": "#e4
 def outclass_figure(rows: list[dict], path: str | Path) -> None:
     """The out-of-class confusion table: each hidden rival (a row, with its physically closest candidate) against
     what the diagnosis said (a column), the cell shaded by how the answer relates to the rival's physics and
-    labelled with the BIC margin over the runner-up when a candidate was named."""
+    labelled with the BIC margin over the runner-up when a candidate was named, or with the nearest candidate when
+    one was strongly evidenced but left the error too far above the floor to be named."""
     truths = sorted({(r["hidden"], r["closest"]) for r in rows if r["kind"] == "rival"})
     truth_labels = [h for h, _ in truths] + (["nothing"] if any(r["kind"] == "null" for r in rows) else [])
     closest = dict(truths)
@@ -299,6 +300,8 @@ def outclass_figure(rows: list[dict], path: str | Path) -> None:
         text = f"{r['steps_actual']:.1f} st" if r["kind"] == "rival" else r["relation"]
         if r["bic_margin"] is not None:
             text += f"\nΔBIC {r['bic_margin']:.0f}"
+        elif r.get("nearest", "none") != "none":
+            text += f"\nnearest {r['nearest'].replace('_', ' ')}"
         ax.text(j, i, text, ha="center", va="center", fontsize=6)
     ax.set_xlim(-0.5, len(said_labels) - 0.5)
     ax.set_ylim(len(truth_labels) - 0.5, -0.5)
@@ -339,6 +342,10 @@ def make_outclass_figure(truth_paths, diagnosis_paths, svg: str | Path, csv: str
         if rows else {}
     write_csv(csv, columns, {"figure": "diag_outclass: one row per out-of-class data set",
                              "steps_actual": "hidden rival's RMS torque change in converter steps (all files)",
-                             "bic_margin": "named candidate's BIC gain over the runner-up's"})
+                             "bic_margin": "named candidate's BIC gain over the runner-up's",
+                             "explained_fraction": "of the excess above the floor, by the named candidate or else "
+                                                   "by the nearest",
+                             "nearest": "strongly evidenced best candidate, named or not (none: no BIC gain above "
+                                        "the threshold)"})
     write_json(json_path, summary)
     return summary
