@@ -1,0 +1,26 @@
+# Rivals of lifting: each rival effect of the library given the strength that matches lifting's rise toward lock
+# in the unladen ground test, then the source's other tests (part laden, air bearings, 68.5 mm spacers) simulated
+# with it, to name the test that tells it from lifting (parksteer.figures.rivals). Writes the figure (SVG), the
+# table (CSV) and the numbers the paper quotes (results/rivals.json).
+from parksteer.figures.rivals import RIVALS as _RIVALS
+
+FIGURES["rivals"] = ["figures/rivals.svg", "figures/rivals.csv"]
+
+
+rule rivals:
+    input:
+        parameters=PARAMETERS,
+        models=[model_manifest("full", None)] + [model_manifest(f"with_{r}", f"+{r}") for r in _RIVALS],
+        code=script_sources("rivals"),
+    output:
+        svg=figure_report("figures/rivals.svg", "bands"),
+        csv=figure_report("figures/rivals.csv", "bands"),
+        json="results/rivals.json",
+    log:
+        "logs/rivals.log",
+    benchmark:
+        benchmark_file("rivals")
+    conda:
+        "../envs/parksteer.yaml"
+    script:
+        "../scripts/rivals.py"
