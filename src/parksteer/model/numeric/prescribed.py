@@ -30,7 +30,7 @@ import numpy as np
 from scipy.integrate import ODEintWarning, odeint
 
 from .statics import static_state
-from .tolerances import PRESCRIBED_ATOL_FACTOR, PRESCRIBED_RTOL, absolute_tolerances, solver_failure
+from .tolerances import PRESCRIBED_ATOL_FACTOR, PRESCRIBED_RTOL, absolute_tolerances, max_steps, solver_failure
 
 # The column twist is integrated exactly for a torque linear between samples this far apart at most (s).
 # Against the column's time constant c / k (0.2 s) the twist filters the torque; at 5 ms the handwheel angle
@@ -170,7 +170,7 @@ def solve(run, p: np.ndarray, rack: RackMotion, t_out, rtol: float = PRESCRIBED_
     grid, at_out = _refined(t_out, TWIST_SAMPLE_S) if outputs else (t_out, np.arange(len(t_out)))
     with warnings.catch_warnings():  # a failure is reported below as one line, not as a warning too
         warnings.simplefilter("ignore", ODEintWarning)
-        states, info = odeint(rhs, z0, grid, Dfun=jacobian, rtol=rtol, atol=atol, mxstep=200000, full_output=True,
+        states, info = odeint(rhs, z0, grid, Dfun=jacobian, rtol=rtol, atol=atol, mxstep=max_steps(grid), full_output=True,
                               h0=FIRST_STEP_S)
     if info["message"] != "Integration successful.":
         raise solver_failure("prescribed-rack integration", info, grid)

@@ -26,7 +26,7 @@ from ..symbolic.components import Effect, discover_effects, resolve_effects
 from .inputs import HandwheelProfile, sawtooth_profile
 from .prescribed import RackMotion, solve as solve_prescribed
 from .statics import static_state
-from .tolerances import PRESCRIBED_RTOL, RTOL, absolute_tolerances, solver_failure
+from .tolerances import PRESCRIBED_RTOL, RTOL, absolute_tolerances, max_steps, solver_failure
 from .values import RunValues, parameter_vector, resolve_values
 
 ROLL_NEUTRAL_KEY = "derived.roll_spring_neutral"
@@ -129,7 +129,7 @@ def integrate(run: PreparedRun, t_out: np.ndarray, y0: np.ndarray | None = None,
     with warnings.catch_warnings():  # a failure is reported below as one line, not as a warning too
         warnings.simplefilter("ignore", ODEintWarning)
         states, info = odeint(rhs, y0, t_out, Dfun=dfun, rtol=rtol, atol=_atol(model) if atol is None else atol,
-                              mxstep=200000, full_output=True, tcrit=corners)
+                              mxstep=max_steps(t_out), full_output=True, tcrit=corners)
     if info["message"] != "Integration successful.":
         raise solver_failure("integration", info, t_out)
     return states
