@@ -129,3 +129,22 @@ def test_rendering_only_change_keeps_its_wording(tmp_path):
     svg.write_text(svg.read_text(encoding="utf-8").replace("</svg>", "<!-- other renderer --></svg>"), encoding="utf-8")
     problems = verify(tmp_path, tmp_path / "figures/SHA256SUMS", files)
     assert len(problems) == 1 and "only the rendering differs" in problems[0], problems
+
+
+def test_a_table_cut_at_a_row_boundary_is_damage_not_a_smaller_table(tmp_path):
+    """A table that lost its last rows to a cut exactly at a line end still parses; the row count that write_csv
+    puts last in the header makes the cut visible to the reader, to the damage check before a build and to verify."""
+    from parksteer.checksums import integrity_problem
+    from parksteer.outputs import content_problem
+    from parksteer.tables import read_csv
+
+    path = tmp_path / "t.csv"
+    write_csv(path, {"x": [1.0, 2.0, 3.0, 4.0]}, {"figure": "t"})
+    assert content_problem(path) is None and integrity_problem(path) is None
+    assert len(read_csv(path)[0]["x"]) == 4
+    lines = path.read_text(encoding="utf-8").splitlines(keepends=True)
+    path.write_text("".join(lines[:-2]), encoding="utf-8")  # the last two rows gone, a newline at the end
+    assert "2 data rows where its header says 4" in content_problem(path)
+    assert "truncated" in integrity_problem(path)
+    with pytest.raises(ValueError, match="truncated"):
+        read_csv(path)

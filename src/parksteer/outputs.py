@@ -28,7 +28,7 @@ from typing import Any
 from .checksums import integrity_problem
 from .model.codegen.cache import cache_root, clean_stale_scratch, entry_is_sound, model_key
 from .model.symbolic.components import resolve_effects
-from .tables import remove_stale_temporaries
+from .tables import ROWS_KEY, remove_stale_temporaries
 
 CHECKED_SUFFIXES = (".csv", ".svg", ".json", ".ipynb", ".pdf")
 PROC = Path("/proc")
@@ -45,9 +45,13 @@ def content_problem(path: Path) -> str | None:
         data = path.read_bytes()
         if not data.endswith(b"\n"):
             return "does not end with a newline (truncated)"
-        rows = [line for line in data.split(b"\n") if line.strip() and not line.startswith(b"#")]
+        lines = data.split(b"\n")
+        rows = [line for line in lines if line.strip() and not line.startswith(b"#")]
         if not rows:
             return "no header row"
+        stated = [line.split(b":", 1)[1].strip() for line in lines if line.startswith(b"# " + ROWS_KEY.encode() + b":")]
+        if stated and stated[-1] != str(len(rows) - 1).encode():
+            return f"{len(rows) - 1} data rows where its header says {stated[-1].decode(errors='replace')} (truncated)"
         cells = rows[0].count(b",")
         for number, row in enumerate(rows[1:], start=1):
             if row.count(b",") != cells:

@@ -120,19 +120,29 @@ def atomic_path(path: str | Path) -> Iterator[Path]:
             os.unlink(tmp)
 
 
+ROWS_KEY = "rows"  # the last header line of a table: its number of data rows
+
+
 def write_csv(
     path: str | Path,
     columns: Mapping[str, Sequence[Any] | np.ndarray],
     header: Mapping[str, Any] | None = None,
     digits: int = SIGNIFICANT_DIGITS,
 ) -> None:
-    """Write named columns as CSV, with optional leading ``# key: value`` lines."""
+    """Write named columns as CSV, with optional leading ``# key: value`` lines and, last of them, ``# rows: N``.
+
+    The row count lets a reader (:func:`read_csv`) and the damage check (:mod:`parksteer.outputs`) tell a table
+    cut exactly at a row boundary, which still parses, from the table that was written.
+    """
     names = list(columns)
     data = [np.asarray(columns[n]) for n in names]
     lengths = {len(c) for c in data}
     if len(lengths) > 1:
         raise ValueError(f"{path}: columns have different lengths {sorted(lengths)}")
+    if header and ROWS_KEY in header:
+        raise ValueError(f"{path}: the header key {ROWS_KEY!r} is the row count's")
     lines = [f"# {k}: {v}" for k, v in (header or {}).items()]
+    lines.append(f"# {ROWS_KEY}: {lengths.pop() if lengths else 0}")
     lines.append(",".join(names))
     for row in zip(*data):
         cells = []
@@ -161,6 +171,8 @@ def read_csv(path: str | Path) -> tuple[dict[str, np.ndarray], dict[str, str]]:
             rows.append(line.split(","))
     if names is None:
         raise ValueError(f"{path}: no header row")
+    if ROWS_KEY in header and header[ROWS_KEY] != str(len(rows)):
+        raise ValueError(f"{path}: {len(rows)} data rows where its header says {header[ROWS_KEY]} (truncated)")
     cols: dict[str, np.ndarray] = {}
     for i, n in enumerate(names):
         raw = [r[i] for r in rows]
