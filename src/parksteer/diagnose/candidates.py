@@ -70,8 +70,12 @@ class Signature:
     observable: bool = True  # False: even its largest strength barely moves the replayed torque
 
 
-def _rms_change(a: list[np.ndarray], b: list[np.ndarray]) -> float:
-    diff = np.concatenate([x - y for x, y in zip(a, b)])
+def _rms_change(problem: Problem, a: list[np.ndarray], b: list[np.ndarray]) -> float:
+    """RMS change of the fitted signals in N m, an angle's change counted in torque floors per angle floor."""
+    if not problem.uses_angle:
+        diff = np.concatenate([x - y for x, y in zip(a, b)])
+    else:
+        diff = problem.in_torque_floors([x - y for x, y in zip(a, b)])
     return float(np.sqrt(np.mean(diff**2)))
 
 
@@ -86,7 +90,7 @@ def probe_signature(problem: Problem, base_effects: list[Effect], candidate: Eff
     probed, change = None, 0.0
     for _ in range(settings.probe_max_tries):
         probed = problem.predict(effects, {**overrides, key: strength})
-        change = _rms_change(probed, zero)
+        change = _rms_change(problem, probed, zero)
         if change > 0.0 and 0.5 <= change / target_Nm <= 2.0:
             break
         factor = target_Nm / change if change > 0.0 else 100.0

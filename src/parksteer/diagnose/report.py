@@ -90,7 +90,14 @@ def diagnosis_dict(diagnosis: Diagnosis) -> dict:
             "replay_uncertainty_rms_Nm": float(np.sqrt(np.mean(delta**2))) if delta is not None else 0.0,
             "rack_smoothing": f.rack.summary(),
         })
-    return {
+        if f.uses_angle:
+            angle_delta = f.replay_uncertainty_rad
+            files[-1]["angle"] = {
+                "noise_floor": f.angle_noise.as_dict(),
+                "replay_uncertainty_rms_rad": (float(np.sqrt(np.mean(angle_delta**2))) if angle_delta is not None
+                                               else 0.0),
+            }
+    out = {
         "schema": SCHEMA_ID,
         "verdict": diagnosis.verdict,
         "effect": diagnosis.effect,
@@ -139,6 +146,14 @@ def diagnosis_dict(diagnosis: Diagnosis) -> dict:
         },
         "cost": {"replays": problem.evaluations, "timings_s": diagnosis.timings_s},
     }
+    if problem.uses_angle:  # the handwheel angle fitted as a second signal: which files, and its floor
+        out["angle"] = {
+            "files": [f.label for f in problem.files if f.uses_angle],
+            "noise_floor_rad": calibrated["angle"]["noise_floor_rad"],
+            "attainable_floor_rad": calibrated["angle"]["attainable_floor_rad"],
+            "offset_fitted": diagnosis.settings.angle_offset_fitted,
+        }
+    return out
 
 
 def _n(x, digits: int = 3) -> str:
@@ -182,6 +197,19 @@ def markdown_report(result: dict, figure: str | None = None) -> str:
               f"{_n(result['attainable_floor_Nm'])} N m. The weighted RMS counts each sample by its attainable "
               "error, so it is the noise floor for a perfect model; the plain RMS also holds the few samples at "
               "reversals where the rack data cannot fix the instant the rack friction turns over.", ""]
+    if result.get("angle"):
+        angle = result["angle"]
+        lines += ["## Handwheel angle", "", f"Fitted beside the torque in {', '.join(angle['files'])} (noise floor "
+                  f"{_n(angle['noise_floor_rad'])} rad, with the replay's uncertainty "
+                  f"{_n(angle['attainable_floor_rad'])} rad).", "",
+                  "| model | RMS (rad) | RMS (degrees) | weighted RMS (rad) | peak (rad) |", "|---|---|---|---|---|"]
+        for label, key in (("nominal parameters", "nominal"), ("calibrated", "calibrated"),
+                           (f"with {result['effect']}", "with_effect")):
+            a = (stats.get(key) or {}).get("angle")
+            if a:
+                lines.append(f"| {label} | {_n(a['rms_rad'])} | {_n(a['rms_deg'])} | {_n(a['weighted_rms_rad'])} | "
+                             f"{_n(a['peak_rad'])} |")
+        lines.append("")
     lines += ["## Calibrated parameters", "", "| parameter | default | fitted | 95 % interval |", "|---|---|---|---|"]
     for key, entry in result["calibrated"].items():
         ci = entry["ci95"]
@@ -230,8 +258,8 @@ def phase_residuals(diagnosis: Diagnosis) -> list[dict]:
     best = candidate_predictions(diagnosis, diagnosis.best) if diagnosis.best is not None else None
     rows = []
     for i, f in enumerate(diagnosis.problem.files):
-        calibrated = f.torque_Nm - diagnosis.calibration.predictions[i]
-        after = f.torque_Nm - best[i] if best is not None else None
+        calibrated = f.torque_Nm - f.torque_part(diagnosis.calibration.predictions[i])
+        after = f.torque_Nm - f.torque_part(best[i]) if best is not None else None
         for phase in PHASES:
             mask = f.phases.mask(phase)
             if not mask.any():

@@ -212,7 +212,10 @@ def diagnose(files: list[FileData], params: Parameters, effects=None, registry: 
     `workers` > 1 replays independent runs side by side (:mod:`parksteer.diagnose.parallel`; the
     result is the same); unless `quiet`, each step says on stderr where it is.
     """
-    problem = Problem(files, params, workers=max(int(workers), 1))
+    for f in files:  # the angle is a second signal where the file has one beside a measured rack, if asked for
+        f.uses_angle = settings.use_handwheel_angle and f.angle_rad is not None
+        f.replay_uncertainty_rad = f.replay_draws_rad = None
+    problem = Problem(files, params, workers=max(int(workers), 1), settings=settings)
     try:
         return _diagnose(problem, effects, registry, strengths, start, settings, Progress(quiet))
     finally:
@@ -236,13 +239,15 @@ def _diagnose(problem: Problem, effects, registry, strengths, start, settings: D
         else resolve_effects(effects)
     progress(f"{len(files)} file(s), {problem.n} samples, {problem.workers} worker(s): replaying the base model "
              f"and its replay uncertainty ({settings.replay_ensemble_draws} racks per file)")
+    if problem.uses_angle:
+        progress("handwheel angle fitted beside the torque in " + ", ".join(f.label for f in files if f.uses_angle))
     nominal = problem.predict(base, {})
     problem.estimate_replay_uncertainty(base, start or {}, settings.replay_ensemble_draws,
                                         settings.replay_ensemble_seed)
     lap("nominal_and_replay_uncertainty")
 
-    progress("calibrating " + ", ".join(settings.calibrated_parameters))
-    calibration = calibrate(problem, base, strengths=strengths, start=start, settings=settings)
+    calibration = calibrate(problem, base, strengths=strengths, start=start, settings=settings,
+                            announce=lambda keys: progress("calibrating " + ", ".join(keys)))
     lap("calibration")
 
     testable, untestable = candidate_effects(base, registry)
