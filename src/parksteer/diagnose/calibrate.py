@@ -41,11 +41,12 @@ Z95 = 1.959964  # two-sided 95 % quantile of the standard normal
 
 @dataclass(frozen=True)
 class FitParameter:
-    """One fitted parameter: key ("effect.param"), transform ("log" of value / reference, or "linear")."""
+    """One fitted parameter: key ("effect.param"), transform ("log" of value / reference; "linear", a strength
+    fitted as it stands from its lower bound; "offset", fitted as it stands from the model's value)."""
 
     key: str
     transform: str
-    reference: float  # log: the value at theta = 0; linear: unused
+    reference: float  # log: the value at theta = 0; offset: the model's value; linear: unused
     lower: float  # bounds on the value
     upper: float
     step: float  # finite-difference step in theta
@@ -128,7 +129,7 @@ class Fit:
             half = math.hypot(max(Z95 * model_se, quantile * sandwich_se), Z95 * math.sqrt(max(replay[i, i], 0.0)))
             se = half / Z95
             low, high = p.value(t - half), p.value(t + half)
-            if p.transform == "linear":
+            if p.transform != "log":
                 low, high = t - half, t + half  # the interval itself may cross a bound
             out[p.key] = {"value": p.value(t), "ci95": [low, high],
                           "standard_error": (p.value(t) * se if p.transform == "log" else se)}
@@ -315,8 +316,8 @@ def offset_parameter(problem: Problem, effects: list[Effect], key: str, half_ran
     """A parameter fitted as it stands within `half_range` of the model's value (an angle such as a phase)."""
     spec = quantity(key)
     default = problem.replay(effects, 0).value(key)
-    return FitParameter(key, "linear", 1.0, max(spec.lower, default - half_range), min(spec.upper, default + half_range),
-                        step)
+    return FitParameter(key, "offset", default, max(spec.lower, default - half_range),
+                        min(spec.upper, default + half_range), step)
 
 
 def calibrate(problem: Problem, effects: list[Effect], fixed: dict[str, float] | None = None,
@@ -332,6 +333,7 @@ def calibrate(problem: Problem, effects: list[Effect], fixed: dict[str, float] |
     if announce is not None:
         announce([p.key for p in parameters if p.key not in (strengths or {})])
     start = start or {}
-    theta0 = np.array([p.theta(start[p.key]) if p.key in start else (0.0 if p.transform == "log" else p.lower)
+    theta0 = np.array([p.theta(start[p.key]) if p.key in start else
+                       {"log": 0.0, "offset": p.reference}.get(p.transform, p.lower)
                        for p in parameters])
     return least_squares(problem, effects, parameters, theta0, fixed, settings=settings)

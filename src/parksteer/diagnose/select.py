@@ -158,7 +158,7 @@ def _compare_refits(problem: Problem, calibration: Fit, refitted: list[Candidate
 def reweigh(problem: Problem, fit: Fit, sigma_before: list[np.ndarray]) -> None:
     """Recompute a fit's weighted residuals and Jacobian after the files' attainable errors changed."""
     fit.weighted = problem.weighted(fit.predictions)
-    ratio = np.concatenate([old / f.sigma_Nm for old, f in zip(sigma_before, problem.files)])
+    ratio = np.concatenate([old / f.sigma for old, f in zip(sigma_before, problem.files)])
     fit.jacobian = fit.jacobian * ratio[:, None]
 
 
@@ -289,7 +289,7 @@ def _diagnose(problem: Problem, effects, registry, strengths, start, settings: D
         # more sharply where the rack data are least certain (a breakaway peak at each reversal). Weigh every
         # model by the larger of the two uncertainties and compare again.
         progress(f"{best.name} evidenced: replay uncertainty again with it")
-        before = [f.sigma_Nm for f in problem.files]
+        before = [f.sigma for f in problem.files]
         problem.estimate_replay_uncertainty(best.signature.model, best.refit.overrides,
                                             settings.replay_ensemble_draws, settings.replay_ensemble_seed,
                                             keep_larger=True)
