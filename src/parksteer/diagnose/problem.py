@@ -330,7 +330,12 @@ class Problem:
             if f.uses_angle:  # each draw's angle carries its own fitted zero (Problem.signals)
                 angle_runs = runs[:, f.n :]
                 f.replay_draws_rad = angle_runs - angle_runs.mean(axis=0)
-                f.replay_uncertainty_rad = _spread(angle_runs, f.replay_uncertainty_rad if keep_larger else None)
+                # The replayed torque is itself off by about its attainable error, and the twist that passes it by
+                # as much through the column's compliance (in a dead band: the band, where |T| is that small).
+                through_torque = self.replay(effects, i).twist_spread(f.sigma_Nm, overrides)
+                spread = np.hypot(_spread(angle_runs, None), maximum_filter1d(through_torque, size=3, mode="nearest"))
+                before = f.replay_uncertainty_rad if keep_larger else None
+                f.replay_uncertainty_rad = spread if before is None else np.maximum(spread, before)
 
 
 def _spread(runs: np.ndarray, before: np.ndarray | None) -> np.ndarray:

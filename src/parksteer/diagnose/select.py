@@ -141,8 +141,23 @@ def refit(problem: Problem, calibration: Fit, signature: Signature, start_streng
     parameters = [*calibration.parameters, strength]
     theta0 = np.concatenate([calibration.theta, [min(max(start_strength, strength.lower), strength.upper)]])
     seed = np.column_stack([calibration.jacobian, signature.weighted])
-    return least_squares(problem, signature.model, parameters, theta0, calibration.fixed, jacobian=seed,
-                         max_iterations=settings.refit_max_iterations, settings=settings)
+    fit = least_squares(problem, signature.model, parameters, theta0, calibration.fixed, jacobian=seed,
+                        max_iterations=settings.refit_max_iterations, settings=settings)
+    angle_keys = set(settings.calibrated_with_angle) | {key for key, _, _ in settings.calibrated_with_angle_offsets}
+    reset = [i for i, p in enumerate(calibration.parameters) if p.key in angle_keys]
+    if problem.uses_angle and reset:
+        # The calibrated base model's column may have absorbed the candidate (a soft column passes for a lash):
+        # refit also from the parameter file's values of what only the angle calibrates, and keep the better fit.
+        theta1 = theta0.copy()
+        for i in reset:
+            theta1[i] = calibration.parameters[i].theta(calibration.parameters[i].reference) \
+                if calibration.parameters[i].transform == "offset" else 0.0
+        other = least_squares(problem, signature.model, parameters, theta1, calibration.fixed,
+                              max_iterations=settings.refit_max_iterations, settings=settings)
+        if other.rss < fit.rss:
+            other.evaluations += fit.evaluations
+            fit = other
+    return fit
 
 
 def _compare_refits(problem: Problem, calibration: Fit, refitted: list[Candidate]):

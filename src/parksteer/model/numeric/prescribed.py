@@ -341,6 +341,28 @@ class ColumnLaw:
         return x, (torque - stiffness * g * slope) / (damping * slope * slope)
 
 
+def twist_spread(run, p: np.ndarray, solution: PrescribedSolution, torque_error: np.ndarray) -> np.ndarray:
+    """How far the twist that passes the solved torque moves if that torque is off by `torque_error` (N m, per
+    sample): half the distance between the static twists passing T - error and T + error.
+
+    For the paper's linear column that is error / k. Under a deflection law it is (g^-1((T + e) / k) -
+    g^-1((T - e) / k)) / 2: on an engaged flank the same, and where |T| is within the error of zero, a dead band's
+    whole width, since a torque that small does not say which flank the hand holds (`solution` with outputs)."""
+    i_k = run.parameter_index("steering.column_torsional_stiffness")
+    stiffness = p[i_k]
+    torque_error = np.asarray(torque_error, dtype=float)
+    if not any(getattr(e, "replaces", None) == "column_deflection" for e in run.effects):
+        return torque_error / stiffness
+    model = run.model
+    i_rack = model.index("rack")
+    column = solution.outputs["column_angle_rad"]
+    rate = solution.outputs["column_angle_per_rack_rad_per_m"] * solution.states[:, model.n_q + i_rack]
+    law = ColumnLaw(model, p, i_k, run.parameter_index("steering.column_torsional_damping"), solution.time_s[0],
+                    solution.states[0], solution.accelerations[0], column[0], rate[0])
+    torque = solution.torque_Nm
+    return 0.5 * (law.inverse((torque + torque_error) / stiffness) - law.inverse((torque - torque_error) / stiffness))
+
+
 def column_twist(t: np.ndarray, torque: np.ndarray, stiffness: float, damping: float
                  ) -> tuple[np.ndarray, np.ndarray]:
     """Twist (rad) and twist rate (rad/s) of the column from ``c dtwist/dt + k twist = T``, from rest at T(t[0]) / k.
