@@ -15,7 +15,11 @@ residuals it is the column ``w`` of a Jacobian. A candidate that even at its lar
 strength moves the replayed torque by less than a tenth of a noise floor is unobservable in
 these data as replayed (a lash between pinion and rack is: with the rack's motion given, the
 torque the rack needs does not depend on the play the hand turned through before it moved;
-the play shows against the handwheel angle instead). It scores zero and is listed as such.
+the play shows against the handwheel angle instead, which a diagnosis with the angle fits as a
+second signal, :attr:`parksteer.diagnose.settings.DiagnosisSettings.use_handwheel_angle`). It scores
+zero and is listed as such. With the angle, a signature and its probe's change are in both signals,
+an angle change counted in torque floors per angle floor (:meth:`parksteer.diagnose.problem.Problem.
+in_torque_floors`).
 
 Score test (Rao): at the calibrated base model, with weighted residual ``r`` and the
 calibrated parameters' sensitivities ``J``, the part of ``w`` that a change of those

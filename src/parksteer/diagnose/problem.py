@@ -24,6 +24,15 @@ the torque drop. Each sample then has an attainable error ``sigma_i = sqrt(noise
 delta_i^2)``; residuals are weighted by it (``(measured - model) / sigma_i``), so a fit
 listens to the samples the replay can predict, and a perfect model has weighted residuals
 of unit variance.
+
+A file with a handwheel angle beside a measured rack may be fitted on both signals
+(:attr:`FileData.uses_angle`, set by the diagnosis when its settings ask): each prediction is
+then the torque followed by the replayed handwheel angle (column angle plus the twist that
+passes the replayed torque, :func:`parksteer.model.numeric.prescribed.solve`), shifted by the
+fitted zero of the angle sensor. The angle's attainable error combines its channel's noise
+floor, the replay ensemble's spread in angle, and the twist that a torque off by its own
+attainable error would give (:func:`parksteer.model.numeric.prescribed.twist_spread`: error / k
+on a linear column, a lash's whole band where the torque is that close to zero).
 """
 
 from __future__ import annotations
