@@ -22,7 +22,7 @@ import pytest
 
 from parksteer.cli import main
 from parksteer.diagnose.problem import prepare_file
-from parksteer.diagnose.report import SCHEMA_PATH, diagnosis_dict
+from parksteer.diagnose.report import SCHEMA_PATH, diagnosis_dict, html_report, markdown_report
 from parksteer.diagnose.select import diagnose
 from parksteer.diagnose.settings import DEFAULT_SETTINGS
 from parksteer.measure.io import write_measurement
@@ -89,7 +89,7 @@ def test_a_soft_column_is_measured_and_nothing_else_is_found(params, tmp_path, c
     Hooke joint's phase (the file's 0, hidden) is found within 0.05 rad (the angle against the rack shows where
     the joint's ripple falls), the angle's weighted error is within 30 % of its noise floor, and the report gives
     the angle's floor (a 14-bit step over +-16 rad, 32 / 16383 rad) and its residual in degrees. The JSON keeps to
-    its schema."""
+    its schema; the markdown and HTML reports name the angle too."""
     path = tmp_path / "soft_column.csv"
     write_measurement(path, angle_record(params, None, {**OFF_NOMINAL, "steering.column_torsional_stiffness": 700.0},
                                          seed=23), params)
@@ -108,6 +108,8 @@ def test_a_soft_column_is_measured_and_nothing_else_is_found(params, tmp_path, c
     angle = result["statistics"]["calibrated"]["angle"]
     assert angle["rms_deg"] == pytest.approx(math.degrees(angle["rms_rad"]))
     assert angle["weighted_rms_rad"] < 1.3 * angle["noise_floor_rad"]
+    assert "## Handwheel angle" in markdown_report(result)  # the readable reports say it too
+    assert "Handwheel angle fitted beside the torque in soft_column.csv" in html_report(result, [], [])
 
 
 def test_without_the_angle_setting_an_angle_channel_changes_nothing(lash_record, params):

@@ -297,12 +297,15 @@ def calibration_parameters(problem: Problem, effects: list[Effect],
                            settings: DiagnosisSettings = DEFAULT_SETTINGS) -> list[FitParameter]:
     """The calibrated parameters the model has (an effect left out of the model leaves its keys out).
 
+    Unless `keys` are given, with a fitted angle also what only the angle shows (the settings'
+    ``calibrated_with_angle`` and ``calibrated_with_angle_offsets``: the column stiffness, the Hooke joint phase).
     `strengths` adds effects' strengths, fitted linearly, with their finite-difference steps.
     """
     used = {k for e in effects for k in e.uses} | set(CORE_PARAMETERS)
+    chosen = keys is not None
     keys = settings.calibrated_parameters if keys is None else keys
     out = [log_parameter(problem, effects, key, settings) for key in keys if key in used]
-    if keys is settings.calibrated_parameters and problem.uses_angle:
+    if not chosen and problem.uses_angle:  # what only the angle shows
         out += [log_parameter(problem, effects, key, settings) for key in settings.calibrated_with_angle
                 if key in used]
         out += [offset_parameter(problem, effects, key, half_range, step)

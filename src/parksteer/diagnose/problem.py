@@ -132,12 +132,6 @@ class FileData:
         return np.concatenate([self.sigma_Nm, self.sigma_rad]) if self.uses_angle else self.sigma_Nm
 
     @property
-    def floors(self) -> np.ndarray:
-        """The noise floor of each fitted signal's samples, stacked as :attr:`measured`."""
-        torque = np.full(self.n, self.noise.total_rms)
-        return np.concatenate([torque, np.full(self.n, self.angle_noise.total_rms)]) if self.uses_angle else torque
-
-    @property
     def replay_draws(self) -> np.ndarray | None:
         """Each draw's replayed signals less the draws' mean, stacked as :attr:`measured`."""
         if not self.uses_angle or self.replay_draws_Nm is None:
@@ -249,10 +243,6 @@ class Problem:
     @property
     def uses_angle(self) -> bool:
         return any(f.uses_angle for f in self.files)
-
-    def torques(self, predictions: list[np.ndarray]) -> list[np.ndarray]:
-        """The torque part of each file's prediction."""
-        return [f.torque_part(m) for f, m in zip(self.files, predictions)]
 
     def signals(self, effects: list[Effect], index: int, overrides: dict[str, float] | None = None,
                 replay: Replay | None = None) -> np.ndarray:

@@ -330,6 +330,12 @@ def html_report(result: dict, figures: list[tuple[str, str]], phases: list[dict]
     out += _table(["file", "case", "surface", "samples", "noise floor (N m)"],
                   [[f["file"], f["case"], f["surface"], f["samples"], _n(f["noise_floor"]["total_rms"])]
                    for f in result["files"]])
+    if result.get("angle"):
+        angle = stats["calibrated"]["angle"]
+        out.append(f"<p>Handwheel angle fitted beside the torque in {html.escape(', '.join(result['angle']['files']))}:"
+                   f" calibrated model's angle residual RMS {html.escape(_n(angle['rms_rad']))} rad "
+                   f"({html.escape(_n(angle['rms_deg']))} degrees), noise floor "
+                   f"{html.escape(_n(result['angle']['noise_floor_rad']))} rad.</p>")
     for k, (caption, svg) in enumerate(figures):
         out += ["<figure>", inline_svg(svg, f"f{k}-"), f"<figcaption>{html.escape(caption)}</figcaption>", "</figure>"]
     out.append("<h2>Residual by phase</h2>")
