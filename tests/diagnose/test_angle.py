@@ -128,3 +128,15 @@ def test_without_the_angle_setting_an_angle_channel_changes_nothing(lash_record,
         results.append(json.dumps(result, sort_keys=True))
     assert results[0] == results[1]
     assert "angle" not in json.loads(results[0])
+
+
+def test_angle_asked_for_without_an_angle_is_one_line(params, tmp_path, capsys):
+    """--angle on a record with no handwheel angle beside its rack is refused before any replay: one line naming
+    the file, exit status 2."""
+    measurement = angle_record(params, None, dict(OFF_NOMINAL), seed=5)
+    path = tmp_path / "no_angle.csv"
+    write_measurement(path, dataclasses.replace(measurement, columns={k: v for k, v in measurement.columns.items()
+                                                                      if k != "handwheel_angle_rad"}), params)
+    assert main(["diagnose", str(path), "--angle", "--json", "--jobs", "1"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and str(path) in err and "--angle needs a handwheel angle" in err
