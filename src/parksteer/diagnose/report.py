@@ -162,6 +162,16 @@ def _n(x, digits: int = 3) -> str:
     return f"{x:.{digits}g}" if abs(x) < 1e4 else f"{x:.3e}"
 
 
+def _angle_change(result: dict) -> str:
+    """', and the angle's from ... to ... rad against ...' when the angle is fitted (the verdict's sentence)."""
+    stats = result["statistics"]
+    if not result.get("angle") or not stats.get("with_effect"):
+        return ""
+    before, after = stats["calibrated"]["angle"], stats["with_effect"]["angle"]
+    return (f"; the handwheel angle's from {_n(before['weighted_rms_rad'])} rad to {_n(after['weighted_rms_rad'])} "
+            f"rad against {_n(result['angle']['noise_floor_rad'])} rad")
+
+
 def markdown_report(result: dict, figure: str | None = None) -> str:
     """A readable report of the JSON of a diagnosis."""
     lines = ["# Diagnosis: model against measurement", ""]
@@ -171,7 +181,7 @@ def markdown_report(result: dict, figure: str | None = None) -> str:
     if verdict == "missing":
         lines.append(f"**Verdict: missing effect `{result['effect']}`.** Adding it takes the weighted RMS error from "
                      f"{_n(stats['calibrated']['weighted_rms_Nm'])} N m to {_n(stats['with_effect']['weighted_rms_Nm'])} "
-                     f"N m, against a noise floor of {_n(floor)} N m.")
+                     f"N m, against a noise floor of {_n(floor)} N m{_angle_change(result)}.")
     elif verdict == "adequate":
         lines.append(f"**Verdict: adequate.** With its calibrated parameters the model's weighted RMS error "
                      f"({_n(stats['calibrated']['weighted_rms_Nm'])} N m) is at the noise floor ({_n(floor)} N m); "
@@ -315,7 +325,7 @@ def html_report(result: dict, figures: list[tuple[str, str]], phases: list[dict]
     if verdict == "missing":
         text = (f"Verdict: missing effect {result['effect']}. Adding it takes the weighted RMS error from "
                 f"{_n(stats['calibrated']['weighted_rms_Nm'])} N m to {_n(stats['with_effect']['weighted_rms_Nm'])} "
-                f"N m, against a noise floor of {_n(floor)} N m.")
+                f"N m, against a noise floor of {_n(floor)} N m{_angle_change(result)}.")
     elif verdict == "adequate":
         text = (f"Verdict: adequate. The calibrated model's weighted RMS error "
                 f"({_n(stats['calibrated']['weighted_rms_Nm'])} N m) is at the noise floor ({_n(floor)} N m).")
