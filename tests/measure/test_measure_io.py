@@ -139,6 +139,8 @@ def test_too_few_samples(tmp_path, params):
         ({"surface": "ground"}, "missing metadata line '# case: ...'"),
         ({"case": "unladen", "surface": "ground", "extra_offset_m": "44.5"}, "looks like millimetres"),
         ({"case": "unladen", "surface": "ground", "bits": "eight"}, "bits = 'eight'"),
+        ({"case": "unladen", "surface": "ground", "bits_handwheel_angle_rad": "0"}, "bits_handwheel_angle_rad = '0'"),
+        ({"case": "unladen", "surface": "ground", "bits_steer": "12"}, "bits_steer names no known column"),
         ({"case": "unladen", "surface": "ground", "full_scale_torque": "25"}, "names no known column"),
     ],
 )
@@ -215,3 +217,15 @@ def test_the_shipped_example_file_is_a_valid_synthetic_measurement(repo_root, pa
     assert m.quantisation_step("handwheel_torque_Nm") == pytest.approx(2 * 25.0 / 255)
     for key in ("noise_seed", "sample_rate_hz", "noise_rms_handwheel_torque_Nm", "hand_seed"):
         assert key in m.metadata
+
+
+def test_a_channel_with_its_own_converter_has_its_own_step(tmp_path, params):
+    """``bits_<column>`` gives one channel its own converter: its step is 2 full_scale / (2**bits - 1) with its own
+    bits (a 12-bit rack over +-0.1 m: 0.2 / 4095 m), while the other channels keep the file's ``bits``."""
+    path = tmp_path / "own_bits.csv"
+    metadata = {"case": "unladen", "surface": "ground", "bits": "8", "full_scale_handwheel_torque_Nm": "25",
+                "full_scale_rack_m": "0.1", "bits_rack_m": "12"}
+    path.write_text(render(good_columns(), metadata), encoding="utf-8")
+    m = read_measurement(path, params)
+    assert m.quantisation_step("rack_m") == pytest.approx(0.2 / 4095)
+    assert m.quantisation_step("handwheel_torque_Nm") == pytest.approx(50.0 / 255)

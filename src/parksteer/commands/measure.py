@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import sys
 from pathlib import Path
@@ -58,6 +59,9 @@ def register(sub) -> None:
     p.add_argument("--jobs", type=int, default=None, metavar="N",
                    help="replays run side by side on N processes (default: the CPUs available; same result)")
     p.add_argument("--quiet", action="store_true", help="no progress lines on stderr")
+    p.add_argument("--angle", action="store_true",
+                   help="fit the measured handwheel angle beside the torque, in files that have one beside a measured "
+                        "rack (the column stiffness and Hooke joint phase are then calibrated, a rack lash observable)")
     p.set_defaults(func=_diagnose)
 
 
@@ -111,7 +115,9 @@ def _compare(args) -> int:
 def _diagnose(args) -> int:
     from ..diagnose.problem import load_files
     from ..diagnose.report import diagnosis_dict, markdown_report, write_markdown
+    from ..diagnose.problem import ANGLE
     from ..diagnose.select import diagnose
+    from ..diagnose.settings import DEFAULT_SETTINGS
     from ..model.symbolic.components import resolve_effects
 
     _check_outputs(args)
@@ -129,7 +135,19 @@ def _diagnose(args) -> int:
     if args.jobs is not None and args.jobs < 1:
         raise UsageError(f"--jobs {args.jobs}: give at least 1")
     workers = args.jobs if args.jobs is not None else available_workers()
-    diagnosis = diagnose(files, params, effects, workers=workers, quiet=args.quiet)
+    settings = DEFAULT_SETTINGS
+    if args.angle:
+        settings = dataclasses.replace(settings, use_handwheel_angle=True)
+        with_angle = [f.label for f in files if f.angle_rad is not None]
+        if not with_angle:
+            f = files[0]
+            why = "its rack is derived from the angle" if ANGLE in f.measurement.columns else f"no column {ANGLE!r}"
+            raise UsageError(f"{f.measurement.path or f.label}: --angle needs a handwheel angle beside a measured rack "
+                             f"({why})")
+        if not args.quiet:
+            print(f"handwheel angle fitted beside the torque in {len(with_angle)} of {len(files)} file(s): "
+                  + ", ".join(with_angle), file=sys.stderr)
+    diagnosis = diagnose(files, params, effects, workers=workers, quiet=args.quiet, settings=settings)
     result = diagnosis_dict(diagnosis)
     if args.plot:
         from ..figures.diagnose import diagnosis_figure

@@ -31,6 +31,7 @@ import numpy as np
 from scipy.stats import t as student_t
 
 from ..model.symbolic.components import Effect
+from ..model.symbolic.system import CORE_PARAMETERS
 from ..parameters import quantity
 from .settings import DEFAULT_SETTINGS, DiagnosisSettings
 from .problem import Problem, lag1_autocorrelation
@@ -40,11 +41,12 @@ Z95 = 1.959964  # two-sided 95 % quantile of the standard normal
 
 @dataclass(frozen=True)
 class FitParameter:
-    """One fitted parameter: key ("effect.param"), transform ("log" of value / reference, or "linear")."""
+    """One fitted parameter: key ("effect.param"), transform ("log" of value / reference; "linear", a strength
+    fitted as it stands from its lower bound; "offset", fitted as it stands from the model's value)."""
 
     key: str
     transform: str
-    reference: float  # log: the value at theta = 0; linear: unused
+    reference: float  # log: the value at theta = 0; offset: the model's value; linear: unused
     lower: float  # bounds on the value
     upper: float
     step: float  # finite-difference step in theta
@@ -127,7 +129,7 @@ class Fit:
             half = math.hypot(max(Z95 * model_se, quantile * sandwich_se), Z95 * math.sqrt(max(replay[i, i], 0.0)))
             se = half / Z95
             low, high = p.value(t - half), p.value(t + half)
-            if p.transform == "linear":
+            if p.transform != "log":
                 low, high = t - half, t + half  # the interval itself may cross a bound
             out[p.key] = {"value": p.value(t), "ci95": [low, high],
                           "standard_error": (p.value(t) * se if p.transform == "log" else se)}
@@ -143,7 +145,7 @@ def block_sandwich(jacobian: np.ndarray, weighted: np.ndarray, problem: Problem,
         t = f.time_s - f.time_s[0]
         count = max(int(round(t[-1] / block_s)), 1)
         block = np.minimum((t / (t[-1] / count)).astype(int), count - 1) if t[-1] > 0 else np.zeros(f.n, dtype=int)
-        ids.append(block + offset)
+        ids.extend([block + offset] * f.signals)  # a file's signals at the same instants share their segment
         offset += count
         start += f.n
     ids = np.concatenate(ids)
@@ -164,10 +166,10 @@ def replay_covariance(jacobian: np.ndarray, problem: Problem) -> np.ndarray:
     deviation d from the ensemble mean, which a fit absorbs as the parameter shift (J^T J)^-1 J^T (d / sigma);
     the covariance of these shifts over the draws. Zero when the ensemble was not run."""
     k = jacobian.shape[1]
-    draws = [f.replay_draws_Nm for f in problem.files]
+    draws = [f.replay_draws for f in problem.files]
     if any(d is None for d in draws) or len({d.shape[0] for d in draws}) != 1 or draws[0].shape[0] < 2:
         return np.zeros((k, k))
-    deviations = np.concatenate([d / f.sigma_Nm for d, f in zip(draws, problem.files)], axis=1)
+    deviations = np.concatenate([d / f.sigma for d, f in zip(draws, problem.files)], axis=1)
     shifts = np.linalg.solve(jacobian.T @ jacobian, jacobian.T @ deviations.T)  # k x draws
     return shifts @ shifts.T / (shifts.shape[1] - 1)
 
@@ -295,24 +297,46 @@ def calibration_parameters(problem: Problem, effects: list[Effect],
                            settings: DiagnosisSettings = DEFAULT_SETTINGS) -> list[FitParameter]:
     """The calibrated parameters the model has (an effect left out of the model leaves its keys out).
 
+    Unless `keys` are given, with a fitted angle also what only the angle shows (the settings'
+    ``calibrated_with_angle`` and ``calibrated_with_angle_offsets``: the column stiffness, the Hooke joint phase).
     `strengths` adds effects' strengths, fitted linearly, with their finite-difference steps.
     """
-    used = {k for e in effects for k in e.uses}
+    used = {k for e in effects for k in e.uses} | set(CORE_PARAMETERS)
+    chosen = keys is not None
     keys = settings.calibrated_parameters if keys is None else keys
     out = [log_parameter(problem, effects, key, settings) for key in keys if key in used]
+    if not chosen and problem.uses_angle:  # what only the angle shows
+        out += [log_parameter(problem, effects, key, settings) for key in settings.calibrated_with_angle
+                if key in used]
+        out += [offset_parameter(problem, effects, key, half_range, step)
+                for key, half_range, step in settings.calibrated_with_angle_offsets if key in used]
     out += [linear_parameter(effects, key, step) for key, step in (strengths or {}).items()]
     return out
 
 
+def offset_parameter(problem: Problem, effects: list[Effect], key: str, half_range: float, step: float
+                     ) -> FitParameter:
+    """A parameter fitted as it stands within `half_range` of the model's value (an angle such as a phase)."""
+    spec = quantity(key)
+    default = problem.replay(effects, 0).value(key)
+    return FitParameter(key, "offset", default, max(spec.lower, default - half_range),
+                        min(spec.upper, default + half_range), step)
+
+
 def calibrate(problem: Problem, effects: list[Effect], fixed: dict[str, float] | None = None,
               keys: tuple[str, ...] | None = None, strengths: dict[str, float] | None = None,
-              start: dict[str, float] | None = None, settings: DiagnosisSettings = DEFAULT_SETTINGS) -> Fit:
+              start: dict[str, float] | None = None, settings: DiagnosisSettings = DEFAULT_SETTINGS,
+              announce=None) -> Fit:
     """Fit the base model's uncertain parameters (and any `strengths`) to all files.
 
-    From the model's defaults, or from the values in `start` where it has them.
+    From the model's defaults, or from the values in `start` where it has them. `announce`, if given, is called
+    with the keys of the calibrated parameters (the base model's, and with a fitted angle the column's).
     """
     parameters = calibration_parameters(problem, effects, keys, strengths, settings)
+    if announce is not None:
+        announce([p.key for p in parameters if p.key not in (strengths or {})])
     start = start or {}
-    theta0 = np.array([p.theta(start[p.key]) if p.key in start else (0.0 if p.transform == "log" else p.lower)
+    theta0 = np.array([p.theta(start[p.key]) if p.key in start else
+                       {"log": 0.0, "offset": p.reference}.get(p.transform, p.lower)
                        for p in parameters])
     return least_squares(problem, effects, parameters, theta0, fixed, settings=settings)

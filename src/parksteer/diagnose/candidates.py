@@ -15,7 +15,11 @@ residuals it is the column ``w`` of a Jacobian. A candidate that even at its lar
 strength moves the replayed torque by less than a tenth of a noise floor is unobservable in
 these data as replayed (a lash between pinion and rack is: with the rack's motion given, the
 torque the rack needs does not depend on the play the hand turned through before it moved;
-the play shows against the handwheel angle instead). It scores zero and is listed as such.
+the play shows against the handwheel angle instead, which a diagnosis with the angle fits as a
+second signal, :attr:`parksteer.diagnose.settings.DiagnosisSettings.use_handwheel_angle`). It scores
+zero and is listed as such. With the angle, a signature and its probe's change are in both signals,
+an angle change counted in torque floors per angle floor (:meth:`parksteer.diagnose.problem.Problem.
+in_torque_floors`).
 
 Score test (Rao): at the calibrated base model, with weighted residual ``r`` and the
 calibrated parameters' sensitivities ``J``, the part of ``w`` that a change of those
@@ -70,8 +74,12 @@ class Signature:
     observable: bool = True  # False: even its largest strength barely moves the replayed torque
 
 
-def _rms_change(a: list[np.ndarray], b: list[np.ndarray]) -> float:
-    diff = np.concatenate([x - y for x, y in zip(a, b)])
+def _rms_change(problem: Problem, a: list[np.ndarray], b: list[np.ndarray]) -> float:
+    """RMS change of the fitted signals in N m, an angle's change counted in torque floors per angle floor."""
+    if not problem.uses_angle:
+        diff = np.concatenate([x - y for x, y in zip(a, b)])
+    else:
+        diff = problem.in_torque_floors([x - y for x, y in zip(a, b)])
     return float(np.sqrt(np.mean(diff**2)))
 
 
@@ -86,7 +94,7 @@ def probe_signature(problem: Problem, base_effects: list[Effect], candidate: Eff
     probed, change = None, 0.0
     for _ in range(settings.probe_max_tries):
         probed = problem.predict(effects, {**overrides, key: strength})
-        change = _rms_change(probed, zero)
+        change = _rms_change(problem, probed, zero)
         if change > 0.0 and 0.5 <= change / target_Nm <= 2.0:
             break
         factor = target_Nm / change if change > 0.0 else 100.0

@@ -67,6 +67,8 @@ def compare_files(files: list[FileData], params: Parameters, effects=None,
     chosen = effects if isinstance(effects, list) and all(isinstance(e, Effect) for e in effects) \
         else resolve_effects(effects)
     overrides = dict(overrides or {})
+    for f in files:  # a comparison is of the torque alone
+        f.uses_angle = False
     problem = Problem(files, params)
     predictions = problem.predict(chosen, overrides)
     problem.estimate_replay_uncertainty(chosen, overrides)

@@ -4,7 +4,7 @@ Rungs: the paper's model at its own parameter values; the same model with its un
 parameters calibrated to the files; then, while the diagnosis names a missing effect, the
 model with that effect added (its strength fitted with the calibrated parameters). After
 each addition the ladder stops if the weighted error has reached the floor (within
-``ADEQUATE_RMS_FACTOR``); otherwise the grown model is diagnosed again (its added strengths
+``ADEQUATE_RMS_FACTOR``; with a fitted handwheel angle, the weighted error of both signals); otherwise the grown model is diagnosed again (its added strengths
 calibrated with the base parameters), up to ``LADDER_MAX_STEPS`` additions.
 """
 
@@ -40,7 +40,18 @@ def _rung(label: str, effects: list[Effect], statistics: dict, parameters: dict[
         "peak_Nm": statistics["peak_Nm"],
         "weighted_rms_over_noise_floor": statistics["weighted_rms_Nm"] / statistics["noise_floor_Nm"],
         "parameters": dict(sorted(parameters.items())),
+        # with a fitted angle: its residual, and the weighted error of both signals together over the floor
+        **({"angle_rms_rad": statistics["angle"]["rms_rad"],
+            "weighted_rms_over_noise_floor_both_signals": (statistics["weighted_rss"] / statistics["samples"]) ** 0.5}
+           if "angle" in statistics else {}),
     }
+
+
+def _at_floor(statistics: dict, settings: DiagnosisSettings) -> bool:
+    """Whether the weighted error is within the adequate factor of the floor (with a fitted angle, of both signals)."""
+    if "angle" in statistics:
+        return (statistics["weighted_rss"] / statistics["samples"]) ** 0.5 <= settings.adequate_rms_factor
+    return statistics["weighted_rms_Nm"] <= settings.adequate_rms_factor * statistics["noise_floor_Nm"]
 
 
 def error_ladder(files: list[FileData], params: Parameters, effects=None, first: Diagnosis | None = None,
@@ -73,7 +84,7 @@ def error_ladder(files: list[FileData], params: Parameters, effects=None, first:
         model = list(best.signature.model)
         strengths[best.signature.key] = best.signature.probe
         rungs.append(_rung(f"+ {best.name}", model, statistics, fit.values))
-        if statistics["weighted_rms_Nm"] <= settings.adequate_rms_factor * statistics["noise_floor_Nm"]:
+        if _at_floor(statistics, settings):
             break
         diagnosis = diagnose(files, params, model, strengths=dict(strengths), start=fit.values, settings=settings,
                              workers=workers)

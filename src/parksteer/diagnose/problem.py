@@ -24,6 +24,15 @@ the torque drop. Each sample then has an attainable error ``sigma_i = sqrt(noise
 delta_i^2)``; residuals are weighted by it (``(measured - model) / sigma_i``), so a fit
 listens to the samples the replay can predict, and a perfect model has weighted residuals
 of unit variance.
+
+A file with a handwheel angle beside a measured rack may be fitted on both signals
+(:attr:`FileData.uses_angle`, set by the diagnosis when its settings ask): each prediction is
+then the torque followed by the replayed handwheel angle (column angle plus the twist that
+passes the replayed torque, :func:`parksteer.model.numeric.prescribed.solve`), shifted by the
+fitted zero of the angle sensor. The angle's attainable error combines its channel's noise
+floor, the replay ensemble's spread in angle, and the twist that a torque off by its own
+attainable error would give (:func:`parksteer.model.numeric.prescribed.twist_spread`: error / k
+on a linear column, a lash's whole band where the torque is that close to zero).
 """
 
 from __future__ import annotations
@@ -45,10 +54,11 @@ from ..model.symbolic.components import Effect
 from ..parameters import Parameters
 from ..synthetic.logger import add_noise, quantise
 from .parallel import fork_map, forks, worker_pool
-from .settings import DEFAULT_SETTINGS
+from .settings import DEFAULT_SETTINGS, DiagnosisSettings
 from .replay import Replay
 
 TORQUE = "handwheel_torque_Nm"
+ANGLE = "handwheel_angle_rad"
 
 
 @dataclass(eq=False)
@@ -65,6 +75,13 @@ class FileData:
     replay_uncertainty_Nm: np.ndarray | None = None
     # each draw's replayed torque less the draws' mean (draws x samples), from the latest estimate
     replay_draws_Nm: np.ndarray | None = None
+    # the measured handwheel angle (rad) when the file has one beside a measured rack, and its noise floor
+    angle_rad: np.ndarray | None = None
+    angle_noise: NoiseFloor | None = None
+    # whether the diagnosis fits the angle as a second signal (set by parksteer.diagnose.select.diagnose)
+    uses_angle: bool = False
+    replay_uncertainty_rad: np.ndarray | None = None
+    replay_draws_rad: np.ndarray | None = None
 
     @property
     def time_s(self) -> np.ndarray:
@@ -88,6 +105,46 @@ class FileData:
         delta = self.replay_uncertainty_Nm if self.replay_uncertainty_Nm is not None else np.zeros(self.n)
         return np.sqrt(self.noise.total_rms**2 + delta**2)
 
+    @property
+    def sigma_rad(self) -> np.ndarray:
+        """Attainable error of the angle at each sample: its noise floor combined with the replay's uncertainty."""
+        delta = self.replay_uncertainty_rad if self.replay_uncertainty_rad is not None else np.zeros(self.n)
+        return np.sqrt(self.angle_noise.total_rms**2 + delta**2)
+
+    @property
+    def signals(self) -> int:
+        """Measured signals fitted: 1 (the torque) or 2 (torque, then the handwheel angle)."""
+        return 2 if self.uses_angle else 1
+
+    @property
+    def m(self) -> int:
+        """Residuals of the file: its samples times its signals."""
+        return self.n * self.signals
+
+    @property
+    def measured(self) -> np.ndarray:
+        """The fitted signals, stacked: the torque (N m), then with an angle the handwheel angle (rad)."""
+        return np.concatenate([self.torque_Nm, self.angle_rad]) if self.uses_angle else self.torque_Nm
+
+    @property
+    def sigma(self) -> np.ndarray:
+        """The attainable error of each fitted signal's samples, stacked as :attr:`measured`."""
+        return np.concatenate([self.sigma_Nm, self.sigma_rad]) if self.uses_angle else self.sigma_Nm
+
+    @property
+    def replay_draws(self) -> np.ndarray | None:
+        """Each draw's replayed signals less the draws' mean, stacked as :attr:`measured`."""
+        if not self.uses_angle or self.replay_draws_Nm is None:
+            return self.replay_draws_Nm
+        return None if self.replay_draws_rad is None else np.concatenate([self.replay_draws_Nm,
+                                                                          self.replay_draws_rad], axis=1)
+
+    def torque_part(self, prediction: np.ndarray) -> np.ndarray:
+        return prediction[: self.n]
+
+    def angle_part(self, prediction: np.ndarray) -> np.ndarray | None:
+        return prediction[self.n :] if self.uses_angle else None
+
 
 def prepare_file(measurement: Measurement, case: str | None = None, label: str | None = None) -> FileData:
     """Smooth the rack, find the phases and the noise floor of one measurement."""
@@ -99,7 +156,12 @@ def prepare_file(measurement: Measurement, case: str | None = None, label: str |
     phases = find_phases(measurement.time_s, measurement.rack_m, measurement.handwheel_torque_Nm,
                          surface=measurement.surface)
     floor = noise_floor(measurement.handwheel_torque_Nm, measurement.quantisation_step(TORQUE))
-    return FileData(label, measurement, case, measurement.surface, rack, phases, floor)
+    angle = angle_floor = None
+    if ANGLE in measurement.columns and "rack_derived" not in measurement.metadata:
+        angle = measurement.columns[ANGLE]
+        angle_floor = noise_floor(angle, measurement.quantisation_step(ANGLE))
+    return FileData(label, measurement, case, measurement.surface, rack, phases, floor, angle_rad=angle,
+                    angle_noise=angle_floor)
 
 
 def load_files(paths: list[str | Path], params: Parameters, case: str | None = None, surface: str | None = None,
@@ -144,6 +206,7 @@ class Problem:
     files: list[FileData]
     params: Parameters
     workers: int = 1
+    settings: DiagnosisSettings = DEFAULT_SETTINGS
     _replays: dict = field(default_factory=dict, repr=False)
     extra_evaluations: int = 0  # replays run in worker processes
     _pool: object = field(default=None, repr=False)
@@ -174,7 +237,28 @@ class Problem:
 
     @property
     def n(self) -> int:
-        return sum(f.n for f in self.files)
+        """Residuals of all files: every fitted signal's samples (the torque's, and the angle's where fitted)."""
+        return sum(f.m for f in self.files)
+
+    @property
+    def uses_angle(self) -> bool:
+        return any(f.uses_angle for f in self.files)
+
+    def signals(self, effects: list[Effect], index: int, overrides: dict[str, float] | None = None,
+                replay: Replay | None = None) -> np.ndarray:
+        """File `index`'s fitted signals replayed: the torque, and with an angle the handwheel angle after it.
+
+        The angle channel's zero is the sensor's, not the model's: with ``angle_offset_fitted`` the replayed
+        angle is shifted by the mean of the measured minus replayed angle (a constant fitted in closed form)."""
+        f = self.files[index]
+        replay = replay if replay is not None else self.replay(effects, index)
+        if not f.uses_angle:
+            return replay.torque(overrides)
+        solution = replay.solve(overrides, outputs=True)
+        angle = solution.handwheel[:, 0]
+        if self.settings.angle_offset_fitted:
+            angle = angle + float(np.mean(f.angle_rad - angle))
+        return np.concatenate([solution.torque_Nm, angle])
 
     def predict(self, effects: list[Effect], overrides: dict[str, float] | None = None) -> list[np.ndarray]:
         """Model torque at every file's samples (one array per file)."""
@@ -188,15 +272,22 @@ class Problem:
                 out = self._pool.map(_pooled_torque, tasks, chunksize=1)
                 self.extra_evaluations += len(tasks)
                 return out
-        return [self.replay(effects, i).torque(overrides) for i in range(len(self.files))]
+        return [self.signals(effects, i, overrides) for i in range(len(self.files))]
 
     def weighted(self, predictions: list[np.ndarray]) -> np.ndarray:
         """Weighted residuals (measured - model) / sigma_i of all files, concatenated."""
-        return np.concatenate([(f.torque_Nm - m) / f.sigma_Nm for f, m in zip(self.files, predictions)])
+        return np.concatenate([(f.measured - m) / f.sigma for f, m in zip(self.files, predictions)])
 
     def scale(self, values: list[np.ndarray]) -> np.ndarray:
         """Model differences divided by sigma_i, concatenated (the weighted units of a sensitivity)."""
-        return np.concatenate([v / f.sigma_Nm for f, v in zip(self.files, values)])
+        return np.concatenate([v / f.sigma for f, v in zip(self.files, values)])
+
+    def in_torque_floors(self, values: list[np.ndarray]) -> np.ndarray:
+        """Model differences with each angle sample rescaled by the torque's over the angle's noise floor: a change
+        of one angle floor counts as one torque floor (N m), so that torque and angle changes add up."""
+        return np.concatenate([v if not f.uses_angle else
+                               np.concatenate([v[: f.n], v[f.n :] * (f.noise.total_rms / f.angle_noise.total_rms)])
+                               for f, v in zip(self.files, values)])
 
     def estimate_replay_uncertainty(self, effects: list[Effect], overrides: dict[str, float] | None = None,
                                     draws: int = DEFAULT_SETTINGS.replay_ensemble_draws,
@@ -227,14 +318,29 @@ class Problem:
                     rack = source.perturbed(rng)
                 racks.append((base, rack))
             base.evaluations += draws
-        torques = fork_map(lambda job: job[0].on_rack(job[1]).torque(overrides), racks, self.workers)
+        owners = [i for i in range(len(self.files)) for _ in range(draws)]
+        replayed = fork_map(lambda job: self.signals(effects, job[0], overrides, job[1][0].on_rack(job[1][1])),
+                            list(zip(owners, racks)), self.workers)
         for i, f in enumerate(self.files):
-            runs = np.array(torques[i * draws : (i + 1) * draws])
-            f.replay_draws_Nm = runs - runs.mean(axis=0)
-            spread = maximum_filter1d(np.std(runs, axis=0, ddof=1), size=3, mode="nearest")
-            if keep_larger and f.replay_uncertainty_Nm is not None:
-                spread = np.maximum(spread, f.replay_uncertainty_Nm)
-            f.replay_uncertainty_Nm = spread
+            runs = np.array(replayed[i * draws : (i + 1) * draws])
+            torque_runs = runs[:, : f.n]
+            f.replay_draws_Nm = torque_runs - torque_runs.mean(axis=0)
+            f.replay_uncertainty_Nm = _spread(torque_runs, f.replay_uncertainty_Nm if keep_larger else None)
+            if f.uses_angle:  # each draw's angle carries its own fitted zero (Problem.signals)
+                angle_runs = runs[:, f.n :]
+                f.replay_draws_rad = angle_runs - angle_runs.mean(axis=0)
+                # The replayed torque is itself off by about its attainable error, and the twist that passes it by
+                # as much through the column's compliance (in a dead band: the band, where |T| is that small).
+                through_torque = self.replay(effects, i).twist_spread(f.sigma_Nm, overrides)
+                spread = np.hypot(_spread(angle_runs, None), maximum_filter1d(through_torque, size=3, mode="nearest"))
+                before = f.replay_uncertainty_rad if keep_larger else None
+                f.replay_uncertainty_rad = spread if before is None else np.maximum(spread, before)
+
+
+def _spread(runs: np.ndarray, before: np.ndarray | None) -> np.ndarray:
+    """The draws' standard deviation at each sample, widened by one sample either side; at least `before`."""
+    spread = maximum_filter1d(np.std(runs, axis=0, ddof=1), size=3, mode="nearest")
+    return spread if before is None else np.maximum(spread, before)
 
 
 _POOLED: Problem | None = None  # the problem a worker pool was forked from (Problem.predict)
@@ -242,7 +348,7 @@ _POOLED: Problem | None = None  # the problem a worker pool was forked from (Pro
 
 def _pooled_torque(task) -> np.ndarray:
     effects, index, overrides = task
-    return _POOLED.replay(effects, index).torque(overrides)
+    return _POOLED.signals(effects, index, overrides)
 
 
 def relogged_rack(rack: SmoothedRack, time_s: np.ndarray, full_scale: float, bits: int, analog_rms: float,
@@ -260,11 +366,11 @@ def rack_logger(measurement: Measurement) -> tuple[float, int, float] | None:
     The analog part is the rack's noise (from its second differences) less the rounding's
     step / sqrt(12), root sum of squares, as :func:`parksteer.measure.metrics.noise_floor` splits it.
     """
-    full_scale = measurement.full_scale("rack_m")
-    if full_scale is None or "bits" not in measurement.metadata:
+    full_scale, bits = measurement.full_scale("rack_m"), measurement.bits("rack_m")
+    if full_scale is None or bits is None:
         return None
     floor = noise_floor(measurement.rack_m, measurement.quantisation_step("rack_m"))
-    return full_scale, int(measurement.metadata["bits"]), floor.analog_rms
+    return full_scale, bits, floor.analog_rms
 
 
 def fit_statistics(problem: Problem, predictions: list[np.ndarray]) -> dict:
@@ -274,32 +380,53 @@ def fit_statistics(problem: Problem, predictions: list[np.ndarray]) -> dict:
     floor_f the file's noise floor: it equals the noise floor for a perfect model, and
     sqrt(floor^2 + e^2) for a model off by e where the replay is certain.
     """
-    residual = np.concatenate([f.torque_Nm - m for f, m in zip(problem.files, predictions)])
+    files = problem.files
+    residual = np.concatenate([f.torque_Nm - f.torque_part(m) for f, m in zip(files, predictions)])
     weighted = problem.weighted(predictions)
-    floors = np.concatenate([np.full(f.n, f.noise.total_rms) for f in problem.files])
-    attainable = np.concatenate([f.sigma_Nm for f in problem.files])
+    is_torque = np.concatenate([np.arange(f.m) < f.n for f in files])
+    floors = np.concatenate([np.full(f.n, f.noise.total_rms) for f in files])
+    attainable = np.concatenate([f.sigma_Nm for f in files])
     floor = float(np.sqrt(np.mean(floors**2)))
-    return {
+    out = {
         "rms_Nm": float(np.sqrt(np.mean(residual**2))),
         "peak_Nm": float(np.max(np.abs(residual))),
-        "weighted_rms_Nm": float(np.sqrt(np.mean((weighted * floors) ** 2))),
+        "weighted_rms_Nm": float(np.sqrt(np.mean((weighted[is_torque] * floors) ** 2))),
         "noise_floor_Nm": floor,
         "attainable_floor_Nm": float(np.sqrt(np.mean(attainable**2))),
         "weighted_rss": float(np.sum(weighted**2)),
-        "samples": int(residual.size),
+        "samples": int(weighted.size),
     }
+    with_angle = [(f, m) for f, m in zip(files, predictions) if f.uses_angle]
+    if with_angle:  # the angle's residual beside the torque's (the same definitions, in rad and degrees)
+        angle = np.concatenate([f.angle_rad - f.angle_part(m) for f, m in with_angle])
+        angle_floors = np.concatenate([np.full(f.n, f.angle_noise.total_rms) for f, _ in with_angle])
+        angle_weighted = np.concatenate([(f.angle_rad - f.angle_part(m)) / f.sigma_rad for f, m in with_angle])
+        angle_attainable = np.concatenate([f.sigma_rad for f, _ in with_angle])
+        rms = float(np.sqrt(np.mean(angle**2)))
+        out["angle"] = {
+            "rms_rad": rms,
+            "rms_deg": math.degrees(rms),
+            "peak_rad": float(np.max(np.abs(angle))),
+            "weighted_rms_rad": float(np.sqrt(np.mean((angle_weighted * angle_floors) ** 2))),
+            "noise_floor_rad": float(np.sqrt(np.mean(angle_floors**2))),
+            "attainable_floor_rad": float(np.sqrt(np.mean(angle_attainable**2))),
+            "weighted_rss": float(np.sum(angle_weighted**2)),
+            "samples": int(angle.size),
+        }
+    return out
 
 
 def lag1_autocorrelation(problem: Problem, weighted: np.ndarray) -> float:
-    """Lag-1 autocorrelation of the weighted residuals, pooled over files (pairs within a file only)."""
+    """Lag-1 autocorrelation of the weighted residuals, pooled over files (pairs within a file and signal)."""
     num = den = 0.0
     start = 0
     for f in problem.files:
-        r = weighted[start : start + f.n]
-        r = r - r.mean()
-        num += float(np.sum(r[1:] * r[:-1]))
-        den += float(np.sum(r * r))
-        start += f.n
+        for _ in range(f.signals):  # pairs within one signal of one file
+            r = weighted[start : start + f.n]
+            r = r - r.mean()
+            num += float(np.sum(r[1:] * r[:-1]))
+            den += float(np.sum(r * r))
+            start += f.n
     return num / den if den > 0 else 0.0
 
 

@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..measure.smoothing import SmoothedRack
-from ..model.numeric.prescribed import PrescribedSolution, solve
+from ..model.numeric.prescribed import PrescribedSolution, solve, twist_spread
 from ..model.numeric.simulate import PreparedRun, prepare
 from ..model.symbolic.components import Effect
 from ..parameters import Parameters, quantity
@@ -113,6 +113,12 @@ class Replay:
         run, p = self.parameter_vector(overrides)
         self.evaluations += 1
         return solve(run, p, self.rack, self.time_s, outputs=outputs)
+
+    def twist_spread(self, torque_error: np.ndarray, overrides: dict[str, float] | None = None) -> np.ndarray:
+        """How far the replayed twist moves for a torque off by `torque_error` at each sample
+        (:func:`parksteer.model.numeric.prescribed.twist_spread`)."""
+        run, p = self.parameter_vector(overrides)
+        return twist_spread(run, p, self.solve(overrides, outputs=True), torque_error)
 
     def torque(self, overrides: dict[str, float] | None = None) -> np.ndarray:
         """Handwheel torque (N m) at `time_s`."""

@@ -90,7 +90,14 @@ def diagnosis_dict(diagnosis: Diagnosis) -> dict:
             "replay_uncertainty_rms_Nm": float(np.sqrt(np.mean(delta**2))) if delta is not None else 0.0,
             "rack_smoothing": f.rack.summary(),
         })
-    return {
+        if f.uses_angle:
+            angle_delta = f.replay_uncertainty_rad
+            files[-1]["angle"] = {
+                "noise_floor": f.angle_noise.as_dict(),
+                "replay_uncertainty_rms_rad": (float(np.sqrt(np.mean(angle_delta**2))) if angle_delta is not None
+                                               else 0.0),
+            }
+    out = {
         "schema": SCHEMA_ID,
         "verdict": diagnosis.verdict,
         "effect": diagnosis.effect,
@@ -140,6 +147,14 @@ def diagnosis_dict(diagnosis: Diagnosis) -> dict:
         },
         "cost": {"replays": problem.evaluations, "timings_s": diagnosis.timings_s},
     }
+    if problem.uses_angle:  # the handwheel angle fitted as a second signal: which files, and its floor
+        out["angle"] = {
+            "files": [f.label for f in problem.files if f.uses_angle],
+            "noise_floor_rad": calibrated["angle"]["noise_floor_rad"],
+            "attainable_floor_rad": calibrated["angle"]["attainable_floor_rad"],
+            "offset_fitted": diagnosis.settings.angle_offset_fitted,
+        }
+    return out
 
 
 def _n(x, digits: int = 3) -> str:
@@ -162,6 +177,16 @@ def _nearest(result: dict) -> str:
             "not the effect itself.")
 
 
+def _angle_change(result: dict) -> str:
+    """', and the angle's from ... to ... rad against ...' when the angle is fitted (the verdict's sentence)."""
+    stats = result["statistics"]
+    if not result.get("angle") or not stats.get("with_effect"):
+        return ""
+    before, after = stats["calibrated"]["angle"], stats["with_effect"]["angle"]
+    return (f"; the handwheel angle's from {_n(before['weighted_rms_rad'])} rad to {_n(after['weighted_rms_rad'])} "
+            f"rad against {_n(result['angle']['noise_floor_rad'])} rad")
+
+
 def markdown_report(result: dict, figure: str | None = None) -> str:
     """A readable report of the JSON of a diagnosis."""
     lines = ["# Diagnosis: model against measurement", ""]
@@ -171,7 +196,7 @@ def markdown_report(result: dict, figure: str | None = None) -> str:
     if verdict == "missing":
         lines.append(f"**Verdict: missing effect `{result['effect']}`.** Adding it takes the weighted RMS error from "
                      f"{_n(stats['calibrated']['weighted_rms_Nm'])} N m to {_n(stats['with_effect']['weighted_rms_Nm'])} "
-                     f"N m, against a noise floor of {_n(floor)} N m.")
+                     f"N m, against a noise floor of {_n(floor)} N m{_angle_change(result)}.")
     elif verdict == "adequate":
         lines.append(f"**Verdict: adequate.** With its calibrated parameters the model's weighted RMS error "
                      f"({_n(stats['calibrated']['weighted_rms_Nm'])} N m) is at the noise floor ({_n(floor)} N m); "
@@ -197,6 +222,19 @@ def markdown_report(result: dict, figure: str | None = None) -> str:
               f"{_n(result['attainable_floor_Nm'])} N m. The weighted RMS counts each sample by its attainable "
               "error, so it is the noise floor for a perfect model; the plain RMS also holds the few samples at "
               "reversals where the rack data cannot fix the instant the rack friction turns over.", ""]
+    if result.get("angle"):
+        angle = result["angle"]
+        lines += ["## Handwheel angle", "", f"Fitted beside the torque in {', '.join(angle['files'])} (noise floor "
+                  f"{_n(angle['noise_floor_rad'])} rad, with the replay's uncertainty "
+                  f"{_n(angle['attainable_floor_rad'])} rad).", "",
+                  "| model | RMS (rad) | RMS (degrees) | weighted RMS (rad) | peak (rad) |", "|---|---|---|---|---|"]
+        for label, key in (("nominal parameters", "nominal"), ("calibrated", "calibrated"),
+                           (f"with {result['effect']}", "with_effect")):
+            a = (stats.get(key) or {}).get("angle")
+            if a:
+                lines.append(f"| {label} | {_n(a['rms_rad'])} | {_n(a['rms_deg'])} | {_n(a['weighted_rms_rad'])} | "
+                             f"{_n(a['peak_rad'])} |")
+        lines.append("")
     lines += ["## Calibrated parameters", "", "| parameter | default | fitted | 95 % interval |", "|---|---|---|---|"]
     for key, entry in result["calibrated"].items():
         ci = entry["ci95"]
@@ -245,8 +283,8 @@ def phase_residuals(diagnosis: Diagnosis) -> list[dict]:
     best = candidate_predictions(diagnosis, diagnosis.best) if diagnosis.best is not None else None
     rows = []
     for i, f in enumerate(diagnosis.problem.files):
-        calibrated = f.torque_Nm - diagnosis.calibration.predictions[i]
-        after = f.torque_Nm - best[i] if best is not None else None
+        calibrated = f.torque_Nm - f.torque_part(diagnosis.calibration.predictions[i])
+        after = f.torque_Nm - f.torque_part(best[i]) if best is not None else None
         for phase in PHASES:
             mask = f.phases.mask(phase)
             if not mask.any():
@@ -302,7 +340,7 @@ def html_report(result: dict, figures: list[tuple[str, str]], phases: list[dict]
     if verdict == "missing":
         text = (f"Verdict: missing effect {result['effect']}. Adding it takes the weighted RMS error from "
                 f"{_n(stats['calibrated']['weighted_rms_Nm'])} N m to {_n(stats['with_effect']['weighted_rms_Nm'])} "
-                f"N m, against a noise floor of {_n(floor)} N m.")
+                f"N m, against a noise floor of {_n(floor)} N m{_angle_change(result)}.")
     elif verdict == "adequate":
         text = (f"Verdict: adequate. The calibrated model's weighted RMS error "
                 f"({_n(stats['calibrated']['weighted_rms_Nm'])} N m) is at the noise floor ({_n(floor)} N m).")
@@ -317,6 +355,12 @@ def html_report(result: dict, figures: list[tuple[str, str]], phases: list[dict]
     out += _table(["file", "case", "surface", "samples", "noise floor (N m)"],
                   [[f["file"], f["case"], f["surface"], f["samples"], _n(f["noise_floor"]["total_rms"])]
                    for f in result["files"]])
+    if result.get("angle"):
+        angle = stats["calibrated"]["angle"]
+        out.append(f"<p>Handwheel angle fitted beside the torque in {html.escape(', '.join(result['angle']['files']))}:"
+                   f" calibrated model's angle residual RMS {html.escape(_n(angle['rms_rad']))} rad "
+                   f"({html.escape(_n(angle['rms_deg']))} degrees), noise floor "
+                   f"{html.escape(_n(result['angle']['noise_floor_rad']))} rad.</p>")
     for k, (caption, svg) in enumerate(figures):
         out += ["<figure>", inline_svg(svg, f"f{k}-"), f"<figcaption>{html.escape(caption)}</figcaption>", "</figure>"]
     out.append("<h2>Residual by phase</h2>")

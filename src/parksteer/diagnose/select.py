@@ -157,8 +157,23 @@ def refit(problem: Problem, calibration: Fit, signature: Signature, start_streng
     parameters = [*calibration.parameters, strength]
     theta0 = np.concatenate([calibration.theta, [min(max(start_strength, strength.lower), strength.upper)]])
     seed = np.column_stack([calibration.jacobian, signature.weighted])
-    return least_squares(problem, signature.model, parameters, theta0, calibration.fixed, jacobian=seed,
-                         max_iterations=settings.refit_max_iterations, settings=settings)
+    fit = least_squares(problem, signature.model, parameters, theta0, calibration.fixed, jacobian=seed,
+                        max_iterations=settings.refit_max_iterations, settings=settings)
+    angle_keys = set(settings.calibrated_with_angle) | {key for key, _, _ in settings.calibrated_with_angle_offsets}
+    reset = [i for i, p in enumerate(calibration.parameters) if p.key in angle_keys]
+    if problem.uses_angle and reset:
+        # The calibrated base model's column may have absorbed the candidate (a soft column passes for a lash):
+        # refit also from the parameter file's values of what only the angle calibrates, and keep the better fit.
+        theta1 = theta0.copy()
+        for i in reset:
+            theta1[i] = calibration.parameters[i].theta(calibration.parameters[i].reference) \
+                if calibration.parameters[i].transform == "offset" else 0.0
+        other = least_squares(problem, signature.model, parameters, theta1, calibration.fixed,
+                              max_iterations=settings.refit_max_iterations, settings=settings)
+        if other.rss < fit.rss:
+            other.evaluations += fit.evaluations
+            fit = other
+    return fit
 
 
 def _compare_refits(problem: Problem, calibration: Fit, refitted: list[Candidate]):
@@ -174,7 +189,7 @@ def _compare_refits(problem: Problem, calibration: Fit, refitted: list[Candidate
 def reweigh(problem: Problem, fit: Fit, sigma_before: list[np.ndarray]) -> None:
     """Recompute a fit's weighted residuals and Jacobian after the files' attainable errors changed."""
     fit.weighted = problem.weighted(fit.predictions)
-    ratio = np.concatenate([old / f.sigma_Nm for old, f in zip(sigma_before, problem.files)])
+    ratio = np.concatenate([old / f.sigma for old, f in zip(sigma_before, problem.files)])
     fit.jacobian = fit.jacobian * ratio[:, None]
 
 
@@ -228,7 +243,10 @@ def diagnose(files: list[FileData], params: Parameters, effects=None, registry: 
     `workers` > 1 replays independent runs side by side (:mod:`parksteer.diagnose.parallel`; the
     result is the same); unless `quiet`, each step says on stderr where it is.
     """
-    problem = Problem(files, params, workers=max(int(workers), 1))
+    for f in files:  # the angle is a second signal where the file has one beside a measured rack, if asked for
+        f.uses_angle = settings.use_handwheel_angle and f.angle_rad is not None
+        f.replay_uncertainty_rad = f.replay_draws_rad = None
+    problem = Problem(files, params, workers=max(int(workers), 1), settings=settings)
     try:
         return _diagnose(problem, effects, registry, strengths, start, settings, Progress(quiet))
     finally:
@@ -252,13 +270,15 @@ def _diagnose(problem: Problem, effects, registry, strengths, start, settings: D
         else resolve_effects(effects)
     progress(f"{len(files)} file(s), {problem.n} samples, {problem.workers} worker(s): replaying the base model "
              f"and its replay uncertainty ({settings.replay_ensemble_draws} racks per file)")
+    if problem.uses_angle:
+        progress("handwheel angle fitted beside the torque in " + ", ".join(f.label for f in files if f.uses_angle))
     nominal = problem.predict(base, {})
     problem.estimate_replay_uncertainty(base, start or {}, settings.replay_ensemble_draws,
                                         settings.replay_ensemble_seed)
     lap("nominal_and_replay_uncertainty")
 
-    progress("calibrating " + ", ".join(settings.calibrated_parameters))
-    calibration = calibrate(problem, base, strengths=strengths, start=start, settings=settings)
+    calibration = calibrate(problem, base, strengths=strengths, start=start, settings=settings,
+                            announce=lambda keys: progress("calibrating " + ", ".join(keys)))
     lap("calibration")
 
     testable, untestable = candidate_effects(base, registry)
@@ -300,7 +320,7 @@ def _diagnose(problem: Problem, effects, registry, strengths, start, settings: D
         # more sharply where the rack data are least certain (a breakaway peak at each reversal). Weigh every
         # model by the larger of the two uncertainties and compare again.
         progress(f"{best.name} evidenced: replay uncertainty again with it")
-        before = [f.sigma_Nm for f in problem.files]
+        before = [f.sigma for f in problem.files]
         problem.estimate_replay_uncertainty(best.signature.model, best.refit.overrides,
                                             settings.replay_ensemble_draws, settings.replay_ensemble_seed,
                                             keep_larger=True)

@@ -28,6 +28,18 @@ class DiagnosisSettings:
     replay_ensemble_draws: int = 8
     replay_ensemble_seed: int = 271828
 
+    # --- the handwheel angle as a second signal (parksteer.diagnose.problem) --------------------------------
+    # A file with a measured handwheel angle beside a measured rack (not a rack derived from the angle) can be
+    # fitted on both: the replayed handwheel angle is the column angle the rack sets plus the column twist that
+    # passes the replayed torque, so the angle sees what the torque cannot (a lash, the column's stiffness).
+    # Off unless asked for (``parksteer diagnose --angle``): an angle channel adds residuals and moves the
+    # weights of every fit, and a coarse channel (the 8-bit +-16 rad of the synthetic car records, a 0.125 rad
+    # step against a column twist of 0.02 rad at most) adds little; with it off, a diagnosis is the torque's alone.
+    use_handwheel_angle: bool = False
+    # The angle sensor's zero is its own (mounted on the column at some spline position, zeroed by hand): a
+    # constant per file, fitted in closed form (the mean of measured minus replayed angle) at every replay.
+    angle_offset_fitted: bool = True
+
     # --- calibration (parksteer.diagnose.calibrate) -----------------------------------------------------------
     # The base model's uncertain parameters, fitted before any candidate is considered, with the
     # relative step of their finite-difference sensitivities and their plausible range (a factor
@@ -36,6 +48,19 @@ class DiagnosisSettings:
         "tyre.friction_coefficient",
         "steering.rack_friction_force",
         "tyre.carcass_torsional_stiffness",
+    )
+    # With the handwheel angle fitted as a second signal (use_handwheel_angle), also the column's stiffness: the
+    # prescribed-rack replay's torque does not depend on it (the twist does not feed back on the torque), so only
+    # the angle, column angle plus twist T / k, sees it (a stiffness 30 % off moves the angle by 1-5 mrad at the
+    # cycle's 5-15 N m, against a 0.1-degree sensor's 0.5 mrad floor) ...
+    calibrated_with_angle: tuple[str, ...] = ("steering.column_torsional_stiffness",)
+    # ... and, when the Hooke joint is in the model, its phase (a reconstruction: the paper does not give it),
+    # fitted as it stands within +-pi/2 of the parameter file's value (the joint's speed ratio repeats every pi of
+    # column angle), finite-difference step 0.05 rad: the joint's map from pinion to column angle departs from
+    # proportional by up to (1/cos(alpha) - 1) / 2, 0.05 rad at alpha = 0.45 rad, at column angles set by the
+    # phase, which the handwheel angle against the rack shows directly (key, half range rad, step rad).
+    calibrated_with_angle_offsets: tuple[tuple[str, float, float], ...] = (
+        ("steering.hooke_joint_phase", 1.5707963267948966, 0.05),
     )
     calibration_relative_step: float = 0.03
     calibration_range_factor: float = 3.0

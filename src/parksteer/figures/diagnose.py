@@ -95,12 +95,12 @@ def diagnosis_figure(diagnosis, path: str | Path) -> None:
     fig, axes = new_figure(7.0, 8.0, nrows=3)
     f = diagnosis.problem.files[0]
     rack_mm = f.rack_m * 1000
-    calibrated = diagnosis.calibration.predictions[0]
+    calibrated = f.torque_part(diagnosis.calibration.predictions[0])
     axes[0].plot(rack_mm, f.torque_Nm, ".", color=MEASURED, markersize=1.5, label=f"measured ({f.label})")
     axes[0].plot(rack_mm, calibrated, color=COLOURS[0], linewidth=1.0, label="calibrated model")
     axes[1].plot(rack_mm, f.torque_Nm - calibrated, ".", color=COLOURS[0], markersize=1.5, label="calibrated model")
     if diagnosis.best is not None:
-        with_best = candidate_predictions(diagnosis, diagnosis.best)[0]
+        with_best = f.torque_part(candidate_predictions(diagnosis, diagnosis.best)[0])
         label = f"+ {diagnosis.best.name}"
         axes[0].plot(rack_mm, with_best, color=COLOURS[1], linewidth=1.0, label=label)
         axes[1].plot(rack_mm, f.torque_Nm - with_best, ".", color=COLOURS[1], markersize=1.5, label=label)

@@ -20,7 +20,8 @@ Metadata: ``case`` (a case of the parameter file) and ``surface`` (``ground`` or
 ``air_bearing``) are required, because a comparison with the model needs both;
 ``extra_offset_m`` (spacer offset, m) and ``source`` are optional; ``full_scale_<column>``
 (the logger's full scale for that column, in the column's unit) and ``bits`` (the logger's
-resolution) let the metrics work out the quantisation step. Any other key is kept as text.
+resolution; ``bits_<column>`` for a channel with a converter of its own, e.g. an angle sensor) let the
+metrics work out the quantisation step. Any other key is kept as text.
 
 Every defect is refused with a :class:`~parksteer.errors.UsageError` whose one-line message
 names the file and, where it applies, the column and the data row (1-based, the first row
@@ -136,12 +137,17 @@ class Measurement:
         value = self.metadata.get(f"full_scale_{column}")
         return None if value is None else float(value)
 
+    def bits(self, column: str) -> int | None:
+        """The converter bits of `column`: its own ``bits_<column>`` if the file states one, else ``bits``."""
+        value = self.metadata.get(f"bits_{column}", self.metadata.get("bits"))
+        return None if value is None else int(value)
+
     def quantisation_step(self, column: str) -> float:
         """The logger's step for `column`: 2 full_scale / (2**bits - 1); 0 if the file does not say."""
-        full_scale = self.full_scale(column)
-        if full_scale is None or "bits" not in self.metadata:
+        full_scale, bits = self.full_scale(column), self.bits(column)
+        if full_scale is None or bits is None:
             return 0.0
-        return 2.0 * full_scale / (2 ** int(self.metadata["bits"]) - 1)
+        return 2.0 * full_scale / (2**bits - 1)
 
 
 def _where(path: Path | str, column: str, row: int, line_numbers: list[int] | None) -> str:
@@ -180,11 +186,13 @@ def _validate_metadata(where: Path | str, metadata: Mapping[str, str], params: P
             )
         if offset < 0.0:
             raise UsageError(f"{where}: metadata extra_offset_m = {offset:g} is negative (spacers add offset)")
-    if "bits" in metadata:
-        bits = metadata["bits"].strip()
-        if not bits.isdigit() or not 1 <= int(bits) <= 32:
-            raise UsageError(f"{where}: metadata bits = {bits!r} is not a whole number of bits from 1 to 32")
     for key, value in metadata.items():
+        if key == "bits" or key.startswith("bits_"):
+            bits = value.strip()
+            if not bits.isdigit() or not 1 <= int(bits) <= 32:
+                raise UsageError(f"{where}: metadata {key} = {bits!r} is not a whole number of bits from 1 to 32")
+            if key != "bits" and key[len("bits_"):] not in ALLOWED_COLUMNS:
+                raise UsageError(f"{where}: metadata {key} names no known column ({', '.join(ALLOWED_COLUMNS)})")
         if key.startswith("full_scale_"):
             column = key[len("full_scale_"):]
             if column not in ALLOWED_COLUMNS:

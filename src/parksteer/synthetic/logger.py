@@ -24,7 +24,7 @@ the synthetic file, with ``synthetic: true``.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -89,6 +89,11 @@ class LoggerSettings:
     noise_rms: Mapping[str, float]
     seed: int
     bits: int = LITECORDER_BITS
+    # a channel with a converter of its own (e.g. a 14-bit handwheel angle sensor beside 8-bit torque): its bits
+    column_bits: Mapping[str, int] = field(default_factory=dict)
+
+    def bits_of(self, column: str) -> int:
+        return int(self.column_bits.get(column, self.bits))
 
     def metadata(self) -> dict[str, Any]:
         """The settings as measurement-file metadata (see parksteer.measure.io)."""
@@ -102,6 +107,8 @@ class LoggerSettings:
             if name in self.full_scale:
                 meta[f"full_scale_{name}"] = float(self.full_scale[name])
                 meta[f"noise_rms_{name}"] = float(self.noise_rms[name])
+                if name in self.column_bits:
+                    meta[f"bits_{name}"] = int(self.column_bits[name])
         return meta
 
 
@@ -133,7 +140,7 @@ def degrade(
     for name in channels:  # canonical column order, so one seed gives one file
         full_scale = logger.full_scale[name]
         noisy = add_noise(sampled[name], logger.noise_rms[name], rng)
-        out[name] = quantise(noisy, full_scale, logger.bits)
+        out[name] = quantise(noisy, full_scale, logger.bits_of(name))
         clipped = int(np.count_nonzero(np.abs(noisy) > full_scale))
         if clipped:
             meta[f"clipped_samples_{name}"] = clipped

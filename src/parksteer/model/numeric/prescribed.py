@@ -7,6 +7,11 @@ Kane equations ``M a = F + b T`` for their accelerations and the column torque T
 rack's acceleration given. The column twist (handwheel minus column angle) does not feed back on T;
 when outputs are asked for it follows from ``c dtwist/dt + k twist = T``, integrated exactly for a
 torque linear between samples at most ``TWIST_SAMPLE_S`` apart, from the static twist at the start.
+Under a column deflection law g (``ModelSpace.set_column_deflection``: the dead band of the rack lash
+candidate) the spring and damper act on g(twist), ``(k g + c g' dtwist/dt) g' = T``, and the twist is
+integrated from that law (:class:`ColumnLaw`): on an engaged flank it is the linear law's widened by
+the band, and inside the band, where the hand turns with no torque, it crosses as fast as the torque
+lets it (the rack and torque fix the handwheel angle there only within the band).
 
 Speed: the integrator (LSODA via odeint, which loops in Fortran) gets an analytic Jacobian of the
 reduced system from the compiled model's full one. With ``h = M^-1 b``, the reduced accelerations of
@@ -22,6 +27,7 @@ from __future__ import annotations
 
 import warnings
 
+from bisect import bisect_right
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Protocol
@@ -36,6 +42,12 @@ from .tolerances import PRESCRIBED_ATOL_FACTOR, PRESCRIBED_RTOL, absolute_tolera
 # Against the column's time constant c / k (0.2 s) the twist filters the torque; at 5 ms the handwheel angle
 # of a prescribed free-simulation rack is within 1e-5 rad of the free simulation's, reversals included.
 TWIST_SAMPLE_S = 0.005
+# The twist through a column deflection law (ColumnLaw.twist) is integrated to these tolerances: a dead band's
+# smoothed corners are 1e-3 rad wide (rack_lash.smoothing_width at the handwheel), the twist is wanted well inside.
+TWIST_RTOL = 1e-8
+TWIST_ATOL_RAD = 1e-10
+# Spacing of the table of a deflection law (ColumnLaw.table), rad: 1/90 of a dead band's smoothed corner.
+TWIST_TABLE_RAD = 2e-5
 # The integrator's first step, s: from rest, well inside the first output interval of any record.
 FIRST_STEP_S = 1e-4
 
@@ -192,18 +204,163 @@ def solve(run, p: np.ndarray, rack: RackMotion, t_out, rtol: float = PRESCRIBED_
     if not outputs:
         return PrescribedSolution(t_out, torque)
 
-    k_col = p[run.parameter_index("steering.column_torsional_stiffness")]
-    c_col = p[run.parameter_index("steering.column_torsional_damping")]
-    twist, twist_rate = column_twist(grid, torque, k_col, c_col)
+    i_k = run.parameter_index("steering.column_torsional_stiffness")
+    i_c = run.parameter_index("steering.column_torsional_damping")
+    twist, twist_rate = column_twist(grid, torque, p[i_k], p[i_c])
+    torque_grid = torque
     full, accs, torque, twist, twist_rate = (a[at_out] for a in (full, accs, torque, twist, twist_rate))
     column = model.evaluate_outputs(t_out, full, p, accs, np.zeros((len(t_out), 2)))
-    handwheel = np.column_stack([column["column_angle_rad"] + twist,
-                                 column["column_angle_per_rack_rad_per_m"] * full[:, n + i_rack] + twist_rate])
+    column_rate = column["column_angle_per_rack_rad_per_m"] * full[:, n + i_rack]
+    if any(getattr(e, "replaces", None) == "column_deflection" for e in run.effects):
+        # The spring and damper act on the deflection g(twist): what column_twist gave is the deflection that
+        # passes the torque; the twist is the one whose deflection that is (a dead band widens it by +-band).
+        law = ColumnLaw(model, p, i_k, i_c, t_out[0], full[0], accs[0], column["column_angle_rad"][0], column_rate[0])
+        twist, twist_rate = (a[at_out] for a in law.twist(grid, torque_grid, p[i_k], p[i_c]))
+    handwheel = np.column_stack([column["column_angle_rad"] + twist, column_rate + twist_rate])
     named = model.evaluate_outputs(t_out, full, p, accs, handwheel)
     # The solved torque: rebuilt from the handwheel through the linear column law, it would be wrong under a
     # column deflection (ModelSpace.set_column_deflection, e.g. lash).
     named["column_torque_Nm"] = torque
     return PrescribedSolution(t_out, torque, full, accs, handwheel, named)
+
+
+class ColumnLaw:
+    """A column's deflection law g(twist), read from the compiled model's column torque.
+
+    The column torque is ``(k g + c g' dtwist/dt) g'`` (``ModelSpace.set_column_deflection``; ``g(x) = x`` for the
+    paper's linear column). With k = 1 and c = 0 the model's torque output is ``g g'``; with k = 0, c = 1 and a
+    unit twist rate it is ``g'^2``: so g and g' follow at any twist, whatever the law, without its formula. The
+    slot's law is a function of the twist alone (``(model, twist) -> g``), so one state of the run serves.
+    """
+
+    def __init__(self, model, p, i_stiffness, i_damping, t, state, acceleration, column_angle, column_rate):
+        self.model, self.t, self.state, self.acceleration = model, float(t), state, acceleration
+        self.column_angle, self.column_rate = float(column_angle), float(column_rate)
+        self.p_spring, self.p_damper = p.copy(), p.copy()
+        self.p_spring[i_stiffness], self.p_spring[i_damping] = 1.0, 0.0
+        self.p_damper[i_stiffness], self.p_damper[i_damping] = 0.0, 1.0
+        self.calls = 0
+
+    def _torque(self, p, twist: np.ndarray, rate: float) -> np.ndarray:
+        m = len(twist)
+        handwheel = np.column_stack([self.column_angle + twist, np.full(m, self.column_rate + rate)])
+        self.calls += 1
+        return self.model.evaluate_outputs(np.full(m, self.t), np.broadcast_to(self.state, (m, len(self.state))), p,
+                                           np.broadcast_to(self.acceleration, (m, len(self.acceleration))),
+                                           handwheel)["column_torque_Nm"]
+
+    def deflection(self, twist) -> tuple[np.ndarray, np.ndarray]:
+        """(g, g') at `twist` (an array)."""
+        twist = np.atleast_1d(np.asarray(twist, dtype=float))
+        slope = np.sqrt(np.maximum(self._torque(self.p_damper, twist, 1.0), 1e-300))
+        return self._torque(self.p_spring, twist, 0.0) / slope, slope
+
+    def inverse(self, deflection, tolerance: float = 1e-13, max_iterations: int = 200) -> np.ndarray:
+        """The twist whose deflection is `deflection` (g is increasing).
+
+        Newton's method kept inside a bracket (bisection where a step would leave it): in a dead band g' is
+        nearly zero and a plain Newton step overshoots.
+        """
+        d = np.atleast_1d(np.asarray(deflection, dtype=float))
+        width = np.full(d.shape, 1e-3)
+        low, high = d - width, d + width
+        for _ in range(60):  # widen the brackets until they hold the root
+            out_low, out_high = self.deflection(low)[0] > d, self.deflection(high)[0] < d
+            if not (out_low.any() or out_high.any()):
+                break
+            width *= 2.0
+            low = np.where(out_low, low - width, low)
+            high = np.where(out_high, high + width, high)
+        else:
+            raise FloatingPointError("column deflection law: no twist gives the deflection")
+        x = np.clip(d, low, high)
+        for _ in range(max_iterations):
+            g, slope = self.deflection(x)
+            error = g - d
+            low, high = np.where(error < 0, x, low), np.where(error > 0, x, high)
+            if np.all(np.abs(error) <= tolerance) or np.all(high - low <= tolerance):
+                break
+            newton = x - error / slope
+            x = np.where((newton > low) & (newton < high), newton, 0.5 * (low + high))
+        return x
+
+    def table(self, low: float, high: float) -> Callable[[float], tuple[float, float]]:
+        """x -> (g, g') on [low, high] by cubic Hermite interpolation of g and g' tabulated every TWIST_TABLE_RAD
+        (exact at the nodes; between them within 1e-12 rad for corners 1e-3 rad wide), evaluated directly outside."""
+        m = int(np.ceil((high - low) / TWIST_TABLE_RAD)) + 1
+        nodes = low + TWIST_TABLE_RAD * np.arange(m)
+        g_nodes, slope_nodes = (a.tolist() for a in self.deflection(nodes))
+        h, last = TWIST_TABLE_RAD, m - 2
+
+        def law(x: float) -> tuple[float, float]:
+            u = (x - low) / h
+            k = int(u)
+            if u < 0.0 or k > last:
+                g, slope = self.deflection(x)
+                return float(g[0]), float(slope[0])
+            s = u - k
+            g0, g1, d0, d1 = g_nodes[k], g_nodes[k + 1], slope_nodes[k] * h, slope_nodes[k + 1] * h
+            s2, s3 = s * s, s * s * s
+            g = (2 * s3 - 3 * s2 + 1) * g0 + (s3 - 2 * s2 + s) * d0 + (-2 * s3 + 3 * s2) * g1 + (s3 - s2) * d1
+            slope = ((6 * s2 - 6 * s) * g0 + (3 * s2 - 4 * s + 1) * d0 + (-6 * s2 + 6 * s) * g1 + (3 * s2 - 2 * s) * d1) / h
+            return g, slope
+
+        return law
+
+    def twist(self, t: np.ndarray, torque: np.ndarray, stiffness: float, damping: float
+              ) -> tuple[np.ndarray, np.ndarray]:
+        """Twist (rad) and twist rate (rad/s) passing `torque` (linear between the samples `t`), from rest.
+
+        ``(k g + c g' dx/dt) g' = T``, i.e. ``dx/dt = (T - k g g') / (c g'^2)``: in a dead band g' is nearly zero,
+        the twist crosses the band as fast as the torque lets it, and the equation is stiff there (LSODA, which
+        switches to a stiff method). It starts from the twist whose deflection passes T(t[0]) statically.
+        Without damping the twist is the one whose deflection is T / k (g' = 1 outside a band's corners).
+        """
+        if damping <= 0.0:
+            x = self.inverse(torque / stiffness)
+            return x, np.gradient(x, t)
+        ends = self.inverse(np.array([torque.min(), torque.max(), torque[0]]) / stiffness)
+        margin = 0.5 * (ends[1] - ends[0]) + 0.01
+        law = self.table(ends[0] - margin, ends[1] + margin)
+        torque_list, time_list = torque.tolist(), t.tolist()
+        slope_T = (np.diff(torque) / np.diff(t)).tolist()
+        last = len(t) - 2
+
+        def rate(x, time):
+            k = min(max(bisect_right(time_list, time) - 1, 0), last)
+            g, slope = law(float(x[0]))
+            return (torque_list[k] + slope_T[k] * (time - time_list[k]) - stiffness * g * slope) / (damping * slope * slope)
+
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", ODEintWarning)
+            x, info = odeint(rate, ends[2:], t, rtol=TWIST_RTOL, atol=TWIST_ATOL_RAD, mxstep=200000, full_output=True)
+        if info["message"] != "Integration successful.":
+            raise solver_failure("column twist through its deflection law", info, t)
+        x = x[:, 0]
+        g, slope = self.deflection(x)
+        return x, (torque - stiffness * g * slope) / (damping * slope * slope)
+
+
+def twist_spread(run, p: np.ndarray, solution: PrescribedSolution, torque_error: np.ndarray) -> np.ndarray:
+    """How far the twist that passes the solved torque moves if that torque is off by `torque_error` (N m, per
+    sample): half the distance between the static twists passing T - error and T + error.
+
+    For the paper's linear column that is error / k. Under a deflection law it is (g^-1((T + e) / k) -
+    g^-1((T - e) / k)) / 2: on an engaged flank the same, and where |T| is within the error of zero, a dead band's
+    whole width, since a torque that small does not say which flank the hand holds (`solution` with outputs)."""
+    i_k = run.parameter_index("steering.column_torsional_stiffness")
+    stiffness = p[i_k]
+    torque_error = np.asarray(torque_error, dtype=float)
+    if not any(getattr(e, "replaces", None) == "column_deflection" for e in run.effects):
+        return torque_error / stiffness
+    model = run.model
+    i_rack = model.index("rack")
+    column = solution.outputs["column_angle_rad"]
+    rate = solution.outputs["column_angle_per_rack_rad_per_m"] * solution.states[:, model.n_q + i_rack]
+    law = ColumnLaw(model, p, i_k, run.parameter_index("steering.column_torsional_damping"), solution.time_s[0],
+                    solution.states[0], solution.accelerations[0], column[0], rate[0])
+    torque = solution.torque_Nm
+    return 0.5 * (law.inverse((torque + torque_error) / stiffness) - law.inverse((torque - torque_error) / stiffness))
 
 
 def column_twist(t: np.ndarray, torque: np.ndarray, stiffness: float, damping: float
