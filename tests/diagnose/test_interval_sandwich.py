@@ -18,6 +18,7 @@ from parksteer.diagnose.calibrate import Z95, block_sandwich
 @dataclass
 class _File:
     time_s: np.ndarray
+    signals: int = 1  # the torque alone
 
     @property
     def n(self) -> int:
@@ -77,9 +78,9 @@ def test_sandwich_agrees_with_white_noise_when_the_residual_is_white():
 
 
 @dataclass
-class _ReplayFile:
-    replay_draws_Nm: np.ndarray
-    sigma_Nm: np.ndarray
+class _ReplayFile:  # a torque-only file: its fitted signals are the torque's
+    replay_draws: np.ndarray
+    sigma: np.ndarray
 
 
 def test_replay_covariance_is_the_spread_of_the_shifts_the_racks_would_cause():

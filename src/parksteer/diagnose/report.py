@@ -141,6 +141,7 @@ def diagnosis_dict(diagnosis: Diagnosis) -> dict:
                 "bic_missing": diagnosis.settings.bic_missing_threshold,
                 "explained_fraction_missing": diagnosis.settings.explained_fraction_missing,
                 "missing_rms_ceiling": diagnosis.settings.missing_rms_ceiling,
+                "missing_ceiling_trim": diagnosis.settings.missing_ceiling_trim,
                 "bic_indistinguishable": diagnosis.settings.bic_indistinguishable,
                 "confounded_fraction": diagnosis.settings.confounded_fraction,
             },

@@ -20,8 +20,9 @@ The steps (:func:`diagnose`):
      the noise floor) or it removes at least ``explained_fraction_missing`` of the weighted
      sum of squares above the floor (a perfect model leaves a weighted sum of squares equal
      to the number of samples); either way the error with it must come within
-     ``missing_rms_ceiling`` floors, since a named effect that leaves the residual above what
-     records with nothing hidden reach is not the whole story. This is tested first: a small
+     ``missing_rms_ceiling`` floors (without its largest ``missing_ceiling_trim`` of residuals),
+     since a named effect that leaves the residual above what records with nothing hidden reach
+     along the strokes is not the whole story. This is tested first: a small
      effect that the calibration has mostly absorbed can leave the error near the floor and
      still be strongly evidenced by its shape;
    - ``adequate``: otherwise, when no candidate is strongly evidenced and the calibrated base
@@ -135,12 +136,25 @@ class Diagnosis:
         return fit_statistics(self.problem, predictions)
 
 
+def trimmed_rms(weighted: np.ndarray, trim: float) -> float:
+    """RMS of the weighted residuals without the largest fraction `trim` of them (in noise floors)."""
+    magnitudes = np.sort(np.abs(np.asarray(weighted, dtype=float)))
+    kept = magnitudes[: max(int(math.ceil((1.0 - trim) * len(magnitudes))), 1)]
+    return float(np.sqrt(np.mean(kept**2)))
+
+
 def choose_verdict(base_ratio: float, best_delta_bic: float | None, after_ratio: float | None,
-                   explained: float | None, settings: DiagnosisSettings = DEFAULT_SETTINGS) -> str:
+                   explained: float | None, settings: DiagnosisSettings = DEFAULT_SETTINGS,
+                   spread_ratio: float | None = None) -> str:
     """The verdict from the calibrated base model's weighted RMS over the floor, the best refit's BIC gain, its
-    weighted RMS over the floor and the fraction of the excess it removes (module docstring, step 6)."""
+    weighted RMS over the floor and the fraction of the excess it removes (module docstring, step 6).
+
+    `spread_ratio` is the best refit's weighted RMS without its largest ``missing_ceiling_trim`` of residuals (by
+    default `after_ratio`): the ceiling is checked on it, so that a misfit confined to a few instants does not
+    block a name while one spread along the strokes does."""
     evidenced = best_delta_bic is not None and best_delta_bic > settings.bic_missing_threshold
-    if (evidenced and after_ratio <= settings.missing_rms_ceiling
+    spread_ratio = after_ratio if spread_ratio is None else spread_ratio
+    if (evidenced and spread_ratio <= settings.missing_rms_ceiling
             and (after_ratio <= settings.adequate_rms_factor
                  or (explained is not None and explained >= settings.explained_fraction_missing))):
         return "missing"
@@ -335,8 +349,9 @@ def _diagnose(problem: Problem, effects, registry, strengths, start, settings: D
     excess = base_rss - n
     explained = (base_rss - best.refit.rss) / excess if (best is not None and excess > 0) else None
     after_ratio = math.sqrt(best.refit.rss / n) if best is not None else None
+    spread_ratio = trimmed_rms(best.refit.weighted, settings.missing_ceiling_trim) if best is not None else None
     verdict = choose_verdict(base_ratio, best.delta_bic if best is not None else None, after_ratio, explained,
-                             settings)
+                             settings, spread_ratio)
 
     separations = []
     if verdict == "missing":
