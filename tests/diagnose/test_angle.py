@@ -89,7 +89,7 @@ def test_a_soft_column_is_measured_and_nothing_else_is_found(params, tmp_path, c
     parameters, diagnosed from the command line with --angle: the verdict is adequate (no candidate evidenced, the
     weighted error at the floor), the calibrated stiffness's 95 % interval holds 700 and not the file's 1000, the
     Hooke joint's phase (the file's 0, hidden) is found within 0.05 rad (the angle against the rack shows where
-    the joint's ripple falls), the angle's weighted error is within 30 % of its noise floor, and the report gives
+    the joint's ripple falls) and its angle (Appendix B's, hidden) within its interval, the angle's weighted error is within 30 % of its noise floor, and the report gives
     the angle's floor (a 14-bit step over +-16 rad, 32 / 16383 rad) and its residual in degrees. The JSON keeps to
     its schema; the markdown and HTML reports name the angle too."""
     path = tmp_path / "soft_column.csv"
@@ -107,6 +107,10 @@ def test_a_soft_column_is_measured_and_nothing_else_is_found(params, tmp_path, c
     assert floor["quantisation_step"] == pytest.approx(32.0 / (2**ANGLE_BITS - 1))
     phase_low, phase_high = result["calibrated"]["steering.hooke_joint_phase"]["ci95"]
     assert phase_low < params["steering.hooke_joint_phase"] < phase_high and phase_high - phase_low < 0.05
+    # the joint's angle (Appendix B's 0.45 rad, hidden as it is) sets the ripple's depth: found within 10 %
+    alpha = result["calibrated"]["steering.hooke_joint_angle"]
+    assert alpha["ci95"][0] < params["steering.hooke_joint_angle"] < alpha["ci95"][1]
+    assert alpha["ci95"][1] - alpha["ci95"][0] < 0.1 * params["steering.hooke_joint_angle"]
     angle = result["statistics"]["calibrated"]["angle"]
     assert angle["rms_deg"] == pytest.approx(math.degrees(angle["rms_rad"]))
     assert angle["weighted_rms_rad"] < 1.3 * angle["noise_floor_rad"]

@@ -53,7 +53,10 @@ class DiagnosisSettings:
     # prescribed-rack replay's torque does not depend on it (the twist does not feed back on the torque), so only
     # the angle, column angle plus twist T / k, sees it (a stiffness 30 % off moves the angle by 1-5 mrad at the
     # cycle's 5-15 N m, against a 0.1-degree sensor's 0.5 mrad floor) ...
-    calibrated_with_angle: tuple[str, ...] = ("steering.column_torsional_stiffness",)
+    # The Hooke joint's angle (Appendix B gives 0.45 rad) is fitted too when the joint is in the model: it sets the
+    # depth of the joint's speed-ratio ripple, cos(alpha) to 1/cos(alpha), which the angle against the rack shows as
+    # a second harmonic of the column angle of amplitude about alpha^2 / 4 rad (0.05 rad at 0.45 rad).
+    calibrated_with_angle: tuple[str, ...] = ("steering.column_torsional_stiffness", "steering.hooke_joint_angle")
     # ... and, when the Hooke joint is in the model, its phase (a reconstruction: the paper does not give it),
     # fitted as it stands within +-pi/2 of the parameter file's value (the joint's speed ratio repeats every pi of
     # column angle), finite-difference step 0.05 rad: the joint's map from pinion to column angle departs from
