@@ -113,13 +113,24 @@ class Fit:
         n, k = self.weighted.size, len(self.parameters)
         rho = min(max(self.rho(problem), 0.0), 0.95)
         variance = self.rss / max(n - k, 1) * (1.0 + rho) / (1.0 - rho)
-        try:
-            covariance = variance * np.linalg.inv(self.jacobian.T @ self.jacobian)
-            sandwich, blocks = block_sandwich(self.jacobian, self.weighted, problem, block_s)
-            replay = replay_covariance(self.jacobian, problem)
-        except np.linalg.LinAlgError:
-            covariance, sandwich, blocks = np.full((k, k), np.inf), np.full((k, k), np.inf), 0
-            replay = np.zeros((k, k))
+        covariance, sandwich, blocks = np.full((k, k), np.inf), np.full((k, k), np.inf), 0
+        replay = np.zeros((k, k))
+        # A parameter the data do not see at all (a tyre's on air bearings) has a zero column and makes J^T J
+        # singular: its interval is infinite, and the others' come from the columns that are left.
+        norms = np.linalg.norm(self.jacobian, axis=0)
+        for seen in (np.ones(k, dtype=bool), norms > 1e-9 * max(float(norms.max(initial=0.0)), 1e-300)):
+            if not seen.any():
+                break
+            jacobian = self.jacobian[:, seen]
+            try:
+                sub = np.ix_(seen, seen)
+                covariance[sub] = variance * np.linalg.inv(jacobian.T @ jacobian)
+                sandwich[sub], blocks = block_sandwich(jacobian, self.weighted, problem, block_s)
+                replay[sub] = replay_covariance(jacobian, problem)
+                break
+            except np.linalg.LinAlgError:
+                covariance, sandwich, blocks = np.full((k, k), np.inf), np.full((k, k), np.inf), 0
+                replay = np.zeros((k, k))
         quantile = float(student_t.ppf(0.975, blocks - k)) if blocks > k else math.inf
         out = {}
         for i, (p, t) in enumerate(zip(self.parameters, self.theta)):

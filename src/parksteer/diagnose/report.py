@@ -122,6 +122,7 @@ def diagnosis_dict(diagnosis: Diagnosis) -> dict:
         ],
         "ranking": [_ranking_entry(diagnosis, c, calibrated) for c in diagnosis.ranked],
         "untestable": diagnosis.untestable,
+        "identification": diagnosis.identification,
         "unobservable": diagnosis.unobservable,
         "noise_floor_Nm": calibrated["noise_floor_Nm"],
         "attainable_floor_Nm": calibrated["attainable_floor_Nm"],
@@ -155,7 +156,25 @@ def diagnosis_dict(diagnosis: Diagnosis) -> dict:
             "attainable_floor_rad": calibrated["angle"]["attainable_floor_rad"],
             "offset_fitted": diagnosis.settings.angle_offset_fitted,
         }
-    return out
+    return _json_safe(out)
+
+
+def _json_safe(obj):
+    """The result with every value JSON can hold: a number that is not finite (a standard error of a parameter the
+    data cannot fix, when the sensitivities are singular) becomes null, and so does an interval holding one."""
+    if isinstance(obj, dict):
+        return {k: _json_safe(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        if obj and all(isinstance(v, (int, float)) for v in obj) and not all(math.isfinite(v) for v in obj):
+            return None
+        return [_json_safe(v) for v in obj]
+    if isinstance(obj, float) and not math.isfinite(obj):
+        return None
+    return obj
+
+
+def _interval(ci, digits: int = 4) -> str:
+    return "-" if ci is None else f"{_n(ci[0], digits)} to {_n(ci[1], digits)}"
 
 
 def _n(x, digits: int = 3) -> str:
@@ -186,6 +205,25 @@ def _angle_change(result: dict) -> str:
     before, after = stats["calibrated"]["angle"], stats["with_effect"]["angle"]
     return (f"; the handwheel angle's from {_n(before['weighted_rms_rad'])} rad to {_n(after['weighted_rms_rad'])} "
             f"rad against {_n(result['angle']['noise_floor_rad'])} rad")
+
+
+def _identification_lines(result: dict) -> list[str]:
+    """One sentence per calibrated (or calibratable) parameter: fixed by these data, or which test would fix it."""
+    lines = []
+    for row in result.get("identification", []):
+        key, test = row["parameter"], row["fixed_by"]
+        if row["status"] == "fixed":
+            lines.append(f"{key}: fixed by these data ({_n(row['value'], 4)}, 95 % interval {_interval(row['ci95'])}).")
+        elif row["status"] == "not calibrated":
+            lines.append(f"{key}: not fixed by these data; {test} would fix it.")
+        elif isinstance(test, dict):
+            lines.append(f"{key}: not fixed by these data (95 % interval {_interval(row['ci95'])}); the "
+                         f"{test['case']} case on {test['surface'].replace('_', ' ')} "
+                         f"would fix it: its interval's ends differ there by {_n(test['predicted_difference_rms_Nm'])} "
+                         f"N m RMS ({_n(test['over_noise_floor'])} noise floors).")
+        else:
+            lines.append(f"{key}: not fixed by these data, and no load case or surface left to measure fixes it.")
+    return lines
 
 
 def markdown_report(result: dict, figure: str | None = None) -> str:
@@ -239,8 +277,7 @@ def markdown_report(result: dict, figure: str | None = None) -> str:
     lines += ["## Calibrated parameters", "", "| parameter | default | fitted | 95 % interval |", "|---|---|---|---|"]
     for key, entry in result["calibrated"].items():
         ci = entry["ci95"]
-        lines.append(f"| {key} | {_n(entry['default'], 4)} | {_n(entry['value'], 4)} | "
-                     f"{_n(ci[0], 4)} to {_n(ci[1], 4)} |")
+        lines.append(f"| {key} | {_n(entry['default'], 4)} | {_n(entry['value'], 4)} | {_interval(ci)} |")
     lines += ["", "## Candidates", "", "| candidate | score | ΔBIC | fitted strength | weighted RMS after (N m) | "
               "identifiable fraction |", "|---|---|---|---|---|---|"]
     for c in result["ranking"]:
@@ -262,6 +299,8 @@ def markdown_report(result: dict, figure: str | None = None) -> str:
             lines.append(f"- `{c['effect']}`: only {_n(100 * c['identifiable_fraction'], 2)} % of its signature "
                          f"is not also made by `{c['confounded_with']}`; these data cannot tell it from a change of "
                          "that parameter.")
+    if result.get("identification"):
+        lines += ["", "## What these data fix", ""] + [f"- {line}" for line in _identification_lines(result)]
     if result["unobservable"]:
         lines += ["", f"Unobservable in these data as replayed (even the largest strength moves the replayed torque "
                   f"by less than a tenth of the noise floor): {', '.join(result['unobservable'])}."]
@@ -378,9 +417,12 @@ def html_report(result: dict, figures: list[tuple[str, str]], phases: list[dict]
         out.append(f"<p>Noise floor {html.escape(_n(ladder['noise_floor_Nm']))} N m; with the replay's uncertainty "
                    f"{html.escape(_n(ladder['attainable_floor_Nm']))} N m.</p>")
     out.append("<h2>Fitted values</h2>")
-    rows = [[key, _n(e["default"], 4), _n(e["value"], 4), f"{_n(e['ci95'][0], 4)} to {_n(e['ci95'][1], 4)}"]
+    rows = [[key, _n(e["default"], 4), _n(e["value"], 4), _interval(e["ci95"])]
             for key, e in result["calibrated"].items()]
     out += _table(["parameter", "default", "fitted", "95 % interval"], rows)
+    if result.get("identification"):
+        out.append("<h2>What these data fix</h2>")
+        out += ["<ul>"] + [f"<li>{html.escape(line)}</li>" for line in _identification_lines(result)] + ["</ul>"]
     out.append("<h2>Ranking of the candidate effects</h2>")
     rows = []
     for c in result["ranking"]:

@@ -112,6 +112,7 @@ class Diagnosis:
     explained_fraction: float | None
     timings_s: dict[str, float] = field(default_factory=dict)
     settings: DiagnosisSettings = DEFAULT_SETTINGS
+    identification: list[dict] = field(default_factory=list)  # what these data fix (:func:`identification`)
 
     @property
     def effect(self) -> str | None:
@@ -161,6 +162,57 @@ def choose_verdict(base_ratio: float, best_delta_bic: float | None, after_ratio:
     if base_ratio <= settings.adequate_rms_factor and not evidenced:
         return "adequate"
     return "unexplained"
+
+
+def identification(problem: Problem, calibration: Fit, settings: DiagnosisSettings = DEFAULT_SETTINGS
+                   ) -> list[dict]:
+    """What these data fix: every parameter the method calibrates (with the angle, also what only the angle
+    shows), each with a status and, where it is not fixed, the test that would fix it.
+
+    ``fixed``: calibrated, its 95 % interval within ``identified_relative_halfwidth`` of its value either side
+    (a phase-like parameter: ``identified_phase_halfwidth_rad``); ``not fixed``: calibrated with a wider
+    interval, replayed at both ends of it on the first file's rack under each load case and surface the data do
+    not cover, the condition where the torque moves most (RMS, in noise floors) named as the test that fixes
+    it; ``not calibrated``: a parameter only the handwheel angle shows, in a diagnosis without it.
+    """
+    intervals = calibration.intervals(problem, settings.interval_block_s)
+    offsets = {key for key, _, _ in settings.calibrated_with_angle_offsets}
+    out = []
+    for key in [*settings.calibrated_parameters, *settings.calibrated_with_angle, *sorted(offsets)]:
+        if key not in intervals:
+            if not problem.uses_angle and (key in settings.calibrated_with_angle or key in offsets):
+                out.append({"parameter": key, "status": "not calibrated", "value": None, "ci95": None,
+                            "fixed_by": "a handwheel angle channel, with the rack logged on 12 bits or finer "
+                                        "(parksteer diagnose --angle)"})
+            continue
+        entry = intervals[key]
+        value, ci = entry["value"], entry["ci95"]
+        if ci is None or not all(math.isfinite(c) for c in ci):
+            halfwidth = math.inf
+        else:
+            halfwidth = (ci[1] - ci[0]) / 2
+        limit = settings.identified_phase_halfwidth_rad if key in offsets \
+            else settings.identified_relative_halfwidth * abs(value)
+        row = {"parameter": key, "status": "fixed" if halfwidth <= limit else "not fixed", "value": value,
+               "ci95": ci, "fixed_by": None}
+        if row["status"] == "not fixed" and math.isfinite(halfwidth):
+            row["fixed_by"] = _fixing_test(problem, calibration, key, ci[0], ci[1])
+        out.append(row)
+    return out
+
+
+def _fixing_test(problem: Problem, calibration: Fit, key: str, low: float, high: float) -> dict | None:
+    """The uncovered condition where the parameter's two interval ends move the replayed torque most."""
+    f = problem.files[0]
+    base = calibration.overrides
+    rows = []
+    for case, surface in conditions_not_covered(problem):
+        replay = Replay(calibration.effects, case, surface, problem.params, f.rack, f.time_s)
+        ends = [replay.torque({**base, key: v}) for v in (low, high)]
+        difference = float(np.sqrt(np.mean((ends[1] - ends[0]) ** 2)))
+        rows.append({"case": case, "surface": surface, "predicted_difference_rms_Nm": difference,
+                     "over_noise_floor": difference / f.noise.total_rms})
+    return max(rows, key=lambda r: r["over_noise_floor"]) if rows else None
 
 
 def refit(problem: Problem, calibration: Fit, signature: Signature, start_strength: float,
@@ -359,7 +411,10 @@ def _diagnose(problem: Problem, effects, registry, strengths, start, settings: D
             if c is not best and c.delta_bic >= best.delta_bic - settings.bic_indistinguishable:
                 separations.append(separation(problem, best, c))
     lap("separation")
+    progress("what these data fix: the calibrated parameters' intervals")
+    identified = identification(problem, calibration, settings)
+    lap("identification")
     progress(f"verdict: {verdict}" + (f" {best.name}" if verdict == "missing" else "")
              + f" ({problem.evaluations} replays)")
     return Diagnosis(problem, base, nominal, calibration, candidates, untestable, verdict, best, separations,
-                     n_eff, rho, explained, timings, settings)
+                     n_eff, rho, explained, timings, settings, identification=identified)

@@ -124,6 +124,15 @@ class DiagnosisSettings:
     # parameters' directions are projected out is reported as confounded with them.
     confounded_fraction: float = 0.3
 
+    # --- what the data fix (parksteer.diagnose.select.identification) -------------------------------------------
+    # A calibrated parameter is fixed by the data when its 95 % interval lies within this fraction of its value
+    # either side (a phase: within this many radians): the paper's headline numbers move by 10-20 % over the
+    # reconstructed inputs, so a parameter known no better than that cannot sharpen them. A parameter that is not
+    # fixed is replayed at both ends of its interval under each load case and surface the data do not cover, and
+    # the one where the torque moves most (in noise floors) is named as the test that would fix it.
+    identified_relative_halfwidth: float = 0.1
+    identified_phase_halfwidth_rad: float = 0.1
+
     # --- the error ladder and the reports ------------------------------------------------------------------
     ladder_max_steps: int = 3  # effects added one at a time beyond the calibrated base
 
