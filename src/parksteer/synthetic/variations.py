@@ -245,6 +245,10 @@ VARIATIONS: tuple[Variation, ...] = (
               _H(0.05, 0.2), _L(1000.0, 12, 8, anti_alias_hz=200.0)),
     Variation("anti_alias_lag_50Hz", "10 Hz anti-alias filter and a torque channel 10 ms behind the rack, 50 Hz",
               _H(0.05, 0.2), _L(50.0, 12, 8, anti_alias_hz=10.0, torque_lag_s=0.01)),
+    Variation("anti_alias_50Hz", "the 10 Hz anti-alias filter alone, 50 Hz",
+              _H(0.05, 0.2), _L(50.0, 12, 8, anti_alias_hz=10.0)),
+    Variation("lag_10ms_50Hz", "the torque channel 10 ms behind the rack alone, 50 Hz",
+              _H(0.05, 0.2), _L(50.0, 12, 8, torque_lag_s=0.01)),
     Variation("three_files", "three files (unladen, part laden, largest spacer), each its own hand",
               _H(0.05, 0.2), _L(100.0, 12, 8), files=3),
 )
