@@ -195,3 +195,21 @@ def test_a_null_case_runs_end_to_end(tmp_path):
     assert o["verdict"] == "adequate" and not o["false_alarm"]
     assert o["calibrated_over_floor"] < DEFAULT_SETTINGS.adequate_rms_factor
     assert o["intervals"] == len(PERTURBATION)
+
+
+def test_a_lagged_torque_channel_is_the_unlagged_one_shifted_and_the_rack_is_untouched():
+    """A logger whose torque channel converts 10 ms after the rack: with fine converters and no noise, its rack
+    is the plain logger's rack and its torque is the plain torque 10 ms earlier (linear interpolation between
+    samples 10 ms apart at 100 Hz is exact at the sample times: the shift is one sample), away from the first
+    sample, where the lagged channel holds its first value."""
+    from parksteer.synthetic.variations import VariationLogger, variation_record
+
+    hand = HandVariant(0.05, 0.2, seed=4)
+    fine = dict(rack_bits=24, torque_bits=24, rack_noise_m=0.0, torque_noise_Nm=0.0, seed=4)
+    plain = variation_record(PARAMS, hand, VariationLogger(100.0, **fine))
+    lagged = variation_record(PARAMS, hand, VariationLogger(100.0, torque_lag_s=0.01, **fine))
+    assert np.array_equal(plain.columns["rack_m"], lagged.columns["rack_m"])
+    step = 2 * 25.0 / (2**24 - 1)
+    shifted = lagged.columns["handwheel_torque_Nm"][1:] - plain.columns["handwheel_torque_Nm"][:-1]
+    assert np.max(np.abs(shifted)) < 2 * step + 1e-6
+    assert lagged.metadata["torque_lag_s"] == "0.01"
