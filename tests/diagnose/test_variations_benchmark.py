@@ -29,6 +29,7 @@ def _design(variations=("pauses",), replicates=1, hidden=("rack_stiction",), ste
 def _row(variation, hidden="nothing", steps=0.0, verdict="adequate", named=False, covered=3, intervals=3,
          over=1.0, after=None, replicate=0, effect=""):
     return {"name": f"{variation}_{hidden}_{steps}", "variation": variation, "replicate": replicate,
+            "hidden_confounded_with": "",
             "hidden": hidden, "steps": steps, "steps_actual": steps, "verdict": verdict, "effect": effect,
             "indistinguishable": "", "named": named, "false_alarm": hidden == "nothing" and verdict == "missing",
             "calibrated_over_floor": over, "after_over_floor": after, "covered": covered, "intervals": intervals,
@@ -45,7 +46,8 @@ def test_summary_counts_each_target_by_hand_and_names_the_variation_that_misses(
         _row("a", "rack_stiction", 3.5, "missing", True, 4, 4, over=5.0, after=1.01, effect="rack_stiction"),
         _row("a", "rack_stiction", 2.0, "missing", True, 4, 4, over=3.0, after=1.05, effect="rack_stiction"),
         _row("b", verdict="missing", over=1.2, effect="column_friction"),  # a false alarm
-        {**_row("b", "rack_stiction", 3.5, "unexplained", False, 1, 3, over=2.0), "not_covered": "p q"},
+        {**_row("b", "rack_stiction", 3.5, "unexplained", False, 1, 3, over=2.0), "not_covered": "p q",
+         "hidden_confounded_with": "steering.rack_friction_force"},
         _row("b", "rack_stiction", 1.0, "adequate", False, 3, 3, over=1.1),  # below the named rate's size
     ]
     s = summarise(rows)
@@ -64,7 +66,12 @@ def test_summary_counts_each_target_by_hand_and_names_the_variation_that_misses(
     assert by["a"]["named_count"] == [2, 2] and by["a"]["null_over_floor"] == [1.0, 1.0]
     assert by["a"]["named_after_over_floor"] == [1.01, 1.05]
     assert by["b"]["not_covered"] == {"p": 1, "q": 1} and by["a"]["not_covered"] == {}
-    assert by["b"]["missed"][0] == {"hidden": "rack_stiction", "steps": 3.5, "said": "unexplained", "effect": ""}
+    assert by["b"]["missed"][0] == {"hidden": "rack_stiction", "steps": 3.5, "said": "unexplained", "effect": "",
+                                    "confounded_with": "steering.rack_friction_force"}
+    h = s["by_hidden"]["rack_stiction"]
+    assert h["named_count"] == [2, 3] and h["missed_flagged_confounded"] == 1
+    assert h["confounded_with"] == ["steering.rack_friction_force"]
+    assert h["missed_in"] == ["b"] and h["named_in_all_of"] == ["a"]
     assert s["null_over_floor"] == {"min": 1.0, "max": 1.2}
     assert s["thresholds"] == {"adequate_rms_factor": DEFAULT_SETTINGS.adequate_rms_factor,
                                "missing_rms_ceiling": DEFAULT_SETTINGS.missing_rms_ceiling}
@@ -111,10 +118,22 @@ def test_outcome_names_from_the_group_and_scores_the_reported_models_intervals()
                                "column_friction.torque": _interval(0.1, 0.3)}}]
     result = _result("missing", "column_friction", group=["rack_stiction"], ranking=ranking)
     o = outcome(_truth("rack_stiction", 250.0), result)
-    assert o["named"] and not o["false_alarm"]
+    assert o["named"] and not o["false_alarm"] and o["hidden_confounded_with"] == ""
     assert (o["covered"], o["intervals"]) == (1, 3)
     assert o["not_covered"] == "column_friction.torque steering.rack_friction_force"
     assert o["calibrated_over_floor"] == pytest.approx(1.5) and o["after_over_floor"] == pytest.approx(1.05)
+
+
+def test_outcome_records_when_the_diagnosis_warned_the_hidden_effect_is_confounded():
+    """A hidden effect called adequate is not named; when the diagnosis listed it as confounded with a calibrated
+    parameter, the outcome keeps that warning (the miss was flagged, not silent)."""
+    result = {**_result("adequate", None, calibrated={"steering.rack_friction_force": _interval(760.0, 780.0)}),
+              "confounded": [{"effect": "kingpin_friction", "confounded_with": "steering.rack_friction_force",
+                              "identifiable_fraction": 0.1}]}
+    truth = {**_truth("kingpin_friction", 0.003), "strength_key": "kingpin_friction.friction_radius"}
+    o = outcome(truth, result)
+    assert not o["named"] and o["hidden_confounded_with"] == "steering.rack_friction_force"
+    assert (o["covered"], o["intervals"]) == (0, 1)  # the rack friction absorbed the hidden friction: 770 vs 700
 
 
 def test_outcome_of_a_null_scores_the_calibrated_intervals_and_a_false_alarm():

@@ -234,6 +234,8 @@ def outcome(truth: dict, result: dict) -> dict:
                for k, v in _reported_intervals(result).items() if k in values and v.get("ci95") is not None}
     floor = result["noise_floor_Nm"]
     after = result["statistics"]["with_effect"]
+    # the diagnosis's own warning that the hidden effect's signature is mostly a calibrated parameter's direction
+    confounded = next((c["confounded_with"] for c in result.get("confounded", []) if c["effect"] == hidden), None)
     return {
         "name": truth["name"],
         "variation": truth["variation"],
@@ -246,6 +248,8 @@ def outcome(truth: dict, result: dict) -> dict:
         "indistinguishable": " ".join(group),
         "named": bool(hidden is not None and missing and (named_effect == hidden or hidden in group)),
         "false_alarm": bool(hidden is None and missing),
+        "hidden_confounded_with": confounded or "",
+        "torque_lag_s": variation_by_name(truth["variation"]).logger.torque_lag_s,
         "calibrated_over_floor": result["statistics"]["calibrated"]["weighted_rms_Nm"] / floor,
         "after_over_floor": after["weighted_rms_Nm"] / floor if after else None,
         "covered": sum(covered.values()),
@@ -284,7 +288,8 @@ def summarise(rows: list[dict], design: VariationDesign | None = None) -> dict:
             if n and k / n < targets_of[key]:
                 misses.append({"variation": name, "target": key, "value": k / n, "count": [k, n]})
         entry["false_alarms"] = sum(r["false_alarm"] for r in nulls)
-        entry["missed"] = [{"hidden": r["hidden"], "steps": r["steps"], "said": r["verdict"], "effect": r["effect"]}
+        entry["missed"] = [{"hidden": r["hidden"], "steps": r["steps"], "said": r["verdict"], "effect": r["effect"],
+                            "confounded_with": r.get("hidden_confounded_with", "")}
                            for r in rs if r["hidden"] != "nothing" and not r["named"]]
         missed_keys = [k for r in rs for k in r["not_covered"].split()]
         entry["not_covered"] = {k: missed_keys.count(k) for k in sorted(set(missed_keys))}
@@ -293,7 +298,34 @@ def summarise(rows: list[dict], design: VariationDesign | None = None) -> dict:
         walls = [r["wall_s"] for r in rs if r.get("wall_s") is not None]
         entry["wall_s_median"] = float(np.median(walls)) if walls else None
         table.append(entry)
+    by_hidden = {}
+    for effect in dict.fromkeys(r["hidden"] for r in rows if r["hidden"] != "nothing"):
+        counted = [r for r in rows if r["hidden"] == effect and r["steps"] >= NAMED_MIN_STEPS]
+        missed = [r for r in counted if not r["named"]]
+        flagged = [r for r in missed if r.get("hidden_confounded_with")]
+        by_hidden[effect] = {
+            "named_count": [len(counted) - len(missed), len(counted)],
+            "named": _rate(len(counted) - len(missed), len(counted)),
+            "missed_flagged_confounded": len(flagged),
+            "confounded_with": sorted({r["hidden_confounded_with"] for r in flagged}),
+            "missed_in": list(dict.fromkeys(r["variation"] for r in missed)),
+            "named_in_all_of": [v for v in dict.fromkeys(r["variation"] for r in counted)
+                                if all(r["named"] for r in counted if r["variation"] == v)],
+        }
     total = counts(rows)
+    # Where the misses come from: records whose torque channel lags the rack (a logger error the diagnosis has no
+    # term for), records whose hidden effect went unnamed while the diagnosis reported it confounded with a
+    # calibrated parameter, and the rest.
+    lagged = [r for r in rows if r.get("torque_lag_s", 0.0) > 0.0]
+    flagged = [r for r in rows if r not in lagged and r["hidden"] != "nothing" and not r["named"]
+               and r.get("hidden_confounded_with")]
+    rest = [r for r in rows if r not in lagged and r not in flagged]
+    sources = {name: {"records": len(rs), "coverage_count": [sum(r["covered"] for r in rs),
+                                                             sum(r["intervals"] for r in rs)]}
+               for name, rs in (("lagged_channel", lagged), ("confounded_unnamed", flagged), ("rest", rest))}
+    counted = [r for r in rows if r["hidden"] != "nothing" and r["steps"] >= NAMED_MIN_STEPS]
+    unflagged = [r for r in counted if r["named"] or not r.get("hidden_confounded_with")]
+    sources["named_where_not_flagged_confounded"] = [sum(r["named"] for r in unflagged), len(unflagged)]
     targets = {key: {"value": _rate(k, n), "count": [k, n], "target": targets_of[key],
                      "met": bool(n and k / n >= targets_of[key])} for key, (k, n) in total.items()}
     null_floors = [r["calibrated_over_floor"] for r in rows if r["hidden"] == "nothing"]
@@ -305,6 +337,8 @@ def summarise(rows: list[dict], design: VariationDesign | None = None) -> dict:
         "target_met": all(t["met"] for t in targets.values()),
         "misses": misses,
         "named_min_steps": NAMED_MIN_STEPS,
+        "by_hidden": by_hidden,
+        "sources": sources,
         "variations": table,
         "null_over_floor": {"min": min(null_floors), "max": max(null_floors)} if null_floors else None,
         "named_after_over_floor": {"min": min(named_after), "max": max(named_after)} if named_after else None,
