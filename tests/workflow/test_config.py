@@ -34,6 +34,8 @@ def test_the_shipped_configuration_is_valid(config, schema):
     ("car", "files", [["unladen"]]),  # (case, surface) pairs
     ("variants", "air_bearing", {"model": "full", "surface": "ice"}),  # a known surface
     ("car", "colour", "red"),  # no unknown key
+    ("variations", "files", [["unladen", "ground"]] * 4),  # a case has one to three files
+    ("variations", "full_grid", "yes"),  # a switch
 ])
 def test_a_bad_design_entry_is_refused(config, schema, section, key, value):
     bad = copy.deepcopy(config)

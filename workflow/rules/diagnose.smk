@@ -6,11 +6,14 @@
 # model and the base model with each candidate, the example user effect among them) is derived by rule derive
 # before any of these runs. diag_outclass_case and diag_outclass are the out-of-class benchmark
 # (config["outclass"]): rival effects that are not candidates, hidden by a truth generator that is not the
-# diagnosis model, scored against the physically closest candidate.
+# diagnosis model, scored against the physically closest candidate. diag_variation_case and diag_variations are
+# the variation benchmark (config["variations"]): records of other hands, loggers and drives, with nothing or a
+# library effect hidden, scored against the targets of parksteer.diagnose.variations.
 from parksteer.diagnose.benchmark import case_names as _bench_case_names
 from parksteer.diagnose.candidates import candidate_models
 from parksteer.parameters import load_parameters as _load_parameters
 from parksteer.diagnose.outclass import case_names as _outclass_case_names
+from parksteer.diagnose.variations import VariationDesign, case_names as _variation_case_names
 from parksteer.synthetic.datasets import BenchmarkDesign, CarDesign, OutclassDesign, file_name as _diag_file_name
 
 DIAG_USER_EFFECT = os.path.relpath(PACKAGE_DIR / "examples" / "column_imbalance.py")
@@ -28,6 +31,9 @@ DIAG_OUTCLASS_FILES = [_diag_file_name(c, s) for c, s in DIAG_OUTCLASS.files]
 # the truth generator's models: the base model with each rival (none of them a candidate)
 DIAG_OUTCLASS_MODELS = [model_manifest(f"with_{rival}", f"+{rival}") for rival in DIAG_OUTCLASS.rivals]
 FIGURES["diag_outclass"] = ["figures/diag_outclass.svg", "figures/diag_outclass.csv"]
+DIAG_VARIATIONS = VariationDesign.from_config(config["variations"], config["benchmark"])
+DIAG_VARIATION_CASES = _variation_case_names(DIAG_VARIATIONS)
+FIGURES["diag_variations"] = ["figures/diag_variations.svg", "figures/diag_variations.csv"]
 
 
 rule diag_car_data:
@@ -200,3 +206,50 @@ rule diag_outclass:
         "../envs/parksteer.yaml"
     script:
         "../scripts/diag_outclass.py"
+
+
+# A case's files depend on its variation (one to three), so they go to a folder output.
+rule diag_variation_case:
+    input:
+        parameters=PARAMETERS,
+        models=DIAG_MODELS,
+        code=script_sources("diag_variation_case"),
+    output:
+        files=directory("results/diagnose/variations/{name}"),
+        truth="results/diagnose/variations/{name}.truth.json",
+        diagnosis="results/diagnose/variations/{name}.diagnosis.json",
+    params:
+        design=config["variations"],
+        benchmark=config["benchmark"],
+    wildcard_constraints:
+        name="|".join(DIAG_VARIATION_CASES) if DIAG_VARIATION_CASES else "none",
+    log:
+        "logs/diag_variation_case/{name}.log",
+    benchmark:
+        benchmark_file("diag_variation_case", "name")
+    conda:
+        "../envs/parksteer.yaml"
+    script:
+        "../scripts/diag_variation_case.py"
+
+
+rule diag_variations:
+    input:
+        truths=expand("results/diagnose/variations/{name}.truth.json", name=DIAG_VARIATION_CASES),
+        diagnoses=expand("results/diagnose/variations/{name}.diagnosis.json", name=DIAG_VARIATION_CASES),
+        code=script_sources("diag_variations"),
+    output:
+        svg=figure_report("figures/diag_variations.svg", "diagnose"),
+        csv=figure_report("figures/diag_variations.csv", "diagnose"),
+        json="results/diag_variations.json",
+    params:
+        design=config["variations"],
+        benchmark=config["benchmark"],
+    log:
+        "logs/diag_variations.log",
+    benchmark:
+        benchmark_file("diag_variations")
+    conda:
+        "../envs/parksteer.yaml"
+    script:
+        "../scripts/diag_variations.py"

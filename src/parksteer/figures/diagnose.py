@@ -349,3 +349,79 @@ def make_outclass_figure(truth_paths, diagnosis_paths, svg: str | Path, csv: str
                                         "the threshold)"})
     write_json(json_path, summary)
     return summary
+
+
+VARIATION_SHADES = {True: "#4daf4a", False: "#e41a1c", None: "#e0e0e0"}
+
+
+def variations_figure(rows: list[dict], summary: dict, path: str | Path) -> None:
+    """The variation benchmark, one row per variation and one for the whole grid. Left: the three targets' rates
+    (named, nulls adequate, intervals covering), each cell its count and shaded by whether the target holds.
+    Right: each null record's calibrated weighted error in noise floors (circles) and each named record's error
+    with the named effect (triangles), against the diagnosis's adequate_rms_factor and missing_rms_ceiling."""
+    from ..diagnose.settings import DEFAULT_SETTINGS
+    from ..diagnose.variations import COVERAGE_TARGET, NAMED_TARGET, NULL_ADEQUATE_TARGET
+
+    table = summary["variations"]
+    labels = [v["variation"].replace("_", " ") for v in table] + ["all"]
+    columns = [("named", NAMED_TARGET, f"named\n(≥ {summary['named_min_steps']:g} steps)"),
+               ("null_adequate", NULL_ADEQUATE_TARGET, "nulls\nadequate"),
+               ("coverage", COVERAGE_TARGET, "95 % intervals\ncovering")]
+    fig, axes = new_figure(7.4, 0.34 * len(labels) + 1.6, ncols=2, gridspec_kw={"width_ratios": [1.1, 1.6]})
+    ax = axes[0]
+    for i, entry in enumerate(table + [None]):
+        for j, (key, target, _title) in enumerate(columns):
+            k, n = (entry[f"{key}_count"] if entry is not None else summary["targets"][key]["count"])
+            met = None if n == 0 else k / n >= target
+            ax.add_patch(_cell(j, i, VARIATION_SHADES[met]))
+            ax.text(j, i, f"{k}/{n}" if n else "-", ha="center", va="center", fontsize=7,
+                    fontweight="bold" if entry is None else "normal")
+    ax.axhline(len(table) - 0.5, color="black", linewidth=0.8)
+    ax.set_xlim(-0.5, len(columns) - 0.5)
+    ax.set_ylim(len(labels) - 0.5, -0.5)
+    ax.set_xticks(np.arange(len(columns)), [f"{t}\ntarget {100 * g:.0f} %" for _k, g, t in columns], fontsize=6.5)
+    ax.xaxis.tick_top()
+    ax.set_yticks(np.arange(len(labels)), labels, fontsize=7)
+    ax.grid(False)
+    ax = axes[1]
+    for i, entry in enumerate(table):
+        nulls = entry["null_over_floor"]
+        after = entry["named_after_over_floor"]
+        ax.plot(nulls, [i - 0.12] * len(nulls), "o", color=COLOURS[0], markersize=5, alpha=0.8,
+                label="nothing hidden: calibrated model" if i == 0 else None)
+        ax.plot(after, [i + 0.12] * len(after), "^", color=COLOURS[1], markersize=5, alpha=0.8,
+                label="hidden effect named: with it" if i == 0 else None)
+    adequate, ceiling = DEFAULT_SETTINGS.adequate_rms_factor, DEFAULT_SETTINGS.missing_rms_ceiling
+    ax.axvline(adequate, color="black", linestyle="--", linewidth=1.0, label=f"adequate_rms_factor {adequate:g}")
+    ax.axvline(ceiling, color="black", linestyle=":", linewidth=1.0, label=f"missing_rms_ceiling {ceiling:g}")
+    values = [x for e in table for x in e["null_over_floor"] + e["named_after_over_floor"]]
+    ax.set_xlim(min(values + [1.0]) - 0.05, max(values + [ceiling]) + 0.08)
+    ax.set_ylim(len(labels) - 0.5, -0.5)
+    ax.set_yticks(np.arange(len(labels)), [""] * len(labels))
+    ax.set_xlabel("weighted RMS error, noise floors")
+    ax.legend(fontsize=6.5, loc="lower right")
+    fig.tight_layout()
+    save_svg(fig, path)
+
+
+def make_variations_figure(truth_paths, diagnosis_paths, svg: str | Path, csv: str | Path, json_path: str | Path,
+                           design=None) -> dict:
+    """figures/diag_variations.svg (targets per variation, errors against the thresholds), its CSV (one row per
+    record) and results/diag_variations.json (the per-variation table and the targets)."""
+    from ..diagnose.variations import aggregate
+    from ..tables import write_csv, write_json
+
+    rows, summary = aggregate(truth_paths, diagnosis_paths, design)
+    variations_figure(rows, summary, svg)
+    # the diagnosis's wall time differs from run to run; it stays in the JSON summary, out of the figure data
+    columns = {key: [("" if r[key] is None else r[key]) for r in rows] for key in rows[0] if key != "wall_s"} \
+        if rows else {}
+    write_csv(csv, columns, {"figure": "diag_variations: one row per record set of the variation benchmark",
+                             "steps": "hidden size requested, converter steps of torque RMS over the case's files",
+                             "steps_actual": "the size the strength search reached",
+                             "named": "verdict missing with the hidden effect named or in the reported group",
+                             "calibrated_over_floor": "calibrated base model's weighted RMS error, noise floors",
+                             "after_over_floor": "with the named effect, noise floors",
+                             "covered": "of the reported model's 95 % intervals, those holding the true value"})
+    write_json(json_path, summary)
+    return summary

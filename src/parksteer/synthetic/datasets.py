@@ -570,19 +570,11 @@ def outclass_specs(params: Parameters, design: OutclassDesign, registry=None) ->
 def chain_logged(params: Parameters, columns: dict[str, np.ndarray], chain: ChainLogger, case: str, surface: str,
                  seed: int, hand_profile: HandProfile) -> Measurement:
     """Pass clean columns (time_s, rack_m, handwheel_torque_Nm on a fine even grid) through the logger chain."""
-    from scipy.signal import butter, sosfilt, sosfilt_zi
-
     from ..measure.io import metadata_text
     from .logger import add_noise, quantise, resample
 
     t = np.asarray(columns["time_s"], dtype=float)
-    dt = float(t[1] - t[0])
-    sos = butter(chain.anti_alias_order, chain.anti_alias_hz, fs=1.0 / dt, output="sos")
-    filtered = {}
-    for name in ("rack_m", "handwheel_torque_Nm"):
-        x = np.asarray(columns[name], dtype=float)
-        filtered[name], _ = sosfilt(sos, x, zi=sosfilt_zi(sos) * x[0])  # from rest at the first value
-    filtered["handwheel_torque_Nm"] = np.interp(t - chain.torque_lag_s, t, filtered["handwheel_torque_Nm"])
+    filtered = anti_alias_and_lag(t, columns, chain.anti_alias_hz, chain.anti_alias_order, chain.torque_lag_s)
     time_s, sampled = resample(t, filtered, chain.sample_rate_hz)
     s = params.sections["synthetic"]
     rng = np.random.default_rng(seed)
@@ -602,6 +594,25 @@ def chain_logged(params: Parameters, columns: dict[str, np.ndarray], chain: Chai
     metadata.update(hand_profile.metadata)
     return Measurement(path=None, columns={"time_s": time_s, "rack_m": rack, "handwheel_torque_Nm": torque},
                        metadata={k: metadata_text(v) for k, v in metadata.items()})
+
+
+def anti_alias_and_lag(time_s: np.ndarray, columns: dict[str, np.ndarray], anti_alias_hz: float, order: int,
+                       torque_lag_s: float) -> dict[str, np.ndarray]:
+    """The analogue front of a logger on clean columns sampled on a fine even grid `time_s`: a causal Butterworth
+    low-pass of `order` at `anti_alias_hz` on the rack and the torque (run from rest at the first value; none when
+    `anti_alias_hz` is 0), then the torque channel delayed `torque_lag_s` behind the rack (linear interpolation)."""
+    from scipy.signal import butter, sosfilt, sosfilt_zi
+
+    t = np.asarray(time_s, dtype=float)
+    filtered = {}
+    if anti_alias_hz > 0.0:
+        sos = butter(order, anti_alias_hz, fs=1.0 / float(t[1] - t[0]), output="sos")
+    for name in ("rack_m", "handwheel_torque_Nm"):
+        x = np.asarray(columns[name], dtype=float)
+        filtered[name] = sosfilt(sos, x, zi=sosfilt_zi(sos) * x[0])[0] if anti_alias_hz > 0.0 else x.copy()
+    if torque_lag_s:
+        filtered["handwheel_torque_Nm"] = np.interp(t - torque_lag_s, t, filtered["handwheel_torque_Nm"])
+    return filtered
 
 
 def chain_torque_step_Nm(params: Parameters, chain: ChainLogger) -> float:

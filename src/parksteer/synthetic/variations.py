@@ -17,13 +17,15 @@ in every one of these, each in a way a real test could:
   (whose full scale is left out): the diagnosis then knows the torque's step and estimates the rack's noise
   from the data.
 
-:func:`null_variations` names one record per way of differing: with nothing hidden, a diagnosis must say
-``adequate`` on each; ``benchmarks/bench_variations.py`` hides library effects in them as well.
+:data:`VARIATIONS` names one record per way of differing (besides the above: uneven strokes, a driver who
+overshoots the lock, 8-, 12- and 16-bit racks beside 8-, 10- and 12-bit torques, 50 Hz to 1 kHz, an anti-alias
+filter and a channel lag, three files to a case): with nothing hidden, a diagnosis must say ``adequate`` on
+each; the variation benchmark (:mod:`parksteer.diagnose.variations`) hides library effects in them as well.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -50,6 +52,9 @@ class HandVariant:
     second strokes (0: no pause). ``end``: ``"rest"`` keeps the record going ``rest_after_s`` at rest
     after the hand stops at straight ahead; ``"mid_stroke"`` cuts the record ``cut_before_end_s`` before
     the hand's stop, while it is slowing (the last stroke's ramp to rest lasts ``ramp_s``).
+    ``stroke_scale``: each of the three strokes lasts its Section 4 duration times this factor (uneven strokes:
+    one hurried, one slow; each still covers its travel). ``overshoot``: the driver turns past each lock by this
+    fraction of the lock angle and comes back to it in ``overshoot_return_s`` before the next stroke (0: none).
     """
 
     rate_variation: float = 0.05
@@ -59,6 +64,9 @@ class HandVariant:
     rest_after_s: float = 1.0
     cut_before_end_s: float = 0.15
     ramp_s: float = 0.6
+    stroke_scale: tuple[float, float, float] = (1.0, 1.0, 1.0)
+    overshoot: float = 0.0
+    overshoot_return_s: float = 0.8
     seed: int = 0
 
     def __post_init__(self):
@@ -68,6 +76,10 @@ class HandVariant:
             raise UsageError(f"hand end must be 'rest' or 'mid_stroke', got {self.end!r}")
         if self.end == "mid_stroke" and not 0.0 < self.cut_before_end_s < self.ramp_s:
             raise UsageError("a mid-stroke end must cut the record inside the last ramp to rest")
+        if len(self.stroke_scale) != 3 or not all(0.5 <= f <= 2.0 for f in self.stroke_scale):
+            raise UsageError(f"hand stroke scale must be three factors in [0.5, 2], got {self.stroke_scale}")
+        if not 0.0 <= self.overshoot <= 0.2:
+            raise UsageError(f"hand overshoot must be in [0, 0.2] of the lock angle, got {self.overshoot:g}")
 
 
 def _smoothstep_rate(t: np.ndarray, t0: float, t1: float, ramp: float) -> np.ndarray:
@@ -81,17 +93,23 @@ def _smoothstep_rate(t: np.ndarray, t0: float, t1: float, ramp: float) -> np.nda
 def variation_hand(params: Parameters, hand: HandVariant) -> tuple[np.ndarray, np.ndarray]:
     """(time s, handwheel angle rad) of `hand`, sampled every HAND_DT_S from 0 to the record's end.
 
-    Each stroke covers exactly its travel (lock, -2 lock, lock): its rate is scaled so that its
-    integral does, whatever the speed variation.
+    Each stroke covers exactly its travel (lock, -2 lock, lock; with an overshoot, past each lock and back): its
+    rate is scaled so that its integral does, whatever the speed variation.
     """
     p = params.sections["input"]
     lock = p["handwheel_lock_angle"]
-    durations = [p["time_to_right_lock"], p["time_right_to_left_lock"], p["time_left_lock_to_centre"]]
-    travels = (lock, -2.0 * lock, lock)
+    durations = [f * p[k] for f, k in zip(hand.stroke_scale, ("time_to_right_lock", "time_right_to_left_lock",
+                                                                "time_left_lock_to_centre"))]
+    travels = [lock, -2.0 * lock, lock]
+    pauses = [hand.pause_s, hand.pause_s, 0.0]
+    if hand.overshoot > 0.0:  # past the right lock and back, past the left lock and back
+        over = hand.overshoot * lock
+        durations = [durations[0], hand.overshoot_return_s, durations[1], hand.overshoot_return_s, durations[2]]
+        travels = [lock + over, -over, -2.0 * lock - over, over, lock]
+        pauses = [hand.pause_s, 0.0, hand.pause_s, 0.0, 0.0]
     rng = np.random.default_rng(hand.seed)
     frequencies = hand.frequency_hz * rng.uniform(0.5, 1.5, size=2)
     phases = rng.uniform(0.0, 2.0 * np.pi, size=2)
-    pauses = (hand.pause_s, hand.pause_s, 0.0)
     end_hand = sum(durations) + sum(pauses)
     end_record = end_hand + hand.rest_after_s if hand.end == "rest" else end_hand - hand.cut_before_end_s
     t = np.arange(0.0, max(end_record, end_hand) + 0.5 * HAND_DT_S, HAND_DT_S)
@@ -99,12 +117,13 @@ def variation_hand(params: Parameters, hand: HandVariant) -> tuple[np.ndarray, n
     rate = np.zeros_like(t)
     start = 0.0
     for duration, travel, pause in zip(durations, travels, pauses):
+        ramp = min(hand.ramp_s, 0.5 * duration)
         if pause > 0.0:  # the hand slows to rest half way, rests, and goes on
             half = 0.5 * duration
-            shape = (_smoothstep_rate(t, start, start + half, hand.ramp_s)
-                     + _smoothstep_rate(t, start + half + pause, start + duration + pause, hand.ramp_s))
+            shape = (_smoothstep_rate(t, start, start + half, ramp)
+                     + _smoothstep_rate(t, start + half + pause, start + duration + pause, ramp))
         else:
-            shape = _smoothstep_rate(t, start, start + duration, hand.ramp_s)
+            shape = _smoothstep_rate(t, start, start + duration, ramp)
         piece = shape * wander
         area = float(np.sum(0.5 * (piece[1:] + piece[:-1]) * np.diff(t)))
         rate += travel / area * piece
@@ -117,7 +136,12 @@ def variation_hand(params: Parameters, hand: HandVariant) -> tuple[np.ndarray, n
 
 @dataclass(frozen=True)
 class VariationLogger:
-    """A logger with its own sample rate and a converter per channel: rack and torque bits, full scales, noise."""
+    """A logger with its own sample rate and a converter per channel: rack and torque bits, full scales, noise.
+
+    ``anti_alias_hz`` (0: none) and ``torque_lag_s`` put the out-of-class logger chain's analogue front before the
+    sampling (:func:`parksteer.synthetic.datasets.anti_alias_and_lag`: a causal Butterworth of
+    ``anti_alias_order`` on both channels, the torque channel delayed behind the rack).
+    """
 
     sample_rate_hz: float = 100.0
     rack_bits: int = 12
@@ -126,6 +150,9 @@ class VariationLogger:
     torque_full_scale_Nm: float = 25.0
     rack_noise_m: float = 2e-5
     torque_noise_Nm: float = 0.1
+    anti_alias_hz: float = 0.0
+    anti_alias_order: int = 2
+    torque_lag_s: float = 0.0
     seed: int = 0
 
 
@@ -137,13 +164,14 @@ def variation_record(params: Parameters, hand: HandVariant, logger: VariationLog
     by default nothing is (a null).
     """
     from ..model.numeric.simulate import simulate
+    from .datasets import anti_alias_and_lag
 
     drive = variation_rack(params, hand)
+    # at least two clean samples per logged one, so that a 1 kHz logger samples a signal finer than itself
     result = simulate(case, effects=effects, overrides=overrides, surface=surface, rack_drive=drive, params=params,
-                      output_dt_s=CLEAN_DT_S)
+                      output_dt_s=min(CLEAN_DT_S, 0.5 / logger.sample_rate_hz))
     t = np.asarray(result.columns["time_s"], dtype=float)
-    clean = {"rack_m": np.asarray(result.columns["rack_m"]),
-             "handwheel_torque_Nm": np.asarray(result.columns["handwheel_torque_Nm"])}
+    clean = anti_alias_and_lag(t, result.columns, logger.anti_alias_hz, logger.anti_alias_order, logger.torque_lag_s)
     time_s, sampled = resample(t, clean, logger.sample_rate_hz)
     rng = np.random.default_rng(logger.seed)
     rack = quantise(add_noise(sampled["rack_m"], logger.rack_noise_m, rng), logger.rack_full_scale_m, logger.rack_bits)
@@ -156,6 +184,14 @@ def variation_record(params: Parameters, hand: HandVariant, logger: VariationLog
         "rack_bits": logger.rack_bits, "hand_rate_variation": hand.rate_variation, "hand_pause_s": hand.pause_s,
         "hand_end": hand.end, "hand_seed": hand.seed, "noise_seed": logger.seed,
     }
+    if hand.stroke_scale != (1.0, 1.0, 1.0):
+        metadata["hand_stroke_scale"] = " ".join(f"{f:g}" for f in hand.stroke_scale)
+    if hand.overshoot:
+        metadata["hand_overshoot"] = hand.overshoot
+    if logger.anti_alias_hz:
+        metadata["anti_alias_hz"] = logger.anti_alias_hz
+    if logger.torque_lag_s:
+        metadata["torque_lag_s"] = logger.torque_lag_s
     columns = {"time_s": time_s, "rack_m": rack, "handwheel_torque_Nm": torque}
     return Measurement(path=None, columns=columns, metadata={k: metadata_text(v) for k, v in metadata.items()})
 
@@ -166,16 +202,65 @@ def variation_rack(params: Parameters, hand: HandVariant):
     return interpolate_rack(t_hand, rack_of_hand(params, angle))
 
 
+@dataclass(frozen=True)
+class Variation:
+    """One way a record can differ from the benchmark's: a hand, a logger (each without its seed) and how many
+    files a case has (the first ``files`` of the design's file list, each with its own hand and noise seeds)."""
+
+    name: str
+    what: str
+    hand: HandVariant
+    logger: VariationLogger
+    files: int = 1
+
+    def settings(self, seed: int) -> tuple[HandVariant, VariationLogger]:
+        """The hand and logger of this variation with `seed` for the hand's wander and the logger's noise."""
+        return replace(self.hand, seed=seed), replace(self.logger, seed=seed)
+
+
+_H = HandVariant
+_L = VariationLogger
+# Every variation of the variation benchmark (parksteer.diagnose.variations), in a fixed order: a record's seeds
+# follow its place here, so that choosing a subset in config/config.yaml does not change any record.
+VARIATIONS: tuple[Variation, ...] = (
+    Variation("rest_after_stop", "5 % smooth rate variation, 1.5 s at rest after the stop",
+              _H(0.05, 0.2, 0.0, "rest", 1.5), _L(100.0, 12, 8)),
+    Variation("mid_stroke_end", "record cut 0.2 s before the hand stops, while it slows",
+              _H(0.04, 0.25, 0.0, "mid_stroke", cut_before_end_s=0.2), _L(100.0, 12, 8)),
+    Variation("pauses", "0.8 s pauses at rest inside the first two strokes",
+              _H(0.06, 0.15, 0.8, "rest", 0.5), _L(100.0, 12, 8)),
+    Variation("rate_8pc_50Hz", "8 % rate variation, logged at 50 Hz",
+              _H(0.08, 0.3, 0.0, "rest", 0.3), _L(50.0, 12, 8)),
+    Variation("rate_3pc_200Hz", "3 % rate variation, logged at 200 Hz, cut mid-stroke",
+              _H(0.03, 0.1, 0.0, "mid_stroke", cut_before_end_s=0.1), _L(200.0, 12, 8)),
+    Variation("rack_8bit_torque_12bit", "8-bit rack beside a 12-bit torque, pauses, cut mid-stroke",
+              _H(0.05, 0.2, 0.6, "mid_stroke", cut_before_end_s=0.15), _L(100.0, 8, 12, rack_noise_m=2e-4)),
+    Variation("uneven_strokes", "strokes 0.7, 1.3 and 0.85 times their Section 4 durations",
+              _H(0.05, 0.2, stroke_scale=(0.7, 1.3, 0.85)), _L(100.0, 12, 8)),
+    Variation("lock_overshoot", "past each lock by 5 % of the lock angle and back in 0.8 s",
+              _H(0.05, 0.2, overshoot=0.05, overshoot_return_s=0.8), _L(100.0, 12, 8)),
+    Variation("rack_16bit_torque_10bit", "16-bit rack beside a 10-bit torque",
+              _H(0.05, 0.2), _L(100.0, 16, 10)),
+    Variation("anti_alias_1kHz", "logged at 1 kHz behind a second-order 200 Hz anti-alias filter",
+              _H(0.05, 0.2), _L(1000.0, 12, 8, anti_alias_hz=200.0)),
+    Variation("anti_alias_lag_50Hz", "10 Hz anti-alias filter and a torque channel 10 ms behind the rack, 50 Hz",
+              _H(0.05, 0.2), _L(50.0, 12, 8, anti_alias_hz=10.0, torque_lag_s=0.01)),
+    Variation("anti_alias_50Hz", "the 10 Hz anti-alias filter alone, 50 Hz",
+              _H(0.05, 0.2), _L(50.0, 12, 8, anti_alias_hz=10.0)),
+    Variation("lag_10ms_50Hz", "the torque channel 10 ms behind the rack alone, 50 Hz",
+              _H(0.05, 0.2), _L(50.0, 12, 8, torque_lag_s=0.01)),
+    Variation("three_files", "three files (unladen, part laden, largest spacer), each its own hand",
+              _H(0.05, 0.2), _L(100.0, 12, 8), files=3),
+)
+
+
+def variation_by_name(name: str) -> Variation:
+    for v in VARIATIONS:
+        if v.name == name:
+            return v
+    raise UsageError(f"unknown variation {name!r} (known: {', '.join(v.name for v in VARIATIONS)})")
+
+
 def null_variations(seed: int = 0) -> list[tuple[str, HandVariant, VariationLogger]]:
-    """A small set of independent null records' settings (name, hand, logger), one per way a record can differ."""
-    return [
-        ("rest_after_stop", HandVariant(0.05, 0.2, 0.0, "rest", 1.5, seed=seed + 1), VariationLogger(100.0, 12, 8, seed=seed + 1)),
-        ("mid_stroke_end", HandVariant(0.04, 0.25, 0.0, "mid_stroke", cut_before_end_s=0.2, seed=seed + 2),
-         VariationLogger(100.0, 12, 8, seed=seed + 2)),
-        ("pauses", HandVariant(0.06, 0.15, 0.8, "rest", 0.5, seed=seed + 3), VariationLogger(100.0, 12, 8, seed=seed + 3)),
-        ("rate_8pc_50Hz", HandVariant(0.08, 0.3, 0.0, "rest", 0.3, seed=seed + 4), VariationLogger(50.0, 12, 8, seed=seed + 4)),
-        ("rate_3pc_200Hz", HandVariant(0.03, 0.1, 0.0, "mid_stroke", cut_before_end_s=0.1, seed=seed + 5),
-         VariationLogger(200.0, 12, 8, seed=seed + 5)),
-        ("rack_8bit_torque_12bit", HandVariant(0.05, 0.2, 0.6, "mid_stroke", cut_before_end_s=0.15, seed=seed + 6),
-         VariationLogger(100.0, 8, 12, rack_noise_m=2e-4, seed=seed + 6)),
-    ]
+    """The first six variations' settings (name, hand, logger), hand and noise seeded seed + 1 to seed + 6."""
+    return [(v.name, *v.settings(seed + i + 1)) for i, v in enumerate(VARIATIONS[:6])]

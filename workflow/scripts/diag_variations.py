@@ -1,0 +1,9 @@
+# Thin rule script: the logic is parksteer.figures.diagnose.make_variations_figure.
+from parksteer.diagnose.variations import VariationDesign
+from parksteer.figures.diagnose import make_variations_figure
+from parksteer.rules import rule_log
+
+with rule_log(snakemake):
+    make_variations_figure(list(snakemake.input.truths), list(snakemake.input.diagnoses), snakemake.output.svg,
+                           snakemake.output.csv, snakemake.output.json,
+                           VariationDesign.from_config(snakemake.params.design, snakemake.params.benchmark))
