@@ -399,7 +399,8 @@ def variations_figure(rows: list[dict], summary: dict, path: str | Path) -> None
     ax.set_ylim(len(labels) - 0.5, -0.5)
     ax.set_yticks(np.arange(len(labels)), [""] * len(labels))
     ax.set_xlabel("weighted RMS error, noise floors")
-    ax.legend(fontsize=6.5, loc="lower right")
+    # below the axes, clear of every row's markers
+    ax.legend(fontsize=6.5, loc="upper center", bbox_to_anchor=(0.5, -0.09), ncol=2, frameon=False)
     fig.tight_layout()
     save_svg(fig, path)
 
