@@ -102,10 +102,11 @@ class DiagnosisSettings:
     # Whichever of the two holds, the error with the named effect must come within this many noise floors: a
     # named effect that leaves the residual above what records with nothing hidden reach is not the whole story
     # ("unexplained", with the candidate reported as the nearest). Records with nothing hidden reach 1.0-1.02
-    # floors in the in-class benchmark, 1.02-1.11 over the variation benchmark's hands and loggers and 1.08-1.24
-    # through the out-of-class benchmark's logger chain; named effects in the in-class benchmark leave 0.99-1.09.
-    # 1.3 is above that whole spread; a rival of another form that the nearest candidate half explains
-    # (top-mount wind-up read as the brush patch: 1.67 floors after) is below it.
+    # floors in the in-class benchmark, 0.94-1.21 over the variation benchmark's full grid of hands and loggers
+    # (0.96-1.07 on its default grid) and 1.08-1.24 through the out-of-class benchmark's logger chain; correctly
+    # named effects leave 0.99-1.09 in the in-class benchmark and 0.91-1.28 over the variation benchmark's full
+    # grid. 1.3 is above that whole spread, if only just for the last; a rival of another form that the nearest
+    # candidate half explains (top-mount wind-up read as the brush patch: 1.67 floors after) is well above it.
     missing_rms_ceiling: float = 1.3
     # The ceiling is checked without the largest 2 % of the named model's weighted residuals: a misfit confined
     # to a few instants the replay cannot time (the hand crossing a lash band, which neither the rack nor the
