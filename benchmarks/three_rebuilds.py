@@ -63,7 +63,7 @@ def main() -> int:
     parser.add_argument("--cores", type=int, default=2)
     parser.add_argument("--keep-models", action="store_true")
     parser.add_argument("targets", nargs="*")
-    args = parser.parse_args()
+    args = parser.parse_intermixed_args()  # the targets may follow the options, as the usage line shows them
     env = {k: v for k, v in os.environ.items() if k != "PARKSTEER_MODEL_CACHE"}
     with tempfile.TemporaryDirectory(prefix="parksteer-rebuilds-") as tmp:
         work = scratch_copy(Path(tmp))
