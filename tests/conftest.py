@@ -3,6 +3,8 @@ per session, seeded) for the data-set and diagnosis tests."""
 
 from __future__ import annotations
 
+import shutil
+import subprocess
 from pathlib import Path
 
 import pytest
@@ -16,6 +18,24 @@ REPO_ROOT = Path(__file__).resolve().parents[1]
 def repo_root() -> Path:
     """The repository checkout (holds Snakefile, workflow/, data/)."""
     return REPO_ROOT
+
+
+@pytest.fixture(scope="session")
+def copy_repository(repo_root):
+    """copy(dest) -> dest: the repository's tracked and new, not ignored, files copied into `dest` (no outputs, no
+    model cache), for the tests that run the pipeline in a scratch copy."""
+
+    def copy(dest: Path) -> Path:
+        listed = subprocess.run(["git", "ls-files", "-z", "--cached", "--others", "--exclude-standard"],
+                                cwd=repo_root, capture_output=True, text=True, check=True).stdout.split("\0")
+        for name in filter(None, listed):
+            source = repo_root / name
+            if source.is_file():
+                (dest / name).parent.mkdir(parents=True, exist_ok=True)
+                shutil.copy2(source, dest / name)
+        return dest
+
+    return copy
 
 
 @pytest.fixture(scope="session")

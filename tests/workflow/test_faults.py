@@ -75,15 +75,8 @@ def _leftovers(work: Path) -> list[str]:
 
 
 @pytest.fixture(scope="module")
-def copy(repo_root, tmp_path_factory) -> Path:
-    listed = subprocess.run(["git", "ls-files", "-z", "--cached", "--others", "--exclude-standard"], cwd=repo_root,
-                            capture_output=True, text=True, check=True).stdout.split("\0")
-    work = tmp_path_factory.mktemp("faults")
-    for name in filter(None, listed):
-        source = repo_root / name
-        if source.is_file():
-            (work / name).parent.mkdir(parents=True, exist_ok=True)
-            shutil.copy2(source, work / name)
+def copy(repo_root, copy_repository, tmp_path_factory) -> Path:
+    work = copy_repository(tmp_path_factory.mktemp("faults"))
     cache = repo_root / "results" / "model"
     entries = [p for p in cache.iterdir() if p.is_dir() and not p.name.startswith(".")] if cache.is_dir() else []
     if not entries:

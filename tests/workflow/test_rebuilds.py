@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import os
 import re
-import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -58,16 +57,9 @@ def edit():
 
 
 @pytest.fixture(scope="module")
-def repository_copy(repo_root, tmp_path_factory) -> Path:
+def repository_copy(copy_repository, tmp_path_factory) -> Path:
     """A copy of the repository whose every pipeline output exists and is up to date."""
-    listed = subprocess.run(["git", "ls-files", "-z", "--cached", "--others", "--exclude-standard"], cwd=repo_root,
-                            capture_output=True, text=True, check=True).stdout.split("\0")
-    work = tmp_path_factory.mktemp("rebuilds")
-    for name in filter(None, listed):
-        source = repo_root / name
-        if source.is_file():
-            (work / name).parent.mkdir(parents=True, exist_ok=True)
-            shutil.copy2(source, work / name)
+    work = copy_repository(tmp_path_factory.mktemp("rebuilds"))
     summary = _snakemake(work, "--summary", "all")
     for line in summary.splitlines()[1:]:
         output = work / line.split("\t")[0]

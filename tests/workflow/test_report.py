@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import json
 import re
-import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -42,17 +41,9 @@ def _script_value(html: str, name: str):
 
 
 @pytest.fixture(scope="module")
-def repository_copy(repo_root, tmp_path_factory) -> Path:
+def repository_copy(copy_repository, tmp_path_factory) -> Path:
     """A copy of the repository (its tracked and new files)."""
-    listed = subprocess.run(["git", "ls-files", "-z", "--cached", "--others", "--exclude-standard"], cwd=repo_root,
-                            capture_output=True, text=True, check=True).stdout.split("\0")
-    work = tmp_path_factory.mktemp("report")
-    for name in filter(None, listed):
-        source = repo_root / name
-        if source.is_file():
-            (work / name).parent.mkdir(parents=True, exist_ok=True)
-            shutil.copy2(source, work / name)
-    return work
+    return copy_repository(tmp_path_factory.mktemp("report"))
 
 
 def _report(work: Path, target: str, *options: str) -> tuple[list[str], dict, str]:

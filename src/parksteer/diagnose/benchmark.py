@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import json
 import time
+from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
@@ -42,6 +43,35 @@ def case_names(design: BenchmarkDesign, params: Parameters | None = None) -> lis
     return [s.name for s in benchmark_specs(params or load_parameters(), design)]
 
 
+def diagnose_written(params: Parameters, records, folder: str | Path, truth: dict, truth_path: str | Path,
+                     diagnosis_path: str | Path, started_s: float) -> dict:
+    """Write `records` ((case, surface, measurement) each) into `folder`, diagnose them from the files (read back
+    through the reader a user's file goes through), write the truth and the result. The result's cost gains the
+    diagnosis's wall time and the generation's (from `started_s`, a perf_counter reading, to the files written)."""
+    paths = []
+    for case, surface, measurement in records:
+        path = Path(folder) / file_name(case, surface)
+        write_measurement(path, measurement, params)
+        paths.append(path)
+    generated = time.perf_counter()
+    result = diagnosis_dict(diagnose(load_files(paths, params), params))
+    result["cost"]["wall_s"] = time.perf_counter() - generated
+    result["cost"]["generation_s"] = generated - started_s
+    write_json(truth_path, truth)
+    write_json(diagnosis_path, result)
+    return result
+
+
+def paired_results(truth_paths, diagnosis_paths, what: str) -> Iterator[tuple[dict, dict]]:
+    """(truth, diagnosis) of each data set, paired by file name; a pair whose names differ is refused in one line
+    naming `what` benchmark."""
+    for t_path, d_path in zip(sorted(map(str, truth_paths)), sorted(map(str, diagnosis_paths))):
+        if Path(t_path).name.split(".")[0] != Path(d_path).name.split(".")[0]:
+            raise UsageError(f"{what}: truth {t_path} and diagnosis {d_path} do not pair up")
+        yield (json.loads(Path(t_path).read_text(encoding="utf-8")),
+               json.loads(Path(d_path).read_text(encoding="utf-8")))
+
+
 def run_case(parameters_path: str | Path, design: BenchmarkDesign, name: str, folder: str | Path,
              truth_path: str | Path, diagnosis_path: str | Path) -> dict:
     """Generate data set `name`, write its files into `folder`, diagnose them from the files, write truth and result."""
@@ -51,20 +81,8 @@ def run_case(parameters_path: str | Path, design: BenchmarkDesign, name: str, fo
         raise UsageError(f"unknown benchmark data set {name!r}")
     start = time.perf_counter()
     dataset = make_dataset(params, specs[name])
-    folder = Path(folder)
-    paths = []
-    for measurement, (case, surface) in zip(dataset.measurements, specs[name].files):
-        path = folder / file_name(case, surface)
-        write_measurement(path, measurement, params)
-        paths.append(path)
-    generated = time.perf_counter()
-    files = load_files(paths, params)
-    result = diagnosis_dict(diagnose(files, params))
-    result["cost"]["wall_s"] = time.perf_counter() - generated
-    result["cost"]["generation_s"] = generated - start
-    write_json(truth_path, dataset.truth)
-    write_json(diagnosis_path, result)
-    return result
+    records = [(case, surface, m) for m, (case, surface) in zip(dataset.measurements, specs[name].files)]
+    return diagnose_written(params, records, folder, dataset.truth, truth_path, diagnosis_path, start)
 
 
 def outcome(truth: dict, result: dict) -> dict:
@@ -107,13 +125,7 @@ def _fraction(values) -> float | None:
 def aggregate(truth_paths: list[str | Path], diagnosis_paths: list[str | Path],
               design: BenchmarkDesign | None = None) -> tuple[list[dict], dict]:
     """(one outcome per data set, the summary numbers, with the design they were made with if given)."""
-    rows = []
-    for t_path, d_path in zip(sorted(map(str, truth_paths)), sorted(map(str, diagnosis_paths))):
-        truth = json.loads(Path(t_path).read_text(encoding="utf-8"))
-        result = json.loads(Path(d_path).read_text(encoding="utf-8"))
-        if Path(t_path).name.split(".")[0] != Path(d_path).name.split(".")[0]:
-            raise UsageError(f"benchmark: truth {t_path} and diagnosis {d_path} do not pair up")
-        rows.append(outcome(truth, result))
+    rows = [outcome(truth, result) for truth, result in paired_results(truth_paths, diagnosis_paths, "benchmark")]
     candidates = [r for r in rows if r["kind"] == "candidate"]
     nulls = [r for r in rows if r["kind"] == "null"]
     outside = [r for r in rows if r["kind"] == "outside"]

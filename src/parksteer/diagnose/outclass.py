@@ -14,20 +14,14 @@ indistinguishable band (the diagnosis's own ``bic_indistinguishable``).
 
 from __future__ import annotations
 
-import json
 import time
-from pathlib import Path
 
 import numpy as np
 
 from ..errors import UsageError
-from ..measure.io import write_measurement
 from ..parameters import load_parameters
-from ..synthetic.datasets import OUTCLASS_RIVALS, OutclassDesign, file_name, make_outclass_dataset, outclass_specs
-from ..tables import write_json
-from .problem import load_files
-from .report import diagnosis_dict
-from .select import diagnose
+from ..synthetic.datasets import OUTCLASS_RIVALS, OutclassDesign, make_outclass_dataset, outclass_specs
+from .benchmark import diagnose_written, paired_results
 
 ADEQUATE_LIMIT_STEPS = 3.0  # a hidden effect this large (converter steps RMS) must not be called adequate
 
@@ -44,18 +38,8 @@ def run_case(parameters_path, design: OutclassDesign, name: str, folder, truth_p
         raise UsageError(f"unknown out-of-class data set {name!r}")
     start = time.perf_counter()
     dataset = make_outclass_dataset(params, specs[name], design)
-    paths = []
-    for measurement, (case, surface) in zip(dataset.measurements, specs[name].files):
-        path = Path(folder) / file_name(case, surface)
-        write_measurement(path, measurement, params)
-        paths.append(path)
-    generated = time.perf_counter()
-    result = diagnosis_dict(diagnose(load_files(paths, params), params))
-    result["cost"]["wall_s"] = time.perf_counter() - generated
-    result["cost"]["generation_s"] = generated - start
-    write_json(truth_path, dataset.truth)
-    write_json(diagnosis_path, result)
-    return result
+    records = [(case, surface, m) for m, (case, surface) in zip(dataset.measurements, specs[name].files)]
+    return diagnose_written(params, records, folder, dataset.truth, truth_path, diagnosis_path, start)
 
 
 def bic_margin(result: dict) -> float | None:
@@ -121,12 +105,8 @@ def outcome(truth: dict, result: dict) -> dict:
 
 def aggregate(truth_paths, diagnosis_paths, design: OutclassDesign | None = None) -> tuple[list[dict], dict]:
     """(one outcome per data set, the summary: confusion table, the target's misses, the closest-candidate table)."""
-    rows = []
-    for t_path, d_path in zip(sorted(map(str, truth_paths)), sorted(map(str, diagnosis_paths))):
-        if Path(t_path).name.split(".")[0] != Path(d_path).name.split(".")[0]:
-            raise UsageError(f"out-of-class benchmark: truth {t_path} and diagnosis {d_path} do not pair up")
-        rows.append(outcome(json.loads(Path(t_path).read_text(encoding="utf-8")),
-                            json.loads(Path(d_path).read_text(encoding="utf-8"))))
+    rows = [outcome(truth, result)
+            for truth, result in paired_results(truth_paths, diagnosis_paths, "out-of-class benchmark")]
     rivals = [r for r in rows if r["kind"] == "rival"]
     nulls = [r for r in rows if r["kind"] == "null"]
     confusion: dict[str, dict[str, int]] = {}

@@ -203,16 +203,28 @@ def identification(problem: Problem, calibration: Fit, settings: DiagnosisSettin
 
 def _fixing_test(problem: Problem, calibration: Fit, key: str, low: float, high: float) -> dict | None:
     """The uncovered condition where the parameter's two interval ends move the replayed torque most."""
-    f = problem.files[0]
     base = calibration.overrides
+    rows = differences_by_condition(problem, [(calibration.effects, {**base, key: v}) for v in (low, high)])
+    return max(rows, key=lambda r: r["over_noise_floor"]) if rows else None
+
+
+def differences_by_condition(problem: Problem, runs: list[tuple[list[Effect], dict[str, float]]]) -> list[dict]:
+    """Two runs ((effects, overrides) each) replayed on the first file's rack under each load case and surface the
+    data do not cover: their RMS torque difference there, in N m and in the file's noise floors. Runs of the same
+    effect set share one prepared replay per condition."""
+    f = problem.files[0]
     rows = []
     for case, surface in conditions_not_covered(problem):
-        replay = Replay(calibration.effects, case, surface, problem.params, f.rack, f.time_s)
-        ends = [replay.torque({**base, key: v}) for v in (low, high)]
-        difference = float(np.sqrt(np.mean((ends[1] - ends[0]) ** 2)))
+        replays: dict[int, Replay] = {}
+        predicted = []
+        for effects, overrides in runs:
+            if id(effects) not in replays:
+                replays[id(effects)] = Replay(effects, case, surface, problem.params, f.rack, f.time_s)
+            predicted.append(replays[id(effects)].torque(overrides))
+        difference = float(np.sqrt(np.mean((predicted[0] - predicted[1]) ** 2)))
         rows.append({"case": case, "surface": surface, "predicted_difference_rms_Nm": difference,
                      "over_noise_floor": difference / f.noise.total_rms})
-    return max(rows, key=lambda r: r["over_noise_floor"]) if rows else None
+    return rows
 
 
 def refit(problem: Problem, calibration: Fit, signature: Signature, start_strength: float,
@@ -266,16 +278,7 @@ def conditions_not_covered(problem: Problem) -> list[tuple[str, str]]:
 
 def separation(problem: Problem, best: Candidate, other: Candidate) -> Separation:
     """Replay both fitted models on the first file's rack under each uncovered condition (module docstring)."""
-    f = problem.files[0]
-    rows = []
-    for case, surface in conditions_not_covered(problem):
-        predicted = []
-        for candidate in (best, other):
-            replay = Replay(candidate.signature.model, case, surface, problem.params, f.rack, f.time_s)
-            predicted.append(replay.torque(candidate.refit.overrides))
-        difference = float(np.sqrt(np.mean((predicted[0] - predicted[1]) ** 2)))
-        rows.append({"case": case, "surface": surface, "predicted_difference_rms_Nm": difference,
-                     "over_noise_floor": difference / f.noise.total_rms})
+    rows = differences_by_condition(problem, [(c.signature.model, c.refit.overrides) for c in (best, other)])
     top = max(rows, key=lambda r: r["over_noise_floor"])
     return Separation(other.name, float(other.delta_bic), top["case"], top["surface"],
                       top["predicted_difference_rms_Nm"], top["over_noise_floor"], rows)

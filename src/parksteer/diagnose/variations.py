@@ -24,24 +24,17 @@ covering in COVERAGE_TARGET. :func:`summarise` reports each and the variations w
 
 from __future__ import annotations
 
-import json
-import math
 import time
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
 from ..errors import UsageError
-from ..measure.io import write_measurement
 from ..parameters import Parameters, load_parameters
-from ..synthetic.datasets import file_name, perturbed_base
+from ..synthetic.datasets import SizeSearch, perturbed_base, rms_difference, strength_for_rms
 from ..synthetic.logger import quantisation_step
 from ..synthetic.variations import VARIATIONS, Variation, variation_by_name, variation_rack, variation_record
-from ..tables import write_json
-from .problem import load_files
-from .report import diagnosis_dict
-from .select import diagnose
+from .benchmark import diagnose_written, paired_results
 from .settings import DEFAULT_SETTINGS
 
 NAMED_MIN_STEPS = 2.0  # converter steps RMS: hidden effects at least this large count towards the named rate
@@ -49,7 +42,8 @@ NAMED_TARGET = 0.90  # of those, named first or in the reported group
 NULL_ADEQUATE_TARGET = 0.95  # of records with nothing hidden, called adequate
 COVERAGE_TARGET = 0.90  # of the reported model's 95 % intervals, holding the true value
 SEARCH_DT_S = 0.01  # s, output spacing of the clean runs the hidden strength is searched on
-SEARCH_STEPS = 3  # secant steps of that search after the probe
+SEARCH_STEPS = 3  # evaluations of that search after the probe
+SEARCH_TOLERANCE = 0.02  # accepted relative error of the hidden RMS change
 
 
 @dataclass(frozen=True)
@@ -127,25 +121,11 @@ def _case_files(case: VariationCase, design: VariationDesign):
             for i, (load_case, surface) in enumerate(design.files[:case.variation.files])]
 
 
-def _torque_change_Nm(params: Parameters, files, base: dict, effect: str, key: str, strength: float) -> float:
-    """RMS change of the clean torque over all files when `effect` is added at `strength` (prescribed rack)."""
-    from ..model.numeric.simulate import simulate
-
-    diffs = []
-    for load_case, surface, hand, _logger in files:
-        drive = variation_rack(params, hand)
-        runs = [simulate(load_case, effects=effects, overrides=overrides, surface=surface, rack_drive=drive,
-                         params=params, output_dt_s=SEARCH_DT_S).columns["handwheel_torque_Nm"]
-                for effects, overrides in ((None, base), (f"+{effect}", {**base, key: strength}))]
-        diffs.append(np.asarray(runs[1], dtype=float) - np.asarray(runs[0], dtype=float))
-    d = np.concatenate(diffs)
-    return float(np.sqrt(np.mean(d**2)))
-
-
 def hidden_strength(params: Parameters, files, base: dict, effect: str, target_Nm: float) -> tuple[str, float, float]:
     """(strength key, strength, RMS torque change at it, N m) of `effect` changing the clean torque by
-    `target_Nm` RMS over `files`: a probe at a hundredth of the upper bound, then secant steps in log-log
-    (the change grows as a power of the strength), clipped to the upper bound."""
+    `target_Nm` RMS over `files` (prescribed racks), found by the benchmark's size search
+    (:func:`parksteer.synthetic.datasets.strength_for_rms`) from a probe at a hundredth of the upper bound."""
+    from ..model.numeric.simulate import simulate
     from ..model.symbolic.components import discover_effects, strength_parameter
 
     registry = discover_effects()
@@ -153,20 +133,21 @@ def hidden_strength(params: Parameters, files, base: dict, effect: str, target_N
         raise UsageError(f"config variations.hidden: unknown effect {effect!r}")
     quantity = strength_parameter(registry[effect], params)
     key, upper = quantity.key, quantity.upper
-    s0 = upper * 1e-2
-    d0 = _torque_change_Nm(params, files, base, effect, key, s0)
-    s1 = min(s0 * target_Nm / d0, upper) if d0 > 0 else upper
-    d1 = _torque_change_Nm(params, files, base, effect, key, s1)
-    for _ in range(SEARCH_STEPS - 1):
-        if d1 <= 0 or abs(math.log(target_Nm / d1)) < 0.02 or s1 == s0 or d0 <= 0:
-            break
-        slope = max(math.log(d1 / d0) / math.log(s1 / s0), 0.1)
-        s2 = min(s1 * (target_Nm / d1) ** (1.0 / slope), upper)
-        if s2 == s1:
-            break
-        s0, d0, s1 = s1, d1, s2
-        d1 = _torque_change_Nm(params, files, base, effect, key, s1)
-    return key, s1, d1
+    drives = [(load_case, surface, variation_rack(params, hand)) for load_case, surface, hand, _logger in files]
+    torques: dict[float, np.ndarray] = {}  # each strength simulated once, the search's reference (0) included
+
+    def torque_of(strength: float) -> np.ndarray:
+        if strength not in torques:
+            effects, overrides = (None, base) if strength == 0.0 else (f"+{effect}", {**base, key: strength})
+            torques[strength] = np.concatenate([
+                np.asarray(simulate(load_case, effects=effects, overrides=overrides, surface=surface, rack_drive=drive,
+                                    params=params, output_dt_s=SEARCH_DT_S).columns["handwheel_torque_Nm"], dtype=float)
+                for load_case, surface, drive in drives])
+        return torques[strength]
+
+    strength = strength_for_rms(torque_of, target_Nm, upper * 1e-2, upper,
+                                SizeSearch(iterations=SEARCH_STEPS, tolerance=SEARCH_TOLERANCE, max_lag_s=0.0))
+    return key, strength, rms_difference(torque_of(strength), torque_of(0.0))
 
 
 def run_case(parameters_path, design: VariationDesign, name: str, folder, truth_path, diagnosis_path) -> dict:
@@ -185,26 +166,16 @@ def run_case(parameters_path, design: VariationDesign, name: str, folder, truth_
         key, strength, change = hidden_strength(params, files, base, case.hidden, case.steps * torque_step)
         overrides[key] = strength
         steps_actual = change / torque_step
-    paths = []
-    for load_case, surface, hand, logger in files:
-        record = variation_record(params, hand, logger, load_case, surface, overrides=overrides,
-                                  effects=f"+{case.hidden}" if case.hidden else None)
-        path = Path(folder) / file_name(load_case, surface)
-        write_measurement(path, record, params)
-        paths.append(path)
-    generated = time.perf_counter()
-    result = diagnosis_dict(diagnose(load_files(paths, params), params))
-    result["cost"]["wall_s"] = time.perf_counter() - generated
-    result["cost"]["generation_s"] = generated - start
+    records = [(load_case, surface, variation_record(params, hand, logger, load_case, surface, overrides=overrides,
+                                                      effects=f"+{case.hidden}" if case.hidden else None))
+               for load_case, surface, hand, logger in files]
     truth = {
         "name": case.name, "variation": case.variation.name, "what": case.variation.what,
         "replicate": case.replicate, "seed": case.seed, "hidden": case.hidden, "steps_requested": case.steps,
         "steps": steps_actual, "torque_step_Nm": torque_step, "strength_key": key, "strength": strength,
         "base_overrides": base, "files": [{"case": c, "surface": s} for c, s, _h, _l in files],
     }
-    write_json(truth_path, truth)
-    write_json(diagnosis_path, result)
-    return result
+    return diagnose_written(params, records, folder, truth, truth_path, diagnosis_path, start)
 
 
 def _reported_intervals(result: dict) -> dict[str, dict]:
@@ -357,10 +328,6 @@ def summarise(rows: list[dict], design: VariationDesign | None = None) -> dict:
 
 def aggregate(truth_paths, diagnosis_paths, design: VariationDesign | None = None) -> tuple[list[dict], dict]:
     """(one outcome per case, the summary of :func:`summarise`) from the cases' truth and diagnosis files."""
-    rows = []
-    for t_path, d_path in zip(sorted(map(str, truth_paths)), sorted(map(str, diagnosis_paths))):
-        if Path(t_path).name.split(".")[0] != Path(d_path).name.split(".")[0]:
-            raise UsageError(f"variation benchmark: truth {t_path} and diagnosis {d_path} do not pair up")
-        rows.append(outcome(json.loads(Path(t_path).read_text(encoding="utf-8")),
-                            json.loads(Path(d_path).read_text(encoding="utf-8"))))
+    rows = [outcome(truth, result)
+            for truth, result in paired_results(truth_paths, diagnosis_paths, "variation benchmark")]
     return rows, summarise(rows, design)

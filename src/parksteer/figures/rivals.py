@@ -92,13 +92,18 @@ def compare_rivals(params: Parameters, simulate=None, rivals=RIVALS, progress=No
     target = lifting["unladen_ground"]["rise_Nm"]
     step = converter_step_Nm(params)
 
+    cycles: dict[tuple[str, str, float], dict] = {}  # each (rival, test, strength) simulated once
+
     def added(rival, key, strength) -> dict:
+        if (rival, key, strength) in cycles:
+            return cycles[rival, key, strength]
         _, case, surface, _ = next(t for t in TESTS if t[0] == key)
         quantity = strength_parameter(registry[rival], params)
         columns = simulate(case, effects=f"+{rival}", overrides={quantity.key: strength}, params=params,
                            surface=surface).columns
         near, plateau = _near_and_plateau(columns, params)
-        return entry(near - base_numbers[key][0], plateau - base_numbers[key][1])
+        cycles[rival, key, strength] = entry(near - base_numbers[key][0], plateau - base_numbers[key][1])
+        return cycles[rival, key, strength]
 
     out = {}
     for rival in rivals:
