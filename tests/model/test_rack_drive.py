@@ -180,3 +180,24 @@ def test_prescribed_rack_with_lash_gives_back_the_free_handwheel_angle(params):
     widened = (d["handwheel_angle_rad"] - d["column_angle_rad"] - linear)[engaged]
     held = np.abs(d["handwheel_torque_Nm"][engaged]) > 1.0
     assert np.max(np.abs(widened[held] - a * np.sign(d["handwheel_torque_Nm"][engaged][held]))) < 0.05 * a
+
+
+def test_the_compiled_rack_table_is_the_spline_scipy_evaluates(params):
+    """The compiled model reads the rack from a table of its polynomial pieces: at any time, inside the record
+    and beyond either end (held at the end values), it gives scipy's PPoly position, speed and acceleration
+    (an evaluation written independently of the C one), so the replay integrates the rack it was given."""
+    from parksteer.model.numeric.prescribed import rack_table
+
+    rng = np.random.default_rng(4)
+    t = np.sort(rng.uniform(0.0, 3.0, 40))
+    spline = CubicSpline(t, 0.05 * np.sin(2.0 * t) + 1e-3 * rng.standard_normal(40))
+    rack = RackSpline.from_ppoly(spline)
+    run = prepare("unladen", params=params)
+    table = rack_table(rack)
+    out = np.zeros(3)
+    times = np.concatenate([rng.uniform(t[0], t[-1], 200), t, [t[0] - 1.0, t[-1] + 1.0]])
+    for time in times:
+        run.model.lib.ps_rack(float(time), table.ctypes.data, out.ctypes.data)
+        inside = min(max(time, t[0]), t[-1])
+        expected = [float(spline(inside, nu)) for nu in (0, 1, 2)]
+        np.testing.assert_allclose(out, expected, rtol=1e-9, atol=1e-12)

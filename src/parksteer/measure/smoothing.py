@@ -20,13 +20,12 @@ least certain there. :meth:`SmoothedRack.perturbed` and :meth:`SmoothedRack.resm
 other racks the data allow as well; :mod:`parksteer.diagnose.problem` replays them to measure
 that uncertainty at every sample.
 
-Every rack here is a :class:`RackSpline` (a piecewise polynomial with ``scalar()``, ``start_s`` and
+Every rack here is a :class:`RackSpline` (a piecewise polynomial: ``breaks``, ``coefficients``, ``start_s`` and
 ``end_s``), the rack motion :func:`parksteer.model.numeric.prescribed.solve` takes.
 """
 
 from __future__ import annotations
 
-import bisect
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -114,25 +113,6 @@ class RackSpline:
             speed = speed * h + position
             position = position * h + c[i]
         return position, speed, accel
-
-    def scalar(self) -> Callable[[float], tuple[float, float, float]]:
-        """A fast scalar evaluator t -> (position, speed, acceleration) for an integrator's right-hand side."""
-        x = [float(v) for v in self.breaks]
-        columns = [[float(v) for v in column] for column in self.coefficients.T]
-        last, t0, t1 = len(x) - 2, x[0], x[-1]
-
-        def at(t: float) -> tuple[float, float, float]:
-            t = t0 if t < t0 else (t1 if t > t1 else t)
-            k = min(bisect.bisect_right(x, t) - 1, last)
-            h = t - x[k]
-            position = speed = accel = 0.0
-            for c in columns[k]:
-                accel = accel * h + 2.0 * speed
-                speed = speed * h + position
-                position = position * h + c
-            return position, speed, accel
-
-        return at
 
 
 def interpolate_rack(time_s, rack_m) -> RackSpline:
@@ -231,12 +211,19 @@ def _knot_vector(t: np.ndarray, spacing_s: float, turns: tuple[float, ...] = (),
     return np.concatenate([[t[0]] * 4, knots, [t[-1]] * 4])
 
 
-def _window_fit(time_s: np.ndarray, rack_m: np.ndarray, noise: float, degree: int) -> tuple[np.ndarray, np.ndarray]:
-    """Least-squares polynomial of `degree` about the window's mid time: (coefficients, their standard errors)."""
-    tau = time_s - 0.5 * (time_s[0] + time_s[-1])
-    design = np.vander(tau, degree + 1, increasing=True)
-    coefficients, *_ = np.linalg.lstsq(design, rack_m, rcond=None)
-    errors = noise * np.sqrt(np.diag(np.linalg.inv(design.T @ design)))
+def _window_fits(time_s: np.ndarray, rack_m: np.ndarray, half: int, noise: float, degree: int
+                 ) -> tuple[np.ndarray, np.ndarray]:
+    """Least-squares polynomials of `degree` over every window of 2 `half` + 1 samples, each about its mid time:
+    (coefficients, their standard errors), one row per window (all windows solved at once, by normal equations:
+    in a window's own time the powers are well scaled)."""
+    windows_t = np.lib.stride_tricks.sliding_window_view(time_s, 2 * half + 1)
+    windows_x = np.lib.stride_tricks.sliding_window_view(rack_m, 2 * half + 1)
+    tau = windows_t - 0.5 * (windows_t[:, :1] + windows_t[:, -1:])
+    powers = tau[:, :, None] ** np.arange(degree + 1)
+    gram = np.einsum("wsi,wsj->wij", powers, powers)
+    inverse = np.linalg.inv(gram)
+    coefficients = np.einsum("wij,wj->wi", inverse, np.einsum("wsi,ws->wi", powers, windows_x))
+    errors = noise * np.sqrt(np.diagonal(inverse, axis1=1, axis2=2))
     return coefficients, errors
 
 
@@ -254,10 +241,8 @@ def rest_intervals(time_s: np.ndarray, rack_m: np.ndarray, noise: float) -> tupl
     if noise <= 0.0 or len(t) < 2 * half + 1 or half < 2:
         return ()
     covered = np.zeros(len(t), dtype=bool)
-    for k in range(half, len(t) - half):
-        c, se = _window_fit(t[k - half : k + half + 1], x[k - half : k + half + 1], noise, 2)
-        if abs(c[1]) <= RACK_REST_SLOPE_SE * se[1] and abs(c[2]) <= RACK_REST_SLOPE_SE * se[2]:
-            covered[k] = True
+    c, se = _window_fits(t, x, half, noise, 2)
+    covered[half : len(t) - half] = np.all(np.abs(c[:, 1:]) <= RACK_REST_SLOPE_SE * se[:, 1:], axis=1)
     edges = np.diff(np.concatenate([[0], covered.astype(int), [0]]))
     out = []
     for a, b in zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1) - 1):

@@ -116,6 +116,10 @@ def load_entry(directory: Path) -> CompiledModel:
         ("ps_drive", None, [vp, vp, vp, vp, vp]),
         ("ps_handwheel", None, [dbl, vp, vp, vp]),
         ("ps_outputs", i32, [i32, vp, vp, vp, vp, vp, vp]),
+        ("ps_rack", None, [dbl, vp, vp]),
+        ("ps_prescribed_rhs", i32, [dbl, vp, vp, vp, vp]),
+        ("ps_prescribed_jac", i32, [dbl, vp, vp, vp, vp, vp]),
+        ("ps_prescribed_samples", i32, [i32, vp, vp, vp, vp, vp, vp, vp]),
     ):
         function = getattr(lib, name)
         function.restype = restype

@@ -13,14 +13,15 @@ integrated from that law (:class:`ColumnLaw`): on an engaged flank it is the lin
 the band, and inside the band, where the hand turns with no torque, it crosses as fast as the torque
 lets it (the rack and torque fix the handwheel angle there only within the band).
 
-Speed: the integrator (LSODA via odeint, which loops in Fortran) gets an analytic Jacobian of the
-reduced system from the compiled model's full one. With ``h = M^-1 b``, the reduced accelerations of
-the other coordinates are ``a_o + h_o dT``, with ``dT`` fixed by the rack's acceleration;
-differentiating gives ``d a_o/dy = J_o - (h_o / h_rack) J_rack``, where J is the full model's
-Jacobian evaluated with a handwheel input that makes its column torque equal the prescribed-rack
-torque (the column law's own dependence on the state cancels between the two terms, whatever the
-law: a linear spring, or the dead band of the rack lash candidate, whose twist is widened by the
-torque it would not pass). An 18 s replay takes a few hundredths of a second.
+Speed: the integrator (LSODA via odeint, which loops in Fortran) calls the compiled model's own
+prescribed-rack functions (``ps_prescribed_rhs``, ``ps_prescribed_jac``, ``ps_prescribed_samples`` in the
+generated runtime, the rack motion passed as a table of its polynomial pieces), so a step costs one call into
+C. The Jacobian of the reduced system is analytic, from the compiled model's full one. With ``h = M^-1 b``,
+the reduced accelerations of the other coordinates are ``a_o + h_o dT``, with ``dT`` fixed by the rack's
+acceleration; differentiating gives ``d a_o/dy = J_o - (h_o / h_rack) J_rack``, where J is the full model's
+Jacobian evaluated with a handwheel input that makes its column torque equal the prescribed-rack torque (the
+column law's own dependence on the state cancels between the two terms, whatever the law: a linear spring,
+or the dead band of the rack lash candidate, whose twist is widened by the torque it would not pass).
 """
 
 from __future__ import annotations
@@ -51,18 +52,16 @@ TWIST_TABLE_RAD = 2e-5
 # The integrator's first step, s: from rest, well inside the first output interval of any record.
 FIRST_STEP_S = 1e-4
 
-try:  # the kernel of np.linalg.solve for one right-hand side, without its checks (a third of each step's cost)
-    from numpy.linalg._umath_linalg import solve1 as _kernel
-
-    def _solve(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-        """np.linalg.solve(a, b) for a square float matrix and a vector: the same LAPACK call, the same numbers."""
-        return _kernel(a, b, signature="dd->d")
-except ImportError:  # a numpy that keeps it elsewhere
-    _solve = np.linalg.solve
-
-
 class RackMotion(Protocol):
-    """A rack motion: ``scalar()`` gives t (s) -> (position m, speed m/s, acceleration m/s^2)."""
+    """A rack motion as a piecewise polynomial in time: position (m) on each piece between ``breaks`` (s,
+    increasing), ``coefficients`` highest power first, one column per piece (as :class:`scipy.interpolate.PPoly`);
+    held at its end values outside the breaks. Its speed and acceleration are the polynomial's derivatives."""
+
+    @property
+    def breaks(self) -> np.ndarray: ...
+
+    @property
+    def coefficients(self) -> np.ndarray: ...
 
     @property
     def start_s(self) -> float: ...
@@ -70,7 +69,14 @@ class RackMotion(Protocol):
     @property
     def end_s(self) -> float: ...
 
-    def scalar(self) -> Callable[[float], tuple[float, float, float]]: ...
+
+def rack_table(rack: RackMotion) -> np.ndarray:
+    """`rack` as the compiled model's rack table: pieces, order, breaks, then the coefficients row by row."""
+    breaks = np.asarray(rack.breaks, dtype=float)
+    coefficients = np.asarray(rack.coefficients, dtype=float)
+    if breaks.ndim != 1 or coefficients.shape[1:] != (len(breaks) - 1,) or len(breaks) < 2:
+        raise ValueError("rack motion: needs breaks (m + 1) and coefficients (order x m)")
+    return np.concatenate([[len(breaks) - 1, len(coefficients)], breaks, coefficients.ravel()])
 
 
 @dataclass
@@ -102,40 +108,24 @@ def solve(run, p: np.ndarray, rack: RackMotion, t_out, rtol: float = PRESCRIBED_
     n = model.n_q
     i_rack = model.index("rack")
     others = np.array([i for i in range(n) if i != i_rack], dtype=int)
-    speeds = others + n
     n_o = len(others)
-    drive = rack.scalar()
     t_out = np.asarray(t_out, dtype=float)
     if t_out.ndim != 1 or len(t_out) < 2 or np.any(np.diff(t_out) <= 0):
         raise ValueError("output times must be at least two, strictly increasing")
     p = np.ascontiguousarray(p, dtype=float)
-
-    y = np.zeros(2 * n)
-    M, F, b = np.zeros((n, n)), np.zeros(n), np.zeros(n)
-    A = np.zeros((n, n))
+    table = rack_table(rack)
     zdot = np.zeros(2 * n_o)
-    y_ptr, p_ptr, M_ptr, F_ptr, b_ptr = (a.ctypes.data for a in (y, p, M, F, b))
+    p_ptr, table_ptr, zdot_ptr = p.ctypes.data, table.ctypes.data, zdot.ctypes.data
+    rhs_c, jac_c = lib.ps_prescribed_rhs, lib.ps_prescribed_jac
 
-    def accelerations(t: float, z: np.ndarray) -> tuple[np.ndarray, float]:
-        """(accelerations of the other coordinates then the column torque, rack acceleration)."""
-        r, rd, rdd = drive(t)
-        y[others] = z[:n_o]
-        y[speeds] = z[n_o:]
-        y[i_rack] = r
-        y[n + i_rack] = rd
-        lib.ps_drive(y_ptr, p_ptr, M_ptr, F_ptr, b_ptr)
-        A[:, :n_o] = M[:, others]
-        A[:, n_o] = -b
-        return _solve(A, F - M[:, i_rack] * rdd), rdd
-
+    # Both in the compiled model (the generated runtime): the reduced right-hand side solves M a = F + b T for the
+    # other accelerations and T together; the Jacobian is the full model's at a constant handwheel input that
+    # gives the prescribed-rack torque through a unit column spring without damping (see the module docstring).
     def rhs(z, t):
-        x, _ = accelerations(t, z)
-        zdot[:n_o] = z[n_o:]
-        zdot[n_o:] = x[:n_o]
+        if rhs_c(t, z.ctypes.data, p_ptr, table_ptr, zdot_ptr):
+            raise FloatingPointError("prescribed rack: the equations for the accelerations and torque are singular")
         return zdot
 
-    # Jacobian: the full model's, at a constant handwheel input that gives the prescribed-rack torque
-    # through a unit column spring without damping (see the module docstring).
     n_par = len(model.info["parameters"])
     p_jac = p.copy()
     p_jac[run.parameter_index("steering.column_torsional_stiffness")] = 1.0
@@ -144,38 +134,19 @@ def solve(run, p: np.ndarray, rack: RackMotion, t_out, rtol: float = PRESCRIBED_
     p_jac[n_par] = 1.0  # one piece: (start time, angle, rate, acceleration)
     p_jac[n_par + 1] = -1.0e9
     p_jac_ptr = p_jac.ctypes.data
-    J_full = np.zeros((2 * n, 2 * n))
     J = np.zeros((2 * n_o, 2 * n_o))
-    J[np.arange(n_o), n_o + np.arange(n_o)] = 1.0
-    reduced = np.concatenate([others, speeds])
-    acc = np.zeros(n)
-    hw = np.zeros(2)
-    t_one = np.zeros(1)
-    out_one = np.zeros(len(model.outputs))
-    i_column = model.outputs.index("column_angle_rad")
-    i_torque = model.outputs.index("column_torque_Nm")
+    J_ptr = J.ctypes.data
 
     def jacobian(z, t):
-        x, rdd = accelerations(t, z)
-        acc[others] = x[:n_o]
-        acc[i_rack] = rdd
-        t_one[0] = t
-        hw[0] = 0.0
-        lib.ps_outputs(1, t_one.ctypes.data, y_ptr, acc.ctypes.data, hw.ctypes.data, p_jac_ptr, out_one.ctypes.data)
-        hw[0] = out_one[i_column] + x[n_o]  # angle = column angle + torque / (unit stiffness)
-        # A column law with a dead band (rack lash) passes less torque for that twist: widen it by the shortfall,
-        # so that the Jacobian is the exact one whatever the column law.
-        lib.ps_outputs(1, t_one.ctypes.data, y_ptr, acc.ctypes.data, hw.ctypes.data, p_jac_ptr, out_one.ctypes.data)
-        p_jac[n_par + 2] = hw[0] + x[n_o] - out_one[i_torque]
-        if lib.ps_jac(float(t), y_ptr, p_jac_ptr, J_full.ctypes.data):
+        if jac_c(t, z.ctypes.data, p_ptr, p_jac_ptr, table_ptr, J_ptr):
             raise FloatingPointError("mass matrix not positive definite")
-        h = _solve(M, b)
-        J[n_o:] = J_full[n + others][:, reduced] - np.outer(h[others] / h[i_rack], J_full[n + i_rack][reduced])
         return J
 
     units = model.info["coordinate_units"]
     atol = absolute_tolerances([units[i] for i in others], atol_factor)
-    y_static = static_state(run, fixed={"rack": drive(float(t_out[0]))[0]}, p=p)
+    rack_start = np.zeros(3)
+    lib.ps_rack(float(t_out[0]), table_ptr, rack_start.ctypes.data)
+    y_static = static_state(run, fixed={"rack": rack_start[0]}, p=p)
     z0 = np.concatenate([y_static[others], np.zeros(n_o)])
     # LSODA interpolates at the output times without stepping to them; with its first step fixed (it would
     # otherwise choose it from the first output interval) the refined grid of the twist changes no step.
@@ -187,20 +158,13 @@ def solve(run, p: np.ndarray, rack: RackMotion, t_out, rtol: float = PRESCRIBED_
     if info["message"] != "Integration successful.":
         raise solver_failure("prescribed-rack integration", info, grid)
 
-    # The accelerations and the torque at every sample, solved together (the same equations as `accelerations`).
+    # The states, accelerations and torque at every sample, solved together (the same equations as the rhs).
     m = len(grid)
-    full = np.zeros((m, 2 * n))
-    full[:, others], full[:, speeds] = states[:, :n_o], states[:, n_o:]
-    rack_states = np.array([drive(float(t)) for t in grid])
-    full[:, i_rack], full[:, n + i_rack] = rack_states[:, 0], rack_states[:, 1]
-    Ms, Fs, bs = np.empty((m, n, n)), np.empty((m, n)), np.empty((m, n))
-    for k in range(m):
-        lib.ps_drive(full[k].ctypes.data, p_ptr, Ms[k].ctypes.data, Fs[k].ctypes.data, bs[k].ctypes.data)
-    system = np.concatenate([Ms[:, :, others], -bs[:, :, None]], axis=2)
-    x = np.linalg.solve(system, (Fs - Ms[:, :, i_rack] * rack_states[:, 2:3])[:, :, None])[:, :, 0]
-    torque = x[:, n_o]
-    accs = np.zeros((m, n))
-    accs[:, others], accs[:, i_rack] = x[:, :n_o], rack_states[:, 2]
+    states = np.ascontiguousarray(states)
+    full, accs, torque = np.empty((m, 2 * n)), np.empty((m, n)), np.empty(m)
+    if lib.ps_prescribed_samples(m, grid.ctypes.data, states.ctypes.data, p_ptr, table_ptr, full.ctypes.data,
+                                 accs.ctypes.data, torque.ctypes.data):
+        raise FloatingPointError("prescribed rack: the equations for the accelerations and torque are singular")
     if not outputs:
         return PrescribedSolution(t_out, torque)
 

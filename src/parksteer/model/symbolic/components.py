@@ -160,8 +160,10 @@ def load_effect_module(ref: str) -> Effect:
     return _effect_of_module(module, ref)
 
 
-def discover_effects() -> dict[str, Effect]:
-    """Every effect the registry can find: the package's modules, entry points and configured modules."""
+@lru_cache(maxsize=1)
+def _installed_effects() -> tuple[tuple[str, Effect], ...]:
+    """The package's effect modules, then the installed entry points' (found once a process: scanning every
+    installed distribution's entry points costs milliseconds, and a diagnosis prepares hundreds of runs)."""
     from . import effects as package
 
     found: dict[str, Effect] = {}
@@ -173,6 +175,12 @@ def discover_effects() -> dict[str, Effect]:
     for ep in sorted(entry_points(group=ENTRY_POINT_GROUP), key=lambda e: e.name):
         effect = _effect_of(ep.load(), f"entry point {ep.name}")
         found.setdefault(effect.name, effect)
+    return tuple(found.items())
+
+
+def discover_effects() -> dict[str, Effect]:
+    """Every effect the registry can find: the package's modules, entry points and configured modules."""
+    found = dict(_installed_effects())
     for ref in filter(None, os.environ.get(MODULES_ENV, "").split(os.pathsep)):
         effect = load_effect_module(ref)
         found[effect.name] = effect
