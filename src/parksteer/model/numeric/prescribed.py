@@ -109,7 +109,7 @@ def solve(run, p: np.ndarray, rack: RackMotion, t_out, rtol: float = PRESCRIBED_
     i_rack = model.index("rack")
     others = np.array([i for i in range(n) if i != i_rack], dtype=int)
     n_o = len(others)
-    t_out = np.asarray(t_out, dtype=float)
+    t_out = np.ascontiguousarray(t_out, dtype=float)  # read by the compiled model: a strided view would not do
     if t_out.ndim != 1 or len(t_out) < 2 or np.any(np.diff(t_out) <= 0):
         raise ValueError("output times must be at least two, strictly increasing")
     p = np.ascontiguousarray(p, dtype=float)
