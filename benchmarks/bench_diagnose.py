@@ -9,7 +9,7 @@ Measures, each in a fresh process per source tree and worker count, compiled mod
 - one replay of an 18 s measured cycle (rack smoothing excluded), median of 20;
 - ``compare`` of one file;
 - one case of the hidden-effect benchmark (rack stiction hidden at 3.5 converter steps RMS in the
-  benchmark's files, base parameters perturbed as the benchmark does), as a ``diag_bench_case`` job
+  benchmark's files, base parameters perturbed as the benchmark does), as a ``diag_bench_batch`` job
   diagnoses it (one worker: the DAG runs cases side by side);
 - ``diagnose`` of one car file (the unladen car on the ground) against every candidate
   (target: 5 s on 2 cores);

@@ -2,7 +2,7 @@
 
     python benchmarks/bench_variations.py OUT.json [--full] [--only pauses,lock_overshoot]
 
-The logic is :mod:`parksteer.diagnose.variations` (rules ``diag_variation_case`` and ``diag_variations`` run
+The logic is :mod:`parksteer.diagnose.variations` (rules ``diag_variation_batch`` and ``diag_variations`` run
 the same cases in the DAG); the grid is config/config.yaml's ``variations`` section (``--full``: its full grid).
 Prints one line per case as it is diagnosed, then per variation the named rate, the nulls called adequate, the
 coverage of the 95 % intervals, the nulls' calibrated error in noise floors and the median diagnosis time; writes

@@ -38,6 +38,24 @@ def copy_repository(repo_root):
     return copy
 
 
+def _placeholder_outputs(work: Path, summary: str) -> None:
+    """Create every output listed by `snakemake --summary` (`summary`) in `work` empty: the workflow's
+    directory() outputs (the diagnosis benchmarks' job folders) are the names without a suffix, made as folders."""
+    for line in summary.splitlines()[1:]:
+        output = work / line.split("\t")[0]
+        if output.suffix:
+            output.parent.mkdir(parents=True, exist_ok=True)
+            output.touch()
+        else:
+            output.mkdir(parents=True, exist_ok=True)
+
+
+@pytest.fixture(scope="session")
+def placeholder_outputs():
+    """placeholder(work, summary): every output of a `snakemake --summary` listing created empty in `work`."""
+    return _placeholder_outputs
+
+
 @pytest.fixture(scope="session")
 def params() -> Parameters:
     """The shipped data/parameters.toml, validated."""

@@ -57,14 +57,10 @@ def edit():
 
 
 @pytest.fixture(scope="module")
-def repository_copy(copy_repository, tmp_path_factory) -> Path:
+def repository_copy(copy_repository, placeholder_outputs, tmp_path_factory) -> Path:
     """A copy of the repository whose every pipeline output exists and is up to date."""
     work = copy_repository(tmp_path_factory.mktemp("rebuilds"))
-    summary = _snakemake(work, "--summary", "all")
-    for line in summary.splitlines()[1:]:
-        output = work / line.split("\t")[0]
-        output.parent.mkdir(parents=True, exist_ok=True)
-        output.touch()
+    placeholder_outputs(work, _snakemake(work, "--summary", "all"))
     return work
 
 
@@ -97,7 +93,7 @@ def test_a_diagnosis_setting_edit_reruns_the_diagnoses_not_the_model_figures(up_
     case study, and leaves the compiled models, the simulations of the model figures and the sweep alone."""
     edit(up_to_date_copy / "src" / "parksteer" / "diagnose" / "settings.py")
     planned = _planned(up_to_date_copy)
-    assert planned["diag_bench_case"] > 0 and planned["case_study"] == 1 and planned["diag_benchmark"] == 1
+    assert planned["diag_bench_batch"] > 0 and planned["case_study"] == 1 and planned["diag_benchmark"] == 1
     assert not {"derive", "simulate_model", "model_figure", "sweep_batch", "fig3", "figA3"} & set(planned)
 
 

@@ -46,13 +46,10 @@ def repository_copy(copy_repository, tmp_path_factory) -> Path:
     return copy_repository(tmp_path_factory.mktemp("report"))
 
 
-def _report(work: Path, target: str, *options: str) -> tuple[list[str], dict, str]:
+def _report(placeholder_outputs, work: Path, target: str, *options: str) -> tuple[list[str], dict, str]:
     """(the inputs of rule `target`, the report's results by path, the report page), every output of the target's
     DAG created empty first."""
-    for line in _snakemake(work, "--summary", target, *options).splitlines()[1:]:
-        output = work / line.split("\t")[0]
-        output.parent.mkdir(parents=True, exist_ok=True)
-        output.touch()
+    placeholder_outputs(work, _snakemake(work, "--summary", target, *options))
     planned = _snakemake(work, target, "--dry-run", "--forcerun", target, *options)
     inputs = re.search(rf"^(?:local)?rule {target}:\n\s+input: (.+)$", planned, re.MULTILINE)
     assert inputs, planned[-3000:]
@@ -62,9 +59,9 @@ def _report(work: Path, target: str, *options: str) -> tuple[list[str], dict, st
 
 
 @pytest.fixture(scope="module")
-def report(repository_copy) -> tuple[list[str], dict, str]:
+def report(repository_copy, placeholder_outputs) -> tuple[list[str], dict, str]:
     """The report of the default target `all`."""
-    return _report(repository_copy, "all")
+    return _report(placeholder_outputs, repository_copy, "all")
 
 
 def test_every_figure_and_the_article_are_in_the_report(report):
@@ -105,10 +102,10 @@ def test_each_entry_is_in_a_category_and_labelled(report):
                                    "file": "data (CSV)" if path.endswith(".csv") else "plot"}
 
 
-def test_a_vehicle_study_report_holds_its_figures_and_the_diagnosis_page(repository_copy):
+def test_a_vehicle_study_report_holds_its_figures_and_the_diagnosis_page(repository_copy, placeholder_outputs):
     """`snakemake --report ... vehicle_study --config vehicle=polo_vi` holds the study's comparison and diagnosis
     figures and its HTML diagnosis report, filed under the vehicle, each caption naming the vehicle."""
-    targets, results, _ = _report(repository_copy, "vehicle_study", "--config", "vehicle=polo_vi")
+    targets, results, _ = _report(placeholder_outputs, repository_copy, "vehicle_study", "--config", "vehicle=polo_vi")
     shown = sorted(t for t in targets if t.endswith((".svg", ".html")))
     assert shown == sorted(["figures/vehicles/polo_vi/compare.svg", "figures/vehicles/polo_vi/diagnosis.svg",
                             "results/vehicles/polo_vi/report.html"])

@@ -116,6 +116,20 @@ def script_sources(script):
     return file_sources(SCRIPTS_DIR / f"{script}.py")
 
 
+def case_batches(prefix, names, per_job):
+    """The cases `names` in jobs of at most `per_job` each, dealt in turn (so that a job mixes costly and cheap
+    cases): {job id: its case names}. A job pays a process start and the package's imports once for its cases."""
+    names = list(names)
+    count = -(-len(names) // max(1, int(per_job)))
+    return {f"{prefix}{k:02d}": names[k::count] for k in range(count)}
+
+
+def case_outputs(folder, names, batches, suffix):
+    """The `suffix` file (truth or diagnosis) of each case of `names`, in its job's folder, in the order of `names`."""
+    job_of = {name: batch for batch, members in batches.items() for name in members}
+    return [f"{folder}/{job_of[name]}/{name}.{suffix}.json" for name in names]
+
+
 def benchmark_file(rule, *wildcards):
     """The rule's benchmark file under results/benchmarks/<rule>/ (one per wildcard combination)."""
     stem = "__".join(f"{{{w}}}" for w in wildcards) or rule

@@ -1,12 +1,13 @@
 # Model against measurement: compare, diagnose, add the missing effect, watch the error fall.
 # diag_car_data makes the synthetic stand-in for the paper's car tests (config["car"]; its truth kept in a separate
 # file); diag_compare and the case_study notebook walk it; diag_ladder plots the error as the model grows;
-# diag_bench_case diagnoses one synthetic data set of the hidden-effect benchmark (config["benchmark"]; one job
-# each, so they run in parallel) and diag_benchmark scores them all. Every model a diagnosis replays (the base
+# diag_bench_batch diagnoses synthetic data sets of the hidden-effect benchmark (config["benchmark"]; the cases
+# dealt into jobs of config["diagnosis_cases_per_job"], which run in parallel, each case in its own folder of the
+# job's folder) and diag_benchmark scores them all. Every model a diagnosis replays (the base
 # model and the base model with each candidate, the example user effect among them) is derived by rule derive
-# before any of these runs. diag_outclass_case and diag_outclass are the out-of-class benchmark
+# before any of these runs. diag_outclass_batch and diag_outclass are the out-of-class benchmark
 # (config["outclass"]): rival effects that are not candidates, hidden by a truth generator that is not the
-# diagnosis model, scored against the physically closest candidate. diag_variation_case and diag_variations are
+# diagnosis model, scored against the physically closest candidate. diag_variation_batch and diag_variations are
 # the variation benchmark (config["variations"]): records of other hands, loggers and drives, with nothing or a
 # library effect hidden, scored against the targets of parksteer.diagnose.variations.
 from parksteer.diagnose.benchmark import case_names as _bench_case_names
@@ -34,6 +35,10 @@ FIGURES["diag_outclass"] = ["figures/diag_outclass.svg", "figures/diag_outclass.
 DIAG_VARIATIONS = VariationDesign.from_config(config["variations"], config["benchmark"])
 DIAG_VARIATION_CASES = _variation_case_names(DIAG_VARIATIONS)
 FIGURES["diag_variations"] = ["figures/diag_variations.svg", "figures/diag_variations.csv"]
+DIAG_PER_JOB = int(config.get("diagnosis_cases_per_job", 6))
+DIAG_BENCH_BATCHES = case_batches("bench_", DIAG_BENCH_CASES, DIAG_PER_JOB)
+DIAG_OUTCLASS_BATCHES = case_batches("outclass_", DIAG_OUTCLASS_CASES, DIAG_PER_JOB)
+DIAG_VARIATION_BATCHES = case_batches("variations_", DIAG_VARIATION_CASES, DIAG_PER_JOB)
 
 
 rule diag_car_data:
@@ -118,33 +123,31 @@ rule diag_ladder:
         "../scripts/diag_ladder.py"
 
 
-rule diag_bench_case:
+rule diag_bench_batch:
     input:
         parameters=PARAMETERS,
         models=DIAG_MODELS,
-        code=script_sources("diag_bench_case"),
+        code=script_sources("diag_bench_batch"),
     output:
-        files=[f"results/diagnose/benchmark/{{name}}/{name}" for name in DIAG_BENCH_FILES],
-        truth="results/diagnose/benchmark/{name}.truth.json",
-        diagnosis="results/diagnose/benchmark/{name}.diagnosis.json",
+        directory("results/diagnose/benchmark/{batch}"),
     params:
         design=config["benchmark"],
+        cases=lambda wildcards: DIAG_BENCH_BATCHES[wildcards.batch],
     wildcard_constraints:
-        name="|".join(DIAG_BENCH_CASES) if DIAG_BENCH_CASES else "none",
+        batch="|".join(DIAG_BENCH_BATCHES) if DIAG_BENCH_BATCHES else "none",
     log:
-        "logs/diag_bench_case/{name}.log",
+        "logs/diag_bench_batch/{batch}.log",
     benchmark:
-        benchmark_file("diag_bench_case", "name")
+        benchmark_file("diag_bench_batch", "batch")
     conda:
         "../envs/parksteer.yaml"
     script:
-        "../scripts/diag_bench_case.py"
+        "../scripts/diag_bench_batch.py"
 
 
 rule diag_benchmark:
     input:
-        truths=expand("results/diagnose/benchmark/{name}.truth.json", name=DIAG_BENCH_CASES),
-        diagnoses=expand("results/diagnose/benchmark/{name}.diagnosis.json", name=DIAG_BENCH_CASES),
+        batches=expand("results/diagnose/benchmark/{batch}", batch=DIAG_BENCH_BATCHES),
         code=script_sources("diag_benchmark"),
     output:
         svg=figure_report("figures/diag_benchmark.svg", "diagnose"),
@@ -152,6 +155,8 @@ rule diag_benchmark:
         json="results/diag_benchmark.json",
     params:
         design=config["benchmark"],
+        truths=case_outputs("results/diagnose/benchmark", DIAG_BENCH_CASES, DIAG_BENCH_BATCHES, "truth"),
+        diagnoses=case_outputs("results/diagnose/benchmark", DIAG_BENCH_CASES, DIAG_BENCH_BATCHES, "diagnosis"),
     log:
         "logs/diag_benchmark.log",
     benchmark:
@@ -162,34 +167,32 @@ rule diag_benchmark:
         "../scripts/diag_benchmark.py"
 
 
-rule diag_outclass_case:
+rule diag_outclass_batch:
     input:
         parameters=PARAMETERS,
         models=DIAG_MODELS + DIAG_OUTCLASS_MODELS,
-        code=script_sources("diag_outclass_case"),
+        code=script_sources("diag_outclass_batch"),
     output:
-        files=[f"results/diagnose/outclass/{{name}}/{name}" for name in DIAG_OUTCLASS_FILES],
-        truth="results/diagnose/outclass/{name}.truth.json",
-        diagnosis="results/diagnose/outclass/{name}.diagnosis.json",
+        directory("results/diagnose/outclass/{batch}"),
     params:
         design=config["outclass"],
         benchmark=config["benchmark"],
+        cases=lambda wildcards: DIAG_OUTCLASS_BATCHES[wildcards.batch],
     wildcard_constraints:
-        name="|".join(DIAG_OUTCLASS_CASES) if DIAG_OUTCLASS_CASES else "none",
+        batch="|".join(DIAG_OUTCLASS_BATCHES) if DIAG_OUTCLASS_BATCHES else "none",
     log:
-        "logs/diag_outclass_case/{name}.log",
+        "logs/diag_outclass_batch/{batch}.log",
     benchmark:
-        benchmark_file("diag_outclass_case", "name")
+        benchmark_file("diag_outclass_batch", "batch")
     conda:
         "../envs/parksteer.yaml"
     script:
-        "../scripts/diag_outclass_case.py"
+        "../scripts/diag_outclass_batch.py"
 
 
 rule diag_outclass:
     input:
-        truths=expand("results/diagnose/outclass/{name}.truth.json", name=DIAG_OUTCLASS_CASES),
-        diagnoses=expand("results/diagnose/outclass/{name}.diagnosis.json", name=DIAG_OUTCLASS_CASES),
+        batches=expand("results/diagnose/outclass/{batch}", batch=DIAG_OUTCLASS_BATCHES),
         code=script_sources("diag_outclass"),
     output:
         svg=figure_report("figures/diag_outclass.svg", "diagnose"),
@@ -198,6 +201,8 @@ rule diag_outclass:
     params:
         design=config["outclass"],
         benchmark=config["benchmark"],
+        truths=case_outputs("results/diagnose/outclass", DIAG_OUTCLASS_CASES, DIAG_OUTCLASS_BATCHES, "truth"),
+        diagnoses=case_outputs("results/diagnose/outclass", DIAG_OUTCLASS_CASES, DIAG_OUTCLASS_BATCHES, "diagnosis"),
     log:
         "logs/diag_outclass.log",
     benchmark:
@@ -208,35 +213,32 @@ rule diag_outclass:
         "../scripts/diag_outclass.py"
 
 
-# A case's files depend on its variation (one to three), so they go to a folder output.
-rule diag_variation_case:
+rule diag_variation_batch:
     input:
         parameters=PARAMETERS,
         models=DIAG_MODELS,
-        code=script_sources("diag_variation_case"),
+        code=script_sources("diag_variation_batch"),
     output:
-        files=directory("results/diagnose/variations/{name}"),
-        truth="results/diagnose/variations/{name}.truth.json",
-        diagnosis="results/diagnose/variations/{name}.diagnosis.json",
+        directory("results/diagnose/variations/{batch}"),
     params:
         design=config["variations"],
         benchmark=config["benchmark"],
+        cases=lambda wildcards: DIAG_VARIATION_BATCHES[wildcards.batch],
     wildcard_constraints:
-        name="|".join(DIAG_VARIATION_CASES) if DIAG_VARIATION_CASES else "none",
+        batch="|".join(DIAG_VARIATION_BATCHES) if DIAG_VARIATION_BATCHES else "none",
     log:
-        "logs/diag_variation_case/{name}.log",
+        "logs/diag_variation_batch/{batch}.log",
     benchmark:
-        benchmark_file("diag_variation_case", "name")
+        benchmark_file("diag_variation_batch", "batch")
     conda:
         "../envs/parksteer.yaml"
     script:
-        "../scripts/diag_variation_case.py"
+        "../scripts/diag_variation_batch.py"
 
 
 rule diag_variations:
     input:
-        truths=expand("results/diagnose/variations/{name}.truth.json", name=DIAG_VARIATION_CASES),
-        diagnoses=expand("results/diagnose/variations/{name}.diagnosis.json", name=DIAG_VARIATION_CASES),
+        batches=expand("results/diagnose/variations/{batch}", batch=DIAG_VARIATION_BATCHES),
         code=script_sources("diag_variations"),
     output:
         svg=figure_report("figures/diag_variations.svg", "diagnose"),
@@ -245,6 +247,8 @@ rule diag_variations:
     params:
         design=config["variations"],
         benchmark=config["benchmark"],
+        truths=case_outputs("results/diagnose/variations", DIAG_VARIATION_CASES, DIAG_VARIATION_BATCHES, "truth"),
+        diagnoses=case_outputs("results/diagnose/variations", DIAG_VARIATION_CASES, DIAG_VARIATION_BATCHES, "diagnosis"),
     log:
         "logs/diag_variations.log",
     benchmark:

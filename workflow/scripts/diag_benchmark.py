@@ -4,6 +4,6 @@ from parksteer.rules import rule_log
 from parksteer.synthetic.datasets import BenchmarkDesign
 
 with rule_log(snakemake):
-    make_benchmark_figure(list(snakemake.input.truths), list(snakemake.input.diagnoses), snakemake.output.svg,
+    make_benchmark_figure(list(snakemake.params.truths), list(snakemake.params.diagnoses), snakemake.output.svg,
                           snakemake.output.csv, snakemake.output.json,
                           BenchmarkDesign.from_config(snakemake.params.design))

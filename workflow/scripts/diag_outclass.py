@@ -4,6 +4,6 @@ from parksteer.rules import rule_log
 from parksteer.synthetic.datasets import OutclassDesign
 
 with rule_log(snakemake):
-    make_outclass_figure(list(snakemake.input.truths), list(snakemake.input.diagnoses), snakemake.output.svg,
+    make_outclass_figure(list(snakemake.params.truths), list(snakemake.params.diagnoses), snakemake.output.svg,
                          snakemake.output.csv, snakemake.output.json,
                          OutclassDesign.from_config(snakemake.params.design, snakemake.params.benchmark))

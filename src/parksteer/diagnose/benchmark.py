@@ -63,9 +63,10 @@ def diagnose_written(params: Parameters, records, folder: str | Path, truth: dic
 
 
 def paired_results(truth_paths, diagnosis_paths, what: str) -> Iterator[tuple[dict, dict]]:
-    """(truth, diagnosis) of each data set, paired by file name; a pair whose names differ is refused in one line
-    naming `what` benchmark."""
-    for t_path, d_path in zip(sorted(map(str, truth_paths)), sorted(map(str, diagnosis_paths))):
+    """(truth, diagnosis) of each data set, paired and ordered by file name (whatever folders the jobs wrote them
+    to); a pair whose names differ is refused in one line naming `what` benchmark."""
+    by_name = lambda path: (Path(path).name, path)  # noqa: E731
+    for t_path, d_path in zip(sorted(map(str, truth_paths), key=by_name), sorted(map(str, diagnosis_paths), key=by_name)):
         if Path(t_path).name.split(".")[0] != Path(d_path).name.split(".")[0]:
             raise UsageError(f"{what}: truth {t_path} and diagnosis {d_path} do not pair up")
         yield (json.loads(Path(t_path).read_text(encoding="utf-8")),
