@@ -80,3 +80,37 @@ def test_independent_null_sits_at_the_noise_floor(name):
     ratio = stats["weighted_rms_Nm"] / stats["noise_floor_Nm"]
     assert 0.9 < ratio < 1.12, ratio
     assert np.max(np.abs(problem.weighted(prediction))) < 12.0
+
+
+def test_an_angle_channel_leaves_the_other_channels_alone_and_shows_a_lash_the_torque_cannot():
+    """Logging the handwheel angle too draws its noise after the other channels', so the rack and torque are the
+    records without it sample for sample; its steps are its converter's. With the rack prescribed the column twist
+    does not feed back on the torque, so a hidden rack lash leaves the torque unchanged (to the solver's
+    tolerance) and moves the angle by the band at the handwheel (the lash in rack travel times the rack-to-handwheel
+    ratio): the twist that passes the same torque is widened by the band on either flank."""
+    from dataclasses import replace
+
+    from parksteer.synthetic.logger import quantisation_step
+    from parksteer.synthetic.variations import variation_by_name
+
+    variation = variation_by_name("angle_channel")
+    hand, logger = variation.settings(7)
+    plain = variation_record(PARAMS, hand, replace(logger, angle_bits=0))
+    with_angle = variation_record(PARAMS, hand, logger)
+    for column in ("time_s", "rack_m", "handwheel_torque_Nm"):
+        np.testing.assert_array_equal(with_angle.columns[column], plain.columns[column])
+    assert "handwheel_angle_rad" not in plain.columns
+    step = quantisation_step(logger.angle_full_scale_rad, logger.angle_bits)
+    assert with_angle.quantisation_step("handwheel_angle_rad") == pytest.approx(step)
+    levels = (with_angle.columns["handwheel_angle_rad"] + logger.angle_full_scale_rad) / step
+    np.testing.assert_allclose(levels, np.rint(levels), atol=1e-6)
+
+    quiet = replace(logger, torque_noise_Nm=0.0, rack_noise_m=0.0, angle_noise_rad=0.0, angle_bits=24, torque_bits=24)
+    lash_m = 1e-4
+    band = lash_m * float(PARAMS["steering.handwheel_to_rack_ratio"])  # rad at the handwheel
+    base = variation_record(PARAMS, hand, quiet)
+    lashed = variation_record(PARAMS, hand, quiet, overrides={"rack_lash.lash": lash_m}, effects="+rack_lash")
+    torque_change = np.abs(lashed.columns["handwheel_torque_Nm"] - base.columns["handwheel_torque_Nm"])
+    angle_change = np.abs(lashed.columns["handwheel_angle_rad"] - base.columns["handwheel_angle_rad"])
+    assert np.max(torque_change) < 0.02
+    assert 0.8 * band < np.max(angle_change) < 1.05 * band

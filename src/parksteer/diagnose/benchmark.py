@@ -34,6 +34,7 @@ from ..tables import write_json
 from .problem import load_files
 from .report import diagnosis_dict
 from .select import diagnose
+from .settings import DEFAULT_SETTINGS, DiagnosisSettings
 
 TARGETS = {"named_or_group_at_2_steps": 0.90, "false_alarm_rate": 0.05, "outside_unexplained": 0.80,
            "rms_after_over_noise_floor": 1.2}
@@ -44,17 +45,19 @@ def case_names(design: BenchmarkDesign, params: Parameters | None = None) -> lis
 
 
 def diagnose_written(params: Parameters, records, folder: str | Path, truth: dict, truth_path: str | Path,
-                     diagnosis_path: str | Path, started_s: float) -> dict:
+                     diagnosis_path: str | Path, started_s: float, settings: DiagnosisSettings = DEFAULT_SETTINGS
+                     ) -> dict:
     """Write `records` ((case, surface, measurement) each) into `folder`, diagnose them from the files (read back
-    through the reader a user's file goes through), write the truth and the result. The result's cost gains the
-    diagnosis's wall time and the generation's (from `started_s`, a perf_counter reading, to the files written)."""
+    through the reader a user's file goes through) with `settings`, write the truth and the result. The result's
+    cost gains the diagnosis's wall time and the generation's (from `started_s`, a perf_counter reading, to the
+    files written)."""
     paths = []
     for case, surface, measurement in records:
         path = Path(folder) / file_name(case, surface)
         write_measurement(path, measurement, params)
         paths.append(path)
     generated = time.perf_counter()
-    result = diagnosis_dict(diagnose(load_files(paths, params), params))
+    result = diagnosis_dict(diagnose(load_files(paths, params), params, settings=settings))
     result["cost"]["wall_s"] = time.perf_counter() - generated
     result["cost"]["generation_s"] = generated - started_s
     write_json(truth_path, truth)

@@ -25,7 +25,7 @@ covering in COVERAGE_TARGET. :func:`summarise` reports each and the variations w
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -59,6 +59,14 @@ class VariationDesign:
     files: tuple[tuple[str, str], ...]
     seed: int
     perturbation: dict[str, float]
+    hidden_with_angle: tuple[str, ...] | None = None  # hidden instead of `hidden` where the angle is fitted
+
+    def hidden_in(self, variation: Variation) -> tuple[str, ...]:
+        """The effects hidden in `variation`'s cases: ``hidden_with_angle`` (the effects the angle makes
+        observable) where the diagnosis fits the handwheel angle and the grid names them, else ``hidden``."""
+        if variation.uses_angle and self.hidden_with_angle is not None:
+            return self.hidden_with_angle
+        return self.hidden
 
     @classmethod
     def from_config(cls, section: dict, benchmark: dict) -> VariationDesign:
@@ -66,10 +74,12 @@ class VariationDesign:
         names = tuple(str(v) for v in grid["variations"])
         for name in names:
             variation_by_name(name)
+        with_angle = grid.get("hidden_with_angle")
         design = cls(names, int(grid["replicates"]), tuple(str(h) for h in grid["hidden"]),
                      tuple(float(s) for s in grid["steps"]),
                      tuple((str(c), str(s)) for c, s in section["files"]), int(section["seed"]),
-                     {str(k): float(v) for k, v in benchmark["perturbation"].items()})
+                     {str(k): float(v) for k, v in benchmark["perturbation"].items()},
+                     None if with_angle is None else tuple(str(h) for h in with_angle))
         too_many = [v for v in names if variation_by_name(v).files > len(design.files)]
         if too_many:
             raise UsageError(f"config variations.files: {too_many[0]} needs {variation_by_name(too_many[0]).files} "
@@ -104,7 +114,7 @@ def variation_cases(design: VariationDesign) -> list[VariationCase]:
             seed = design.seed + 1000 * replicate + 10 * order.index(name)
             stem = f"{name}__r{replicate}"
             cases.append(VariationCase(f"{stem}__null", variation, replicate, None, None, seed))
-            for effect in design.hidden:
+            for effect in design.hidden_in(variation):
                 for steps in design.steps:
                     label = f"{effect}_{steps:g}".replace(".", "p")
                     cases.append(VariationCase(f"{stem}__{label}", variation, replicate, effect, steps, seed))
@@ -121,10 +131,12 @@ def _case_files(case: VariationCase, design: VariationDesign):
             for i, (load_case, surface) in enumerate(design.files[:case.variation.files])]
 
 
-def hidden_strength(params: Parameters, files, base: dict, effect: str, target_Nm: float) -> tuple[str, float, float]:
-    """(strength key, strength, RMS torque change at it, N m) of `effect` changing the clean torque by
-    `target_Nm` RMS over `files` (prescribed racks), found by the benchmark's size search
-    (:func:`parksteer.synthetic.datasets.strength_for_rms`) from a probe at a hundredth of the upper bound."""
+def hidden_strength(params: Parameters, files, base: dict, effect: str, target: float,
+                    signal: str = "handwheel_torque_Nm") -> tuple[str, float, float]:
+    """(strength key, strength, RMS change of `signal` at it) of `effect` changing the clean `signal` (the torque,
+    or the handwheel angle where the diagnosis fits it) by `target` RMS over `files` (prescribed racks), found by
+    the benchmark's size search (:func:`parksteer.synthetic.datasets.strength_for_rms`) from a probe at a
+    hundredth of the upper bound."""
     from ..model.numeric.simulate import simulate
     from ..model.symbolic.components import discover_effects, strength_parameter
 
@@ -134,20 +146,20 @@ def hidden_strength(params: Parameters, files, base: dict, effect: str, target_N
     quantity = strength_parameter(registry[effect], params)
     key, upper = quantity.key, quantity.upper
     drives = [(load_case, surface, variation_rack(params, hand)) for load_case, surface, hand, _logger in files]
-    torques: dict[float, np.ndarray] = {}  # each strength simulated once, the search's reference (0) included
+    signals: dict[float, np.ndarray] = {}  # each strength simulated once, the search's reference (0) included
 
-    def torque_of(strength: float) -> np.ndarray:
-        if strength not in torques:
+    def signal_of(strength: float) -> np.ndarray:
+        if strength not in signals:
             effects, overrides = (None, base) if strength == 0.0 else (f"+{effect}", {**base, key: strength})
-            torques[strength] = np.concatenate([
+            signals[strength] = np.concatenate([
                 np.asarray(simulate(load_case, effects=effects, overrides=overrides, surface=surface, rack_drive=drive,
-                                    params=params, output_dt_s=SEARCH_DT_S).columns["handwheel_torque_Nm"], dtype=float)
+                                    params=params, output_dt_s=SEARCH_DT_S).columns[signal], dtype=float)
                 for load_case, surface, drive in drives])
-        return torques[strength]
+        return signals[strength]
 
-    strength = strength_for_rms(torque_of, target_Nm, upper * 1e-2, upper,
+    strength = strength_for_rms(signal_of, target, upper * 1e-2, upper,
                                 SizeSearch(iterations=SEARCH_STEPS, tolerance=SEARCH_TOLERANCE, max_lag_s=0.0))
-    return key, strength, rms_difference(torque_of(strength), torque_of(0.0))
+    return key, strength, rms_difference(signal_of(strength), signal_of(0.0))
 
 
 def run_case(parameters_path, design: VariationDesign, name: str, folder, truth_path, diagnosis_path) -> dict:
@@ -160,22 +172,29 @@ def run_case(parameters_path, design: VariationDesign, name: str, folder, truth_
     start = time.perf_counter()
     files = _case_files(case, design)
     base = perturbed_base(params, case.seed, design.perturbation)
-    torque_step = quantisation_step(files[0][3].torque_full_scale_Nm, files[0][3].torque_bits)
+    logger = files[0][3]
+    torque_step = quantisation_step(logger.torque_full_scale_Nm, logger.torque_bits)
+    # Where the angle is fitted, the hidden effect's size is its change of the angle in the angle converter's
+    # steps: with the rack prescribed, what the angle makes observable (a lash) does not change the torque at all.
+    signal, size_step = ("handwheel_angle_rad", quantisation_step(logger.angle_full_scale_rad, logger.angle_bits)) \
+        if case.variation.uses_angle else ("handwheel_torque_Nm", torque_step)
     overrides, key, strength, steps_actual = dict(base), None, None, None
     if case.hidden is not None:
-        key, strength, change = hidden_strength(params, files, base, case.hidden, case.steps * torque_step)
+        key, strength, change = hidden_strength(params, files, base, case.hidden, case.steps * size_step, signal)
         overrides[key] = strength
-        steps_actual = change / torque_step
+        steps_actual = change / size_step
     records = [(load_case, surface, variation_record(params, hand, logger, load_case, surface, overrides=overrides,
                                                       effects=f"+{case.hidden}" if case.hidden else None))
                for load_case, surface, hand, logger in files]
     truth = {
         "name": case.name, "variation": case.variation.name, "what": case.variation.what,
         "replicate": case.replicate, "seed": case.seed, "hidden": case.hidden, "steps_requested": case.steps,
-        "steps": steps_actual, "torque_step_Nm": torque_step, "strength_key": key, "strength": strength,
+        "steps": steps_actual, "torque_step_Nm": torque_step, "size_signal": signal, "size_step": size_step,
+        "strength_key": key, "strength": strength,
         "base_overrides": base, "files": [{"case": c, "surface": s} for c, s, _h, _l in files],
     }
-    return diagnose_written(params, records, folder, truth, truth_path, diagnosis_path, start)
+    settings = replace(DEFAULT_SETTINGS, use_handwheel_angle=True) if case.variation.uses_angle else DEFAULT_SETTINGS
+    return diagnose_written(params, records, folder, truth, truth_path, diagnosis_path, start, settings)
 
 
 def _reported_intervals(result: dict) -> dict[str, dict]:
@@ -318,6 +337,9 @@ def summarise(rows: list[dict], design: VariationDesign | None = None) -> dict:
                        "missing_rms_ceiling": DEFAULT_SETTINGS.missing_rms_ceiling},
         "settings": None if design is None else {
             "variations": list(design.variations), "replicates": design.replicates, "hidden": list(design.hidden),
+            "with_angle": [v for v in design.variations if variation_by_name(v).uses_angle],
+            "hidden_with_angle": list(design.hidden_with_angle if design.hidden_with_angle is not None
+                                      else design.hidden),
             "steps": list(design.steps), "files": [list(f) for f in design.files], "seed": design.seed,
             "what": {v: variation_by_name(v).what for v in design.variations},
         },

@@ -141,6 +141,8 @@ class VariationLogger:
     ``anti_alias_hz`` (0: none) and ``torque_lag_s`` put the out-of-class logger chain's analogue front before the
     sampling (:func:`parksteer.synthetic.datasets.anti_alias_and_lag`: a causal Butterworth of
     ``anti_alias_order`` on both channels, the torque channel delayed behind the rack).
+    ``angle_bits`` (0: no angle channel) logs the handwheel angle too, as an encoder would: sampled without the
+    analogue filter, with ``angle_noise_rad`` RMS noise on +-``angle_full_scale_rad``.
     """
 
     sample_rate_hz: float = 100.0
@@ -154,6 +156,9 @@ class VariationLogger:
     anti_alias_order: int = 2
     torque_lag_s: float = 0.0
     seed: int = 0
+    angle_bits: int = 0
+    angle_full_scale_rad: float = 16.0
+    angle_noise_rad: float = 2e-4
 
 
 def variation_record(params: Parameters, hand: HandVariant, logger: VariationLogger, case: str = "unladen",
@@ -172,6 +177,8 @@ def variation_record(params: Parameters, hand: HandVariant, logger: VariationLog
                       output_dt_s=min(CLEAN_DT_S, 0.5 / logger.sample_rate_hz))
     t = np.asarray(result.columns["time_s"], dtype=float)
     clean = anti_alias_and_lag(t, result.columns, logger.anti_alias_hz, logger.anti_alias_order, logger.torque_lag_s)
+    if logger.angle_bits:
+        clean["handwheel_angle_rad"] = np.asarray(result.columns["handwheel_angle_rad"], dtype=float)
     time_s, sampled = resample(t, clean, logger.sample_rate_hz)
     rng = np.random.default_rng(logger.seed)
     rack = quantise(add_noise(sampled["rack_m"], logger.rack_noise_m, rng), logger.rack_full_scale_m, logger.rack_bits)
@@ -193,6 +200,11 @@ def variation_record(params: Parameters, hand: HandVariant, logger: VariationLog
     if logger.torque_lag_s:
         metadata["torque_lag_s"] = logger.torque_lag_s
     columns = {"time_s": time_s, "rack_m": rack, "handwheel_torque_Nm": torque}
+    if logger.angle_bits:  # its noise drawn after the others', so that the other channels are those without it
+        columns["handwheel_angle_rad"] = quantise(add_noise(sampled["handwheel_angle_rad"], logger.angle_noise_rad, rng),
+                                                  logger.angle_full_scale_rad, logger.angle_bits)
+        metadata["bits_handwheel_angle_rad"] = logger.angle_bits
+        metadata["full_scale_handwheel_angle_rad"] = logger.angle_full_scale_rad
     return Measurement(path=None, columns=columns, metadata={k: metadata_text(v) for k, v in metadata.items()})
 
 
@@ -204,14 +216,16 @@ def variation_rack(params: Parameters, hand: HandVariant):
 
 @dataclass(frozen=True)
 class Variation:
-    """One way a record can differ from the benchmark's: a hand, a logger (each without its seed) and how many
-    files a case has (the first ``files`` of the design's file list, each with its own hand and noise seeds)."""
+    """One way a record can differ from the benchmark's: a hand, a logger (each without its seed), how many
+    files a case has (the first ``files`` of the design's file list, each with its own hand and noise seeds) and
+    whether the diagnosis fits the handwheel angle its logger logs."""
 
     name: str
     what: str
     hand: HandVariant
     logger: VariationLogger
     files: int = 1
+    uses_angle: bool = False  # diagnosed with the handwheel angle as a second signal (its logger logs one)
 
     def settings(self, seed: int) -> tuple[HandVariant, VariationLogger]:
         """The hand and logger of this variation with `seed` for the hand's wander and the logger's noise."""
@@ -251,6 +265,8 @@ VARIATIONS: tuple[Variation, ...] = (
               _H(0.05, 0.2), _L(50.0, 12, 8, torque_lag_s=0.01)),
     Variation("three_files", "three files (unladen, part laden, largest spacer), each its own hand",
               _H(0.05, 0.2), _L(100.0, 12, 8), files=3),
+    Variation("angle_channel", "a 14-bit handwheel angle beside the 12-bit rack and 8-bit torque, 50 Hz; diagnosed "
+              "with the angle as a second signal", _H(0.05, 0.2), _L(50.0, 12, 8, angle_bits=14), uses_angle=True),
 )
 
 
