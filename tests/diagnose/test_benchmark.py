@@ -74,8 +74,9 @@ def test_rates_and_confusion_matrix(scored):
 
 
 def test_benchmark_figure_data_is_the_same_whatever_the_timings(tmp_path):
-    """Figure data is checksummed, so it must not change from run to run: two benchmarks that differ only in the
-    wall-clock time of each diagnosis give byte-identical figure data (timings stay in the JSON summary)."""
+    """Figure data and key numbers are checksummed and reproduced by a rebuild, so they must not change from run to
+    run: two benchmarks that differ only in the wall-clock and stage times of each diagnosis give byte-identical
+    figure data and key-number file, and neither holds a machine time."""
     from parksteer.figures.diagnose import make_benchmark_figure
 
     csv_bytes = []
@@ -86,11 +87,13 @@ def test_benchmark_figure_data_is_the_same_whatever_the_timings(tmp_path):
         for truth, result in CASES:
             t, d = folder / f"{truth['name']}.truth.json", folder / f"{truth['name']}.diagnosis.json"
             t.write_text(json.dumps(truth))
-            d.write_text(json.dumps({**result, "cost": {"replays": 100, "wall_s": wall_s}}))
+            d.write_text(json.dumps({**result, "cost": {"replays": 100, "wall_s": wall_s,
+                                                         "timings_s": {"calibration": wall_s / 3}}}))
             truths.append(t), results.append(d)
         make_benchmark_figure(truths, results, folder / "b.svg", folder / "b.csv", folder / "b.json")
-        csv_bytes.append((folder / "b.csv").read_bytes())
+        csv_bytes.append((folder / "b.csv").read_bytes() + (folder / "b.json").read_bytes())
     assert csv_bytes[0] == csv_bytes[1]
+    assert b"wall_s" not in csv_bytes[0] and b"timings_s" not in csv_bytes[0]
 
 
 def test_benchmark_figure_shows_both_curves_when_they_coincide(scored, tmp_path, monkeypatch):

@@ -38,7 +38,7 @@ from IPython.display import SVG, Markdown, display
 from parksteer.diagnose.compare import compare_files
 from parksteer.diagnose.ladder import error_ladder
 from parksteer.diagnose.problem import load_files
-from parksteer.diagnose.report import diagnosis_dict
+from parksteer.diagnose.report import diagnosis_dict, without_machine_times
 from parksteer.diagnose.select import diagnose
 from parksteer.figures.diagnose import compare_figure, diagnosis_figure, ladder_figure, shown_files
 from parksteer.measure.phases import PHASES
@@ -219,7 +219,7 @@ table(["parameter", "true", "calibrated without the effect", "fitted with the ef
 data_description = {"files": [{"file": f.label, "case": f.case, "surface": f.surface, "samples": f.n}
                               for f in files],
                     "synthetic": True, "hidden_steps": truth["steps"], "torque_step_Nm": truth["torque_step_Nm"]}
-write_json(OUT_JSON, {"data": data_description, "compare": summary, "diagnosis": result,
+write_json(OUT_JSON, {"data": data_description, "compare": summary, "diagnosis": without_machine_times(result),
                       "ladder": ladder.as_dict(), "reveal": reveal})
 write_csv(OUT_RESIDUALS, residuals, {"file": files[first_file].label,
                                      "residual": "measured - model handwheel torque, N m"})

@@ -118,9 +118,6 @@ def outcome(truth: dict, result: dict) -> dict:
     }
 
 
-TIMING_FIELDS = ("wall_s",)
-
-
 def _fraction(values) -> float | None:
     values = list(values)
     return float(np.mean(values)) if values else None

@@ -66,6 +66,21 @@ def _ranking_entry(diagnosis: Diagnosis, candidate: Candidate, before: dict) -> 
     }
 
 
+# Machine times in a diagnosis or a benchmark summary: they differ from run to run and machine to machine, so the
+# pipeline's key-number files (results/<target>.json), which a rebuild must reproduce byte for byte, leave them out.
+MACHINE_TIME_KEYS = frozenset({"timings_s", "wall_s", "generation_s", "wall_s_median", "diagnosis_wall_s_median",
+                               "diagnosis_wall_s_total"})
+
+
+def without_machine_times(value):
+    """`value` (JSON-like) with every MACHINE_TIME_KEYS entry removed, at any depth."""
+    if isinstance(value, dict):
+        return {k: without_machine_times(v) for k, v in value.items() if k not in MACHINE_TIME_KEYS}
+    if isinstance(value, list):
+        return [without_machine_times(v) for v in value]
+    return value
+
+
 def diagnosis_dict(diagnosis: Diagnosis) -> dict:
     """The JSON of a diagnosis (see workflow/schemas/diagnosis.schema.json)."""
     problem = diagnosis.problem

@@ -172,6 +172,7 @@ def make_ladder_figure(case_study_json: str | Path, residuals_csv: str | Path, s
     """figures/diag_ladder from the case study's numbers (results/case_study.json) and residuals."""
     import json
 
+    from ..diagnose.report import without_machine_times
     from ..tables import read_csv, write_csv, write_json
 
     study = json.loads(Path(case_study_json).read_text(encoding="utf-8"))
@@ -187,7 +188,7 @@ def make_ladder_figure(case_study_json: str | Path, residuals_csv: str | Path, s
                "noise_floor_Nm": f"{ladder['noise_floor_Nm']:.6g}",
                "attainable_floor_Nm": f"{ladder['attainable_floor_Nm']:.6g}"})
     summary = {key: study[key] for key in ("ladder", "compare", "diagnosis", "reveal", "data")}
-    write_json(json_path, summary)
+    write_json(json_path, without_machine_times(summary))
     return summary
 
 
@@ -239,16 +240,17 @@ def benchmark_figure(rows: list[dict], summary: dict, path: str | Path) -> None:
 def make_benchmark_figure(truth_paths, diagnosis_paths, svg: str | Path, csv: str | Path, json_path: str | Path,
                           design=None) -> dict:
     """figures/diag_benchmark.svg (confusion matrix, accuracy against strength), its CSV, results JSON."""
-    from ..diagnose.benchmark import TIMING_FIELDS, aggregate
+    from ..diagnose.benchmark import aggregate
+    from ..diagnose.report import MACHINE_TIME_KEYS, without_machine_times
     from ..tables import write_csv, write_json
 
     rows, summary = aggregate(truth_paths, diagnosis_paths, design)
     benchmark_figure(rows, summary, svg)
-    # Timings differ from run to run; they stay in the JSON summary, out of the checksummed figure data.
-    columns = {key: [r[key] for r in rows] for key in rows[0] if key not in TIMING_FIELDS} if rows else {}
+    # machine times differ from run to run: out of the checksummed figure data and the key numbers
+    columns = {key: [r[key] for r in rows] for key in rows[0] if key not in MACHINE_TIME_KEYS} if rows else {}
     write_csv(csv, columns, {"figure": "diag_benchmark: one row per synthetic data set",
                              "steps": "hidden size as converter steps of torque RMS on the unladen ground file"})
-    write_json(json_path, summary)
+    write_json(json_path, without_machine_times(summary))
     return summary
 
 
@@ -333,13 +335,14 @@ def make_outclass_figure(truth_paths, diagnosis_paths, svg: str | Path, csv: str
                          design=None) -> dict:
     """figures/diag_outclass.svg (the out-of-class confusion table), its CSV (one row per data set), results JSON."""
     from ..diagnose.outclass import aggregate
+    from ..diagnose.report import MACHINE_TIME_KEYS, without_machine_times
     from ..tables import write_csv, write_json
 
     rows, summary = aggregate(truth_paths, diagnosis_paths, design)
     outclass_figure(rows, svg)
-    # the diagnosis's wall time differs from run to run; it stays in the JSON summary, out of the figure data
-    columns = {key: [("" if r[key] is None else r[key]) for r in rows] for key in rows[0] if key != "wall_s"} \
-        if rows else {}
+    # machine times differ from run to run: out of the checksummed figure data and the key numbers
+    columns = {key: [("" if r[key] is None else r[key]) for r in rows] for key in rows[0]
+               if key not in MACHINE_TIME_KEYS} if rows else {}
     write_csv(csv, columns, {"figure": "diag_outclass: one row per out-of-class data set",
                              "steps_actual": "hidden rival's RMS torque change in converter steps (all files)",
                              "bic_margin": "named candidate's BIC gain over the runner-up's",
@@ -347,7 +350,7 @@ def make_outclass_figure(truth_paths, diagnosis_paths, svg: str | Path, csv: str
                                                    "by the nearest",
                              "nearest": "strongly evidenced best candidate, named or not (none: no BIC gain above "
                                         "the threshold)"})
-    write_json(json_path, summary)
+    write_json(json_path, without_machine_times(summary))
     return summary
 
 
@@ -409,14 +412,15 @@ def make_variations_figure(truth_paths, diagnosis_paths, svg: str | Path, csv: s
                            design=None) -> dict:
     """figures/diag_variations.svg (targets per variation, errors against the thresholds), its CSV (one row per
     record) and results/diag_variations.json (the per-variation table and the targets)."""
+    from ..diagnose.report import MACHINE_TIME_KEYS, without_machine_times
     from ..diagnose.variations import aggregate
     from ..tables import write_csv, write_json
 
     rows, summary = aggregate(truth_paths, diagnosis_paths, design)
     variations_figure(rows, summary, svg)
-    # the diagnosis's wall time differs from run to run; it stays in the JSON summary, out of the figure data
-    columns = {key: [("" if r[key] is None else r[key]) for r in rows] for key in rows[0] if key != "wall_s"} \
-        if rows else {}
+    # machine times differ from run to run: out of the checksummed figure data and the key numbers
+    columns = {key: [("" if r[key] is None else r[key]) for r in rows] for key in rows[0]
+               if key not in MACHINE_TIME_KEYS} if rows else {}
     write_csv(csv, columns, {"figure": "diag_variations: one row per record set of the variation benchmark",
                              "steps": "hidden size requested, converter steps of torque RMS over the case's files",
                              "steps_actual": "the size the strength search reached",
@@ -424,5 +428,5 @@ def make_variations_figure(truth_paths, diagnosis_paths, svg: str | Path, csv: s
                              "calibrated_over_floor": "calibrated base model's weighted RMS error, noise floors",
                              "after_over_floor": "with the named effect, noise floors",
                              "covered": "of the reported model's 95 % intervals, those holding the true value"})
-    write_json(json_path, summary)
+    write_json(json_path, without_machine_times(summary))
     return summary
