@@ -368,7 +368,16 @@ map: {x: tyre.tyre_pressure, y: design.front_axle_load, quantity: peak_torque_Nm
 
 
 @pytest.fixture(scope="module")
-def tiny_grid(params):
+def default_model():
+    """The paper's model derived (a sweep point never derives; rule derive does it before the points run)."""
+    from parksteer.model.numeric.compiled import load_model
+    from parksteer.model.symbolic.components import resolve_effects
+
+    return load_model(resolve_effects(None))
+
+
+@pytest.fixture(scope="module")
+def tiny_grid(params, default_model):
     """Four points of the multibody model: two pressures x two front axle loads, the rest the test car."""
     out = {}
     for pressure in (122500.0, 245000.0):
@@ -408,7 +417,7 @@ def test_plateau_tyre_share_rises_with_load_as_w_to_the_1_5(tiny_grid):
         assert rack == pytest.approx([730.0 / 186.47] * 2, rel=0.01)
 
 
-def test_plateau_scales_inversely_with_steering_ratio(params):
+def test_plateau_scales_inversely_with_steering_ratio(params, default_model):
     """Through lossless gearing the handwheel carries the road-side resistance divided by the overall ratio:
     plateau x G is the same for G = 16 and 30 within 2 % (the Hooke-joint ripple is averaged over whole
     periods, the column damping adds only c * rate, under 0.1 N m at these rates)."""
@@ -426,12 +435,16 @@ def test_braked_wheels_effect_agrees_with_rig_theory_and_matters_only_with_offse
     as the rig theory applied after the fact (within 1 %: the effect's series for the patch integral and its
     lateral-only offset), and the plateau by over 20 % (the drag part without equation (2)'s pressure correction,
     as Fig. 4); with the standard wheels (5.8 mm) by under 1 %."""
+    from parksteer.model.numeric.compiled import load_model
+    from parksteer.model.symbolic.components import resolve_effects
+
+    braked_effects = sorted(["braked_wheels", "carcass_compliance", "hooke_joint", "lifting", "rack_friction",
+                             "tyre_friction"])
+    load_model(resolve_effects(braked_effects))  # a sweep point never derives: derived here, as rule derive would
     plateaus = {}
     for offset in (0.0, 0.0685):
         spec = {"sweep": "tiny", "point": "x", "case": "unladen", "effects": None, "surface": "ground",
-                "values": {"design.extra_offset": offset}, "braked": "braked_wheels",
-                "braked_effects": sorted(["braked_wheels", "carcass_compliance", "hooke_joint", "lifting",
-                                          "rack_friction", "tyre_friction"])}
+                "values": {"design.extra_offset": offset}, "braked": "braked_wheels", "braked_effects": braked_effects}
         record = simulate_point(spec, params)
         braked = record["braked"]
         assert braked["factor"] == pytest.approx(braked["rig_theory_factor"], rel=0.01)
