@@ -125,9 +125,13 @@ def case_batches(prefix, names, per_job):
 
 
 def case_outputs(folder, names, batches, suffix):
-    """The `suffix` file (truth or diagnosis) of each case of `names`, in its job's folder, in the order of `names`."""
+    """The `suffix` file (truth or diagnosis) of each case of `names`, in its job's folder (where run_batch puts
+    it: parksteer.diagnose.benchmark.case_files), in the order of `names`."""
+    from parksteer.diagnose.benchmark import case_files
+
+    part = {"truth": 1, "diagnosis": 2}[suffix]
     job_of = {name: batch for batch, members in batches.items() for name in members}
-    return [f"{folder}/{job_of[name]}/{name}.{suffix}.json" for name in names]
+    return [str(case_files(f"{folder}/{job_of[name]}", name)[part]) for name in names]
 
 
 def benchmark_file(rule, *wildcards):

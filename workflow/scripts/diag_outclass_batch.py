@@ -1,14 +1,10 @@
-# Thin rule script: the logic is parksteer.diagnose.outclass.run_case, once per case of the job.
-from pathlib import Path
-
+# Thin rule script: the logic is parksteer.diagnose.outclass.run_case, once per case of the job (run_batch).
+from parksteer.diagnose.benchmark import run_batch
 from parksteer.diagnose.outclass import run_case
 from parksteer.rules import rule_log
 from parksteer.synthetic.datasets import OutclassDesign
 
 with rule_log(snakemake):
-    design = OutclassDesign.from_config(snakemake.params.design, snakemake.params.benchmark)
-    out = Path(snakemake.output[0])
-    for name in snakemake.params.cases:
-        (out / name).mkdir(parents=True, exist_ok=True)
-        run_case(snakemake.input.parameters, design, name, out / name, out / f"{name}.truth.json",
-                 out / f"{name}.diagnosis.json")
+    run_batch(run_case, snakemake.input.parameters,
+              OutclassDesign.from_config(snakemake.params.design, snakemake.params.benchmark),
+              snakemake.params.cases, snakemake.output[0])

@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import json
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import numpy as np
@@ -63,6 +63,23 @@ def diagnose_written(params: Parameters, records, folder: str | Path, truth: dic
     write_json(truth_path, truth)
     write_json(diagnosis_path, result)
     return result
+
+
+def case_files(folder: str | Path, name: str) -> tuple[Path, Path, Path]:
+    """Where case `name` of a benchmark job goes in the job's `folder`: (its records' folder, its truth file, its
+    diagnosis file)."""
+    folder = Path(folder)
+    return folder / name, folder / f"{name}.truth.json", folder / f"{name}.diagnosis.json"
+
+
+def run_batch(run_case: Callable, parameters_path: str | Path, design, names: list[str], folder: str | Path) -> None:
+    """Run the cases `names` of one benchmark job, each with `run_case` (this module's, the out-of-class or the
+    variation benchmark's: ``run_case(parameters_path, design, name, records_folder, truth_path, diagnosis_path)``)
+    into its place in `folder` (:func:`case_files`)."""
+    for name in names:
+        records, truth, diagnosis = case_files(folder, name)
+        records.mkdir(parents=True, exist_ok=True)
+        run_case(parameters_path, design, name, records, truth, diagnosis)
 
 
 def paired_results(truth_paths, diagnosis_paths, what: str) -> Iterator[tuple[dict, dict]]:
