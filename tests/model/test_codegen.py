@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 import sympy as sp
 
 from parksteer.model.symbolic.components import resolve_effects
@@ -14,8 +15,8 @@ def _random_states(model, rng, count):
     scale_q = {"rack": 0.06, "bounce": 2e-3, "roll": 2e-3, "twist_left": 0.2, "twist_right": 0.2}
     scale_u = {"rack": 0.03, "bounce": 0.01, "roll": 0.02, "twist_left": 0.05, "twist_right": 0.05}
     for _ in range(count):
-        q = [scale_q[c] * rng.uniform(-1, 1) for c in model.coordinates]
-        u = [scale_u[c] * rng.uniform(-1, 1) for c in model.coordinates]
+        q = [scale_q.get(c, 1e-3) * rng.uniform(-1, 1) for c in model.coordinates]
+        u = [scale_u.get(c, 1e-2) * rng.uniform(-1, 1) for c in model.coordinates]
         yield rng.uniform(0, 18), np.array(q + u)
 
 
@@ -41,9 +42,12 @@ def test_compiled_right_hand_side_equals_sympy_equations(params):
         np.testing.assert_allclose(run.model.rhs(t, y, run.p)[n:], a, rtol=1e-9, atol=1e-9 * np.max(np.abs(a)))
 
 
-def test_analytic_jacobian_equals_finite_differences(params):
+# The default model, and effects whose laws bring conditions (braked wheels), an extra state (pre-sliding
+# friction) or a second linkage geometry (Ackermann) into the chain rule through the common subexpressions.
+@pytest.mark.parametrize("effects", [None, "+braked_wheels", "+rack_presliding", "+ackermann"])
+def test_analytic_jacobian_equals_finite_differences(params, effects):
     """The generated Jacobian d(u, M^-1 f)/d(q, u) matches central differences of the compiled right-hand side."""
-    run = prepare("unladen", params=params)
+    run = prepare("unladen", effects=effects, params=params)
     model, p = run.model, run.p
     for t, y in _random_states(model, np.random.default_rng(5), 4):
         jac = model.jacobian(t, y, p)

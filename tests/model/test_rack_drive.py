@@ -26,16 +26,23 @@ def hermite_rack(time_s, position, speed, acceleration) -> RackSpline:
 def test_prescribed_free_simulation_rack_gives_back_its_handwheel_torque_and_angle(params):
     """Independent paths: the free (handwheel-driven) integration of the full model, and the constrained solve of
     the same equations with its rack prescribed (from its own rack states, smoothly) and the column torque solved
-    for. The solve gives back the free run's handwheel torque (within 0.01 N m), its handwheel angle through the
-    solved column twist (within 2e-5 rad) and its wheel loads (within 1 N of 2.7 kN)."""
+    for. Solved to convergence (rtol 1e-8, the free run's absolute tolerances), the solve gives back the free run's
+    handwheel torque (within 1e-3 N m; they agree to about 4e-6 N m), its handwheel angle through the solved column
+    twist (within 2e-5 rad) and its wheel loads (within 1 N of 2.7 kN). Converged, because the default replay
+    tolerance is looser: on this rack it leaves transients up to 0.09 N m (tolerances.PRESCRIBED_RTOL)."""
     free = simulate("unladen", params=params, output_dt_s=0.005)
     model, n = free.model, free.model.n_q
     i = model.index("rack")
     c = free.columns
     acceleration = np.array([model.rhs(t, y, free.parameter_vector)[n + i] for t, y in zip(c["time_s"], free.states)])
     rack = hermite_rack(c["time_s"], free.states[:, i], free.states[:, n + i], acceleration)
-    d = simulate("unladen", params=params, rack_drive=rack, output_dt_s=0.01).columns
-    for name, tolerance in (("handwheel_torque_Nm", 0.01), ("handwheel_angle_rad", 2e-5), ("load_left_N", 1.0),
+    t = np.round(np.arange(0.0, c["time_s"][-1] + 1e-9, 0.01), 12)
+    run = prepare("unladen", params=params)
+    solution = solve(run, run.p, rack, t, rtol=1e-8, atol_factor=1.0, outputs=True)
+    d = {"time_s": t, "handwheel_torque_Nm": solution.outputs["column_torque_Nm"],
+         "handwheel_angle_rad": solution.handwheel[:, 0], "load_left_N": solution.outputs["load_left_N"],
+         "load_right_N": solution.outputs["load_right_N"]}
+    for name, tolerance in (("handwheel_torque_Nm", 1e-3), ("handwheel_angle_rad", 2e-5), ("load_left_N", 1.0),
                             ("load_right_N", 1.0)):
         expected = np.interp(d["time_s"], c["time_s"], c[name])
         assert np.max(np.abs(d[name] - expected)) < tolerance, name

@@ -204,7 +204,7 @@ class ModelSpace:
         for effect in self.effects:
             for key in effect.uses:
                 self._symbol(key)
-        self.handwheel_angle, self.handwheel_rate = sp.symbols("handwheel_angle handwheel_rate")
+        self.handwheel_angle, self.handwheel_rate = sp.symbols("handwheel_angle handwheel_rate", real=True)
         self.rack_q, self.rack_u = self.add_coordinate("rack", "m", owner="core")
         self.bounce_q, self.bounce_u = self.add_coordinate("bounce", "m", owner="core")
         self.roll_q, self.roll_u = self.add_coordinate("roll", "rad", owner="core")
@@ -250,7 +250,7 @@ class ModelSpace:
             raise RuntimeError("coordinates must be added in Effect.configure")
         if any(c.name == name for c in self.coordinates):
             raise ValueError(f"coordinate {name!r} already exists")
-        q, u = me.dynamicsymbols(f"q_{name} u_{name}")
+        q, u = me.dynamicsymbols(f"q_{name} u_{name}", real=True)  # real: sympy answers is_real at once
         if self.speeds_as_qdot:
             u = q.diff(self.t)
         self.coordinates.append(Coordinate(name, unit, q, u, owner))

@@ -90,9 +90,13 @@ class BrakedWheels(Effect):
         out = []
         for side in SIDES:
             load = k.wheel_load[side]
-            patch_radius_squared = sp.Piecewise((load, load > 0), (0, True)) / (sp.pi * pressure)
-            # a wheel off the ground has no patch (and no moment: moment_limit is 0 there)
-            k_squared = self.scrub_offset_squared(model, side) / sp.Max(patch_radius_squared, sp.Float(1e-12))
+            # the patch radius squared, kept above 1e-12 m^2: a wheel off the ground has no patch (and no moment:
+            # moment_limit is 0 there). A Piecewise rather than Max, which re-simplifies its arguments on every
+            # substitution (seconds per model in the code generation).
+            floor = sp.Float(1e-12)
+            patch_radius_squared = sp.Piecewise((load / (sp.pi * pressure), load > floor * sp.pi * pressure),
+                                                (floor, True))
+            k_squared = self.scrub_offset_squared(model, side) / patch_radius_squared
             # equation (1): equation (2) without its pressure correction (p0/p)^(n - 1/2)
             spin_uniform = TYRE_FRICTION.moment_limit(model, load) / (p0 / pressure) ** (n - sp.Rational(1, 2))
             excess = fraction * spin_uniform * braked_excess_ratio(k_squared)
