@@ -1,4 +1,5 @@
 import ast
+import json
 import os
 from functools import lru_cache
 from pathlib import Path
@@ -68,10 +69,53 @@ def _module_file(name):
     return None
 
 
+# The import lists of parsed files are kept between runs in .snakemake/, each under its file's path, size and
+# modification time, so a run parses only the files that changed (parsing all of them was most of the Snakefile's
+# own time in a run with nothing to do). A missing or unreadable cache is rebuilt.
+IMPORT_CACHE = Path(".snakemake") / "parksteer-imports.json"
+
+
+def _read_import_cache():
+    try:
+        cached = json.loads(IMPORT_CACHE.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return {}
+    return cached if isinstance(cached, dict) else {}
+
+
+_IMPORTS_KNOWN = _read_import_cache()
+_IMPORTS_PARSED = {}
+
+
+def save_import_cache():
+    """Write the import lists parsed in this run into IMPORT_CACHE (atomically; a read-only directory is fine)."""
+    if not _IMPORTS_PARSED:
+        return
+    merged = {**_IMPORTS_KNOWN, **_IMPORTS_PARSED}
+    scratch = IMPORT_CACHE.with_name(f"{IMPORT_CACHE.name}.{os.getpid()}")
+    try:
+        IMPORT_CACHE.parent.mkdir(exist_ok=True)
+        scratch.write_text(json.dumps(merged, sort_keys=True), encoding="utf-8")
+        os.replace(scratch, IMPORT_CACHE)
+    except OSError:
+        pass
+
+
 @lru_cache(maxsize=None)
 def _imported_names(path, module):
     """Every module name an import statement of `path` (module `module`, or None for a script) may load; each
-    file is parsed once per Snakemake run, however many rule scripts import it."""
+    file is parsed once per Snakemake run, however many rule scripts import it, and again only when it changes."""
+    stat = path.stat()
+    key, stamp = f"{path}|{module}", [stat.st_mtime_ns, stat.st_size]
+    known = _IMPORTS_KNOWN.get(key)
+    if isinstance(known, list) and len(known) == 2 and known[0] == stamp:
+        return tuple(known[1])
+    names = _parse_imports(path, module)
+    _IMPORTS_PARSED[key] = [stamp, list(names)]
+    return names
+
+
+def _parse_imports(path, module):
     package = module if path.name == "__init__.py" else (module or "").rpartition(".")[0]
     names = []
     for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"), filename=str(path))):

@@ -24,7 +24,6 @@ import numpy as np
 from ..errors import UsageError
 from ..geometry import steer_axis
 from ..parameters import Parameters, load_parameters
-from ..plotting import COLOURS, new_figure, save_svg
 from ..tables import read_csv, write_csv, write_json
 
 Run = tuple[str, str]  # (case, variant)
@@ -220,6 +219,8 @@ def until_hand_stops(columns: dict, params: Parameters) -> np.ndarray:
 
 
 def _torque_against_rack(params, runs, data, labels, title, ylabel="handwheel torque (N m)"):
+    from ..plotting import COLOURS, new_figure  # matplotlib only where a figure is drawn
+
     fig, ax = new_figure(6.5, 4.2)
     for colour, (case, variant) in zip(COLOURS, runs):
         c = data[(case, variant)]
@@ -239,6 +240,8 @@ def _torque_against_rack(params, runs, data, labels, title, ylabel="handwheel to
 
 
 def _loads_against_rack(params, runs, data, labels):
+    from ..plotting import COLOURS, new_figure  # matplotlib only where a figure is drawn
+
     fig, ax = new_figure(6.5, 4.8)
     for colour, (case, variant) in zip(COLOURS, runs):
         c = data[(case, variant)]
@@ -255,6 +258,8 @@ def _loads_against_rack(params, runs, data, labels):
 
 
 def _contributions_over_time(params, c):
+    from ..plotting import COLOURS, new_figure  # matplotlib only where a figure is drawn
+
     fig, (top, bottom) = new_figure(6.5, 5.5, nrows=2, sharex=True)
     t = c["time_s"]
     present = [n for n in ("tyre_friction", "rack_friction", "lifting", "carcass_compliance", "hooke_joint", "inertia")
@@ -354,6 +359,8 @@ def make_model_figure(name: str, runs: list[Run], labels: dict[str, str], parame
 
     `labels` maps a variant to its legend label (a variant without one is labelled by its case).
     """
+    from ..plotting import save_svg  # matplotlib only where a figure is drawn (the Snakefile imports this module)
+
     params = load_parameters(parameters_path)
     runs = [(str(case), str(variant)) for case, variant in runs]
     if len(simulation_csvs) != len(runs):

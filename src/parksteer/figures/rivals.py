@@ -36,7 +36,6 @@ import numpy as np
 
 from ..model.symbolic.components import discover_effects, strength_parameter
 from ..parameters import Parameters, load_parameters
-from ..plotting import COLOURS, new_figure, save_svg
 from ..tables import write_csv, write_json
 from .model import cycle_summary
 
@@ -187,6 +186,8 @@ def rivals_table(result: dict) -> dict[str, list]:
 
 def plot_rivals(result: dict):
     """The rise toward lock that lifting and each rival add in the source's four tests."""
+    from ..plotting import COLOURS, new_figure  # matplotlib only where a figure is drawn
+
     names = ["lifting", *result["order"]]
     tests = result["tests"]
     fig, ax = new_figure(7.0, 3.4)
@@ -216,6 +217,8 @@ def plot_rivals(result: dict):
 def make_rivals(parameters_path: str | Path, svg_path: str | Path, csv_path: str | Path, json_path: str | Path,
                 progress=None) -> dict:
     """Write the rivals figure (SVG), its table (CSV) and the numbers the paper quotes (JSON)."""
+    from ..plotting import save_svg  # matplotlib only where a figure is drawn (the Snakefile imports this module)
+
     params = load_parameters(parameters_path)
     result = compare_rivals(params, progress=progress)
     header = {

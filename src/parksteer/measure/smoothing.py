@@ -30,12 +30,18 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
+from typing import TYPE_CHECKING
+
 import numpy as np
-from scipy.interpolate import BSpline, CubicSpline, PPoly
 
 from ..errors import UsageError
 from .metrics import estimate_noise_rms
 from .phases import local_linear_fit
+
+if TYPE_CHECKING:
+    from scipy.interpolate import PPoly
+# scipy.interpolate is imported where a spline is made: the workflow's Snakefile imports this module (through the
+# synthetic data designs), and scipy.interpolate is half a second of every Snakemake start.
 
 # --- smoothing settings (settings of the method, not properties of the car; each with its reason) ---------------
 # The spacing of the knots is the largest whose fit residual (per degree of freedom) is within this factor of the
@@ -127,6 +133,8 @@ def interpolate_rack(time_s, rack_m) -> RackSpline:
         raise UsageError("rack spline: needs at least 4 samples of time_s and rack_m")
     if not (np.all(np.isfinite(t)) and np.all(np.isfinite(x))) or np.any(np.diff(t) <= 0):
         raise UsageError("rack spline: time_s must be finite and strictly increasing, rack_m finite")
+    from scipy.interpolate import CubicSpline
+
     return RackSpline.from_ppoly(CubicSpline(t, x))
 
 
@@ -152,6 +160,8 @@ class SmoothedRack(RackSpline):
     @classmethod
     def from_bspline(cls, knots, bspline, covariance, knot_spacing_s, fit_rms_m, noise_rms_m,
                      held_at_rest=(False, False), turning_times_s=(), rest_intervals_s=()) -> SmoothedRack:
+        from scipy.interpolate import BSpline, PPoly
+
         piecewise = RackSpline.from_ppoly(PPoly.from_spline(BSpline(knots, bspline, 3, extrapolate=False)))
         return cls(piecewise.breaks, piecewise.coefficients, knots, bspline, covariance, float(knot_spacing_s),
                    float(fit_rms_m), float(noise_rms_m), tuple(held_at_rest), tuple(turning_times_s),
@@ -299,6 +309,8 @@ def _lsq_fit(t: np.ndarray, x: np.ndarray, spacing_s: float, turns: tuple[float,
     reaching the end holds it). Over each of `rests` the spline is constant.
     None if the spline is ill-posed.
     """
+    from scipy.interpolate import BSpline
+
     knots = _knot_vector(t, spacing_s, turns, rests)
     design = BSpline.design_matrix(t, knots, 3).toarray()
     gram = design.T @ design
