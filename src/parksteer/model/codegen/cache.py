@@ -84,12 +84,13 @@ def _effect_source(effect: Effect) -> str:
 
 
 def model_key(effects: list[Effect]) -> str:
-    """Hash of the effect set, the symbolic half's source (symbolic/ and codegen/), external effects' source and
-    the sympy version."""
+    """Hash of the effect set, the symbolic half's source (symbolic/ and codegen/, Python and C), external effects'
+    source and the sympy version."""
     digest = hashlib.sha256()
     digest.update(f"format {FORMAT_VERSION}\nsympy {sympy.__version__}\n".encode())
     digest.update(("effects " + ",".join(e.name for e in effects) + "\n").encode())
-    for path in sorted(p for d in SYMBOLIC_DIRS for p in d.rglob("*.py") if p != KEYLESS_SOURCE):
+    sources = (p for d in SYMBOLIC_DIRS for pattern in ("*.py", "*.c") for p in d.rglob(pattern))
+    for path in sorted(p for p in sources if p != KEYLESS_SOURCE):
         digest.update(str(path.relative_to(MODEL_DIR)).encode() + b"\0" + path.read_bytes() + b"\0")
     for effect in effects:
         digest.update(_effect_source(effect).encode())

@@ -1,8 +1,9 @@
 """C code for one derived model: mass matrix, forcing, analytic Jacobian, outputs.
 
-The generated file has two parts: functions written from the sympy expressions (after
-common-subexpression elimination) and a fixed runtime (handwheel input, Cholesky solve of
-the symmetric positive definite mass matrix, right-hand side, Jacobian, batched outputs).
+The generated file has three parts: functions written from the sympy expressions (after
+common-subexpression elimination), a fixed runtime (handwheel input, Cholesky solve of
+the symmetric positive definite mass matrix, right-hand side, Jacobian, batched outputs), and
+the stiff integrator of ``integrator.c`` (``ps_integrate``: a whole handwheel-driven run in one call).
 Every parameter is read from the vector ``p`` at run time.
 
 The Jacobian of y' = (u, M^-1 f) is assembled from generated partial derivatives:
@@ -15,6 +16,7 @@ expressions: the same numbers, a fraction of the sympy time, and the shared term
 from __future__ import annotations
 
 import time
+from pathlib import Path
 
 import sympy as sp
 from sympy.printing.c import C99CodePrinter
@@ -201,8 +203,12 @@ def generate(derivation: Derivation) -> tuple[str, dict]:
         f"#define RACK {rack}\n#define OUT_COLUMN_ANGLE {info['outputs'].index('column_angle_rad')}\n"
         f"#define OUT_COLUMN_TORQUE {info['outputs'].index('column_torque_Nm')}\n\n"
     )
-    return header + "\n".join(parts) + RUNTIME, {**info, "codegen_timings_s": timings}
+    return header + "\n".join(parts) + RUNTIME + INTEGRATOR, {**info, "codegen_timings_s": timings}
 
+
+# The stiff integrator of the handwheel-driven model (ps_integrate), C kept in a file of its own; it follows the
+# runtime in the same translation unit, so it calls ps_rhs and ps_jac directly.
+INTEGRATOR = "\n" + (Path(__file__).with_name("integrator.c")).read_text(encoding="utf-8")
 
 RUNTIME = r"""
 /* ---- fixed runtime ---------------------------------------------------------------- */

@@ -1,22 +1,19 @@
 """Simulate the steering model: the paper's handwheel cycle, or a prescribed rack travel.
 
-With the handwheel prescribed, the model integrates y' = (u, M^-1 f) with scipy's odeint
-(LSODA, which loops in Fortran) and the compiled analytic Jacobian; each call of the
-right-hand side is one call into the generated C. With a prescribed rack (a rack motion, such
+With the handwheel prescribed, the model integrates y' = (u, M^-1 f) in the generated C: one call of
+``ps_integrate`` (variable-order NDF, the method of MATLAB's ode15s, with the compiled analytic Jacobian;
+model/codegen/integrator.c) runs the whole cycle, restarting at each corner of the handwheel input. With a prescribed rack (a rack motion, such
 as a measurement's rack smoothed by :func:`parksteer.measure.smoothing.smooth_rack`), the
 handwheel torque is solved for by :func:`parksteer.model.numeric.prescribed.solve`.
 """
 
 from __future__ import annotations
 
-import warnings
-
 import dataclasses
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-from scipy.integrate import ODEintWarning, odeint
 
 from ...errors import SolverError, UsageError
 from ...parameters import Parameters, load_parameters
@@ -26,7 +23,7 @@ from ..symbolic.components import Effect, discover_effects, resolve_effects
 from .inputs import HandwheelProfile, sawtooth_profile
 from .prescribed import RackMotion, solve as solve_prescribed
 from .statics import static_state
-from .tolerances import PRESCRIBED_RTOL, RTOL, absolute_tolerances, max_steps, solver_failure
+from .tolerances import PRESCRIBED_RTOL, RTOL, absolute_tolerances, integrator_failure, max_steps
 from .values import RunValues, parameter_vector, resolve_values
 
 ROLL_NEUTRAL_KEY = "derived.roll_spring_neutral"
@@ -105,33 +102,21 @@ def _atol(model: CompiledModel) -> np.ndarray:
 
 def integrate(run: PreparedRun, t_out: np.ndarray, y0: np.ndarray | None = None, rtol: float = RTOL,
               atol: np.ndarray | None = None) -> np.ndarray:
-    """States at `t_out` (odeint/LSODA with the compiled Jacobian), from `y0` or the static state."""
+    """States at `t_out` (increasing), from `y0` or the static state: one call of the generated integrator."""
     model, p = run.model, run.p
     n_y = 2 * model.n_q
     y0 = static_state(run) if y0 is None else np.asarray(y0, dtype=float)
-    lib = model.lib
-    rhs_c, jac_c = lib.ps_rhs, lib.ps_jac
-    p_ptr = p.ctypes.data
-    ydot = np.empty(n_y)
-    ydot_ptr = ydot.ctypes.data
-    jac = np.empty((n_y, n_y))
-    jac_ptr = jac.ctypes.data
-
-    def rhs(y, t):
-        rhs_c(t, y.ctypes.data, p_ptr, ydot_ptr)
-        return ydot
-
-    def dfun(y, t):
-        jac_c(t, y.ctypes.data, p_ptr, jac_ptr)
-        return jac
-
-    corners = np.array([piece[0] for piece in run.profile.pieces])
-    with warnings.catch_warnings():  # a failure is reported below as one line, not as a warning too
-        warnings.simplefilter("ignore", ODEintWarning)
-        states, info = odeint(rhs, y0, t_out, Dfun=dfun, rtol=rtol, atol=_atol(model) if atol is None else atol,
-                              mxstep=max_steps(t_out), full_output=True, tcrit=corners)
-    if info["message"] != "Integration successful.":
-        raise solver_failure("integration", info, t_out)
+    t_out = np.ascontiguousarray(t_out, dtype=float)
+    y0 = np.ascontiguousarray(y0, dtype=float)
+    atol = np.ascontiguousarray(_atol(model) if atol is None else np.broadcast_to(atol, (n_y,)), dtype=float)
+    corners = np.ascontiguousarray([piece[0] for piece in run.profile.pieces], dtype=float)
+    states = np.empty((len(t_out), n_y))
+    stats = np.zeros(4)
+    code = model.lib.ps_integrate(p.ctypes.data, y0.ctypes.data, len(t_out), t_out.ctypes.data, len(corners),
+                                  corners.ctypes.data, float(rtol), atol.ctypes.data, max_steps(t_out),
+                                  states.ctypes.data, stats.ctypes.data)
+    if code != 0:
+        raise integrator_failure("integration", code, float(stats[3]))
     return states
 
 

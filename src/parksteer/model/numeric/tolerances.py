@@ -10,7 +10,8 @@ import numpy as np
 # Handwheel-driven integration (parksteer.model.numeric.simulate.integrate): relative, and absolute per unit of
 # each coordinate (m or rad) and its rate. The column damping turns rack-speed error into handwheel torque at
 # c * G^2 (about 37,000 N m per m/s), so the speeds need tight absolute tolerances: with these the nominal
-# cycle's torque is within 0.002 N m of a run at rtol 1e-11, atol 1e-13.
+# cycle's torque is within 0.0004 N m of a run at rtol 1e-11 and a ten-thousandth of these atol (LSODA, which
+# integrated the cycle before the generated integrator: 0.0008 N m).
 RTOL = 1e-7
 ATOL_Q = {"m": 1e-10, "rad": 1e-9}
 ATOL_U = {"m": 1e-8, "rad": 1e-7}
@@ -27,18 +28,21 @@ PRESCRIBED_ATOL_FACTOR = 100.0  # 1
 
 
 # Work budget of both integrations: at most this many steps per simulated second between two output times
-# (odeint's mxstep, scaled by the output spacing, never below MIN_STEPS_PER_OUTPUT). The paper's cycles take
-# about 170 steps per second (3,000 over 18 s; at most 47 between 10 ms outputs), a tyre a hundred times stiffer
+# (odeint's mxstep and ps_integrate's max_steps, scaled by the output spacing, never below MIN_STEPS_PER_OUTPUT).
+# Measured with LSODA: the paper's cycles take about 170 steps per second (3,000 over 18 s, the generated
+# integrator 1,800; at most 47 between 10 ms outputs), a tyre a hundred times stiffer
 # radially than any car tyre (1e10 N/m) about 7,000, and the stiffest effect of the library, the pre-sliding rack
 # friction with its 0.1 ms bristle, about 100,000 (234,000 in its busiest 10 ms, at 1,560 N). Values that need
-# more than twice that are far outside what the model is for: without the budget a 1e14 N/m tyre ran for
-# minutes; with it the run fails in one line within two seconds.
+# more than twice that are far outside what the model is for: without the budget a 1e14 N/m tyre ran LSODA for
+# minutes (the generated integrator follows it in 9 s, within 0.002 N m of a 1e10 N/m tyre); with it a 1e16 N/m
+# tyre fails in one line within two seconds.
 STEP_BUDGET_PER_S = 500_000
 MIN_STEPS_PER_OUTPUT = 2_000
 
 
 def max_steps(t_out) -> int:
-    """odeint's mxstep for the output times `t_out`: the work budget over the longest output interval."""
+    """The step limit between two outputs for the output times `t_out`: the work budget over the longest output
+    interval."""
     t_out = np.asarray(t_out, dtype=float)
     longest = float(np.max(np.diff(t_out))) if len(t_out) > 1 else 0.0
     return max(MIN_STEPS_PER_OUTPUT, int(np.ceil(STEP_BUDGET_PER_S * longest)))
@@ -67,6 +71,25 @@ def solver_failure(what: str, info: dict, t_out: np.ndarray) -> "SolverError":
     # odeint's words, without its guess at the cause ("Excess work done on this call (perhaps wrong Dfun type).")
     message = str(info.get("message", "unknown failure")).split(" on this call")[0].rstrip(".").replace("\n", " ")
     if message.startswith("Excess work done"):
-        message = (f"more than {STEP_BUDGET_PER_S:,} integration steps per simulated second (the work budget, "
-                   "parksteer.model.numeric.tolerances): the values make the model too stiff to integrate")
+        message = BUDGET_MESSAGE
     return SolverError(f"{what} failed at t = {t_failed:.4g} s: {message}", t_failed)
+
+
+BUDGET_MESSAGE = (f"more than {STEP_BUDGET_PER_S:,} integration steps per simulated second (the work budget, "
+                  "parksteer.model.numeric.tolerances): the values make the model too stiff to integrate")
+# The return codes of the generated integrator (ps_integrate, model/codegen/integrator.c), in words.
+INTEGRATOR_FAILURES = {
+    1: BUDGET_MESSAGE,
+    2: "the step size fell below 1e-14 of the time: the solution is not smooth enough to follow (a singularity "
+       "or a discontinuity the model does not declare)",
+    3: "the right-hand side could not be evaluated (mass matrix not positive definite, or a value not finite) "
+       "even after ten halvings of the step",
+}
+
+
+def integrator_failure(what: str, code: int, t_reached: float) -> "SolverError":
+    """The one-line error of a ps_integrate call that returned `code`, having reached `t_reached`."""
+    from ...errors import SolverError
+
+    message = INTEGRATOR_FAILURES.get(code, f"unknown failure (code {code})")
+    return SolverError(f"{what} failed at t = {t_reached:.4g} s: {message}", t_reached)
