@@ -11,6 +11,8 @@ one line naming the file and the key.
 
 from __future__ import annotations
 
+from functools import lru_cache
+
 import dataclasses
 import math
 import tomllib
@@ -270,17 +272,24 @@ RENAMED: dict[str, str] = {
 }
 
 
-def registry() -> dict[str, Quantity]:
-    """Every known key: the parameter file's, ``case.*``, and those declared by loaded effects."""
+@lru_cache(maxsize=1)
+def _file_and_case_keys() -> dict[str, Quantity]:
+    """The parameter file's keys and ``case.*`` (fixed at import; built once, looked up for every value)."""
     out = {q.key: q for table in SCHEMA.values() for q in table.values()}
     out.update({q.key: q for q in CASE_SCHEMA.values()})
-    out.update(_DECLARED)
     return out
+
+
+def registry() -> dict[str, Quantity]:
+    """Every known key: the parameter file's, ``case.*``, and those declared by loaded effects."""
+    return {**_file_and_case_keys(), **_DECLARED}
 
 
 def quantity(key: str) -> Quantity:
     """The quantity of `key`; an unknown or renamed key is a one-line UsageError."""
-    found = registry().get(key)
+    found = _DECLARED.get(key)
+    if found is None:
+        found = _file_and_case_keys().get(key)
     if found is None:
         raise UsageError(unknown_key_message(key))
     return found

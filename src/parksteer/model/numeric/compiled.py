@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..codegen.cache import ensure_entry
+from ..codegen.cache import ensure_entry, entry_path
 from ..symbolic.components import Effect
 
 
@@ -131,5 +131,7 @@ def load_entry(directory: Path) -> CompiledModel:
 
 
 def load_model(effects: list[Effect]) -> CompiledModel:
-    """The compiled model of `effects`, from the cache (derived and compiled once if missing)."""
-    return load_entry(ensure_entry(effects))
+    """The compiled model of `effects`, from the cache (derived and compiled once if missing). An entry this
+    process has loaded is used again without re-checking its files: the library in memory is the one checked."""
+    loaded = _LOADED.get(entry_path(effects).resolve())
+    return loaded if loaded is not None else load_entry(ensure_entry(effects))
