@@ -2,12 +2,15 @@
 
 With the handwheel prescribed, the model integrates y' = (u, M^-1 f) in the generated C: one call of
 ``ps_integrate`` (variable-order NDF, the method of MATLAB's ode15s, with the compiled analytic Jacobian;
-model/codegen/integrator.c) runs the whole cycle, restarting at each corner of the handwheel input. With a prescribed rack (a rack motion, such
-as a measurement's rack smoothed by :func:`parksteer.measure.smoothing.smooth_rack`), the
-handwheel torque is solved for by :func:`parksteer.model.numeric.prescribed.solve`.
+model/codegen/integrator.c) runs the whole cycle, restarting at each corner of the handwheel input.
+With a prescribed rack (a rack motion, such as a measurement's rack smoothed by
+:func:`parksteer.measure.smoothing.smooth_rack`), the handwheel torque is solved for by
+:func:`parksteer.model.numeric.prescribed.solve`.
 """
 
 from __future__ import annotations
+
+from typing import TYPE_CHECKING
 
 import dataclasses
 from dataclasses import dataclass, field
@@ -21,10 +24,12 @@ from ...tables import write_csv
 from .compiled import CompiledModel, load_model
 from ..symbolic.components import Effect, discover_effects, resolve_effects
 from .inputs import HandwheelProfile, sawtooth_profile
-from .prescribed import RackMotion, solve as solve_prescribed
 from .statics import static_state
 from .tolerances import PRESCRIBED_RTOL, RTOL, absolute_tolerances, integrator_failure, max_steps
 from .values import RunValues, parameter_vector, resolve_values
+
+if TYPE_CHECKING:
+    from .prescribed import RackMotion
 
 ROLL_NEUTRAL_KEY = "derived.roll_spring_neutral"
 
@@ -220,6 +225,8 @@ def _simulate_rack_drive(run: PreparedRun, rack: RackMotion, t_end_s, output_dt_
     t = t[t <= rack.end_s]
     if len(t) < 2:
         raise UsageError(f"rack drive: the run from {t0:g} s to {t_end:g} s holds fewer than two outputs")
+    from .prescribed import solve as solve_prescribed  # with its odeint: a free run never imports either
+
     solution = solve_prescribed(run, run.p, rack, t, rtol=rtol, outputs=True)
     columns = _columns(run, t, solution.states, solution.outputs, solution.handwheel)
     return SimulationResult(columns, _header(run, "prescribed rack"), solution.states, run.p, run.model, run.values)
