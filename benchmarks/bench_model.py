@@ -4,7 +4,8 @@
 
 Times: one 18 s cycle of the nominal case (one call of the generated integrator, ps_integrate, with
 the analytic Jacobian, cache warm), and as a reference in the same run the same compiled right-hand side and
-Jacobian called back from scipy's odeint (LSODA), the path before the integrator moved into C; one 18 s prescribed-rack replay of data/measurements/example_unladen.csv
+Jacobian called back from scipy's odeint (LSODA), the path before the integrator moved into C; one 18 s
+prescribed-rack replay of data/measurements/example_unladen.csv
 (the solver of ``parksteer simulate --rack-from`` and ``parksteer compare``, on the smoothed rack;
 target 0.3 s); all the simulations of Figs. 12-16 and the contribution figure;
 derivation + code generation + compilation of the default model (into a scratch cache);

@@ -54,8 +54,8 @@ def _c_block(assignments: list[tuple[str, sp.Expr]], printer: _Printer) -> list[
     return lines
 
 
-def _function(name: str, args: str, assignments, printer) -> str:
-    body = "\n".join(_c_block(assignments, printer))
+def _function(name: str, args: str, lines: list[str]) -> str:
+    body = "\n".join(lines)
     return f"static void {name}({args})\n{{\n{body}\n}}\n"
 
 
@@ -169,16 +169,15 @@ def generate(derivation: Derivation) -> tuple[str, dict]:
     start = time.perf_counter()
     args_mf = "const double *q, const double *u, const double *p, double th, double thd, double *M, double *F"
     parts = [
-        _function("eval_mf", args_mf, mf, printer),
-        "static void eval_jac(const double *q, const double *u, const double *a, const double *p, double th, "
-        "double thd, double *dFdq, double *dFdu)\n{\n"
-        + "\n".join(_derivative_block(residual, q + u, jac_targets, printer)) + "\n}\n",
+        _function("eval_mf", args_mf, _c_block(mf, printer)),
+        _function("eval_jac", "const double *q, const double *u, const double *a, const double *p, double th, "
+                  "double thd, double *dFdq, double *dFdu", _derivative_block(residual, q + u, jac_targets, printer)),
         _function("eval_drive", "const double *q, const double *u, const double *p, double *M, double *F, double *b",
-                  drive, printer),
+                  _c_block(drive, printer)),
         _function(
             "eval_outputs",
             "const double *q, const double *u, const double *a, const double *p, double th, double thd, double *out",
-            out_assign, printer,
+            _c_block(out_assign, printer),
         ),
     ]
     timings["cse_derivatives_print_s"] = time.perf_counter() - start
