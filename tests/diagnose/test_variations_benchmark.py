@@ -70,6 +70,9 @@ def test_summary_counts_each_target_by_hand_and_names_the_variation_that_misses(
                                     "confounded_with": "steering.rack_friction_force"}
     h = s["by_hidden"]["rack_stiction"]
     assert h["named_count"] == [2, 3] and h["missed_flagged_confounded"] == 1
+    assert h["observable_fraction"] is None  # no record says how much of its change survives a calibration
+    kept = summarise([{**r, "steps_observable": 0.5 * r["steps"]} for r in rows])["by_hidden"]["rack_stiction"]
+    assert kept["observable_fraction"] == {"median": 0.5, "min": 0.5, "max": 0.5}
     assert h["confounded_with"] == ["steering.rack_friction_force"]
     assert h["missed_in"] == ["b"] and h["named_in_all_of"] == ["a"]
     assert s["null_over_floor"] == {"min": 1.0, "max": 1.2}
@@ -177,6 +180,30 @@ def test_an_unknown_variation_or_too_many_files_is_refused_in_one_line():
     section["small"]["variations"] = ["three_files"]
     with pytest.raises(UsageError, match="three_files needs 3 files"):
         VariationDesign.from_config(section, {"perturbation": PERTURBATION})
+
+
+@pytest.mark.parametrize("effect, confounded", [("kingpin_friction", True), ("rack_stiction", False)])
+def test_what_a_calibration_can_absorb_of_a_hidden_effect(effect, confounded):
+    """On one load, a king-pin friction (the load times a friction radius, a torque about each king-pin axis that
+    the steering arms pass to the rack as a nearly constant force) is mostly a change of the calibrated rack
+    friction force: less than the diagnosis's confounded_fraction (0.3) of its change survives the projection off
+    the calibrated directions, the same verdict the diagnosis reaches on its own from the replayed signature. A
+    rack stiction (a breakaway peak at each rack reversal, which no constant force, friction coefficient or carcass
+    stiffness makes) keeps most of its change. The size is set on the whole change (2 steps +-2 %)."""
+    from parksteer.diagnose.variations import _case_files, hidden_strength
+    from parksteer.synthetic.datasets import perturbed_base
+    from parksteer.synthetic.logger import quantisation_step
+
+    design = _design(("pauses",), hidden=(effect,), steps=(2.0,))
+    case = next(c for c in variation_cases(design) if c.hidden)
+    files = _case_files(case, design)
+    logger = files[0][3]
+    step = quantisation_step(logger.torque_full_scale_Nm, logger.torque_bits)
+    _key, strength, change, observable = hidden_strength(PARAMS, files, perturbed_base(PARAMS, case.seed, PERTURBATION),
+                                                         effect, 2.0 * step)
+    assert strength > 0.0 and change == pytest.approx(2.0 * step, rel=0.021)
+    kept = observable / change
+    assert kept < DEFAULT_SETTINGS.confounded_fraction if confounded else kept > 0.8
 
 
 def test_uneven_strokes_and_lock_overshoot_keep_the_travel():

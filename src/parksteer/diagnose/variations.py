@@ -13,6 +13,8 @@ replicate the same records are diagnosed:
 - with each hidden library effect at each size (converter steps of torque RMS over the case's files; the
   strength from a small probe and secant steps in log-log on the prescribed-rack solve): *named* when the
   verdict is ``missing`` and the effect is the one named or in the indistinguishable group reported with it;
+  each such record also keeps the part of its hidden change that the calibrated parameters cannot absorb
+  (:func:`hidden_strength`), which says how much of it any diagnosis could see;
 - coverage: each 95 % interval of the model the diagnosis reports (the calibrated base, or with the named effect
   when it says ``missing``) against the true value (the perturbed base, the hidden strength, 0 for a named
   effect that was not hidden).
@@ -35,7 +37,8 @@ from ..synthetic.datasets import SizeSearch, perturbed_base, rms_difference, str
 from ..synthetic.logger import quantisation_step
 from ..synthetic.variations import VARIATIONS, Variation, variation_by_name, variation_rack, variation_record
 from .benchmark import diagnose_written, paired_results
-from .settings import DEFAULT_SETTINGS
+from ..model.symbolic.system import CORE_PARAMETERS
+from .settings import DEFAULT_SETTINGS, DiagnosisSettings
 
 NAMED_MIN_STEPS = 2.0  # converter steps RMS: hidden effects at least this large count towards the named rate
 NAMED_TARGET = 0.90  # of those, named first or in the reported group
@@ -131,14 +134,38 @@ def _case_files(case: VariationCase, design: VariationDesign):
             for i, (load_case, surface) in enumerate(design.files[:case.variation.files])]
 
 
+def calibrated_keys(effects, uses_angle: bool, settings: DiagnosisSettings = DEFAULT_SETTINGS
+                    ) -> tuple[list[str], list[tuple[str, float]]]:
+    """(log-fitted keys, [(offset-fitted key, its step)]) that a diagnosis calibrates for a model of `effects`
+    (the settings' calibrated parameters the model has, and with a fitted angle the column's stiffness and the
+    Hooke joint's angle and phase): the directions a calibration can absorb a hidden effect's change along."""
+    used = {k for e in effects for k in e.uses} | set(CORE_PARAMETERS)
+    logs = [k for k in settings.calibrated_parameters if k in used]
+    offsets = []
+    if uses_angle:
+        logs += [k for k in settings.calibrated_with_angle if k in used]
+        offsets = [(k, step) for k, _half_range, step in settings.calibrated_with_angle_offsets if k in used]
+    return logs, offsets
+
+
 def hidden_strength(params: Parameters, files, base: dict, effect: str, target: float,
-                    signal: str = "handwheel_torque_Nm") -> tuple[str, float, float]:
-    """(strength key, strength, RMS change of `signal` at it) of `effect` changing the clean `signal` (the torque,
-    or the handwheel angle where the diagnosis fits it) by `target` RMS over `files` (prescribed racks), found by
-    the benchmark's size search (:func:`parksteer.synthetic.datasets.strength_for_rms`) from a probe at a
-    hundredth of the upper bound."""
+                    signal: str = "handwheel_torque_Nm", settings: DiagnosisSettings = DEFAULT_SETTINGS
+                    ) -> tuple[str, float, float, float]:
+    """(strength key, strength, RMS change of `signal` at it, the part of that change a calibration cannot absorb)
+    of `effect` changing the clean `signal` (the torque, or the handwheel angle where the diagnosis fits it) by
+    `target` RMS over `files` (prescribed racks), found by the benchmark's size search
+    (:func:`parksteer.synthetic.datasets.strength_for_rms`) from a probe at a hundredth of the upper bound.
+
+    The part a calibration cannot absorb (the observable change) is what is left of the change once it is
+    projected off the directions the diagnosis calibrates (:func:`calibrated_keys`: the finite-difference changes
+    of the clean signal at the perturbed base, of the settings' relative step; with the angle, also one constant
+    per file, the sensor's zero), in the linear least-squares sense. A king-pin friction on one load is nearly a
+    rack friction (the steering arm's lever varies little over the cycle), so most of its change is absorbed by
+    the calibrated rack friction force. The size is set on the whole change, as the targets state it: sized on the
+    observable part, a king-pin or column friction would need several times its physical range.
+    """
     from ..model.numeric.simulate import simulate
-    from ..model.symbolic.components import discover_effects, strength_parameter
+    from ..model.symbolic.components import discover_effects, resolve_effects, strength_parameter
 
     registry = discover_effects()
     if effect not in registry:
@@ -146,20 +173,39 @@ def hidden_strength(params: Parameters, files, base: dict, effect: str, target: 
     quantity = strength_parameter(registry[effect], params)
     key, upper = quantity.key, quantity.upper
     drives = [(load_case, surface, variation_rack(params, hand)) for load_case, surface, hand, _logger in files]
-    signals: dict[float, np.ndarray] = {}  # each strength simulated once, the search's reference (0) included
+
+    def run(effects, overrides) -> list[np.ndarray]:
+        return [np.asarray(simulate(load_case, effects=effects, overrides=overrides, surface=surface, rack_drive=drive,
+                                    params=params, output_dt_s=SEARCH_DT_S).columns[signal], dtype=float)
+                for load_case, surface, drive in drives]
+
+    reference = run(None, base)
+    logs, offsets = calibrated_keys(resolve_effects(None), signal == "handwheel_angle_rad", settings)
+    step = settings.calibration_relative_step
+    moved = [{**base, k: base.get(k, params[k]) * (1.0 + step)} for k in logs]
+    moved += [{**base, k: base.get(k, params[k]) + offset_step} for k, offset_step in offsets]
+    columns = [np.concatenate(run(None, overrides)) - np.concatenate(reference) for overrides in moved]
+    if signal == "handwheel_angle_rad" and settings.angle_offset_fitted:  # each file's sensor zero
+        sizes = [len(r) for r in reference]
+        edges = np.cumsum([0] + sizes)
+        columns += [((np.arange(edges[-1]) >= lo) & (np.arange(edges[-1]) < hi)).astype(float)
+                    for lo, hi in zip(edges[:-1], edges[1:])]
+    absorbed = np.linalg.qr(np.column_stack(columns))[0] if columns else np.zeros((sum(map(len, reference)), 0))
+    signals: dict[float, np.ndarray] = {0.0: np.concatenate(reference)}  # each strength simulated once
 
     def signal_of(strength: float) -> np.ndarray:
         if strength not in signals:
-            effects, overrides = (None, base) if strength == 0.0 else (f"+{effect}", {**base, key: strength})
-            signals[strength] = np.concatenate([
-                np.asarray(simulate(load_case, effects=effects, overrides=overrides, surface=surface, rack_drive=drive,
-                                    params=params, output_dt_s=SEARCH_DT_S).columns[signal], dtype=float)
-                for load_case, surface, drive in drives])
+            signals[strength] = np.concatenate(run(f"+{effect}", {**base, key: strength}))
         return signals[strength]
+
+    def observable_of(strength: float) -> np.ndarray:
+        change = signal_of(strength) - signals[0.0]
+        return change - absorbed @ (absorbed.T @ change)
 
     strength = strength_for_rms(signal_of, target, upper * 1e-2, upper,
                                 SizeSearch(iterations=SEARCH_STEPS, tolerance=SEARCH_TOLERANCE, max_lag_s=0.0))
-    return key, strength, rms_difference(signal_of(strength), signal_of(0.0))
+    return (key, strength, rms_difference(signal_of(strength), signals[0.0]),
+            rms_difference(observable_of(strength), 0.0))
 
 
 def run_case(parameters_path, design: VariationDesign, name: str, folder, truth_path, diagnosis_path) -> dict:
@@ -178,18 +224,19 @@ def run_case(parameters_path, design: VariationDesign, name: str, folder, truth_
     # steps: with the rack prescribed, what the angle makes observable (a lash) does not change the torque at all.
     signal, size_step = ("handwheel_angle_rad", quantisation_step(logger.angle_full_scale_rad, logger.angle_bits)) \
         if case.variation.uses_angle else ("handwheel_torque_Nm", torque_step)
-    overrides, key, strength, steps_actual = dict(base), None, None, None
+    overrides, key, strength, steps_actual, steps_observable = dict(base), None, None, None, None
     if case.hidden is not None:
-        key, strength, change = hidden_strength(params, files, base, case.hidden, case.steps * size_step, signal)
+        key, strength, change, observable = hidden_strength(params, files, base, case.hidden,
+                                                            case.steps * size_step, signal)
         overrides[key] = strength
-        steps_actual = change / size_step
+        steps_actual, steps_observable = change / size_step, observable / size_step
     records = [(load_case, surface, variation_record(params, hand, logger, load_case, surface, overrides=overrides,
                                                       effects=f"+{case.hidden}" if case.hidden else None))
                for load_case, surface, hand, logger in files]
     truth = {
         "name": case.name, "variation": case.variation.name, "what": case.variation.what,
         "replicate": case.replicate, "seed": case.seed, "hidden": case.hidden, "steps_requested": case.steps,
-        "steps": steps_actual, "torque_step_Nm": torque_step, "size_signal": signal, "size_step": size_step,
+        "steps": steps_actual, "steps_observable": steps_observable, "torque_step_Nm": torque_step, "size_signal": signal, "size_step": size_step,
         "strength_key": key, "strength": strength,
         "base_overrides": base, "files": [{"case": c, "surface": s} for c, s, _h, _l in files],
     }
@@ -233,6 +280,7 @@ def outcome(truth: dict, result: dict) -> dict:
         "hidden": hidden or "nothing",
         "steps": truth["steps_requested"] or 0.0,
         "steps_actual": truth["steps"] or 0.0,
+        "steps_observable": truth.get("steps_observable") or 0.0,
         "verdict": result["verdict"],
         "effect": named_effect or "",
         "indistinguishable": " ".join(group),
@@ -293,6 +341,8 @@ def summarise(rows: list[dict], design: VariationDesign | None = None) -> dict:
         counted = [r for r in rows if r["hidden"] == effect and r["steps"] >= NAMED_MIN_STEPS]
         missed = [r for r in counted if not r["named"]]
         flagged = [r for r in missed if r.get("hidden_confounded_with")]
+        kept = [r["steps_observable"] / r["steps_actual"] for r in counted
+                if r.get("steps_observable") and r["steps_actual"] > 0.0]
         by_hidden[effect] = {
             "named_count": [len(counted) - len(missed), len(counted)],
             "named": _rate(len(counted) - len(missed), len(counted)),
@@ -301,6 +351,9 @@ def summarise(rows: list[dict], design: VariationDesign | None = None) -> dict:
             "missed_in": list(dict.fromkeys(r["variation"] for r in missed)),
             "named_in_all_of": [v for v in dict.fromkeys(r["variation"] for r in counted)
                                 if all(r["named"] for r in counted if r["variation"] == v)],
+            # the share of the hidden change a calibration cannot absorb (hidden_strength), median and range
+            "observable_fraction": ({"median": float(np.median(kept)), "min": min(kept), "max": max(kept)}
+                                    if kept else None),
         }
     total = counts(rows)
     # Where the misses come from: records whose torque channel lags the rack (a logger error the diagnosis has no

@@ -424,6 +424,7 @@ def make_variations_figure(truth_paths, diagnosis_paths, svg: str | Path, csv: s
     write_csv(csv, columns, {"figure": "diag_variations: one row per record set of the variation benchmark",
                              "steps": "hidden size requested, converter steps of torque RMS over the case's files",
                              "steps_actual": "the size the strength search reached",
+                             "steps_observable": "the part of it the calibrated parameters cannot absorb, steps RMS",
                              "named": "verdict missing with the hidden effect named or in the reported group",
                              "calibrated_over_floor": "calibrated base model's weighted RMS error, noise floors",
                              "after_over_floor": "with the named effect, noise floors",
