@@ -14,7 +14,7 @@ replicate the same records are diagnosed:
   strength from a small probe and secant steps in log-log on the prescribed-rack solve): *named* when the
   verdict is ``missing`` and the effect is the one named or in the indistinguishable group reported with it;
   each such record also keeps the part of its hidden change that the calibrated parameters cannot absorb
-  (:func:`hidden_strength`), which says how much of it any diagnosis could see;
+  (:func:`hidden_strength`), to first order what a diagnosis could see of it;
 - coverage: each 95 % interval of the model the diagnosis reports (the calibrated base, or with the named effect
   when it says ``missing``) against the true value (the perturbed base, the hidden strength, 0 for a named
   effect that was not hidden).
@@ -161,8 +161,10 @@ def hidden_strength(params: Parameters, files, base: dict, effect: str, target: 
     of the clean signal at the perturbed base, of the settings' relative step; with the angle, also one constant
     per file, the sensor's zero), in the linear least-squares sense. A king-pin friction on one load is nearly a
     rack friction (the steering arm's lever varies little over the cycle), so most of its change is absorbed by
-    the calibrated rack friction force. The size is set on the whole change, as the targets state it: sized on the
-    observable part, a king-pin or column friction would need several times its physical range.
+    the calibrated rack friction force. It is a first-order measure: the diagnosis's fit is nonlinear and weighted
+    and can absorb more (a king-pin friction keeping 0.42 steps here left a one-load record at 1.04 noise floors,
+    while a column friction keeping 0.27 was named). The size is set on the whole change, as the targets state it:
+    sized on the observable part, a king-pin or column friction would need several times its physical range.
     """
     from ..model.numeric.simulate import simulate
     from ..model.symbolic.components import discover_effects, resolve_effects, strength_parameter
