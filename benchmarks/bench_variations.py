@@ -1,12 +1,14 @@
 """The variation benchmark outside the DAG (not a test): run its cases in a scratch folder, print the table.
 
-    python benchmarks/bench_variations.py OUT.json [--full] [--only pauses,lock_overshoot]
+    python benchmarks/bench_variations.py OUT.json [--full] [--only pauses,lock_overshoot] [--sizes]
 
 The logic is :mod:`parksteer.diagnose.variations` (rules ``diag_variation_batch`` and ``diag_variations`` run
 the same cases in the DAG); the grid is config/config.yaml's ``variations`` section (``--full``: its full grid).
 Prints one line per case as it is diagnosed, then per variation the named rate, the nulls called adequate, the
 coverage of the 95 % intervals, the nulls' calibrated error in noise floors and the median diagnosis time; writes
-the summary and every case's outcome as JSON.
+the summary and every case's outcome as JSON. With ``--sizes``, no record is made or diagnosed: each hidden case's
+strength, its whole change and the part of it a calibration cannot absorb (to first order) are found, and per
+hidden effect the median and range of that observable share are printed (a minute for the full grid).
 """
 
 from __future__ import annotations
@@ -27,6 +29,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("out", help="JSON file for the results")
     parser.add_argument("--full", action="store_true", help="the configuration's full grid")
     parser.add_argument("--only", default="", help="comma-separated variation names (default: the grid's)")
+    parser.add_argument("--sizes", action="store_true", help="only the hidden sizes, whole and observable")
     args = parser.parse_args(argv)
 
     import yaml
@@ -41,6 +44,8 @@ def main(argv: list[str] | None = None) -> int:
     if args.only:
         section["full" if args.full else "small"]["variations"] = args.only.split(",")
     design = VariationDesign.from_config(section, config["benchmark"])
+    if args.sizes:
+        return _sizes(design, args.out)
     rows = []
     with tempfile.TemporaryDirectory() as scratch:
         for name in case_names(design):
@@ -64,6 +69,35 @@ def main(argv: list[str] | None = None) -> int:
     for key, t in summary["targets"].items():
         print(f"{key:14s} {_count(t['count'])} = {t['value']:.3f} against {t['target']:.2f}: "
               f"{'met' if t['met'] else 'MISSED'}")
+    return 0
+
+
+def _sizes(design, out: str) -> int:
+    """Each hidden case's whole and observable change (case_truth), and per hidden effect the observable share."""
+    import numpy as np
+
+    from parksteer.diagnose.variations import case_truth, variation_cases
+    from parksteer.parameters import load_parameters
+    from parksteer.tables import write_json
+
+    params = load_parameters()
+    rows = []
+    for case in variation_cases(design):
+        if case.hidden is None:
+            continue
+        _files, truth = case_truth(params, design, case)
+        rows.append({k: truth[k] for k in ("name", "variation", "hidden", "steps_requested", "steps",
+                                           "steps_observable", "strength_key", "strength")})
+        print(f"{case.name:48s} {truth['steps']:5.2f} steps, observable {truth['steps_observable']:5.2f}",
+              file=sys.stderr, flush=True)
+    table = {}
+    for effect in dict.fromkeys(r["hidden"] for r in rows):
+        share = [r["steps_observable"] / r["steps"] for r in rows if r["hidden"] == effect]
+        table[effect] = {"records": len(share), "median": float(np.median(share)), "min": min(share),
+                         "max": max(share)}
+        print(f"{effect:20s} {len(share):4d} records, observable share median {table[effect]['median']:.3f} "
+              f"({table[effect]['min']:.3f}-{table[effect]['max']:.3f})")
+    write_json(out, {"observable_share": table, "records": rows})
     return 0
 
 

@@ -210,14 +210,9 @@ def hidden_strength(params: Parameters, files, base: dict, effect: str, target: 
             rms_difference(observable_of(strength), 0.0))
 
 
-def run_case(parameters_path, design: VariationDesign, name: str, folder, truth_path, diagnosis_path) -> dict:
-    """Make variation case `name`'s records, write them into `folder`, diagnose them from the files."""
-    params = load_parameters(parameters_path)
-    cases = {c.name: c for c in variation_cases(design)}
-    if name not in cases:
-        raise UsageError(f"unknown variation case {name!r}")
-    case = cases[name]
-    start = time.perf_counter()
+def case_truth(params: Parameters, design: VariationDesign, case: VariationCase) -> tuple[list, dict]:
+    """(the case's files as (case, surface, hand, logger), its truth): the perturbed base, and what is hidden at
+    which strength, with its whole and its observable change in converter steps (:func:`hidden_strength`)."""
     files = _case_files(case, design)
     base = perturbed_base(params, case.seed, design.perturbation)
     logger = files[0][3]
@@ -226,22 +221,35 @@ def run_case(parameters_path, design: VariationDesign, name: str, folder, truth_
     # steps: with the rack prescribed, what the angle makes observable (a lash) does not change the torque at all.
     signal, size_step = ("handwheel_angle_rad", quantisation_step(logger.angle_full_scale_rad, logger.angle_bits)) \
         if case.variation.uses_angle else ("handwheel_torque_Nm", torque_step)
-    overrides, key, strength, steps_actual, steps_observable = dict(base), None, None, None, None
+    key, strength, steps_actual, steps_observable = None, None, None, None
     if case.hidden is not None:
         key, strength, change, observable = hidden_strength(params, files, base, case.hidden,
                                                             case.steps * size_step, signal)
-        overrides[key] = strength
         steps_actual, steps_observable = change / size_step, observable / size_step
+    return files, {
+        "name": case.name, "variation": case.variation.name, "what": case.variation.what,
+        "replicate": case.replicate, "seed": case.seed, "hidden": case.hidden, "steps_requested": case.steps,
+        "steps": steps_actual, "steps_observable": steps_observable, "torque_step_Nm": torque_step,
+        "size_signal": signal, "size_step": size_step, "strength_key": key, "strength": strength,
+        "base_overrides": base, "files": [{"case": c, "surface": s} for c, s, _h, _l in files],
+    }
+
+
+def run_case(parameters_path, design: VariationDesign, name: str, folder, truth_path, diagnosis_path) -> dict:
+    """Make variation case `name`'s records, write them into `folder`, diagnose them from the files."""
+    params = load_parameters(parameters_path)
+    cases = {c.name: c for c in variation_cases(design)}
+    if name not in cases:
+        raise UsageError(f"unknown variation case {name!r}")
+    case = cases[name]
+    start = time.perf_counter()
+    files, truth = case_truth(params, design, case)
+    overrides = dict(truth["base_overrides"])
+    if case.hidden is not None:
+        overrides[truth["strength_key"]] = truth["strength"]
     records = [(load_case, surface, variation_record(params, hand, logger, load_case, surface, overrides=overrides,
                                                       effects=f"+{case.hidden}" if case.hidden else None))
                for load_case, surface, hand, logger in files]
-    truth = {
-        "name": case.name, "variation": case.variation.name, "what": case.variation.what,
-        "replicate": case.replicate, "seed": case.seed, "hidden": case.hidden, "steps_requested": case.steps,
-        "steps": steps_actual, "steps_observable": steps_observable, "torque_step_Nm": torque_step, "size_signal": signal, "size_step": size_step,
-        "strength_key": key, "strength": strength,
-        "base_overrides": base, "files": [{"case": c, "surface": s} for c, s, _h, _l in files],
-    }
     settings = replace(DEFAULT_SETTINGS, use_handwheel_angle=True) if case.variation.uses_angle else DEFAULT_SETTINGS
     return diagnose_written(params, records, folder, truth, truth_path, diagnosis_path, start, settings)
 
