@@ -74,9 +74,7 @@ def main(argv: list[str] | None = None) -> int:
 
 def _sizes(design, out: str) -> int:
     """Each hidden case's whole and observable change (case_truth), and per hidden effect the observable share."""
-    import numpy as np
-
-    from parksteer.diagnose.variations import case_truth, variation_cases
+    from parksteer.diagnose.variations import case_truth, spread, variation_cases
     from parksteer.parameters import load_parameters
     from parksteer.tables import write_json
 
@@ -93,8 +91,7 @@ def _sizes(design, out: str) -> int:
     table = {}
     for effect in dict.fromkeys(r["hidden"] for r in rows):
         share = [r["steps_observable"] / r["steps"] for r in rows if r["hidden"] == effect]
-        table[effect] = {"records": len(share), "median": float(np.median(share)), "min": min(share),
-                         "max": max(share)}
+        table[effect] = {"records": len(share), **spread(share)}
         print(f"{effect:20s} {len(share):4d} records, observable share median {table[effect]['median']:.3f} "
               f"({table[effect]['min']:.3f}-{table[effect]['max']:.3f})")
     write_json(out, {"observable_share": table, "records": rows})

@@ -312,17 +312,33 @@ def calibration_parameters(problem: Problem, effects: list[Effect],
     ``calibrated_with_angle`` and ``calibrated_with_angle_offsets``: the column stiffness, the Hooke joint phase).
     `strengths` adds effects' strengths, fitted linearly, with their finite-difference steps.
     """
-    used = {k for e in effects for k in e.uses} | set(CORE_PARAMETERS)
-    chosen = keys is not None
-    keys = settings.calibrated_parameters if keys is None else keys
-    out = [log_parameter(problem, effects, key, settings) for key in keys if key in used]
-    if not chosen and problem.uses_angle:  # what only the angle shows
-        out += [log_parameter(problem, effects, key, settings) for key in settings.calibrated_with_angle
-                if key in used]
-        out += [offset_parameter(problem, effects, key, half_range, step)
-                for key, half_range, step in settings.calibrated_with_angle_offsets if key in used]
+    if keys is None:
+        logs, offsets = calibrated_keys(effects, problem.uses_angle, settings)
+    else:
+        used = _used_keys(effects)
+        logs, offsets = [key for key in keys if key in used], []
+    out = [log_parameter(problem, effects, key, settings) for key in logs]
+    out += [offset_parameter(problem, effects, key, half_range, step) for key, half_range, step in offsets]
     out += [linear_parameter(effects, key, step) for key, step in (strengths or {}).items()]
     return out
+
+
+def _used_keys(effects: list[Effect]) -> set[str]:
+    return {k for e in effects for k in e.uses} | set(CORE_PARAMETERS)
+
+
+def calibrated_keys(effects: list[Effect], uses_angle: bool, settings: DiagnosisSettings = DEFAULT_SETTINGS
+                    ) -> tuple[list[str], list[tuple[str, float, float]]]:
+    """(log-fitted keys, [(offset-fitted key, half range, step)]) a diagnosis calibrates in a model of `effects`:
+    the settings' calibrated parameters the model has, and with a fitted angle what only the angle shows (the
+    column's stiffness, the Hooke joint's angle and phase)."""
+    used = _used_keys(effects)
+    logs = [key for key in settings.calibrated_parameters if key in used]
+    offsets = []
+    if uses_angle:
+        logs += [key for key in settings.calibrated_with_angle if key in used]
+        offsets = [entry for entry in settings.calibrated_with_angle_offsets if entry[0] in used]
+    return logs, offsets
 
 
 def offset_parameter(problem: Problem, effects: list[Effect], key: str, half_range: float, step: float

@@ -37,7 +37,7 @@ from ..synthetic.datasets import SizeSearch, perturbed_base, rms_difference, str
 from ..synthetic.logger import quantisation_step
 from ..synthetic.variations import VARIATIONS, Variation, variation_by_name, variation_rack, variation_record
 from .benchmark import diagnose_written, paired_results
-from ..model.symbolic.system import CORE_PARAMETERS
+from .calibrate import calibrated_keys
 from .settings import DEFAULT_SETTINGS, DiagnosisSettings
 
 NAMED_MIN_STEPS = 2.0  # converter steps RMS: hidden effects at least this large count towards the named rate
@@ -134,20 +134,6 @@ def _case_files(case: VariationCase, design: VariationDesign):
             for i, (load_case, surface) in enumerate(design.files[:case.variation.files])]
 
 
-def calibrated_keys(effects, uses_angle: bool, settings: DiagnosisSettings = DEFAULT_SETTINGS
-                    ) -> tuple[list[str], list[tuple[str, float]]]:
-    """(log-fitted keys, [(offset-fitted key, its step)]) that a diagnosis calibrates for a model of `effects`
-    (the settings' calibrated parameters the model has, and with a fitted angle the column's stiffness and the
-    Hooke joint's angle and phase): the directions a calibration can absorb a hidden effect's change along."""
-    used = {k for e in effects for k in e.uses} | set(CORE_PARAMETERS)
-    logs = [k for k in settings.calibrated_parameters if k in used]
-    offsets = []
-    if uses_angle:
-        logs += [k for k in settings.calibrated_with_angle if k in used]
-        offsets = [(k, step) for k, _half_range, step in settings.calibrated_with_angle_offsets if k in used]
-    return logs, offsets
-
-
 def hidden_strength(params: Parameters, files, base: dict, effect: str, target: float,
                     signal: str = "handwheel_torque_Nm", settings: DiagnosisSettings = DEFAULT_SETTINGS
                     ) -> tuple[str, float, float, float]:
@@ -157,11 +143,11 @@ def hidden_strength(params: Parameters, files, base: dict, effect: str, target: 
     (:func:`parksteer.synthetic.datasets.strength_for_rms`) from a probe at a hundredth of the upper bound.
 
     The part a calibration cannot absorb (the observable change) is what is left of the change once it is
-    projected off the directions the diagnosis calibrates (:func:`calibrated_keys`: the finite-difference changes
-    of the clean signal at the perturbed base, of the settings' relative step; with the angle, also one constant
-    per file, the sensor's zero), in the linear least-squares sense. A king-pin friction on one load is nearly a
-    rack friction (the steering arm's lever varies little over the cycle), so most of its change is absorbed by
-    the calibrated rack friction force. It is a first-order measure: the diagnosis's fit is nonlinear and weighted
+    projected off the directions the diagnosis calibrates (:func:`parksteer.diagnose.calibrate.calibrated_keys`:
+    the finite-difference changes of the clean signal at the perturbed base, of the settings' relative step; with
+    the angle, also one constant per file, the sensor's zero), in the linear least-squares sense. A king-pin
+    friction on one load is nearly a rack friction (the steering arm's lever varies little over the cycle), so
+    most of its change is absorbed by the calibrated rack friction force. It is a first-order measure: the diagnosis's fit is nonlinear and weighted
     and can absorb more (a king-pin friction keeping 0.42 steps here left a one-load record at 1.04 noise floors,
     while a column friction keeping 0.27 was named). The size is set on the whole change, as the targets state it:
     sized on the observable part, a king-pin or column friction would need several times its physical range.
@@ -185,14 +171,12 @@ def hidden_strength(params: Parameters, files, base: dict, effect: str, target: 
     logs, offsets = calibrated_keys(resolve_effects(None), signal == "handwheel_angle_rad", settings)
     step = settings.calibration_relative_step
     moved = [{**base, k: base.get(k, params[k]) * (1.0 + step)} for k in logs]
-    moved += [{**base, k: base.get(k, params[k]) + offset_step} for k, offset_step in offsets]
+    moved += [{**base, k: base.get(k, params[k]) + offset_step} for k, _half_range, offset_step in offsets]
     columns = [np.concatenate(run(None, overrides)) - np.concatenate(reference) for overrides in moved]
     if signal == "handwheel_angle_rad" and settings.angle_offset_fitted:  # each file's sensor zero
-        sizes = [len(r) for r in reference]
-        edges = np.cumsum([0] + sizes)
-        columns += [((np.arange(edges[-1]) >= lo) & (np.arange(edges[-1]) < hi)).astype(float)
-                    for lo, hi in zip(edges[:-1], edges[1:])]
-    absorbed = np.linalg.qr(np.column_stack(columns))[0] if columns else np.zeros((sum(map(len, reference)), 0))
+        columns += [np.concatenate([np.full(len(r), float(j == i)) for j, r in enumerate(reference)])
+                    for i in range(len(reference))]
+    absorbed = np.linalg.qr(np.column_stack(columns))[0]
     signals: dict[float, np.ndarray] = {0.0: np.concatenate(reference)}  # each strength simulated once
 
     def signal_of(strength: float) -> np.ndarray:
@@ -307,6 +291,11 @@ def outcome(truth: dict, result: dict) -> dict:
     }
 
 
+def spread(values: list[float]) -> dict | None:
+    """Median, least and largest of `values` (None if there are none)."""
+    return {"median": float(np.median(values)), "min": min(values), "max": max(values)} if values else None
+
+
 def _rate(k: int, n: int) -> float | None:
     return k / n if n else None
 
@@ -361,9 +350,8 @@ def summarise(rows: list[dict], design: VariationDesign | None = None) -> dict:
             "missed_in": list(dict.fromkeys(r["variation"] for r in missed)),
             "named_in_all_of": [v for v in dict.fromkeys(r["variation"] for r in counted)
                                 if all(r["named"] for r in counted if r["variation"] == v)],
-            # the share of the hidden change a calibration cannot absorb (hidden_strength), median and range
-            "observable_fraction": ({"median": float(np.median(kept)), "min": min(kept), "max": max(kept)}
-                                    if kept else None),
+            # the share of the hidden change a calibration cannot absorb (hidden_strength)
+            "observable_fraction": spread(kept),
         }
     total = counts(rows)
     # Where the misses come from: records whose torque channel lags the rack (a logger error the diagnosis has no
