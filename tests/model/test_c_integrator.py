@@ -1,7 +1,9 @@
 """The C stiff integrator (src/parksteer/model/codegen/integrator.c) on test problems with known answers.
 
 Each test compiles integrator.c after a small C preamble that defines NY, NQ, ps_rhs and ps_jac (as the
-generated model code does), with the system cc, and calls ps_integrate through ctypes.
+generated model code does; the prescribed-rack functions as stubs), with the system cc, and calls ps_integrate
+through ctypes. The prescribed-rack path (ps_integrate_prescribed) is checked on the model itself, in
+tests/model/test_rack_drive.py.
 """
 
 from __future__ import annotations
@@ -54,13 +56,24 @@ class Problem:
         return function
 
 
+# The test problems are handwheel-driven systems; the prescribed-rack entry points the integrator also dispatches to
+# (ps_integrate_prescribed) are stubs that fail, never called here.
+PRESCRIBED_STUBS = """
+#define NO (NQ - 1)
+int ps_prescribed_rhs(double t, const double *z, const double *p, const double *rack, double *zdot) { return -1; }
+int ps_prescribed_jac(double t, const double *z, const double *p, double *p_jac, const double *rack, double *J)
+{ return -1; }
+"""
+
+
 @pytest.fixture(scope="module")
 def compile_problem(tmp_path_factory):
     """compile_problem(name, n_y, body) -> Problem: integrator.c compiled after a preamble defining the problem."""
     directory = tmp_path_factory.mktemp("c_integrator")
 
     def build(name: str, n_y: int, body: str) -> Problem:
-        preamble = f"#include <math.h>\n#include <string.h>\n#define NY {n_y}\n#define NQ (NY / 2)\n{body}\n"
+        preamble = (f"#include <math.h>\n#include <string.h>\n#define NY {n_y}\n#define NQ (NY / 2)\n{body}\n"
+                    + PRESCRIBED_STUBS)
         source = directory / f"{name}.c"
         source.write_text(preamble + INTEGRATOR_C.read_text(encoding="utf-8"), encoding="utf-8")
         library = directory / f"{name}.so"

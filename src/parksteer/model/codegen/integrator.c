@@ -1,8 +1,10 @@
-/* Stiff integration of the model's y' = ps_rhs(t, y, p) in C: one call runs a whole cycle.
+/* Stiff integration of the model in C: one call runs a whole cycle, handwheel-driven (ps_integrate: y' = ps_rhs)
+   or with the rack prescribed (ps_integrate_prescribed: the reduced system of ps_prescribed_rhs).
 
-   Appended as text after the generated model code (one translation unit), which defines NY, ps_rhs and ps_jac
-   and includes <math.h> and <string.h>. Every name here starts with bdf_ (or is ps_integrate), so as not to
-   clash with the model code's own static helpers; all state lives on the call's stack (reentrant).
+   Appended as text after the generated model code and its runtime (one translation unit), which define NY, NO,
+   ps_rhs, ps_jac, ps_prescribed_rhs and ps_prescribed_jac and include <math.h> and <string.h>. Every name here
+   starts with bdf_ (or is ps_integrate...), so as not to clash with the model code's own static helpers; all state
+   lives on the call's stack (reentrant).
 
    Method: the variable-order (1 to 5), variable-step numerical differentiation formulas (NDF) of
    L. F. Shampine and M. W. Reichelt, "The MATLAB ODE Suite", SIAM J. Sci. Comput. 18 (1997) 1-22 (the
@@ -79,52 +81,65 @@ static int bdf_all_finite(const double *v, int n)
     return 1;
 }
 
-/* ps_rhs with non-finite results reported as failure too; counts the call. */
-static int bdf_rhs(double t, const double *y, const double *p, double *ydot, long *n_rhs)
+/* The system integrated: the handwheel-driven model (rack NULL: y' = ps_rhs(t, y, p), n = NY), or the model with
+   its rack prescribed (the reduced system z' = ps_prescribed_rhs(t, z, p, rack), n = 2 NO, its Jacobian from
+   ps_prescribed_jac with the parameters p_jac, which each call writes into). Arrays are sized NY, the largest n. */
+typedef struct {
+    int n;
+    const double *p;
+    const double *rack;
+    double *p_jac;
+} bdf_system;
+
+/* The right-hand side, with non-finite results reported as failure too; counts the call. */
+static int bdf_rhs(const bdf_system *s, double t, const double *y, double *ydot, long *n_rhs)
 {
     ++*n_rhs;
-    return ps_rhs(t, y, p, ydot) != 0 || !bdf_all_finite(ydot, NY);
+    int failed = s->rack ? ps_prescribed_rhs(t, y, s->p, s->rack, ydot) : ps_rhs(t, y, s->p, ydot);
+    return failed != 0 || !bdf_all_finite(ydot, s->n);
 }
 
-static int bdf_jac(double t, const double *y, const double *p, double *jac, long *n_jac)
+/* The Jacobian, row-major n x n. */
+static int bdf_jac(const bdf_system *s, double t, const double *y, double *jac, long *n_jac)
 {
     ++*n_jac;
-    return ps_jac(t, y, p, jac) != 0 || !bdf_all_finite(jac, NY * NY);
+    int failed = s->rack ? ps_prescribed_jac(t, y, s->p, s->p_jac, s->rack, jac) : ps_jac(t, y, s->p, jac);
+    return failed != 0 || !bdf_all_finite(jac, s->n * s->n);
 }
 
 /* RMS norm of v / scale (the weighted norm of the error test and of the Newton corrections). */
-static double bdf_norm(const double *v, const double *scale)
+static double bdf_norm(int n, const double *v, const double *scale)
 {
     double sum = 0.0;
-    for (int i = 0; i < NY; i++) {
+    for (int i = 0; i < n; i++) {
         double r = v[i] / scale[i];
         sum += r * r;
     }
-    return sqrt(sum / NY);
+    return sqrt(sum / n);
 }
 
-/* In-place LU factorisation with partial pivoting of the row-major NY x NY matrix A; 0, or -1 if singular. */
-static int bdf_lu_factor(double *A, int *pivot)
+/* In-place LU factorisation with partial pivoting of the row-major n x n matrix A; 0, or -1 if singular. */
+static int bdf_lu_factor(int n, double *A, int *pivot)
 {
-    for (int k = 0; k < NY; k++) {
+    for (int k = 0; k < n; k++) {
         int best = k;
-        double largest = fabs(A[k * NY + k]);
-        for (int i = k + 1; i < NY; i++)
-            if (fabs(A[i * NY + k]) > largest) { largest = fabs(A[i * NY + k]); best = i; }
+        double largest = fabs(A[k * n + k]);
+        for (int i = k + 1; i < n; i++)
+            if (fabs(A[i * n + k]) > largest) { largest = fabs(A[i * n + k]); best = i; }
         pivot[k] = best;
         if (!(largest > 0.0) || !isfinite(largest)) return -1;
         if (best != k)
-            for (int j = 0; j < NY; j++) {
-                double swap = A[k * NY + j];
-                A[k * NY + j] = A[best * NY + j];
-                A[best * NY + j] = swap;
+            for (int j = 0; j < n; j++) {
+                double swap = A[k * n + j];
+                A[k * n + j] = A[best * n + j];
+                A[best * n + j] = swap;
             }
-        double inverse_pivot = 1.0 / A[k * NY + k];
-        for (int i = k + 1; i < NY; i++) {
-            double factor = A[i * NY + k] * inverse_pivot;
-            A[i * NY + k] = factor;
+        double inverse_pivot = 1.0 / A[k * n + k];
+        for (int i = k + 1; i < n; i++) {
+            double factor = A[i * n + k] * inverse_pivot;
+            A[i * n + k] = factor;
             if (factor != 0.0)
-                for (int j = k + 1; j < NY; j++) A[i * NY + j] -= factor * A[k * NY + j];
+                for (int j = k + 1; j < n; j++) A[i * n + j] -= factor * A[k * n + j];
         }
     }
     return 0;
@@ -132,16 +147,16 @@ static int bdf_lu_factor(double *A, int *pivot)
 
 /* Solve (LU) x = b in place. The factorisation swaps whole rows (multipliers too), so all swaps are applied
    to b before the forward substitution, not interleaved with it. */
-static void bdf_lu_solve(const double *LU, const int *pivot, double *b)
+static void bdf_lu_solve(int n, const double *LU, const int *pivot, double *b)
 {
-    for (int k = 0; k < NY; k++)
+    for (int k = 0; k < n; k++)
         if (pivot[k] != k) { double swap = b[k]; b[k] = b[pivot[k]]; b[pivot[k]] = swap; }
-    for (int k = 0; k < NY; k++)
-        for (int i = k + 1; i < NY; i++) b[i] -= LU[i * NY + k] * b[k];
-    for (int i = NY - 1; i >= 0; i--) {
+    for (int k = 0; k < n; k++)
+        for (int i = k + 1; i < n; i++) b[i] -= LU[i * n + k] * b[k];
+    for (int i = n - 1; i >= 0; i--) {
         double s = b[i];
-        for (int j = i + 1; j < NY; j++) s -= LU[i * NY + j] * b[j];
-        b[i] = s / LU[i * NY + i];
+        for (int j = i + 1; j < n; j++) s -= LU[i * n + j] * b[j];
+        b[i] = s / LU[i * n + i];
     }
 }
 
@@ -158,7 +173,7 @@ static void bdf_compute_R(int order, double factor, double R[BDF_MAX_ORDER + 1][
 }
 
 /* Rescale the differences D[0..order] from step h to step factor * h (the same interpolating polynomial). */
-static void bdf_change_D(double D[][NY], int order, double factor)
+static void bdf_change_D(int n, double D[][NY], int order, double factor)
 {
     double R[BDF_MAX_ORDER + 1][BDF_MAX_ORDER + 1], U[BDF_MAX_ORDER + 1][BDF_MAX_ORDER + 1];
     double RU[BDF_MAX_ORDER + 1][BDF_MAX_ORDER + 1], old[BDF_MAX_ORDER + 1][NY];
@@ -172,10 +187,10 @@ static void bdf_change_D(double D[][NY], int order, double factor)
         }
     memcpy(old, D, (size_t)(order + 1) * sizeof old[0]);
     for (int j = 0; j <= order; j++)
-        for (int n = 0; n < NY; n++) {
+        for (int i = 0; i < n; i++) {
             double s = 0.0;
-            for (int m = 0; m <= order; m++) s += RU[m][j] * old[m][n];
-            D[j][n] = s;
+            for (int m = 0; m <= order; m++) s += RU[m][j] * old[m][i];
+            D[j][i] = s;
         }
 }
 
@@ -192,19 +207,20 @@ static double bdf_next_stop(double t, double t_end, int n_crit, const double *t_
    select_initial_step): an explicit Euler trial step estimates y'' and the step is chosen so that its
    local error is about 1 % of the tolerance, capped by the distance to the next stop. One right-hand side;
    if it fails, a cautious guess (the error test takes over). */
-static double bdf_initial_step(double t, const double *y, const double *f, const double *p, double rtol,
+static double bdf_initial_step(const bdf_system *s, double t, const double *y, const double *f, double rtol,
                                const double *atol, double stop, long *n_rhs)
 {
+    const int n = s->n;
     double scale[NY], y_euler[NY], f_euler[NY], difference[NY];
-    for (int i = 0; i < NY; i++) scale[i] = atol[i] + rtol * fabs(y[i]);
-    double d0 = bdf_norm(y, scale), d1 = bdf_norm(f, scale);
+    for (int i = 0; i < n; i++) scale[i] = atol[i] + rtol * fabs(y[i]);
+    double d0 = bdf_norm(n, y, scale), d1 = bdf_norm(n, f, scale);
     double span = stop - t;
     double h0 = (d0 < 1e-5 || d1 < 1e-5) ? 1e-6 : 0.01 * d0 / d1;
     h0 = fmin(h0, span);
-    for (int i = 0; i < NY; i++) y_euler[i] = y[i] + h0 * f[i];
-    if (bdf_rhs(t + h0, y_euler, p, f_euler, n_rhs)) return fmin(h0, 1e-6 * span);
-    for (int i = 0; i < NY; i++) difference[i] = f_euler[i] - f[i];
-    double d2 = bdf_norm(difference, scale) / h0;
+    for (int i = 0; i < n; i++) y_euler[i] = y[i] + h0 * f[i];
+    if (bdf_rhs(s, t + h0, y_euler, f_euler, n_rhs)) return fmin(h0, 1e-6 * span);
+    for (int i = 0; i < n; i++) difference[i] = f_euler[i] - f[i];
+    double d2 = bdf_norm(n, difference, scale) / h0;
     double h1 = (d1 <= 1e-15 && d2 <= 1e-15) ? fmax(1e-6, 1e-3 * h0) : sqrt(0.01 / fmax(d1, d2));
     return fmin(fmin(100.0 * h0, h1), span);
 }
@@ -212,23 +228,24 @@ static double bdf_initial_step(double t, const double *y, const double *f, const
 /* Simplified Newton iteration for the NDF step (scipy's solve_bdf_system): on success, y_new and
    d = y_new - y_pred. Stops early when the observed contraction rate says tol cannot be reached within the
    iteration limit. *evaluation_failed tells a failed right-hand side from slow convergence. */
-static int bdf_newton(double t_new, const double *y_pred, double c, const double *psi, const double *lu,
-                      const int *pivot, const double *scale, double tol, const double *p, double *y_new, double *d,
+static int bdf_newton(const bdf_system *s, double t_new, const double *y_pred, double c, const double *psi, const double *lu,
+                      const int *pivot, const double *scale, double tol, double *y_new, double *d,
                       int *n_iter, int *evaluation_failed, long *n_rhs)
 {
+    const int n = s->n;
     double f[NY], dy[NY], dy_norm_old = 0.0;
-    memcpy(y_new, y_pred, NY * sizeof(double));
-    memset(d, 0, NY * sizeof(double));
+    memcpy(y_new, y_pred, n * sizeof(double));
+    memset(d, 0, n * sizeof(double));
     *evaluation_failed = 0;
     for (int k = 0; k < BDF_NEWTON_MAXITER; k++) {
         *n_iter = k + 1;
-        if (bdf_rhs(t_new, y_new, p, f, n_rhs)) { *evaluation_failed = 1; return 0; }
-        for (int i = 0; i < NY; i++) dy[i] = c * f[i] - psi[i] - d[i];
-        bdf_lu_solve(lu, pivot, dy);
-        double dy_norm = bdf_norm(dy, scale);
+        if (bdf_rhs(s, t_new, y_new, f, n_rhs)) { *evaluation_failed = 1; return 0; }
+        for (int i = 0; i < n; i++) dy[i] = c * f[i] - psi[i] - d[i];
+        bdf_lu_solve(n, lu, pivot, dy);
+        double dy_norm = bdf_norm(n, dy, scale);
         double rate = k > 0 ? dy_norm / dy_norm_old : -1.0;
         if (k > 0 && (rate >= 1.0 || pow(rate, BDF_NEWTON_MAXITER - k) / (1.0 - rate) * dy_norm > tol)) return 0;
-        for (int i = 0; i < NY; i++) { y_new[i] += dy[i]; d[i] += dy[i]; }
+        for (int i = 0; i < n; i++) { y_new[i] += dy[i]; d[i] += dy[i]; }
         if (dy_norm == 0.0 || (k > 0 && rate / (1.0 - rate) * dy_norm < tol)) return 1;
         dy_norm_old = dy_norm;
     }
@@ -237,31 +254,32 @@ static int bdf_newton(double t_new, const double *y_pred, double c, const double
 
 /* The interpolating polynomial of the differences at time t (scipy's BdfDenseOutput): y at t_now, and
    prod_{m<j} (t - t_now + m h) / ((m + 1) h) times D[j]. */
-static void bdf_interpolate(double t, double t_now, double h, int order, double D[][NY], double *y)
+static void bdf_interpolate(int n, double t, double t_now, double h, int order, double D[][NY], double *y)
 {
     double product = 1.0;
-    memcpy(y, D[0], NY * sizeof(double));
+    memcpy(y, D[0], n * sizeof(double));
     for (int j = 1; j <= order; j++) {
         product *= (t - (t_now - (j - 1) * h)) / (j * h);
-        for (int i = 0; i < NY; i++) y[i] += D[j][i] * product;
+        for (int i = 0; i < n; i++) y[i] += D[j][i] * product;
     }
 }
 
-/* Integrate y' = ps_rhs(t, y, p) from t_out[0] (state y0) and write the state at every t_out[k] (increasing)
-   into y_out[k*NY ...] (y_out[0..NY) = y0). No step crosses a t_crit value: each is reached exactly and the
+/* Integrate the system s from t_out[0] (state y0) and write the state at every t_out[k] (increasing)
+   into y_out[k*n ...] (y_out[0..n) = y0). No step crosses a t_crit value: each is reached exactly and the
    method restarts there. Error weights rtol |y_i| + atol[i], RMS norm. max_steps bounds the step attempts
    (rejected ones included) between two consecutive output times, as odeint's mxstep. stats[0..4): accepted
    steps, rhs calls, jac calls, last time reached. Returns 0 on success, 1 step budget exceeded, 2 step size
    too small (h < 1e-14 |t|), 3 rhs or jac failed (nonzero or non-finite) at the start of a piece, or still
    after 10 halvings of the step. */
-int ps_integrate(const double *p, const double *y0, int n_out, const double *t_out,
-                 int n_crit, const double *t_crit, double rtol, const double *atol,
-                 long max_steps, double *y_out, double *stats)
+static int bdf_solve(const bdf_system *s, const double *y0, int n_out, const double *t_out, int n_crit,
+                     const double *t_crit, double rtol, const double *atol, long max_steps, double *y_out,
+                     double *stats)
 {
+    const int n = s->n;
     long n_steps = 0, n_rhs = 0, n_jac = 0;
     double t = n_out > 0 ? t_out[0] : 0.0;
     int status = BDF_OK;
-    if (n_out > 0) memcpy(y_out, y0, NY * sizeof(double));
+    if (n_out > 0) memcpy(y_out, y0, n * sizeof(double));
 
     bdf_coefficients co;
     bdf_make_coefficients(&co);
@@ -277,7 +295,7 @@ int ps_integrate(const double *p, const double *y0, int n_out, const double *t_o
     int order = 1, n_equal_steps = 0, jac_is_current = 0, restart = 1, failed_evaluations = 0;
     int next_out = 1;
     long attempts_since_output = 0;
-    memcpy(D[0], y0, NY * sizeof(double));
+    memcpy(D[0], y0, n * sizeof(double));
 
     while (next_out < n_out) {
         double stop = bdf_next_stop(t, t_end, n_crit, t_crit);
@@ -287,19 +305,19 @@ int ps_integrate(const double *p, const double *y0, int n_out, const double *t_o
         if (stop - t <= 64.0 * DBL_EPSILON * fabs(stop)) {
             t = stop;
             for (; next_out < n_out && t_out[next_out] <= t; ++next_out)
-                memcpy(y_out + (long)next_out * NY, D[0], NY * sizeof(double));
+                memcpy(y_out + (long)next_out * n, D[0], n * sizeof(double));
             attempts_since_output = 0;
             restart = 1;
             continue;
         }
 
         if (restart) { /* at the start and at each corner: order 1, fresh Jacobian, new starting step */
-            if (bdf_rhs(t, D[0], p, f, &n_rhs) || bdf_jac(t, D[0], p, jac, &n_jac)) {
+            if (bdf_rhs(s, t, D[0], f, &n_rhs) || bdf_jac(s, t, D[0], jac, &n_jac)) {
                 status = BDF_EVAL_FAILED;
                 goto done;
             }
-            h = bdf_initial_step(t, D[0], f, p, rtol, atol, stop, &n_rhs);
-            for (int i = 0; i < NY; i++) D[1][i] = h * f[i];
+            h = bdf_initial_step(s, t, D[0], f, rtol, atol, stop, &n_rhs);
+            for (int i = 0; i < n; i++) D[1][i] = h * f[i];
             order = 1;
             n_equal_steps = 0;
             jac_is_current = 1;
@@ -317,7 +335,7 @@ int ps_integrate(const double *p, const double *y0, int n_out, const double *t_o
 
             if (t + 1.0001 * h >= stop) { /* land exactly on the stop (stretching h by up to 0.01 %) */
                 double shortened = stop - t;
-                bdf_change_D(D, order, shortened / h);
+                bdf_change_D(n, D, order, shortened / h);
                 h = shortened;
                 n_equal_steps = 0;
                 t_new = stop;
@@ -325,7 +343,7 @@ int ps_integrate(const double *p, const double *y0, int n_out, const double *t_o
                 t_new = t + h;
             }
 
-            for (int i = 0; i < NY; i++) {
+            for (int i = 0; i < n; i++) {
                 double sum = 0.0, weighted = 0.0;
                 for (int j = 0; j <= order; j++) sum += D[j][i];
                 for (int j = 1; j <= order; j++) weighted += co.gamma[j] * D[j][i];
@@ -338,16 +356,16 @@ int ps_integrate(const double *p, const double *y0, int n_out, const double *t_o
             int converged = 0, evaluation_failed = 0;
             for (;;) {
                 if (c != c_factored) { /* the LU is cheap at this size: refactor whenever h or order changes */
-                    for (int i = 0; i < NY * NY; i++) lu[i] = -c * jac[i];
-                    for (int i = 0; i < NY; i++) lu[i * NY + i] += 1.0;
-                    c_factored = bdf_lu_factor(lu, pivot) ? 0.0 : c;
+                    for (int i = 0; i < n * n; i++) lu[i] = -c * jac[i];
+                    for (int i = 0; i < n; i++) lu[i * n + i] += 1.0;
+                    c_factored = bdf_lu_factor(n, lu, pivot) ? 0.0 : c;
                 }
                 if (c_factored != 0.0)
-                    converged = bdf_newton(t_new, y_pred, c, psi, lu, pivot, scale, newton_tol, p, y_new, d,
+                    converged = bdf_newton(s, t_new, y_pred, c, psi, lu, pivot, scale, newton_tol, y_new, d,
                                            &n_iter, &evaluation_failed, &n_rhs);
                 if (converged || jac_is_current) break;
                 /* Slow convergence with an old Jacobian: refresh it at the predicted point and retry. */
-                if (bdf_jac(t_new, y_pred, p, jac, &n_jac)) { evaluation_failed = 1; break; }
+                if (bdf_jac(s, t_new, y_pred, jac, &n_jac)) { evaluation_failed = 1; break; }
                 jac_is_current = 1;
                 c_factored = 0.0;
             }
@@ -356,21 +374,21 @@ int ps_integrate(const double *p, const double *y0, int n_out, const double *t_o
                     status = BDF_EVAL_FAILED;
                     goto done;
                 }
-                bdf_change_D(D, order, 0.5);
+                bdf_change_D(n, D, order, 0.5);
                 h *= 0.5;
                 n_equal_steps = 0;
                 continue;
             }
 
             double safety = 0.9 * (2 * BDF_NEWTON_MAXITER + 1) / (2 * BDF_NEWTON_MAXITER + n_iter);
-            for (int i = 0; i < NY; i++) {
+            for (int i = 0; i < n; i++) {
                 scale[i] = atol[i] + rtol * fabs(y_new[i]);
                 error[i] = co.error_const[order] * d[i];
             }
-            double error_norm = bdf_norm(error, scale);
+            double error_norm = bdf_norm(n, error, scale);
             if (error_norm > 1.0) {
                 double factor = fmax(bdf_min_factor, safety * pow(error_norm, -1.0 / (order + 1)));
-                bdf_change_D(D, order, factor);
+                bdf_change_D(n, D, order, factor);
                 h *= factor;
                 n_equal_steps = 0;
                 continue;
@@ -382,12 +400,12 @@ int ps_integrate(const double *p, const double *y0, int n_out, const double *t_o
             ++n_equal_steps;
             failed_evaluations = 0;
             jac_is_current = 0;
-            for (int i = 0; i < NY; i++) {
+            for (int i = 0; i < n; i++) {
                 D[order + 2][i] = d[i] - D[order + 1][i];
                 D[order + 1][i] = d[i];
             }
             for (int j = order; j >= 0; j--)
-                for (int i = 0; i < NY; i++) D[j][i] += D[j + 1][i];
+                for (int i = 0; i < n; i++) D[j][i] += D[j + 1][i];
             t = t_new;
 
             /* After order + 1 steps of equal size: choose order q-1, q or q+1 and the next step from the error
@@ -395,13 +413,13 @@ int ps_integrate(const double *p, const double *y0, int n_out, const double *t_o
             if (n_equal_steps >= order + 1) {
                 double factor_lower = 0.0, factor_same, factor_higher = 0.0;
                 if (order > 1) {
-                    for (int i = 0; i < NY; i++) error[i] = co.error_const[order - 1] * D[order][i];
-                    factor_lower = pow(bdf_norm(error, scale), -1.0 / order);
+                    for (int i = 0; i < n; i++) error[i] = co.error_const[order - 1] * D[order][i];
+                    factor_lower = pow(bdf_norm(n, error, scale), -1.0 / order);
                 }
                 factor_same = pow(error_norm, -1.0 / (order + 1));
                 if (order < BDF_MAX_ORDER) {
-                    for (int i = 0; i < NY; i++) error[i] = co.error_const[order + 1] * D[order + 2][i];
-                    factor_higher = pow(bdf_norm(error, scale), -1.0 / (order + 2));
+                    for (int i = 0; i < n; i++) error[i] = co.error_const[order + 1] * D[order + 2][i];
+                    factor_higher = pow(bdf_norm(n, error, scale), -1.0 / (order + 2));
                 }
                 double best = factor_same;
                 int new_order = order;
@@ -409,7 +427,7 @@ int ps_integrate(const double *p, const double *y0, int n_out, const double *t_o
                 if (factor_higher > best) { best = factor_higher; new_order = order + 1; }
                 order = new_order;
                 double factor = fmin(bdf_max_factor, safety * best);
-                bdf_change_D(D, order, factor);
+                bdf_change_D(n, D, order, factor);
                 h *= factor;
                 n_equal_steps = 0;
             }
@@ -419,9 +437,9 @@ int ps_integrate(const double *p, const double *y0, int n_out, const double *t_o
         /* Outputs within the step just taken: the interpolating polynomial (exact at the step's end). */
         if (t_out[next_out] <= t) {
             while (next_out < n_out && t_out[next_out] <= t) {
-                double *row = y_out + (long)next_out * NY;
-                if (t_out[next_out] == t) memcpy(row, D[0], NY * sizeof(double));
-                else bdf_interpolate(t_out[next_out], t, h, order, D, row);
+                double *row = y_out + (long)next_out * n;
+                if (t_out[next_out] == t) memcpy(row, D[0], n * sizeof(double));
+                else bdf_interpolate(n, t_out[next_out], t, h, order, D, row);
                 ++next_out;
             }
             attempts_since_output = 0;
@@ -437,4 +455,22 @@ done:
         stats[3] = t;
     }
     return status;
+}
+
+/* The handwheel-driven model: y' = ps_rhs(t, y, p), NY states (bdf_solve). */
+int ps_integrate(const double *p, const double *y0, int n_out, const double *t_out, int n_crit, const double *t_crit,
+                 double rtol, const double *atol, long max_steps, double *y_out, double *stats)
+{
+    const bdf_system s = {NY, p, NULL, NULL};
+    return bdf_solve(&s, y0, n_out, t_out, n_crit, t_crit, rtol, atol, max_steps, y_out, stats);
+}
+
+/* The model with its rack prescribed by the table `rack` (ps_rack): the reduced system of the other coordinates,
+   z' = ps_prescribed_rhs(t, z, p, rack), 2 NO states; p_jac as ps_prescribed_jac takes it (bdf_solve). */
+int ps_integrate_prescribed(const double *p, double *p_jac, const double *rack, const double *z0, int n_out,
+                            const double *t_out, int n_crit, const double *t_crit, double rtol, const double *atol,
+                            long max_steps, double *z_out, double *stats)
+{
+    const bdf_system s = {2 * NO, p, rack, p_jac};
+    return bdf_solve(&s, z0, n_out, t_out, n_crit, t_crit, rtol, atol, max_steps, z_out, stats);
 }

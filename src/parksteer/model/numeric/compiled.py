@@ -121,6 +121,7 @@ def load_entry(directory: Path) -> CompiledModel:
         ("ps_prescribed_jac", i32, [dbl, vp, vp, vp, vp, vp]),
         ("ps_prescribed_samples", i32, [i32, vp, vp, vp, vp, vp, vp, vp]),
         ("ps_integrate", i32, [vp, vp, i32, vp, i32, vp, dbl, vp, ctypes.c_long, vp, vp]),
+        ("ps_integrate_prescribed", i32, [vp, vp, vp, vp, i32, vp, i32, vp, dbl, vp, ctypes.c_long, vp, vp]),
     ):
         function = getattr(lib, name)
         function.restype = restype

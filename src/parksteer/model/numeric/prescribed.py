@@ -13,10 +13,10 @@ integrated from that law (:class:`ColumnLaw`): on an engaged flank it is the lin
 the band, and inside the band, where the hand turns with no torque, it crosses as fast as the torque
 lets it (the rack and torque fix the handwheel angle there only within the band).
 
-Speed: the integrator (LSODA via odeint, which loops in Fortran) calls the compiled model's own
-prescribed-rack functions (``ps_prescribed_rhs``, ``ps_prescribed_jac``, ``ps_prescribed_samples`` in the
-generated runtime, the rack motion passed as a table of its polynomial pieces), so a step costs one call into
-C. The Jacobian of the reduced system is analytic, from the compiled model's full one. With ``h = M^-1 b``,
+Speed: the whole solve is one call of the compiled model's stiff integrator (``ps_integrate_prescribed``, the
+integrator of the handwheel-driven model applied to the reduced system of ``ps_prescribed_rhs`` and
+``ps_prescribed_jac`` in the generated runtime, the rack motion passed as a table of its polynomial pieces); no
+step calls back into Python. The Jacobian of the reduced system is analytic, from the compiled model's full one. With ``h = M^-1 b``,
 the reduced accelerations of the other coordinates are ``a_o + h_o dT``, with ``dT`` fixed by the rack's
 acceleration; differentiating gives ``d a_o/dy = J_o - (h_o / h_rack) J_rack``, where J is the full model's
 Jacobian evaluated with a handwheel input that makes its column torque equal the prescribed-rack torque (the
@@ -34,10 +34,10 @@ from dataclasses import dataclass
 from typing import Protocol
 
 import numpy as np
-from scipy.integrate import ODEintWarning, odeint
 
 from .statics import static_state
-from .tolerances import PRESCRIBED_ATOL_FACTOR, PRESCRIBED_RTOL, absolute_tolerances, max_steps, solver_failure
+from .tolerances import (PRESCRIBED_ATOL_FACTOR, PRESCRIBED_RTOL, absolute_tolerances, integrator_failure,
+                         max_steps)
 
 # The column twist is integrated exactly for a torque linear between samples this far apart at most (s).
 # Against the column's time constant c / k (0.2 s) the twist filters the torque; at 5 ms the handwheel angle
@@ -49,8 +49,9 @@ TWIST_RTOL = 1e-8
 TWIST_ATOL_RAD = 1e-10
 # Spacing of the table of a deflection law (ColumnLaw.table), rad: 1/90 of a dead band's smoothed corner.
 TWIST_TABLE_RAD = 2e-5
-# The integrator's first step, s: from rest, well inside the first output interval of any record.
-FIRST_STEP_S = 1e-4
+# A break of the rack's pieces where its position, speed or acceleration jumps by more than this fraction of the
+# largest value of each over the pieces is a corner of the input: the integrator stops and restarts there.
+CORNER_TOLERANCE = 1e-9
 
 class RackMotion(Protocol):
     """A rack motion as a piecewise polynomial in time: position (m) on each piece between ``breaks`` (s,
@@ -77,6 +78,30 @@ def rack_table(rack: RackMotion) -> np.ndarray:
     if breaks.ndim != 1 or coefficients.shape[1:] != (len(breaks) - 1,) or len(breaks) < 2:
         raise ValueError("rack motion: needs breaks (m + 1) and coefficients (order x m)")
     return np.concatenate([[len(breaks) - 1, len(coefficients)], breaks, coefficients.ravel()])
+
+
+def rack_corners(rack: RackMotion, t_start: float, t_end: float) -> np.ndarray:
+    """The corners of `rack` strictly between `t_start` and `t_end` (s): its start and end, where it is held, and
+    every break where its position, speed or acceleration jumps (by more than ``CORNER_TOLERANCE`` of the largest
+    value of each over the pieces; a cubic spline's pieces join with none)."""
+    breaks = np.asarray(rack.breaks, dtype=float)
+    c = np.asarray(rack.coefficients, dtype=float)
+    order = len(c)
+    h = np.diff(breaks)
+    jumps = np.zeros(len(breaks) - 2, dtype=bool)
+    for derivative in range(min(3, order)):
+        # the derivative's polynomial on each piece, highest power first: its value at the piece's start (the
+        # constant term) and at its end
+        d = c[: order - derivative] * np.array([np.prod(np.arange(k - derivative + 1, k + 1))
+                                                for k in range(order - 1, derivative - 1, -1)])[:, None]
+        at_start = d[-1]
+        at_end = np.zeros(len(h))
+        for row in d:
+            at_end = at_end * h + row
+        scale = max(float(np.max(np.abs(at_start))), float(np.max(np.abs(at_end))), np.finfo(float).tiny)
+        jumps |= np.abs(at_start[1:] - at_end[:-1]) > CORNER_TOLERANCE * scale
+    corners = np.concatenate([[rack.start_s, rack.end_s], breaks[1:-1][jumps]])
+    return np.unique(corners[(corners > t_start) & (corners < t_end)])
 
 
 @dataclass
@@ -114,53 +139,39 @@ def solve(run, p: np.ndarray, rack: RackMotion, t_out, rtol: float = PRESCRIBED_
         raise ValueError("output times must be at least two, strictly increasing")
     p = np.ascontiguousarray(p, dtype=float)
     table = rack_table(rack)
-    zdot = np.zeros(2 * n_o)
-    p_ptr, table_ptr, zdot_ptr = p.ctypes.data, table.ctypes.data, zdot.ctypes.data
-    rhs_c, jac_c = lib.ps_prescribed_rhs, lib.ps_prescribed_jac
+    p_ptr, table_ptr = p.ctypes.data, table.ctypes.data
 
-    # Both in the compiled model (the generated runtime): the reduced right-hand side solves M a = F + b T for the
-    # other accelerations and T together; the Jacobian is the full model's at a constant handwheel input that
-    # gives the prescribed-rack torque through a unit column spring without damping (see the module docstring).
-    def rhs(z, t):
-        if rhs_c(t, z.ctypes.data, p_ptr, table_ptr, zdot_ptr):
-            raise FloatingPointError("prescribed rack: the equations for the accelerations and torque are singular")
-        return zdot
-
+    # The Jacobian (ps_prescribed_jac) is the full model's at a constant handwheel input that gives the
+    # prescribed-rack torque through a unit column spring without damping (see the module docstring): these are
+    # its parameters, the input's one piece (start time, angle, rate, acceleration) set by each call.
     n_par = len(model.info["parameters"])
     p_jac = p.copy()
     p_jac[run.parameter_index("steering.column_torsional_stiffness")] = 1.0
     p_jac[run.parameter_index("steering.column_torsional_damping")] = 0.0
     p_jac[n_par:] = 0.0
-    p_jac[n_par] = 1.0  # one piece: (start time, angle, rate, acceleration)
+    p_jac[n_par] = 1.0
     p_jac[n_par + 1] = -1.0e9
-    p_jac_ptr = p_jac.ctypes.data
-    J = np.zeros((2 * n_o, 2 * n_o))
-    J_ptr = J.ctypes.data
-
-    def jacobian(z, t):
-        if jac_c(t, z.ctypes.data, p_ptr, p_jac_ptr, table_ptr, J_ptr):
-            raise FloatingPointError("mass matrix not positive definite")
-        return J
 
     units = model.info["coordinate_units"]
-    atol = absolute_tolerances([units[i] for i in others], atol_factor)
+    atol = np.ascontiguousarray(absolute_tolerances([units[i] for i in others], atol_factor))
     rack_start = np.zeros(3)
     lib.ps_rack(float(t_out[0]), table_ptr, rack_start.ctypes.data)
     y_static = static_state(run, fixed={"rack": rack_start[0]}, p=p)
-    z0 = np.concatenate([y_static[others], np.zeros(n_o)])
-    # LSODA interpolates at the output times without stepping to them; with its first step fixed (it would
-    # otherwise choose it from the first output interval) the refined grid of the twist changes no step.
+    z0 = np.ascontiguousarray(np.concatenate([y_static[others], np.zeros(n_o)]))
+    # The integrator interpolates at the output times without stepping to them, so the refined grid of the
+    # twist changes no step.
     grid, at_out = _refined(t_out, TWIST_SAMPLE_S) if outputs else (t_out, np.arange(len(t_out)))
-    with warnings.catch_warnings():  # a failure is reported below as one line, not as a warning too
-        warnings.simplefilter("ignore", ODEintWarning)
-        states, info = odeint(rhs, z0, grid, Dfun=jacobian, rtol=rtol, atol=atol, mxstep=max_steps(grid), full_output=True,
-                              h0=FIRST_STEP_S)
-    if info["message"] != "Integration successful.":
-        raise solver_failure("prescribed-rack integration", info, grid)
+    corners = np.ascontiguousarray(rack_corners(rack, grid[0], grid[-1]))
+    states = np.empty((len(grid), 2 * n_o))
+    stats = np.zeros(4)
+    code = lib.ps_integrate_prescribed(p_ptr, p_jac.ctypes.data, table_ptr, z0.ctypes.data, len(grid),
+                                       grid.ctypes.data, len(corners), corners.ctypes.data, float(rtol),
+                                       atol.ctypes.data, max_steps(grid), states.ctypes.data, stats.ctypes.data)
+    if code != 0:
+        raise integrator_failure("prescribed-rack integration", code, float(stats[3]))
 
     # The states, accelerations and torque at every sample, solved together (the same equations as the rhs).
     m = len(grid)
-    states = np.ascontiguousarray(states)
     full, accs, torque = np.empty((m, 2 * n)), np.empty((m, n)), np.empty(m)
     if lib.ps_prescribed_samples(m, grid.ctypes.data, states.ctypes.data, p_ptr, table_ptr, full.ctypes.data,
                                  accs.ctypes.data, torque.ctypes.data):
@@ -294,6 +305,10 @@ class ColumnLaw:
             k = min(max(bisect_right(time_list, time) - 1, 0), last)
             g, slope = law(float(x[0]))
             return (torque_list[k] + slope_T[k] * (time - time_list[k]) - stiffness * g * slope) / (damping * slope * slope)
+
+        from scipy.integrate import ODEintWarning, odeint  # only a column deflection law's twist needs it
+
+        from .tolerances import solver_failure
 
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", ODEintWarning)

@@ -225,7 +225,7 @@ def _simulate_rack_drive(run: PreparedRun, rack: RackMotion, t_end_s, output_dt_
     t = t[t <= rack.end_s]
     if len(t) < 2:
         raise UsageError(f"rack drive: the run from {t0:g} s to {t_end:g} s holds fewer than two outputs")
-    from .prescribed import solve as solve_prescribed  # with its odeint: a free run never imports either
+    from .prescribed import solve as solve_prescribed  # a free run never imports it
 
     solution = solve_prescribed(run, run.p, rack, t, rtol=rtol, outputs=True)
     columns = _columns(run, t, solution.states, solution.outputs, solution.handwheel)

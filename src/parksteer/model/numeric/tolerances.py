@@ -16,13 +16,14 @@ RTOL = 1e-7
 ATOL_Q = {"m": 1e-10, "rad": 1e-9}
 ATOL_U = {"m": 1e-8, "rad": 1e-7}
 
-# Prescribed-rack solve (parksteer.model.numeric.prescribed): relative, and a multiple of the absolute
-# tolerances above. With the rack prescribed, no rack-speed error reaches the column damping, so looser
-# tolerances suffice: on data/measurements/example_unladen.csv the torque is within 0.004 N m (RMS 0.0007 N m)
-# of a solve at rtol 1e-10 and a hundredth of ATOL_Q/ATOL_U, 2 % of an 8-bit converter step (0.2 N m); the
-# solve takes a little over half the time it takes at RTOL and ATOL_Q/ATOL_U. The error is not uniform: on the exact
-# rack of a free run (tests/model/test_rack_drive.py) a burst of 0.14 s reaches 0.09 N m, half an 8-bit step, while
-# a solve at rtol 1e-8 gives the free run's torque back to 4e-6 N m.
+# Prescribed-rack solve (parksteer.model.numeric.prescribed, the generated integrator on the reduced system):
+# relative, and a multiple of the absolute tolerances above. With the rack prescribed, no rack-speed error reaches
+# the column damping, so looser tolerances suffice: on data/measurements/example_unladen.csv the torque is within
+# 0.0005 N m (RMS 0.00014 N m) of a solve at rtol 1e-10 and a hundredth of ATOL_Q/ATOL_U, a quarter of a per cent
+# of an 8-bit converter step (0.2 N m); the solve takes 4.0 ms, against 6.7 ms at RTOL and ATOL_Q/ATOL_U. On the
+# exact rack of a free run (tests/model/test_rack_drive.py) the largest error is 0.003 N m, where a solve at rtol
+# 1e-8 gives the free run's torque back to 2e-5 N m. (LSODA, which ran this solve before, was within 0.004 N m on
+# the record and 0.09 N m on the free run's rack at these tolerances.)
 PRESCRIBED_RTOL = 1e-5  # 1
 PRESCRIBED_ATOL_FACTOR = 100.0  # 1
 
