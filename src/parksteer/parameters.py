@@ -225,6 +225,7 @@ _SCHEMA: dict[str, dict[str, dict[str, Any]]] = {
         "presliding_displacement": _range("m", 1.0e-6, 1.0e-2),
         "slip_smoothing": _range("s/m", 10.0, 1.0e6),
         "node_mass": _range("kg", 1.0e-4, 10.0),
+        "damping_ratio": _range("1", 0.0, 10.0),
     },
     "top_mount_windup": {"stiffness": _range("N m/rad", 0.0, 1000.0)},
     "tyre_stribeck": {

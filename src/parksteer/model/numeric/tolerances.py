@@ -29,11 +29,13 @@ PRESCRIBED_ATOL_FACTOR = 100.0  # 1
 
 
 # Work budget of both integrations: at most this many steps per simulated second between two output times
-# (odeint's mxstep and ps_integrate's max_steps, scaled by the output spacing, never below MIN_STEPS_PER_OUTPUT).
+# (ps_integrate's and ps_integrate_prescribed's max_steps, scaled by the output spacing, never below
+# MIN_STEPS_PER_OUTPUT).
 # Measured with LSODA: the paper's cycles take about 170 steps per second (3,000 over 18 s, the generated
 # integrator 1,800; at most 47 between 10 ms outputs), a tyre a hundred times stiffer
-# radially than any car tyre (1e10 N/m) about 7,000, and the stiffest effect of the library, the pre-sliding rack
-# friction with its 0.1 ms bristle, about 100,000 (234,000 in its busiest 10 ms, at 1,560 N). Values that need
+# radially than any car tyre (1e10 N/m) about 7,000, and the pre-sliding rack friction with its bristle root's
+# mode undamped (rack_presliding.damping_ratio = 0), about 100,000 (234,000 in its busiest 10 ms, at 1,560 N;
+# damped, as by default, its cycle takes 12 ms like the paper's). Values that need
 # more than twice that are far outside what the model is for: without the budget a 1e14 N/m tyre ran LSODA for
 # minutes (the generated integrator follows it in 9 s, within 0.002 N m of a 1e10 N/m tyre); with it a 1e16 N/m
 # tyre fails in one line within two seconds.
