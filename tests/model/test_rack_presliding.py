@@ -60,3 +60,20 @@ def test_reversal_spreads_over_the_presliding_displacement(runs):
     assert 0.5 * x_p < travel < 2.0 * x_p
     half = after[np.argmax(rack[top] - rack[after] > 0.5 * x_p)]  # half way to the crossing
     assert extra[half] > 0.0 and coulomb[half] < 0.0
+
+
+def test_the_root_damper_only_removes_the_root_masss_own_mode(runs):
+    """The damper in parallel with the bristle spring (damping_ratio) is there to end the oscillation of the root's
+    small mass on the spring, a mode the massless bristle does not have. Its force, c times the bristle's
+    deformation rate with c = 2 zeta sqrt(k m), is zero in steady sliding and small in pre-sliding: at a tenth of
+    the root mass (c down by sqrt(10)), or at half and twice the damping ratio, the torque moves by less than
+    0.02 N m (a tenth of an 8-bit converter step), against the bristle's own effect of 0.6 N m at 100 N."""
+    dt = 0.001
+    effect = np.max(np.abs(runs["bristle"]["handwheel_torque_Nm"] - runs["base"]["handwheel_torque_Nm"]))
+    assert effect > 0.5
+    for overrides in ({"rack_presliding.node_mass": 0.001}, {"rack_presliding.damping_ratio": 0.5},
+                      {"rack_presliding.damping_ratio": 2.0}):
+        other = simulate("unladen", effects="+rack_presliding", output_dt_s=dt,
+                         overrides={"rack_presliding.force": FORCE_N, **overrides})
+        moved = np.max(np.abs(np.asarray(other.columns["handwheel_torque_Nm"]) - runs["bristle"]["handwheel_torque_Nm"]))
+        assert moved < 0.02, (overrides, moved)
