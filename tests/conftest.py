@@ -13,6 +13,18 @@ from parksteer.parameters import DEFAULT_PATH, Parameters, load_parameters
 REPO_ROOT = Path(__file__).resolve().parents[1]
 
 
+def pytest_collection_modifyitems(config, items):
+    """The modules marked slow first, and the real SLURM run first of all (it mostly waits on the cluster's
+    polling): the test run's workers take modules in this order (xdist's loadscope), so the long ones start
+    while short ones remain to fill the other worker, and the workers finish together (longest first)."""
+    def rank(item):
+        if item.get_closest_marker("slurm"):
+            return 0
+        return 1 if item.get_closest_marker("slow") else 2
+
+    items.sort(key=rank)  # stable: the order within each rank is the collection order
+
+
 @pytest.fixture(scope="session")
 def repo_root() -> Path:
     """The repository checkout (holds Snakefile, workflow/, data/)."""

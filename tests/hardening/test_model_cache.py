@@ -16,6 +16,8 @@ import pytest
 from parksteer.model.codegen import cache
 from parksteer.model.symbolic.components import resolve_effects
 
+pytestmark = pytest.mark.slow
+
 # The smallest effect set: the quickest build (a few seconds).
 SMALL = "-rack_friction,-tyre_friction"
 
