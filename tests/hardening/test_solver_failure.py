@@ -18,6 +18,16 @@ from parksteer.model.numeric.tolerances import solver_failure
 from .corpus import _write, record_text
 
 
+@pytest.fixture(scope="module", autouse=True)
+def _paper_model_built():
+    """The paper's model compiled before these tests, so that their one-line checks of stderr see the failure only
+    and not a cold cache's derivation notes (whichever tests ran before)."""
+    from parksteer.model.codegen.cache import ensure
+    from parksteer.model.symbolic.components import resolve_effects
+
+    ensure(resolve_effects(None))
+
+
 @pytest.mark.filterwarnings("ignore::scipy.integrate.ODEintWarning")  # odeint called directly warns
 def test_solver_failure_reports_the_last_time_reached():
     """odeint's own report of a starved stiff problem (Van der Pol, mu = 1000) becomes one line with the time

@@ -228,7 +228,7 @@ def _lsoda_torque(run, p, rack, t, rtol, atol_factor):
     one) calling back the compiled model's reduced right-hand side and Jacobian, then its per-sample solve."""
     from scipy.integrate import odeint
 
-    from parksteer.model.numeric.prescribed import rack_table
+    from parksteer.model.numeric.prescribed import jacobian_parameters, rack_table
     from parksteer.model.numeric.tolerances import absolute_tolerances
 
     model, lib = run.model, run.model.lib
@@ -236,12 +236,7 @@ def _lsoda_torque(run, p, rack, t, rtol, atol_factor):
     others = [i for i in range(n) if i != i_rack]
     n_o = len(others)
     table, zdot, J = rack_table(rack), np.zeros(2 * n_o), np.zeros((2 * n_o, 2 * n_o))
-    p_jac = p.copy()  # as prescribed.solve makes it: unit column spring, no damper, one input piece
-    n_par = len(model.info["parameters"])
-    p_jac[run.parameter_index("steering.column_torsional_stiffness")] = 1.0
-    p_jac[run.parameter_index("steering.column_torsional_damping")] = 0.0
-    p_jac[n_par:] = 0.0
-    p_jac[n_par], p_jac[n_par + 1] = 1.0, -1.0e9
+    p_jac = jacobian_parameters(run, p)
 
     def rhs(z, time):
         assert lib.ps_prescribed_rhs(time, np.ascontiguousarray(z).ctypes.data, p.ctypes.data, table.ctypes.data,

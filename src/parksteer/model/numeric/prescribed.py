@@ -104,6 +104,21 @@ def rack_corners(rack: RackMotion, t_start: float, t_end: float) -> np.ndarray:
     return np.unique(corners[(corners > t_start) & (corners < t_end)])
 
 
+def jacobian_parameters(run, p: np.ndarray) -> np.ndarray:
+    """The parameter vector ``ps_prescribed_jac`` takes with `p`: the Jacobian is the full model's at a constant
+    handwheel input that gives the prescribed-rack torque through a unit column spring without damping (see the
+    module docstring), so a unit stiffness, no damping and one input piece (count, then start time, angle, rate,
+    acceleration), whose angle each call sets."""
+    n_par = len(run.model.info["parameters"])
+    p_jac = np.array(p, dtype=float)
+    p_jac[run.parameter_index("steering.column_torsional_stiffness")] = 1.0
+    p_jac[run.parameter_index("steering.column_torsional_damping")] = 0.0
+    p_jac[n_par:] = 0.0
+    p_jac[n_par] = 1.0
+    p_jac[n_par + 1] = -1.0e9
+    return p_jac
+
+
 @dataclass
 class PrescribedSolution:
     """The solve at the output times: the handwheel torque, and with outputs also the states and the model's outputs.
@@ -141,17 +156,7 @@ def solve(run, p: np.ndarray, rack: RackMotion, t_out, rtol: float = PRESCRIBED_
     table = rack_table(rack)
     p_ptr, table_ptr = p.ctypes.data, table.ctypes.data
 
-    # The Jacobian (ps_prescribed_jac) is the full model's at a constant handwheel input that gives the
-    # prescribed-rack torque through a unit column spring without damping (see the module docstring): these are
-    # its parameters, the input's one piece (start time, angle, rate, acceleration) set by each call.
-    n_par = len(model.info["parameters"])
-    p_jac = p.copy()
-    p_jac[run.parameter_index("steering.column_torsional_stiffness")] = 1.0
-    p_jac[run.parameter_index("steering.column_torsional_damping")] = 0.0
-    p_jac[n_par:] = 0.0
-    p_jac[n_par] = 1.0
-    p_jac[n_par + 1] = -1.0e9
-
+    p_jac = jacobian_parameters(run, p)
     units = model.info["coordinate_units"]
     atol = np.ascontiguousarray(absolute_tolerances([units[i] for i in others], atol_factor))
     rack_start = np.zeros(3)

@@ -66,27 +66,28 @@ class RackPresliding(Effect):
         state.point = root
         return [me.Particle("bristle_root", root, model.p("rack_presliding.node_mass"))]
 
+    def _stiffness(self, model):
+        """The bristle's stiffness k = F_d / x_p."""
+        return model.p("rack_presliding.force") / model.p("rack_presliding.presliding_displacement")
+
     def _spring_force(self, model):
         q, _ = model.state(self).root
-        stiffness = model.p("rack_presliding.force") / model.p("rack_presliding.presliding_displacement")
-        return stiffness * (model.rack_q - q)
+        return self._stiffness(model) * (model.rack_q - q)
 
     def loads(self, model):
         k, state = model.kinematics, model.state(self)
         _, u = state.root
-        spring = self._spring_force(model)
-        # The damper in parallel with the spring, on the bristle's deformation rate (rack speed less root speed)
-        stiffness = model.p("rack_presliding.force") / model.p("rack_presliding.presliding_displacement")
-        damping = 2 * model.p("rack_presliding.damping_ratio") * sp.sqrt(stiffness * model.p("rack_presliding.node_mass"))
-        spring = spring + damping * (model.rack_u - u)
+        # spring and damper in parallel, the damper on the bristle's deformation rate (rack speed less root speed)
+        damping = 2 * model.p("rack_presliding.damping_ratio") * sp.sqrt(
+            self._stiffness(model) * model.p("rack_presliding.node_mass"))
+        bristle = self._spring_force(model) + damping * (model.rack_u - u)
         slider = model.p("rack_presliding.force") * sp.tanh(model.p("rack_presliding.slip_smoothing") * u)
-        return (action_reaction(k.rack_point, -spring * k.B.y, state.point)
+        return (action_reaction(k.rack_point, -bristle * k.B.y, state.point)
                 + action_reaction(state.point, -slider * k.B.y, k.rack_housing_point))
 
     def potential_energy(self, model):
         q, _ = model.state(self).root
-        stiffness = model.p("rack_presliding.force") / model.p("rack_presliding.presliding_displacement")
-        return stiffness * (model.rack_q - q) ** 2 / 2
+        return self._stiffness(model) * (model.rack_q - q) ** 2 / 2
 
 
 EFFECT = RackPresliding()
