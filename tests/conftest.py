@@ -15,7 +15,8 @@ REPO_ROOT = Path(__file__).resolve().parents[1]
 
 def pytest_collection_modifyitems(config, items):
     """The modules marked slow first, and the real SLURM run first of all (it mostly waits on the cluster's
-    polling): the test run's workers take modules in this order (xdist's loadscope), so the long ones start
+    polling): the test run's workers take modules in this order (xdist's loadscope with --no-loadscope-reorder,
+    pyproject.toml; by default loadscope would order modules by their number of tests), so the long ones start
     while short ones remain to fill the other worker, and the workers finish together (longest first)."""
     def rank(item):
         if item.get_closest_marker("slurm"):

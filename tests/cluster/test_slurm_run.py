@@ -93,9 +93,11 @@ def _point_the_profile_at_the_test_cluster(work: Path, cpus: int, memory_mb: int
     limits["cpus_per_task"] = min(int(limits.get("cpus_per_task", cpus)), cpus)
     limits["mem_mb"] = min(int(limits.get("mem_mb", memory_mb)), memory_mb)
     # slurm.conf.in keeps a finished job in squeue for MinJobAge = 600 s, well above the plugin's threshold
-    # (3 x the first check's delay); a first check after 2 s instead of 40 keeps the run short.
+    # (3 x the first check's delay). The plugin checks first after this delay, then 10 s later than the time before
+    # until a job has finished: each of the run's three jobs (4-8 s) is seen done at the second check, 1 + 11 s
+    # after its submission with a first check after 1 s (2 + 12 s after 2 s, 40 + 50 s after the default 40 s).
     profile["slurm-status-command"] = "squeue"
-    profile["slurm-init-seconds-before-status-checks"] = 2
+    profile["slurm-init-seconds-before-status-checks"] = 1
     path.write_text(yaml.safe_dump(profile, sort_keys=False), encoding="utf-8")
 
 

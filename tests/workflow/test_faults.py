@@ -236,14 +236,39 @@ def test_a_manifest_is_trusted_only_if_its_cache_entry_exists_and_matches(tmp_pa
     key = model_key(resolve_effects(None))
     manifest = tmp_path / "full.json"
     manifest.write_text(json.dumps({"key": key}), "utf-8")
-    assert "is missing or fails its SHA-256 check" in manifest_problem(manifest, None)
+    assert "is missing or fails its SHA-256 check" in manifest_problem(manifest, key)
     entry = tmp_path / "cache" / key
     entry.mkdir(parents=True)
     (entry / "model.c").write_text("int f(void) { return 1; }\n", "utf-8")
     (entry / "model.so").write_bytes(b"\x7fELF library")
     sums = {name: _sha256(entry / name) for name in ("model.c", "model.so")}
     (entry / "model.json").write_text(json.dumps({"sha256": sums}), "utf-8")
-    assert manifest_problem(manifest, None) is None
+    assert manifest_problem(manifest, key) is None
     (entry / "model.so").write_bytes(b"\x7fELF replaced")
-    assert "is missing or fails its SHA-256 check" in manifest_problem(manifest, None)
-    assert "but the model's sources now key it" in manifest_problem(manifest, "-rack_friction")
+    assert "is missing or fails its SHA-256 check" in manifest_problem(manifest, key)
+    other = model_key(resolve_effects("-rack_friction"))
+    assert "but the model's sources now key it" in manifest_problem(manifest, other)
+
+
+def test_an_output_is_read_again_only_when_its_size_or_time_changed(tmp_path, monkeypatch):
+    """check_outputs reads a file it found sound before only if its size or modification time changed since: an
+    unchanged file is not read, a truncated one is read and removed, and one rewritten with the same size (a new
+    modification time) is read again."""
+    import parksteer.outputs as outputs
+
+    table = tmp_path / "results" / "table.csv"
+    table.parent.mkdir()
+    table.write_text("a,b\n1,2\n3,4\n", "utf-8")
+    read = []
+    real = outputs.content_problem
+    monkeypatch.setattr(outputs, "content_problem", lambda path: read.append(path.name) or real(path))
+    assert outputs.check_outputs({}, tmp_path) == [] and read == ["table.csv"]
+    assert outputs.check_outputs({}, tmp_path) == [] and read == ["table.csv"]
+    stat = table.stat()
+    table.write_text("a,b\n5,6\n7,8\n", "utf-8")
+    os.utime(table, ns=(stat.st_atime_ns, stat.st_mtime_ns + 1_000_000))
+    assert outputs.check_outputs({}, tmp_path) == [] and read == ["table.csv"] * 2
+    table.write_text("a,b\n5,6\n7,", "utf-8")
+    assert outputs.check_outputs({}, tmp_path) == [
+        "removed results/table.csv: does not end with a newline (truncated); it is rebuilt"]
+    assert not table.exists() and read == ["table.csv"] * 3

@@ -10,6 +10,7 @@ writes no metadata), so the copy is up to date again for the next test without a
 
 from __future__ import annotations
 
+import json
 import os
 import re
 import subprocess
@@ -17,6 +18,7 @@ import sys
 from pathlib import Path
 
 import pytest
+import yaml
 
 pytestmark = pytest.mark.slow
 
@@ -111,3 +113,31 @@ def test_a_design_entry_reruns_what_it_affects(up_to_date_copy, tmp_path):
     label.write_text("variants:\n  no_friction: {model: no_friction, surface: ground, label: lifting alone}\n",
                      encoding="utf-8")
     assert _planned(up_to_date_copy, "--configfile", str(label)) == {"model_figure": 1, "paper": 1, "all": 1}
+
+
+def test_the_plan_is_recomputed_when_the_checkout_changes(up_to_date_copy, edit):
+    """The values the rules take from the package (parksteer.plan) are kept between runs under a fingerprint of
+    the checkout: after an edit of a package module the next run keeps them under the new fingerprint, and what it
+    keeps is what the package computes afresh for this checkout."""
+    from parksteer.plan import diagnosis, fingerprint
+
+    def cached():
+        return json.loads((up_to_date_copy / ".snakemake" / "parksteer-plan.json").read_text("utf-8"))
+
+    before = json.loads(json.dumps(fingerprint(up_to_date_copy)))
+    edit(up_to_date_copy / "src" / "parksteer" / "diagnose" / "settings.py")
+    _planned(up_to_date_copy)
+    after = cached()
+    assert after["fingerprint"] != before
+    assert after["fingerprint"] == json.loads(json.dumps(fingerprint(up_to_date_copy)))
+    config = yaml.safe_load((up_to_date_copy / "config" / "config.yaml").read_text("utf-8"))
+    kept = [value for key, value in after["values"].items() if json.loads(key)[0] == "diagnosis"]
+    user_effect = os.path.relpath(up_to_date_copy / "src" / "parksteer" / "examples" / "column_imbalance.py",
+                                  up_to_date_copy)
+    parameters = str(up_to_date_copy / config["parameters"])
+    fresh = diagnosis({key: config[key] for key in ("car", "benchmark", "outclass", "variations")}, parameters,
+                      str(up_to_date_copy / user_effect))
+    assert len(kept) == 1
+    assert {k: v for k, v in kept[0].items() if k != "candidates"} == {
+        k: v for k, v in json.loads(json.dumps(fresh)).items() if k != "candidates"}
+    assert list(kept[0]["candidates"]) == list(fresh["candidates"])

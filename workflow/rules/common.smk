@@ -87,18 +87,23 @@ _IMPORTS_KNOWN = _read_import_cache()
 _IMPORTS_PARSED = {}
 
 
-def save_import_cache():
-    """Write the import lists parsed in this run into IMPORT_CACHE (atomically; a read-only directory is fine)."""
-    if not _IMPORTS_PARSED:
-        return
-    merged = {**_IMPORTS_KNOWN, **_IMPORTS_PARSED}
-    scratch = IMPORT_CACHE.with_name(f"{IMPORT_CACHE.name}.{os.getpid()}")
+def _write_cache(path, data):
+    """Write `data` as JSON into `path` atomically; a read-only directory is fine (the next run recomputes)."""
+    scratch = path.with_name(f"{path.name}.{os.getpid()}")
     try:
-        IMPORT_CACHE.parent.mkdir(exist_ok=True)
-        scratch.write_text(json.dumps(merged, sort_keys=True), encoding="utf-8")
-        os.replace(scratch, IMPORT_CACHE)
+        path.parent.mkdir(exist_ok=True)
+        scratch.write_text(json.dumps(data, sort_keys=True), encoding="utf-8")
+        os.replace(scratch, path)
     except OSError:
-        pass
+        scratch.unlink(missing_ok=True)
+
+
+def save_caches():
+    """Keep what this run parsed (IMPORT_CACHE) and planned (PLAN_CACHE) for the next run."""
+    if _IMPORTS_PARSED:
+        _write_cache(IMPORT_CACHE, {**_IMPORTS_KNOWN, **_IMPORTS_PARSED})
+    if _PLANNED:
+        _write_cache(PLAN_CACHE, {"fingerprint": _PLAN_FINGERPRINT, "values": {**_PLAN_KNOWN, **_PLANNED}})
 
 
 @lru_cache(maxsize=None)
@@ -160,6 +165,52 @@ def script_sources(script):
     return file_sources(SCRIPTS_DIR / f"{script}.py")
 
 
+# --- the plan: what the rules take from the package (parksteer.plan), kept between runs ---------------------
+# Effect sets, case names and cache keys come from code that imports sympy and scipy (about 0.8 s). They are kept
+# in .snakemake/ under a fingerprint of the package, configuration, data and examples (each file's size and
+# modification time) and the Python and sympy in use; a value is recomputed when any of these, or a file its
+# call names (`files`), changed. A missing or unreadable cache is rebuilt.
+PLAN_CACHE = Path(".snakemake") / "parksteer-plan.json"
+
+
+def _read_plan_cache():
+    from parksteer.plan import fingerprint
+
+    current = json.loads(json.dumps(fingerprint(WORKFLOW_DIR.parent)))  # lists, as read back from the cache
+    try:
+        cached = json.loads(PLAN_CACHE.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return current, {}
+    if not isinstance(cached, dict) or cached.get("fingerprint") != current or not isinstance(cached.get("values"), dict):
+        return current, {}
+    return current, cached["values"]
+
+
+_PLAN_FINGERPRINT, _PLAN_KNOWN = _read_plan_cache()
+_PLANNED = {}
+
+
+def planned(function, *args, files=()):
+    """parksteer.plan.<function>(*args), from the plan cache when nothing it depends on changed."""
+    stamps = []
+    for name in files:
+        try:
+            stat = os.stat(name)
+            stamps.append([str(name), stat.st_size, stat.st_mtime_ns])
+        except OSError:
+            stamps.append([str(name), None])
+    key = json.dumps([function, args, stamps], sort_keys=True)
+    if key in _PLANNED:
+        return _PLANNED[key]
+    if key in _PLAN_KNOWN:
+        return _PLAN_KNOWN[key]
+    import parksteer.plan
+
+    value = json.loads(json.dumps(getattr(parksteer.plan, function)(*args)))
+    _PLANNED[key] = value
+    return value
+
+
 def case_batches(prefix, names, per_job):
     """The cases `names` in jobs of at most `per_job` each, dealt in turn (so that a job mixes costly and cheap
     cases): {job id: its case names}. A job pays a process start and the package's imports once for its cases."""
@@ -171,11 +222,8 @@ def case_batches(prefix, names, per_job):
 def case_outputs(folder, names, batches, suffix):
     """The `suffix` file (truth or diagnosis) of each case of `names`, in its job's folder (where run_batch puts
     it: parksteer.diagnose.benchmark.case_files), in the order of `names`."""
-    from parksteer.diagnose.benchmark import case_files
-
-    part = {"truth": 1, "diagnosis": 2}[suffix]
     job_of = {name: batch for batch, members in batches.items() for name in members}
-    return [str(case_files(f"{folder}/{job_of[name]}", name)[part]) for name in names]
+    return [planned("case_file", f"{folder}/{job_of[name]}", name, suffix) for name in names]
 
 
 def benchmark_file(rule, *wildcards):
@@ -186,17 +234,17 @@ def benchmark_file(rule, *wildcards):
 
 # --- compiled models: every named effect set the pipeline needs, derived once by rule derive ----------------
 MODEL_SETS = {}  # name -> effects spec
+MODEL_KEYS = {}  # name -> the model cache key its effect set has now
 _MODEL_NAMES = {}  # the resolved effect names -> the name first registered for them
 
 
 def model_manifest(name, spec):
     """Register the effect set `spec` as `name` (or under the name of an identical set registered before) and
     return the path of its manifest, results/model/<name>.json, which rule derive writes."""
-    from parksteer.model.symbolic.components import resolve_effects
-
-    effects = tuple(e.name for e in resolve_effects(spec))
-    name = _MODEL_NAMES.setdefault(effects, name)
+    resolved = planned("model_set", spec, files=effect_files(spec))
+    name = _MODEL_NAMES.setdefault(tuple(resolved["effects"]), name)
     MODEL_SETS.setdefault(name, spec)
+    MODEL_KEYS.setdefault(name, resolved["key"])
     return f"results/model/{name}.json"
 
 
@@ -227,5 +275,5 @@ def check_outputs():
     (parksteer.outputs.check_outputs), saying in one line each what was removed and why."""
     from parksteer.outputs import check_outputs as check
 
-    for line in check(MODEL_SETS):
+    for line in check(MODEL_KEYS):
         print(f"parksteer: {line}", file=sys.stderr)

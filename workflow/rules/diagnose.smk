@@ -10,30 +10,23 @@
 # diagnosis model, scored against the physically closest candidate. diag_variation_batch and diag_variations are
 # the variation benchmark (config["variations"]): records of other hands, loggers and drives, with nothing or a
 # library effect hidden, scored against the targets of parksteer.diagnose.variations.
-from parksteer.diagnose.benchmark import case_names as _bench_case_names
-from parksteer.diagnose.candidates import candidate_models
-from parksteer.parameters import load_parameters as _load_parameters
-from parksteer.diagnose.outclass import case_names as _outclass_case_names
-from parksteer.diagnose.variations import VariationDesign, case_names as _variation_case_names
-from parksteer.synthetic.datasets import BenchmarkDesign, CarDesign, OutclassDesign, file_name as _diag_file_name
-
 DIAG_USER_EFFECT = os.path.relpath(PACKAGE_DIR / "examples" / "column_imbalance.py")
-DIAG_MODELS = [
-    model_manifest(name, spec) for name, spec in candidate_models(None, (DIAG_USER_EFFECT,)).items()
-]
-DIAG_CAR = CarDesign.from_config(config["car"], config["benchmark"]["perturbation"])
-DIAG_BENCH = BenchmarkDesign.from_config(config["benchmark"])
-DIAG_CAR_FILES = [f"results/diagnose/car/{_diag_file_name(c, s)}" for c, s in DIAG_CAR.files]
-DIAG_BENCH_CASES = _bench_case_names(DIAG_BENCH, _load_parameters(PARAMETERS))
-DIAG_BENCH_FILES = [_diag_file_name(c, s) for c, s in DIAG_BENCH.files]
-DIAG_OUTCLASS = OutclassDesign.from_config(config["outclass"], config["benchmark"])
-DIAG_OUTCLASS_CASES = _outclass_case_names(DIAG_OUTCLASS, _load_parameters(PARAMETERS))
-DIAG_OUTCLASS_FILES = [_diag_file_name(c, s) for c, s in DIAG_OUTCLASS.files]
+# candidate model specs, the car data set's files, the three benchmarks' case names (parksteer.plan.diagnosis)
+DIAG_PLAN = planned(
+    "diagnosis",
+    {key: config[key] for key in ("car", "benchmark", "outclass", "variations")},
+    PARAMETERS,
+    DIAG_USER_EFFECT,
+    files=[PARAMETERS],
+)
+DIAG_MODELS = [model_manifest(name, spec) for name, spec in DIAG_PLAN["candidates"].items()]
+DIAG_CAR_FILES = [f"results/diagnose/car/{name}" for name in DIAG_PLAN["car_files"]]
+DIAG_BENCH_CASES = DIAG_PLAN["bench_cases"]
+DIAG_OUTCLASS_CASES = DIAG_PLAN["outclass_cases"]
 # the truth generator's models: the base model with each rival (none of them a candidate)
-DIAG_OUTCLASS_MODELS = [model_manifest(f"with_{rival}", f"+{rival}") for rival in DIAG_OUTCLASS.rivals]
+DIAG_OUTCLASS_MODELS = [model_manifest(f"with_{rival}", f"+{rival}") for rival in DIAG_PLAN["outclass_rivals"]]
 FIGURES["diag_outclass"] = ["figures/diag_outclass.svg", "figures/diag_outclass.csv"]
-DIAG_VARIATIONS = VariationDesign.from_config(config["variations"], config["benchmark"])
-DIAG_VARIATION_CASES = _variation_case_names(DIAG_VARIATIONS)
+DIAG_VARIATION_CASES = DIAG_PLAN["variation_cases"]
 FIGURES["diag_variations"] = ["figures/diag_variations.svg", "figures/diag_variations.csv"]
 DIAG_PER_JOB = int(config.get("diagnosis_cases_per_job", 6))
 DIAG_BENCH_BATCHES = case_batches("bench_", DIAG_BENCH_CASES, DIAG_PER_JOB)

@@ -5,30 +5,24 @@
 # unchanged on a cluster (workflow/profiles/slurm). Each batch job reads the compiled model of its effect sets
 # ("free", and "braked" when the sweep simulates braked wheels) from the cache, where rule derive puts it, and
 # never derives; sweep_<name> gathers the table, the key numbers and the torque maps.
-from parksteer.parameters import load_parameters
 from parksteer.errors import UsageError
-from parksteer.sweep import load_sweep
 from parksteer.sweep.declaration import DEFAULT_BATCH_SIZE
 
 SWEEP_BATCH_SIZE = int(config.get("sweep_batch_size", DEFAULT_BATCH_SIZE))
+SWEEP_FILE = config.get("sweep", "config/sweeps/design.yaml")
+SWEEP_FULL = bool(config.get("sweep_full", False))
 # A bad declaration (empty axis, unknown key or effect, a value out of its bounds, a missing file) is refused
 # here, while the DAG is built, with one line naming the file and the key.
 try:
-    SWEEP = load_sweep(
-        config.get("sweep", "config/sweeps/design.yaml"),
-        load_parameters(PARAMETERS),
-        full=bool(config.get("sweep_full", False)),
-    )
-    SWEEP_BATCHES = SWEEP.batches(SWEEP_BATCH_SIZE)
+    SWEEP = planned("sweep", SWEEP_FILE, PARAMETERS, SWEEP_FULL, SWEEP_BATCH_SIZE, files=[SWEEP_FILE, PARAMETERS])
     SWEEP_MODEL_MANIFESTS = [
-        model_manifest(f"sweep_{SWEEP.name}_{variant}", effects) for variant, effects in SWEEP.model_sets.items()
+        model_manifest(f"sweep_{SWEEP['name']}_{variant}", effects) for variant, effects in SWEEP["model_sets"].items()
     ]
 except UsageError as error:  # SweepError is one
     print(f"parksteer: error: {error}", file=sys.stderr)
     sys.exit(2)
-SWEEP_BATCH_FILES = expand(
-    "results/sweeps/{sweep}/batches/{batch}.json", sweep=SWEEP.name, batch=sorted(SWEEP_BATCHES)
-)
+SWEEP_NAME = SWEEP["name"]
+SWEEP_BATCH_FILES = expand("results/sweeps/{sweep}/batches/{batch}.json", sweep=SWEEP_NAME, batch=SWEEP["batches"])
 
 
 # A batch's id hashes its points' ids and each point's id hashes what it simulates; the points' values are a
@@ -42,9 +36,9 @@ rule sweep_batch:
     output:
         batch="results/sweeps/{sweep}/batches/{batch}.json",
     params:
-        spec=lambda wildcards: SWEEP.batch_spec(wildcards.batch, SWEEP_BATCH_SIZE),
+        spec=lambda wildcards: SWEEP["batches"][wildcards.batch],
     wildcard_constraints:
-        sweep=SWEEP.name,
+        sweep=SWEEP_NAME,
         batch="[0-9a-f]{10}",
     log:
         "logs/sweep_batch/{sweep}/{batch}.log",
@@ -58,22 +52,22 @@ rule sweep_batch:
 
 rule:
     name:
-        f"sweep_{SWEEP.name}"
+        f"sweep_{SWEEP_NAME}"
     input:
-        sweep=str(SWEEP.path),
+        sweep=SWEEP_FILE,
         parameters=PARAMETERS,
         batches=SWEEP_BATCH_FILES,
         code=script_sources("sweep_figure"),
     output:
-        svg=figure_report(f"figures/sweep_{SWEEP.name}.svg", "sweep", caption="sweep"),
-        csv=figure_report(f"figures/sweep_{SWEEP.name}.csv", "sweep", caption="sweep"),
-        json=f"results/sweep_{SWEEP.name}.json",
+        svg=figure_report(f"figures/sweep_{SWEEP_NAME}.svg", "sweep", caption="sweep"),
+        csv=figure_report(f"figures/sweep_{SWEEP_NAME}.csv", "sweep", caption="sweep"),
+        json=f"results/sweep_{SWEEP_NAME}.json",
     params:
-        full=SWEEP.full,
+        full=SWEEP_FULL,
     log:
-        f"logs/sweep_{SWEEP.name}.log",
+        f"logs/sweep_{SWEEP_NAME}.log",
     benchmark:
-        benchmark_file(f"sweep_{SWEEP.name}")
+        benchmark_file(f"sweep_{SWEEP_NAME}")
     conda:
         "../envs/parksteer.yaml"
     script:

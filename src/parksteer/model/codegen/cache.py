@@ -24,12 +24,13 @@ import time
 from functools import lru_cache
 from importlib import metadata
 from pathlib import Path
-
-import sympy
+from typing import TYPE_CHECKING
 
 from ...errors import UsageError
 from ...progress import note
-from ..symbolic.components import Effect
+
+if TYPE_CHECKING:  # the workflow checks cache entries on every run: sympy is imported only to derive or key a model
+    from ..symbolic.components import Effect
 
 CACHE_ENV = "PARKSTEER_MODEL_CACHE"
 FORMAT_VERSION = "1"
@@ -99,6 +100,8 @@ def _symbolic_half_source() -> bytes:
 def model_key(effects: list[Effect]) -> str:
     """Hash of the effect set, the symbolic half's source (symbolic/ and codegen/, Python and C), external effects'
     source, the sympy version and the compiler flags."""
+    import sympy
+
     digest = hashlib.sha256()
     digest.update(f"format {FORMAT_VERSION}\nsympy {sympy.__version__}\ncc {' '.join(COMPILE_FLAGS)}\n".encode())
     digest.update(("effects " + ",".join(e.name for e in effects) + "\n").encode())
@@ -118,6 +121,8 @@ def find_compiler() -> str:
 
 def build_entry(effects: list[Effect], directory: Path) -> dict:
     """Derive, generate and compile the model for `effects` into `directory`; return its description."""
+    import sympy
+
     from ..symbolic.derive import derive
     from .generate import generate
 

@@ -1,0 +1,100 @@
+"""What the workflow takes from the package while it builds its DAG, as plain data (names, paths, cache keys).
+
+The Snakefile needs the effect set of every model it derives, the case names of the three benchmarks, the
+car data set's files and the rivals of the out-of-class benchmark. Computing them imports the effect registry
+(sympy) and the synthetic data sets (scipy): about 0.8 s, paid by every Snakemake run, a run with nothing to do
+included. Each function here returns JSON-ready data, so that workflow/rules/common.smk can keep its results in
+.snakemake/ between runs, keyed by the package's, configuration's and data's files, and import none of this
+when nothing they depend on changed.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+from typing import Any
+
+
+def model_set(spec: Any) -> dict:
+    """The effects spec `spec` resolved: {"effects": the effect names in order, "key": its model cache key}."""
+    from .model.codegen.cache import model_key
+    from .model.symbolic.components import resolve_effects
+
+    effects = resolve_effects(spec)
+    return {"effects": [e.name for e in effects], "key": model_key(effects)}
+
+
+def rival_names() -> list[str]:
+    """The rival effects the rivals figure compares (parksteer.figures.rivals.RIVALS)."""
+    from .figures.rivals import RIVALS
+
+    return list(RIVALS)
+
+
+def case_file(folder: str, name: str, part: str) -> str:
+    """The truth or diagnosis file of benchmark case `name` in its job's `folder`
+    (parksteer.diagnose.benchmark.case_files)."""
+    from .diagnose.benchmark import case_files
+
+    return str(case_files(folder, name)[{"truth": 1, "diagnosis": 2}[part]])
+
+
+def diagnosis(config: dict, parameters_path: str, user_effect: str) -> dict:
+    """What the diagnosis rules need of the configuration's car data set and its three benchmarks:
+    candidate model specs by name, the car data set's files, and the case names (and rivals) of the hidden-effect,
+    out-of-class and variation benchmarks."""
+    from .diagnose.benchmark import case_names as bench_case_names
+    from .diagnose.candidates import candidate_models
+    from .diagnose.outclass import case_names as outclass_case_names
+    from .diagnose.variations import VariationDesign, case_names as variation_case_names
+    from .parameters import load_parameters
+    from .synthetic.datasets import BenchmarkDesign, CarDesign, OutclassDesign, file_name
+
+    params = load_parameters(parameters_path)
+    car = CarDesign.from_config(config["car"], config["benchmark"]["perturbation"])
+    bench = BenchmarkDesign.from_config(config["benchmark"])
+    outclass = OutclassDesign.from_config(config["outclass"], config["benchmark"])
+    variations = VariationDesign.from_config(config["variations"], config["benchmark"])
+    return {
+        "candidates": dict(candidate_models(None, (user_effect,))),
+        "car_files": [file_name(case, surface) for case, surface in car.files],
+        "bench_cases": bench_case_names(bench, params),
+        "outclass_cases": outclass_case_names(outclass, params),
+        "outclass_rivals": list(outclass.rivals),
+        "variation_cases": variation_case_names(variations),
+    }
+
+
+def sweep(path: str, parameters_path: str, full: bool, batch_size: int) -> dict:
+    """The sweep declared in `path`, read, checked and expanded (parksteer.sweep.load_sweep; its braked-wheel
+    check resolves effects): its name, effect sets by variant, and each batch's spec by batch id."""
+    from .parameters import load_parameters
+    from .sweep import load_sweep
+
+    declared = load_sweep(path, load_parameters(parameters_path), full=full)
+    return {
+        "name": declared.name,
+        "model_sets": dict(declared.model_sets),
+        "batches": {batch: declared.batch_spec(batch, batch_size) for batch in sorted(declared.batches(batch_size))},
+    }
+
+
+def fingerprint(root: str | Path) -> list:
+    """What every value here may depend on, cheaply: the size and modification time (ns) of each file of the
+    checkout `root`'s package, configuration, data and examples, and the Python and sympy in use (a model's
+    cache key names the sympy version)."""
+    import importlib.util
+    import sys
+
+    root = Path(root)
+    stamps = []
+    for folder in ("src", "config", "data", "examples"):
+        for directory, subfolders, names in os.walk(root / folder):
+            subfolders[:] = sorted(d for d in subfolders if d != "__pycache__")
+            for name in sorted(names):
+                stat = os.stat(os.path.join(directory, name))
+                stamps.append([os.path.relpath(os.path.join(directory, name), root), stat.st_size, stat.st_mtime_ns])
+    spec = importlib.util.find_spec("sympy")  # located, not imported: its installed version's metadata folder
+    site = Path(spec.origin).parent.parent if spec is not None and spec.origin else None
+    sympy = sorted(p.name for p in site.glob("sympy-*-info")) if site is not None else None
+    return [sys.version, sympy, stamps]
