@@ -88,11 +88,13 @@ _IMPORTS_PARSED = {}
 
 
 def _write_cache(path, data):
-    """Write `data` as JSON into `path` atomically; a read-only directory is fine (the next run recomputes)."""
+    """Write `data` as JSON into `path` atomically; a read-only directory is fine (the next run recomputes). Keys
+    keep their order: a planned value read back must equal the value computed (rule parameters are compared
+    with the previous run's, key order included)."""
     scratch = path.with_name(f"{path.name}.{os.getpid()}")
     try:
         path.parent.mkdir(exist_ok=True)
-        scratch.write_text(json.dumps(data, sort_keys=True), encoding="utf-8")
+        scratch.write_text(json.dumps(data), encoding="utf-8")
         os.replace(scratch, path)
     except OSError:
         scratch.unlink(missing_ok=True)
@@ -168,15 +170,16 @@ def script_sources(script):
 # --- the plan: what the rules take from the package (parksteer.plan), kept between runs ---------------------
 # Effect sets, case names and cache keys come from code that imports sympy and scipy (about 0.8 s). They are kept
 # in .snakemake/ under a fingerprint of the package, configuration, data and examples (each file's size and
-# modification time) and the Python and sympy in use; a value is recomputed when any of these, or a file its
-# call names (`files`), changed. A missing or unreadable cache is rebuilt.
+# modification time), the Python and sympy in use and this file; a value is recomputed when any of these, or a
+# file its call names (`files`), changed. A missing or unreadable cache is rebuilt.
 PLAN_CACHE = Path(".snakemake") / "parksteer-plan.json"
 
 
 def _read_plan_cache():
     from parksteer.plan import fingerprint
 
-    current = json.loads(json.dumps(fingerprint(WORKFLOW_DIR.parent)))  # lists, as read back from the cache
+    here = os.stat(Path(workflow.current_basedir) / "common.smk")  # this file writes and reads the cache
+    current = json.loads(json.dumps([fingerprint(WORKFLOW_DIR.parent), [here.st_size, here.st_mtime_ns]]))
     try:
         cached = json.loads(PLAN_CACHE.read_text(encoding="utf-8"))
     except (OSError, ValueError):
