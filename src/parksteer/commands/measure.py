@@ -62,6 +62,9 @@ def register(sub) -> None:
     p.add_argument("--angle", action="store_true",
                    help="fit the measured handwheel angle beside the torque, in files that have one beside a measured "
                         "rack (the column stiffness and Hooke joint phase are then calibrated, a rack lash observable)")
+    p.add_argument("--torque-lag", action="store_true",
+                   help="search each file for a lag of the torque channel behind the rack channel (up to 40 ms) and "
+                        "replay the model at the instants the torque was sampled (for a logger known to delay it)")
     p.set_defaults(func=_diagnose)
 
 
@@ -136,6 +139,8 @@ def _diagnose(args) -> int:
         raise UsageError(f"--jobs {args.jobs}: give at least 1")
     workers = args.jobs if args.jobs is not None else available_workers()
     settings = DEFAULT_SETTINGS
+    if args.torque_lag:
+        settings = dataclasses.replace(settings, torque_lag_fitted=True)
     if args.angle:
         settings = dataclasses.replace(settings, use_handwheel_angle=True)
         with_angle = [f.label for f in files if f.angle_rad is not None]

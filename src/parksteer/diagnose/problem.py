@@ -82,10 +82,19 @@ class FileData:
     uses_angle: bool = False
     replay_uncertainty_rad: np.ndarray | None = None
     replay_draws_rad: np.ndarray | None = None
+    # how far the torque channel runs behind the rack's (s), estimated by the diagnosis (select.estimate_lags)
+    torque_lag_s: float = 0.0
+    torque_lag_gain: float = 0.0  # what the latest lag search's best lag took off the weighted residual sum of squares
 
     @property
     def time_s(self) -> np.ndarray:
         return self.measurement.time_s
+
+    @property
+    def replay_time_s(self) -> np.ndarray:
+        """The instants the model is replayed at to predict the samples: the torque sample at t_i was taken by
+        the sensor at t_i - torque_lag_s on the rack's clock."""
+        return self.measurement.time_s - self.torque_lag_s
 
     @property
     def rack_m(self) -> np.ndarray:
@@ -215,12 +224,17 @@ class Problem:
         key = (effect_key(effects), index)
         if key not in self._replays:
             f = self.files[index]
-            self._replays[key] = Replay(list(effects), f.case, f.surface, self.params, f.rack, f.time_s)
+            self._replays[key] = Replay(list(effects), f.case, f.surface, self.params, f.rack, f.replay_time_s)
         return self._replays[key]
 
     @property
     def evaluations(self) -> int:
         return sum(r.evaluations for r in self._replays.values()) + self.extra_evaluations
+
+    def forget_replays(self) -> None:
+        """Drop the kept replays (their instants changed: a file's torque lag), keeping their count of solves."""
+        self.extra_evaluations += sum(r.evaluations for r in self._replays.values())
+        self._replays.clear()
 
     @property
     def parallel_files(self) -> bool:

@@ -62,6 +62,12 @@ class Replay:
         return Replay(self.effects, self.case, self.surface, self.params, rack, self.time_s,
                       dict(self.base_overrides), runs=self._runs)
 
+    def at_times(self, time_s: np.ndarray) -> Replay:
+        """The same model, case, surface and rack replayed at other instants (a lagged channel's): the prepared
+        runs are shared, not made again."""
+        return Replay(self.effects, self.case, self.surface, self.params, self.rack, time_s,
+                      dict(self.base_overrides), runs=self._runs)
+
     def _prepared(self, overrides: dict[str, float]) -> PreparedRun:
         key = tuple(sorted(overrides.items()))
         if key not in self._runs:

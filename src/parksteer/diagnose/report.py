@@ -104,6 +104,7 @@ def diagnosis_dict(diagnosis: Diagnosis) -> dict:
             "noise_floor": f.noise.as_dict(),
             "replay_uncertainty_rms_Nm": float(np.sqrt(np.mean(delta**2))) if delta is not None else 0.0,
             "rack_smoothing": f.rack.summary(),
+            "torque_lag_s": f.torque_lag_s,
         })
         if f.uses_angle:
             angle_delta = f.replay_uncertainty_rad

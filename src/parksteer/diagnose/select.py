@@ -53,6 +53,7 @@ import numpy as np
 
 from ..model.symbolic.components import Effect, discover_effects, resolve_effects
 from ..model.numeric.values import SURFACES
+from ..errors import SolverError
 from ..parameters import Parameters
 from .settings import DEFAULT_SETTINGS, DiagnosisSettings
 from .calibrate import Fit, FitParameter, calibrate, least_squares
@@ -299,6 +300,47 @@ def _in_workers(problem: Problem, function, items: list, by_candidate: bool) -> 
     return [result for result, _ in out]
 
 
+def estimate_torque_lags(problem: Problem, effects: list[Effect], overrides: dict[str, float],
+                         settings: DiagnosisSettings = DEFAULT_SETTINGS) -> list[float]:
+    """Each file's torque channel lag behind its rack channel (s), found on the model `effects` with `overrides`
+    (the calibrated base) and set on the file where it pays for itself (with settings.torque_lag_fitted: a grid search
+    and a parabola through its best three, kept if it lowers the file's weighted residual sum of squares by more
+    than log(samples)); returns the lags kept (0 where none). A file fitted on its angle keeps none."""
+    if not settings.torque_lag_fitted or settings.torque_lag_max_s <= 0.0:
+        return [f.torque_lag_s for f in problem.files]
+    lags = np.arange(-settings.torque_lag_max_s, settings.torque_lag_max_s + 0.5 * settings.torque_lag_step_s,
+                     settings.torque_lag_step_s)
+    for i, f in enumerate(problem.files):
+        if f.uses_angle:
+            continue
+        replay = problem.replay(effects, i)
+        sigma = f.sigma_Nm
+
+        def rss(lag: float) -> float:
+            try:
+                torque = replay.at_times(f.time_s - f.torque_lag_s - lag).torque(overrides)
+            except SolverError:  # the solver gave up at these instants: not a lag to keep
+                return math.inf
+            return float(np.sum(((f.torque_Nm - torque) / sigma) ** 2))
+
+        values = np.array([rss(lag) for lag in lags])
+        k = int(np.argmin(values))
+        best, best_rss = float(lags[k]), float(values[k])
+        if 0 < k < len(lags) - 1 and np.all(np.isfinite(values[k - 1 : k + 2])):
+            left, centre, right = values[k - 1 : k + 2]
+            curvature = left - 2.0 * centre + right
+            if curvature > 0.0:
+                vertex = best + 0.5 * settings.torque_lag_step_s * (left - right) / curvature
+                at_vertex = rss(vertex)
+                if at_vertex < best_rss:
+                    best, best_rss = vertex, at_vertex
+        at_zero = values[int(np.argmin(np.abs(lags)))]
+        f.torque_lag_gain = float(at_zero - best_rss)
+        if at_zero - best_rss > math.log(f.n):
+            f.torque_lag_s = float(f.torque_lag_s + best)
+    return [f.torque_lag_s for f in problem.files]
+
+
 def diagnose(files: list[FileData], params: Parameters, effects=None, registry: dict[str, Effect] | None = None,
              strengths: dict[str, float] | None = None, start: dict[str, float] | None = None,
              settings: DiagnosisSettings = DEFAULT_SETTINGS, workers: int = 1, quiet: bool = True) -> Diagnosis:
@@ -348,6 +390,22 @@ def _diagnose(problem: Problem, effects, registry, strengths, start, settings: D
 
     calibration = calibrate(problem, base, strengths=strengths, start=start, settings=settings,
                             announce=lambda keys: progress("calibrating " + ", ".join(keys)))
+    # A lag and the calibrated parameters each absorb part of the other's signature: search again on the new
+    # calibration, until no file's lag moves by a search step.
+    for _ in range(settings.torque_lag_rounds):
+        before = [f.torque_lag_s for f in files]
+        lags = estimate_torque_lags(problem, base, calibration.overrides, settings)
+        if max(abs(a - b) for a, b in zip(lags, before)) < settings.torque_lag_step_s:
+            break
+        progress("torque channel behind the rack's: " + ", ".join(
+            f"{f.label} {1000.0 * f.torque_lag_s:.1f} ms" for f in files if f.torque_lag_s)
+                 + "; replay uncertainty and calibration again at the lagged instants")
+        problem.forget_replays()
+        for f in files:
+            f.replay_uncertainty_Nm = f.replay_draws_Nm = None
+        problem.estimate_replay_uncertainty(base, start or {}, settings.replay_ensemble_draws,
+                                            settings.replay_ensemble_seed)
+        calibration = calibrate(problem, base, strengths=strengths, start=start, settings=settings)
     lap("calibration")
 
     testable, untestable = candidate_effects(base, registry)

@@ -40,6 +40,27 @@ class DiagnosisSettings:
     # constant per file, fitted in closed form (the mean of measured minus replayed angle) at every replay.
     angle_offset_fitted: bool = True
 
+    # --- the torque channel's lag (parksteer.diagnose.select.estimate_torque_lags) ------------------------------
+    # A logger's torque channel may run behind its rack channel (a sensor's or an amplifier's filter delay,
+    # channels converted in turn): the torque sample stamped t_i was taken at t_i - lag on the rack's clock. The
+    # base model cannot follow that: 10 ms at 50 Hz moves each friction reversal by half a sample, which left
+    # the variation benchmark's lagged nulls at 1.1-1.3 noise floors and their calibrated intervals off the truth
+    # (1 of 3 covering). With ``torque_lag_fitted`` (``parksteer diagnose --torque-lag``), after the base
+    # calibration each file's lag is searched for over +-torque_lag_max_s in steps of torque_lag_step_s (then a
+    # parabola through the best three) on the calibrated base's replay at the lagged instants, and kept where it
+    # lowers the file's weighted residual sum of squares by more than log(samples) (the BIC's price of one more
+    # parameter); the replay uncertainty and the calibration are then made again at the lagged instants, and the
+    # search repeated on the new calibration (at most torque_lag_rounds times) until no lag moves by a step. A
+    # file fitted on its angle too keeps no lag (both channels are replayed at the same instants).
+    # Off unless asked for: at 50 Hz a lag and an effect at the reversals (a stiction's breakaway) look alike
+    # over a record's three reversals, and a lag searched on the base model takes up part of that effect (a
+    # hidden rack stiction gave a 4-5 ms lag on a logger without one). Searched on every record of the variation
+    # grid, the lag made the lagged nulls adequate but cost coverage elsewhere (611 of 746 intervals against 641).
+    torque_lag_fitted: bool = False
+    torque_lag_max_s: float = 0.04
+    torque_lag_step_s: float = 0.002
+    torque_lag_rounds: int = 3
+
     # --- calibration (parksteer.diagnose.calibrate) -----------------------------------------------------------
     # The base model's uncertain parameters, fitted before any candidate is considered, with the
     # relative step of their finite-difference sensitivities and their plausible range (a factor

@@ -234,7 +234,10 @@ def run_case(parameters_path, design: VariationDesign, name: str, folder, truth_
     records = [(load_case, surface, variation_record(params, hand, logger, load_case, surface, overrides=overrides,
                                                       effects=f"+{case.hidden}" if case.hidden else None))
                for load_case, surface, hand, logger in files]
-    settings = replace(DEFAULT_SETTINGS, use_handwheel_angle=True) if case.variation.uses_angle else DEFAULT_SETTINGS
+    # as a user would: the angle fitted where the logger has one, the torque lag searched for where the logger is
+    # known to delay its torque channel (the lag itself is found by the diagnosis)
+    settings = replace(DEFAULT_SETTINGS, use_handwheel_angle=case.variation.uses_angle,
+                       torque_lag_fitted=case.variation.logger.torque_lag_s > 0.0)
     return diagnose_written(params, records, folder, truth, truth_path, diagnosis_path, start, settings)
 
 
@@ -282,6 +285,8 @@ def outcome(truth: dict, result: dict) -> dict:
         "false_alarm": bool(hidden is None and missing),
         "hidden_confounded_with": confounded or "",
         "torque_lag_s": variation_by_name(truth["variation"]).logger.torque_lag_s,
+        # the lag the diagnosis found (the mean over the files: one logger)
+        "torque_lag_found_s": float(np.mean([f.get("torque_lag_s", 0.0) for f in result.get("files", [])] or [0.0])),
         "calibrated_over_floor": result["statistics"]["calibrated"]["weighted_rms_Nm"] / floor,
         "after_over_floor": after["weighted_rms_Nm"] / floor if after else None,
         "covered": sum(covered.values()),
@@ -354,9 +359,9 @@ def summarise(rows: list[dict], design: VariationDesign | None = None) -> dict:
             "observable_fraction": spread(kept),
         }
     total = counts(rows)
-    # Where the misses come from: records whose torque channel lags the rack (a logger error the diagnosis has no
-    # term for), records whose hidden effect went unnamed while the diagnosis reported it confounded with a
-    # calibrated parameter, and the rest.
+    # Where the misses come from: records whose torque channel lags the rack (a logger error the diagnosis
+    # estimates, select.estimate_torque_lags), records whose hidden effect went unnamed while the diagnosis
+    # reported it confounded with a calibrated parameter, and the rest.
     lagged = [r for r in rows if r.get("torque_lag_s", 0.0) > 0.0]
     flagged = [r for r in rows if r not in lagged and r["hidden"] != "nothing" and not r["named"]
                and r.get("hidden_confounded_with")]
@@ -369,6 +374,15 @@ def summarise(rows: list[dict], design: VariationDesign | None = None) -> dict:
     sources["named_where_not_flagged_confounded"] = [sum(r["named"] for r in unflagged), len(unflagged)]
     targets = {key: {"value": _rate(k, n), "count": [k, n], "target": targets_of[key],
                      "met": bool(n and k / n >= targets_of[key])} for key, (k, n) in total.items()}
+    # the lags found behind each lagged logger (a filter before the converter adds its own delay to the lag), and
+    # where the channels are in step (searched only where the logger is known to lag: run_case)
+    lags_found = {name: {"true_s": variation_by_name(name).logger.torque_lag_s,
+                         "nulls_s": spread([r.get("torque_lag_found_s", 0.0) for r in lagged
+                                            if r["variation"] == name and r["hidden"] == "nothing"]),
+                         "hidden_s": spread([r.get("torque_lag_found_s", 0.0) for r in lagged
+                                             if r["variation"] == name and r["hidden"] != "nothing"])}
+                  for name in dict.fromkeys(r["variation"] for r in lagged)}
+    in_step = [abs(r.get("torque_lag_found_s", 0.0)) for r in rows if r not in lagged]
     null_floors = [r["calibrated_over_floor"] for r in rows if r["hidden"] == "nothing"]
     named_after = [r["after_over_floor"] for r in rows if r["named"] and r["after_over_floor"] is not None]
     walls = [r["wall_s"] for r in rows if r.get("wall_s") is not None]
@@ -380,6 +394,8 @@ def summarise(rows: list[dict], design: VariationDesign | None = None) -> dict:
         "named_min_steps": NAMED_MIN_STEPS,
         "by_hidden": by_hidden,
         "sources": sources,
+        "torque_lag_found_s": {"by_variation": lags_found, "in_step_max": max(in_step) if in_step else None,
+                               "in_step_nonzero": sum(x > 0.0 for x in in_step), "in_step_records": len(in_step)},
         "variations": table,
         "null_over_floor": {"min": min(null_floors), "max": max(null_floors)} if null_floors else None,
         "named_after_over_floor": {"min": min(named_after), "max": max(named_after)} if named_after else None,
