@@ -374,8 +374,8 @@ def summarise(rows: list[dict], design: VariationDesign | None = None) -> dict:
     sources["named_where_not_flagged_confounded"] = [sum(r["named"] for r in unflagged), len(unflagged)]
     targets = {key: {"value": _rate(k, n), "count": [k, n], "target": targets_of[key],
                      "met": bool(n and k / n >= targets_of[key])} for key, (k, n) in total.items()}
-    # the lags found behind each lagged logger (a filter before the converter adds its own delay to the lag), and
-    # where the channels are in step (searched only where the logger is known to lag: run_case)
+    # the lags found behind each lagged logger, on its nulls and where an effect was hidden too, and where the
+    # channels are in step (searched only where the logger is known to lag: run_case)
     lags_found = {name: {"true_s": variation_by_name(name).logger.torque_lag_s,
                          "nulls_s": spread([r.get("torque_lag_found_s", 0.0) for r in lagged
                                             if r["variation"] == name and r["hidden"] == "nothing"]),
