@@ -47,7 +47,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -358,8 +358,26 @@ def diagnose(files: list[FileData], params: Parameters, effects=None, registry: 
         f.uses_angle = settings.use_handwheel_angle and f.angle_rad is not None
         f.replay_uncertainty_rad = f.replay_draws_rad = None
     problem = Problem(files, params, workers=max(int(workers), 1), settings=settings)
+    progress = Progress(quiet)
     try:
-        return _diagnose(problem, effects, registry, strengths, start, settings, Progress(quiet))
+        result = _diagnose(problem, effects, registry, strengths, start, settings, progress)
+        if settings.torque_lag_fitted and result.verdict == "missing":
+            # The lag was searched on the base model, which lacks the named effect: an effect at the reversals (a
+            # stiction's breakaway) pulls it off. Searched again with the effect, a lag that moves by a step or
+            # more is kept and the diagnosis made again with the lags held.
+            before = [f.torque_lag_s for f in files]
+            lags = estimate_torque_lags(problem, result.best.signature.model, result.best.refit.overrides, settings)
+            if max(abs(a - b) for a, b in zip(lags, before)) >= settings.torque_lag_step_s:
+                progress(f"torque lag again with {result.best.name}: " + ", ".join(
+                    f"{f.label} {1000.0 * f.torque_lag_s:.1f} ms" for f in files) + "; diagnosing again")
+                problem.forget_replays()
+                for f in files:
+                    f.replay_uncertainty_Nm = f.replay_draws_Nm = None
+                held = replace(settings, torque_lag_fitted=False)
+                problem.settings = held
+                result = _diagnose(problem, effects, registry, strengths, start, held, progress)
+                result.settings = problem.settings = settings
+        return result
     finally:
         problem.close()
 

@@ -50,12 +50,16 @@ class DiagnosisSettings:
     # parabola through the best three) on the calibrated base's replay at the lagged instants, and kept where it
     # lowers the file's weighted residual sum of squares by more than log(samples) (the BIC's price of one more
     # parameter); the replay uncertainty and the calibration are then made again at the lagged instants, and the
-    # search repeated on the new calibration (at most torque_lag_rounds times) until no lag moves by a step. A
-    # file fitted on its angle too keeps no lag (both channels are replayed at the same instants).
+    # search repeated on the new calibration (at most torque_lag_rounds times) until no lag moves by a step.
+    # When the verdict is missing, the lag is searched again on the model with the named effect and, if it moves
+    # by a step, the diagnosis is made again with the lags held. A file fitted on its angle too keeps no lag
+    # (both channels are replayed at the same instants).
     # Off unless asked for: at 50 Hz a lag and an effect at the reversals (a stiction's breakaway) look alike
     # over a record's three reversals, and a lag searched on the base model takes up part of that effect (a
-    # hidden rack stiction gave a 4-5 ms lag on a logger without one). Searched on every record of the variation
-    # grid, the lag made the lagged nulls adequate but cost coverage elsewhere (611 of 746 intervals against 641).
+    # hidden rack stiction gave a 4-5 ms lag on a logger without one, 12.6-17.5 ms on one 10 ms late; searched
+    # again with the named stiction, 10.8-12.3 ms). Searched on every record of the variation grid (without the
+    # second search), the lag made the lagged nulls adequate but cost coverage elsewhere (611 of 746 intervals
+    # against 641).
     torque_lag_fitted: bool = False
     torque_lag_max_s: float = 0.04
     torque_lag_step_s: float = 0.002
