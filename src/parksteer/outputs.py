@@ -27,7 +27,7 @@ from pathlib import Path
 
 from .checksums import integrity_problem
 from .model.codegen.cache import cache_root, clean_stale_scratch, entry_is_sound
-from .tables import ROWS_KEY, remove_stale_temporaries
+from .tables import ROWS_KEY, atomic_path, remove_stale_temporaries
 
 CHECKED_SUFFIXES = (".csv", ".svg", ".json", ".ipynb", ".pdf")
 PROC = Path("/proc")
@@ -162,13 +162,11 @@ def _read_stamps(store: Path) -> dict:
 
 
 def _write_stamps(store: Path, files: dict) -> None:
-    scratch = store.with_name(f"{store.name}.{os.getpid()}")
     try:
-        store.parent.mkdir(exist_ok=True)
-        scratch.write_text(json.dumps({"checker": _stamp(Path(__file__)), "files": files}), encoding="utf-8")
-        os.replace(scratch, store)
+        with atomic_path(store) as scratch:
+            scratch.write_text(json.dumps({"checker": _stamp(Path(__file__)), "files": files}), encoding="utf-8")
     except OSError:  # a read-only folder: every run reads every file
-        scratch.unlink(missing_ok=True)
+        pass
 
 
 def check_outputs(model_keys: Mapping[str, str], root: str | Path = ".") -> list[str]:

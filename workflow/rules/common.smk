@@ -91,13 +91,13 @@ def _write_cache(path, data):
     """Write `data` as JSON into `path` atomically; a read-only directory is fine (the next run recomputes). Keys
     keep their order: a planned value read back must equal the value computed (rule parameters are compared
     with the previous run's, key order included)."""
-    scratch = path.with_name(f"{path.name}.{os.getpid()}")
+    from parksteer.tables import atomic_path
+
     try:
-        path.parent.mkdir(exist_ok=True)
-        scratch.write_text(json.dumps(data), encoding="utf-8")
-        os.replace(scratch, path)
+        with atomic_path(path) as scratch:
+            scratch.write_text(json.dumps(data), encoding="utf-8")
     except OSError:
-        scratch.unlink(missing_ok=True)
+        pass
 
 
 def save_caches():

@@ -82,9 +82,8 @@ class FileData:
     uses_angle: bool = False
     replay_uncertainty_rad: np.ndarray | None = None
     replay_draws_rad: np.ndarray | None = None
-    # how far the torque channel runs behind the rack's (s), estimated by the diagnosis (select.estimate_lags)
+    # how far the torque channel runs behind the rack's (s), estimated by the diagnosis (select.estimate_torque_lags)
     torque_lag_s: float = 0.0
-    torque_lag_gain: float = 0.0  # what the latest lag search's best lag took off the weighted residual sum of squares
 
     @property
     def time_s(self) -> np.ndarray:
@@ -232,9 +231,12 @@ class Problem:
         return sum(r.evaluations for r in self._replays.values()) + self.extra_evaluations
 
     def forget_replays(self) -> None:
-        """Drop the kept replays (their instants changed: a file's torque lag), keeping their count of solves."""
+        """Drop the kept replays and the replay uncertainty estimated from them (their instants changed: a file's
+        torque lag), keeping their count of solves."""
         self.extra_evaluations += sum(r.evaluations for r in self._replays.values())
         self._replays.clear()
+        for f in self.files:
+            f.replay_uncertainty_Nm = f.replay_draws_Nm = None
 
     @property
     def parallel_files(self) -> bool:

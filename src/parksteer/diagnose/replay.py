@@ -59,14 +59,16 @@ class Replay:
     def on_rack(self, rack: SmoothedRack) -> Replay:
         """The same model, case and surface driven by another rack, at the same times: the prepared runs
         (which do not depend on the rack) are shared, not made again."""
-        return Replay(self.effects, self.case, self.surface, self.params, rack, self.time_s,
-                      dict(self.base_overrides), runs=self._runs)
+        return self._sharing(rack, self.time_s)
 
     def at_times(self, time_s: np.ndarray) -> Replay:
         """The same model, case, surface and rack replayed at other instants (a lagged channel's): the prepared
         runs are shared, not made again."""
-        return Replay(self.effects, self.case, self.surface, self.params, self.rack, time_s,
-                      dict(self.base_overrides), runs=self._runs)
+        return self._sharing(self.rack, time_s)
+
+    def _sharing(self, rack: SmoothedRack, time_s: np.ndarray) -> Replay:
+        return Replay(self.effects, self.case, self.surface, self.params, rack, time_s, dict(self.base_overrides),
+                      runs=self._runs)
 
     def _prepared(self, overrides: dict[str, float]) -> PreparedRun:
         key = tuple(sorted(overrides.items()))

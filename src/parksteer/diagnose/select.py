@@ -301,24 +301,25 @@ def _in_workers(problem: Problem, function, items: list, by_candidate: bool) -> 
 
 
 def estimate_torque_lags(problem: Problem, effects: list[Effect], overrides: dict[str, float],
-                         settings: DiagnosisSettings = DEFAULT_SETTINGS) -> list[float]:
-    """Each file's torque channel lag behind its rack channel (s), found on the model `effects` with `overrides`
-    (the calibrated base) and set on the file where it pays for itself (with settings.torque_lag_fitted: a grid search
-    and a parabola through its best three, kept if it lowers the file's weighted residual sum of squares by more
-    than log(samples)); returns the lags kept (0 where none). A file fitted on its angle keeps none."""
+                         settings: DiagnosisSettings = DEFAULT_SETTINGS) -> float:
+    """Search each file's torque channel lag behind its rack channel on the model `effects` with `overrides`
+    (with settings.torque_lag_fitted: a grid search around the file's present lag and a parabola through its best
+    three) and move the file's lag there where that lowers its weighted residual sum of squares by more than
+    log(samples); return the largest move (s). A file fitted on its angle keeps none."""
     if not settings.torque_lag_fitted or settings.torque_lag_max_s <= 0.0:
-        return [f.torque_lag_s for f in problem.files]
+        return 0.0
     lags = np.arange(-settings.torque_lag_max_s, settings.torque_lag_max_s + 0.5 * settings.torque_lag_step_s,
                      settings.torque_lag_step_s)
+    largest = 0.0
     for i, f in enumerate(problem.files):
         if f.uses_angle:
             continue
-        replay = problem.replay(effects, i)
+        replay = problem.replay(effects, i)  # at the file's present replay instants
         sigma = f.sigma_Nm
 
         def rss(lag: float) -> float:
             try:
-                torque = replay.at_times(f.time_s - f.torque_lag_s - lag).torque(overrides)
+                torque = replay.at_times(replay.time_s - lag).torque(overrides)
             except SolverError:  # the solver gave up at these instants: not a lag to keep
                 return math.inf
             return float(np.sum(((f.torque_Nm - torque) / sigma) ** 2))
@@ -335,10 +336,22 @@ def estimate_torque_lags(problem: Problem, effects: list[Effect], overrides: dic
                 if at_vertex < best_rss:
                     best, best_rss = vertex, at_vertex
         at_zero = values[int(np.argmin(np.abs(lags)))]
-        f.torque_lag_gain = float(at_zero - best_rss)
         if at_zero - best_rss > math.log(f.n):
             f.torque_lag_s = float(f.torque_lag_s + best)
-    return [f.torque_lag_s for f in problem.files]
+            largest = max(largest, abs(best))
+    return largest
+
+
+def _lags_moved(problem: Problem, effects: list[Effect], overrides: dict[str, float], settings: DiagnosisSettings,
+                progress: Progress, why: str) -> bool:
+    """Search the lags again on `effects` with `overrides`; if one moved by a search step or more, say so and drop
+    the replays made at the old instants (Problem.forget_replays)."""
+    if estimate_torque_lags(problem, effects, overrides, settings) < settings.torque_lag_step_s:
+        return False
+    progress(f"torque channel behind the rack's{why}: " + ", ".join(
+        f"{f.label} {1000.0 * f.torque_lag_s:.1f} ms" for f in problem.files if f.torque_lag_s))
+    problem.forget_replays()
+    return True
 
 
 def diagnose(files: list[FileData], params: Parameters, effects=None, registry: dict[str, Effect] | None = None,
@@ -361,22 +374,16 @@ def diagnose(files: list[FileData], params: Parameters, effects=None, registry: 
     progress = Progress(quiet)
     try:
         result = _diagnose(problem, effects, registry, strengths, start, settings, progress)
-        if settings.torque_lag_fitted and result.verdict == "missing":
-            # The lag was searched on the base model, which lacks the named effect: an effect at the reversals (a
-            # stiction's breakaway) pulls it off. Searched again with the effect, a lag that moves by a step or
-            # more is kept and the diagnosis made again with the lags held.
-            before = [f.torque_lag_s for f in files]
-            lags = estimate_torque_lags(problem, result.best.signature.model, result.best.refit.overrides, settings)
-            if max(abs(a - b) for a, b in zip(lags, before)) >= settings.torque_lag_step_s:
-                progress(f"torque lag again with {result.best.name}: " + ", ".join(
-                    f"{f.label} {1000.0 * f.torque_lag_s:.1f} ms" for f in files) + "; diagnosing again")
-                problem.forget_replays()
-                for f in files:
-                    f.replay_uncertainty_Nm = f.replay_draws_Nm = None
-                held = replace(settings, torque_lag_fitted=False)
-                problem.settings = held
-                result = _diagnose(problem, effects, registry, strengths, start, held, progress)
-                result.settings = problem.settings = settings
+        # The lag was searched on the base model, which lacks the named effect: an effect at the reversals (a
+        # stiction's breakaway) pulls it off. Searched again with the effect, a lag that moves by a step or more is
+        # kept and the diagnosis made again with the lags held.
+        if settings.torque_lag_fitted and result.verdict == "missing" and _lags_moved(
+                problem, result.best.signature.model, result.best.refit.overrides, settings, progress,
+                f" (again, with {result.best.name}; diagnosing again)"):
+            held = replace(settings, torque_lag_fitted=False)
+            problem.settings = held
+            result = _diagnose(problem, effects, registry, strengths, start, held, progress)
+            result.settings = problem.settings = settings
         return result
     finally:
         problem.close()
@@ -411,16 +418,9 @@ def _diagnose(problem: Problem, effects, registry, strengths, start, settings: D
     # A lag and the calibrated parameters each absorb part of the other's signature: search again on the new
     # calibration, until no file's lag moves by a search step.
     for _ in range(settings.torque_lag_rounds):
-        before = [f.torque_lag_s for f in files]
-        lags = estimate_torque_lags(problem, base, calibration.overrides, settings)
-        if max(abs(a - b) for a, b in zip(lags, before)) < settings.torque_lag_step_s:
+        if not _lags_moved(problem, base, calibration.overrides, settings, progress,
+                           " (replay uncertainty and calibration again at the lagged instants)"):
             break
-        progress("torque channel behind the rack's: " + ", ".join(
-            f"{f.label} {1000.0 * f.torque_lag_s:.1f} ms" for f in files if f.torque_lag_s)
-                 + "; replay uncertainty and calibration again at the lagged instants")
-        problem.forget_replays()
-        for f in files:
-            f.replay_uncertainty_Nm = f.replay_draws_Nm = None
         problem.estimate_replay_uncertainty(base, start or {}, settings.replay_ensemble_draws,
                                             settings.replay_ensemble_seed)
         calibration = calibrate(problem, base, strengths=strengths, start=start, settings=settings)

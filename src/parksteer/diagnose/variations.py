@@ -374,15 +374,14 @@ def summarise(rows: list[dict], design: VariationDesign | None = None) -> dict:
     sources["named_where_not_flagged_confounded"] = [sum(r["named"] for r in unflagged), len(unflagged)]
     targets = {key: {"value": _rate(k, n), "count": [k, n], "target": targets_of[key],
                      "met": bool(n and k / n >= targets_of[key])} for key, (k, n) in total.items()}
-    # the lags found behind each lagged logger, on its nulls and where an effect was hidden too, and where the
-    # channels are in step (searched only where the logger is known to lag: run_case)
+    # the lags found behind each lagged logger, on its nulls and where an effect was hidden too (a lag is searched
+    # only where the logger is known to have one: run_case)
     lags_found = {name: {"true_s": variation_by_name(name).logger.torque_lag_s,
                          "nulls_s": spread([r.get("torque_lag_found_s", 0.0) for r in lagged
                                             if r["variation"] == name and r["hidden"] == "nothing"]),
                          "hidden_s": spread([r.get("torque_lag_found_s", 0.0) for r in lagged
                                              if r["variation"] == name and r["hidden"] != "nothing"])}
                   for name in dict.fromkeys(r["variation"] for r in lagged)}
-    in_step = [abs(r.get("torque_lag_found_s", 0.0)) for r in rows if r not in lagged]
     null_floors = [r["calibrated_over_floor"] for r in rows if r["hidden"] == "nothing"]
     named_after = [r["after_over_floor"] for r in rows if r["named"] and r["after_over_floor"] is not None]
     walls = [r["wall_s"] for r in rows if r.get("wall_s") is not None]
@@ -394,8 +393,7 @@ def summarise(rows: list[dict], design: VariationDesign | None = None) -> dict:
         "named_min_steps": NAMED_MIN_STEPS,
         "by_hidden": by_hidden,
         "sources": sources,
-        "torque_lag_found_s": {"by_variation": lags_found, "in_step_max": max(in_step) if in_step else None,
-                               "in_step_nonzero": sum(x > 0.0 for x in in_step), "in_step_records": len(in_step)},
+        "torque_lag_found_s": {"by_variation": lags_found},
         "variations": table,
         "null_over_floor": {"min": min(null_floors), "max": max(null_floors)} if null_floors else None,
         "named_after_over_floor": {"min": min(named_after), "max": max(named_after)} if named_after else None,
