@@ -515,10 +515,13 @@ def test_slurm_profile_dry_run_lists_the_batch_jobs_and_their_resources(repo_roo
     assert stats["sweep_batch"] == len(batches) and stats["sweep_design"] == 1
     assert out.count("Group job sweep_batches") == math.ceil(len(batches) / 8)
     assert set(re.findall(r"logs/sweep_batch/design/([0-9a-f]{10})\.log", out)) == set(batches)
-    batch_resources = [line for line in out.splitlines() if "resources:" in line and "runtime=10" in line]
+    # each job's block starts at its "rule <name>:" line; the resources of the sweep_batch blocks
+    blocks = re.split(r"^ *(?:local)?rule (\w+):$", out, flags=re.MULTILINE)[1:]
+    batch_resources = [line for name, block in zip(blocks[::2], blocks[1::2]) if name == "sweep_batch"
+                       for line in block.splitlines() if "resources:" in line]
     assert len(batch_resources) == len(batches)
     assert all("slurm_partition=your_partition" in r and "slurm_account=your_account" in r and "mem_mb=1000" in r
-               for r in batch_resources)
+               and "runtime=10" in r for r in batch_resources)
     assert not called.exists()
 
 

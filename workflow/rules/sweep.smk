@@ -50,9 +50,12 @@ rule sweep_batch:
         "../scripts/sweep_batch.py"
 
 
+# Gathering the batches and drawing the maps takes seconds: on a cluster it runs on the submitting host instead of
+# waiting in the queue and for the executor's status checks (one round of each, after the batch jobs).
 rule:
     name:
         f"sweep_{SWEEP_NAME}"
+    localrule: True
     input:
         sweep=SWEEP_FILE,
         parameters=PARAMETERS,
