@@ -1,6 +1,7 @@
 """The variation benchmark outside the DAG (not a test): run its cases in a scratch folder, print the table.
 
-    python benchmarks/bench_variations.py OUT.json [--full] [--only pauses,lock_overshoot] [--sizes]
+    python benchmarks/bench_variations.py OUT.json [--full] [--only pauses,lock_overshoot] [--hidden kingpin_friction]
+        [--confound-tests] [--sizes]
 
 The logic is :mod:`parksteer.diagnose.variations` (rules ``diag_variation_batch`` and ``diag_variations`` run
 the same cases in the DAG); the grid is config/config.yaml's ``variations`` section (``--full``: its full grid).
@@ -8,7 +9,10 @@ Prints one line per case as it is diagnosed, then per variation the named rate, 
 coverage of the 95 % intervals, the nulls' calibrated error in noise floors and the median diagnosis time; writes
 the summary and every case's outcome as JSON. With ``--sizes``, no record is made or diagnosed: each hidden case's
 strength, its whole change and the part of it a calibration cannot absorb (to first order) are found, and per
-hidden effect the median and range of that observable share are printed (a minute for the full grid).
+hidden effect the median and range of that observable share are printed (a minute for the full grid). With
+``--hidden``, only those effects are hidden (the angle's cases too). With ``--confound-tests``, the diagnoses name
+where each confounded candidate would show (off in the DAG's benchmarks), and the summary counts, per hidden
+effect, the measurements named for its misses flagged as confounded.
 """
 
 from __future__ import annotations
@@ -29,11 +33,16 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("out", help="JSON file for the results")
     parser.add_argument("--full", action="store_true", help="the configuration's full grid")
     parser.add_argument("--only", default="", help="comma-separated variation names (default: the grid's)")
+    parser.add_argument("--hidden", default="", help="comma-separated effects to hide (default: the grid's)")
+    parser.add_argument("--confound-tests", action="store_true",
+                        help="name where each confounded candidate would show, as a user's diagnosis does")
     parser.add_argument("--sizes", action="store_true", help="only the hidden sizes, whole and observable")
     args = parser.parse_args(argv)
 
     import yaml
 
+    from parksteer.diagnose.benchmark import BENCHMARK_SETTINGS
+    from parksteer.diagnose.settings import DEFAULT_SETTINGS
     from parksteer.diagnose.variations import VariationDesign, case_names, outcome, run_case, summarise
     from parksteer.parameters import DEFAULT_PATH
     from parksteer.tables import write_json
@@ -41,8 +50,11 @@ def main(argv: list[str] | None = None) -> int:
     config = yaml.safe_load((ROOT / "config" / "config.yaml").read_text("utf-8"))
     section = copy.deepcopy(config["variations"])
     section["full_grid"] = bool(args.full)
+    grid = section["full" if args.full else "small"]
     if args.only:
-        section["full" if args.full else "small"]["variations"] = args.only.split(",")
+        grid["variations"] = args.only.split(",")
+    if args.hidden:
+        grid["hidden"] = grid["hidden_with_angle"] = args.hidden.split(",")
     design = VariationDesign.from_config(section, config["benchmark"])
     if args.sizes:
         return _sizes(design, args.out)
@@ -52,7 +64,8 @@ def main(argv: list[str] | None = None) -> int:
             folder = Path(scratch) / name
             folder.mkdir()
             start = time.perf_counter()
-            result = run_case(DEFAULT_PATH, design, name, folder, folder / "truth.json", folder / "diagnosis.json")
+            result = run_case(DEFAULT_PATH, design, name, folder, folder / "truth.json", folder / "diagnosis.json",
+                              DEFAULT_SETTINGS if args.confound_tests else BENCHMARK_SETTINGS)
             truth = json.loads((folder / "truth.json").read_text("utf-8"))
             row = outcome(truth, result)
             rows.append(row)
@@ -66,6 +79,10 @@ def main(argv: list[str] | None = None) -> int:
         print(f"{v['variation']:24s} {_count(v['named_count']):>7s} {_count(v['null_adequate_count']):>8s} "
               f"{_count(v['coverage_count']):>7s} {' '.join(f'{x:.2f}' for x in v['null_over_floor']):>12s} "
               f"{v['wall_s_median']:5.1f}s")
+    for effect, h in summary["by_hidden"].items():
+        if h.get("flagged_separated_by"):
+            print(f"{effect}: {h['missed_flagged_confounded']} misses flagged confounded, would show in "
+                  + ", ".join(f"{k} ({n})" for k, n in h["flagged_separated_by"].items()))
     for key, t in summary["targets"].items():
         print(f"{key:14s} {_count(t['count'])} = {t['value']:.3f} against {t['target']:.2f}: "
               f"{'met' if t['met'] else 'MISSED'}")

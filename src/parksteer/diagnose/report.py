@@ -133,7 +133,9 @@ def diagnosis_dict(diagnosis: Diagnosis) -> dict:
         ],
         "confounded": [
             {"effect": c.name, "confounded_with": c.score.confounded_with,
-             "identifiable_fraction": c.score.identifiable_fraction}
+             "identifiable_fraction": c.score.identifiable_fraction,
+             # None also where the settings leave the tests off
+             "separating_measurement": diagnosis.confound_tests.get(c.name)}
             for c in diagnosis.confounded
         ],
         "ranking": [_ranking_entry(diagnosis, c, calibrated) for c in diagnosis.ranked],
@@ -312,9 +314,19 @@ def markdown_report(result: dict, figure: str | None = None) -> str:
     if result["confounded"]:
         lines += ["", "## Confounded with the calibrated parameters", ""]
         for c in result["confounded"]:
-            lines.append(f"- `{c['effect']}`: only {_n(100 * c['identifiable_fraction'], 2)} % of its signature "
-                         f"is not also made by `{c['confounded_with']}`; these data cannot tell it from a change of "
-                         "that parameter.")
+            line = (f"- `{c['effect']}`: only {_n(100 * c['identifiable_fraction'], 2)} % of its signature is not "
+                    f"also made by `{c['confounded_with']}`; these data cannot tell it from a change of that "
+                    "parameter, whose calibrated value holds only if it is absent.")
+            m = c.get("separating_measurement")
+            if m:
+                line += (f" At a strength that changes this torque by {_n(m['change_here_rms_Nm'])} N m RMS, the "
+                         f"calibrated parameters take up all but {_n(m['left_here_rms_Nm'])} N m "
+                         f"({_n(m['left_here_over_noise_floor'])} noise floors) of it; measure the `{m['case']}` "
+                         f"case on `{m['surface'].replace('_', ' ')}`, where it would still change the torque by "
+                         f"{_n(m['predicted_difference_rms_Nm'])} N m RMS ({_n(m['over_noise_floor'])} noise "
+                         f"floors, {_n(100 * m['predicted_difference_rms_Nm'] / m['change_here_rms_Nm'], 2)} % of "
+                         "its change here).")
+            lines.append(line)
     if result.get("identification"):
         lines += ["", "## What these data fix", ""] + [f"- {line}" for line in _identification_lines(result)]
     if result["unobservable"]:

@@ -40,7 +40,10 @@ The steps (:func:`diagnose`):
    data; for each, both fitted models are replayed (on the first file's rack) under every
    condition the data do not cover (the other load cases and spacers, on the ground and on
    air bearings), and the condition where they differ most, relative to the noise floor, is
-   named as the measurement that would separate them.
+   named as the measurement that would separate them;
+8. a candidate ``confounded`` with the calibrated parameters (these data cannot tell it from a
+   change of them) gets the same: the measurement where it would show although the calibrated
+   parameters take it up here (:func:`confound_tests`).
 """
 
 from __future__ import annotations
@@ -125,10 +128,11 @@ class Diagnosis:
         others = sorted((c for c in self.candidates if c.refit is None), key=lambda c: -c.score.statistic)
         return refitted + others
 
+    confound_tests: dict[str, dict | None] = field(default_factory=dict)  # by confounded candidate (confound_tests)
+
     @property
     def confounded(self) -> list[Candidate]:
-        return [c for c in self.candidates
-                if c.signature.observable and c.score.identifiable_fraction < self.settings.confounded_fraction]
+        return confounded_candidates(self.candidates, self.settings)
 
     @property
     def unobservable(self) -> list[str]:
@@ -136,6 +140,13 @@ class Diagnosis:
 
     def statistics(self, predictions: list[np.ndarray]) -> dict:
         return fit_statistics(self.problem, predictions)
+
+
+def confounded_candidates(candidates: list[Candidate], settings: DiagnosisSettings) -> list[Candidate]:
+    """The observable candidates whose signature is mostly a calibrated parameter's (identifiable fraction below
+    the settings' confounded_fraction): these data cannot tell them from a change of that parameter."""
+    return [c for c in candidates
+            if c.signature.observable and c.score.identifiable_fraction < settings.confounded_fraction]
 
 
 def trimmed_rms(weighted: np.ndarray, trim: float) -> float:
@@ -202,19 +213,60 @@ def identification(problem: Problem, calibration: Fit, settings: DiagnosisSettin
     return out
 
 
+def confound_tests(problem: Problem, calibration: Fit, candidates: list[Candidate]) -> dict[str, dict | None]:
+    """Where each candidate that the calibrated parameters take up in these data would show, by name: None if
+    the data cover every load case and surface.
+
+    A candidate at its probe strength changes the replayed torque by a few noise floors; the calibrated
+    parameters, moved by the least-squares change that best cancels that change here (to first order, through
+    the calibration's Jacobian), take up all but the part the score test sees (its identifiable fraction). The
+    compensated model and the calibrated base model, which the data cannot tell apart, are then replayed on the
+    first file's rack under each condition the data do not cover (the base model once for all candidates), and
+    the condition where they differ most (RMS, in noise floors) is the measurement that would tell the candidate
+    from the parameter: a king-pin friction, whose moment grows with the wheel load, from a rack friction, which
+    does not.
+    """
+    if not candidates or not conditions_not_covered(problem):
+        return {c.name: None for c in candidates}
+    runs, summaries = [(calibration.effects, calibration.overrides)], []
+    for candidate in candidates:
+        signature = candidate.signature
+        change = signature.weighted * signature.probe  # the probe's change here, weighted
+        jacobian = calibration.jacobian
+        step = np.linalg.lstsq(jacobian, change, rcond=None)[0] if jacobian.shape[1] else np.zeros(0)
+        moved = {p.key: p.value(t) for p, t in zip(calibration.parameters, calibration.theta - step)}
+        runs.append((signature.model, {**calibration.fixed, **moved, signature.key: signature.probe}))
+        left = change - jacobian @ step if step.size else change
+        # the plain RMS change here, and the share of it the moved parameters leave (in the weighted sense)
+        left_Nm = signature.rms_change_Nm * float(np.linalg.norm(left) / max(np.linalg.norm(change), 1e-300))
+        summaries.append({"strength": signature.probe, "change_here_rms_Nm": signature.rms_change_Nm,
+                          "left_here_rms_Nm": left_Nm,
+                          "left_here_over_noise_floor": left_Nm / problem.files[0].noise.total_rms,
+                          "compensated": moved})
+    out = {}
+    for candidate, rows, summary in zip(candidates, differences_by_condition(problem, runs), summaries):
+        top = max(rows, key=lambda r: r["over_noise_floor"])
+        out[candidate.name] = {"case": top["case"], "surface": top["surface"],
+                               "predicted_difference_rms_Nm": top["predicted_difference_rms_Nm"],
+                               "over_noise_floor": top["over_noise_floor"], **summary}
+    return out
+
+
 def _fixing_test(problem: Problem, calibration: Fit, key: str, low: float, high: float) -> dict | None:
     """The uncovered condition where the parameter's two interval ends move the replayed torque most."""
     base = calibration.overrides
-    rows = differences_by_condition(problem, [(calibration.effects, {**base, key: v}) for v in (low, high)])
+    rows = differences_by_condition(problem, [(calibration.effects, {**base, key: v}) for v in (low, high)])[0]
     return max(rows, key=lambda r: r["over_noise_floor"]) if rows else None
 
 
-def differences_by_condition(problem: Problem, runs: list[tuple[list[Effect], dict[str, float]]]) -> list[dict]:
-    """Two runs ((effects, overrides) each) replayed on the first file's rack under each load case and surface the
-    data do not cover: their RMS torque difference there, in N m and in the file's noise floors. Runs of the same
-    effect set share one prepared replay per condition."""
+def differences_by_condition(problem: Problem, runs: list[tuple[list[Effect], dict[str, float]]]
+                             ) -> list[list[dict]]:
+    """The first run and each other ((effects, overrides) each), replayed on the first file's rack under each
+    load case and surface the data do not cover: for each other run, one row per condition with the RMS torque
+    difference from the first there, in N m and in the file's noise floors. Runs of the same effect set share
+    one prepared replay per condition."""
     f = problem.files[0]
-    rows = []
+    rows: list[list[dict]] = [[] for _ in runs[1:]]
     for case, surface in conditions_not_covered(problem):
         replays: dict[int, Replay] = {}
         predicted = []
@@ -222,9 +274,10 @@ def differences_by_condition(problem: Problem, runs: list[tuple[list[Effect], di
             if id(effects) not in replays:
                 replays[id(effects)] = Replay(effects, case, surface, problem.params, f.rack, f.time_s)
             predicted.append(replays[id(effects)].torque(overrides))
-        difference = float(np.sqrt(np.mean((predicted[0] - predicted[1]) ** 2)))
-        rows.append({"case": case, "surface": surface, "predicted_difference_rms_Nm": difference,
-                     "over_noise_floor": difference / f.noise.total_rms})
+        for out, other in zip(rows, predicted[1:]):
+            difference = float(np.sqrt(np.mean((predicted[0] - other) ** 2)))
+            out.append({"case": case, "surface": surface, "predicted_difference_rms_Nm": difference,
+                        "over_noise_floor": difference / f.noise.total_rms})
     return rows
 
 
@@ -279,7 +332,7 @@ def conditions_not_covered(problem: Problem) -> list[tuple[str, str]]:
 
 def separation(problem: Problem, best: Candidate, other: Candidate) -> Separation:
     """Replay both fitted models on the first file's rack under each uncovered condition (module docstring)."""
-    rows = differences_by_condition(problem, [(c.signature.model, c.refit.overrides) for c in (best, other)])
+    rows = differences_by_condition(problem, [(c.signature.model, c.refit.overrides) for c in (best, other)])[0]
     top = max(rows, key=lambda r: r["over_noise_floor"])
     return Separation(other.name, float(other.delta_bic), top["case"], top["surface"],
                       top["predicted_difference_rms_Nm"], top["over_noise_floor"], rows)
@@ -492,8 +545,13 @@ def _diagnose(problem: Problem, effects, registry, strengths, start, settings: D
     lap("separation")
     progress("what these data fix: the calibrated parameters' intervals")
     identified = identification(problem, calibration, settings)
+    confounded = confounded_candidates(candidates, settings) if settings.confound_tests else []
+    if confounded:
+        progress("where the confounded candidates would show: " + ", ".join(c.name for c in confounded))
+    tested = confound_tests(problem, calibration, confounded)
     lap("identification")
     progress(f"verdict: {verdict}" + (f" {best.name}" if verdict == "missing" else "")
              + f" ({problem.evaluations} replays)")
     return Diagnosis(problem, base, nominal, calibration, candidates, untestable, verdict, best, separations,
-                     n_eff, rho, explained, timings, settings, identification=identified)
+                     n_eff, rho, explained, timings, settings, identification=identified,
+                     confound_tests=tested)

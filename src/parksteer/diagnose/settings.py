@@ -158,6 +158,12 @@ class DiagnosisSettings:
     # the one where the torque moves most (in noise floors) is named as the test that would fix it.
     identified_relative_halfwidth: float = 0.1
     identified_phase_halfwidth_rad: float = 0.1
+    # Each confounded candidate is replayed, with the calibrated parameters moved to take it up, beside the base
+    # model under every load case and surface the data lack, and the one where it would still show is named
+    # (select.confound_tests). On one file with four confounded candidates that is nine conditions of five models,
+    # about 0.2 s. The diagnosis benchmarks, which score verdicts, names and intervals (none of which this changes),
+    # leave it off (parksteer.diagnose.benchmark.BENCHMARK_SETTINGS).
+    confound_tests: bool = True
 
     # --- the error ladder and the reports ------------------------------------------------------------------
     ladder_max_steps: int = 3  # effects added one at a time beyond the calibrated base

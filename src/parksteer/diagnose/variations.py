@@ -36,7 +36,7 @@ from ..parameters import Parameters, load_parameters
 from ..synthetic.datasets import SizeSearch, perturbed_base, rms_difference, strength_for_rms
 from ..synthetic.logger import quantisation_step
 from ..synthetic.variations import VARIATIONS, Variation, variation_by_name, variation_rack, variation_record
-from .benchmark import diagnose_written, paired_results
+from .benchmark import BENCHMARK_SETTINGS, diagnose_written, paired_results
 from .calibrate import calibrated_keys
 from .settings import DEFAULT_SETTINGS, DiagnosisSettings
 
@@ -219,8 +219,10 @@ def case_truth(params: Parameters, design: VariationDesign, case: VariationCase)
     }
 
 
-def run_case(parameters_path, design: VariationDesign, name: str, folder, truth_path, diagnosis_path) -> dict:
-    """Make variation case `name`'s records, write them into `folder`, diagnose them from the files."""
+def run_case(parameters_path, design: VariationDesign, name: str, folder, truth_path, diagnosis_path,
+             settings: DiagnosisSettings = BENCHMARK_SETTINGS) -> dict:
+    """Make variation case `name`'s records, write them into `folder`, diagnose them from the files with
+    `settings` (and the angle and lag settings below)."""
     params = load_parameters(parameters_path)
     cases = {c.name: c for c in variation_cases(design)}
     if name not in cases:
@@ -236,7 +238,7 @@ def run_case(parameters_path, design: VariationDesign, name: str, folder, truth_
                for load_case, surface, hand, logger in files]
     # as a user would: the angle fitted where the logger has one, the torque lag searched for where the logger is
     # known to delay its torque channel (the lag itself is found by the diagnosis)
-    settings = replace(DEFAULT_SETTINGS, use_handwheel_angle=case.variation.uses_angle,
+    settings = replace(settings, use_handwheel_angle=case.variation.uses_angle,
                        torque_lag_fitted=case.variation.logger.torque_lag_s > 0.0)
     return diagnose_written(params, records, folder, truth, truth_path, diagnosis_path, start, settings)
 
@@ -269,7 +271,9 @@ def outcome(truth: dict, result: dict) -> dict:
     floor = result["noise_floor_Nm"]
     after = result["statistics"]["with_effect"]
     # the diagnosis's own warning that the hidden effect's signature is mostly a calibrated parameter's direction
-    confounded = next((c["confounded_with"] for c in result.get("confounded", []) if c["effect"] == hidden), None)
+    flag = next((c for c in result.get("confounded", []) if c["effect"] == hidden), None)
+    confounded = flag["confounded_with"] if flag else None
+    separating = (flag or {}).get("separating_measurement")  # where present (the confound tests on)
     return {
         "name": truth["name"],
         "variation": truth["variation"],
@@ -284,6 +288,7 @@ def outcome(truth: dict, result: dict) -> dict:
         "named": bool(hidden is not None and missing and (named_effect == hidden or hidden in group)),
         "false_alarm": bool(hidden is None and missing),
         "hidden_confounded_with": confounded or "",
+        "hidden_separated_by": f"{separating['case']}/{separating['surface']}" if separating else "",
         "torque_lag_s": variation_by_name(truth["variation"]).logger.torque_lag_s,
         # the lag the diagnosis found (the mean over the files: one logger)
         "torque_lag_found_s": float(np.mean([f.get("torque_lag_s", 0.0) for f in result.get("files", [])] or [0.0])),
@@ -352,6 +357,9 @@ def summarise(rows: list[dict], design: VariationDesign | None = None) -> dict:
             "named": _rate(len(counted) - len(missed), len(counted)),
             "missed_flagged_confounded": len(flagged),
             "confounded_with": sorted({r["hidden_confounded_with"] for r in flagged}),
+            # where the diagnosis said the flagged misses would show (with the confound tests on)
+            "flagged_separated_by": {k: [r.get("hidden_separated_by") for r in flagged].count(k)
+                                     for k in sorted({r.get("hidden_separated_by") or "" for r in flagged} - {""})},
             "missed_in": list(dict.fromkeys(r["variation"] for r in missed)),
             "named_in_all_of": [v for v in dict.fromkeys(r["variation"] for r in counted)
                                 if all(r["named"] for r in counted if r["variation"] == v)],
