@@ -117,6 +117,8 @@ class Diagnosis:
     timings_s: dict[str, float] = field(default_factory=dict)
     settings: DiagnosisSettings = DEFAULT_SETTINGS
     identification: list[dict] = field(default_factory=list)  # what these data fix (:func:`identification`)
+    # where each confounded candidate would show, by name (:func:`confound_tests`; empty where the settings say not)
+    confound_tests: dict[str, dict | None] = field(default_factory=dict)
 
     @property
     def effect(self) -> str | None:
@@ -127,8 +129,6 @@ class Diagnosis:
         refitted = sorted((c for c in self.candidates if c.refit is not None), key=lambda c: -(c.delta_bic or 0.0))
         others = sorted((c for c in self.candidates if c.refit is None), key=lambda c: -c.score.statistic)
         return refitted + others
-
-    confound_tests: dict[str, dict | None] = field(default_factory=dict)  # by confounded candidate (confound_tests)
 
     @property
     def confounded(self) -> list[Candidate]:
@@ -548,8 +548,9 @@ def _diagnose(problem: Problem, effects, registry, strengths, start, settings: D
     confounded = confounded_candidates(candidates, settings) if settings.confound_tests else []
     if confounded:
         progress("where the confounded candidates would show: " + ", ".join(c.name for c in confounded))
-    tested = confound_tests(problem, calibration, confounded)
     lap("identification")
+    tested = confound_tests(problem, calibration, confounded)
+    lap("confound_tests")
     progress(f"verdict: {verdict}" + (f" {best.name}" if verdict == "missing" else "")
              + f" ({problem.evaluations} replays)")
     return Diagnosis(problem, base, nominal, calibration, candidates, untestable, verdict, best, separations,
