@@ -117,6 +117,9 @@ class Score:
     removed_rss: float  # u^2 / |w~|^2 (0 if the strength would be negative)
     identifiable_fraction: float  # |w~| / |w|
     confounded_with: str | None  # the calibrated parameter whose sensitivity is closest to the signature
+    # (J^T J)^-1 J^T w: the change of the calibrated parameters (theta) that best makes the signature per unit
+    # strength, the part projected out; None for an unobservable candidate
+    calibrated_equivalent: np.ndarray | None = None
 
 
 def score(signature: Signature, calibration: Fit) -> Score:
@@ -126,22 +129,23 @@ def score(signature: Signature, calibration: Fit) -> Score:
     r = calibration.weighted
     J = calibration.jacobian
     if J.shape[1]:
-        projected = w - J @ np.linalg.lstsq(J, w, rcond=None)[0]
+        equivalent = np.linalg.lstsq(J, w, rcond=None)[0]
+        projected = w - J @ equivalent
         cosines = [abs(float(w @ J[:, i])) / (np.linalg.norm(w) * np.linalg.norm(J[:, i]) + 1e-300)
                    for i in range(J.shape[1])]
         closest = calibration.parameters[int(np.argmax(cosines))].key
     else:
-        projected, closest = w, None
+        projected, closest, equivalent = w, None, np.zeros(0)
     norm2 = float(projected @ projected)
     full = float(np.linalg.norm(w))
     fraction = min(math.sqrt(norm2) / full, 1.0) if full > 0 else 0.0
     u = float(projected @ r)
     if norm2 <= 0.0:
-        return Score(signature.effect.name, 0.0, 0.0, 0.0, fraction, closest)
+        return Score(signature.effect.name, 0.0, 0.0, 0.0, fraction, closest, equivalent)
     variance = float(r @ r) / r.size
     allowed_negative = strength_parameter(signature.effect).lower < 0.0
     removed = u * u / norm2 if (u > 0 or allowed_negative) else 0.0
-    return Score(signature.effect.name, removed / variance, u / norm2, removed, fraction, closest)
+    return Score(signature.effect.name, removed / variance, u / norm2, removed, fraction, closest, equivalent)
 
 
 def candidate_models(effects: str | None = None, extra: tuple[str, ...] = ()) -> dict[str, str | None]:

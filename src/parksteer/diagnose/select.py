@@ -218,8 +218,9 @@ def confound_tests(problem: Problem, calibration: Fit, candidates: list[Candidat
     the data cover every load case and surface.
 
     A candidate at its probe strength changes the replayed torque by a few noise floors; the calibrated
-    parameters, moved by the least-squares change that best cancels that change here (to first order, through
-    the calibration's Jacobian), take up all but the part the score test sees (its identifiable fraction). The
+    parameters, moved by the least-squares change that best cancels that change here (to first order: the score
+    test's projection, Score.calibrated_equivalent), take up all but the part the score test sees (its
+    identifiable fraction). The
     compensated model and the calibrated base model, which the data cannot tell apart, are then replayed on the
     first file's rack under each condition the data do not cover (the base model once for all candidates), and
     the condition where they differ most (RMS, in noise floors) is the measurement that would tell the candidate
@@ -230,15 +231,12 @@ def confound_tests(problem: Problem, calibration: Fit, candidates: list[Candidat
         return {c.name: None for c in candidates}
     runs, summaries = [(calibration.effects, calibration.overrides)], []
     for candidate in candidates:
-        signature = candidate.signature
-        change = signature.weighted * signature.probe  # the probe's change here, weighted
-        jacobian = calibration.jacobian
-        step = np.linalg.lstsq(jacobian, change, rcond=None)[0] if jacobian.shape[1] else np.zeros(0)
-        moved = {p.key: p.value(t) for p, t in zip(calibration.parameters, calibration.theta - step)}
+        signature, score = candidate.signature, candidate.score
+        theta = calibration.theta - signature.probe * score.calibrated_equivalent
+        moved = {p.key: p.value(t) for p, t in zip(calibration.parameters, theta)}
         runs.append((signature.model, {**calibration.fixed, **moved, signature.key: signature.probe}))
-        left = change - jacobian @ step if step.size else change
-        # the plain RMS change here, and the share of it the moved parameters leave (in the weighted sense)
-        left_Nm = signature.rms_change_Nm * float(np.linalg.norm(left) / max(np.linalg.norm(change), 1e-300))
+        # what the moved parameters leave of the probe's plain RMS change here (in the weighted sense)
+        left_Nm = signature.rms_change_Nm * score.identifiable_fraction
         summaries.append({"strength": signature.probe, "change_here_rms_Nm": signature.rms_change_Nm,
                           "left_here_rms_Nm": left_Nm,
                           "left_here_over_noise_floor": left_Nm / problem.files[0].noise.total_rms,

@@ -27,6 +27,7 @@ covering in COVERAGE_TARGET. :func:`summarise` reports each and the variations w
 from __future__ import annotations
 
 import time
+from collections import Counter
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -358,8 +359,8 @@ def summarise(rows: list[dict], design: VariationDesign | None = None) -> dict:
             "missed_flagged_confounded": len(flagged),
             "confounded_with": sorted({r["hidden_confounded_with"] for r in flagged}),
             # where the diagnosis said the flagged misses would show (with the confound tests on)
-            "flagged_separated_by": {k: [r.get("hidden_separated_by") for r in flagged].count(k)
-                                     for k in sorted({r.get("hidden_separated_by") or "" for r in flagged} - {""})},
+            "flagged_separated_by": dict(sorted(Counter(r["hidden_separated_by"] for r in flagged
+                                                        if r.get("hidden_separated_by")).items())),
             "missed_in": list(dict.fromkeys(r["variation"] for r in missed)),
             "named_in_all_of": [v for v in dict.fromkeys(r["variation"] for r in counted)
                                 if all(r["named"] for r in counted if r["variation"] == v)],
