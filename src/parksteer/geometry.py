@@ -19,18 +19,19 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import portable as pm
 from .parameters import Parameters
 
 SIDES = ("left", "right")
 
 
 def _rot_x(a: float) -> np.ndarray:
-    c, s = np.cos(a), np.sin(a)
+    c, s = pm.cos(a), pm.sin(a)
     return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
 
 
 def _rot_y(a: float) -> np.ndarray:
-    c, s = np.cos(a), np.sin(a)
+    c, s = pm.cos(a), pm.sin(a)
     return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
 
 
@@ -52,12 +53,12 @@ class SteerAxis:
     def foot(self) -> np.ndarray:
         """A: the foot of the perpendicular from C onto the axis."""
         oc = self.wheel_centre - self.top
-        return self.top + np.dot(oc, self.direction) * self.direction
+        return self.top + pm.dot(oc, self.direction) * self.direction
 
     @property
     def offset_d_m(self) -> float:
         """d: perpendicular distance from the wheel centre to the steer axis."""
-        return float(np.linalg.norm(self.wheel_centre - self.foot))
+        return pm.norm(self.wheel_centre - self.foot)
 
     def ground_intercept(self) -> np.ndarray:
         """Where the axis meets the ground plane (z = ground)."""
@@ -74,12 +75,12 @@ class SteerAxis:
         """Rotation matrix (body axes) of the wheel about this axis by `steer_rad`."""
         k = self.direction
         kx = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
-        return np.eye(3) + np.sin(steer_rad) * kx + (1.0 - np.cos(steer_rad)) * (kx @ kx)
+        return np.eye(3) + pm.sin(steer_rad) * kx + (1.0 - pm.cos(steer_rad)) * pm.matmul(kx, kx)
 
     def wheel_centre_at(self, steer_rad: float) -> np.ndarray:
         """C' : the wheel centre after steering by `steer_rad` (Rodrigues rotation about the axis)."""
         a = self.foot
-        return a + self.rotation(steer_rad) @ (self.wheel_centre - a)
+        return a + pm.matmul(self.rotation(steer_rad), self.wheel_centre - a)
 
     def wheel_drop_m(self, steer_rad: float | np.ndarray) -> np.ndarray | float:
         """Downward displacement of the wheel centre (and contact point) relative to the body, from zero steer."""
@@ -97,7 +98,7 @@ def steer_axis(params: Parameters, case: str, side: str) -> SteerAxis:
     c = params.case(case)
     sign = -1.0 if side == "left" else 1.0  # y of the left side is negative
     kpi = g["kingpin_inclination"] * (1.0 if side == "left" else -1.0)
-    frame = _rot_y(g["castor_angle"]) @ _rot_x(kpi)
+    frame = pm.matmul(_rot_y(g["castor_angle"]), _rot_x(kpi))
     top = np.array([-g["mechanical_trail"], sign * g["kingpin_top_y"], g["kingpin_top_z"]])
     centre = np.array([0.0, sign * c["wheel_centre_y"], g["wheel_centre_z"]])
     return SteerAxis(side, top, frame, centre, g["ground_z"] - g["wheel_centre_z"])
@@ -121,7 +122,7 @@ def lifting_torque_a1(params: Parameters, case: str, steer_rad: float | np.ndarr
     eps, chi = g["castor_angle"], g["kingpin_inclination"]
     wl, wr = c["load_left"], c["load_right"]
     delta = np.asarray(steer_rad, dtype=float)
-    tau = d * ((wr - wl) * np.sin(eps) * np.cos(delta) + (wr + wl) * np.cos(eps) * np.sin(chi) * np.sin(delta))
+    tau = d * ((wr - wl) * pm.sin(eps) * pm.cos(delta) + (wr + wl) * pm.cos(eps) * pm.sin(chi) * pm.sin(delta))
     return tau / overall_steering_ratio(params)
 
 
@@ -139,10 +140,10 @@ def pinion_angle_from_column(column_angle_rad, joint_angle_rad: float, phase_rad
     least cos(alpha) > 0, so the angle stays continuous over any number of turns.
     """
     theta_c = np.asarray(column_angle_rad, dtype=float)
-    cos_a = np.cos(joint_angle_rad)
+    cos_a = pm.cos(joint_angle_rad)
     psi = theta_c - phase_rad
-    s, c = np.sin(psi), np.cos(psi)
-    return theta_c + np.arctan((1.0 - cos_a) * s * c / (cos_a * c**2 + s**2))
+    s, c = pm.sin(psi), pm.cos(psi)
+    return theta_c + pm.atan((1.0 - cos_a) * s * c / (cos_a * c**2 + s**2))
 
 
 def rack_from_handwheel(handwheel_angle_rad, handwheel_torque_Nm, params: Parameters) -> np.ndarray:

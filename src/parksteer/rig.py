@@ -37,6 +37,7 @@ from pathlib import Path
 import numpy as np
 from scipy.special import ellipe, ellipk
 
+from . import portable as pm
 from .errors import UsageError
 from .parameters import Parameters
 
@@ -56,12 +57,12 @@ def patch_radius_m(load_N, pressure_Pa):
 def gough_torque_Nm(load_N, pressure_Pa, mu):
     """Equation (1): torque to slide the uniform-pressure disc about its centre, (2 mu/3) W^1.5 / sqrt(pi p)."""
     load_N = np.asarray(load_N, dtype=float)
-    return 2.0 * mu / 3.0 * load_N**1.5 / np.sqrt(math.pi * np.asarray(pressure_Pa, dtype=float))
+    return 2.0 * mu / 3.0 * (load_N * np.sqrt(load_N)) / np.sqrt(math.pi * np.asarray(pressure_Pa, dtype=float))
 
 
 def pressure_correction(pressure_Pa, reference_pressure_Pa, pressure_index):
     """Ratio of equation (2) to equation (1) at one pressure: (p0 / p)^(n - 0.5); 1 at p = p0."""
-    return (reference_pressure_Pa / np.asarray(pressure_Pa, dtype=float)) ** (pressure_index - 0.5)
+    return pm.power(reference_pressure_Pa / np.asarray(pressure_Pa, dtype=float), pressure_index - 0.5)
 
 
 def empirical_torque_Nm(load_N, pressure_Pa, mu, reference_pressure_Pa, pressure_index):
@@ -69,12 +70,12 @@ def empirical_torque_Nm(load_N, pressure_Pa, mu, reference_pressure_Pa, pressure
     load_N = np.asarray(load_N, dtype=float)
     pressure_Pa = np.asarray(pressure_Pa, dtype=float)
     return (
-        reference_pressure_Pa ** (pressure_index - 0.5)
+        pm.power(reference_pressure_Pa, pressure_index - 0.5)
         * 2.0
         * mu
         / (3.0 * math.sqrt(math.pi))
-        * load_N**1.5
-        / pressure_Pa**pressure_index
+        * (load_N * np.sqrt(load_N))
+        / pm.power(pressure_Pa, pressure_index)
     )
 
 
@@ -104,17 +105,17 @@ def disc_distance_integral_m3(radius_m, offset_m):
     # (1 - m) K(m) -> 0 as m -> 1 although K diverges: take the limit explicitly.
     with np.errstate(invalid="ignore", divide="ignore"):
         one_minus_m_k = np.where(m < 1.0, (1.0 - m) * ellipk(np.minimum(m, 1.0)), 0.0)
-    out[inside] = 4.0 * r**3 / 9.0 * ((7.0 + m) * ellipe(m) - 4.0 * one_minus_m_k)
+    out[inside] = 4.0 * (r * r * r) / 9.0 * ((7.0 + m) * ellipe(m) - 4.0 * one_minus_m_k)
 
     r, e = radius_m[near_outside], offset_m[near_outside]
     m = (r / e) ** 2
     with np.errstate(invalid="ignore", divide="ignore"):
         one_minus_m_k = np.where(m < 1.0, (1.0 - m) * ellipk(np.minimum(m, 1.0)), 0.0)
-    out[near_outside] = 4.0 * e**3 / 9.0 * ((1.0 + 7.0 * m) * ellipe(m) - (1.0 + 3.0 * m) * one_minus_m_k)
+    out[near_outside] = 4.0 * (e * e * e) / 9.0 * ((1.0 + 7.0 * m) * ellipe(m) - (1.0 + 3.0 * m) * one_minus_m_k)
 
     r, e = radius_m[far], offset_m[far]
     m = (r / e) ** 2
-    out[far] = math.pi * r**2 * e * (1.0 + m / 8.0 + m**2 / 192.0 + m**3 / 1024.0)
+    out[far] = math.pi * r**2 * e * (1.0 + m / 8.0 + m**2 / 192.0 + (m * m * m) / 1024.0)
     return out
 
 
@@ -235,7 +236,7 @@ def read_printed_table1(path: str | Path) -> tuple[list[dict[str, str]], dict[st
 def printed_half_unit(text: str) -> float:
     """Half a unit in the last printed digit: the rounding interval of a printed number ("0.097" -> 0.0005)."""
     _, _, decimals = text.strip().partition(".")
-    return 0.5 * 10.0 ** (-len(decimals))
+    return 0.5 / 10 ** len(decimals)
 
 
 def table1(params: Parameters, printed_rows: Sequence[Mapping[str, str]]) -> dict[str, np.ndarray]:

@@ -22,6 +22,7 @@ import tomllib
 from pathlib import Path
 from typing import Any
 
+from . import portable as pm
 from .geometry import lock_steer_angle, steer_axis
 from .parameters import (
     CASE_SCHEMA,
@@ -242,10 +243,10 @@ def derive(spec: Specification, base: Parameters | None = None) -> list[Derived]
     chi, eps = spec.kingpin_inclination_rad, spec.castor_rad
     wheel_z = GROUND_Z_M - spec.tyre_radius_m
     top_z = wheel_z - STRUT_HEIGHT_M
-    front_view_slope = math.tan(chi) / math.cos(eps)  # lateral run of the axis per unit height (see geometry.steer_axis)
+    front_view_slope = pm.tan(chi) / pm.cos(eps)  # lateral run of the axis per unit height (see geometry.steer_axis)
     intercept_y = half_track - spec.scrub_radius_m
     top_y = intercept_y - (GROUND_Z_M - top_z) * front_view_slope
-    trail = (wheel_z - top_z) * math.tan(eps)
+    trail = (wheel_z - top_z) * pm.tan(eps)
     geo = {
         "geometry.castor_angle": (eps, "rad", src("castor_rad"), ""),
         "geometry.kingpin_inclination": (chi, "rad", src("kingpin_inclination_rad"), ""),
@@ -261,7 +262,7 @@ def derive(spec: Specification, base: Parameters | None = None) -> list[Derived]
             f"{front_view_slope:.5g}"),
         "geometry.mechanical_trail": (trail, "m", "derived: the axis through the wheel centre in side view, as the "
                                                   "paper's reconstruction",
-                                      f"(z2 - z1) tan(castor) = {wheel_z - top_z:g} x {math.tan(eps):.5g}"),
+                                      f"(z2 - z1) tan(castor) = {wheel_z - top_z:g} x {pm.tan(eps):.5g}"),
     }
     for key, (value, unit, source, how) in geo.items():
         out[key] = Derived(key, value, unit, source, how)

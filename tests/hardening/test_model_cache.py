@@ -1,5 +1,6 @@
 """The compiled-model cache survives a killed build and damage: a killed build's scratch directory is removed by
-the next build, and an entry whose library or source no longer matches the SHA-256 it recorded is rebuilt."""
+the next build, and an entry whose library or source no longer matches the SHA-256 it recorded is rebuilt; processes
+that need the same model at the same time build it once."""
 
 from __future__ import annotations
 
@@ -34,7 +35,7 @@ def _dead_pid() -> int:
 
 
 def _scratch(root: Path) -> list[Path]:
-    return [p for p in root.iterdir() if p.name.startswith(".")]
+    return [p for p in root.iterdir() if p.name.startswith(".") and p.is_dir()]
 
 
 def test_killed_build_leaves_scratch_that_the_next_build_removes(cache_dir):
@@ -88,3 +89,20 @@ def test_entry_without_recorded_hashes_is_not_trusted(tmp_path):
     (d / "model.c").write_text("x", encoding="utf-8")
     assert not cache.entry_is_sound(d)
     assert not cache.entry_is_sound(tmp_path / "missing")
+
+
+def test_processes_that_need_the_same_model_at_once_build_it_once(cache_dir):
+    """Three processes ask for the same missing model together: one derives it, the others wait for its lock and
+    load the entry it built; no lock file or scratch directory is left."""
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
+    code = ("from parksteer.model.codegen.cache import ensure_entry;"
+            "from parksteer.model.symbolic.components import resolve_effects;"
+            f"print(ensure_entry(resolve_effects({SMALL!r})))")
+    procs = [subprocess.Popen([sys.executable, "-c", code], env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                              text=True) for _ in range(3)]
+    outputs = [p.communicate(timeout=600) for p in procs]
+    assert all(p.returncode == 0 for p in procs), [err for _, err in outputs]
+    assert len({out.strip() for out, _ in outputs}) == 1
+    derivations = sum(err.count("deriving the model") for _, err in outputs)
+    assert derivations == 1, [err for _, err in outputs]
+    assert [p for p in cache_dir.iterdir() if p.name.startswith(".")] == []

@@ -6,6 +6,7 @@ import math
 import re
 from pathlib import Path
 
+from .. import portable as pm
 from ..errors import UsageError
 from ..parameters import DEFAULT_PATH, load_parameters
 
@@ -70,7 +71,7 @@ def specification(args, gravity: float):
     if args.scrub_radius_m is not None:
         scrub = args.scrub_radius_m
     else:  # the axis runs inboard by tan(kpi)/cos(castor) per unit height above the ground
-        scrub = args.kingpin_offset_m - radius * math.tan(chi) / math.cos(eps)
+        scrub = args.kingpin_offset_m - radius * pm.tan(chi) / pm.cos(eps)
     for option, value, low, high in (("--left-share", args.left_share, 0.0, 1.0),
                                      ("--steering-ratio", args.steering_ratio, 1.0, 100.0),
                                      ("--lock-turns", args.lock_turns, 0.1, 10.0),

@@ -30,6 +30,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.special import stdtrit  # the t quantile, without importing scipy.stats (a second per process)
 
+from .. import portable as pm
 from ..model.symbolic.components import Effect
 from ..model.symbolic.system import CORE_PARAMETERS
 from ..parameters import quantity
@@ -52,15 +53,15 @@ class FitParameter:
     step: float  # finite-difference step in theta
 
     def value(self, theta: float) -> float:
-        raw = self.reference * math.exp(theta) if self.transform == "log" else theta
+        raw = self.reference * pm.exp(theta) if self.transform == "log" else theta
         return min(max(raw, self.lower), self.upper)
 
     def theta(self, value: float) -> float:
-        return math.log(value / self.reference) if self.transform == "log" else value
+        return pm.log(value / self.reference) if self.transform == "log" else value
 
     def theta_bounds(self) -> tuple[float, float]:
         if self.transform == "log":
-            return math.log(self.lower / self.reference), math.log(self.upper / self.reference)
+            return pm.log(self.lower / self.reference), pm.log(self.upper / self.reference)
         return self.lower, self.upper
 
 
@@ -117,18 +118,18 @@ class Fit:
         replay = np.zeros((k, k))
         # A parameter the data do not see at all (a tyre's on air bearings) has a zero column and makes J^T J
         # singular: its interval is infinite, and the others' come from the columns that are left.
-        norms = np.linalg.norm(self.jacobian, axis=0)
+        norms = pm.norm(self.jacobian, axis=0)
         for seen in (np.ones(k, dtype=bool), norms > 1e-9 * max(float(norms.max(initial=0.0)), 1e-300)):
             if not seen.any():
                 break
             jacobian = self.jacobian[:, seen]
             try:
                 sub = np.ix_(seen, seen)
-                covariance[sub] = variance * np.linalg.inv(jacobian.T @ jacobian)
+                covariance[sub] = variance * pm.inv(pm.matmul(jacobian.T, jacobian))
                 sandwich[sub], blocks = block_sandwich(jacobian, self.weighted, problem, block_s)
                 replay[sub] = replay_covariance(jacobian, problem)
                 break
-            except np.linalg.LinAlgError:
+            except pm.LinAlgError:
                 covariance, sandwich, blocks = np.full((k, k), np.inf), np.full((k, k), np.inf), 0
                 replay = np.zeros((k, k))
         quantile = float(stdtrit(blocks - k, 0.975)) if blocks > k else math.inf
@@ -137,7 +138,7 @@ class Fit:
             model_se = math.sqrt(max(covariance[i, i], 0.0))
             sandwich_se = math.sqrt(max(sandwich[i, i], 0.0))
             # the replay's own error is common to every block (one rack for the whole record): added apart
-            half = math.hypot(max(Z95 * model_se, quantile * sandwich_se), Z95 * math.sqrt(max(replay[i, i], 0.0)))
+            half = pm.hypot(max(Z95 * model_se, quantile * sandwich_se), Z95 * math.sqrt(max(replay[i, i], 0.0)))
             se = half / Z95
             low, high = p.value(t - half), p.value(t + half)
             if p.transform != "log":
@@ -161,14 +162,14 @@ def block_sandwich(jacobian: np.ndarray, weighted: np.ndarray, problem: Problem,
         start += f.n
     ids = np.concatenate(ids)
     k = jacobian.shape[1]
-    bread = np.linalg.inv(jacobian.T @ jacobian)
+    bread = pm.inv(pm.matmul(jacobian.T, jacobian))
     meat = np.zeros((k, k))
     for b in range(offset):
         rows = ids == b
-        score = jacobian[rows].T @ weighted[rows]
+        score = pm.matmul(jacobian[rows].T, weighted[rows])
         meat += np.outer(score, score)
     scale = offset / max(offset - k, 1)
-    return scale * bread @ meat @ bread, offset
+    return pm.matmul(pm.matmul(scale * bread, meat), bread), offset
 
 
 def replay_covariance(jacobian: np.ndarray, problem: Problem) -> np.ndarray:
@@ -181,8 +182,8 @@ def replay_covariance(jacobian: np.ndarray, problem: Problem) -> np.ndarray:
     if any(d is None for d in draws) or len({d.shape[0] for d in draws}) != 1 or draws[0].shape[0] < 2:
         return np.zeros((k, k))
     deviations = np.concatenate([d / f.sigma for d, f in zip(draws, problem.files)], axis=1)
-    shifts = np.linalg.solve(jacobian.T @ jacobian, jacobian.T @ deviations.T)  # k x draws
-    return shifts @ shifts.T / (shifts.shape[1] - 1)
+    shifts = pm.solve(pm.matmul(jacobian.T, jacobian), pm.matmul(jacobian.T, deviations.T))  # k x draws
+    return pm.matmul(shifts, shifts.T) / (shifts.shape[1] - 1)
 
 
 def _predict(problem: Problem, effects: list[Effect], parameters: list[FitParameter], theta: np.ndarray,
@@ -225,7 +226,7 @@ def least_squares(problem: Problem, effects: list[Effect], parameters: list[FitP
     upper = np.array([p.theta_bounds()[1] for p in parameters])
     theta = np.clip(np.asarray(theta0, dtype=float), lower, upper)
     predictions, r = _predict(problem, effects, parameters, theta, fixed)
-    rss = float(r @ r)
+    rss = pm.dot(r, r)
     history = [rss]
     if not parameters:
         return Fit(effects, parameters, theta, fixed, predictions, r, np.zeros((r.size, 0)), 0, 0, history)
@@ -236,7 +237,7 @@ def least_squares(problem: Problem, effects: list[Effect], parameters: list[FitP
     iterations = 0
     failures = 0
     while iterations < max_iterations:
-        JTJ = J.T @ J
+        JTJ = pm.matmul(J.T, J)
         scale = np.diag(JTJ).copy()
         scale[scale <= 0] = 1.0
         # Converged when the full Gauss-Newton step (kept within the bounds) is a small fraction of every
@@ -245,25 +246,25 @@ def least_squares(problem: Problem, effects: list[Effect], parameters: list[FitP
         # parameters trade against each other, e.g. a rack damping against the rack friction.)
         se = np.full(len(theta), np.inf)
         try:
-            newton = np.clip(theta + np.linalg.solve(JTJ, J.T @ r), lower, upper) - theta
-            se = np.sqrt(np.maximum(np.diag(np.linalg.inv(JTJ)), 0.0) * rss / max(r.size - len(theta), 1))
+            newton = np.clip(theta + pm.solve(JTJ, pm.matmul(J.T, r)), lower, upper) - theta
+            se = np.sqrt(np.maximum(np.diag(pm.inv(JTJ)), 0.0) * rss / max(r.size - len(theta), 1))
             if np.all(np.abs(newton) <= tolerance * se):
                 break
-        except np.linalg.LinAlgError:
+        except pm.LinAlgError:
             pass
         iterations += 1
-        step = np.linalg.solve(JTJ + damping * np.diag(scale), J.T @ r)
+        step = pm.solve(JTJ + damping * np.diag(scale), pm.matmul(J.T, r))
         trial = np.clip(theta + step, lower, upper)
         step = trial - theta
         if not np.any(step):
             break
         trial_predictions, trial_r = _predict(problem, effects, parameters, trial, fixed)
-        trial_rss = float(trial_r @ trial_r)
-        predicted = rss - float(np.sum((r - J @ step) ** 2))
+        trial_rss = pm.dot(trial_r, trial_r)
+        predicted = rss - float(np.sum((r - pm.matmul(J, step)) ** 2))
         # Broyden: the actual change of model / sigma is r - trial_r. A step much smaller than the standard
         # errors moves the model by little more than the integrator's own noise: it would corrupt J.
         if np.any(np.abs(step) > se):
-            J += np.outer((r - trial_r) - J @ step, step) / float(step @ step)
+            J += np.outer((r - trial_r) - pm.matmul(J, step), step) / pm.dot(step, step)
         if trial_rss < rss:
             poor = predicted > 0 and (rss - trial_rss) < 0.25 * predicted
             theta, predictions, r, rss = trial, trial_predictions, trial_r, trial_rss

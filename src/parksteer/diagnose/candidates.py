@@ -41,6 +41,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .. import portable as pm
 from ..model.symbolic.components import Effect, discover_effects, strength_parameter
 from .settings import DEFAULT_SETTINGS, DiagnosisSettings
 from .calibrate import Fit
@@ -129,20 +130,20 @@ def score(signature: Signature, calibration: Fit) -> Score:
     r = calibration.weighted
     J = calibration.jacobian
     if J.shape[1]:
-        equivalent = np.linalg.lstsq(J, w, rcond=None)[0]
-        projected = w - J @ equivalent
-        cosines = [abs(float(w @ J[:, i])) / (np.linalg.norm(w) * np.linalg.norm(J[:, i]) + 1e-300)
+        equivalent = pm.lstsq(J, w)
+        projected = w - pm.matmul(J, equivalent)
+        cosines = [abs(pm.dot(w, J[:, i])) / (pm.norm(w) * pm.norm(J[:, i]) + 1e-300)
                    for i in range(J.shape[1])]
         closest = calibration.parameters[int(np.argmax(cosines))].key
     else:
         projected, closest, equivalent = w, None, np.zeros(0)
-    norm2 = float(projected @ projected)
-    full = float(np.linalg.norm(w))
+    norm2 = pm.dot(projected, projected)
+    full = pm.norm(w)
     fraction = min(math.sqrt(norm2) / full, 1.0) if full > 0 else 0.0
-    u = float(projected @ r)
+    u = pm.dot(projected, r)
     if norm2 <= 0.0:
         return Score(signature.effect.name, 0.0, 0.0, 0.0, fraction, closest, equivalent)
-    variance = float(r @ r) / r.size
+    variance = pm.dot(r, r) / r.size
     allowed_negative = strength_parameter(signature.effect).lower < 0.0
     removed = u * u / norm2 if (u > 0 or allowed_negative) else 0.0
     return Score(signature.effect.name, removed / variance, u / norm2, removed, fraction, closest, equivalent)

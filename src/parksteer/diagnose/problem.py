@@ -44,6 +44,7 @@ from pathlib import Path
 import numpy as np
 from scipy.ndimage import maximum_filter1d
 
+from .. import portable as pm
 from ..errors import UsageError, naming
 from ..measure.importers import load_record
 from ..measure.io import Measurement
@@ -348,7 +349,7 @@ class Problem:
                 # The replayed torque is itself off by about its attainable error, and the twist that passes it by
                 # as much through the column's compliance (in a dead band: the band, where |T| is that small).
                 through_torque = self.replay(effects, i).twist_spread(f.sigma_Nm, overrides)
-                spread = np.hypot(_spread(angle_runs, None), maximum_filter1d(through_torque, size=3, mode="nearest"))
+                spread = pm.hypot(_spread(angle_runs, None), maximum_filter1d(through_torque, size=3, mode="nearest"))
                 before = f.replay_uncertainty_rad if keep_larger else None
                 f.replay_uncertainty_rad = spread if before is None else np.maximum(spread, before)
 
@@ -454,4 +455,4 @@ def effective_samples(n: int, rho: float) -> float:
 
 def information_criterion(weighted_rss: float, n: int, n_eff: float, parameters: int) -> float:
     """BIC over the effective sample size: n_eff ln(RSS / n) + k ln(n_eff)."""
-    return n_eff * math.log(max(weighted_rss, 1e-300) / n) + parameters * math.log(n_eff)
+    return n_eff * pm.log(max(weighted_rss, 1e-300) / n) + parameters * pm.log(n_eff)

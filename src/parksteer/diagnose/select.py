@@ -54,6 +54,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from .. import portable as pm
 from ..model.symbolic.components import Effect, discover_effects, resolve_effects
 from ..model.numeric.values import SURFACES
 from ..errors import SolverError
@@ -312,7 +313,7 @@ def _compare_refits(problem: Problem, calibration: Fit, refitted: list[Candidate
     rho = lag1_autocorrelation(problem, best_fit.weighted)
     n_eff = effective_samples(problem.n, rho)
     for c in refitted:
-        c.delta_bic = n_eff * math.log(calibration.rss / c.refit.rss) - math.log(n_eff)
+        c.delta_bic = n_eff * pm.log(calibration.rss / c.refit.rss) - pm.log(n_eff)
     return max(refitted, key=lambda c: c.delta_bic, default=None), n_eff, rho
 
 
@@ -387,7 +388,7 @@ def estimate_torque_lags(problem: Problem, effects: list[Effect], overrides: dic
                 if at_vertex < best_rss:
                     best, best_rss = vertex, at_vertex
         at_zero = values[int(np.argmin(np.abs(lags)))]
-        if at_zero - best_rss > math.log(f.n):
+        if at_zero - best_rss > pm.log(f.n):
             f.torque_lag_s = float(f.torque_lag_s + best)
             largest = max(largest, abs(best))
     return largest

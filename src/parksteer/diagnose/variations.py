@@ -32,6 +32,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from .. import portable as pm
 from ..errors import UsageError
 from ..parameters import Parameters, load_parameters
 from ..synthetic.datasets import SizeSearch, perturbed_base, rms_difference, strength_for_rms
@@ -177,7 +178,7 @@ def hidden_strength(params: Parameters, files, base: dict, effect: str, target: 
     if signal == "handwheel_angle_rad" and settings.angle_offset_fitted:  # each file's sensor zero
         columns += [np.concatenate([np.full(len(r), float(j == i)) for j, r in enumerate(reference)])
                     for i in range(len(reference))]
-    absorbed = np.linalg.qr(np.column_stack(columns))[0]
+    absorbed = pm.qr(np.column_stack(columns))[0]
     signals: dict[float, np.ndarray] = {0.0: np.concatenate(reference)}  # each strength simulated once
 
     def signal_of(strength: float) -> np.ndarray:
@@ -187,7 +188,7 @@ def hidden_strength(params: Parameters, files, base: dict, effect: str, target: 
 
     def observable_of(strength: float) -> np.ndarray:
         change = signal_of(strength) - signals[0.0]
-        return change - absorbed @ (absorbed.T @ change)
+        return change - pm.matmul(absorbed, pm.matmul(absorbed.T, change))
 
     strength = strength_for_rms(signal_of, target, upper * 1e-2, upper,
                                 SizeSearch(iterations=SEARCH_STEPS, tolerance=SEARCH_TOLERANCE, max_lag_s=0.0))

@@ -41,6 +41,7 @@ from pathlib import Path
 import numpy as np
 from matplotlib.patches import Patch
 
+from .. import portable as pm
 from ..geometry import lifting_torque_a1, steer_axis
 from ..parameters import Parameters, load_parameters
 from ..plotting import COLOURS, new_figure, save_svg
@@ -114,7 +115,7 @@ def hooke_speed_ratio(params: Parameters, column_angle_rad) -> np.ndarray:
     the factor by which the joint carries a pinion torque to the column (1/cos a at psi = 0)."""
     a = params["steering.hooke_joint_angle"]
     psi = np.asarray(column_angle_rad, dtype=float) - params["steering.hooke_joint_phase"]
-    return np.cos(a) / (np.cos(a) ** 2 * np.cos(psi) ** 2 + np.sin(psi) ** 2)
+    return pm.cos(a) / (pm.cos(a) ** 2 * pm.cos(psi) ** 2 + pm.sin(psi) ** 2)
 
 
 def a1_deviation(columns: dict, params: Parameters, case: str) -> dict:

@@ -14,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .. import portable as pm
 from ..geometry import lifting_torque_a1, lock_steer_angle, overall_steering_ratio, steer_axis
 from ..parameters import Parameters, load_parameters
 from ..plotting import COLOURS, new_figure, save_svg
@@ -38,7 +39,7 @@ def first_term_a1_Nm(params: Parameters, case: str, steer_rad: float | np.ndarra
     d_m = steer_axis(params, case, "left").offset_d_m
     castor_rad = params["geometry.castor_angle"]
     load_difference_N = c["load_right"] - c["load_left"]
-    return d_m * load_difference_N * np.sin(castor_rad) * np.cos(steer_rad) / overall_steering_ratio(params)
+    return d_m * load_difference_N * pm.sin(castor_rad) * pm.cos(steer_rad) / overall_steering_ratio(params)
 
 
 def lifting_curves(params: Parameters, cases: tuple[str, ...] = FIGA3_CASES, n_points: int = N_POINTS) -> dict:

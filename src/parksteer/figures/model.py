@@ -21,6 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .. import portable as pm
 from ..errors import UsageError
 from ..geometry import steer_axis
 from ..parameters import Parameters, load_parameters
@@ -136,7 +137,7 @@ def reversal_step(columns: dict, params: Parameters) -> dict:
     share's own step.
     """
     t = np.asarray(columns["time_s"], dtype=float)
-    level = np.tanh(params["steering.friction_smoothing"] * np.asarray(columns["rack_speed_m_s"], dtype=float))
+    level = pm.tanh(params["steering.friction_smoothing"] * np.asarray(columns["rack_speed_m_s"], dtype=float))
     i_lock = int(np.argmax(columns["rack_m"]))
     start = int(np.flatnonzero((level[:i_lock] >= STEP_LEVEL))[-1])
     t0 = _crossing_time(t, level, STEP_LEVEL, start)
@@ -213,7 +214,7 @@ def until_hand_stops(columns: dict, params: Parameters) -> np.ndarray:
     tanh(beta v) vanishes, so the torque falls (16.7 to 12.8 N m unladen) along a vertical line at rack 0 that
     is the friction model's artefact, not a measurement; the torque-rack figures end their curves before it."""
     t = np.asarray(columns["time_s"], dtype=float)
-    level = np.abs(np.tanh(params["steering.friction_smoothing"] * np.asarray(columns["rack_speed_m_s"])))
+    level = np.abs(pm.tanh(params["steering.friction_smoothing"] * np.asarray(columns["rack_speed_m_s"])))
     stopping = t > t[-1] - _times(params)["half_rounding"]
     return ~(stopping & (level < STEP_LEVEL))
 
@@ -330,8 +331,8 @@ def _summary(name: str, runs: list[Run], params: Parameters, data: dict) -> dict
         out["offset_d_m"] = [steer_axis(params, c, "left").offset_d_m for c, _ in runs]
         out["plateau_torque_Nm"] = plateau.tolist()
         out["torque_near_right_lock_Nm"] = near_lock.tolist()
-        out["plateau_sensitivity_Nm_per_m_offset"] = float(np.polyfit(offsets, plateau, 1)[0])
-        out["near_lock_sensitivity_Nm_per_m_offset"] = float(np.polyfit(offsets, near_lock, 1)[0])
+        out["plateau_sensitivity_Nm_per_m_offset"] = float(pm.lstsq(np.column_stack([offsets, np.ones(len(offsets))]), plateau)[0])
+        out["near_lock_sensitivity_Nm_per_m_offset"] = float(pm.lstsq(np.column_stack([offsets, np.ones(len(offsets))]), near_lock)[0])
         out["largest_plateau_change_relative"] = float((plateau.max() - plateau.min()) / plateau[0])
     if name in ("fig12", "fig13"):
         out["plateau_torque_Nm"] = {k: s["plateau_torque_Nm"] for k, s in summaries.items()}

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import gc
 import io as _io
+import math
 import re
 import sys
 from dataclasses import dataclass
@@ -27,6 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .. import portable as pm
 from ..errors import UsageError
 from ..geometry import rack_from_handwheel
 from ..parameters import Parameters, load_parameters
@@ -372,8 +374,8 @@ def _lock_rack_m(params: Parameters) -> float:
 def _lock_limits(params: Parameters) -> dict[str, float]:
     """The largest plausible |rack| and |handwheel angle| of the car, margins included (see LOCK_MARGIN)."""
     s = params.sections["steering"]
-    cos_a = np.cos(s["hooke_joint_angle"])
-    hooke_lead = float(np.arctan((1.0 - cos_a) / (2.0 * np.sqrt(cos_a))))
+    cos_a = pm.cos(s["hooke_joint_angle"])
+    hooke_lead = pm.atan((1.0 - cos_a) / (2.0 * math.sqrt(cos_a)))
     twist = LOCK_TWIST_TORQUE_NM / s["column_torsional_stiffness"]
     angle = (params["input.handwheel_lock_angle"] + hooke_lead + twist) * LOCK_MARGIN
     return {ANGLE: angle, RACK: angle / s["handwheel_to_rack_ratio"]}
@@ -421,8 +423,8 @@ def _check_against_lock(where: Path, columns: dict, chosen: dict, params: Parame
 def _rack_speed(time_s: np.ndarray, rack_m: np.ndarray) -> np.ndarray:
     dt = float(np.median(np.diff(time_s)))
     width = max(1, int(round(SPEED_WINDOW_S / dt)))
-    kernel = np.ones(width) / width
-    smooth = np.convolve(np.pad(rack_m, (width // 2, width - 1 - width // 2), mode="edge"), kernel, mode="valid")
+    padded = np.pad(rack_m, (width // 2, width - 1 - width // 2), mode="edge")
+    smooth = np.sum(np.lib.stride_tricks.sliding_window_view(padded, width), axis=-1) / width  # a moving mean
     return np.gradient(smooth, time_s)
 
 
@@ -590,7 +592,7 @@ def load_record(path: str | Path, channel_map: str | list[Channel] | None = None
 def _decimate(path: Path, columns: dict[str, np.ndarray], metadata: dict[str, str]) -> dict[str, np.ndarray]:
     """A record sampled faster than METHOD_RATE_HZ, filtered (FIR anti-alias, zero phase) and decimated by the
     largest whole factor that keeps at least that rate; a record with uneven sampling is left as it is."""
-    from scipy.signal import decimate
+    from scipy.signal import resample_poly
 
     time_s = columns[TIME]
     steps = np.diff(time_s)
@@ -599,9 +601,11 @@ def _decimate(path: Path, columns: dict[str, np.ndarray], metadata: dict[str, st
     if factor < 2 or float(steps.max() - steps.min()) > 0.01 * dt or len(time_s) < 40 * factor:
         return columns
     out = {TIME: time_s[::factor]}
+    # scipy.signal.decimate's filter (ftype="fir", zero_phase=True), designed without numpy's CPU-dispatched sin
+    fir = pm.hamming_lowpass_fir(20 * factor + 1, 1.0 / factor)
     for name, values in columns.items():
         if name != TIME:
-            out[name] = decimate(values, factor, ftype="fir", zero_phase=True)[: len(out[TIME])]
+            out[name] = resample_poly(values, 1, factor, window=fir)[: len(out[TIME])]
     for column in list(metadata):  # a quantisation step no longer describes filtered samples
         if column.startswith("full_scale_") or column == "bits":
             del metadata[column]

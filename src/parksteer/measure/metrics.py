@@ -35,6 +35,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .. import portable as pm
 from ..errors import UsageError
 from .io import Measurement
 from .phases import PHASES, CyclePhases, find_phases
@@ -129,7 +130,7 @@ def noise_floor(values: np.ndarray, quantisation_step: float = 0.0, mask: np.nda
     q_rms = quantisation_noise_rms(quantisation_step)
     total = estimate_noise_rms(values, mask)
     analog = math.sqrt(max(total**2 - q_rms**2, 0.0))
-    return NoiseFloor(quantisation_step, q_rms, analog, math.hypot(q_rms, analog))
+    return NoiseFloor(quantisation_step, q_rms, analog, pm.hypot(q_rms, analog))
 
 
 @dataclass(frozen=True)

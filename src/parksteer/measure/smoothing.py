@@ -34,6 +34,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from .. import portable as pm
 from ..errors import UsageError
 from .metrics import estimate_noise_rms
 from .phases import local_linear_fit
@@ -133,9 +134,33 @@ def interpolate_rack(time_s, rack_m) -> RackSpline:
         raise UsageError("rack spline: needs at least 4 samples of time_s and rack_m")
     if not (np.all(np.isfinite(t)) and np.all(np.isfinite(x))) or np.any(np.diff(t) <= 0):
         raise UsageError("rack spline: time_s must be finite and strictly increasing, rack_m finite")
-    from scipy.interpolate import CubicSpline
+    return _not_a_knot_spline(t, x)
 
-    return RackSpline.from_ppoly(CubicSpline(t, x))
+
+def _not_a_knot_spline(t: np.ndarray, x: np.ndarray) -> RackSpline:
+    """The interpolating cubic spline with not-a-knot ends (scipy.interpolate.CubicSpline's default), its slopes
+    from the tridiagonal system written out and solved by :func:`parksteer.portable.solve_tridiagonal`."""
+    dt = np.diff(t)
+    slope = np.diff(x) / dt
+    n = len(t)
+    diagonal, lower, upper, rhs = np.empty(n), np.empty(n - 1), np.empty(n - 1), np.empty(n)
+    # interior: continuity of the second derivative at each knot
+    diagonal[1:-1] = 2.0 * (dt[:-1] + dt[1:])
+    lower[:-1] = dt[1:]
+    upper[1:] = dt[:-1]
+    rhs[1:-1] = 3.0 * (dt[1:] * slope[:-1] + dt[:-1] * slope[1:])
+    # not-a-knot: the third derivative continuous at the second and the last-but-one knots
+    span = t[2] - t[0]
+    diagonal[0], upper[0] = dt[1], span
+    rhs[0] = ((dt[0] + 2.0 * span) * dt[1] * slope[0] + dt[0] * dt[0] * slope[1]) / span
+    span = t[-1] - t[-3]
+    diagonal[-1], lower[-1] = dt[-2], span
+    rhs[-1] = (dt[-1] * dt[-1] * slope[-2] + (2.0 * span + dt[-1]) * dt[-2] * slope[-1]) / span
+    s = pm.solve_tridiagonal(lower, diagonal, upper, rhs)
+    # Hermite cubic on each piece, highest power first
+    excess = (s[:-1] + s[1:] - 2.0 * slope) / dt
+    coefficients = np.vstack([excess / dt, (slope - s[:-1]) / dt - excess, s[:-1], x[:-1]])
+    return RackSpline(t.copy(), coefficients)
 
 
 @dataclass(frozen=True, eq=False)
@@ -169,7 +194,8 @@ class SmoothedRack(RackSpline):
 
     def perturbed(self, rng: np.random.Generator) -> SmoothedRack:
         """A rack the data allow as well: coefficients drawn from their least-squares distribution."""
-        draw = rng.multivariate_normal(self.bspline, self.coefficient_covariance, method="eigh")
+        factor = pm.psd_factor(self.coefficient_covariance)
+        draw = self.bspline + pm.matmul(factor, rng.standard_normal(factor.shape[1]))
         return SmoothedRack.from_bspline(self.knots, draw, self.coefficient_covariance, self.knot_spacing_s,
                                          self.fit_rms_m, self.noise_rms_m, self.held_at_rest, self.turning_times_s,
                                          self.rest_intervals_s)
@@ -229,10 +255,17 @@ def _window_fits(time_s: np.ndarray, rack_m: np.ndarray, half: int, noise: float
     windows_t = np.lib.stride_tricks.sliding_window_view(time_s, 2 * half + 1)
     windows_x = np.lib.stride_tricks.sliding_window_view(rack_m, 2 * half + 1)
     tau = windows_t - 0.5 * (windows_t[:, :1] + windows_t[:, -1:])
-    powers = tau[:, :, None] ** np.arange(degree + 1)
-    gram = np.einsum("wsi,wsj->wij", powers, powers)
-    inverse = np.linalg.inv(gram)
-    coefficients = np.einsum("wij,wj->wi", inverse, np.einsum("wsi,ws->wi", powers, windows_x))
+    powers = [np.ones_like(tau)]
+    for _ in range(degree):
+        powers.append(powers[-1] * tau)
+    n = degree + 1
+    gram = np.empty((len(tau), n, n))
+    for i in range(n):
+        for j in range(i, n):
+            gram[:, i, j] = gram[:, j, i] = np.sum(powers[i] * powers[j], axis=1)
+    rhs = np.stack([np.sum(power * windows_x, axis=1) for power in powers], axis=1)
+    inverse = pm.inv_spd_batched(gram)
+    coefficients = np.sum(inverse * rhs[:, None, :], axis=2)
     errors = noise * np.sqrt(np.diagonal(inverse, axis1=1, axis2=2))
     return coefficients, errors
 
@@ -280,16 +313,18 @@ def turning_times(time_s: np.ndarray, rack_m: np.ndarray) -> tuple[float, ...]:
     return tuple(turns)
 
 
-def _constrained_solve(gram: np.ndarray, rhs: np.ndarray, constraints: np.ndarray):
-    """Least squares with linear equality constraints C c = 0: (coefficients, their covariance per unit variance)."""
-    inverse = np.linalg.inv(gram)
-    coefficients = inverse @ rhs
+def _constrained_solve(inverse: np.ndarray, rhs: np.ndarray, constraints: np.ndarray):
+    """Least squares with linear equality constraints C c = 0, from the inverse of the normal equations' matrix:
+    (coefficients, their covariance per unit variance)."""
+    coefficients = pm.matmul(inverse, rhs)
     covariance = inverse
     if len(constraints):
-        gc = inverse @ constraints.T
-        correction = gc @ np.linalg.pinv(constraints @ gc)  # pinv: a rest reaching an end already fixes its speed
-        coefficients = coefficients - correction @ (constraints @ coefficients)
-        covariance = inverse - correction @ gc.T
+        gc = pm.matmul(inverse, constraints.T)
+        # A generalised inverse (a rest reaching an end already fixes its speed, so C may repeat a constraint):
+        # any G with M G M = M gives the same coefficients and covariance.
+        correction = pm.matmul(gc, pm.generalized_inverse(pm.matmul(constraints, gc)))
+        coefficients = coefficients - pm.matmul(correction, pm.matmul(constraints, coefficients))
+        covariance = inverse - pm.matmul(correction, gc.T)
     return coefficients, 0.5 * (covariance + covariance.T)
 
 
@@ -312,12 +347,14 @@ def _lsq_fit(t: np.ndarray, x: np.ndarray, spacing_s: float, turns: tuple[float,
     from scipy.interpolate import BSpline
 
     knots = _knot_vector(t, spacing_s, turns, rests)
-    design = BSpline.design_matrix(t, knots, 3).toarray()
-    gram = design.T @ design
+    # Sparse (four B-splines are nonzero at a time): scipy's sparse products sum in a fixed order, without BLAS.
+    design = BSpline.design_matrix(t, knots, 3).tocsr()
+    gram = (design.T @ design).toarray()
     try:
-        np.linalg.cholesky(gram)
-    except np.linalg.LinAlgError:  # Schoenberg-Whitney fails: an interval without data
+        pm.cholesky(gram)
+    except pm.LinAlgError:  # Schoenberg-Whitney fails: an interval without data
         return None
+    inverse = pm.inv(gram)
     rhs = design.T @ x
     still = []  # B-spline coefficients acting over a rest are equal: the spline is constant there
     for a, b in rests:
@@ -326,19 +363,19 @@ def _lsq_fit(t: np.ndarray, x: np.ndarray, spacing_s: float, turns: tuple[float,
             row = np.zeros(len(rhs))
             row[j], row[k] = 1.0, -1.0
             still.append(row)
-    free, _ = _constrained_solve(gram, rhs, np.array(still).reshape(len(still), len(rhs)))
+    free, _ = _constrained_solve(inverse, rhs, np.array(still).reshape(len(still), len(rhs)))
     rss_free = float(np.sum((design @ free - x) ** 2))
     noise_var = max(rss_free / max(len(t) - len(rhs), 1), 1e-30)
     speed_rows = np.array([BSpline(knots, np.eye(len(rhs))[j], 3)(np.array([t[0], t[-1]]), 1)
                            for j in range(len(rhs))]).T
     held, at_rest = list(still), []
     for row in speed_rows:
-        trial, _ = _constrained_solve(gram, rhs, np.array(held + [row]))
+        trial, _ = _constrained_solve(inverse, rhs, np.array(held + [row]))
         rss = float(np.sum((design @ trial - x) ** 2))
         at_rest.append(hold_rest and rss - rss_free < RACK_REST_TEST_CHI2 * noise_var)
         if at_rest[-1]:
             held.append(row)
-    coefficients, covariance = _constrained_solve(gram, rhs, np.array(held).reshape(len(held), len(rhs)))
+    coefficients, covariance = _constrained_solve(inverse, rhs, np.array(held).reshape(len(held), len(rhs)))
     rms = float(np.sqrt(np.mean((design @ coefficients - x) ** 2)))
     return knots, coefficients, covariance, rms, tuple(at_rest)
 
@@ -348,7 +385,7 @@ def knot_spacings(time_s: np.ndarray) -> list[float]:
     dt = float(np.median(np.diff(time_s)))
     low, high = RACK_KNOT_SPACING_RANGE_S
     low = max(low, RACK_MIN_SAMPLES_PER_KNOT * dt)
-    count = int(math.floor(math.log(high / low) / math.log(RACK_KNOT_SPACING_STEP))) + 1
+    count = int(math.floor(pm.log(high / low) / pm.log(RACK_KNOT_SPACING_STEP))) + 1
     return [low * RACK_KNOT_SPACING_STEP**i for i in range(max(count, 1))]
 
 

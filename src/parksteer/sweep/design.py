@@ -19,8 +19,8 @@ gravity or unsprung mass enters the statics.
 
 from __future__ import annotations
 
-import math
 
+from .. import portable as pm
 from ..errors import UsageError
 from ..parameters import Parameters
 
@@ -80,7 +80,7 @@ def point_overrides(params: Parameters, case: str, values: dict[str, float]) -> 
     if castor is not None:
         out["geometry.castor_angle"] = castor
         out["geometry.mechanical_trail"] = (get("geometry.wheel_centre_z") - get("geometry.kingpin_top_z")) * \
-            math.tan(castor)
+            pm.tan(castor)
     return out
 
 

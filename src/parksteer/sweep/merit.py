@@ -30,6 +30,7 @@ from collections.abc import Mapping
 
 import numpy as np
 
+from .. import portable as pm
 from ..geometry import steer_axis
 from ..rig import disc_distance_integral_m3, patch_radius_m, pressure_correction
 
@@ -120,7 +121,7 @@ def ground_offset_m(params, case: str, side: str) -> float:
     """Distance in the ground plane from the contact centre to where the steer axis meets the ground."""
     axis = steer_axis(params, case, side)
     contact = axis.wheel_centre + np.array([0.0, 0.0, axis.wheel_radius_m])
-    return float(np.hypot(*(axis.ground_intercept() - contact)[:2]))
+    return pm.hypot(*(axis.ground_intercept() - contact)[:2])
 
 
 def braked_factor(params, case: str, pressure_Pa: float) -> float:
@@ -138,8 +139,8 @@ def braked_factor(params, case: str, pressure_Pa: float) -> float:
     for side in SIDES:
         radius = float(patch_radius_m(loads[side], pressure_Pa))
         ratio = float(disc_distance_integral_m3(radius, ground_offset_m(params, case, side))) / (
-            2.0 * math.pi * radius**3 / 3.0)
-        weight = loads[side] ** 1.5
+            2.0 * math.pi * (radius * radius * radius) / 3.0)
+        weight = loads[side] * math.sqrt(loads[side])
         weighted += weight * (1.0 + (ratio - 1.0) / scale)
         total += weight
     return weighted / total

@@ -41,6 +41,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .. import portable as pm
 from ..errors import UsageError
 from .hand import HandProfile, irregular_hand_profile
 from .logger import quantisation_step, synthetic_measurement
@@ -120,8 +121,8 @@ class Disturbance:
         elif self.kind == "gear_tooth":
             ratio = params["steering.handwheel_to_rack_ratio"]
             angle = ratio * columns["rack_m"] + self.phase
-            out["rack_m"] = columns["rack_m"] + self.size * np.sin(angle)
-            out["handwheel_torque_Nm"] = torque * (1.0 + self.size * ratio * np.cos(angle))
+            out["rack_m"] = columns["rack_m"] + self.size * pm.sin(angle)
+            out["handwheel_torque_Nm"] = torque * (1.0 + self.size * ratio * pm.cos(angle))
         elif self.kind == "channel_lag":
             out["handwheel_torque_Nm"] = np.interp(t - self.size, t, torque)
         return out
@@ -183,8 +184,8 @@ def strength_for_rms(torque_of, target_Nm: float, start: float, upper: float, se
             guess = s * target_Nm / value if value > 0.0 else s * 4.0  # linearised: change proportional to size
         else:
             (s0, v0), (s1, v1) = points[-2], points[-1]
-            slope = math.log(v1 / v0) / math.log(s1 / s0) if v0 > 0.0 and s0 != s1 and v1 != v0 else 0.0
-            guess = s1 * (target_Nm / v1) ** (1.0 / slope) if slope > 0.0 else -1.0
+            slope = pm.log(v1 / v0) / pm.log(s1 / s0) if v0 > 0.0 and s0 != s1 and v1 != v0 else 0.0
+            guess = s1 * pm.power(target_Nm / v1, 1.0 / slope) if slope > 0.0 else -1.0
         if not low < guess < high:  # outside the bracket
             if guess >= high and not bounded:
                 guess = upper  # nothing above has reached the target yet: try the largest size itself
@@ -601,15 +602,15 @@ def anti_alias_and_lag(time_s: np.ndarray, columns: dict[str, np.ndarray], anti_
     """The analogue front of a logger on clean columns sampled on a fine even grid `time_s`: a causal Butterworth
     low-pass of `order` at `anti_alias_hz` on the rack and the torque (run from rest at the first value; none when
     `anti_alias_hz` is 0), then the torque channel delayed `torque_lag_s` behind the rack (linear interpolation)."""
-    from scipy.signal import butter, sosfilt, sosfilt_zi
+    from scipy.signal import sosfilt
 
     t = np.asarray(time_s, dtype=float)
     filtered = {}
     if anti_alias_hz > 0.0:
-        sos = butter(order, anti_alias_hz, fs=1.0 / float(t[1] - t[0]), output="sos")
+        sos = pm.butterworth_lowpass_sos(order, anti_alias_hz, 1.0 / float(t[1] - t[0]))
     for name in ("rack_m", "handwheel_torque_Nm"):
         x = np.asarray(columns[name], dtype=float)
-        filtered[name] = sosfilt(sos, x, zi=sosfilt_zi(sos) * x[0])[0] if anti_alias_hz > 0.0 else x.copy()
+        filtered[name] = sosfilt(sos, x, zi=pm.sos_steady_state(sos) * x[0])[0] if anti_alias_hz > 0.0 else x.copy()
     if torque_lag_s:
         filtered["handwheel_torque_Nm"] = np.interp(t - torque_lag_s, t, filtered["handwheel_torque_Nm"])
     return filtered

@@ -12,6 +12,7 @@ from typing import Any
 
 import numpy as np
 
+from .. import portable as pm
 from ..errors import UsageError
 from ..parameters import Parameters
 
@@ -123,7 +124,7 @@ class HandVariation:
         shares = rng.uniform(0.5, 1.0, size=self.components)
         amplitudes = self.speed_variation * shares / shares.sum()
         t = np.asarray(t_s, dtype=float)[..., None]
-        return 1.0 + np.sum(amplitudes * np.sin(2.0 * np.pi * frequencies * t + phases), axis=-1)
+        return 1.0 + np.sum(amplitudes * pm.sin(2.0 * np.pi * frequencies * t + phases), axis=-1)
 
     def metadata(self) -> dict[str, Any]:
         low, high = self.frequency_range_hz

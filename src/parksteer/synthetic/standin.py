@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .. import portable as pm
 from ..geometry import lifting_torque_a1, overall_steering_ratio
 from ..parameters import Parameters
 from ..rig import limiting_torque_Nm
@@ -31,14 +32,14 @@ from ..measure.io import SURFACES
 
 def hooke_speed_ratio(column_angle_rad: np.ndarray, joint_angle_rad: float, phase_rad: float) -> np.ndarray:
     """Pinion speed / column speed of a Hooke joint: cos(b) / (1 - sin(b)^2 cos(theta - phase)^2)."""
-    c = np.cos(np.asarray(column_angle_rad) - phase_rad)
-    return np.cos(joint_angle_rad) / (1.0 - np.sin(joint_angle_rad) ** 2 * c**2)
+    c = pm.cos(np.asarray(column_angle_rad) - phase_rad)
+    return pm.cos(joint_angle_rad) / (1.0 - pm.sin(joint_angle_rad) ** 2 * c**2)
 
 
 def hooke_output_angle(column_angle_rad: np.ndarray, joint_angle_rad: float, phase_rad: float) -> np.ndarray:
     """Pinion angle of a Hooke joint, tan(out - phase) = tan(in - phase) / cos(b), continuous in the input."""
     u = np.asarray(column_angle_rad, dtype=float) - phase_rad
-    lag = np.arctan2(np.sin(u), np.cos(u) * np.cos(joint_angle_rad)) - u
+    lag = pm.atan2(pm.sin(u), pm.cos(u) * pm.cos(joint_angle_rad)) - u
     lag = (lag + np.pi) % (2.0 * np.pi) - np.pi  # the lag is small; remove the 2 pi wraps
     return column_angle_rad + lag
 
@@ -78,7 +79,7 @@ def quasi_static_cycle(
     steer = rack_m * s["roadwheel_to_rack_ratio"]
     overall = overall_steering_ratio(params)
 
-    pinion_torque = s["rack_friction_force"] / s["handwheel_to_rack_ratio"] * np.tanh(
+    pinion_torque = s["rack_friction_force"] / s["handwheel_to_rack_ratio"] * pm.tanh(
         s["friction_smoothing"] * rack_speed
     )
     if surface == "ground":

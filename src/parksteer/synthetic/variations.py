@@ -29,6 +29,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from .. import portable as pm
 from ..errors import UsageError
 from ..measure.io import Measurement, metadata_text
 from ..measure.smoothing import interpolate_rack
@@ -86,7 +87,7 @@ def _smoothstep_rate(t: np.ndarray, t0: float, t1: float, ramp: float) -> np.nda
     """A rate shape rising from 0 at t0 to 1 over `ramp`, 1 in the cruise, back to 0 at t1 (C1 cosine ramps)."""
     up = np.clip((t - t0) / ramp, 0.0, 1.0)
     down = np.clip((t1 - t) / ramp, 0.0, 1.0)
-    shape = 0.5 - 0.5 * np.cos(np.pi * np.minimum(up, down))
+    shape = 0.5 - 0.5 * pm.cos(np.pi * np.minimum(up, down))
     return np.where((t > t0) & (t < t1), shape, 0.0)
 
 
@@ -113,7 +114,7 @@ def variation_hand(params: Parameters, hand: HandVariant) -> tuple[np.ndarray, n
     end_hand = sum(durations) + sum(pauses)
     end_record = end_hand + hand.rest_after_s if hand.end == "rest" else end_hand - hand.cut_before_end_s
     t = np.arange(0.0, max(end_record, end_hand) + 0.5 * HAND_DT_S, HAND_DT_S)
-    wander = 1.0 + hand.rate_variation * 0.5 * np.sum(np.sin(2 * np.pi * frequencies * t[:, None] + phases), axis=1)
+    wander = 1.0 + hand.rate_variation * 0.5 * np.sum(pm.sin(2 * np.pi * frequencies * t[:, None] + phases), axis=1)
     rate = np.zeros_like(t)
     start = 0.0
     for duration, travel, pause in zip(durations, travels, pauses):

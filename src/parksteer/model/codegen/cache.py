@@ -11,6 +11,7 @@ user's cache directory. :func:`ensure` is the one way to get a model built and d
 
 from __future__ import annotations
 
+import fcntl
 import hashlib
 import inspect
 import json
@@ -21,6 +22,8 @@ import subprocess
 import sys
 import tempfile
 import time
+from collections.abc import Iterator
+from contextlib import contextmanager, suppress
 from functools import lru_cache
 from importlib import metadata
 from pathlib import Path
@@ -40,8 +43,10 @@ SYMBOLIC_DIRS = (MODEL_DIR / "symbolic", MODEL_DIR / "codegen")
 # This module stores entries and generates nothing, so its source is not part of the key.
 KEYLESS_SOURCE = Path(__file__).resolve()
 # How the generated C is compiled; part of the model key. -O1: the same integration time as -O2 on the default
-# model (4.8 ms a cycle) for two thirds of the compile time (1.0 s instead of 1.5 s).
-COMPILE_FLAGS = ("-O1", "-shared", "-fPIC")
+# model (4.8 ms a cycle) for two thirds of the compile time (1.0 s instead of 1.5 s). -ffp-contract=off: no fused
+# multiply-add, which GCC otherwise forms wherever the target has one (aarch64, or x86 with -march=native), so
+# every product is rounded on its own and the bits do not depend on the target.
+COMPILE_FLAGS = ("-O1", "-ffp-contract=off", "-shared", "-fPIC")
 # Built files whose SHA-256 model.json records: an entry is used only if both exist and match.
 BUILT_FILES = ("model.c", "model.so")
 # A scratch directory (".<key>.<host>.<pid>.<random>") whose builder is gone is removed by the next build; one
@@ -186,14 +191,35 @@ def _alive(pid: int) -> bool:
     return True
 
 
+def _unheld(lock: Path) -> bool:
+    """Whether no process holds the build lock `lock` now."""
+    try:
+        fd = os.open(lock, os.O_RDWR)
+    except OSError:
+        return False
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        return True
+    except BlockingIOError:
+        return False
+    finally:
+        os.close(fd)
+
+
 def clean_stale_scratch(root: Path) -> list[Path]:
-    """Remove scratch directories of builds that were killed (their process is gone); return what was removed."""
+    """Remove scratch directories and build locks of builds that were killed (their process is gone); return what
+    was removed."""
     removed = []
     host = socket.gethostname().replace(".", "-")  # as the scratch name writes it
     if not root.is_dir():
         return removed
     for path in root.iterdir():
         parts = path.name.split(".")
+        if path.name.startswith(".") and path.name.endswith(".lock") and _unheld(path):
+            with suppress(FileNotFoundError):
+                path.unlink()  # the build lock of a killed build
+            removed.append(path)
+            continue
         if not (path.name.startswith(".") and len(parts) >= 5 and path.is_dir()):
             continue
         _, _key, owner_host, pid, *_ = parts
@@ -210,30 +236,62 @@ def clean_stale_scratch(root: Path) -> list[Path]:
     return removed
 
 
+@contextmanager
+def _build_lock(final: Path) -> Iterator[None]:
+    """Hold the build of one cache entry: processes that need the same model at the same time build it once, the
+    others wait here and then find it built. The lock file goes when its holder is done (a waiter that wakes on a
+    removed file takes the lock again on the new one)."""
+    path = final.parent / f".{final.name}.lock"
+    while True:
+        fd = os.open(path, os.O_CREAT | os.O_RDWR, 0o644)
+        try:
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except BlockingIOError:
+                note(f"another process is building the model {final.name}: waiting for it")
+                fcntl.flock(fd, fcntl.LOCK_EX)
+            try:
+                current = os.stat(path).st_ino == os.fstat(fd).st_ino
+            except FileNotFoundError:
+                current = False
+            if current:
+                try:
+                    yield
+                finally:
+                    with suppress(FileNotFoundError):
+                        os.unlink(path)
+                return
+        finally:
+            os.close(fd)
+
+
 def ensure_entry(effects: list[Effect]) -> Path:
     """The cache entry of `effects`, built if missing or unsound (atomically: built aside, then renamed into
-    place; a scratch directory left by a killed build is removed here)."""
+    place; a scratch directory left by a killed build is removed here; one build at a time per entry)."""
     final = entry_path(effects)
     if entry_is_sound(final):
         return final
     final.parent.mkdir(parents=True, exist_ok=True)
-    clean_stale_scratch(final.parent)
-    host = socket.gethostname().replace(".", "-")
-    scratch = Path(tempfile.mkdtemp(prefix=f".{final.name}.{host}.{os.getpid()}.", dir=final.parent))
-    try:
-        build_entry(effects, scratch)
-        if final.exists() and not entry_is_sound(final):  # damaged or incomplete: replaced by the new build
-            broken = Path(tempfile.mkdtemp(prefix=f".{final.name}.{host}.{os.getpid()}.", dir=final.parent))
-            os.rename(final, broken / "old")
-            shutil.rmtree(broken, ignore_errors=True)
+    with _build_lock(final):
+        if entry_is_sound(final):  # built by the process this one waited for
+            return final
+        clean_stale_scratch(final.parent)
+        host = socket.gethostname().replace(".", "-")
+        scratch = Path(tempfile.mkdtemp(prefix=f".{final.name}.{host}.{os.getpid()}.", dir=final.parent))
         try:
-            os.rename(scratch, final)
-        except OSError:
-            if not entry_is_sound(final):  # someone else's complete entry wins
-                raise
-    finally:
-        if scratch.exists():
-            shutil.rmtree(scratch, ignore_errors=True)
+            build_entry(effects, scratch)
+            if final.exists() and not entry_is_sound(final):  # damaged or incomplete: replaced by the new build
+                broken = Path(tempfile.mkdtemp(prefix=f".{final.name}.{host}.{os.getpid()}.", dir=final.parent))
+                os.rename(final, broken / "old")
+                shutil.rmtree(broken, ignore_errors=True)
+            try:
+                os.rename(scratch, final)
+            except OSError:
+                if not entry_is_sound(final):  # someone else's complete entry wins
+                    raise
+        finally:
+            if scratch.exists():
+                shutil.rmtree(scratch, ignore_errors=True)
     return final
 
 

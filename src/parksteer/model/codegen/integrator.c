@@ -244,7 +244,7 @@ static int bdf_newton(const bdf_system *s, double t_new, const double *y_pred, d
         bdf_lu_solve(n, lu, pivot, dy);
         double dy_norm = bdf_norm(n, dy, scale);
         double rate = k > 0 ? dy_norm / dy_norm_old : -1.0;
-        if (k > 0 && (rate >= 1.0 || pow(rate, BDF_NEWTON_MAXITER - k) / (1.0 - rate) * dy_norm > tol)) return 0;
+        if (k > 0 && (rate >= 1.0 || ps_pow(rate, BDF_NEWTON_MAXITER - k) / (1.0 - rate) * dy_norm > tol)) return 0;
         for (int i = 0; i < n; i++) { y_new[i] += dy[i]; d[i] += dy[i]; }
         if (dy_norm == 0.0 || (k > 0 && rate / (1.0 - rate) * dy_norm < tol)) return 1;
         dy_norm_old = dy_norm;
@@ -387,7 +387,7 @@ static int bdf_solve(const bdf_system *s, const double *y0, int n_out, const dou
             }
             double error_norm = bdf_norm(n, error, scale);
             if (error_norm > 1.0) {
-                double factor = fmax(bdf_min_factor, safety * pow(error_norm, -1.0 / (order + 1)));
+                double factor = fmax(bdf_min_factor, safety * ps_pow(error_norm, -1.0 / (order + 1)));
                 bdf_change_D(n, D, order, factor);
                 h *= factor;
                 n_equal_steps = 0;
@@ -414,12 +414,12 @@ static int bdf_solve(const bdf_system *s, const double *y0, int n_out, const dou
                 double factor_lower = 0.0, factor_same, factor_higher = 0.0;
                 if (order > 1) {
                     for (int i = 0; i < n; i++) error[i] = co.error_const[order - 1] * D[order][i];
-                    factor_lower = pow(bdf_norm(n, error, scale), -1.0 / order);
+                    factor_lower = ps_pow(bdf_norm(n, error, scale), -1.0 / order);
                 }
-                factor_same = pow(error_norm, -1.0 / (order + 1));
+                factor_same = ps_pow(error_norm, -1.0 / (order + 1));
                 if (order < BDF_MAX_ORDER) {
                     for (int i = 0; i < n; i++) error[i] = co.error_const[order + 1] * D[order + 2][i];
-                    factor_higher = pow(bdf_norm(n, error, scale), -1.0 / (order + 2));
+                    factor_higher = ps_pow(bdf_norm(n, error, scale), -1.0 / (order + 2));
                 }
                 double best = factor_same;
                 int new_order = order;

@@ -35,6 +35,7 @@ from typing import Protocol
 
 import numpy as np
 
+from ... import portable as pm
 from .statics import static_state
 from .tolerances import (PRESCRIBED_ATOL_FACTOR, PRESCRIBED_RTOL, absolute_tolerances, integrator_failure,
                          max_steps)
@@ -358,7 +359,7 @@ def column_twist(t: np.ndarray, torque: np.ndarray, stiffness: float, damping: f
         return twist, np.gradient(twist, t)
     tau = damping / stiffness
     h = np.diff(t)
-    decay = np.exp(-h / tau)
+    decay = pm.exp(-h / tau)
     slope = np.diff(torque) / h
     # x(t0 + h) = T1/k - tau s/k + (x0 - T0/k + tau s/k) e^(-h/tau), s the torque's slope over the interval
     twist = np.empty(len(t))

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ... import portable as pm
+
 
 def static_state(run, fixed: dict[str, float] | None = None, t_s: float = 0.0, p: np.ndarray | None = None
                  ) -> np.ndarray:
@@ -24,7 +26,7 @@ def static_state(run, fixed: dict[str, float] | None = None, t_s: float = 0.0, p
         residual = model.forcing(t_s, y, p)[free]
         jac = model.forcing_dq(t_s, y, p)[np.ix_(free, free)]
         # least squares: a coordinate with neither stiffness nor load (an effect at strength 0) stays put
-        step = np.linalg.lstsq(jac, -residual, rcond=None)[0]
+        step = pm.lstsq(jac, -residual)
         y[free] += step
         if np.max(np.abs(step)) < 1e-14:
             break

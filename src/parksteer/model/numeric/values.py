@@ -15,6 +15,7 @@ import math
 
 import numpy as np
 
+from ... import portable as pm
 from ...errors import UsageError
 from ...geometry import steer_axis
 from ...parameters import CASE_SCHEMA, SCHEMA, Parameters, quantity
@@ -113,11 +114,11 @@ def derived_values(values: RunValues) -> dict[str, float]:
         axis = steer_axis(params, case, side)
         frame = axis.axis_frame
         foot = axis.foot
-        centre = frame.T @ (axis.wheel_centre - foot)
-        outboard = centre / np.linalg.norm(centre)
+        centre = pm.matmul(frame.T, axis.wheel_centre - foot)
+        outboard = centre / pm.norm(centre)
         cg = params["steering.steering_assembly_cg_outboard"] * outboard
         # Inertia given about axes parallel to the body axes at zero steer; S turns with the wheel.
-        inertia = frame.T @ inertia_body @ frame
+        inertia = pm.matmul(pm.matmul(frame.T, inertia_body), frame)
         load = c[f"load_{side}"]
         entries = {f"foot_{a}": foot[i] for i, a in enumerate("xyz")}
         entries.update({f"axis_frame_{i}{j}": frame[i, j] for i in range(3) for j in range(3)})
