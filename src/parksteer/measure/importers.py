@@ -457,11 +457,17 @@ def load_record(path: str | Path, channel_map: str | list[Channel] | None = None
     for target, (src, ch) in chosen.items():
         unit = ch.unit or src.unit
         at = f"{path}: channel {src.name!r}"
-        if ch.unit is not None and src.unit is not None and ch.unit != src.unit:
-            one = np.ones(1)
-            if to_si(one, ch.unit, target, at)[0] != to_si(one, src.unit, target, at)[0]:
-                raise UsageError(f"{at}: {ch.origin} says [{ch.unit}] but the file says [{src.unit}]; give one unit")
-        values = to_si(src.values, unit, target, at)
+        try:
+            if ch.unit is not None and src.unit is not None and ch.unit != src.unit:
+                one = np.ones(1)
+                same = to_si(one, ch.unit, target, at)[0] == to_si(one, src.unit, target, at)[0]
+            values = to_si(src.values, unit, target, at)
+        except UsageError as exc:
+            if ch.unit is None or ch.origin in ("alias", "master") or repr(ch.unit) not in str(exc):
+                raise
+            raise UsageError(f"{exc} (the unit of {ch.origin})") from None
+        if ch.unit is not None and src.unit is not None and ch.unit != src.unit and not same:
+            raise UsageError(f"{at}: {ch.origin} says [{ch.unit}] but the file says [{src.unit}]; give one unit")
         columns[target] = -values if ch.negate else values
     renamed = [Channel(src.name, ch.unit or src.unit, ch.target, ch.negate).spec() for src, ch in chosen.values()
                if (src.name != ch.target or ch.negate) and ch.origin != "master"]
