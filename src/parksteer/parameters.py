@@ -46,6 +46,7 @@ class Quantity:
     upper_inclusive: bool = True
     is_list: bool = False
     description: str = ""
+    why: str = ""  # the range of real cars behind the bounds, given with a refusal
     default: float | None = None
     source: str = ""
 
@@ -76,8 +77,9 @@ class Quantity:
         if not math.isfinite(value):
             raise ParameterError(f"{where}: value {value} is not finite")
         if not self.within(value):
+            why = f"; {self.why}" if self.why else ""
             raise ParameterError(
-                f"{where}: value {value:g} {self.unit} is non-physical (allowed {self.bounds_text()})"
+                f"{where}: value {value:g} {self.unit} is non-physical (allowed {self.bounds_text()}{why})"
             )
         return value
 
@@ -104,31 +106,45 @@ def _any(unit: str) -> dict[str, Any]:
 
 # Unit and physical bounds of every key of the parameter file: the one home of both. The file must hold
 # every key listed here, in the unit given here.
+# Masses, inertias, stiffnesses and dampings have upper (and masses and inertias lower) bounds a road car cannot
+# leave, each about ten times beyond the range of cars (the reason beside each): a value beyond is a wrong unit or
+# a typo, and it is refused up front, naming file and key, instead of making the model too stiff to integrate
+# (a tyre's radial stiffness of 1e15 N/m stops the integrator at 0.19 s) or meaningless.
+ASSEMBLY_INERTIA = "a wheel, hub, brake and strut about its axes: 0.3-3 kg m^2"
 _SCHEMA: dict[str, dict[str, dict[str, Any]]] = {
     "vehicle": {
         "gravity": _pos("m/s^2"),
-        "unsprung_mass": _pos("kg"),
-        "chassis_roll_inertia": _pos("kg m^2"),
-        "chassis_roll_stiffness": _pos("N m/rad"),
-        "chassis_roll_damping": _nonneg("N m s/rad"),
+        "unsprung_mass": _q("kg", 1.0, 2000.0,
+            why="a front end's moving parts: 50-250 kg"),
+        "chassis_roll_inertia": _q("kg m^2", 1.0, 1.0e5,
+            why="a car body about its roll axis: 100-1000 kg m^2"),
+        "chassis_roll_stiffness": _q("N m/rad", 0.0, 1.0e8,
+            why="a road car's roll stiffness: 2e4-2e6 N m/rad"),
+        "chassis_roll_damping": _q("N m s/rad", 0.0, 1.0e6, lower_inclusive=True,
+            why="a car's roll damping: 1e3-1e5 N m s/rad"),
         "chassis_cg_z": _any("m"),
         "roll_axis_z": _any("m"),
     },
     "steering": {
-        "rack_mass": _pos("kg"),
-        "rack_roll_inertia": _nonneg("kg m^2"),
+        "rack_mass": _q("kg", 0.1, 100.0,
+            why="a rack with its piston: 2-15 kg"),
+        "rack_roll_inertia": _q("kg m^2", 0.0, 10.0, lower_inclusive=True,
+            why="a rack about its axis: ~0.01 kg m^2"),
         "rack_friction_force": _range("N", 0.0, 1.0e5),
         "handwheel_to_rack_ratio": _pos("rad/m"),
         "roadwheel_to_rack_ratio": _pos("rad/m"),
-        "column_torsional_stiffness": _pos("N m/rad"),
-        "column_torsional_damping": _nonneg("N m s/rad"),
+        "column_torsional_stiffness": _q(
+            "N m/rad", 0.0, 1.0e6, why="an EPS torsion bar is 100-3000 N m/rad, a plain column shaft 1e4-1e5"),
+        "column_torsional_damping": _q("N m s/rad", 0.0, 1.0e5, lower_inclusive=True,
+            why="Appendix B gives 200 N m s/rad"),
         "hooke_joint_angle": _range("rad", 0.0, 1.2),
         "hooke_joint_phase": _range("rad", -10.0, 10.0),
         "steering_assembly_cg_outboard": _any("m"),
-        "steering_assembly_mass": _pos("kg"),
-        "steering_assembly_inertia_x": _pos("kg m^2"),
-        "steering_assembly_inertia_y": _pos("kg m^2"),
-        "steering_assembly_inertia_z": _pos("kg m^2"),
+        "steering_assembly_mass": _q("kg", 1.0, 500.0,
+            why="wheel, hub, brake and strut: 20-80 kg"),
+        "steering_assembly_inertia_x": _q("kg m^2", 1.0e-3, 100.0, why=ASSEMBLY_INERTIA),
+        "steering_assembly_inertia_y": _q("kg m^2", 1.0e-3, 100.0, why=ASSEMBLY_INERTIA),
+        "steering_assembly_inertia_z": _q("kg m^2", 1.0e-3, 100.0, why=ASSEMBLY_INERTIA),
         "rack_axis_z": _range("m", -2.0, 2.0),
         "friction_smoothing": _range("s/m", 1.0, 1.0e6),
     },
@@ -147,12 +163,16 @@ _SCHEMA: dict[str, dict[str, dict[str, Any]]] = {
         "friction_coefficient": _range("1", 0.0, 3.0),
         "reference_pressure": _range("Pa", 1.0e4, 1.0e6),
         "pressure_index": _range("1", 0.0, 3.0),
-        "radial_stiffness": _pos("N/m"),
-        "radial_damping": _nonneg("N s/m"),
+        "radial_stiffness": _q("N/m", 1.0e4, 1.0e7, why="a car tyre's vertical stiffness is 1.5e5-4e5 N/m, a "
+                                                           "truck's about 1e6 N/m"),
+        "radial_damping": _q("N s/m", 0.0, 1.0e6, lower_inclusive=True,
+            why="Appendix B's 1e5 is already heavy"),
         "carcass_torsional_stiffness": _range("N m/rad", 1.0, 1.0e6),
         "carcass_torsional_damping": _range("N m s/rad", 0.0, 1.0e4),
-        "tread_ring_mass": _pos("kg"),
-        "tread_ring_yaw_inertia": _pos("kg m^2"),
+        "tread_ring_mass": _q("kg", 0.01, 100.0,
+            why="a tyre's tread and belts: 2-10 kg"),
+        "tread_ring_yaw_inertia": _q("kg m^2", 1.0e-3, 100.0,
+            why="the same about the steer axis: 0.1-1 kg m^2"),
     },
     "rig": {
         "friction_test_force": _pos("N"),
@@ -235,7 +255,8 @@ _SCHEMA: dict[str, dict[str, dict[str, Any]]] = {
 }
 
 _CASE_SCHEMA: dict[str, dict[str, Any]] = {
-    "chassis_mass": _pos("kg"),
+    "chassis_mass": _q("kg", 10.0, 2.0e4,
+        why="the front axle's share of a body: 300-1500 kg for a car"),
     "chassis_cg_y": _any("m"),
     "wheel_centre_y": _pos("m"),
     "load_left": _pos("N"),

@@ -52,7 +52,7 @@ def record_text(meta=None, header=None, data=None, *, columns: dict | None = Non
 @dataclass(frozen=True)
 class Case:
     name: str
-    entry: str  # compare | diagnose | simulate | check-params | checksums
+    entry: str  # compare | diagnose | simulate | check-params | checksums | vehicle
     make: Callable[[Path], list[str]]  # scratch folder -> argv (files written there)
     expect: str  # ACCEPTED or a fragment of the one-line error
     outputs: tuple[str, ...] = ()  # files (relative to the scratch folder) that must not exist after an error
@@ -328,5 +328,268 @@ def checksum_cases() -> list[Case]:
     ]
 
 
+
+
+# ------------------------------------------------------------------------------ findings and further entry points
+
+VEHICLE = REPO / "data" / "vehicles" / "maestro.toml"
+
+
+def _logger_text() -> str:
+    """The base record as a logger writes it: its own names, units in brackets (rack in mm), semicolons."""
+    m, _, d = base_record()
+    header = ["Time [s]", "RackPos [mm]", "SteerTorque [N*m]"]
+    rows = [f"{t:.9g};{1000 * x:.9g};{T:.9g}" for t, x, T in d[:, :3]]
+    return "\n".join([line for line in m if not line.startswith(("# full_scale", "# bits"))] + [";".join(header)]
+                     + rows) + "\n"
+
+
+def _quoted_text() -> str:
+    """The base record with every header name and number in double quotes, as some spreadsheets export."""
+    return "".join(line + "\n" if line.startswith("#") else ",".join(f'"{c}"' for c in line.split(",")) + "\n"
+                   for line in record_text().splitlines())
+
+
+def _rack_renamed_text() -> str:
+    """Time, torque and a rack column under a name no alias knows, and no angle to derive the rack from."""
+    out = []
+    for line in record_text().splitlines():
+        if line.startswith("#"):
+            if "rack_m" not in line and "angle" not in line:
+                out.append(line)
+        else:
+            out.append(",".join(line.split(",")[:3]).replace("rack_m", "Zahnrad"))
+    return "\n".join(out) + "\n"
+
+
+def _loop(folder: Path) -> Path:
+    import os
+
+    path = folder / "loop.csv"
+    os.symlink(path, path)
+    return path
+
+
+def _mdf(folder: Path, *, unit: str = "mm", time_back: bool = False) -> Path:
+    """The base record as MDF 4 (asammdf): torque and rack channels; a rack unit, a time base going back."""
+    import asammdf
+
+    _, _, d = base_record()
+    t = d[:, 0].copy()
+    if time_back:
+        t[40] = t[38]
+    mdf = asammdf.MDF(version="4.10")
+    mdf.append([asammdf.Signal(d[:, 2], d[:, 0], name="SteerTorque", unit="N*m")])
+    mdf.append([asammdf.Signal(1000 * d[:, 1], t, name="RackPos", unit=unit)])
+    path = Path(mdf.save(folder / "log.mf4", overwrite=True))
+    mdf.close()
+    return path
+
+
+def _vehicle_text(old: str | None = None, new: str | None = None) -> str:
+    text = VEHICLE.read_text(encoding="utf-8")
+    if old is not None and "kingpin_top_y" in old:  # an inboard top leans the axis across the centreline
+        text = text.replace("kingpin_inclination = { value = 0.219,", "kingpin_inclination = { value = -0.45,", 1)
+    if old is not None:
+        assert old in text, old
+        text = text.replace(old, new, 1)
+    return text
+
+
+SPEC = ["--front-axle-mass-kg", "780", "--track-m", "1.46", "--kingpin-inclination-deg", "13", "--castor-deg", "3",
+        "--scrub-radius-m", "0.01", "--tyre-size", "185/65R15", "--tyre-pressure-bar", "2.2", "--steering-ratio",
+        "15", "--lock-turns", "3"]
+
+
+def _spec(folder: Path, option: str | None = None, value: str | None = None) -> list[str]:
+    argv = ["vehicle", "new", "--out", str(folder / "car.toml"), *SPEC]
+    if option is not None:
+        if option in argv:
+            argv[argv.index(option) + 1] = value
+        else:
+            argv += [option, value]
+    return argv
+
+
+def finding_cases() -> list[Case]:
+    """The bad inputs a review found handled badly, each now refused (or read) as it should be."""
+    out = ("out.csv",)
+    stiff = _params_text("radial_stiffness = { value = 160000.0,", "radial_stiffness = { value = 1e15,")
+    return [
+        Case("compare:rack_column_unknown_name", "compare",
+             lambda f: ["compare", str(_write(f, "r.csv", _rack_renamed_text())), "--plot", str(f / "out.svg")],
+             "of which Zahnrad is not a known channel name", ("out.svg",)),
+        Case("simulate:parameters_radial_stiffness_1e15", "simulate",
+             lambda f: ["simulate", "--case", "unladen", "--parameters", str(_write(f, "p.toml", stiff)), "--out",
+                        str(f / "out.csv")], "p.toml: tyre.radial_stiffness: value 1e+15 N/m is non-physical", out),
+        Case("check-params:radial_stiffness_1e15", "check-params",
+             lambda f: ["check-params", str(_write(f, "p.toml", stiff))], "tyre.radial_stiffness"),
+        Case("check-params:rack_mass_in_grams", "check-params",
+             lambda f: ["check-params", str(_write(f, "p.toml", _params_text("rack_mass = { value = 10.0,",
+                                                                              "rack_mass = { value = 10000.0,")))],
+             "steering.rack_mass: value 10000 kg is non-physical"),
+        Case("compare:quoted_numbers", "compare",
+             lambda f: ["compare", str(_write(f, "q.csv", _quoted_text()))], ACCEPTED),
+        Case("simulate:quoted_numbers", "simulate",
+             lambda f: _record_argv("simulate", _write(f, "q.csv", _quoted_text()), f), ACCEPTED),
+        Case("compare:symlink_loop", "compare", lambda f: ["compare", str(_loop(f))], "symbolic link loop"),
+        Case("simulate:rack_from_symlink_loop", "simulate",
+             lambda f: _record_argv("simulate", _loop(f), f), "symbolic link loop", out),
+    ]
+
+
+def map_cases() -> list[Case]:
+    """--map and --map-file on a logger's export: unknown unit, unknown channel, a target mapped twice."""
+    def with_map(spec: str):
+        return lambda f: ["compare", str(_write(f, "log.csv", _logger_text())), "--map", spec, "--plot",
+                          str(f / "out.svg")]
+
+    def with_file(lines: str):
+        return lambda f: ["compare", str(_write(f, "log.csv", _logger_text())), "--map-file",
+                          str(_write(f, "map.txt", lines)), "--plot", str(f / "out.svg")]
+
+    svg = ("out.svg",)
+    return [
+        Case("compare:logger_export", "compare", lambda f: ["compare", str(_write(f, "log.csv", _logger_text()))],
+             ACCEPTED),
+        Case("compare:map_unknown_unit", "compare", with_map("RackPos[furlongz]=rack_m"),
+             "unit 'furlongz' is not a unit pint knows (the unit of --map)", svg),
+        Case("compare:map_unknown_channel", "compare", with_map("Wheel[mm]=rack_m"),
+             "--map names channel 'Wheel', which the file does not have", svg),
+        Case("compare:map_duplicate_target", "compare", with_map("RackPos[mm]=rack_m,SteerTorque[N*m]=rack_m"),
+             "both map to 'rack_m'", svg),
+        Case("compare:map_file_unknown_unit", "compare", with_file("# logger\nRackPos[furlongz]=rack_m\n"),
+             "(the unit of ", svg),
+        Case("compare:map_file_unknown_channel", "compare", with_file("Wheel[mm]=rack_m\n"),
+             "map.txt: line 1 names channel 'Wheel'", svg),
+        Case("compare:map_file_duplicate_target", "compare",
+             with_file("RackPos[mm]=rack_m\nSteerTorque[N*m]=rack_m\n"), "map.txt: line 2", svg),
+        Case("compare:map_and_map_file_same_target", "compare",
+             lambda f: ["compare", str(_write(f, "log.csv", _logger_text())), "--map-file",
+                        str(_write(f, "map.txt", "RackPos[mm]=rack_m\n")), "--map", "SteerTorque[N*m]=rack_m",
+                        "--plot", str(f / "out.svg")], "repeats a channel or target", svg),
+    ]
+
+
+def vehicle_cases() -> list[Case]:
+    """--vehicle with every statics check of a vehicle file failing, and vehicle new/check on absurd specs."""
+    statics = {
+        "shipped": (None, None, ACCEPTED),
+        "unsprung_mass": ("unsprung_mass = { value = 100.0,", "unsprung_mass = { value = 150.0,",
+                          "vehicle.unsprung_mass: 150 kg, but the parts"),
+        "negative_mass": ("rack_mass = { value = 10.0,", "rack_mass = { value = -10.0,", "steering.rack_mass"),
+        "load_sum": ("load_left = { value = 2698.0,", "load_left = { value = 3698.0,", "wheel loads sum to"),
+        "heights_out_of_order": ("wheel_centre_z = { value = 0.2,", "wheel_centre_z = { value = 0.6,",
+                                 "geometry.wheel_centre_z: heights out of order"),
+        "kingpin_outboard": ("kingpin_top_y = { value = 0.58,", "kingpin_top_y = { value = 0.9,",
+                             "is not outboard of geometry.kingpin_top_y"),
+        "axis_across_centreline": ("kingpin_top_y = { value = 0.58,", "kingpin_top_y = { value = 0.1,",
+                                   "across the centreline"),
+        "lock_beyond_linkage": ("handwheel_lock_angle = { value = 12.566,", "handwheel_lock_angle = { value = 40.0,",
+                                "input.handwheel_lock_angle"),
+        "missing_value": ('rack_mass = { value = 10.0, unit = "kg", source = "Appendix B" }\n', "",
+                          "steering.rack_mass: missing value"),
+        "unknown_key": ("[steering]\n", "[steering]\nrack_colour = { value = 1.0, unit = \"1\", source = \"x\" }\n",
+                        "steering.rack_colour: unknown key"),
+    }
+    cases = []
+    for name, (old, new, fragment) in statics.items():
+        def make(f, old=old, new=new):
+            return ["simulate", "--vehicle", str(_write(f, "car.toml", _vehicle_text(old, new))), "--case", "unladen",
+                    "--output-dt", "0.5", "--out", str(f / "out.csv")]
+
+        cases.append(Case(f"simulate:vehicle_{name}", "simulate", make, fragment,
+                          () if fragment == ACCEPTED else ("out.csv",)))
+    cases.append(Case("vehicle:check_negative_mass", "vehicle",
+                      lambda f: ["vehicle", "check", str(_write(f, "car.toml", _vehicle_text(
+                          "rack_mass = { value = 10.0,", "rack_mass = { value = -10.0,")))], "steering.rack_mass"))
+    cases.append(Case("vehicle:check_missing", "vehicle", lambda f: ["vehicle", "check", str(f / "nope.toml")],
+                      "nope.toml: cannot read"))
+    absurd = {
+        "accepted": (None, None, ACCEPTED),
+        "negative_mass": ("--front-axle-mass-kg", "-780", "--front-axle-mass-kg -780: must be positive"),
+        "zero_load": ("--front-axle-mass-kg", "0", "--front-axle-mass-kg 0: must be positive"),
+        "mass_below_unsprung": ("--front-axle-mass-kg", "50", "nothing written: "),
+        "ratio_zero": ("--steering-ratio", "0", "--steering-ratio 0"),
+        "lock_turns_zero": ("--lock-turns", "0", "--lock-turns 0"),
+        "track_negative": ("--track-m", "-1.46", "--track-m -1.46"),
+        "left_share_above_one": ("--left-share", "1.5", "--left-share 1.5"),
+        "tyre_size_word": ("--tyre-size", "big", "--tyre-size 'big'"),
+        "kingpin_inclination_80deg": ("--kingpin-inclination-deg", "80", "--kingpin-inclination-deg 80: outside"),
+        "castor_80deg": ("--castor-deg", "80", "--castor-deg 80: outside"),
+        "pressure_negative": ("--tyre-pressure-bar", "-2", "--tyre-pressure-bar -2"),
+        "scrub_radius_beyond_track": ("--scrub-radius-m", "5", "geometry.kingpin_top_y"),
+        "lock_beyond_linkage": ("--steering-ratio", "3", "input.handwheel_lock_angle"),
+        "out_not_toml": ("--out", "car.txt", "name it .toml"),
+    }
+    for name, (option, value, fragment) in absurd.items():
+        def make(f, option=option, value=value):
+            argv = _spec(f, option, str(f / value) if option == "--out" else value)
+            return argv
+
+        cases.append(Case(f"vehicle:new_{name}", "vehicle", make, fragment,
+                          () if fragment == ACCEPTED else ("car.toml", "car.txt")))
+    return cases
+
+
+def diagnose_option_cases() -> list[Case]:
+    """diagnose --angle, --torque-lag and --html where they cannot apply."""
+    no_angle = lambda: record_text(header=None)  # noqa: E731 (the base record has an angle; dropped below)
+
+    def without_angle(f):
+        lines = []
+        for line in no_angle().splitlines():
+            lines.append(line if line.startswith("#") else ",".join(line.split(",")[:3]))
+        return ["diagnose", str(_write(f, "r.csv", "\n".join(l for l in lines if "angle" not in l) + "\n")),
+                "--angle", "--report", str(f / "out.md")]
+
+    def angle_only(f):
+        m, h, d = base_record()
+        text = "\n".join([x for x in m if "rack_m" not in x] + ["time_s,handwheel_torque_Nm,handwheel_angle_rad"]
+                         + [f"{r[0]:.9g},{r[2]:.9g},{r[3]:.9g}" for r in d]) + "\n"
+        return ["diagnose", str(_write(f, "a.csv", text)), "--angle", "--report", str(f / "out.md")]
+
+    def lag_angle_only(f):
+        argv = angle_only(f)
+        argv[argv.index("--angle")] = "--torque-lag"
+        return argv
+
+    return [
+        Case("diagnose:angle_without_angle_column", "diagnose", without_angle, "--angle needs a handwheel angle",
+             ("out.md",)),
+        Case("diagnose:angle_with_rack_derived", "diagnose", angle_only, "its rack is derived from the angle",
+             ("out.md",)),
+        Case("diagnose:torque_lag_with_rack_derived", "diagnose", lag_angle_only, "--torque-lag", ("out.md",)),
+        Case("diagnose:html_in_proc", "diagnose",
+             lambda f: ["diagnose", str(_write(f, "ok.csv", record_text())), "--html", "/proc/out.html"],
+             "cannot write in folder /proc"),
+        Case("diagnose:html_under_a_file", "diagnose",
+             lambda f: ["diagnose", str(_write(f, "ok.csv", record_text())), "--html", str(f / "ok.csv" / "o.html")],
+             "is a file, not a folder"),
+    ]
+
+
+def mdf_cases() -> list[Case]:
+    """ASAM MDF files (written here with asammdf): read, a channel the map names missing, a unit that is no
+    length, a time base that goes back."""
+    fill = ["--case", "unladen", "--surface", "ground"]
+    svg = ("out.svg",)
+
+    def argv(path: Path, f: Path, *extra: str) -> list[str]:
+        return ["compare", str(path), *fill, *extra, "--plot", str(f / "out.svg")]
+
+    return [
+        Case("compare:mdf", "compare", lambda f: argv(_mdf(f), f), ACCEPTED),
+        Case("compare:mdf_missing_channel", "compare",
+             lambda f: argv(_mdf(f), f, "--map", "SWA[deg]=handwheel_angle_rad"),
+             "--map names channel 'SWA', which the file does not have", svg),
+        Case("compare:mdf_wrong_unit", "compare", lambda f: argv(_mdf(f, unit="N"), f),
+             "channel 'RackPos': unit 'N' is not a unit of length", svg),
+        Case("compare:mdf_time_goes_back", "compare", lambda f: argv(_mdf(f, time_back=True), f),
+             "channel 'RackPos': time stamps do not increase", svg),
+    ]
+
+
 def all_cases() -> list[Case]:
-    return record_cases() + odd_record_cases() + parameter_cases() + checksum_cases()
+    return (record_cases() + odd_record_cases() + parameter_cases() + checksum_cases() + finding_cases()
+            + map_cases() + vehicle_cases() + diagnose_option_cases() + mdf_cases())

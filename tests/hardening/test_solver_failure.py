@@ -72,12 +72,31 @@ def test_rack_drive_failure_names_the_file(tmp_path, capsys, monkeypatch):
     assert not out.exists()
 
 
-def test_an_absurdly_stiff_tyre_fails_in_one_line_within_the_work_budget(tmp_path, capsys):
-    """No starving here: a radial tyre stiffness of 1e16 N/m (a car tyre has about 2e5) makes the bounce mode so
+def test_an_absurdly_stiff_tyre_is_refused_before_integrating(tmp_path, capsys):
+    """The registry's bounds refuse a radial tyre stiffness of 1e16 N/m up front, naming the key and the range of
+    real tyres, exit 2, nothing written."""
+    out = tmp_path / "out.csv"
+    status = main(["simulate", "--case", "unladen", "--set", "tyre.radial_stiffness=1e16", "--out", str(out)])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert status == 2 and len(err) == 1, err
+    assert "tyre.radial_stiffness: value 1e+16 N/m is non-physical" in err[0] and "integrat" not in err[0], err[0]
+    assert not out.exists()
+
+
+def test_an_absurdly_stiff_tyre_fails_in_one_line_within_the_work_budget(tmp_path, capsys, monkeypatch):
+    """No starving here: a radial tyre stiffness of 1e16 N/m (a car tyre has about 2e5; the registry's bounds,
+    lifted here, refuse it) makes the bounce mode so
     stiff that an integration could run for minutes (LSODA did at 1e14, which the generated integrator follows in
     about 9 s); the work budget (tolerances.STEP_BUDGET_PER_S) stops it with one line naming the value, exit 2,
     nothing written. It stops early in the run, long before the 18 s cycle ends, because the budget is per
     simulated second."""
+    import dataclasses
+    import math
+
+    from parksteer import parameters
+
+    unbounded = dataclasses.replace(parameters.quantity("tyre.radial_stiffness"), upper=math.inf)
+    monkeypatch.setitem(parameters._file_and_case_keys(), "tyre.radial_stiffness", unbounded)
     out = tmp_path / "out.csv"
     status = main(["simulate", "--case", "unladen", "--set", "tyre.radial_stiffness=1e16", "--out", str(out)])
     err = capsys.readouterr().err.strip().splitlines()

@@ -75,10 +75,25 @@ def _check_outputs(args) -> None:
             if Path(value).is_dir():
                 raise UsageError(f"--{option} {value}: is a directory; name a file to write")
             parent = Path(value).resolve().parent
+            if parent.exists() and not parent.is_dir():
+                raise UsageError(f"--{option} {value}: {parent} is a file, not a folder")
             if not parent.is_dir():
                 raise UsageError(f"--{option} {value}: folder {parent} does not exist")
+            _check_writable(option, value, parent)
     if getattr(args, "plot", None) is not None and not args.plot.endswith(".svg"):
         raise UsageError(f"--plot {args.plot}: the figure is written as SVG; name it .svg")
+
+
+def _check_writable(option: str, value: str, folder: Path) -> None:
+    """Refuse an output folder nothing can be written in before the work, not after it (a probe file is made and
+    removed: permissions alone do not tell, e.g. for root or a read-only mount)."""
+    import tempfile
+
+    try:
+        with tempfile.NamedTemporaryFile(dir=folder, prefix=".parksteer-probe-"):
+            pass
+    except OSError as exc:
+        raise UsageError(f"--{option} {value}: cannot write in folder {folder} ({exc.strerror})") from None
 
 
 def _print_json(result: dict) -> None:
@@ -140,6 +155,11 @@ def _diagnose(args) -> int:
     workers = args.jobs if args.jobs is not None else available_workers()
     settings = DEFAULT_SETTINGS
     if args.torque_lag:
+        derived = next((f for f in files if "rack_derived" in f.measurement.metadata), None)
+        if derived is not None:
+            raise UsageError(f"{derived.measurement.path or derived.label}: --torque-lag needs a measured rack channel "
+                             "(this file's rack is derived from the angle and the torque itself, so it has no lag "
+                             "behind the torque to find)")
         settings = dataclasses.replace(settings, torque_lag_fitted=True)
     if args.angle:
         settings = dataclasses.replace(settings, use_handwheel_angle=True)

@@ -63,8 +63,8 @@ def _simulate(args) -> int:
         raise UsageError(f"--out {args.out}: is a directory; name a file to write")
     if args.raw_rack and args.rack_from is None:
         raise UsageError("--raw-rack needs --rack-from FILE")
-    if args.rack_from is not None and not Path(args.rack_from).exists():
-        raise UsageError(f"--rack-from {args.rack_from}: no such file")
+    if args.rack_from is not None and not Path(args.rack_from).exists() and not Path(args.rack_from).is_symlink():
+        raise UsageError(f"--rack-from {args.rack_from}: no such file")  # a link that leads nowhere: said on reading
     params = parameters_of(args)
     if args.rack_from is None and args.case is None:
         if args.vehicle is None or len(params.case_names) != 1:

@@ -12,6 +12,8 @@ from ..parameters import DEFAULT_PATH, load_parameters
 
 BAR_PA = 1.0e5
 INCH_M = 0.0254
+# King-pin inclination and castor: the registry's bounds, 0.5 rad (geometry.kingpin_inclination, castor_angle).
+MAX_AXIS_ANGLE_DEG = math.degrees(0.5)
 TYRE_SIZE = re.compile(r"^\s*(\d{3})\s*/\s*(\d{2})\s*Z?R\s*(\d{2}(?:\.\d)?)\s*$", re.IGNORECASE)
 
 
@@ -66,6 +68,16 @@ def specification(args, gravity: float):
     from ..vehicle import Specification
 
     load_N = args.front_axle_load_N if args.front_axle_load_N is not None else args.front_axle_mass_kg * gravity
+    load_option = "--front-axle-load-N" if args.front_axle_load_N is not None else "--front-axle-mass-kg"
+    load_given = args.front_axle_load_N if args.front_axle_load_N is not None else args.front_axle_mass_kg
+    if not load_N > 0.0:
+        raise UsageError(f"{load_option} {load_given:g}: must be positive")
+    for option, degrees in (("--kingpin-inclination-deg", args.kingpin_inclination_deg),
+                            ("--castor-deg", args.castor_deg)):
+        if not abs(degrees) <= MAX_AXIS_ANGLE_DEG:
+            raise UsageError(f"{option} {degrees:g}: outside +-{MAX_AXIS_ANGLE_DEG:g} degrees (road cars: 0-20)")
+    if args.tyre_radius_m is not None and not 0.1 < args.tyre_radius_m < 1.0:
+        raise UsageError(f"--tyre-radius-m {args.tyre_radius_m:g}: outside (0.1, 1) m")
     radius = args.tyre_radius_m if args.tyre_radius_m is not None else tyre_radius_m(args.tyre_size)
     chi, eps = math.radians(args.kingpin_inclination_deg), math.radians(args.castor_deg)
     if args.scrub_radius_m is not None:
@@ -106,7 +118,10 @@ def _new(args) -> int:
     spec = specification(args, base["vehicle.gravity"])
     values = derive(spec, base)
     text = template_text(vehicle_name(out), spec, values)
-    vehicle_from_text(text, out, base)  # checked as a vehicle file before anything is written
+    try:
+        vehicle_from_text(text, out, base)  # checked as a vehicle file before anything is written
+    except UsageError as exc:
+        raise UsageError(f"the specification gives no valid car, nothing written: {exc}") from None
     with atomic_path(out) as tmp:
         tmp.write_text(text, encoding="utf-8")
     print(f"{out}: vehicle {vehicle_name(out)}, case {spec.case}")

@@ -1,5 +1,8 @@
 """The import layer: every measurement, rack drive or angle record enters through :func:`load_record`.
 
+The file format is the business of its reader (:mod:`parksteer.measure.readers`, one module each, found through
+its table ``READERS``); this module maps what a reader gives to the native columns, the same for every format.
+
 A logger export rarely looks like the native format (data/measurements/README.md): its channels have their own
 names and units, cells may be separated by semicolons or tabs with a decimal comma, a units row may sit under the
 header, and automotive loggers write ASAM MDF. :func:`load_record` reads any of these, maps the channels to the
@@ -18,10 +21,8 @@ the opposite sign convention). A target without a source unit is taken in its ow
 
 from __future__ import annotations
 
-import gc
-import io as _io
+import errno
 import math
-import re
 import sys
 from dataclasses import dataclass
 from pathlib import Path
@@ -32,7 +33,9 @@ from .. import portable as pm
 from ..errors import UsageError
 from ..geometry import rack_from_handwheel
 from ..parameters import Parameters, load_parameters
-from .io import ALLOWED_COLUMNS, REQUIRED_COLUMNS, UNITS, Measurement, read_table, validate_record
+from .io import ALLOWED_COLUMNS, REQUIRED_COLUMNS, UNITS, Measurement, validate_record
+from .readers import Record, Source, reader_for
+from .readers.base import TIME_ALIASES, name_and_unit, normal_name
 
 RACK, TORQUE, ANGLE, TIME = "rack_m", "handwheel_torque_Nm", "handwheel_angle_rad", "time_s"
 RACK_DRIVE_COLUMNS = (TIME, RACK)
@@ -48,7 +51,7 @@ ANGLE_UNIT_WORDS = ("radian", "degree", "revolution", "turn", "grade", "arcminut
 
 # Channel names loggers use for the native columns, compared lower-case without spaces, '_', '-' or '.'.
 ALIASES = {
-    TIME: ("time", "t", "zeit", "timestamp", "timestamps"),
+    TIME: TIME_ALIASES,
     RACK: ("rack", "rackpos", "rackposition", "rackdisplacement", "racktravel", "zahnstange", "zahnstangenweg"),
     TORQUE: ("torque", "steertorque", "steeringtorque", "handwheeltorque", "steeringwheeltorque", "swt",
              "lenkmoment", "lenkradmoment"),
@@ -74,7 +77,6 @@ UNIT_SUSPECTS = {RACK: (("centimetres", "cm", 100.0), ("millimetres", "mm", 1000
 SIGN_CORRELATION_LIMIT = -0.3
 SPEED_WINDOW_S = 0.25  # rack speed from a moving average over this window (converter steps are not motion)
 
-MDF_MAGIC = (b"MDF     ", b"UnFinMF ")
 # Big and fast records. The method resolves a steering cycle's phases over windows of 0.1 s and more, and it is
 # shown to work on 50 Hz loggers (data/measurements/example_unladen.csv); 100 samples a second, twice that, carry
 # all it uses. A faster record is low-pass filtered (an FIR anti-alias filter, zero phase) and decimated to at
@@ -100,17 +102,6 @@ class Channel:
         return f"{self.source}{unit}={'-' if negate else ''}{self.target}"
 
 
-_BRACKETED = re.compile(r"^(?P<name>.*?)\s*[\[(](?P<unit>[^\[\]()]*)[\])]\s*$")
-
-
-def _name_and_unit(text: str) -> tuple[str, str | None]:
-    """'RackPos[mm]' or 'RackPos (mm)' -> ('RackPos', 'mm'); 'RackPos' -> ('RackPos', None)."""
-    match = _BRACKETED.match(text.strip())
-    if match and match.group("name"):
-        return match.group("name").strip(), match.group("unit").strip()
-    return text.strip(), None
-
-
 def _split_entries(text: str) -> list[str]:
     """Split a map on commas outside brackets (a unit may not contain one, but a stray one gets a clear error)."""
     entries, depth, current = [], 0, ""
@@ -134,7 +125,7 @@ def parse_channel_map(text: str, origin: str = "--map") -> list[Channel]:
         target = target.strip()
         negate = target.startswith("-")
         target = target.lstrip("-").strip()
-        source, unit = _name_and_unit(source_text)
+        source, unit = name_and_unit(source_text)
         if not eq or not source:
             raise UsageError(f"{origin}: entry {entry!r} must read 'Source[unit]=target', e.g. 'RackPos[mm]=rack_m'")
         if target not in ALLOWED_COLUMNS:
@@ -243,80 +234,6 @@ def from_si(values, unit: str | None, target: str, where: str = "value") -> np.n
     return np.asarray(values, dtype=float) / one
 
 
-# ------------------------------------------------------------------------------------------------ sources
-
-@dataclass
-class Source:
-    """One channel of a file before mapping: its name, stated unit, samples and (MDF) its own time stamps."""
-
-    name: str
-    unit: str | None
-    values: np.ndarray | None = None  # filled when the channel is used
-    timestamps: np.ndarray | None = None
-    column: int | None = None  # position in a text table
-
-
-def _normal(name: str) -> str:
-    return re.sub(r"[\s_.\-]", "", name.lower())
-
-
-def _text_sources(table) -> list[Source]:
-    sources = []
-    for j, cell in enumerate(table.header):
-        name, unit = _name_and_unit(cell)
-        row_unit = table.units[j].strip() if table.units is not None and table.units[j].strip() else None
-        if unit is not None and row_unit is not None and unit != row_unit:
-            raise UsageError(f"{table.where}: column {name!r}: header says [{unit}] but the units row says {row_unit!r}")
-        sources.append(Source(name, unit if unit is not None else row_unit, column=j))
-    names = [s.name for s in sources]
-    for name in names:
-        if names.count(name) > 1:
-            raise UsageError(f"{table.where}: column {name!r} appears twice in the header row")
-    return sources
-
-
-def _read_mdf(raw: bytes, where: Path) -> list[Source]:
-    try:
-        from asammdf import MDF
-    except ImportError:
-        raise UsageError(
-            f"{where}: an ASAM MDF file; reading it needs the optional extra: pip install 'parksteer[mdf]'"
-        ) from None
-    problem = None
-    try:
-        mdf = MDF(_io.BytesIO(raw))
-    except Exception as exc:  # asammdf raises many types for a damaged file; the user needs the file and the gist
-        problem = re.sub(r"'?<_io\.BytesIO object at 0x[0-9a-f]+>'?", "it", f"{type(exc).__name__}: {exc}")
-    if problem is not None:
-        # The half-built reader's finaliser fails on a damaged file and would print a traceback: collect it now,
-        # with that report silenced.
-        hook, sys.unraisablehook = sys.unraisablehook, lambda report: None
-        try:
-            gc.collect()
-        finally:
-            sys.unraisablehook = hook
-        raise UsageError(f"{where}: cannot read as ASAM MDF ({problem.splitlines()[0]})")
-    sources: list[Source] = []
-    try:
-        for name, places in mdf.channels_db.items():
-            if _normal(name) in ALIASES[TIME] or name.startswith("$"):
-                continue  # master (time) channels and asammdf's own bookkeeping
-            if len(places) > 1:
-                raise UsageError(f"{where}: channel {name!r} appears in {len(places)} channel groups; rename one")
-            group, index = places[0]
-            signal = mdf.get(name, group=group, index=index)
-            samples = np.asarray(signal.samples)
-            if samples.ndim != 1 or samples.dtype.kind not in "iuf" or len(samples) < 2:
-                continue  # arrays, strings, bus frames and empty channels cannot be a native column
-            sources.append(Source(name, str(signal.unit).strip() or None, samples.astype(float),
-                                  np.asarray(signal.timestamps, dtype=float)))
-    finally:
-        mdf.close()
-    if not sources:
-        raise UsageError(f"{where}: the MDF file holds no numeric channel")
-    return sources
-
-
 # ---------------------------------------------------------------------------------------------- mapping
 
 def _map_sources(where: Path, sources: list[Source], channel_map: list[Channel] | None) -> dict[str, tuple[Source, Channel]]:
@@ -343,8 +260,8 @@ def _map_sources(where: Path, sources: list[Source], channel_map: list[Channel] 
             continue
         if s.name in ALLOWED_COLUMNS:
             target = s.name
-        elif channel_map is None or _normal(s.name) in ALIASES[TIME]:
-            target = next((t for t, names in ALIASES.items() if _normal(s.name) in names), None)
+        elif channel_map is None or normal_name(s.name) in ALIASES[TIME]:
+            target = next((t for t, names in ALIASES.items() if normal_name(s.name) in names), None)
         else:
             target = None
         if target is None:
@@ -459,31 +376,14 @@ def _check_signs(where: Path, columns: dict, chosen: dict, derived_rack: bool) -
 
 # ------------------------------------------------------------------------------------------------ reader
 
-def _note(message: str) -> None:
-    sys.stderr.write(message + "\n")
-
-
 def _fill(metadata: dict[str, str], key: str, value: str | None) -> None:
     """A value the caller gives fills what the file does not state; the caller decides about a conflict."""
     if value is not None and key not in metadata:
         metadata[key] = value
 
 
-def load_record(path: str | Path, channel_map: str | list[Channel] | None = None, case: str | None = None,
-                surface: str | None = None, params: Parameters | None = None, *,
-                required: tuple[str, ...] = REQUIRED_COLUMNS) -> Measurement:
-    """Read a measurement (native CSV, logger CSV or ASAM MDF) into native SI columns on one time base.
-
-    channel_map: a map spec (``"RackPos[mm]=rack_m,..."``) or parsed channels; without one, native column names
-    and, when unambiguous, known aliases map the channels. case, surface: fill what the file does not state.
-    required: the native columns the caller needs (a rack drive needs only time_s and rack_m); a rack is derived
-    from handwheel angle and torque when the file has no rack channel.
-    """
-    path = Path(path)
-    if params is None:
-        params = load_parameters()
-    if isinstance(channel_map, str):
-        channel_map = parse_channel_map(channel_map)
+def read_record_bytes(path: Path) -> bytes:
+    """The bytes of a record file, refused in one line beyond MAX_RECORD_BYTES, unreadable, or a link loop."""
     try:
         size = path.stat().st_size if path.is_file() else 0
         if size > MAX_RECORD_BYTES:
@@ -491,62 +391,85 @@ def load_record(path: str | Path, channel_map: str | list[Channel] | None = None
                              f"record may have; cut it to the steering cycles or decimate it to {METHOD_RATE_HZ:g} Hz")
         raw = path.read_bytes()
     except OSError as exc:
+        if exc.errno == errno.ELOOP:
+            raise UsageError(f"{path}: a symbolic link loop (a link that leads back to itself); point it at the "
+                             "record file") from None
         raise UsageError(f"{path}: cannot read ({exc.strerror})") from None
     if len(raw) > MAX_RECORD_BYTES:
         raise UsageError(f"{path}: more than {MAX_RECORD_BYTES / 2**20:.0f} MiB, the most a record may have; cut it "
                          f"to the steering cycles or decimate it to {METHOD_RATE_HZ:g} Hz")
+    return raw
 
-    line_numbers: list[int] | None = None
-    if raw[:8] in MDF_MAGIC:
-        sources = _read_mdf(raw, path)
-        metadata: dict[str, str] = {"format": "ASAM MDF"}
-    else:
-        try:
-            text = raw.decode("utf-8")
-        except UnicodeDecodeError as exc:
-            raise UsageError(f"{path}: not UTF-8 text (byte {exc.start})") from None
-        table = read_table(text, path)
-        sources = _text_sources(table)
-        metadata = dict(table.metadata)
-        line_numbers = table.line_numbers
+
+def _on_one_time_base(path: Path, record: Record, chosen: dict, listing: str) -> None:
+    """Fill each chosen source's values on one time base: a shared time base's columns as they are; channels
+    with time stamps of their own resampled onto the torque channel's (the signal the model is judged on), within
+    the span every used channel covers."""
+    if record.shared_time_base:
+        for src, _ in chosen.values():
+            src.values = record.samples(src)
+        return
+    base_target = next((t for t in (TORQUE, RACK, ANGLE) if t in chosen), None)
+    if base_target is None:
+        raise UsageError(f"{path}: no torque, rack or angle channel (channels: {listing}); map them with --map")
+    base = chosen[base_target][0].timestamps
+    start = max(src.timestamps[0] for src, _ in chosen.values())
+    end = min(src.timestamps[-1] for src, _ in chosen.values())
+    base = base[(base >= start) & (base <= end)]
+    for src, _ in chosen.values():
+        if np.any(np.diff(src.timestamps) <= 0.0):
+            raise UsageError(f"{path}: channel {src.name!r}: time stamps do not increase")
+        src.values = np.interp(base, src.timestamps, src.values)
+    chosen[TIME] = (Source("time", "s", base), Channel("time", "s", TIME, False, "master"))
+
+
+def load_record(path: str | Path, channel_map: str | list[Channel] | None = None, case: str | None = None,
+                surface: str | None = None, params: Parameters | None = None, *,
+                required: tuple[str, ...] = REQUIRED_COLUMNS) -> Measurement:
+    """Read a measurement (any format of :data:`parksteer.measure.readers.READERS`: native CSV, logger CSV, ASAM
+    MDF) into native SI columns on one time base.
+
+    channel_map: a map spec (``"RackPos[mm]=rack_m,..."``) or parsed channels; without one, native column names
+    and, when unambiguous, known aliases map the channels. case, surface: fill what the file does not state.
+    required: the native columns the caller needs (a rack drive needs only time_s and rack_m); a rack is derived
+    from handwheel angle and torque when the file has no rack channel. Notes (an ignored channel, a decimation)
+    go to stderr only when the record is read: a refused record gives its one line alone.
+    """
+    path = Path(path)
+    if params is None:
+        params = load_parameters()
+    if isinstance(channel_map, str):
+        channel_map = parse_channel_map(channel_map)
+    raw = read_record_bytes(path)
+    record = reader_for(raw).read(raw, path)
+    sources, metadata, line_numbers = record.sources, dict(record.metadata), record.line_numbers
+    notes: list[str] = []
 
     chosen = _map_sources(path, sources, channel_map)
     listing = ", ".join(s.name for s in sources)
-    if TIME not in chosen and raw[:8] not in MDF_MAGIC:
+    if TIME not in chosen and record.shared_time_base:
         raise UsageError(f"{path}: no time channel (channels: {listing}); map one, e.g. --map 'Time[s]=time_s'")
     ignored = [s.name for s in sources if all(s is not src for src, _ in chosen.values())]
     if ignored:
-        _note(f"{path}: note: ignored channel{'s' if len(ignored) > 1 else ''} {', '.join(ignored)} "
-              f"(not mapped to {', '.join(ALLOWED_COLUMNS)})")
-
-    # MDF channels each have their own time stamps: resample onto the torque channel's (the signal the model is
-    # judged on), within the span every used channel covers.
-    if raw[:8] in MDF_MAGIC:
-        base_target = next((t for t in (TORQUE, RACK, ANGLE) if t in chosen), None)
-        if base_target is None:
-            raise UsageError(f"{path}: no torque, rack or angle channel (channels: {listing}); map them with --map")
-        base = chosen[base_target][0].timestamps
-        start = max(src.timestamps[0] for src, _ in chosen.values())
-        end = min(src.timestamps[-1] for src, _ in chosen.values())
-        base = base[(base >= start) & (base <= end)]
-        for target, (src, ch) in chosen.items():
-            if np.any(np.diff(src.timestamps) <= 0.0):
-                raise UsageError(f"{path}: channel {src.name!r}: time stamps do not increase")
-            src.values = np.interp(base, src.timestamps, src.values)
-        chosen[TIME] = (Source("time", "s", base), Channel("time", "s", TIME, False, "master"))
-    else:
-        for target, (src, ch) in chosen.items():
-            src.values = table.column(src.column, src.name)
+        notes.append(f"{path}: note: ignored channel{'s' if len(ignored) > 1 else ''} {', '.join(ignored)} "
+                     f"(not mapped to {', '.join(ALLOWED_COLUMNS)})")
+    _on_one_time_base(path, record, chosen, listing)
 
     columns: dict[str, np.ndarray] = {}
     for target, (src, ch) in chosen.items():
         unit = ch.unit or src.unit
         at = f"{path}: channel {src.name!r}"
-        if ch.unit is not None and src.unit is not None and ch.unit != src.unit:
-            one = np.ones(1)
-            if to_si(one, ch.unit, target, at)[0] != to_si(one, src.unit, target, at)[0]:
-                raise UsageError(f"{at}: {ch.origin} says [{ch.unit}] but the file says [{src.unit}]; give one unit")
-        values = to_si(src.values, unit, target, at)
+        try:
+            if ch.unit is not None and src.unit is not None and ch.unit != src.unit:
+                one = np.ones(1)
+                same = to_si(one, ch.unit, target, at)[0] == to_si(one, src.unit, target, at)[0]
+            values = to_si(src.values, unit, target, at)
+        except UsageError as exc:
+            if ch.unit is None or ch.origin in ("alias", "master") or repr(ch.unit) not in str(exc):
+                raise
+            raise UsageError(f"{exc} (the unit of {ch.origin})") from None
+        if ch.unit is not None and src.unit is not None and ch.unit != src.unit and not same:
+            raise UsageError(f"{at}: {ch.origin} says [{ch.unit}] but the file says [{src.unit}]; give one unit")
         columns[target] = -values if ch.negate else values
     renamed = [Channel(src.name, ch.unit or src.unit, ch.target, ch.negate).spec() for src, ch in chosen.values()
                if (src.name != ch.target or ch.negate) and ch.origin != "master"]
@@ -567,29 +490,38 @@ def load_record(path: str | Path, channel_map: str | list[Channel] | None = None
             derived = True
         else:
             raise UsageError(f"{path}: no rack channel, and no handwheel angle and torque to derive it from "
-                             f"(channels: {listing}); map one, e.g. --map 'RackPos[mm]=rack_m'")
+                             f"(channels: {listing}){_unmapped(ignored)}; map one, e.g. --map 'RackPos[mm]=rack_m'")
     missing = [t for t in required if t not in columns]
     if missing:
-        raise UsageError(f"{path}: no channel for {missing[0]!r} (channels: {listing}); map one, e.g. "
-                         f"--map 'NAME[{SI_UNITS[missing[0]]}]={missing[0]}'")
+        raise UsageError(f"{path}: no channel for {missing[0]!r} (channels: {listing}){_unmapped(ignored)}; map one, "
+                         f"e.g. --map 'NAME[{SI_UNITS[missing[0]]}]={missing[0]}'")
 
-    is_text = line_numbers is not None
     if "case" not in metadata and case is None:
-        add = "add '# case: NAME' above the header or " if is_text else ""
+        add = "add '# case: NAME' above the header or " if record.is_text else ""
         raise UsageError(f"{path}: the file names no case; {add}give --case (known: {', '.join(params.case_names)})")
     if "surface" not in metadata and surface is None:
-        add = "add '# surface: ground' above the header or " if is_text else ""
+        add = "add '# surface: ground' above the header or " if record.is_text else ""
         raise UsageError(f"{path}: the file names no surface; {add}give --surface ground|air_bearing")
     _fill(metadata, "case", case)
     _fill(metadata, "surface", surface)
     ordered = {name: columns[name] for name in ALLOWED_COLUMNS if name in columns}
     validate_record(path, ordered, metadata, params, line_numbers, required)
     _check_signs(path, ordered, chosen, derived)
-    ordered = _decimate(path, ordered, metadata)
+    ordered = _decimate(path, ordered, metadata, notes)
+    for note in notes:
+        sys.stderr.write(note + "\n")
     return Measurement(path=path, columns=ordered, metadata=metadata)
 
 
-def _decimate(path: Path, columns: dict[str, np.ndarray], metadata: dict[str, str]) -> dict[str, np.ndarray]:
+def _unmapped(ignored: list[str]) -> str:
+    """', of which X is not a known channel name' for an error about a missing channel, naming those ignored."""
+    if not ignored:
+        return ""
+    return f", of which {', '.join(ignored)} {'is' if len(ignored) == 1 else 'are'} not a known channel name"
+
+
+def _decimate(path: Path, columns: dict[str, np.ndarray], metadata: dict[str, str], notes: list[str]
+              ) -> dict[str, np.ndarray]:
     """A record sampled faster than METHOD_RATE_HZ, filtered (FIR anti-alias, zero phase) and decimated by the
     largest whole factor that keeps at least that rate; a record with uneven sampling is left as it is."""
     from scipy.signal import resample_poly
@@ -611,7 +543,7 @@ def _decimate(path: Path, columns: dict[str, np.ndarray], metadata: dict[str, st
             del metadata[column]
     metadata["decimated"] = (f"from {1.0 / dt:.6g} Hz by {factor} to {1.0 / (dt * factor):.6g} Hz with an FIR "
                              "anti-alias filter (parksteer.measure.importers.METHOD_RATE_HZ)")
-    _note(f"{path}: note: {1.0 / dt:.6g} Hz decimated by {factor} to {1.0 / (dt * factor):.6g} Hz")
+    notes.append(f"{path}: note: {1.0 / dt:.6g} Hz decimated by {factor} to {1.0 / (dt * factor):.6g} Hz")
     return out
 
 

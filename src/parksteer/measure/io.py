@@ -30,6 +30,7 @@ after the header is row 1) with its line number in the file.
 
 from __future__ import annotations
 
+import csv
 import math
 import re
 from collections.abc import Mapping
@@ -310,7 +311,42 @@ class Table:
 
 
 def _split(line: str, delimiter: str) -> list[str]:
-    return [cell.strip() for cell in line.split(delimiter)]
+    """The cells of a line; a cell in double quotes (as spreadsheets write "0.01" or "time_s") loses its quotes,
+    and a delimiter inside quotes is part of the cell."""
+    if '"' not in line:
+        return [cell.strip() for cell in line.split(delimiter)]
+    cells = next(csv.reader([line], delimiter=delimiter, skipinitialspace=True))
+    return [_unquote(cell.strip()) for cell in cells]
+
+
+def _unquote(cell: str) -> str:
+    """'"0.01"' -> '0.01' (a quoted cell followed by spaces keeps its quotes through the csv module)."""
+    if len(cell) >= 2 and cell[0] == cell[-1] == '"':
+        return cell[1:-1].replace('""', '"').strip()
+    return cell
+
+
+def _delimiter(header_text: str) -> str:
+    """The header names the columns once each: the delimiter it uses most is the file's (tab, semicolon, else
+    comma)."""
+    counts = {d: header_text.count(d) for d in ("\t", ";")}
+    return max(counts, key=counts.get) if max(counts.values()) > 0 else ","
+
+
+def header_cells(text: str, rows: int = 1) -> list[list[str]]:
+    """The cells of the header row and the `rows` - 1 rows after it (fewer if the text ends), split as
+    :func:`read_table` splits them; for a reader to tell a format by its first lines."""
+    found: list[list[str]] = []
+    delimiter = ","
+    for line in text.removeprefix("\ufeff").splitlines():
+        if not line.strip() or (line.startswith("#") and not found):
+            continue
+        if not found:
+            delimiter = _delimiter(line)
+        found.append(_split(line, delimiter))
+        if len(found) == rows:
+            break
+    return found
 
 
 def _is_number(cell: str, decimal: str) -> bool:
@@ -354,9 +390,7 @@ def read_table(text: str, where: Path | str) -> Table:
             lines.append((line_no, line))
     if header_text is None:
         raise UsageError(f"{where}: empty file (no header row)")
-    # The header names the columns once each: the delimiter it uses most is the file's.
-    counts = {d: header_text.count(d) for d in ("\t", ";")}
-    delimiter = max(counts, key=counts.get) if max(counts.values()) > 0 else ","
+    delimiter = _delimiter(header_text)
     header = _split(header_text, delimiter)
     if any(not name for name in header):
         raise UsageError(f"{where}: line {header_line}: empty column name in the header row")

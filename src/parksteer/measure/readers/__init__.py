@@ -1,0 +1,36 @@
+"""Readers of measurement formats, one module each, found through :data:`READERS` (as scipy.integrate finds its
+solvers through METHODS). Adding a format is one module with a class following :class:`~.base.Reader` and one
+entry in the table.
+
+- :mod:`.native_csv`: the native format (data/measurements/README.md);
+- :mod:`.logger_csv`: a logger's or spreadsheet's text export (own names, units, dialect);
+- :mod:`.mdf`: ASAM MDF through the optional asammdf.
+"""
+
+from __future__ import annotations
+
+from .base import Reader, Record, Source
+from .logger_csv import LoggerCsvReader
+from .mdf import MdfReader
+from .native_csv import NativeCsvReader
+
+# Asked in this order; the first whose sniff accepts a file reads it (the logger CSV reader accepts any file).
+READERS: dict[str, type[Reader]] = {
+    "mdf": MdfReader,
+    "native_csv": NativeCsvReader,
+    "logger_csv": LoggerCsvReader,
+}
+# How many leading bytes a reader's sniff sees.
+SNIFF_BYTES = 4096
+
+
+def reader_for(raw: bytes) -> Reader:
+    """The reader of a file whose bytes are `raw`."""
+    head = raw[:SNIFF_BYTES]
+    for reader in READERS.values():
+        if reader().sniff(head):
+            return reader()
+    raise AssertionError("the logger CSV reader accepts every file")  # READERS ends with it
+
+
+__all__ = ["READERS", "Reader", "Record", "Source", "reader_for"]
