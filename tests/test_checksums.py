@@ -414,3 +414,11 @@ def test_every_stored_figure_has_a_tolerance_family():
     root = Path(__file__).resolve().parents[1]
     stems = {Path(rel).stem for rel in read_sums(root / "figures/SHA256SUMS")}
     assert stems and not [s for s in sorted(stems) if family_of(s) is None]
+
+
+def test_docs_show_the_declared_tolerances():
+    """docs/reproducibility.md shows the tolerance table exactly as parksteer.checksums.tolerances declares it."""
+    from parksteer.checksums.tolerances import table_markdown
+
+    docs = (Path(__file__).resolve().parents[1] / "docs/reproducibility.md").read_text(encoding="utf-8")
+    assert table_markdown() in docs
