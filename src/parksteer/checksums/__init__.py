@@ -142,8 +142,8 @@ def _compare_with_reference(root: Path, rel: str, data: str | None, reference: P
     drawing_reference = reference_path(reference, rel)
     if not drawing_reference.exists():
         return f"data {data} {table.describe()}, but no reference copy {drawing_reference.name} of the drawing"
-    drawing = compare_drawings(root / rel, gzip.decompress(drawing_reference.read_bytes()).decode("utf-8"))
-    return drawing
+    return compare_drawings(root / rel, gzip.decompress(drawing_reference.read_bytes()).decode("utf-8"),
+                            family.drawing)
 
 
 def verify(root: Path, sums_path: Path, expected_files: list[str],

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..tables import SIGNIFICANT_DIGITS
-from .tolerances import SVG_DRAWING_ATOL, Family, Tolerance, tolerance_for, unit_of
+from .tolerances import Family, Tolerance, tolerance_for, unit_of
 
 # A number as write_csv, the header lines and matplotlib's SVG writer print it.
 NUMBER = re.compile(r"[-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?|\bnan\b|[-+]?\binf\b")
@@ -173,14 +173,13 @@ def _canonical_ids(svg: str) -> str:
     return re.sub(r"(?<=[\"#])[pm][0-9a-f]{10}(?=[\")])", rename, svg)
 
 
-def compare_drawings(new_svg: Path, reference_svg_text: str) -> Comparison:
-    """Compare an SVG with its reference: identical text around the numbers, numbers within SVG_DRAWING_ATOL."""
+def compare_drawings(new_svg: Path, reference_svg_text: str, tolerance: Tolerance) -> Comparison:
+    """Compare an SVG with its reference: identical text around the numbers, numbers within `tolerance` (points)."""
     old = _canonical_ids(reference_svg_text)
     new = _canonical_ids(Path(new_svg).read_text(encoding="utf-8"))
     old_lines, new_lines = old.splitlines(), new.splitlines()
     if len(old_lines) != len(new_lines):
         return Comparison(f"drawing has {len(old_lines)} lines in the reference and {len(new_lines)} now")
-    tolerance = Tolerance(0.0, SVG_DRAWING_ATOL, "")
     worst: NumberDifference | None = None
     for n, (a, b) in enumerate(zip(old_lines, new_lines), start=1):
         if a == b:

@@ -37,6 +37,7 @@ class Family:
     figures: tuple[str, ...]  # figure names (file stems) or glob patterns of them
     computed_by: str
     default: Tolerance  # a column whose unit has no entry in by_unit (or that has no unit)
+    drawing: Tolerance  # the numbers of the figure's SVG, in drawing units (points)
     by_unit: dict[str, Tolerance] = field(default_factory=dict)
 
 
@@ -64,6 +65,8 @@ FAMILIES: tuple[Family, ...] = (
         "closed form", ("fig3", "fig4", "figA3", "table1"),
         "closed-form tyre rig and lifting formulas (equations (1), (2), (A1), Table 1's geometry)",
         default=_CLOSED_FORM,
+        drawing=Tolerance(0.0, 0.01, "matplotlib writes coordinates in points with 6 decimals; 0.01 pt (3.5 "
+                                     "micrometres) is invisible and far above a last-bit difference"),
     ),
     Family(
         "model", ("fig12", "fig13", "fig14", "fig15", "fig16", "figContrib", "bands", "rivals", "sweep_*"),
@@ -71,6 +74,9 @@ FAMILIES: tuple[Family, ...] = (
         default=Tolerance(_MODEL_RTOL, _MODEL_TORQUE_ATOL_Nm / _TYPICAL_PARKING_TORQUE_Nm,
                           f"a ratio of torques (share, factor): the torque tolerance over a "
                           f"{_TYPICAL_PARKING_TORQUE_Nm:g} N m parking torque"),
+        drawing=Tolerance(0.0, 0.05, "the torque tolerance moves a curve by about 0.02 pt at the figures' 10 pt "
+                                     "per N m (a 3e-4 N m wobble of fig12's runs moved it 0.003 pt); 0.05 pt (18 "
+                                     "micrometres) is invisible"),
         by_unit={
             "N m": Tolerance(_MODEL_RTOL, _MODEL_TORQUE_ATOL_Nm,
                              f"{_MODEL_FACTOR:g} x the integrator's rtol, and {_MODEL_FACTOR:g} x its rack-speed "
@@ -100,6 +106,9 @@ FAMILIES: tuple[Family, ...] = (
                           "(parksteer.diagnose.settings.calibration_tolerance): a last bit can end it one step "
                           "earlier or later, which moves a fitted parameter by a fraction of its standard error and "
                           "an RMS or ratio by far less than 1e-3 of itself"),
+        drawing=Tolerance(0.0, 0.5, "1e-3 of a plotted value is up to about 0.2 pt on axes of 200 pt that span the "
+                                    "values shown; 0.5 pt (0.18 mm) is at the edge of visible, a moved tick label "
+                                    "or marker is far beyond it"),
         by_unit={
             "bic": Tolerance(1e-3, 0.1,
                              "a BIC is a chi-square: a fit stopped 0.3 standard errors from its optimum moves it by "
@@ -110,12 +119,6 @@ FAMILIES: tuple[Family, ...] = (
 
 # Text (verdicts, names, mechanisms, units) has no tolerance: a verdict that changes is "changed".
 TEXT = "exact: text (verdicts, names) must match"
-
-# SVG: besides its data, the drawing's numbers (coordinates, sizes) may move this much, in drawing units (points).
-SVG_DRAWING_ATOL = 0.01
-SVG_REASON = ("matplotlib writes coordinates in points with 6 decimals, from data within its family's tolerance; "
-              "0.01 pt (3.5 micrometres) is invisible and far above a last-bit difference")
-
 
 def family_of(figure: str) -> Family | None:
     """The family of a figure (file stem), or None if none declares it."""
@@ -151,8 +154,9 @@ def table_markdown() -> str:
         rows = [("other / none", family.default)] + [(u, t) for u, t in family.by_unit.items()]
         for unit, tol in rows:
             lines.append(f"| {family.name} | {figures} | {unit} | {tol.rtol:.3g} | {tol.atol:.3g} | {tol.reason} |")
+        tol = family.drawing
+        lines.append(f"| {family.name} | {figures} | SVG drawing, pt | - | {tol.atol:.3g} | {tol.reason} |")
     lines.append(f"| every family | all | text | - | - | {TEXT} |")
-    lines.append(f"| SVG drawing | all | pt | - | {SVG_DRAWING_ATOL:g} | {SVG_REASON} |")
     return "\n".join(lines)
 
 
