@@ -22,8 +22,12 @@ import io
 import shutil
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from ..tables import atomic_path, read_csv
+
+if TYPE_CHECKING:
+    from .compare import Comparison
 
 SUMS_NAME = "SHA256SUMS"
 REFERENCE_DIR = "reference"
@@ -119,7 +123,7 @@ class FileCheck:
         return f"{self.path}: {self.outcome}" + (f": {self.detail}" if self.detail else "")
 
 
-def _compare_with_reference(root: Path, rel: str, data: str | None, reference: Path):
+def _compare_with_reference(root: Path, rel: str, data: str | None, reference: Path) -> Comparison | str:
     """The Comparison of a mismatching file (and its data) with the reference copies, or a string saying why there
     is nothing to compare."""
     from .compare import Comparison, compare_drawings, compare_tables

@@ -98,11 +98,13 @@ def write(path: Path, facts: dict[str, str]) -> None:
 
 
 def read(path: Path) -> dict[str, str] | None:
-    """The recorded facts, or None if there is no record."""
+    """The recorded facts, or None if there is no readable record."""
     path = Path(path)
-    if not path.exists():
+    try:
+        recorded = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError):  # no record, or not one verification can read: said as "no record"
         return None
-    return {str(k): str(v) for k, v in json.loads(path.read_text(encoding="utf-8")).items()}
+    return {str(k): str(v) for k, v in recorded.items()} if isinstance(recorded, dict) else None
 
 
 def differences(recorded: dict[str, str] | None, running: dict[str, str]) -> list[str]:

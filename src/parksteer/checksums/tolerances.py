@@ -110,7 +110,7 @@ FAMILIES: tuple[Family, ...] = (
                                     "values shown; 0.5 pt (0.18 mm) is at the edge of visible, a moved tick label "
                                     "or marker is far beyond it"),
         by_unit={
-            "bic": Tolerance(1e-3, 0.1,
+            "BIC": Tolerance(1e-3, 0.1,
                              "a BIC is a chi-square: a fit stopped 0.3 standard errors from its optimum moves it by "
                              "up to 0.3^2 = 0.09"),
         },
@@ -133,7 +133,7 @@ def family_of(figure: str) -> Family | None:
 def unit_of(column: str, row_unit: str | None = None) -> str | None:
     """The unit of a column from its name's suffix (torque_Nm -> N m), else the row's `unit` cell, else None."""
     if re.search(r"(^|_)bic(_|$)", column):
-        return "bic"
+        return "BIC"
     for suffix, unit in UNIT_SUFFIXES.items():
         if column.endswith("_" + suffix):
             return unit
