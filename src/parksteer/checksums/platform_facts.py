@@ -61,8 +61,23 @@ def _blas() -> tuple[str, str]:
     return name, core
 
 
+def _cpu() -> tuple[str, str]:
+    """The CPU's model name and whether it has FMA (glibc's libm picks FMA variants of exp, log, sin, pow by it)."""
+    try:
+        text = Path("/proc/cpuinfo").read_text(encoding="utf-8", errors="replace")
+    except OSError:  # not Linux
+        return platform.processor() or "unknown", "unknown"
+    first = text.split("\n\n", 1)[0]
+    fields = {k.strip(): v.strip() for k, _, v in (line.partition(":") for line in first.splitlines())}
+    name = fields.get("model name") or fields.get("CPU part") or platform.processor() or "unknown"
+    flags = (fields.get("flags") or fields.get("Features") or "").split()
+    fma = "yes" if ("fma" in flags or "asimd" in flags) else "no"  # aarch64's Advanced SIMD always fuses
+    return name, fma
+
+
 def _compiler() -> str:
-    """First line of `$CC --version` (the compiler the generated model is built with), or why there is none."""
+    """First line of `$CC --version` (the compiler the generated model is built with) and its target, or why there
+    is none."""
     cc = os.environ.get("CC", "cc").split()[0]
     if shutil.which(cc) is None:
         return f"{cc}: not found"
@@ -70,15 +85,26 @@ def _compiler() -> str:
         out = subprocess.run([cc, "--version"], capture_output=True, text=True, timeout=10).stdout
     except (OSError, subprocess.SubprocessError) as exc:
         return f"{cc}: {type(exc).__name__}"
-    return out.splitlines()[0].strip() if out.strip() else f"{cc}: no version"
+    if not out.strip():
+        return f"{cc}: no version"
+    try:
+        target = subprocess.run([cc, "-dumpmachine"], capture_output=True, text=True, timeout=10).stdout.strip()
+    except (OSError, subprocess.SubprocessError):
+        target = ""
+    return out.splitlines()[0].strip() + (f", target {target}" if target else "")
 
 
 def gather() -> dict[str, str]:
     """The running platform's facts, each a string."""
     libc, libc_version = platform.libc_ver()
+    if not libc and platform.system() == "Darwin":
+        libc, libc_version = "libSystem macOS", platform.mac_ver()[0]
     blas, blas_core = _blas()
+    cpu, cpu_fma = _cpu()
     facts = {
         "machine": platform.machine(),
+        "cpu": cpu,
+        "cpu_fma": cpu_fma,
         "os": f"{platform.system()} {platform.release()}",
         "libc": f"{libc or 'unknown'} {libc_version}".strip(),
         "python": platform.python_version(),
