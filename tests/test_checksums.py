@@ -423,3 +423,14 @@ def test_docs_show_the_declared_tolerances():
 
     docs = (Path(__file__).resolve().parents[1] / "docs/reproducibility.md").read_text(encoding="utf-8")
     assert table_markdown() in docs
+
+
+def test_platform_differences_name_each_fact_and_ignore_a_kernel_update():
+    """Each differing fact is named old -> new; another kernel release of the same OS is not a difference, another
+    OS is; a missing record is said as such."""
+    from parksteer.checksums.platform_facts import differences
+
+    running = dict(PLATFORM, os="Linux 6.8", libc="glibc 2.39")
+    assert differences(PLATFORM, running) == ["libc glibc 2.36 -> glibc 2.39"]
+    assert differences(PLATFORM, dict(PLATFORM, os="Darwin 23.1.0")) == ["os Linux 6.1 -> Darwin 23.1.0"]
+    assert "no record" in differences(None, PLATFORM)[0]
