@@ -51,6 +51,7 @@ CHECKOUT = Path(workflow.current_basedir).parent.parent  # this file is workflow
 PACKAGE_DIR = CHECKOUT / "src" / "parksteer"
 CODE_INPUTS_FILE = CHECKOUT / "workflow" / "code_inputs.yaml"
 CODE_INPUTS = yaml.load(CODE_INPUTS_FILE.read_text(encoding="utf-8"), Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
+_CHECKOUT_HERE = os.path.relpath(CHECKOUT)  # "." unless Snakemake runs in another directory (--directory)
 
 
 def file_sources(path):
@@ -58,7 +59,7 @@ def file_sources(path):
     relative to the working directory."""
     if path not in CODE_INPUTS:
         sys.exit(f"parksteer: error: {CODE_INPUTS_FILE} has no entry for {path}: run `parksteer plan`")
-    return [os.path.relpath(CHECKOUT / name) for name in CODE_INPUTS[path]]
+    return [os.path.normpath(os.path.join(_CHECKOUT_HERE, name)) for name in CODE_INPUTS[path]]
 
 
 def script_sources(script):
