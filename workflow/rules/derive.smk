@@ -15,7 +15,7 @@ rule derive:
     params:
         effects=lambda w: model_set(w.model),
     wildcard_constraints:
-        model="[A-Za-z0-9_]+",
+        model="[^/]+",
     log:
         "logs/derive/{model}.log",
     benchmark:
