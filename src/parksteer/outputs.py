@@ -5,8 +5,9 @@ Snakemake compares timestamps only, so a truncated output newer than its inputs 
 - every empty, truncated or unparsable CSV, SVG, JSON, notebook or PDF a rule wrote (results/, figures/*.svg,
   figures/*.csv, paper/*.pdf; figures/reference/ is source and never touched), read with the integrity checks of
   parksteer.checksums;
-- a model manifest results/model/<set>.json whose cache entry is missing or fails its SHA-256 check: a manifest
-  is trusted only if what it points at is sound;
+- a model manifest results/model/<set>.json whose cache key is not the one its effects have now (their sources,
+  the sympy in use), or whose cache entry is missing or fails its SHA-256 check: a manifest is trusted only if
+  what it points at is sound and current;
 - temporary files of writers that were killed (:func:`parksteer.tables.remove_stale_temporaries`) and scratch
   directories of killed model builds (:func:`parksteer.model.codegen.cache.clean_stale_scratch`);
 - Snakemake's lock (.snakemake/locks) when no Snakemake process runs in the folder any more. A run started from
@@ -81,6 +82,20 @@ def manifest_problem(path: Path, expected: str | None = None) -> str | None:
     if not entry_is_sound(cache_root() / key):
         return f"names cache entry {key}, which is missing or fails its SHA-256 check ({cache_root() / key})"
     return None
+
+
+def current_model_key(manifest: Path) -> str | None:
+    """The cache key the effects the model manifest `manifest` names have now (their sources and the sympy in
+    use: parksteer.model.codegen.cache.model_key), or None when they cannot be resolved by name (an effect from a
+    file outside the package, or no readable list of effects)."""
+    from .model.codegen.cache import model_key
+    from .model.symbolic.components import resolve_effects
+
+    try:
+        names = json.loads(Path(manifest).read_text(encoding="utf-8"))["effects"]
+        return model_key(resolve_effects([str(name) for name in names]))
+    except (OSError, ValueError, KeyError, TypeError):  # a UsageError is a ValueError
+        return None
 
 
 def _parent_pid(pid: int) -> int | None:
@@ -160,7 +175,7 @@ def repair(root: str | Path = ".") -> tuple[list[str], int]:
         checked += 1
         why = content_problem(path)
         if why is None and path.parent == manifests and path.suffix == ".json":
-            why = manifest_problem(path)
+            why = manifest_problem(path, current_model_key(path))
         if why is not None:
             path.unlink(missing_ok=True)
             lines.append(f"removed {path.relative_to(root)}: {why}; the next run rebuilds it")

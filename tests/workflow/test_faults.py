@@ -267,6 +267,22 @@ def test_a_manifest_is_trusted_only_if_its_cache_entry_exists_and_matches(tmp_pa
     assert "but the model's sources now key it" in manifest_problem(manifest, other)
 
 
+def test_repair_knows_the_key_a_manifests_effects_have_now(tmp_path):
+    """The key `parksteer repair` expects of a manifest is the one its effects have now: the paper's set by its
+    names gives the key the set is derived under, a set other than the manifest's gives another key, and an effect
+    the library does not have by name (one from a file outside the package) leaves only the entry check."""
+    from parksteer.model.codegen.cache import model_key
+    from parksteer.model.symbolic.components import resolve_effects
+    from parksteer.outputs import current_model_key
+
+    manifest = tmp_path / "full.json"
+    paper = resolve_effects(None)
+    manifest.write_text(json.dumps({"key": "f" * 20, "effects": [e.name for e in paper]}), "utf-8")
+    assert current_model_key(manifest) == model_key(paper) != model_key(resolve_effects("-rack_friction"))
+    manifest.write_text(json.dumps({"key": "f" * 20, "effects": ["lifting", "column_imbalance"]}), "utf-8")
+    assert current_model_key(manifest) is None
+
+
 def test_repair_removes_the_damaged_outputs_only_and_says_why(tmp_path, monkeypatch, capsys):
     """`parksteer repair` reads every output rules write: a truncated table and an unparsable key-number file are
     removed, one line each naming the file and why; a sound table, a sound figure's data and the reference data of
