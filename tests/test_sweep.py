@@ -563,9 +563,7 @@ def test_slurm_submission_with_stand_in_tools_requests_bounded_group_jobs(repo_r
     with log_path.open("w", encoding="utf-8") as log:
         process = subprocess.Popen(
             [str(snakemake), "sweep_design", "--snakefile", str(work / "workflow" / "Snakefile"),
-             "--directory", str(work), "--profile", str(repo_root / "workflow" / "profiles" / "slurm"),
-             # the manifests above are placeholders, which the damage check (check_outputs) would remove
-             "--config", "check_outputs=False"],
+             "--directory", str(work), "--profile", str(repo_root / "workflow" / "profiles" / "slurm")],
             stdout=log, stderr=subprocess.STDOUT, env=env, text=True,
             start_new_session=True,  # its own process group, so every child dies with it below
         )

@@ -19,6 +19,7 @@ from .errors import UsageError
 # Modules that add subcommands, in the order they appear in --help.
 COMMAND_MODULES = [
     "parksteer.commands.pipeline",
+    "parksteer.commands.workflow",
     "parksteer.commands.model",
     "parksteer.commands.sweep",
     "parksteer.commands.measure",

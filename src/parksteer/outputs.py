@@ -1,20 +1,20 @@
-"""What earlier pipeline runs left behind, checked by content before Snakemake builds its DAG.
+"""Repair what earlier pipeline runs left behind: ``parksteer repair``, run before Snakemake.
 
 Snakemake compares timestamps only, so a truncated output newer than its inputs would be trusted on every run.
-:func:`check_outputs` (called by the workflow, workflow/rules/common.smk) removes, in the working directory:
+:func:`repair` removes, in the working directory:
 - every empty, truncated or unparsable CSV, SVG, JSON, notebook or PDF a rule wrote (results/, figures/*.svg,
-  figures/*.csv, paper/*.pdf; figures/reference/ is source and never touched);
-- a model manifest results/model/<set>.json whose cache key is not the one the set has now, or whose cache entry
-  is missing or fails its SHA-256 check: a manifest is trusted only if what it points at is sound;
+  figures/*.csv, paper/*.pdf; figures/reference/ is source and never touched), read with the integrity checks of
+  parksteer.checksums;
+- a model manifest results/model/<set>.json whose cache key is not the one its effects have now (their sources,
+  the sympy in use), or whose cache entry is missing or fails its SHA-256 check: a manifest is trusted only if
+  what it points at is sound and current;
 - temporary files of writers that were killed (:func:`parksteer.tables.remove_stale_temporaries`) and scratch
   directories of killed model builds (:func:`parksteer.model.codegen.cache.clean_stale_scratch`);
 - Snakemake's lock (.snakemake/locks) when no Snakemake process runs in the folder any more. A run started from
   another host on a shared file system cannot be seen from here: do not run one folder from two hosts at once.
-Snakemake then treats what was removed as any missing file: a missing target is built, a missing intermediate
-as soon as a job that reads it runs.
-The check runs whenever the workflow is loaded in Snakemake's main process, a dry run included (which then shows
-the rebuild). Reading the 420 files (21 MB) of a full build takes about 0.5 s, so a file is read again only when
-its size or modification time changed since it was last found sound (CHECKED_STAMPS).
+The next Snakemake run treats what was removed as any missing file: a missing target is built, a missing
+intermediate as soon as a job that reads it runs. Nothing here runs while Snakemake reads the workflow; reading
+the 420 files (21 MB) of a full build takes about 0.5 s.
 """
 
 from __future__ import annotations
@@ -22,19 +22,15 @@ from __future__ import annotations
 import json
 import os
 import shutil
-from collections.abc import Iterator, Mapping
+from collections.abc import Iterator
 from pathlib import Path
 
 from .checksums import integrity_problem
 from .model.codegen.cache import cache_root, clean_stale_scratch, entry_is_sound
-from .tables import ROWS_KEY, atomic_path, remove_stale_temporaries
+from .tables import ROWS_KEY, remove_stale_temporaries
 
 CHECKED_SUFFIXES = (".csv", ".svg", ".json", ".ipynb", ".pdf")
 PROC = Path("/proc")
-# The size and modification time (ns) of every output found sound, kept between runs: a file whose stamp has not
-# changed since is the file that was checked, and is not read again. A writer killed half-way, or any other
-# change, gives the file a new stamp. The stamps are dropped when this module changes.
-CHECKED_STAMPS = Path(".snakemake") / "parksteer-checked.json"
 
 
 def content_problem(path: Path) -> str | None:
@@ -44,7 +40,7 @@ def content_problem(path: Path) -> str | None:
         return integrity_problem(path)
     if path.stat().st_size == 0:
         return "empty"
-    if path.suffix == ".csv":  # the shape only: parsing every number would double the time of a DAG build
+    if path.suffix == ".csv":  # the shape only: parsing every number would double the repair's time
         data = path.read_bytes()
         if not data.endswith(b"\n"):
             return "does not end with a newline (truncated)"
@@ -73,18 +69,33 @@ def content_problem(path: Path) -> str | None:
     return None
 
 
-def manifest_problem(path: Path, expected: str) -> str | None:
-    """Why the model manifest `path` cannot be trusted, or None; `expected` is the cache key its effect set has
-    now (parksteer.model.codegen.cache.model_key)."""
+def manifest_problem(path: Path, expected: str | None = None) -> str | None:
+    """Why the model manifest `path` cannot be trusted, or None: not a manifest, its cache entry missing or failing
+    its SHA-256 check, or (when `expected` is given) naming another cache key than `expected`, the key its effect
+    set has now (parksteer.model.codegen.cache.model_key)."""
     try:
         key = json.loads(Path(path).read_text(encoding="utf-8"))["key"]
     except (ValueError, UnicodeDecodeError, KeyError, TypeError) as exc:
         return f"not a model manifest ({type(exc).__name__}: {exc})"
-    if key != expected:
+    if expected is not None and key != expected:
         return f"names cache entry {key}, but the model's sources now key it {expected}"
     if not entry_is_sound(cache_root() / key):
-        return f"its cache entry {cache_root() / key} is missing or fails its SHA-256 check"
+        return f"names cache entry {key}, which is missing or fails its SHA-256 check ({cache_root() / key})"
     return None
+
+
+def current_model_key(manifest: Path) -> str | None:
+    """The cache key the effects the model manifest `manifest` names have now (their sources and the sympy in
+    use: parksteer.model.codegen.cache.model_key), or None when they cannot be resolved by name (an effect from a
+    file outside the package, or no readable list of effects)."""
+    from .model.codegen.cache import model_key
+    from .model.symbolic.components import resolve_effects
+
+    try:
+        names = json.loads(Path(manifest).read_text(encoding="utf-8"))["effects"]
+        return model_key(resolve_effects([str(name) for name in names]))
+    except (OSError, ValueError, KeyError, TypeError):  # a UsageError is a ValueError
+        return None
 
 
 def _parent_pid(pid: int) -> int | None:
@@ -124,7 +135,7 @@ def other_snakemake_running(folder: str | Path = ".") -> bool:
 
 
 def written_files(root: Path) -> Iterator[Path]:
-    """The files rules write under `root` that check_outputs reads: results/ (but the model cache's entries, checked
+    """The files rules write under `root` that repair reads: results/ (but the model cache's entries, checked
     through their manifests, Snakemake's benchmark records and the directory outputs results/vehicles/*/synthetic),
     figures/*.svg and *.csv, paper/*.pdf."""
     results = root / "results"
@@ -145,35 +156,9 @@ def written_files(root: Path) -> Iterator[Path]:
     yield from sorted(p for p in (root / "paper").glob("*.pdf") if p.is_file())
 
 
-def _stamp(path: Path) -> list[int]:
-    stat = path.stat()
-    return [stat.st_size, stat.st_mtime_ns]
-
-
-def _read_stamps(store: Path) -> dict:
-    try:
-        data = json.loads(store.read_text(encoding="utf-8"))
-    except (OSError, ValueError):
-        return {}
-    if not isinstance(data, dict) or data.get("checker") != _stamp(Path(__file__)):
-        return {}
-    files = data.get("files")
-    return files if isinstance(files, dict) else {}
-
-
-def _write_stamps(store: Path, files: dict) -> None:
-    try:
-        with atomic_path(store) as scratch:
-            scratch.write_text(json.dumps({"checker": _stamp(Path(__file__)), "files": files}), encoding="utf-8")
-    except OSError:  # a read-only folder: every run reads every file
-        pass
-
-
-def check_outputs(model_keys: Mapping[str, str], root: str | Path = ".") -> list[str]:
-    """Remove what earlier runs left damaged or half-done under `root` (see the module's description); return one
-    line for each removal, naming the file and why. `model_keys` maps each manifest's name to the cache key its
-    effect set has now. Outputs whose size and modification time are those they had when last found sound
-    (CHECKED_STAMPS) are not read again; manifests are always checked, since their cache entries live elsewhere."""
+def repair(root: str | Path = ".") -> tuple[list[str], int]:
+    """Remove what earlier runs left damaged or half-done under `root` (see the module's description). Return one
+    line for each removal, naming the file and why, and the number of outputs read."""
     root = Path(root)
     lines = []
     locks = root / ".snakemake" / "locks"
@@ -184,19 +169,14 @@ def check_outputs(model_keys: Mapping[str, str], root: str | Path = ".") -> list
         lines.append(f"removed {path.relative_to(root)}: a temporary file of a killed writer")
     for path in clean_stale_scratch(cache_root()):
         lines.append(f"removed {path}: a scratch directory of a killed model build")
-    manifests = {root / "results" / "model" / f"{name}.json": key for name, key in model_keys.items()}
-    store = root / CHECKED_STAMPS
-    known, sound = _read_stamps(store), {}
+    manifests = root / "results" / "model"
+    checked = 0
     for path in written_files(root):
-        name, stamp = str(path.relative_to(root)), _stamp(path)
-        why = None if known.get(name) == stamp else content_problem(path)
-        if why is None and path in manifests:
-            why = manifest_problem(path, manifests[path])
+        checked += 1
+        why = content_problem(path)
+        if why is None and path.parent == manifests and path.suffix == ".json":
+            why = manifest_problem(path, current_model_key(path))
         if why is not None:
             path.unlink(missing_ok=True)
-            lines.append(f"removed {path.relative_to(root)}: {why}; it is rebuilt")
-        else:
-            sound[name] = stamp
-    if sound != known:
-        _write_stamps(store, sound)
-    return lines
+            lines.append(f"removed {path.relative_to(root)}: {why}; the next run rebuilds it")
+    return lines, checked

@@ -2,7 +2,6 @@
 # lock angle, wheel radius, assembly mass centre, saw-tooth rounding), moved one at a time through parameter
 # overrides of the figures' compiled model (parksteer.figures.bands). Writes the band table (CSV), a tornado
 # figure (SVG) and the numbers the paper quotes (results/bands.json).
-FIGURES["bands"] = ["figures/bands.svg", "figures/bands.csv"]
 
 
 rule bands:

@@ -1,11 +1,11 @@
-import ast
 import json
 import os
-from functools import lru_cache
 from pathlib import Path
 
-# Shared names. FIGURES maps each figure or table target to the files it writes;
-# these are the files checksummed in figures/SHA256SUMS.
+import yaml
+
+# Shared names. FIGURES maps each figure or table target to the files it writes: the one list of them. These are
+# the files checksummed in figures/SHA256SUMS, the targets of rule `all` and the figures the paper shows.
 PARAMETERS = config["parameters"]
 
 FIGURES = {
@@ -23,6 +23,10 @@ FIGURES = {
     "diag_compare": ["figures/diag_compare.svg", "figures/diag_compare.csv"],
     "diag_ladder": ["figures/diag_ladder.svg", "figures/diag_ladder.csv"],
     "diag_benchmark": ["figures/diag_benchmark.svg", "figures/diag_benchmark.csv"],
+    "diag_outclass": ["figures/diag_outclass.svg", "figures/diag_outclass.csv"],
+    "diag_variations": ["figures/diag_variations.svg", "figures/diag_variations.csv"],
+    "bands": ["figures/bands.svg", "figures/bands.csv"],
+    "rivals": ["figures/rivals.svg", "figures/rivals.csv"],
 }
 
 
@@ -39,139 +43,36 @@ def paper_sources():
     return sorted(str(p) for p in Path("paper").glob("*.typ"))
 
 
-# --- exact rebuilds: each rule's inputs include the package modules its script runs -------------------------
-# The modules a script imports, found statically (every `import` and `from ... import`, also inside functions),
-# then the modules those import, and so on; importing parksteer.a.b also runs parksteer/__init__.py and
-# parksteer/a/__init__.py. A changed module then reruns exactly the rules that can run it.
-WORKFLOW_DIR = Path(workflow.current_basedir).parent  # this file is workflow/rules/common.smk
-SCRIPTS_DIR = WORKFLOW_DIR / "scripts"
-PACKAGE_DIR = WORKFLOW_DIR.parent / "src" / "parksteer"
-# Imports no `import` statement shows: the effect registry loads every module of model/symbolic/effects.
-DYNAMIC_IMPORTS = {
-    "parksteer.model.symbolic.components": tuple(
-        f"parksteer.model.symbolic.effects.{p.stem}"
-        for p in sorted((PACKAGE_DIR / "model" / "symbolic" / "effects").glob("*.py"))
-        if p.stem != "__init__"
-    ),
-}
-
-
-@lru_cache(maxsize=None)
-def _module_file(name):
-    """The source file of module `name` in this checkout's package, or None (not parksteer's, or not a module)."""
-    parts = name.split(".")
-    if parts[0] != "parksteer":
-        return None
-    base = PACKAGE_DIR.joinpath(*parts[1:])
-    for candidate in (base / "__init__.py", base.with_suffix(".py")):
-        if candidate.is_file():
-            return candidate
-    return None
-
-
-# The import lists of parsed files are kept between runs in .snakemake/, each under its file's path, size and
-# modification time, so a run parses only the files that changed (parsing all of them was most of the Snakefile's
-# own time in a run with nothing to do). A missing or unreadable cache is rebuilt.
-IMPORT_CACHE = Path(".snakemake") / "parksteer-imports.json"
-
-
-def _read_import_cache():
-    try:
-        cached = json.loads(IMPORT_CACHE.read_text(encoding="utf-8"))
-    except (OSError, ValueError):
-        return {}
-    return cached if isinstance(cached, dict) else {}
-
-
-_IMPORTS_KNOWN = _read_import_cache()
-_IMPORTS_PARSED = {}
-
-
-def _write_cache(path, data):
-    """Write `data` as JSON into `path` atomically; a read-only directory is fine (the next run recomputes). Keys
-    keep their order: a planned value read back must equal the value computed (rule parameters are compared
-    with the previous run's, key order included)."""
-    from parksteer.tables import atomic_path
-
-    try:
-        with atomic_path(path) as scratch:
-            scratch.write_text(json.dumps(data), encoding="utf-8")
-    except OSError:
-        pass
-
-
-def save_caches():
-    """Keep what this run parsed (IMPORT_CACHE) and planned (PLAN_CACHE) for the next run."""
-    if _IMPORTS_PARSED:
-        _write_cache(IMPORT_CACHE, {**_IMPORTS_KNOWN, **_IMPORTS_PARSED})
-    if _PLANNED:
-        _write_cache(PLAN_CACHE, {"fingerprint": _PLAN_FINGERPRINT, "values": {**_PLAN_KNOWN, **_PLANNED}})
-
-
-@lru_cache(maxsize=None)
-def _imported_names(path, module):
-    """Every module name an import statement of `path` (module `module`, or None for a script) may load; each
-    file is parsed once per Snakemake run, however many rule scripts import it, and again only when it changes."""
-    stat = path.stat()
-    key, stamp = f"{path}|{module}", [stat.st_mtime_ns, stat.st_size]
-    known = _IMPORTS_KNOWN.get(key)
-    if isinstance(known, list) and len(known) == 2 and known[0] == stamp:
-        return tuple(known[1])
-    names = _parse_imports(path, module)
-    _IMPORTS_PARSED[key] = [stamp, list(names)]
-    return names
-
-
-def _parse_imports(path, module):
-    package = module if path.name == "__init__.py" else (module or "").rpartition(".")[0]
-    names = []
-    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"), filename=str(path))):
-        if isinstance(node, ast.Import):
-            names.extend(alias.name for alias in node.names)
-        elif isinstance(node, ast.ImportFrom):
-            if node.level:
-                anchor = package.split(".")[: len(package.split(".")) - node.level + 1]
-                target = ".".join(anchor + ([node.module] if node.module else []))
-            else:
-                target = node.module
-            names.append(target)
-            names.extend(f"{target}.{alias.name}" for alias in node.names)  # `from pkg import submodule`
-    return tuple(names)
-
-
-@lru_cache(maxsize=None)
-def _closure(path, module):
-    """The modules loaded by running `path` (as module `module`, None for a script), by name."""
-    seen, todo = set(), [(Path(path), module)]
-    while todo:
-        source, name = todo.pop()
-        for imported in _imported_names(source, name):
-            parts = imported.split(".")
-            for depth in range(1, len(parts) + 1):
-                prefix = ".".join(parts[:depth])
-                for loaded in (prefix, *DYNAMIC_IMPORTS.get(prefix, ())):
-                    found = _module_file(loaded)
-                    if found is not None and loaded not in seen:
-                        seen.add(loaded)
-                        todo.append((found, loaded))
-    return frozenset(seen)
+# --- exact rebuilds: each rule's inputs include the package files its script can run ------------------------
+# Read from the declaration workflow/code_inputs.yaml, which `parksteer plan` writes from the sources
+# (parksteer.code_inputs) and tests/workflow/test_code_inputs.py keeps current. A changed module then reruns
+# exactly the rules that can run it.
+CHECKOUT = Path(workflow.current_basedir).parent.parent  # this file is workflow/rules/common.smk
+PACKAGE_DIR = CHECKOUT / "src" / "parksteer"
+CODE_INPUTS_FILE = CHECKOUT / "workflow" / "code_inputs.yaml"
+CODE_INPUTS = yaml.load(CODE_INPUTS_FILE.read_text(encoding="utf-8"), Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
+_CHECKOUT_HERE = os.path.relpath(CHECKOUT)  # "." unless Snakemake runs in another directory (--directory)
 
 
 def file_sources(path):
-    """The package files a Python file outside the package (a notebook in percent format) loads."""
-    return sorted(os.path.relpath(_module_file(n)) for n in _closure(Path(path).resolve(), None))
+    """The package files the workflow file `path` (a rule script or notebook, relative to the checkout) can run,
+    relative to the working directory."""
+    if path not in CODE_INPUTS:
+        sys.exit(f"parksteer: error: {CODE_INPUTS_FILE} has no entry for {path}: run `parksteer plan`")
+    return [os.path.normpath(os.path.join(_CHECKOUT_HERE, name)) for name in CODE_INPUTS[path]]
 
 
 def script_sources(script):
-    """The package files a rule script (workflow/scripts/<script>.py) loads, relative to the working directory."""
-    return file_sources(SCRIPTS_DIR / f"{script}.py")
+    """The package files the rule script workflow/scripts/<script>.py can run."""
+    return file_sources(f"workflow/scripts/{script}.py")
 
 
 # --- the plan: what the rules take from the package (parksteer.plan), kept between runs ---------------------
 # Effect sets, case names and cache keys come from code that imports sympy and scipy (about 0.8 s). They are kept
 # in .snakemake/ under a fingerprint of the package, configuration, data and examples (each file's size and
 # modification time), the Python and sympy in use and this file; a value is recomputed when any of these, or a
-# file its call names (`files`), changed. A missing or unreadable cache is rebuilt.
+# file its call names (`files`), changed. A missing or unreadable cache is rebuilt. The Snakefile saves what a
+# run computed (save_plan) once every rule file is read.
 PLAN_CACHE = Path(".snakemake") / "parksteer-plan.json"
 
 
@@ -179,7 +80,7 @@ def _read_plan_cache():
     from parksteer.plan import fingerprint
 
     here = os.stat(Path(workflow.current_basedir) / "common.smk")  # this file writes and reads the cache
-    current = json.loads(json.dumps([fingerprint(WORKFLOW_DIR.parent), [here.st_size, here.st_mtime_ns]]))
+    current = json.loads(json.dumps([fingerprint(CHECKOUT), [here.st_size, here.st_mtime_ns]]))
     try:
         cached = json.loads(PLAN_CACHE.read_text(encoding="utf-8"))
     except (OSError, ValueError):
@@ -214,6 +115,22 @@ def planned(function, *args, files=()):
     return value
 
 
+def save_plan():
+    """Keep the values this run computed for the next run, written atomically (key order kept: a planned value
+    read back must equal the value computed, since Snakemake compares rule parameters with the previous run's,
+    key order included). A read-only folder is fine: the next run computes them again."""
+    if not _PLANNED:
+        return
+    from parksteer.tables import atomic_path
+
+    try:
+        with atomic_path(PLAN_CACHE) as scratch:
+            values = {**_PLAN_KNOWN, **_PLANNED}
+            scratch.write_text(json.dumps({"fingerprint": _PLAN_FINGERPRINT, "values": values}), encoding="utf-8")
+    except OSError:
+        pass
+
+
 def case_batches(prefix, names, per_job):
     """The cases `names` in jobs of at most `per_job` each, dealt in turn (so that a job mixes costly and cheap
     cases): {job id: its case names}. A job pays a process start and the package's imports once for its cases."""
@@ -237,7 +154,6 @@ def benchmark_file(rule, *wildcards):
 
 # --- compiled models: every named effect set the pipeline needs, derived once by rule derive ----------------
 MODEL_SETS = {}  # name -> effects spec
-MODEL_KEYS = {}  # name -> the model cache key its effect set has now
 _MODEL_NAMES = {}  # the resolved effect names -> the name first registered for them
 
 
@@ -247,8 +163,15 @@ def model_manifest(name, spec):
     resolved = planned("model_set", spec, files=effect_files(spec))
     name = _MODEL_NAMES.setdefault(tuple(resolved["effects"]), name)
     MODEL_SETS.setdefault(name, spec)
-    MODEL_KEYS.setdefault(name, resolved["key"])
     return f"results/model/{name}.json"
+
+
+def model_set(name):
+    """The effects spec registered as `name`. Rule derive looks it up when it plans a job, once every rule file
+    has registered its sets: the rule files can be included in any order."""
+    if name not in MODEL_SETS:
+        raise ValueError(f"results/model/{name}.json: no effect set named {name!r} (the sets: {', '.join(MODEL_SETS)})")
+    return MODEL_SETS[name]
 
 
 def effect_files(spec):
@@ -260,23 +183,3 @@ def effect_files(spec):
 def figure_runs(wildcards):
     """The (case, variant) runs of the model figure `wildcards.figure` (config["model_figures"])."""
     return FIGURE_DESIGN.figures[wildcards.figure]
-
-
-# --- damage and interruptions: what the next ordinary run repairs -----------------------------------------------
-# Snakemake compares timestamps only: a truncated intermediate newer than its inputs would be trusted on every
-# run. So before the DAG is built (the Snakefile calls check_outputs in the main process, never in a job), the
-# content of what earlier runs wrote is checked, and what no job can have written is removed (damaged CSV, SVG,
-# JSON and PDF outputs, model manifests whose cache entry is missing or unsound, temporary files and scratch
-# directories of killed writers, and the lock of a killed run; parksteer.outputs says exactly what and how).
-# Snakemake then treats a removed file as any missing one: a missing target is built, a missing intermediate as
-# soon as a job that reads it runs (one whose readers are intact and up to date is needed by nothing and stays
-# missing, as a temp() file would). Outputs a killed job left marked incomplete are rerun by `rerun-incomplete`
-# in workflow/profiles/default. `--config check_outputs=False` skips the checks (for tests that stand empty
-# placeholders in for outputs).
-def check_outputs():
-    """Remove damaged outputs, untrusted model manifests, leftovers of killed writers and a dead run's lock
-    (parksteer.outputs.check_outputs), saying in one line each what was removed and why."""
-    from parksteer.outputs import check_outputs as check
-
-    for line in check(MODEL_KEYS):
-        print(f"parksteer: {line}", file=sys.stderr)

@@ -2,19 +2,20 @@
 # model_manifest (the figures' models, the sweep's, the diagnosis's base model and candidates), each built or
 # found in the cache by parksteer.model.codegen.cache.ensure. Its inputs are the modules that derivation and
 # code generation run (model/symbolic, model/codegen and what they import): an edit of model/numeric derives
-# nothing. Included last, once every set is registered.
+# nothing. The set of a job is looked up when the job is planned (model_set), so this file can be included
+# before or after the rule files that register sets.
 
 
 rule derive:
     input:
         code=script_sources("derive"),
-        effects=lambda w: effect_files(MODEL_SETS[w.model]),
+        effects=lambda w: effect_files(model_set(w.model)),
     output:
         manifest="results/model/{model}.json",
     params:
-        effects=lambda w: MODEL_SETS[w.model],
+        effects=lambda w: model_set(w.model),
     wildcard_constraints:
-        model="|".join(MODEL_SETS),
+        model="[^/]+",
     log:
         "logs/derive/{model}.log",
     benchmark:

@@ -25,9 +25,7 @@ DIAG_BENCH_CASES = DIAG_PLAN["bench_cases"]
 DIAG_OUTCLASS_CASES = DIAG_PLAN["outclass_cases"]
 # the truth generator's models: the base model with each rival (none of them a candidate)
 DIAG_OUTCLASS_MODELS = [model_manifest(f"with_{rival}", f"+{rival}") for rival in DIAG_PLAN["outclass_rivals"]]
-FIGURES["diag_outclass"] = ["figures/diag_outclass.svg", "figures/diag_outclass.csv"]
 DIAG_VARIATION_CASES = DIAG_PLAN["variation_cases"]
-FIGURES["diag_variations"] = ["figures/diag_variations.svg", "figures/diag_variations.csv"]
 DIAG_PER_JOB = int(config.get("diagnosis_cases_per_job", 6))
 DIAG_BENCH_BATCHES = case_batches("bench_", DIAG_BENCH_CASES, DIAG_PER_JOB)
 DIAG_OUTCLASS_BATCHES = case_batches("outclass_", DIAG_OUTCLASS_CASES, DIAG_PER_JOB)

@@ -4,8 +4,6 @@
 # table (CSV) and the numbers the paper quotes (results/rivals.json).
 _RIVALS = planned("rival_names")
 
-FIGURES["rivals"] = ["figures/rivals.svg", "figures/rivals.csv"]
-
 
 rule rivals:
     input:
