@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import importlib.util
 import os
+import shutil
 from pathlib import Path
 
 # One BLAS thread per test process, set before numpy loads here and inherited by the workers and every subprocess:
@@ -48,6 +49,23 @@ def copy_repository(repo_root):
     bench_pipeline = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(bench_pipeline)
     return bench_pipeline.scratch_copy  # the benchmarks' scratch copy: the same files the cold-DAG timing builds
+
+
+@pytest.fixture(scope="session")
+def copy_with_models(repo_root, copy_repository):
+    """copy(dest, need_models=True) -> dest: a scratch copy of the repository with the worktree's compiled models
+    (results/model/<key>/, copied, so that a pipeline run in it derives nothing); skips when the worktree has built
+    none, unless `need_models` is false (then the copy's first run derives what it needs)."""
+    def copy(dest: Path, need_models: bool = True) -> Path:
+        cache = repo_root / "results" / "model"
+        entries = [p for p in cache.iterdir() if p.is_dir() and not p.name.startswith(".")] if cache.is_dir() else []
+        if not entries and need_models:
+            pytest.skip("no compiled models in results/model: run `snakemake --cores 2 fig12` once")
+        work = copy_repository(dest)
+        for entry in entries:
+            shutil.copytree(entry, work / "results" / "model" / entry.name)
+        return work
+    return copy
 
 
 def _placeholder_outputs(work: Path, summary: str) -> None:

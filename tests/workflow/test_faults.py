@@ -83,15 +83,8 @@ def _leftovers(work: Path) -> list[str]:
 
 
 @pytest.fixture(scope="module")
-def copy(repo_root, copy_repository, tmp_path_factory) -> Path:
-    work = copy_repository(tmp_path_factory.mktemp("faults"))
-    cache = repo_root / "results" / "model"
-    entries = [p for p in cache.iterdir() if p.is_dir() and not p.name.startswith(".")] if cache.is_dir() else []
-    if not entries:
-        pytest.skip("no compiled models in results/model: run `snakemake --cores 2 fig12` once")
-    for entry in entries:
-        shutil.copytree(entry, work / "results" / "model" / entry.name)
-    return work
+def copy(copy_with_models, tmp_path_factory) -> Path:
+    return copy_with_models(tmp_path_factory.mktemp("faults"))
 
 
 @pytest.mark.slow

@@ -1,7 +1,8 @@
 """The same bytes whatever arithmetic libraries the machine gives: the pipeline's outputs do not depend on the OpenBLAS
 kernel, numpy's SIMD level or the thread count.
 
-A scratch copy of the repository (with the worktree's compiled models, so nothing is derived) rebuilds the outputs
+A scratch copy of the repository (with the worktree's compiled models where it has them; otherwise the first run
+derives them, which does not touch the BLAS) rebuilds the outputs
 that go through the simulation and the diagnosis: fig12 (the model), figContrib (the mechanisms' shares), bands
 (the reconstructed inputs swept), diag_compare (synthetic car data, calibration and diagnosis) and the design
 sweep's batches, once under each of three settings:
@@ -17,7 +18,6 @@ from __future__ import annotations
 
 import hashlib
 import os
-import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -44,15 +44,8 @@ def _sha256(path: Path) -> str:
 
 
 @pytest.fixture(scope="module")
-def copy(repo_root, copy_repository, tmp_path_factory) -> Path:
-    work = copy_repository(tmp_path_factory.mktemp("machines"))
-    cache = repo_root / "results" / "model"
-    entries = [p for p in cache.iterdir() if p.is_dir() and not p.name.startswith(".")] if cache.is_dir() else []
-    if not entries:
-        pytest.skip("no compiled models in results/model: run `snakemake --cores 2 fig12` once")
-    for entry in entries:
-        shutil.copytree(entry, work / "results" / "model" / entry.name)
-    return work
+def copy(copy_with_models, tmp_path_factory) -> Path:
+    return copy_with_models(tmp_path_factory.mktemp("machines"), need_models=False)
 
 
 def _rebuild(work: Path, setting: dict[str, str]) -> dict[str, str]:
