@@ -157,11 +157,13 @@ def threshold_crossings(sweep: Sweep, records: list[dict], design: dict, quantit
         return []
     held = {k: spec.hold.get(k, d["nearest"]) for k, d in design.items() if k not in (spec.x, spec.y, spec.panels)}
     panels = axis_values(sweep, spec.panels) if spec.panels else [None]
+    lines: dict[tuple, list[dict]] = {}  # (panel, x) -> its records, in the order of `records`: one pass over them
+    for r in matching(records, held):
+        lines.setdefault((r["values"].get(spec.panels) if spec.panels else None, r["values"].get(spec.x)), []).append(r)
     out = []
     for panel in panels:
-        fixed = dict(held, **({spec.panels: panel} if spec.panels else {}))
         for x in axis_values(sweep, spec.x):
-            line = sorted(matching(records, dict(fixed, **{spec.x: x})), key=lambda r: r["values"][spec.y])
+            line = sorted(lines.get((panel, x), []), key=lambda r: r["values"][spec.y])
             ys = np.array([r["values"][spec.y] for r in line])
             qs = np.array([point_quantity(r, quantity) for r in line])
             crossing = math.nan
