@@ -95,7 +95,8 @@ def scratch_copy(repo: Path, dest: Path) -> Path:
 
 def stage_dag(repo: Path, work: Path, decl: Path, n: int) -> dict:
     shutil.rmtree(work / ".snakemake", ignore_errors=True)
-    out = _timed([str(BIN / "snakemake"), "-n", f"sweep_scale{n}", "--config", f"sweep={decl}"], work, _env(repo))
+    out = _timed([str(BIN / "snakemake"), "-n", f"sweep_scale{n}", "--config", f"sweep={decl}",
+                  f"sweep_batch_size={BATCH_SIZE}"], work, _env(repo))
     return {"wall_s": out["wall_s"], "cpu_s": out["cpu_s"]}
 
 
@@ -230,11 +231,12 @@ def point_cost(repo: Path, n_points: int = 21) -> dict:
     return measured
 
 
-def predict(n_points: int, dag_s: float, gather_s: float, cost: dict, submit_s: float) -> list[dict]:
+def predict(n_points: int, dag_s: float, gather_s: float, cost: dict, submit_s: float, n_batches: int | None = None
+            ) -> list[dict]:
     """Wall time of an n_points sweep under the SLURM profile on `cores` cores (Amdahl): the serial parts (DAG
     build, one sbatch per group job, the gathering) plus the batch work shared by the cores, each batch paying a
     job start; at most one core per batch."""
-    n_batches = math.ceil(n_points / BATCH_SIZE)
+    n_batches = n_batches or math.ceil(n_points / BATCH_SIZE)
     n_groups = math.ceil(n_batches / GROUP_BATCHES)
     work_s = n_points * cost["point_s"] + n_batches * cost["job_start_s"]
     serial_s = dag_s + n_groups * submit_s + gather_s
@@ -248,6 +250,7 @@ def predict(n_points: int, dag_s: float, gather_s: float, cost: dict, submit_s: 
 
 
 def main() -> int:
+    global BATCH_SIZE
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("out")
     parser.add_argument("--sizes", type=int, nargs="+", default=sorted(GRIDS), choices=sorted(GRIDS))
@@ -255,12 +258,25 @@ def main() -> int:
                         choices=["dag", "expand", "batching", "gather"])
     parser.add_argument("--point-cost", action="store_true")
     parser.add_argument("--submit-s", type=float, default=0.25,
-                        help="seconds per sbatch submission (the executor submits each group job in turn)")
+                        help="seconds per sbatch submission (the executor submits each group job in turn; an "
+                             "assumption: sbatch alone takes 0.05 s on the test cluster of tests/cluster, a busy "
+                             "controller several times that)")
     parser.add_argument("--repo", type=Path, default=REPO)
+    parser.add_argument("--from-json", type=Path,
+                        help="measure nothing: report (and predict) from the results file of an earlier run")
+    parser.add_argument("--batch-size", type=int, default=BATCH_SIZE,
+                        help="points per batch (config sweep_batch_size; the pipeline's default 50)")
     args = parser.parse_args()
+    BATCH_SIZE = args.batch_size
     repo = args.repo.resolve()
+    if args.from_json:
+        results = json.loads(args.from_json.read_text(encoding="utf-8"))
+        _report(results, args)
+        Path(args.out).write_text(json.dumps(results, indent=1) + "\n", encoding="utf-8")
+        return 0
     results: dict = {"machine": {"cpus": os.cpu_count(), "python": platform.python_version(),
-                                 "platform": platform.platform()}, "repo": str(repo), "sizes": {}}
+                                 "platform": platform.platform(), "load_average": os.getloadavg()},
+                     "repo": str(repo), "batch_size": BATCH_SIZE, "sizes": {}}
     with tempfile.TemporaryDirectory(prefix="bench_sweep_scale_") as tmp:
         work = scratch_copy(repo, Path(tmp) / "work")
         for n in args.sizes:
@@ -311,7 +327,7 @@ def _report(results: dict, args) -> None:
         row = results["sizes"][largest]
         if "dag" in row and "gather" in row:
             rows = predict(int(largest), row["dag"]["wall_s"], row["gather"]["gather_s"], results["point_cost"],
-                           args.submit_s)
+                           args.submit_s, row.get("batching", {}).get("n_batches"))
             results["prediction"] = {"points": int(largest), "submit_s": args.submit_s, "rows": rows}
             print(f"\n{int(largest):,} points under the SLURM profile (point {results['point_cost']['point_s']:.3f} s, "
                   f"job start {results['point_cost']['job_start_s']:.2f} s, sbatch {args.submit_s} s)")
