@@ -25,7 +25,7 @@ from ..sweep.aggregate import (
     point_quantity,
     summarize,
 )
-from ..sweep.declaration import Sweep, SweepError, load_sweep, parameter_bounds
+from ..sweep.declaration import Sweep, load_sweep, parameter_bounds
 from ..tables import write_json
 
 # How each SI unit is shown on an axis: (factor, label).

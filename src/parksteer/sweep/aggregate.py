@@ -37,14 +37,11 @@ def _batch_records(path) -> list[dict[str, Any]]:
 
 def read_points(paths, sweep: Sweep) -> list[dict[str, Any]]:
     """Point records (JSON files written by run_point, or batch files written by run_batch) in the sweep's order,
-    each given its index there."""
-    order = {point.id: point.index for point in sweep.points}
-    records = []
-    for path in paths:
-        doc = json.loads(Path(path).read_text(encoding="utf-8"))
-        records.extend(doc["records"] if "records" in doc else [doc])  # a batch file holds its points' records
+    each given its index there, all in memory (gather_points streams them)."""
+    records = [record for path in paths for record in _batch_records(path)]
     for record in records:
-        record["index"] = order.get(record["point"], -1)
+        point = sweep.find(record["point"])
+        record["index"] = point.index if point is not None else -1
     return sorted(records, key=lambda r: r["index"])
 
 
