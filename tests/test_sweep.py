@@ -233,6 +233,85 @@ def test_a_batch_writes_the_records_its_points_give_alone(tmp_path, params):
     assert [r["point"] for r in out["records"]] == saved["points"]
 
 
+def test_point_ids_in_bulk_are_point_id_of_each_point():
+    """The bulk hashing (pieces kept per key and value) gives each point the id point_id gives it alone, signed
+    zeros, mixed key sets and keys out of order included."""
+    from parksteer.sweep.declaration import point_id, point_ids
+
+    values = [{"tyre.tyre_pressure": 122500.0, "design.front_axle_load": 5576.0},
+              {"design.front_axle_load": 5576.0, "tyre.tyre_pressure": 122500.0},
+              {"design.castor_angle": 0.0}, {"design.castor_angle": -0.0}, {"design.castor_angle": 0.1},
+              {"design.castor_angle": -0.0, "tyre.tyre_pressure": 1.0e5}, {"design.castor_angle": 0.1}]
+    for effects, surface in ((None, "ground"), ("default,+my/effect.py", "air_bearing")):
+        assert point_ids("unladen", effects, surface, values) == [point_id("unladen", effects, surface, v)
+                                                                  for v in values]
+    assert point_id("unladen", None, "ground", {"design.castor_angle": 0.0}) != \
+        point_id("unladen", None, "ground", {"design.castor_angle": -0.0})
+
+
+@pytest.mark.parametrize("declaration", ["grid", "listed"])
+def test_a_batch_job_reads_from_the_batch_index_the_spec_the_sweep_gives(tmp_path, params, declaration):
+    """Each batch's spec read from the batch index (what the batch job runs) equals Sweep.batch_spec; a job that
+    finds no index writes it; an index that no longer matches its batch is refused, not run."""
+    from parksteer.sweep.declaration import batch_index_path, batch_spec_from_index, write_batch_index
+
+    path = _write(tmp_path, GRID) if declaration == "grid" else _listed(tmp_path, range(100000, 300000, 7000), "l.yaml")
+    sweep = load_sweep(path, params)
+    index_dir = tmp_path / "index"
+    assert not batch_index_path(index_dir, path, False, 4).exists()
+    for batch in sweep.batches(4):  # the first call writes the index
+        assert batch_spec_from_index(path, params.path, False, 4, batch, sweep.shared_spec, index_dir) == \
+            sweep.batch_spec(batch, 4)
+    index = write_batch_index(sweep, 4, index_dir)
+    assert index == batch_index_path(index_dir, path, False, 4) and len(index.read_text().splitlines()) == \
+        len(sweep.batches(4))
+    first, second = sorted(sweep.batches(4))[:2]
+    lines = index.read_text().splitlines()
+    index.write_text("\n".join([f"{first} {lines[1].split(' ', 1)[1]}", *lines[1:]]) + "\n")
+    with pytest.raises(SweepError, match="does not match the declaration"):
+        batch_spec_from_index(path, params.path, False, 4, first, sweep.shared_spec, index_dir)
+    with pytest.raises(SweepError, match="no batch"):
+        batch_spec_from_index(path, params.path, False, 4, "0123456789", sweep.shared_spec, index_dir)
+
+
+def test_the_streamed_table_is_the_table_of_all_records(tmp_path, params):
+    """gather_points, reading batch files in any order and spilling rows, writes the table sweep_table and
+    write_csv give from every record in memory, byte for byte, and keeps every record the summary and the maps
+    select (a line through the design point on each axis, the map's held slice)."""
+    from parksteer.sweep.aggregate import gather_points, matching, read_points, sweep_table
+    from parksteer.tables import write_csv
+
+    path = _write(tmp_path, GRID + "map: {x: tyre.tyre_pressure, y: design.front_axle_load, quantity: peak_torque_Nm}\n")
+    sweep = load_sweep(path, params)
+    files = []
+    for k, (batch, members) in enumerate(sorted(sweep.batches(3).items())):
+        records = []
+        for m in members:
+            point = sweep.point(m)
+            merits = {"peak_torque_Nm": 20.0 + point.index, "plateau_torque_Nm": 18.0, "lock_torque_Nm": 19.0,
+                      "reversal_drop_Nm": 9.0, "sliding_start_rack_m": 0.02, "share_contrib_lifting_Nm": 0.1}
+            if point.index % 5 == 3:  # a share that some points have: its column joins where it first shows
+                merits["share_contrib_rack_friction_Nm"] = 0.3
+            records.append({"point": m, "effects": ["lifting"], "values": point.values, "merits": merits,
+                            "braked": {"method": "none", "factor": math.nan, "ground_offset_m": math.nan,
+                                       "plateau_torque_Nm": math.nan, "peak_torque_Nm": math.nan,
+                                       "lock_torque_Nm": math.nan}})
+        files.append(tmp_path / f"b{k}.json")
+        files[-1].write_text(json.dumps({"batch": batch, "records": records}), encoding="utf-8")
+    files.reverse()
+    header = {"sweep": "streamed"}
+    kept, totals = gather_points(files, sweep, params, tmp_path / "streamed.csv", lambda totals: header, 30.0)
+    everything = read_points(files, sweep)
+    write_csv(tmp_path / "memory.csv", sweep_table(sweep, everything, 30.0), header)
+    assert (tmp_path / "streamed.csv").read_bytes() == (tmp_path / "memory.csv").read_bytes()
+    assert totals.n_points == len(everything) == 12 and totals.peak_range_Nm == (20.0, 31.0)
+    assert len(totals.points_above) == sum(r["merits"]["peak_torque_Nm"] > 30.0 for r in everything)
+    held = {"steering.rack_friction_force": 730.0}
+    assert [r["point"] for r in matching(kept, held)] == [r["point"] for r in matching(everything, held)]
+    with pytest.raises(SweepError, match="point files do not match"):
+        gather_points(files[1:], sweep, params, tmp_path / "short.csv", lambda totals: header, 30.0)
+
+
 # ---------------------------------------------------------------------------- design variables
 
 

@@ -65,17 +65,22 @@ def diagnosis(config: dict, parameters_path: str, user_effect: str) -> dict:
     }
 
 
-def sweep(path: str, parameters_path: str, full: bool, batch_size: int) -> dict:
+def sweep(path: str, parameters_path: str, full: bool, batch_size: int, index_dir: str) -> dict:
     """The sweep declared in `path`, read, checked and expanded (parksteer.sweep.load_sweep; its braked-wheel
-    check resolves effects): its name, effect sets by variant, and each batch's spec by batch id."""
+    check resolves effects): its name, effect sets by variant, what every point spec shares, and its batch ids;
+    each batch's points go to the sweep's batch index under `index_dir`
+    (parksteer.sweep.declaration.write_batch_index), where its job reads them."""
     from .parameters import load_parameters
     from .sweep import load_sweep
+    from .sweep.declaration import write_batch_index
 
     declared = load_sweep(path, load_parameters(parameters_path), full=full)
+    write_batch_index(declared, batch_size, index_dir)
     return {
         "name": declared.name,
         "model_sets": dict(declared.model_sets),
-        "batches": {batch: declared.batch_spec(batch, batch_size) for batch in sorted(declared.batches(batch_size))},
+        "shared": declared.shared_spec,
+        "batches": sorted(declared.batches(batch_size)),
     }
 
 

@@ -12,6 +12,7 @@ at the end each output with its size and the key numbers of its JSON outputs, an
 
 from __future__ import annotations
 
+import hashlib
 import json
 import sys
 import time
@@ -99,3 +100,14 @@ def rule_log(snakemake: Any) -> Iterator[None]:
         for line in describe_outputs(snakemake.output):
             note(line)
         log.flush()
+
+
+def write_code_stamp(sources, out_path: str | Path) -> None:
+    """Write the sha256 and path of each file of `sources`, one line each (sha256sum's format): a single file
+    that a rule can take as input in place of the many modules its script runs, and that is rewritten when one
+    of them changes (the rule writing it reruns)."""
+    from .tables import atomic_path
+
+    lines = [f"{hashlib.sha256(Path(p).read_bytes()).hexdigest()}  {p}" for p in sources]
+    with atomic_path(out_path) as scratch:
+        scratch.write_text("".join(f"{line}\n" for line in lines), encoding="utf-8")

@@ -15,7 +15,7 @@ import os
 import socket
 import tempfile
 import time
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Any, Iterator
@@ -139,21 +139,28 @@ def write_csv(
     lengths = {len(c) for c in data}
     if len(lengths) > 1:
         raise ValueError(f"{path}: columns have different lengths {sorted(lengths)}")
+    rows = (",".join(str(v) if isinstance(v, (str, np.str_)) else format_number(v, digits) for v in row)
+            for row in zip(*data))
+    write_csv_rows(path, names, rows, lengths.pop() if lengths else 0, header)
+
+
+def write_csv_rows(path: str | Path, names: Sequence[str], rows: Iterable[str], n_rows: int,
+                   header: Mapping[str, Any] | None = None) -> None:
+    """Write a CSV as write_csv does, from its column names and its data rows, each already joined by commas,
+    written as they come (a table of a million rows need not be held); `n_rows` is their number."""
     if header and ROWS_KEY in header:
         raise ValueError(f"{path}: the header key {ROWS_KEY!r} is the row count's")
     lines = [f"# {k}: {v}" for k, v in (header or {}).items()]
-    lines.append(f"# {ROWS_KEY}: {lengths.pop() if lengths else 0}")
+    lines.append(f"# {ROWS_KEY}: {n_rows}")
     lines.append(",".join(names))
-    for row in zip(*data):
-        cells = []
-        for v in row:
-            if isinstance(v, (str, np.str_)):
-                cells.append(str(v))
-            else:
-                cells.append(format_number(v, digits))
-        lines.append(",".join(cells))
-    with atomic_path(path) as tmp:
-        tmp.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    written = 0
+    with atomic_path(path) as tmp, open(tmp, "w", encoding="utf-8", newline="\n") as out:
+        out.write("\n".join(lines) + "\n")
+        for row in rows:
+            out.write(row + "\n")
+            written += 1
+        if written != n_rows:  # inside: a table whose count is wrong is never put in place
+            raise ValueError(f"{path}: {written} rows written where {n_rows} were announced")
 
 
 def read_csv(path: str | Path) -> tuple[dict[str, np.ndarray], dict[str, str]]:

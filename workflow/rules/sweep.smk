@@ -5,16 +5,21 @@
 # unchanged on a cluster (workflow/profiles/slurm). Each batch job reads the compiled model of its effect sets
 # ("free", and "braked" when the sweep simulates braked wheels) from the cache, where rule derive puts it, and
 # never derives; sweep_<name> gathers the table, the key numbers and the torque maps.
+# The plan holds the batch ids only: each batch's points are in the sweep's batch index (SWEEP_INDEX_DIR, written
+# once per declaration while the DAG is built; parksteer.sweep.declaration.write_batch_index), where its job reads
+# them, so that the DAG of a million points costs the scheduler a name per batch and no spec.
 from parksteer.errors import UsageError
-from parksteer.sweep.declaration import DEFAULT_BATCH_SIZE
+from parksteer.sweep.declaration import DEFAULT_BATCH_SIZE, DEFAULT_SWEEP_FILE
 
 SWEEP_BATCH_SIZE = int(config.get("sweep_batch_size", DEFAULT_BATCH_SIZE))
-SWEEP_FILE = config.get("sweep", "config/sweeps/design.yaml")
+SWEEP_FILE = config.get("sweep", DEFAULT_SWEEP_FILE)
 SWEEP_FULL = bool(config.get("sweep_full", False))
+SWEEP_INDEX_DIR = ".snakemake/parksteer-sweeps"
 # A bad declaration (empty axis, unknown key or effect, a value out of its bounds, a missing file) is refused
 # here, while the DAG is built, with one line naming the file and the key.
 try:
-    SWEEP = planned("sweep", SWEEP_FILE, PARAMETERS, SWEEP_FULL, SWEEP_BATCH_SIZE, files=[SWEEP_FILE, PARAMETERS])
+    SWEEP = planned("sweep", SWEEP_FILE, PARAMETERS, SWEEP_FULL, SWEEP_BATCH_SIZE, SWEEP_INDEX_DIR,
+                    files=[SWEEP_FILE, PARAMETERS])
     SWEEP_MODEL_MANIFESTS = [
         model_manifest(f"sweep_{SWEEP['name']}_{variant}", effects) for variant, effects in SWEEP["model_sets"].items()
     ]
@@ -25,18 +30,43 @@ SWEEP_NAME = SWEEP["name"]
 SWEEP_BATCH_FILES = expand("results/sweeps/{sweep}/batches/{batch}.json", sweep=SWEEP_NAME, batch=SWEEP["batches"])
 
 
-# A batch's id hashes its points' ids and each point's id hashes what it simulates; the points' values are a
-# parameter, not an input file. Editing the declaration (another axis value, a new map) runs only the batches
-# that gained or lost a point, never the whole sweep again.
+# The package modules a batch job runs (script_sources), as one input file of each batch job instead of some sixty:
+# the scheduler's cost per job is mostly its input files, and a sweep has many jobs. An edit of one of them reruns
+# this rule and so every batch, as the modules themselves would.
+SWEEP_BATCH_CODE = "results/sweeps/sweep_batch_code.txt"
+
+
+rule sweep_batch_code:
+    localrule: True
+    input:
+        code=script_sources("sweep_batch"),
+    output:
+        stamp=SWEEP_BATCH_CODE,
+    log:
+        "logs/sweep_batch_code.log",
+    benchmark:
+        benchmark_file("sweep_batch_code")
+    conda:
+        "../envs/parksteer.yaml"
+    script:
+        "../scripts/sweep_batch_code.py"
+
+
+# A batch's id hashes its points' ids and each point's id hashes what it simulates; what the points share (case,
+# effects, surface, braked wheels) is a parameter, and the declaration an input whose time does not count
+# (ancient). Editing the declaration (another axis value, a new map) runs only the batches that gained or lost a
+# point, never the whole sweep again. The job reads the batch size and sweep_full from the configuration as above.
 rule sweep_batch:
     input:
         parameters=PARAMETERS,
+        declaration=ancient(SWEEP_FILE),
         models=SWEEP_MODEL_MANIFESTS,
-        code=script_sources("sweep_batch"),
+        code=SWEEP_BATCH_CODE,
     output:
         batch="results/sweeps/{sweep}/batches/{batch}.json",
     params:
-        spec=lambda wildcards: SWEEP["batches"][wildcards.batch],
+        shared=SWEEP["shared"],
+        index_dir=SWEEP_INDEX_DIR,
     wildcard_constraints:
         sweep=SWEEP_NAME,
         batch="[0-9a-f]{10}",

@@ -17,16 +17,16 @@ import numpy as np
 from ..parameters import Parameters, load_parameters
 from ..plotting import COLOURS, new_figure, save_svg
 from ..sweep.aggregate import (
+    Totals,
     axis_values,
     design_values,
+    gather_points,
     matching,
     point_quantity,
-    read_points,
     summarize,
-    sweep_table,
 )
-from ..sweep.declaration import Sweep, SweepError, load_sweep, parameter_bounds
-from ..tables import write_csv, write_json
+from ..sweep.declaration import Sweep, load_sweep, parameter_bounds
+from ..tables import write_json
 
 # How each SI unit is shown on an axis: (factor, label).
 DISPLAY_UNITS = {"Pa": (1.0e-5, "bar"), "N": (1.0e-3, "kN"), "m": (1.0e3, "mm"), "rad": (180.0 / math.pi, "deg"),
@@ -111,11 +111,14 @@ def _draw_sensitivity(ax, sweep: Sweep, records: list[dict], key: str, design: d
     ax.set_xlabel(label)
 
 
-def plot_sweep(sweep: Sweep, params: Parameters, records: list[dict], out_svg: str | Path) -> None:
-    design = design_values(sweep, params, records)
+def plot_sweep(sweep: Sweep, params: Parameters, records: list[dict], out_svg: str | Path,
+               totals: Totals | None = None) -> None:
+    """Draw the maps and sensitivity lines from the sweep's records (all, or those gather_points keeps with its
+    totals)."""
+    design = design_values(sweep, params)
     keys = sweep.keys
     spec = sweep.map
-    panels = (axis_values(sweep, records, spec.panels) if spec and spec.panels else [None])[:MAX_MAP_PANELS]
+    panels = (axis_values(sweep, spec.panels) if spec and spec.panels else [None])[:MAX_MAP_PANELS]
     n_top = len(panels) if spec else 0
     n_bottom = len(keys)
     ncols = max(n_top, n_bottom, 1)
@@ -124,9 +127,11 @@ def plot_sweep(sweep: Sweep, params: Parameters, records: list[dict], out_svg: s
     grid = fig.add_gridspec(2 if n_top else 1, n_top * n_bottom if n_top else n_bottom, hspace=0.45, wspace=0.6)
     threshold = sweep.assistance.torque_Nm if sweep.assistance else None
     if n_top:
-        qs = np.array([point_quantity(r, spec.quantity) for r in records])
-        low = CONTOUR_STEP_NM * math.floor(np.nanmin(qs) / CONTOUR_STEP_NM)
-        high = CONTOUR_STEP_NM * math.ceil(np.nanmax(qs) / CONTOUR_STEP_NM)
+        if totals is None:
+            totals = Totals.of(records, threshold, spec.quantity)
+        lowest, highest = totals.map_range[spec.quantity]
+        low = CONTOUR_STEP_NM * math.floor(lowest / CONTOUR_STEP_NM)
+        high = CONTOUR_STEP_NM * math.ceil(highest / CONTOUR_STEP_NM)
         levels = np.arange(low, high + CONTOUR_STEP_NM / 2, CONTOUR_STEP_NM)
         held = {k: spec.hold.get(k, d["nearest"]) for k, d in design.items() if k not in (spec.x, spec.y, spec.panels)}
         design_panel = design[spec.panels]["nearest"] if spec.panels else None
@@ -169,25 +174,25 @@ def make_sweep_figure(sweep_path: str | Path, parameters: Parameters | str | Pat
     """Write the sweep's table (CSV), its key numbers (JSON) and its torque maps (SVG); return the numbers."""
     params = parameters if isinstance(parameters, Parameters) else load_parameters(parameters)
     sweep = load_sweep(sweep_path, params, full=full)
-    records = read_points(point_paths, sweep)
-    found = {r["point"] for r in records}
-    if found != set(sweep.point_ids):
-        missing = sorted(set(sweep.point_ids) - found) or sorted(found - set(sweep.point_ids))
-        raise SweepError(f"{sweep.path}: point files do not match the sweep (first difference: {missing[0]})")
     threshold = sweep.assistance.torque_Nm if sweep.assistance else None
-    header = {
-        "sweep": f"{sweep.name} ({len(records)} points{', full' if sweep.full else ''}) from {sweep.path}",
-        "description": sweep.description,
-        "model": f"case {sweep.base_case}, effects {', '.join(records[0]['effects'])}, surface {sweep.surface}",
-        "merits": "see parksteer.sweep.merit: plateau = mean over the sliding part of the right-going stroke, "
-                  "whole Hooke-joint ripple periods; shares are of the plateau",
-        "braked": records[0]["braked"]["method"],
-    }
-    if threshold is not None:
-        header["assistance threshold"] = (f"{threshold:g} N m = {sweep.assistance.rim_force_N:g} N x "
-                                          f"{sweep.assistance.rim_radius_m:g} m; needs_assistance = peak above it")
-    write_csv(out_csv, sweep_table(sweep, records, threshold), header)
-    summary = summarize(sweep, params, records)
+
+    def header(totals: Totals) -> dict[str, str]:
+        lines = {
+            "sweep": f"{sweep.name} ({totals.n_points} points{', full' if sweep.full else ''}) from {sweep.path}",
+            "description": sweep.description,
+            "model": f"case {sweep.base_case}, effects {', '.join(totals.effects)}, surface {sweep.surface}",
+            "merits": "see parksteer.sweep.merit: plateau = mean over the sliding part of the right-going stroke, "
+                      "whole Hooke-joint ripple periods; shares are of the plateau",
+            "braked": totals.braked_method,
+        }
+        if threshold is not None:
+            lines["assistance threshold"] = (f"{threshold:g} N m = {sweep.assistance.rim_force_N:g} N x "
+                                             f"{sweep.assistance.rim_radius_m:g} m; needs_assistance = peak above it")
+        return lines
+
+    # the table is written as the point files are read; only what the summary and the maps select is kept
+    records, totals = gather_points(point_paths, sweep, params, out_csv, header, threshold)
+    summary = summarize(sweep, params, records, totals)
     write_json(out_json, summary)
-    plot_sweep(sweep, params, records, out_svg)
+    plot_sweep(sweep, params, records, out_svg, totals)
     return summary

@@ -13,13 +13,16 @@ from __future__ import annotations
 
 import json
 import math
+import tempfile
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from ..parameters import Parameters
-from .declaration import Sweep, parameter_bounds
+from ..tables import format_number, write_csv_rows
+from .declaration import Sweep, SweepError, parameter_bounds
 from .design import base_value
 
 # Relative tolerance for "this grid value is the base car's value".
@@ -27,16 +30,18 @@ ON_DESIGN_RTOL = 1e-3
 SUMMARY_MERITS = ("peak_torque_Nm", "plateau_torque_Nm", "lock_torque_Nm", "reversal_drop_Nm")
 
 
+def _batch_records(path) -> list[dict[str, Any]]:
+    doc = json.loads(Path(path).read_text(encoding="utf-8"))
+    return doc["records"] if "records" in doc else [doc]  # a batch file holds its points' records
+
+
 def read_points(paths, sweep: Sweep) -> list[dict[str, Any]]:
     """Point records (JSON files written by run_point, or batch files written by run_batch) in the sweep's order,
-    each given its index there."""
-    order = {point.id: point.index for point in sweep.points}
-    records = []
-    for path in paths:
-        doc = json.loads(Path(path).read_text(encoding="utf-8"))
-        records.extend(doc["records"] if "records" in doc else [doc])  # a batch file holds its points' records
+    each given its index there, all in memory (gather_points streams them)."""
+    records = [record for path in paths for record in _batch_records(path)]
     for record in records:
-        record["index"] = order.get(record["point"], -1)
+        point = sweep.find(record["point"])
+        record["index"] = point.index if point is not None else -1
     return sorted(records, key=lambda r: r["index"])
 
 
@@ -86,18 +91,19 @@ def sweep_table(sweep: Sweep, records: list[dict], threshold_Nm: float | None) -
     return cols
 
 
-def axis_values(sweep: Sweep, records: list[dict], key: str) -> list[float]:
+def axis_values(sweep: Sweep, key: str) -> list[float]:
+    """The values the sweep gives `key`: its axis, or those of its declared points, sorted."""
     if sweep.axes:
         return list(sweep.axes[key])
-    return sorted({r["values"][key] for r in records if key in r["values"]})
+    return sorted({p.values[key] for p in sweep.points if key in p.values})
 
 
-def design_values(sweep: Sweep, params: Parameters, records: list[dict]) -> dict[str, dict[str, Any]]:
+def design_values(sweep: Sweep, params: Parameters) -> dict[str, dict[str, Any]]:
     """For each key: the base car's value, the sweep value nearest it, and whether they agree."""
     out = {}
     for key in sweep.keys:
         base = base_value(params, sweep.base_case, key)
-        values = np.array(axis_values(sweep, records, key))
+        values = np.array(axis_values(sweep, key))
         nearest = float(values[np.argmin(np.abs(values - base))])
         on_design = math.isclose(nearest, base, rel_tol=ON_DESIGN_RTOL, abs_tol=1e-12)
         out[key] = {"base": base, "nearest": nearest, "on_design": on_design}
@@ -147,12 +153,14 @@ def threshold_crossings(sweep: Sweep, records: list[dict], design: dict, quantit
     if spec is None:
         return []
     held = {k: spec.hold.get(k, d["nearest"]) for k, d in design.items() if k not in (spec.x, spec.y, spec.panels)}
-    panels = axis_values(sweep, records, spec.panels) if spec.panels else [None]
+    panels = axis_values(sweep, spec.panels) if spec.panels else [None]
+    lines: dict[tuple, list[dict]] = {}  # (panel, x) -> its records, in the order of `records`: one pass over them
+    for r in matching(records, held):
+        lines.setdefault((r["values"].get(spec.panels) if spec.panels else None, r["values"].get(spec.x)), []).append(r)
     out = []
     for panel in panels:
-        fixed = dict(held, **({spec.panels: panel} if spec.panels else {}))
-        for x in axis_values(sweep, records, spec.x):
-            line = sorted(matching(records, dict(fixed, **{spec.x: x})), key=lambda r: r["values"][spec.y])
+        for x in axis_values(sweep, spec.x):
+            line = sorted(lines.get((panel, x), []), key=lambda r: r["values"][spec.y])
             ys = np.array([r["values"][spec.y] for r in line])
             qs = np.array([point_quantity(r, quantity) for r in line])
             crossing = math.nan
@@ -166,9 +174,13 @@ def threshold_crossings(sweep: Sweep, records: list[dict], design: dict, quantit
     return out
 
 
-def summarize(sweep: Sweep, params: Parameters, records: list[dict]) -> dict[str, Any]:
-    """The key numbers of a sweep (results/sweep_<name>.json)."""
-    design = design_values(sweep, params, records)
+def summarize(sweep: Sweep, params: Parameters, records: list[dict], totals: Totals | None = None
+              ) -> dict[str, Any]:
+    """The key numbers of a sweep (results/sweep_<name>.json), from its records in the sweep's order: all of them,
+    or those gather_points keeps with the totals it counts over all."""
+    if totals is None:
+        totals = Totals.of(records, sweep.assistance.torque_Nm if sweep.assistance else None)
+    design = design_values(sweep, params)
     design_fixed = {k: d["nearest"] for k, d in design.items()}
     found = matching(records, design_fixed)
     design_point = {"values": design_fixed, "on_design": all(d["on_design"] for d in design.values()),
@@ -181,22 +193,19 @@ def summarize(sweep: Sweep, params: Parameters, records: list[dict]) -> dict[str
         "sweep": sweep.name,
         "description": sweep.description,
         "full": sweep.full,
-        "n_points": len(records),
+        "n_points": totals.n_points,
         "base_case": sweep.base_case,
-        "effects": records[0]["effects"] if records else [],
+        "effects": totals.effects,
         "surface": sweep.surface,
-        "axes": {k: {"values": axis_values(sweep, records, k), "unit": parameter_bounds(k)[3],
+        "axes": {k: {"values": axis_values(sweep, k), "unit": parameter_bounds(k)[3],
                      "column": column_name(k), **design[k]} for k in sweep.keys},
         "design_point": design_point,
         "sensitivity": sensitivities(sweep, records, design),
-        "braked_method": records[0]["braked"]["method"] if records else "",
-        "peak_torque_range_Nm": [min(point_quantity(r, "peak_torque_Nm") for r in records),
-                                 max(point_quantity(r, "peak_torque_Nm") for r in records)] if records else [],
+        "braked_method": totals.braked_method,
+        "peak_torque_range_Nm": list(totals.peak_range_Nm),
     }
     if sweep.assistance is not None:
         threshold = sweep.assistance.torque_Nm
-        above = [r for r in records if point_quantity(r, "peak_torque_Nm") > threshold]
-        above_braked = [r for r in records if point_quantity(r, "peak_torque_braked_Nm") > threshold]
         summary["assistance"] = {
             "threshold_Nm": threshold,
             "rim_force_N": sweep.assistance.rim_force_N,
@@ -204,10 +213,9 @@ def summarize(sweep: Sweep, params: Parameters, records: list[dict]) -> dict[str
             "rim_force_source": sweep.assistance.rim_force_source,
             "rim_radius_source": sweep.assistance.rim_radius_source,
             "quantity": "peak_torque_Nm",
-            "n_above": len(above),
-            "n_above_braked": len(above_braked),
-            "points_above": [{"point": r["point"], "values": r["values"],
-                              "peak_torque_Nm": point_quantity(r, "peak_torque_Nm")} for r in above],
+            "n_above": len(totals.points_above),
+            "n_above_braked": totals.n_above_braked,
+            "points_above": [entry for _, entry in sorted(totals.points_above, key=lambda item: item[0])],
             "crossings": threshold_crossings(sweep, records, design, "peak_torque_Nm", threshold),
         }
         if sweep.map is not None:
@@ -220,3 +228,123 @@ def summarize(sweep: Sweep, params: Parameters, records: list[dict]) -> dict[str
                                    if k not in (sweep.map.x, sweep.map.y, sweep.map.panels)},
                           "quantity": sweep.map.quantity}
     return summary
+
+
+# ---------------------------------------------------------------------------- gathering, streamed
+
+
+@dataclass
+class Totals:
+    """What the summary and the maps take from every record of a sweep, counted one record at a time."""
+
+    threshold_Nm: float | None
+    n_points: int = 0
+    first_index: int = -1
+    effects: list = field(default_factory=list)
+    braked_method: str = ""
+    peak_range_Nm: tuple = ()
+    map_range: dict = field(default_factory=dict)  # map quantity -> (nanmin, nanmax) over every record
+    points_above: list = field(default_factory=list)  # (index, entry) of each point above the threshold
+    n_above_braked: int = 0
+
+    def add(self, record: dict) -> None:
+        self.n_points += 1
+        if self.first_index < 0 or record["index"] < self.first_index:
+            self.first_index = record["index"]
+            self.effects, self.braked_method = record["effects"], record["braked"]["method"]
+        peak = point_quantity(record, "peak_torque_Nm")
+        self.peak_range_Nm = (min(self.peak_range_Nm[0], peak), max(self.peak_range_Nm[1], peak)) \
+            if self.peak_range_Nm else (peak, peak)
+        for quantity, (low, high) in list(self.map_range.items()):
+            value = point_quantity(record, quantity)
+            if not math.isnan(value):
+                self.map_range[quantity] = (min(low, value), max(high, value))
+        if self.threshold_Nm is not None:
+            if peak > self.threshold_Nm:
+                self.points_above.append((record["index"], {"point": record["point"], "values": record["values"],
+                                                            "peak_torque_Nm": peak}))
+            if point_quantity(record, "peak_torque_braked_Nm") > self.threshold_Nm:
+                self.n_above_braked += 1
+
+    @classmethod
+    def of(cls, records: list[dict], threshold_Nm: float | None, map_quantity: str | None = None) -> Totals:
+        totals = cls(threshold_Nm, map_range={map_quantity: (math.inf, -math.inf)} if map_quantity else {})
+        for record in records:
+            totals.add(record)
+        return totals
+
+
+def _row(keys: list[str], record: dict, threshold_Nm: float | None) -> tuple[str, dict[str, str], str]:
+    """A record's row of the sweep table (as sweep_table and write_csv give it), in three parts: the cells before
+    the share columns, the share cells by merit name, the cells after them."""
+    head = [record["point"], format_number(record["index"])]
+    head += [format_number(_nan(record["values"].get(key))) for key in keys]
+    head += [format_number(point_quantity(record, q)) for q in SUMMARY_MERITS]
+    shares = {k: format_number(_nan(v)) for k, v in record["merits"].items() if k.startswith("share_contrib_")}
+    peak, peak_braked = point_quantity(record, "peak_torque_Nm"), point_quantity(record, "peak_torque_braked_Nm")
+    tail = [format_number(_nan(record["merits"]["sliding_start_rack_m"])),
+            format_number(point_quantity(record, "plateau_torque_braked_Nm")), format_number(peak_braked),
+            format_number(_nan(record["braked"]["factor"])), format_number(_nan(record["braked"]["ground_offset_m"]))]
+    if threshold_Nm is not None:
+        tail += [format_number(int(peak > threshold_Nm)), format_number(int(peak_braked > threshold_Nm))]
+    return ",".join(head), shares, ",".join(tail)
+
+
+def gather_points(paths, sweep: Sweep, params: Parameters, out_csv: str | Path, header, threshold_Nm: float | None
+                  ) -> tuple[list[dict[str, Any]], Totals]:
+    """Read the point or batch files `paths` one at a time and write the sweep's table (the file sweep_table and
+    write_csv give) to `out_csv`: each record's row goes to a scratch file as it is read, the rows are then
+    copied in the sweep's order under the lines header(totals) gives. Keep only the records the summary and the maps select (those on a line through
+    the design point, and on the map's held values) and the totals over all; return both.
+
+    Memory: those records, the totals (one entry per point above the assistance threshold) and two numbers per
+    point, whatever the number of points; the sweep's own expansion aside."""
+    design = design_values(sweep, params)
+    keys = sweep.keys
+    design_fixed = {k: d["nearest"] for k, d in design.items()}
+    spec = sweep.map
+    map_held = {k: spec.hold.get(k, d["nearest"]) for k, d in design.items()
+                if k not in (spec.x, spec.y, spec.panels)} if spec else None
+    totals = Totals(threshold_Nm, map_range={spec.quantity: (math.inf, -math.inf)} if spec else {})
+    n = len(sweep.points)
+    offsets = np.full(n, -1, dtype=np.int64)
+    first_share: dict[str, tuple[int, int]] = {}  # merit name -> (index, position) where it first shows
+    kept, unknown = [], []
+    with tempfile.TemporaryFile("w+", encoding="utf-8", dir=Path(out_csv).parent or None) as spill:
+        for path in paths:
+            for record in _batch_records(path):
+                point = sweep.find(record["point"])
+                if point is None:
+                    unknown.append(record["point"])
+                    continue
+                record["index"] = point.index
+                head, shares, tail = _row(keys, record, threshold_Nm)
+                for position, name in enumerate(shares):
+                    if name not in first_share or first_share[name] > (point.index, position):
+                        first_share[name] = (point.index, position)
+                offsets[point.index] = spill.tell()
+                spill.write(json.dumps([head, shares, tail]) + "\n")
+                totals.add(record)
+                if sum(record["values"].get(k) != v for k, v in design_fixed.items()) <= 1 or (
+                        map_held is not None and all(record["values"].get(k) == v for k, v in map_held.items())):
+                    kept.append(record)
+        missing = np.flatnonzero(offsets < 0)
+        if len(missing) or unknown:
+            first = sorted(sweep.points[i].id for i in missing) or sorted(unknown)
+            raise SweepError(f"{sweep.path}: point files do not match the sweep (first difference: {first[0]})")
+        shares = sorted(first_share, key=first_share.get)
+        names = ["point", "index", *(column_name(k) for k in keys), *SUMMARY_MERITS,
+                 *(name.replace("share_contrib_", "share_").removesuffix("_Nm") for name in shares),
+                 "sliding_start_rack_m", "plateau_torque_braked_Nm", "peak_torque_braked_Nm", "braked_factor",
+                 "ground_offset_m", *(("needs_assistance", "needs_assistance_braked") if threshold_Nm is not None
+                                      else ())]
+        nan = format_number(math.nan)
+
+        def rows():
+            for offset in offsets:
+                spill.seek(int(offset))
+                head, cells, tail = json.loads(spill.readline())
+                yield ",".join([head, *(cells.get(name, nan) for name in shares), tail])
+
+        write_csv_rows(out_csv, names, rows(), n, header(totals))
+    return sorted(kept, key=lambda r: r["index"]), totals
