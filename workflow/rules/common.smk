@@ -23,6 +23,7 @@ FIGURES = {
     "diag_compare": ["figures/diag_compare.svg", "figures/diag_compare.csv"],
     "diag_ladder": ["figures/diag_ladder.svg", "figures/diag_ladder.csv"],
     "diag_benchmark": ["figures/diag_benchmark.svg", "figures/diag_benchmark.csv"],
+    "diag_peers": ["figures/diag_peers.svg", "figures/diag_peers.csv"],
 }
 
 
