@@ -95,9 +95,9 @@ def test_every_setting_of_the_grid_answers_and_the_hidden_term_is_named():
     answers = peer_answers(library)
     assert set(answers["stlsq"]) == {setting_label("stlsq", s) for s in STLSQ_SETTINGS}
     assert set(answers["frols"]) == {setting_label("frols", s) for s in FROLS_SETTINGS}
-    assert answers["stlsq"]["threshold=0.2,ridge=0n"]["effect"] == "rack_stiction"
-    assert answers["stlsq"]["threshold=3,ridge=0n"]["verdict"] == "adequate"  # above the term's 0.5
-    assert answers["frols"]["bic,err>=0.01"]["effect"] == "rack_stiction"
+    assert answers["stlsq"]["threshold=0.2 ridge=0n"]["effect"] == "rack_stiction"
+    assert answers["stlsq"]["threshold=3 ridge=0n"]["verdict"] == "adequate"  # above the term's 0.5
+    assert answers["frols"]["bic err>=0.01"]["effect"] == "rack_stiction"
 
 
 def _case(hidden, stlsq_answers, benchmark="variations", kind=None):
@@ -128,7 +128,7 @@ def test_an_out_of_class_rival_answered_with_an_unrelated_candidate_is_a_peers_c
     rival["truth"].update(closest="column_friction", related=["kingpin_friction"])
     related = _case("gear_efficiency", [("missing", "kingpin_friction")] * len(STLSQ_THRESHOLDS), "outclass", "rival")
     related["truth"].update(closest="column_friction", related=["kingpin_friction"])
-    numbers = score_method([rival, related], "stlsq", "threshold=1,ridge=0n")
+    numbers = score_method([rival, related], "stlsq", "threshold=1 ridge=0n")
     assert numbers["confident_wrong"] == 1
     assert numbers["outclass"] == {"closest or related": 1, "unrelated": 1, "unexplained": 0, "adequate": 0}
 

@@ -63,7 +63,7 @@ FROLS_ERR_TOLERANCES = (0.0, 0.001, 0.003, 0.01, 0.02, 0.05, 0.1, 0.2, 0.3)
 FROLS_SETTINGS = tuple((c, t) for c in FROLS_CRITERIA for t in FROLS_ERR_TOLERANCES)
 FROLS_MAX_TERMS = 10  # SysIdentPy's n_info_values default: the criterion is evaluated for 1..10 terms
 METHODS = ("diagnose", "stlsq", "frols")
-METHOD_LABELS = {"diagnose": "parksteer diagnose", "stlsq": "PySINDy STLSQ", "frols": "FROLS (own, after SysIdentPy)"}
+METHOD_LABELS = {"diagnose": "parksteer diagnose", "stlsq": "PySINDy STLSQ", "frols": "FROLS (own, as SysIdentPy's)"}
 GENERIC_TERMS = ("constant", "sign(v)", "v", "|v|", "x", "x^2", "x^3", "|x|x", "sin(theta)", "cos(theta)",
                  "sin(2theta)", "cos(2theta)")
 
@@ -222,7 +222,9 @@ def verdict_of(selected: dict[str, float], library: Library) -> tuple[str, str |
 
 def peer_answers(library: Library) -> dict:
     """Every peer's answer at every setting of its grid, and each peer's own time (s) for the whole grid:
-    {"stlsq": {threshold: {...}}, "frols": {"aic@0.01": {...}}, "time_s": {...}}."""
+    {"stlsq": {"threshold=0.3 ridge=0n": {...}}, "frols": {"aic err>=0.01": {...}}, "time_s": {...}}."""
+    import pysindy.optimizers  # noqa: F401  (imported before the clock starts: once per process, not per record)
+
     answers: dict = {"stlsq": {}, "frols": {}, "time_s": {}}
     start = time.perf_counter()
     for threshold, ridge in STLSQ_SETTINGS:
@@ -247,9 +249,9 @@ def peer_answers(library: Library) -> dict:
 def setting_label(method: str, setting) -> str:
     if method == "stlsq":
         threshold, ridge = setting
-        return f"threshold={threshold:g},ridge={ridge:g}n"
+        return f"threshold={threshold:g} ridge={ridge:g}n"
     criterion, tolerance = setting
-    return f"{criterion},err>={tolerance:g}"
+    return f"{criterion} err>={tolerance:g}"
 
 
 def settings_of(method: str) -> list[str]:

@@ -26,7 +26,7 @@ def _rates(row: dict) -> dict[str, float]:
 def peers_figure(comparison: dict, svg: str | Path) -> None:
     """Grouped bars: per measure, one bar per method (the peers at their tuned setting), each labelled k/n."""
     rows = comparison["methods"]
-    fig, ax = new_figure(6.5, 3.6)
+    fig, ax = new_figure(6.5, 4.4)
     width = 0.8 / len(rows)
     x = np.arange(len(RATES))
     for k, row in enumerate(rows):
@@ -43,7 +43,8 @@ def peers_figure(comparison: dict, svg: str | Path) -> None:
     ax.set_ylabel("fraction of records")
     ax.set_title(f"{comparison['records']['evaluation']} benchmark records; peers tuned on "
                  f"{comparison['records']['tuning']} of another seed", fontsize=9)
-    ax.legend(fontsize=7, loc="upper right")
+    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.1), ncol=1, frameon=False)
+    fig.subplots_adjust(bottom=0.3)
     save_svg(fig, svg)
 
 
