@@ -61,7 +61,7 @@ STLSQ_MAX_ITERATIONS = 20  # PySINDy's default
 FROLS_CRITERIA = ("aic", "bic")
 FROLS_ERR_TOLERANCES = (0.0, 0.001, 0.003, 0.01, 0.02, 0.05, 0.1, 0.2, 0.3)
 FROLS_SETTINGS = tuple((c, t) for c in FROLS_CRITERIA for t in FROLS_ERR_TOLERANCES)
-FROLS_MAX_TERMS = 10  # SysIdentPy's n_info_values default: the criterion is evaluated for 1..10 terms
+FROLS_MAX_TERMS = 15  # SysIdentPy's n_info_values default: the criterion is evaluated for 1..15 terms
 METHODS = ("diagnose", "stlsq", "frols")
 METHOD_LABELS = {"diagnose": "parksteer diagnose", "stlsq": "PySINDy STLSQ", "frols": "FROLS (own, as SysIdentPy's)"}
 GENERIC_TERMS = ("constant", "sign(v)", "v", "|v|", "x", "x^2", "x^3", "|x|x", "sin(theta)", "cos(theta)",
@@ -158,7 +158,8 @@ def frols_ranking(library: Library, max_terms: int = FROLS_MAX_TERMS) -> FrolsRa
     """Orthogonal forward regression with the error reduction ratio (Billings; SysIdentPy's FROLS): at each step
     the term whose part orthogonal to the terms taken (classical Gram-Schmidt) explains the largest share
     ERR = (w.y)^2 / ((w.w)(y.y)) of the residual's sum of squares. After k terms, AIC = n ln(s2) + 2 k and
-    BIC = n ln(s2) + k ln(n), s2 the variance left (SysIdentPy's formulas)."""
+    BIC = n ln(s2) + k ln(n), s2 the variance (ddof 1) of what the least-squares fit on the k terms leaves
+    (SysIdentPy's formulas; it fits by recursive least squares by default, here exactly)."""
     y = library.residual
     n = y.size
     yy = float(y @ y)
@@ -183,7 +184,7 @@ def frols_ranking(library: Library, max_terms: int = FROLS_MAX_TERMS) -> FrolsRa
         remaining.remove(best)
         basis.append(best_w)
         left = left - (best_w @ left) * best_w
-        variance = max(float(left @ left) / n, 1e-300)
+        variance = max(float(np.var(left, ddof=1)), 1e-300)
         k = len(basis)
         names.append(library.names[best])
         errs.append(best_err)
@@ -193,12 +194,15 @@ def frols_ranking(library: Library, max_terms: int = FROLS_MAX_TERMS) -> FrolsRa
 
 
 def frols(ranking: FrolsRanking, criterion: str, err_tolerance: float) -> dict[str, float]:
-    """FROLS's selection from `ranking`: the terms up to the `criterion`'s minimum (at least one, as SysIdentPy
-    takes), then cut at the first whose ERR is below `err_tolerance`: {term: ERR}."""
+    """FROLS's selection from `ranking`: the terms up to the `criterion`'s first minimum (SysIdentPy's
+    ``get_min_info_value``: the terms before the criterion first rises; at least one), then cut at the first
+    whose ERR is below `err_tolerance`: {term: ERR}. SysIdentPy's own ``err_tol`` stops once the ERRs add up to
+    it and always keeps a term; the per-term floor is what lets FROLS answer that nothing is missing."""
     values = ranking.aic if criterion == "aic" else ranking.bic
     if not values:
         return {}
-    order = int(np.argmin(values)) + 1
+    rises = np.flatnonzero(np.diff(values) > 0)
+    order = int(rises[0]) + 1 if rises.size else len(values)
     selected = {}
     for name, err in zip(ranking.names[:order], ranking.err[:order]):
         if err < err_tolerance:
