@@ -246,7 +246,8 @@ def peer_answers(library: Library) -> dict:
         answers["frols"][setting_label("frols", (criterion, tolerance))] = {"verdict": verdict, "effect": effect,
                                                                             "selected": selected}
     answers["time_s"]["frols"] = ranked  # one ranking serves every setting
-    answers["frols_ranking"] = [{"term": t, "err": e} for t, e in zip(ranking.names, ranking.err)]
+    answers["frols_ranking"] = [{"term": t, "err": e, "aic": a, "bic": b}
+                                for t, e, a, b in zip(ranking.names, ranking.err, ranking.aic, ranking.bic)]
     return answers
 
 
@@ -505,6 +506,11 @@ def run_peer_batch(parameters_path, jobs: list[str], folder, tuning=None) -> Non
             path = Path(what)
             truth = json.loads(path.read_text(encoding="utf-8"))
             result = diagnose_case(params, path.parent / truth["name"], truth, kind, "evaluation")
+            written = path.with_name(f"{truth['name']}.diagnosis.json")  # the benchmark's own diagnosis
+            if written.exists():
+                said = json.loads(written.read_text(encoding="utf-8"))
+                result["diagnosis"]["benchmark_said"] = said["effect"] if said["verdict"] == "missing" \
+                    else said["verdict"]
         else:
             raise UsageError(f"peers job {job!r}: not tuning:, variations: or outclass:")
         write_json(out / f"{result['name']}.peers.json", result)
