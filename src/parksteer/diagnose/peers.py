@@ -50,9 +50,10 @@ from .select import Diagnosis
 # STLSQ thresholds tried, in noise floors RMS of a term's contribution (a coefficient of the unit-RMS terms)
 STLSQ_THRESHOLDS = (0.05, 0.1, 0.2, 0.3, 0.5, 0.75, 1.0, 1.5, 2.0, 3.0)
 # STLSQ's ridge (PySINDy's alpha) tried, as a fraction of the rows (each unit-RMS term's own sum of squares): 0 is
-# PySINDy's default alpha 0.05, which over thousands of rows barely counts; 0.01 and 0.1 shrink the opposing
-# coefficients of terms that nearly make one another (a sign term and a friction candidate's signature)
-STLSQ_RIDGES = (0.0, 0.01, 0.1)
+# PySINDy's default alpha 0.05, which over thousands of rows barely counts; the others shrink the opposing
+# coefficients of terms that nearly make one another (a sign term and a friction candidate's signature), 1 halving
+# the coefficient of a term no other term makes
+STLSQ_RIDGES = (0.0, 0.01, 0.1, 0.3, 1.0)
 STLSQ_DEFAULT_ALPHA = 0.05
 STLSQ_SETTINGS = tuple((t, r) for t in STLSQ_THRESHOLDS for r in STLSQ_RIDGES)
 STLSQ_MAX_ITERATIONS = 20  # PySINDy's default
@@ -417,6 +418,9 @@ def compare(cases: list[dict]) -> dict:
         grids[method] = {"best": best, "tuning": table,
                          "evaluation": [{"setting": s, **_brief(score_method(evaluation, method, s))}
                                         for s in settings_of(method)]}
+        if method == "stlsq":  # PySINDy's own ridge: the best of its thresholds on the tuning split
+            default = [row for row, (_t, ridge) in zip(table, STLSQ_SETTINGS) if ridge == 0.0]
+            grids[method]["default_ridge_best"] = max(default, key=lambda row: row["score"])
         rows.append(score_method(evaluation, method, best))
     rows_tuning = [score_method(tuning, "diagnose")] + [score_method(tuning, m, grids[m]["best"])
                                                          for m in ("stlsq", "frols")]
@@ -440,6 +444,10 @@ def peer_wins(rows: list[dict]) -> list[str]:
                         f"{ours['named'][0]}/{ours['named'][1]})")
         if (row["null_adequate_rate"] or 0.0) > (ours["null_adequate_rate"] or 0.0):
             wins.append(f"{row['label']} calls more nulls adequate")
+        if row["outclass"]["closest or related"] > ours["outclass"]["closest or related"]:
+            wins.append(f"{row['label']} names the closest or a related candidate for more out-of-class rivals "
+                        f"({row['outclass']['closest or related']} of {row['outclass_rivals']} against "
+                        f"{ours['outclass']['closest or related']})")
         if row["confident_wrong"] < ours["confident_wrong"]:
             wins.append(f"{row['label']} gives fewer confident wrong answers out of class")
         if row["time_with_upstream_s_median"] < ours["time_s_median"]:
