@@ -63,6 +63,11 @@ def table(comparison: dict) -> str:
     for method, grid in comparison["grids"].items():
         lines.append(f"{method} tuning (score: mean of named rate and nulls adequate), best {grid['best']}:")
         lines.append("  " + "  ".join(f"{row['setting']} {row['score']:.2f}" for row in grid["tuning"]))
+        spread = grid["tied_best_evaluation"]
+        lines.append(f"  tied at the best score: {', '.join(grid['tied_best'])}; on the evaluation records they name "
+                     f"{spread['named'][0]}-{spread['named'][1]}, call {spread['null_adequate'][0]}-"
+                     f"{spread['null_adequate'][1]} nulls adequate, {spread['confident_wrong'][0]}-"
+                     f"{spread['confident_wrong'][1]} confident wrong")
     return "\n".join(lines)
 
 

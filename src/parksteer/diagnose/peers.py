@@ -418,6 +418,15 @@ def compare(cases: list[dict]) -> dict:
         grids[method] = {"best": best, "tuning": table,
                          "evaluation": [{"setting": s, **_brief(score_method(evaluation, method, s))}
                                         for s in settings_of(method)]}
+        # every setting tied with the best on the tuning split, and the spread of their evaluation numbers: the
+        # tie-break's share of the result
+        top = max(row["score"] for row in table)
+        tied = [e for row, e in zip(table, grids[method]["evaluation"]) if row["score"] == top]
+        count = {"named": lambda e: e["named"][0], "null_adequate": lambda e: e["null_adequate"][0],
+                 "confident_wrong": lambda e: e["confident_wrong"]}
+        grids[method]["tied_best"] = [e["setting"] for e in tied]
+        grids[method]["tied_best_evaluation"] = {key: [min(map(f, tied)), max(map(f, tied))]
+                                                 for key, f in count.items()}
         if method == "stlsq":  # PySINDy's own ridge: the best of its thresholds on the tuning split
             default = [row for row, (_t, ridge) in zip(table, STLSQ_SETTINGS) if ridge == 0.0]
             grids[method]["default_ridge_best"] = max(default, key=lambda row: row["score"])
