@@ -150,3 +150,31 @@ def test_the_library_of_a_real_diagnosis_holds_its_residual_and_its_candidates_s
         assert np.allclose(column, w / np.sqrt(np.mean(w**2)))
     assert {"sign(v)", "x^3", "cos(2theta)"} <= set(library.names)
     assert library.matrix.shape == (diagnosis.problem.n, len(library.names))
+
+
+def test_the_comparison_tunes_on_the_tuning_split_and_scores_on_the_evaluation_records():
+    from parksteer.diagnose.peers import compare
+
+    k = len(STLSQ_THRESHOLDS)
+    frols_quiet = {setting_label("frols", s): {"verdict": "adequate", "effect": None} for s in FROLS_SETTINGS}
+
+    def case(split, hidden, answers):
+        c = _case(hidden, answers)
+        c["split"], c["frols"] = split, frols_quiet
+        c["diagnosis"]["outcome"]["named"] = hidden is not None
+        return c
+
+    # tuning: the hidden effect named up to the 5th threshold, the null quiet from the 3rd; evaluation: the
+    # hidden effect named only up to the 2nd, so the tuned 5th threshold misses it
+    cases = [case("tuning", "rack_lash", [("missing", "rack_lash")] * 5 + [("adequate", None)] * (k - 5)),
+             case("tuning", None, [("unexplained", None)] * 2 + [("adequate", None)] * (k - 2)),
+             case("evaluation", "rack_lash", [("missing", "rack_lash")] * 2 + [("adequate", None)] * (k - 2))]
+    comparison = compare(cases)
+    assert comparison["records"] == {"tuning": 2, "evaluation": 1}
+    ours, stlsq_row, frols_row = comparison["methods"]
+    assert stlsq_row["setting"] == setting_label("stlsq", (STLSQ_THRESHOLDS[4], STLSQ_RIDGES[-1]))
+    assert stlsq_row["named"] == [0, 1] and ours["named"] == [1, 1]
+    assert comparison["grids"]["stlsq"]["tied_best"] == [setting_label("stlsq", (t, r))
+                                                         for t in STLSQ_THRESHOLDS[2:5] for r in STLSQ_RIDGES]
+    assert comparison["grids"]["stlsq"]["tied_best_evaluation"]["named"] == [0, 0]
+    assert frols_row["named"] == [0, 1]
