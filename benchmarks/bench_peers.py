@@ -6,8 +6,9 @@ The logic is :mod:`parksteer.diagnose.peers` (rules ``diag_peers_batch`` and ``d
 the DAG). The evaluation records are those the variation and out-of-class benchmarks wrote under ``--records``
 (``variations/*/`` and ``outclass/*/``, each case's truth beside its folder of files: run the DAG's
 ``diag_variations`` and ``diag_outclass`` first); the tuning split is made here, the variation grid of
-config/config.yaml with the seed ``peers.tuning_seed``. Each case's result goes to OUT_FOLDER/<split>/<case>.peers.json
-(a case already there is not run again: ``--table-only`` runs none). Then each peer is tuned on the tuning split,
+config/config.yaml with the seed ``peers.tuning_seed``. Each case's result goes to
+OUT_FOLDER/<split>/<split>__<case>.peers.json (a case already there is not run again: ``--table-only`` runs none).
+Then each peer is tuned on the tuning split,
 and the table prints per method: hidden library effects named, nulls called adequate, what the out-of-class rivals
 were called, confident wrong answers, and the median time per record (a peer's own, and with the calibration and
 signatures it needs, which the diagnosis computes); then every peer setting's tuning score.
@@ -82,7 +83,7 @@ def main(argv: list[str] | None = None) -> int:
     sys.path.insert(0, str(ROOT / "src"))
     import yaml
 
-    from parksteer.diagnose.peers import compare, read_cases
+    from parksteer.diagnose.peers import compare, peers_file_name, read_cases
     from parksteer.diagnose.variations import VariationDesign
 
     config = yaml.safe_load((ROOT / "config" / "config.yaml").read_text(encoding="utf-8"))
@@ -91,7 +92,7 @@ def main(argv: list[str] | None = None) -> int:
     todo = []
     for split, job in _jobs(Path(args.records), design):
         name = Path(job.partition(":")[2]).name.split(".")[0]
-        if not (out / split / f"{name}.peers.json").exists() and not args.table_only:
+        if not (out / split / peers_file_name(split, name)).exists() and not args.table_only:
             todo.append((str(out / split), job, config["peers"]["tuning_seed"]))
     if todo:
         from multiprocessing import get_context

@@ -500,8 +500,8 @@ def run_tuning_case(params, design, name: str, folder) -> dict:
 
 
 def run_peer_batch(parameters_path, jobs: list[str], folder, tuning=None) -> None:
-    """Run one job's cases into `folder` ({case}.peers.json each). A job is ``tuning:<case name>`` (made with the
-    `tuning` design, its records in folder/<case>) or ``variations:<truth file>`` / ``outclass:<truth file>`` (a
+    """Run one job's cases into `folder` (<split>__<case>.peers.json each: a tuning case has its evaluation twin's
+    name). A job is ``tuning:<case name>`` (made with the `tuning` design, its records in folder/tuning/<case>) or ``variations:<truth file>`` / ``outclass:<truth file>`` (a
     benchmark case's truth, its records in the folder of its name beside it)."""
     import json
     from pathlib import Path
@@ -518,7 +518,7 @@ def run_peer_batch(parameters_path, jobs: list[str], folder, tuning=None) -> Non
         if kind == "tuning":
             if tuning is None:
                 raise UsageError(f"peers job {job!r}: no tuning design given")
-            result = run_tuning_case(params, tuning, what, out / what)
+            result = run_tuning_case(params, tuning, what, out / "tuning" / what)
         elif kind in ("variations", "outclass"):
             path = Path(what)
             truth = json.loads(path.read_text(encoding="utf-8"))
@@ -530,7 +530,11 @@ def run_peer_batch(parameters_path, jobs: list[str], folder, tuning=None) -> Non
                     else said["verdict"]
         else:
             raise UsageError(f"peers job {job!r}: not tuning:, variations: or outclass:")
-        write_json(out / f"{result['name']}.peers.json", result)
+        write_json(out / peers_file_name(result["split"], result["name"]), result)
+
+
+def peers_file_name(split: str, name: str) -> str:
+    return f"{split}__{name}.peers.json"
 
 
 def read_cases(paths) -> list[dict]:
