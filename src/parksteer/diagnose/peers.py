@@ -57,16 +57,14 @@ STLSQ_RIDGES = (0.0, 0.01, 0.1, 0.3, 1.0)
 STLSQ_DEFAULT_ALPHA = 0.05
 STLSQ_SETTINGS = tuple((t, r) for t in STLSQ_THRESHOLDS for r in STLSQ_RIDGES)
 STLSQ_MAX_ITERATIONS = 20  # PySINDy's default
-# FROLS: (information criterion, ERR tolerance): a term is kept up to the criterion's minimum and while its ERR
-# is at least the tolerance
+# FROLS: (information criterion, ERR tolerance): a term is kept up to the criterion's first minimum and while its
+# ERR is at least the tolerance
 FROLS_CRITERIA = ("aic", "bic")
 FROLS_ERR_TOLERANCES = (0.0, 0.001, 0.003, 0.01, 0.02, 0.05, 0.1, 0.2, 0.3)
 FROLS_SETTINGS = tuple((c, t) for c in FROLS_CRITERIA for t in FROLS_ERR_TOLERANCES)
 FROLS_MAX_TERMS = 15  # SysIdentPy's n_info_values default: the criterion is evaluated for 1..15 terms
 METHODS = ("diagnose", "stlsq", "frols")
 METHOD_LABELS = {"diagnose": "parksteer diagnose", "stlsq": "PySINDy STLSQ", "frols": "FROLS (own, as SysIdentPy's)"}
-GENERIC_TERMS = ("constant", "sign(v)", "v", "|v|", "x", "x^2", "x^3", "|x|x", "sin(theta)", "cos(theta)",
-                 "sin(2theta)", "cos(2theta)")
 
 
 @dataclass(frozen=True)
