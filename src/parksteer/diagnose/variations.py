@@ -226,11 +226,19 @@ def run_case(parameters_path, design: VariationDesign, name: str, folder, truth_
     """Make variation case `name`'s records, write them into `folder`, diagnose them from the files with
     `settings` (and the angle and lag settings below)."""
     params = load_parameters(parameters_path)
+    start = time.perf_counter()
+    truth, records, settings = case_records(params, design, name, settings)
+    return diagnose_written(params, records, folder, truth, truth_path, diagnosis_path, start, settings)
+
+
+def case_records(params: Parameters, design: VariationDesign, name: str,
+                 settings: DiagnosisSettings = BENCHMARK_SETTINGS) -> tuple[dict, list, DiagnosisSettings]:
+    """(truth, records as (case, surface, measurement), the settings a user would diagnose them with) of
+    variation case `name`."""
     cases = {c.name: c for c in variation_cases(design)}
     if name not in cases:
         raise UsageError(f"unknown variation case {name!r}")
     case = cases[name]
-    start = time.perf_counter()
     files, truth = case_truth(params, design, case)
     overrides = dict(truth["base_overrides"])
     if case.hidden is not None:
@@ -242,7 +250,7 @@ def run_case(parameters_path, design: VariationDesign, name: str, folder, truth_
     # known to delay its torque channel (the lag itself is found by the diagnosis)
     settings = replace(settings, use_handwheel_angle=case.variation.uses_angle,
                        torque_lag_fitted=case.variation.logger.torque_lag_s > 0.0)
-    return diagnose_written(params, records, folder, truth, truth_path, diagnosis_path, start, settings)
+    return truth, records, settings
 
 
 def _reported_intervals(result: dict) -> dict[str, dict]:
