@@ -111,6 +111,19 @@ def test_cli_verify_exit_status(tmp_path):
     assert bad.returncode == 1 and "0 identical, 0 within tolerance, 2 changed" in bad.stdout, bad.stdout
 
 
+def test_cli_verify_of_a_subset_checks_only_those_files_unless_complete(tmp_path):
+    """A user checking the files built (one figure of several) passes on identical files; the verify rule's
+    `--complete` reports a stored figure that was not given as no longer made."""
+    files = _make_figure(tmp_path, "f", 1.0) + _make_figure(tmp_path, "g", 3.0)
+    cmd = [sys.executable, "-m", "parksteer.cli", "checksums"]
+    assert subprocess.run(cmd + ["refresh", *files], cwd=tmp_path, capture_output=True).returncode == 0
+    subset = [f for f in files if "/f." in f]
+    ok = subprocess.run(cmd + ["verify", *subset, "--strict"], cwd=tmp_path, capture_output=True, text=True)
+    assert ok.returncode == 0 and "2 identical, 0 within tolerance, 0 changed" in ok.stdout, ok.stdout
+    bad = subprocess.run(cmd + ["verify", *subset, "--complete"], cwd=tmp_path, capture_output=True, text=True)
+    assert bad.returncode == 1 and "no longer makes it" in bad.stdout, bad.stdout
+
+
 @pytest.mark.parametrize("value,text", [(-0.0, "0"), (1e-12, "1e-12"), (0.1 + 0.2, "0.3"), (float("nan"), "nan")])
 def test_number_formatting_absorbs_last_bit_noise(value, text):
     """Seven significant digits: a last-bit floating-point difference does not change the bytes."""

@@ -20,7 +20,7 @@ rule verify:
     conda:
         "../envs/parksteer.yaml"
     shell:
-        "parksteer checksums verify {input.figures} {params.strictness} --report {output} > {log} 2>&1 "
+        "parksteer checksums verify {input.figures} --complete {params.strictness} --report {output} > {log} 2>&1 "
         "|| (cat {log}; exit 1)"
 
 

@@ -151,8 +151,10 @@ def _compare_with_reference(root: Path, rel: str, data: str | None, reference: P
 
 
 def verify(root: Path, sums_path: Path, expected_files: list[str],
-           platform_now: dict[str, str] | None = None) -> list[FileCheck]:
-    """Check every expected file (and every stored one) against the stored sums and reference copies.
+           platform_now: dict[str, str] | None = None, complete: bool = True) -> list[FileCheck]:
+    """Check every expected file (and, with `complete`, every stored one) against the stored sums and reference
+    copies. `complete`: the files given are all the pipeline makes, so a stored sum with no file is a change;
+    without it only the files given are checked (a user's subset).
 
     `platform_now`: the running platform's facts (gathered when a file is within tolerance and not given)."""
     from .platform_facts import PLATFORM_NAME, differences, gather, read
@@ -162,7 +164,7 @@ def verify(root: Path, sums_path: Path, expected_files: list[str],
     reference = Path(sums_path).parent / REFERENCE_DIR
     platform_note: str | None = None
     checks: list[FileCheck] = []
-    for rel in sorted(set(expected_files) | set(sums)):
+    for rel in sorted(set(expected_files) | (set(sums) if complete else set())):
         path = root / rel
         if rel not in sums:
             checks.append(FileCheck(rel, CHANGED, "no stored checksum (new figure? refresh the sums)"))

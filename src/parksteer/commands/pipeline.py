@@ -32,6 +32,9 @@ def register_checksums(sub) -> None:
     p.add_argument("--report", help="write the verification result here as well (when it passes)")
     p.add_argument("--strict", action="store_true",
                    help="fail on a file within tolerance too: only byte-identical figures pass (CI)")
+    p.add_argument("--complete", action="store_true",
+                   help="the files given are every file the pipeline makes: a stored sum without one is reported "
+                        "(the verify rule); without it only the files given are checked")
     p.set_defaults(func=_checksums)
 
 
@@ -50,7 +53,7 @@ def _checksums(args) -> int:
         return 0
     if not sums.exists():
         raise UsageError(f"{sums}: no stored checksums (run: snakemake --cores 2 refresh_checksums)")
-    checks = verify(root, sums, args.files)
+    checks = verify(root, sums, args.files, complete=args.complete)
     failing = failures(checks, strict=args.strict)
     lines = [check.line for check in checks]
     lines.append(summary(checks) + (" (strict: only identical passes)" if args.strict else ""))
