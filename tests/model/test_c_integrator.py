@@ -1,8 +1,8 @@
 """The C stiff integrator (src/parksteer/model/codegen/integrator.c) on test problems with known answers.
 
-Each test compiles integrator.c after a small C preamble that defines NY, NQ, ps_rhs and ps_jac (as the
-generated model code does; the prescribed-rack functions as stubs), with the system cc, and calls ps_integrate
-through ctypes. The prescribed-rack path (ps_integrate_prescribed) is checked on the model itself, in
+Each test compiles integrator.c after portable_math.c and a small C preamble that defines NY, NQ, ps_rhs and
+ps_jac (as the generated model code does; the prescribed-rack functions as stubs), with the system cc, and calls
+ps_integrate through ctypes. The prescribed-rack path (ps_integrate_prescribed) is checked on the model itself, in
 tests/model/test_rack_drive.py.
 """
 
@@ -21,6 +21,7 @@ from scipy.linalg import expm
 import parksteer
 
 INTEGRATOR_C = Path(parksteer.__file__).resolve().parent / "model" / "codegen" / "integrator.c"
+PORTABLE_MATH_C = INTEGRATOR_C.with_name("portable_math.c")  # ps_pow of the step control, as in a generated model
 
 pytestmark = pytest.mark.skipif(shutil.which("cc") is None, reason="needs a C compiler (cc)")
 
@@ -72,8 +73,8 @@ def compile_problem(tmp_path_factory):
     directory = tmp_path_factory.mktemp("c_integrator")
 
     def build(name: str, n_y: int, body: str) -> Problem:
-        preamble = (f"#include <math.h>\n#include <string.h>\n#define NY {n_y}\n#define NQ (NY / 2)\n{body}\n"
-                    + PRESCRIBED_STUBS)
+        preamble = (f"#include <math.h>\n#include <string.h>\n{PORTABLE_MATH_C.read_text(encoding='utf-8')}\n"
+                    f"#define NY {n_y}\n#define NQ (NY / 2)\n{body}\n" + PRESCRIBED_STUBS)
         source = directory / f"{name}.c"
         source.write_text(preamble + INTEGRATOR_C.read_text(encoding="utf-8"), encoding="utf-8")
         library = directory / f"{name}.so"
