@@ -331,8 +331,9 @@ def _summary(name: str, runs: list[Run], params: Parameters, data: dict) -> dict
         out["offset_d_m"] = [steer_axis(params, c, "left").offset_d_m for c, _ in runs]
         out["plateau_torque_Nm"] = plateau.tolist()
         out["torque_near_right_lock_Nm"] = near_lock.tolist()
-        out["plateau_sensitivity_Nm_per_m_offset"] = float(pm.lstsq(np.column_stack([offsets, np.ones(len(offsets))]), plateau)[0])
-        out["near_lock_sensitivity_Nm_per_m_offset"] = float(pm.lstsq(np.column_stack([offsets, np.ones(len(offsets))]), near_lock)[0])
+        line = np.column_stack([offsets, np.ones(len(offsets))])  # torque = slope * offset + intercept
+        out["plateau_sensitivity_Nm_per_m_offset"] = float(pm.lstsq(line, plateau)[0])
+        out["near_lock_sensitivity_Nm_per_m_offset"] = float(pm.lstsq(line, near_lock)[0])
         out["largest_plateau_change_relative"] = float((plateau.max() - plateau.min()) / plateau[0])
     if name in ("fig12", "fig13"):
         out["plateau_torque_Nm"] = {k: s["plateau_torque_Nm"] for k, s in summaries.items()}

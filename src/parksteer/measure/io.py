@@ -349,7 +349,8 @@ def header_cells(text: str, rows: int = 1) -> list[list[str]]:
     return found
 
 
-def _is_number(cell: str, decimal: str) -> bool:
+def is_number(cell: str, decimal: str = ".") -> bool:
+    """Whether `cell` reads as a number with the decimal mark `decimal` ("." or ",")."""
     try:
         float(cell.replace(",", ".") if decimal == "," else cell)
     except ValueError:
@@ -407,7 +408,7 @@ def read_table(text: str, where: Path | str) -> Table:
     if delimiter != "," and any(_DECIMAL_COMMA.match(cell) for _, cells in rows[:200] for cell in cells):
         decimal = ","
     units = None
-    if rows and any(rows[0][1]) and not any(_is_number(cell, decimal) for cell in rows[0][1] if cell):
+    if rows and any(rows[0][1]) and not any(is_number(cell, decimal) for cell in rows[0][1] if cell):
         units = rows.pop(0)[1]
         if len(units) != len(header):
             raise UsageError(

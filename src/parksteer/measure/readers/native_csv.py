@@ -7,7 +7,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import ClassVar
 
-from ..io import ALLOWED_COLUMNS, header_cells, read_table
+from ..io import ALLOWED_COLUMNS, header_cells, is_number, read_table
 from .base import Record, Source, decode_text
 
 
@@ -20,18 +20,10 @@ class NativeCsvReader:
         rows = header_cells(head.decode("utf-8", errors="replace"), rows=2)
         if len(rows) < 1 or not all(name in ALLOWED_COLUMNS for name in rows[0]):
             return False
-        return len(rows) < 2 or all(_is_number(cell) for cell in rows[1] if cell)
+        return len(rows) < 2 or all(is_number(cell, ",") for cell in rows[1] if cell)
 
     def read(self, raw: bytes, where: Path) -> Record:
         table = read_table(decode_text(raw, where), where)
         sources = [Source(name, None, column=j) for j, name in enumerate(table.header)]
         return Record(self.name, sources, dict(table.metadata), table.line_numbers,
                       lambda source: table.column(source.column, source.name))
-
-
-def _is_number(cell: str) -> bool:
-    try:
-        float(cell.replace(",", "."))
-    except ValueError:
-        return False
-    return True

@@ -58,13 +58,14 @@ static double ps_kernel_cos(double x, double y)
     return w + (((1.0 - w) - hz) + (z * r - x * y));
 }
 
-static double ps_sin(double x)
+static double ps_sin_quadrant(double x, int shift)
 {
+    /* the sine for shift 0, the cosine (the sine a quarter turn on) for shift 1: the quadrant moved on by one */
     double y0, y1;
     int n;
     if (!(fabs(x) < PS_REDUCE_LIMIT)) return x - x + NAN;
     ps_reduce(x, &y0, &y1, &n);
-    switch (n) {
+    switch ((n + shift) & 3) {
     case 0: return ps_kernel_sin(y0, y1);
     case 1: return ps_kernel_cos(y0, y1);
     case 2: return -ps_kernel_sin(y0, y1);
@@ -72,19 +73,9 @@ static double ps_sin(double x)
     }
 }
 
-static double ps_cos(double x)
-{
-    double y0, y1;
-    int n;
-    if (!(fabs(x) < PS_REDUCE_LIMIT)) return x - x + NAN;
-    ps_reduce(x, &y0, &y1, &n);
-    switch (n) {
-    case 0: return ps_kernel_cos(y0, y1);
-    case 1: return -ps_kernel_sin(y0, y1);
-    case 2: return -ps_kernel_cos(y0, y1);
-    default: return ps_kernel_sin(y0, y1);
-    }
-}
+static double ps_sin(double x) { return ps_sin_quadrant(x, 0); }
+
+static double ps_cos(double x) { return ps_sin_quadrant(x, 1); }
 
 static const double PS_ATANHI[4] = {4.63647609000806093515e-01, 7.85398163397448278999e-01,
                                     9.82793723247329054082e-01, 1.57079632679489655800e+00};
