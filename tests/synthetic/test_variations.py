@@ -75,7 +75,7 @@ def test_independent_null_sits_at_the_noise_floor(name):
     problem = Problem([prepare_file(record, "unladen", name)], PARAMS)
     effects = resolve_effects(None)
     prediction = problem.predict(effects)
-    problem.estimate_replay_uncertainty(effects)
+    problem = problem.with_replay_uncertainty(effects)
     stats = fit_statistics(problem, prediction)
     ratio = stats["weighted_rms_Nm"] / stats["noise_floor_Nm"]
     assert 0.9 < ratio < 1.12, ratio

@@ -174,7 +174,7 @@ def block_sandwich(jacobian: np.ndarray, weighted: np.ndarray, problem: Problem,
 
 def replay_covariance(jacobian: np.ndarray, problem: Problem) -> np.ndarray:
     """Covariance of the fitted parameters from the replay's own uncertainty: each rack of the replay ensemble
-    (:meth:`parksteer.diagnose.problem.Problem.estimate_replay_uncertainty`) changes the replayed torque by its
+    (:meth:`parksteer.diagnose.problem.Problem.with_replay_uncertainty`) changes the replayed torque by its
     deviation d from the ensemble mean, which a fit absorbs as the parameter shift (J^T J)^-1 J^T (d / sigma);
     the covariance of these shifts over the draws. Zero when the ensemble was not run."""
     k = jacobian.shape[1]

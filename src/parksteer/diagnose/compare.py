@@ -12,7 +12,7 @@ equals the noise floor for a perfect model.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -67,11 +67,10 @@ def compare_files(files: list[FileData], params: Parameters, effects=None,
     chosen = effects if isinstance(effects, list) and all(isinstance(e, Effect) for e in effects) \
         else resolve_effects(effects)
     overrides = dict(overrides or {})
-    for f in files:  # a comparison is of the torque alone
-        f.uses_angle = False
-    problem = Problem(files, params)
+    problem = Problem([replace(f, uses_angle=False) for f in files], params)  # a comparison is of the torque alone
     predictions = problem.predict(chosen, overrides)
-    problem.estimate_replay_uncertainty(chosen, overrides)
+    problem = problem.with_replay_uncertainty(chosen, overrides)
+    files = list(problem.files)
     comparisons = [
         compare(f.time_s, f.torque_Nm, m, phases=f.phases,
                 quantisation_step=f.measurement.quantisation_step("handwheel_torque_Nm"))

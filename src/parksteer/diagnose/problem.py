@@ -3,8 +3,10 @@
 Each file (:class:`FileData`) carries what its residuals need: the measured torque, the
 phases of its cycle (:mod:`parksteer.measure.phases`), its noise floor
 (:mod:`parksteer.measure.metrics`: quantisation step / sqrt(12) combined with the analog
-noise estimated from the data) and, once :meth:`Problem.estimate_replay_uncertainty` has
-run, the replay's own uncertainty at every sample.
+noise estimated from the data) and, in the files :meth:`Problem.with_replay_uncertainty` makes,
+the replay's own uncertainty at every sample. A file is never changed: what a diagnosis derives for
+it (its replay uncertainty, its torque lag, whether its angle is fitted) goes into a new
+:class:`FileData` (``dataclasses.replace``), and into a new :class:`Problem` that holds it.
 
 The replay uncertainty is found by propagation, not assumed: the smoothed rack is one
 spline among many the rack data allow equally well. When the file states its logger (the
@@ -26,7 +28,7 @@ listens to the samples the replay can predict, and a perfect model has weighted 
 of unit variance.
 
 A file with a handwheel angle beside a measured rack may be fitted on both signals
-(:attr:`FileData.uses_angle`, set by the diagnosis when its settings ask): each prediction is
+(:attr:`FileData.uses_angle`, in the copies the diagnosis makes when its settings ask): each prediction is
 then the torque followed by the replayed handwheel angle (column angle plus the twist that
 passes the replayed torque, :func:`parksteer.model.numeric.prescribed.solve`), shifted by the
 fitted zero of the angle sensor. The angle's attainable error combines its channel's noise
@@ -38,7 +40,7 @@ on a linear column, a lash's whole band where the torque is that close to zero).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -62,9 +64,9 @@ TORQUE = "handwheel_torque_Nm"
 ANGLE = "handwheel_angle_rad"
 
 
-@dataclass(eq=False)
+@dataclass(frozen=True, eq=False)
 class FileData:
-    """One measurement file, ready to be replayed."""
+    """One measurement file, ready to be replayed (frozen: what a diagnosis derives for it goes into a copy)."""
 
     label: str
     measurement: Measurement
@@ -79,11 +81,11 @@ class FileData:
     # the measured handwheel angle (rad) when the file has one beside a measured rack, and its noise floor
     angle_rad: np.ndarray | None = None
     angle_noise: NoiseFloor | None = None
-    # whether the diagnosis fits the angle as a second signal (set by parksteer.diagnose.select.diagnose)
+    # whether the diagnosis fits the angle as a second signal (in the copies parksteer.diagnose.stages makes)
     uses_angle: bool = False
     replay_uncertainty_rad: np.ndarray | None = None
     replay_draws_rad: np.ndarray | None = None
-    # how far the torque channel runs behind the rack's (s), estimated by the diagnosis (select.estimate_torque_lags)
+    # how far the torque channel runs behind the rack's (s), estimated by the diagnosis (stages/torque_lag.py)
     torque_lag_s: float = 0.0
 
     @property
@@ -204,40 +206,71 @@ def effect_key(effects: list[Effect]) -> tuple[str, ...]:
 
 
 @dataclass(eq=False)
+class ReplayCache:
+    """What every :class:`Problem` derived from one another shares: the replays made (one per effect set, file and
+    set of replay instants: with_files), the count of solves run in worker processes, and
+    the worker pool. A cache only: which entry a computation finds never changes its result."""
+
+    workers: int = 1
+    replays: dict = field(default_factory=dict)
+    extra_evaluations: int = 0  # replays run in worker processes
+    pool: object = None
+
+    @property
+    def evaluations(self) -> int:
+        return sum(r.evaluations for r in self.replays.values()) + self.extra_evaluations
+
+
 class Problem:
     """Files and the models to replay them with; caches one :class:`Replay` per effect set and file.
 
     With `workers` > 1 the files of a prediction are replayed side by side, on a pool of processes
     forked once (:mod:`parksteer.diagnose.parallel`; :meth:`close` ends it), and the draws of the
     replay ensemble likewise: the same numbers as in line.
+
+    A problem is not changed once made: :meth:`with_files` and :meth:`with_replay_uncertainty` make a new one
+    (the files derived), sharing the replay cache. `angle_offset_fitted` is the one setting it reads
+    (:meth:`signals`); the diagnosis's settings are owned by the diagnosis.
     """
 
-    files: list[FileData]
-    params: Parameters
-    workers: int = 1
-    settings: DiagnosisSettings = DEFAULT_SETTINGS
-    _replays: dict = field(default_factory=dict, repr=False)
-    extra_evaluations: int = 0  # replays run in worker processes
-    _pool: object = field(default=None, repr=False)
+    def __init__(self, files, params: Parameters, workers: int = 1,
+                 angle_offset_fitted: bool = DEFAULT_SETTINGS.angle_offset_fitted, cache: ReplayCache | None = None,
+                 instants: int = 0):
+        self.files: tuple[FileData, ...] = tuple(files)
+        self.params = params
+        self.angle_offset_fitted = angle_offset_fitted
+        self.cache = cache if cache is not None else ReplayCache(workers=max(int(workers), 1))
+        self.instants = instants  # which replays of the cache are this problem's (with_files)
+
+    def with_files(self, files, new_instants: bool = False) -> Problem:
+        """The same problem on other files (derived from these: the same records, one per index), sharing the
+        replay cache.
+
+        With `new_instants` (a file's torque lag moved), the replays made so far are not this problem's: each is
+        made again at the files' instants when first asked for (the solves already run stay counted). Without,
+        the replays made so far are kept, at the instants they were made for: a lag moved by less than a search
+        step keeps them (parksteer.diagnose.stages.torque_lag)."""
+        return Problem(files, self.params, angle_offset_fitted=self.angle_offset_fitted, cache=self.cache,
+                       instants=self.instants + 1 if new_instants else self.instants)
+
+    @property
+    def workers(self) -> int:
+        return self.cache.workers
 
     def replay(self, effects: list[Effect], index: int) -> Replay:
-        key = (effect_key(effects), index)
-        if key not in self._replays:
-            f = self.files[index]
-            self._replays[key] = Replay(list(effects), f.case, f.surface, self.params, f.rack, f.replay_time_s)
-        return self._replays[key]
+        f = self.files[index]
+        key = (effect_key(effects), index, self.instants)
+        if key not in self.cache.replays:
+            self.cache.replays[key] = Replay(list(effects), f.case, f.surface, self.params, f.rack, f.replay_time_s)
+        return self.cache.replays[key]
 
     @property
     def evaluations(self) -> int:
-        return sum(r.evaluations for r in self._replays.values()) + self.extra_evaluations
+        return self.cache.evaluations
 
-    def forget_replays(self) -> None:
-        """Drop the kept replays and the replay uncertainty estimated from them (their instants changed: a file's
-        torque lag), keeping their count of solves."""
-        self.extra_evaluations += sum(r.evaluations for r in self._replays.values())
-        self._replays.clear()
-        for f in self.files:
-            f.replay_uncertainty_Nm = f.replay_draws_Nm = None
+    def count_extra(self, evaluations: int) -> None:
+        """Count replays run in worker processes (they are not in this process's cache)."""
+        self.cache.extra_evaluations += evaluations
 
     @property
     def parallel_files(self) -> bool:
@@ -246,11 +279,11 @@ class Problem:
 
     def close(self) -> None:
         """End the worker pool, if one was started; later predictions run in line."""
-        self.workers = 1
-        if self._pool is not None:
-            self._pool.close()
-            self._pool.join()
-            self._pool = None
+        self.cache.workers = 1
+        if self.cache.pool is not None:
+            self.cache.pool.close()
+            self.cache.pool.join()
+            self.cache.pool = None
 
     @property
     def n(self) -> int:
@@ -273,21 +306,21 @@ class Problem:
             return replay.torque(overrides)
         solution = replay.solve(overrides, outputs=True)
         angle = solution.handwheel[:, 0]
-        if self.settings.angle_offset_fitted:
+        if self.angle_offset_fitted:
             angle = angle + float(np.mean(f.angle_rad - angle))
         return np.concatenate([solution.torque_Nm, angle])
 
     def predict(self, effects: list[Effect], overrides: dict[str, float] | None = None) -> list[np.ndarray]:
         """Model torque at every file's samples (one array per file)."""
         if self.parallel_files:
-            if self._pool is None:
+            if self.cache.pool is None:
                 global _POOLED
                 _POOLED = self
-                self._pool = worker_pool(self.workers)
-            if self._pool is not None:
+                self.cache.pool = worker_pool(self.workers)
+            if self.cache.pool is not None:
                 tasks = [(list(effects), i, overrides) for i in range(len(self.files))]
-                out = self._pool.map(_pooled_torque, tasks, chunksize=1)
-                self.extra_evaluations += len(tasks)
+                out = self.cache.pool.map(_pooled_torque, tasks, chunksize=1)
+                self.count_extra(len(tasks))
                 return out
         return [self.signals(effects, i, overrides) for i in range(len(self.files))]
 
@@ -306,10 +339,12 @@ class Problem:
                                np.concatenate([v[: f.n], v[f.n :] * (f.noise.total_rms / f.angle_noise.total_rms)])
                                for f, v in zip(self.files, values)])
 
-    def estimate_replay_uncertainty(self, effects: list[Effect], overrides: dict[str, float] | None = None,
-                                    draws: int = DEFAULT_SETTINGS.replay_ensemble_draws,
-                                    seed: int = DEFAULT_SETTINGS.replay_ensemble_seed, keep_larger: bool = False) -> None:
-        """Set each file's replay uncertainty: spread of replays of racks the data allow (module docstring).
+    def with_replay_uncertainty(self, effects: list[Effect], overrides: dict[str, float] | None = None,
+                                draws: int = DEFAULT_SETTINGS.replay_ensemble_draws,
+                                seed: int = DEFAULT_SETTINGS.replay_ensemble_seed, keep_larger: bool = False
+                                ) -> Problem:
+        """This problem on files with their replay uncertainty: the spread of replays of racks the data allow
+        (module docstring).
 
         The spread is widened by one sample either side (a running maximum), since a torque
         drop the draws place on one sample may fall on its neighbour. With `keep_larger`, each
@@ -338,20 +373,23 @@ class Problem:
         owners = [i for i in range(len(self.files)) for _ in range(draws)]
         replayed = fork_map(lambda job: self.signals(effects, job[0], overrides, job[1][0].on_rack(job[1][1])),
                             list(zip(owners, racks)), self.workers)
+        files = []
         for i, f in enumerate(self.files):
             runs = np.array(replayed[i * draws : (i + 1) * draws])
             torque_runs = runs[:, : f.n]
-            f.replay_draws_Nm = torque_runs - torque_runs.mean(axis=0)
-            f.replay_uncertainty_Nm = _spread(torque_runs, f.replay_uncertainty_Nm if keep_larger else None)
+            f = replace(f, replay_draws_Nm=torque_runs - torque_runs.mean(axis=0),
+                        replay_uncertainty_Nm=_spread(torque_runs, f.replay_uncertainty_Nm if keep_larger else None))
             if f.uses_angle:  # each draw's angle carries its own fitted zero (Problem.signals)
                 angle_runs = runs[:, f.n :]
-                f.replay_draws_rad = angle_runs - angle_runs.mean(axis=0)
                 # The replayed torque is itself off by about its attainable error, and the twist that passes it by
                 # as much through the column's compliance (in a dead band: the band, where |T| is that small).
                 through_torque = self.replay(effects, i).twist_spread(f.sigma_Nm, overrides)
                 spread = pm.hypot(_spread(angle_runs, None), maximum_filter1d(through_torque, size=3, mode="nearest"))
                 before = f.replay_uncertainty_rad if keep_larger else None
-                f.replay_uncertainty_rad = spread if before is None else np.maximum(spread, before)
+                f = replace(f, replay_draws_rad=angle_runs - angle_runs.mean(axis=0),
+                            replay_uncertainty_rad=spread if before is None else np.maximum(spread, before))
+            files.append(f)
+        return self.with_files(files)
 
 
 def _spread(runs: np.ndarray, before: np.ndarray | None) -> np.ndarray:

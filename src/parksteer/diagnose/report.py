@@ -13,7 +13,7 @@ import numpy as np
 from ..measure.phases import PHASES
 from ..resources import data_file
 from ..tables import atomic_path
-from .select import Candidate, Diagnosis
+from .state import Candidate, Diagnosis
 
 SCHEMA_ID = "parksteer.diagnosis/1"
 SCHEMA_PATH = data_file("diagnosis.schema.json")

@@ -1,0 +1,25 @@
+"""The base model's uncertain parameters calibrated to all files (:mod:`parksteer.diagnose.calibrate`)."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+from ..calibrate import Fit, calibrate
+from ..problem import Problem
+from ..state import DiagnosisState
+from .base import Stage
+
+
+def calibrated(state: DiagnosisState, problem: Problem, announce=None) -> Fit:
+    """The base model calibrated on `problem` with the state's strengths, start values and settings."""
+    return calibrate(problem, list(state.base), strengths=None if state.strengths is None else dict(state.strengths),
+                     start=None if state.start is None else dict(state.start), settings=state.settings,
+                     announce=announce)
+
+
+class Calibrate(Stage):
+    name = "calibration"
+
+    def run(self, state: DiagnosisState) -> DiagnosisState:
+        fit = calibrated(state, state.problem, announce=lambda keys: state.progress("calibrating " + ", ".join(keys)))
+        return replace(state, calibration=fit)

@@ -1,0 +1,57 @@
+"""The refits compared by an information criterion over the effective sample size (module docstring of
+:mod:`parksteer.diagnose.select`, step 5), and compared again with the larger replay uncertainty where a
+candidate is evidenced."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from ... import portable as pm
+from ..calibrate import Fit
+from ..problem import Problem, effective_samples, lag1_autocorrelation
+from ..state import Candidate, DiagnosisState
+from .base import Stage
+from .replay_uncertainty import with_replay_uncertainty
+
+
+def compare_refits(problem: Problem, calibration: Fit, refitted: list[Candidate]
+                   ) -> tuple[Candidate | None, float, float, list[Candidate]]:
+    """(best candidate, effective sample size, rho, the candidates with their BIC gain over the calibrated base
+    model)."""
+    best_fit = min((c.refit for c in refitted), key=lambda f: f.rss, default=calibration)
+    rho = lag1_autocorrelation(problem, best_fit.weighted)
+    n_eff = effective_samples(problem.n, rho)
+    refitted = [replace(c, delta_bic=n_eff * pm.log(calibration.rss / c.refit.rss) - pm.log(n_eff))
+                for c in refitted]
+    return max(refitted, key=lambda c: c.delta_bic, default=None), n_eff, rho, refitted
+
+
+def reweigh(problem: Problem, fit: Fit, sigma_before: list[np.ndarray]) -> Fit:
+    """A fit's copy with its weighted residuals and Jacobian recomputed for the files' new attainable errors."""
+    ratio = np.concatenate([old / f.sigma for old, f in zip(sigma_before, problem.files)])
+    return replace(fit, weighted=problem.weighted(fit.predictions), jacobian=fit.jacobian * ratio[:, None])
+
+
+class Select(Stage):
+    name = "selection"
+
+    def run(self, state: DiagnosisState) -> DiagnosisState:
+        problem, calibration, settings = state.problem, state.calibration, state.settings
+        refitted = [c for c in state.candidates if c.refit is not None]
+        best, n_eff, rho, refitted = compare_refits(problem, calibration, refitted)
+        if best is not None and best.delta_bic > settings.bic_missing_threshold:
+            # The replay's uncertainty was estimated with the base model; with the candidate, the torque may turn
+            # more sharply where the rack data are least certain (a breakaway peak at each reversal). Weigh every
+            # model by the larger of the two uncertainties and compare again.
+            state.progress(f"{best.name} evidenced: replay uncertainty again with it")
+            before = [f.sigma for f in problem.files]
+            problem = with_replay_uncertainty(state, best.signature.model, best.refit.overrides, keep_larger=True)
+            calibration = reweigh(problem, calibration, before)
+            refitted = [replace(c, refit=reweigh(problem, c.refit, before)) for c in refitted]
+            best, n_eff, rho, refitted = compare_refits(problem, calibration, refitted)
+        by_name = {c.name: c for c in refitted}
+        return replace(state, problem=problem, calibration=calibration,
+                       candidates=tuple(by_name.get(c.name, c) for c in state.candidates),
+                       best=best.name if best is not None else None, n_eff=n_eff, rho=rho)
