@@ -1,4 +1,4 @@
-"""What the data fix (parksteer.diagnose.select.identification): each calibrated parameter fixed or not by the
+"""What the data fix (parksteer.diagnose.stages.identify.identification): each calibrated parameter fixed or not by the
 records given, and for one that is not, the test that would fix it, judged by physics."""
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """A torque channel logged behind the rack channel: asked to (settings.torque_lag_fitted, `parksteer diagnose
 --torque-lag`), the diagnosis finds the lag and replays the model at the instants the torque was really sampled
-(parksteer.diagnose.select.estimate_torque_lags).
+(parksteer.diagnose.stages.torque_lag).
 
 The records come from the variation benchmark's hand and logger (parksteer.synthetic.variations), not from the
 diagnosis's own generator: the torque is the model's prescribed-rack solve on a hand-driven rack, delayed by the

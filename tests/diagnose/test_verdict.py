@@ -1,4 +1,4 @@
-"""The verdict rule (parksteer.diagnose.select.choose_verdict) on the numbers real diagnoses produced.
+"""The verdict rule (parksteer.diagnose.stages.verdict.choose_verdict) on the numbers real diagnoses produced.
 
 The rule is logic, not physics: these tests pin what each verdict means, with the statistics of records the
 benchmarks produced (weighted RMS in noise floors, BIC gains, the fraction of the excess a candidate removes).

@@ -9,8 +9,10 @@ data set, the hidden-effect benchmark) is the pipeline's configuration, config/c
 The replay's smoothing settings live with the smoothing (parksteer.measure.smoothing) and its
 integration tolerances with the solver (parksteer.model.numeric.tolerances), each with its reason.
 The diagnosis's settings are one frozen :class:`DiagnosisSettings`, passed to
-:func:`parksteer.diagnose.select.diagnose` (and on to calibration, candidates, the ladder and
-the report); :data:`DEFAULT_SETTINGS` holds the values below with their reasons.
+:func:`parksteer.diagnose.select.diagnose`, held by the diagnosis's state (its one owner,
+:class:`parksteer.diagnose.state.DiagnosisState`) and read from there by each stage, and by the
+ladder and the report from the result; :data:`DEFAULT_SETTINGS` holds the values below with their
+reasons.
 """
 
 from __future__ import annotations
@@ -40,26 +42,24 @@ class DiagnosisSettings:
     # constant per file, fitted in closed form (the mean of measured minus replayed angle) at every replay.
     angle_offset_fitted: bool = True
 
-    # --- the torque channel's lag (parksteer.diagnose.select.estimate_torque_lags) ------------------------------
+    # --- the torque channel's lag (parksteer.diagnose.stages.torque_lag) ---------------------------------------
     # A logger's torque channel may run behind its rack channel (a sensor's or an amplifier's filter delay,
     # channels converted in turn): the torque sample stamped t_i was taken at t_i - lag on the rack's clock. The
-    # base model cannot follow that: 10 ms at 50 Hz moves each friction reversal by half a sample, which left
-    # the variation benchmark's lagged nulls at 1.1-1.3 noise floors and their calibrated intervals off the truth
-    # (1 of 3 covering). With ``torque_lag_fitted`` (``parksteer diagnose --torque-lag``), after the base
-    # calibration each file's lag is searched for over +-torque_lag_max_s in steps of torque_lag_step_s (then a
-    # parabola through the best three) on the calibrated base's replay at the lagged instants, and kept where it
-    # lowers the file's weighted residual sum of squares by more than log(samples) (the BIC's price of one more
-    # parameter); the replay uncertainty and the calibration are then made again at the lagged instants, and the
-    # search repeated on the new calibration (at most torque_lag_rounds times) until no lag moves by a step.
-    # When the verdict is missing, the lag is searched again on the model with the named effect and, if it moves
-    # by a step, the diagnosis is made again with the lags held. A file fitted on its angle too keeps no lag
-    # (both channels are replayed at the same instants).
+    # base model cannot follow that: 10 ms at 50 Hz moves each friction reversal by half a sample, enough to lift
+    # a null record above the adequate band and move its calibrated intervals off the truth. With
+    # ``torque_lag_fitted`` (``parksteer diagnose --torque-lag``), after the base calibration each file's lag is
+    # searched for over +-torque_lag_max_s in steps of torque_lag_step_s (then a parabola through the best three)
+    # on the calibrated base's replay at the lagged instants, and kept where it lowers the file's weighted
+    # residual sum of squares by more than log(samples) (the BIC's price of one more parameter); the replay
+    # uncertainty and the calibration are then made again at the lagged instants, and the search repeated on the
+    # new calibration (at most torque_lag_rounds times) until no lag moves by a step. When the verdict is
+    # missing, the lag is searched again on the model with the named effect and, if it moves by a step, the
+    # diagnosis is made again with the lags held. A file fitted on its angle too keeps no lag (both channels are
+    # replayed at the same instants).
     # Off unless asked for: at 50 Hz a lag and an effect at the reversals (a stiction's breakaway) look alike
-    # over a record's three reversals, and a lag searched on the base model takes up part of that effect (a
-    # hidden rack stiction gave a 4-5 ms lag on a logger without one, 12.6-17.5 ms on one 10 ms late; searched
-    # again with the named stiction, 10.8-12.3 ms). Searched on every record of the variation grid (without the
-    # second search), the lag made the lagged nulls adequate but cost coverage elsewhere (611 of 746 intervals
-    # against 641).
+    # over a record's three reversals, so a lag searched on the base model takes up part of such an effect (a
+    # lag is then found on a logger without one), and searched on every record the lag costs interval coverage
+    # on records whose channels are in step.
     torque_lag_fitted: bool = False
     torque_lag_max_s: float = 0.04
     torque_lag_step_s: float = 0.002
@@ -104,7 +104,7 @@ class DiagnosisSettings:
     # taken as dependent and segments as independent; an 18 s record gives 9 segments.
     interval_block_s: float = 2.0
 
-    # --- candidates, score test and selection (parksteer.diagnose.candidates, .select) ---------------------
+    # --- candidates, score test and selection (parksteer.diagnose.candidates, .stages) ---------------------
     # A candidate's signature is taken at a probe strength giving this RMS torque change (in noise
     # floors): large enough to stand above the integrator's noise, small enough to be nearly linear.
     probe_effect_noise_floors: float = 3.0
@@ -150,7 +150,7 @@ class DiagnosisSettings:
     # parameters' directions are projected out is reported as confounded with them.
     confounded_fraction: float = 0.3
 
-    # --- what the data fix (parksteer.diagnose.select.identification) -------------------------------------------
+    # --- what the data fix (parksteer.diagnose.stages.identify) ------------------------------------------------
     # A calibrated parameter is fixed by the data when its 95 % interval lies within this fraction of its value
     # either side (a phase: within this many radians): the paper's headline numbers move by 10-20 % over the
     # reconstructed inputs, so a parameter known no better than that cannot sharpen them. A parameter that is not
@@ -160,9 +160,9 @@ class DiagnosisSettings:
     identified_phase_halfwidth_rad: float = 0.1
     # Each confounded candidate is replayed, with the calibrated parameters moved to take it up, beside the base
     # model under every load case and surface the data lack, and the one where it would still show is named
-    # (select.confound_tests). On one file with four confounded candidates that is nine conditions of five models,
-    # about 0.2 s. The diagnosis benchmarks, which score verdicts, names and intervals (none of which this changes),
-    # leave it off (parksteer.diagnose.benchmark.BENCHMARK_SETTINGS).
+    # (parksteer.diagnose.stages.confound). On one file with four confounded candidates that is nine conditions of
+    # five models replayed. The diagnosis benchmarks, which score verdicts, names and intervals (none of which this
+    # changes), leave it off (parksteer.diagnose.benchmark.BENCHMARK_SETTINGS).
     confound_tests: bool = True
 
     # --- the error ladder and the reports ------------------------------------------------------------------
