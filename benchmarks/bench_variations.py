@@ -43,6 +43,7 @@ def main(argv: list[str] | None = None) -> int:
 
     from parksteer.diagnose.benchmark import BENCHMARK_SETTINGS
     from parksteer.diagnose.settings import DEFAULT_SETTINGS
+    from parksteer.diagnose.rows import as_dict
     from parksteer.diagnose.variations import VariationDesign, case_names, outcome, run_case, summarise
     from parksteer.parameters import DEFAULT_PATH
     from parksteer.tables import write_json
@@ -69,11 +70,11 @@ def main(argv: list[str] | None = None) -> int:
             truth = json.loads((folder / "truth.json").read_text("utf-8"))
             row = outcome(truth, result)
             rows.append(row)
-            print(f"{name:48s} -> {row['verdict']:11s} {row['effect']:16s} {row['calibrated_over_floor']:5.2f} floors "
-                  f"covered {row['covered']}/{row['intervals']}  diagnosis {row['wall_s']:5.1f} s, "
+            print(f"{name:48s} -> {row.verdict:11s} {row.effect:16s} {row.calibrated_over_floor:5.2f} floors "
+                  f"covered {row.covered}/{row.intervals}  diagnosis {row.wall_s:5.1f} s, "
                   f"case {time.perf_counter() - start:5.1f} s", file=sys.stderr, flush=True)
     summary = summarise(rows, design)
-    write_json(args.out, {"summary": summary, "records": rows})
+    write_json(args.out, {"summary": summary, "records": [as_dict(r) for r in rows]})
     print(f"{'variation':24s} {'named':>7s} {'adequate':>8s} {'cover':>7s} {'null/floor':>12s} {'time':>6s}")
     for v in summary["variations"]:
         print(f"{v['variation']:24s} {_count(v['named_count']):>7s} {_count(v['null_adequate_count']):>8s} "

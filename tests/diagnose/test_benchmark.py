@@ -51,9 +51,9 @@ def scored(tmp_path):
 def test_named_first_and_in_group_are_counted_separately():
     """A hidden effect named first counts for both rates; one only inside the indistinguishable group counts for the
     second; a wrong name outside the group counts for neither."""
-    assert outcome(*CASES[0])["named_first"] and outcome(*CASES[0])["named_or_group"]
-    assert not outcome(*CASES[2])["named_first"] and outcome(*CASES[2])["named_or_group"]
-    assert not outcome(*CASES[3])["named_or_group"]
+    assert outcome(*CASES[0]).named_first and outcome(*CASES[0]).named_or_group
+    assert not outcome(*CASES[2]).named_first and outcome(*CASES[2]).named_or_group
+    assert not outcome(*CASES[3]).named_or_group
 
 
 def test_rates_and_confusion_matrix(scored):
@@ -70,7 +70,7 @@ def test_rates_and_confusion_matrix(scored):
     assert summary["confusion"]["kingpin_friction"] == {"column_friction": 2}
     assert summary["confusion"]["outside: torque_drift"] == {"rack_damping": 1}
     # RMS after adding, over the successes only: 0.17 / 0.16 and 0.18 / 0.16
-    assert summary["rms_after_over_noise_floor"]["max"] == pytest.approx(0.18 / 0.16)
+    assert summary["after_over_floor"]["max"] == pytest.approx(0.18 / 0.16)
 
 
 def test_benchmark_figure_data_is_the_same_whatever_the_timings(tmp_path):

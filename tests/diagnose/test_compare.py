@@ -26,7 +26,7 @@ def test_the_model_against_its_own_data_sits_at_the_noise_floor(own_data, params
     result = compare_files(load_files(own_data, params), params)
     summary = result.as_dict()["files"][0]
     floor = summary["noise_floor"]["total_rms"]
-    assert 0.9 < summary["weighted_rms_over_noise_floor"] < 1.15
+    assert 0.9 < summary["over_floor"] < 1.15
     assert summary["by_phase"]["plateau"]["rms"] < 1.2 * floor
     assert abs(summary["by_phase"]["plateau"]["mean"]) < 0.3 * floor
     # the logger's noise floor: a 25 N m full scale in 8 bits is a 0.196 N m step, 0.057 N m RMS, with 0.15 N m analog

@@ -125,7 +125,7 @@ def test_the_error_ladder_falls_to_the_noise_floor(hidden_user_effect, params):
     errors = [r["weighted_rms_Nm"] for r in ladder.rungs]
     assert [r["label"] for r in ladder.rungs] == ["paper's model", "calibrated", "+ column_imbalance"]
     assert all(a > b for a, b in zip(errors, errors[1:]))
-    assert ladder.rungs[-1]["weighted_rms_over_noise_floor"] < 1.2
+    assert ladder.rungs[-1]["over_floor"] < 1.2
 
 
 def test_the_user_effect_joins_compare_by_spec_and_by_environment(written, tmp_path, capsys, monkeypatch):

@@ -89,28 +89,28 @@ def test_scoring_follows_the_targets():
     answer, within it is not; 'adequate' at >= 3 steps misses, below it does not; the closest, a related
     candidate, or 'unexplained' meet the target."""
     wrong = outcome(_truth(), _result("missing", "rack_lash", gains=(30.0, 10.0)))
-    assert (wrong["relation"], wrong["bic_margin"], wrong["confident_wrong"], wrong["target_met"]) == (
+    assert (wrong.relation, wrong.bic_margin, wrong.confident_wrong, wrong.target_met) == (
         "unrelated", 20.0, True, False)
     close_call = outcome(_truth(), _result("missing", "rack_lash", gains=(30.0, 26.0), group=("braked_wheels",)))
-    assert close_call["relation"] == "unrelated" and not close_call["confident_wrong"]
-    assert close_call["closest_in_group"]
-    assert outcome(_truth(), _result("missing", "braked_wheels", gains=(50.0,)))["relation"] == "closest"
-    assert outcome(_truth(), _result("missing", "kingpin_friction", gains=(50.0,)))["relation"] == "related"
-    assert outcome(_truth(), _result("unexplained"))["target_met"]
-    assert not outcome(_truth(steps=3.0), _result("adequate"))["target_met"]
-    assert outcome(_truth(steps=2.0), _result("adequate"))["target_met"]
-    assert outcome(_truth(None, None, "null"), _result("adequate"))["relation"] == "correct"
+    assert close_call.relation == "unrelated" and not close_call.confident_wrong
+    assert close_call.closest_in_group
+    assert outcome(_truth(), _result("missing", "braked_wheels", gains=(50.0,))).relation == "closest"
+    assert outcome(_truth(), _result("missing", "kingpin_friction", gains=(50.0,))).relation == "related"
+    assert outcome(_truth(), _result("unexplained")).target_met
+    assert not outcome(_truth(steps=3.0), _result("adequate")).target_met
+    assert outcome(_truth(steps=2.0), _result("adequate")).target_met
+    assert outcome(_truth(None, None, "null"), _result("adequate")).relation == "correct"
 
 
 def test_an_unexplained_verdict_reports_the_strongly_evidenced_nearest_candidate():
     """An unexplained verdict with a candidate above the BIC threshold (named but not the whole story) keeps that
     candidate as the nearest, with the error it leaves; one with no strong evidence has none."""
     row = outcome(_truth("top_mount_windup"), _result("unexplained", gains=(496.1, 20.0)))
-    assert row["said"] == "unexplained" and row["target_met"]
-    assert row["nearest"] == "c0" and row["nearest_after_over_floor"] == pytest.approx(0.3 / 0.16)
-    assert row["explained_fraction"] == 0.5
+    assert row.said == "unexplained" and row.target_met
+    assert row.nearest == "c0" and row.nearest_after_over_floor == pytest.approx(0.3 / 0.16)
+    assert row.explained_fraction == 0.5
     weak = outcome(_truth("top_mount_windup"), _result("unexplained", gains=(4.0,)))
-    assert weak["nearest"] == "none" and weak["nearest_after_over_floor"] is None
+    assert weak.nearest == "none" and weak.nearest_after_over_floor is None
 
 
 def test_a_small_case_runs(tmp_path):
@@ -128,7 +128,7 @@ def test_a_small_case_runs(tmp_path):
     assert truth["rtol"] == 1e-9
     assert (tmp_path / "files" / "unladen__ground.csv").exists()
     row = outcome(truth, result)
-    assert row["relation"] in ("closest", "related", "unrelated", "unexplained", "adequate")
+    assert row.relation in ("closest", "related", "unrelated", "unexplained", "adequate")
 
 
 def test_config_grids():

@@ -4,10 +4,12 @@ their records as designed, and one small real case runs end to end."""
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 
 import numpy as np
 import pytest
 
+from parksteer.diagnose.rows import VariationRow
 from parksteer.diagnose.settings import DEFAULT_SETTINGS
 from parksteer.diagnose.variations import (COVERAGE_TARGET, NAMED_MIN_STEPS, NAMED_TARGET, NULL_ADEQUATE_TARGET,
                                            VariationDesign, outcome, run_case, summarise, variation_cases)
@@ -28,12 +30,11 @@ def _design(variations=("pauses",), replicates=1, hidden=("rack_stiction",), ste
 
 def _row(variation, hidden="nothing", steps=0.0, verdict="adequate", named=False, covered=3, intervals=3,
          over=1.0, after=None, replicate=0, effect=""):
-    return {"name": f"{variation}_{hidden}_{steps}", "variation": variation, "replicate": replicate,
-            "hidden_confounded_with": "",
-            "hidden": hidden, "steps": steps, "steps_actual": steps, "verdict": verdict, "effect": effect,
-            "indistinguishable": "", "named": named, "false_alarm": hidden == "nothing" and verdict == "missing",
-            "calibrated_over_floor": over, "after_over_floor": after, "covered": covered, "intervals": intervals,
-            "not_covered": "", "wall_s": 10.0}
+    return VariationRow(name=f"{variation}_{hidden}_{steps}", variation=variation, replicate=replicate,
+                        hidden=hidden, steps=steps, steps_actual=steps, verdict=verdict, effect=effect,
+                        named=named, false_alarm=hidden == "nothing" and verdict == "missing",
+                        calibrated_over_floor=over, after_over_floor=after, covered=covered, intervals=intervals,
+                        wall_s=10.0)
 
 
 def test_summary_counts_each_target_by_hand_and_names_the_variation_that_misses():
@@ -46,8 +47,8 @@ def test_summary_counts_each_target_by_hand_and_names_the_variation_that_misses(
         _row("a", "rack_stiction", 3.5, "missing", True, 4, 4, over=5.0, after=1.01, effect="rack_stiction"),
         _row("a", "rack_stiction", 2.0, "missing", True, 4, 4, over=3.0, after=1.05, effect="rack_stiction"),
         _row("b", verdict="missing", over=1.2, effect="column_friction"),  # a false alarm
-        {**_row("b", "rack_stiction", 3.5, "unexplained", False, 1, 3, over=2.0), "not_covered": "p q",
-         "hidden_confounded_with": "steering.rack_friction_force"},
+        replace(_row("b", "rack_stiction", 3.5, "unexplained", False, 1, 3, over=2.0), not_covered="p q",
+                hidden_confounded_with="steering.rack_friction_force"),
         _row("b", "rack_stiction", 1.0, "adequate", False, 3, 3, over=1.1),  # below the named rate's size
     ]
     s = summarise(rows)
@@ -71,7 +72,7 @@ def test_summary_counts_each_target_by_hand_and_names_the_variation_that_misses(
     h = s["by_hidden"]["rack_stiction"]
     assert h["named_count"] == [2, 3] and h["missed_flagged_confounded"] == 1
     assert h["observable_fraction"] is None  # no record says how much of its change survives a calibration
-    kept = summarise([{**r, "steps_observable": 0.5 * r["steps"]} for r in rows])["by_hidden"]["rack_stiction"]
+    kept = summarise([replace(r, steps_observable=0.5 * r.steps) for r in rows])["by_hidden"]["rack_stiction"]
     assert kept["observable_fraction"] == {"median": 0.5, "min": 0.5, "max": 0.5}
     assert h["confounded_with"] == ["steering.rack_friction_force"]
     assert h["missed_in"] == ["b"] and h["named_in_all_of"] == ["a"]
@@ -121,10 +122,10 @@ def test_outcome_names_from_the_group_and_scores_the_reported_models_intervals()
                                "column_friction.torque": _interval(0.1, 0.3)}}]
     result = _result("missing", "column_friction", group=["rack_stiction"], ranking=ranking)
     o = outcome(_truth("rack_stiction", 250.0), result)
-    assert o["named"] and not o["false_alarm"] and o["hidden_confounded_with"] == ""
-    assert (o["covered"], o["intervals"]) == (1, 3)
-    assert o["not_covered"] == "column_friction.torque steering.rack_friction_force"
-    assert o["calibrated_over_floor"] == pytest.approx(1.5) and o["after_over_floor"] == pytest.approx(1.05)
+    assert o.named and not o.false_alarm and o.hidden_confounded_with == ""
+    assert (o.covered, o.intervals) == (1, 3)
+    assert o.not_covered == "column_friction.torque steering.rack_friction_force"
+    assert o.calibrated_over_floor == pytest.approx(1.5) and o.after_over_floor == pytest.approx(1.05)
 
 
 def test_outcome_records_when_the_diagnosis_warned_the_hidden_effect_is_confounded():
@@ -135,8 +136,8 @@ def test_outcome_records_when_the_diagnosis_warned_the_hidden_effect_is_confound
                               "identifiable_fraction": 0.1}]}
     truth = {**_truth("kingpin_friction", 0.003), "strength_key": "kingpin_friction.friction_radius"}
     o = outcome(truth, result)
-    assert not o["named"] and o["hidden_confounded_with"] == "steering.rack_friction_force"
-    assert (o["covered"], o["intervals"]) == (0, 1)  # the rack friction absorbed the hidden friction: 770 vs 700
+    assert not o.named and o.hidden_confounded_with == "steering.rack_friction_force"
+    assert (o.covered, o.intervals) == (0, 1)  # the rack friction absorbed the hidden friction: 770 vs 700
 
 
 def test_outcome_of_a_null_scores_the_calibrated_intervals_and_a_false_alarm():
@@ -145,11 +146,11 @@ def test_outcome_of_a_null_scores_the_calibrated_intervals_and_a_false_alarm():
     calibrated = {"tyre.friction_coefficient": _interval(0.75, 0.85),
                   "steering.rack_friction_force": _interval(650.0, 720.0)}
     o = outcome(_truth(), _result("adequate", None, calibrated=calibrated))
-    assert (o["covered"], o["intervals"], o["named"], o["false_alarm"]) == (2, 2, False, False)
+    assert (o.covered, o.intervals, o.named, o.false_alarm) == (2, 2, False, False)
     ranking = [{"effect": "rack_damping", "strength_parameter": "rack_damping.coefficient",
                 "parameters": {"rack_damping.coefficient": _interval(-1.0, 5.0)}}]
     o = outcome(_truth(), _result("missing", "rack_damping", ranking=ranking))
-    assert o["false_alarm"] and not o["named"] and (o["covered"], o["intervals"]) == (1, 1)
+    assert o.false_alarm and not o.named and (o.covered, o.intervals) == (1, 1)
 
 
 def test_cases_of_one_variation_share_their_records_and_a_smaller_grid_is_part_of_a_larger():
@@ -238,9 +239,9 @@ def test_a_null_case_runs_end_to_end(tmp_path):
     assert record.metadata["sample_rate_hz"].startswith("50")
     assert truth["hidden"] is None and set(truth["base_overrides"]) == set(PERTURBATION)
     o = outcome(truth, result)
-    assert o["verdict"] == "adequate" and not o["false_alarm"]
-    assert o["calibrated_over_floor"] < DEFAULT_SETTINGS.adequate_rms_factor
-    assert o["intervals"] == len(PERTURBATION)
+    assert o.verdict == "adequate" and not o.false_alarm
+    assert o.calibrated_over_floor < DEFAULT_SETTINGS.adequate_rms_factor
+    assert o.intervals == len(PERTURBATION)
 
 
 def test_a_lagged_torque_channel_is_the_unlagged_one_shifted_and_the_rack_is_untouched():

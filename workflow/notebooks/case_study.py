@@ -88,7 +88,7 @@ table(["file", "case", "surface", "samples", "noise floor (N m)", "rack spline k
 compared = compare_files(files, params)
 summary = compared.as_dict()
 table(["file", "RMS (N m)", "weighted RMS / noise floor"] + [p.replace("_", " ") for p in PHASES],
-      [[f["file"], f"{f['overall']['rms']:.3f}", f"{f['weighted_rms_over_noise_floor']:.2f}"]
+      [[f["file"], f"{f['overall']['rms']:.3f}", f"{f['over_floor']:.2f}"]
        + [f"{f['by_phase'][p]['rms']:.3f}" if p in f["by_phase"] else "-" for p in PHASES]
        for f in summary["files"]])
 show(compare_figure, compared, shown=shown_files(compared.files))
@@ -111,8 +111,8 @@ for f in summary["files"]:
 ground = [f for f in summary["files"] if f["surface"] == "ground"]
 air = [f for f in summary["files"] if f["surface"] == "air_bearing"]
 print("phase with the largest RMS error, per file:", worst)
-print(f"mean weighted RMS / noise floor: ground {np.mean([f['weighted_rms_over_noise_floor'] for f in ground]):.2f}, "
-      f"air bearings {np.mean([f['weighted_rms_over_noise_floor'] for f in air]):.2f}")
+print(f"mean weighted RMS / noise floor: ground {np.mean([f['over_floor'] for f in ground]):.2f}, "
+      f"air bearings {np.mean([f['over_floor'] for f in air]):.2f}")
 
 # %% [markdown]
 # ## 3. Diagnose
@@ -155,7 +155,7 @@ show(diagnosis_figure, diagnosis)
 # %%
 ladder = error_ladder(files, params, first=diagnosis)
 table(["model", "RMS (N m)", "weighted RMS (N m)", "weighted RMS / noise floor"],
-      [[r["label"], f"{r['rms_Nm']:.3f}", f"{r['weighted_rms_Nm']:.3f}", f"{r['weighted_rms_over_noise_floor']:.2f}"]
+      [[r["label"], f"{r['rms_Nm']:.3f}", f"{r['weighted_rms_Nm']:.3f}", f"{r['over_floor']:.2f}"]
        for r in ladder.rungs])
 first_file = next((i for i, f in enumerate(files) if (f.case, f.surface) == ("unladen", "ground")), 0)
 f = files[first_file]

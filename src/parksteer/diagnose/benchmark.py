@@ -34,6 +34,7 @@ from ..synthetic.datasets import BenchmarkDesign, benchmark_specs, file_name, ma
 from ..tables import write_json
 from .problem import load_files
 from .report import diagnosis_dict
+from .rows import BenchmarkRow
 from .select import diagnose
 from .settings import DEFAULT_SETTINGS, DiagnosisSettings
 
@@ -42,7 +43,7 @@ from .settings import DEFAULT_SETTINGS, DiagnosisSettings
 BENCHMARK_SETTINGS = replace(DEFAULT_SETTINGS, confound_tests=False)
 
 TARGETS = {"named_or_group_at_2_steps": 0.90, "false_alarm_rate": 0.05, "outside_unexplained": 0.80,
-           "rms_after_over_noise_floor": 1.2}
+           "after_over_floor": 1.2}
 
 
 def case_names(design: BenchmarkDesign, params: Parameters | None = None) -> list[str]:
@@ -111,7 +112,7 @@ def run_case(parameters_path: str | Path, design: BenchmarkDesign, name: str, fo
     return diagnose_written(params, records, folder, dataset.truth, truth_path, diagnosis_path, start)
 
 
-def outcome(truth: dict, result: dict) -> dict:
+def outcome(truth: dict, result: dict) -> BenchmarkRow:
     """How one diagnosis fares against its truth."""
     group = [s["effect"] for s in result["indistinguishable"]]
     said = result["effect"] if result["verdict"] == "missing" else result["verdict"]
@@ -119,25 +120,25 @@ def outcome(truth: dict, result: dict) -> dict:
     in_group = truth["kind"] == "candidate" and result["verdict"] == "missing" and truth["hidden"] in group
     floor = result["noise_floor_Nm"]
     after = result["statistics"]["with_effect"]
-    return {
-        "name": truth["name"],
-        "kind": truth["kind"],
-        "hidden": truth["hidden"] or "nothing",
+    return BenchmarkRow(
+        name=truth["name"],
+        kind=truth["kind"],
+        hidden=truth["hidden"] or "nothing",
         # grouped by the size asked for; a candidate whose largest strength falls short is hidden at that
         # strength and its actual size is kept beside it
-        "steps": truth.get("steps_requested", truth["steps"]) or 0.0,
-        "steps_actual": truth["steps"] if truth["steps"] is not None else 0.0,
-        "said": said,
-        "verdict": result["verdict"],
-        "indistinguishable": " ".join(group),
-        "named_first": named_first,
-        "named_or_group": named_first or in_group,
-        "calibrated_over_floor": result["statistics"]["calibrated"]["weighted_rms_Nm"] / floor,
-        "after_over_floor": after["weighted_rms_Nm"] / floor if after else float("nan"),
-        "plain_after_over_floor": after["rms_Nm"] / floor if after else float("nan"),
-        "replays": result["cost"]["replays"],
-        "wall_s": result["cost"].get("wall_s", float("nan")),
-    }
+        steps=truth.get("steps_requested", truth["steps"]) or 0.0,
+        steps_actual=truth["steps"] if truth["steps"] is not None else 0.0,
+        said=said,
+        verdict=result["verdict"],
+        indistinguishable=" ".join(group),
+        named_first=named_first,
+        named_or_group=named_first or in_group,
+        calibrated_over_floor=result["statistics"]["calibrated"]["weighted_rms_Nm"] / floor,
+        after_over_floor=after["weighted_rms_Nm"] / floor if after else float("nan"),
+        plain_after_over_floor=after["rms_Nm"] / floor if after else float("nan"),
+        replays=result["cost"]["replays"],
+        wall_s=result["cost"].get("wall_s", float("nan")),
+    )
 
 
 def _fraction(values) -> float | None:
@@ -146,36 +147,36 @@ def _fraction(values) -> float | None:
 
 
 def aggregate(truth_paths: list[str | Path], diagnosis_paths: list[str | Path],
-              design: BenchmarkDesign | None = None) -> tuple[list[dict], dict]:
+              design: BenchmarkDesign | None = None) -> tuple[list[BenchmarkRow], dict]:
     """(one outcome per data set, the summary numbers, with the design they were made with if given)."""
     rows = [outcome(truth, result) for truth, result in paired_results(truth_paths, diagnosis_paths, "benchmark")]
-    candidates = [r for r in rows if r["kind"] == "candidate"]
-    nulls = [r for r in rows if r["kind"] == "null"]
-    outside = [r for r in rows if r["kind"] == "outside"]
-    steps = sorted({r["steps"] for r in candidates})
+    candidates = [r for r in rows if r.kind == "candidate"]
+    nulls = [r for r in rows if r.kind == "null"]
+    outside = [r for r in rows if r.kind == "outside"]
+    steps = sorted({r.steps for r in candidates})
     by_steps = {
         f"{s:g}": {
-            "data_sets": sum(r["steps"] == s for r in candidates),
-            "named_first": _fraction(r["named_first"] for r in candidates if r["steps"] == s),
-            "named_or_group": _fraction(r["named_or_group"] for r in candidates if r["steps"] == s),
+            "data_sets": sum(r.steps == s for r in candidates),
+            "named_first": _fraction(r.named_first for r in candidates if r.steps == s),
+            "named_or_group": _fraction(r.named_or_group for r in candidates if r.steps == s),
         }
         for s in steps
     }
-    strong = [r for r in candidates if r["steps"] >= 2.0]
+    strong = [r for r in candidates if r.steps >= 2.0]
     by_candidate = {
         name: {
-            "named_or_group_at_2_steps": _fraction(r["named_or_group"] for r in strong if r["hidden"] == name),
-            "said": [r["said"] for r in candidates if r["hidden"] == name],
+            "named_or_group_at_2_steps": _fraction(r.named_or_group for r in strong if r.hidden == name),
+            "said": [r.said for r in candidates if r.hidden == name],
         }
-        for name in sorted({r["hidden"] for r in candidates})
+        for name in sorted({r.hidden for r in candidates})
     }
-    successes = [r for r in candidates if r["named_or_group"]]
-    after = [r["after_over_floor"] for r in successes if np.isfinite(r["after_over_floor"])]
+    successes = [r for r in candidates if r.named_or_group]
+    after = [r.after_over_floor for r in successes if np.isfinite(r.after_over_floor)]
     confusion: dict[str, dict[str, int]] = {}
     for r in rows:
-        truth_label = r["hidden"] if r["kind"] != "outside" else f"outside: {r['hidden']}"
+        truth_label = r.hidden if r.kind != "outside" else f"outside: {r.hidden}"
         confusion.setdefault(truth_label, {})
-        confusion[truth_label][r["said"]] = confusion[truth_label].get(r["said"], 0) + 1
+        confusion[truth_label][r.said] = confusion[truth_label].get(r.said, 0) + 1
     summary = {
         "data_sets": len(rows),
         "candidates": len(candidates),
@@ -183,16 +184,16 @@ def aggregate(truth_paths: list[str | Path], diagnosis_paths: list[str | Path],
         "outside": len(outside),
         "by_steps": by_steps,
         "by_candidate": by_candidate,
-        "named_first_at_2_steps": _fraction(r["named_first"] for r in strong),
-        "named_or_group_at_2_steps": _fraction(r["named_or_group"] for r in strong),
-        "false_alarm_rate": _fraction(r["verdict"] == "missing" for r in nulls),
-        "null_not_adequate_rate": _fraction(r["verdict"] != "adequate" for r in nulls),
-        "outside_unexplained": _fraction(r["verdict"] == "unexplained" for r in outside),
-        "outside_said": {r["name"]: r["said"] for r in outside},
-        "rms_after_over_noise_floor": {
+        "named_first_at_2_steps": _fraction(r.named_first for r in strong),
+        "named_or_group_at_2_steps": _fraction(r.named_or_group for r in strong),
+        "false_alarm_rate": _fraction(r.verdict == "missing" for r in nulls),
+        "null_not_adequate_rate": _fraction(r.verdict != "adequate" for r in nulls),
+        "outside_unexplained": _fraction(r.verdict == "unexplained" for r in outside),
+        "outside_said": {r.name: r.said for r in outside},
+        "after_over_floor": {
             "median": float(np.median(after)) if after else None,
             "max": float(np.max(after)) if after else None,
-            "within_target": _fraction(a <= TARGETS["rms_after_over_noise_floor"] for a in after),
+            "within_target": _fraction(a <= TARGETS["after_over_floor"] for a in after),
         },
         "confusion": confusion,
         "targets": TARGETS,
@@ -203,8 +204,8 @@ def aggregate(truth_paths: list[str | Path], diagnosis_paths: list[str | Path],
             "seed": design.seed,
         },
         "cost": {
-            "replays_median": float(np.median([r["replays"] for r in rows])) if rows else None,
-            "diagnosis_wall_s_median": float(np.median([r["wall_s"] for r in rows])) if rows else None,
+            "replays_median": float(np.median([r.replays for r in rows])) if rows else None,
+            "diagnosis_wall_s_median": float(np.median([r.wall_s for r in rows])) if rows else None,
         },
     }
     return rows, summary

@@ -51,7 +51,7 @@ class CompareResult:
                 "rms_over_noise_floor": summary["rms_over_noise_floor"],
                 "replay_uncertainty_rms_Nm": float(np.sqrt(np.mean(delta**2))) if delta is not None else 0.0,
                 "weighted_rms_Nm": float(np.sqrt(np.mean(weighted**2))),
-                "weighted_rms_over_noise_floor": float(np.sqrt(np.mean(weighted**2)) / f.noise.total_rms),
+                "over_floor": float(np.sqrt(np.mean(weighted**2)) / f.noise.total_rms),
             })
         return {
             "effects": [e.name for e in self.effects],

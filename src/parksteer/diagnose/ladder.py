@@ -38,11 +38,11 @@ def _rung(label: str, effects: list[Effect], statistics: dict, parameters: dict[
         "rms_Nm": statistics["rms_Nm"],
         "weighted_rms_Nm": statistics["weighted_rms_Nm"],
         "peak_Nm": statistics["peak_Nm"],
-        "weighted_rms_over_noise_floor": statistics["weighted_rms_Nm"] / statistics["noise_floor_Nm"],
+        "over_floor": statistics["weighted_rms_Nm"] / statistics["noise_floor_Nm"],
         "parameters": dict(sorted(parameters.items())),
         # with a fitted angle: its residual, and the weighted error of both signals together over the floor
         **({"angle_rms_rad": statistics["angle"]["rms_rad"],
-            "weighted_rms_over_noise_floor_both_signals": (statistics["weighted_rss"] / statistics["samples"]) ** 0.5}
+            "over_floor_both_signals": (statistics["weighted_rss"] / statistics["samples"]) ** 0.5}
            if "angle" in statistics else {}),
     }
 

@@ -22,6 +22,7 @@ from ..errors import UsageError
 from ..parameters import load_parameters
 from ..synthetic.datasets import OUTCLASS_RIVALS, OutclassDesign, make_outclass_dataset, outclass_specs
 from .benchmark import diagnose_written, paired_results
+from .rows import OutclassRow
 
 ADEQUATE_LIMIT_STEPS = 3.0  # a hidden effect this large (converter steps RMS) must not be called adequate
 
@@ -50,7 +51,7 @@ def bic_margin(result: dict) -> float | None:
     return float(gains[0] - (gains[1] if len(gains) > 1 else 0.0))
 
 
-def outcome(truth: dict, result: dict) -> dict:
+def outcome(truth: dict, result: dict) -> OutclassRow:
     """How one diagnosis fares: what it said, how that relates to the rival's physics, and the two targets."""
     band = result["selection"]["thresholds"]["bic_indistinguishable"]
     named = result["effect"] if result["verdict"] == "missing" else None
@@ -76,55 +77,56 @@ def outcome(truth: dict, result: dict) -> dict:
     # The strongly evidenced candidate an unexplained verdict still reports as the nearest form the library has.
     top = result["ranking"][0] if result["ranking"] else None
     evidenced = top is not None and (top["delta_bic"] or 0.0) > result["selection"]["thresholds"]["bic_missing"]
-    return {
-        "name": truth["name"],
-        "kind": truth["kind"],
-        "hidden": truth["hidden"] or "nothing",
-        "steps": truth.get("steps_requested") or 0.0,
-        "steps_actual": steps,
-        "closest": closest or "none",
-        "said": said,
-        "relation": relation,
-        "closest_in_group": bool(closest and (named == closest or (named and closest in group))),
-        "indistinguishable": " ".join(group),
-        "bic_margin": margin,
-        "best_delta_bic": max((c["delta_bic"] for c in result["ranking"] if c["delta_bic"] is not None),
+    return OutclassRow(
+        name=truth["name"],
+        kind=truth["kind"],
+        hidden=truth["hidden"] or "nothing",
+        steps=truth.get("steps_requested") or 0.0,
+        steps_actual=steps,
+        closest=closest or "none",
+        said=said,
+        relation=relation,
+        closest_in_group=bool(closest and (named == closest or (named and closest in group))),
+        indistinguishable=" ".join(group),
+        bic_margin=margin,
+        best_delta_bic=max((c["delta_bic"] for c in result["ranking"] if c["delta_bic"] is not None),
                               default=None),
-        "explained_fraction": next((c.get("explained_fraction") for c in result["ranking"] if c["effect"] == named),
+        explained_fraction=next((c.get("explained_fraction") for c in result["ranking"] if c["effect"] == named),
                                    None) if named else (top.get("explained_fraction") if evidenced else None),
-        "calibrated_over_floor": result["statistics"]["calibrated"]["weighted_rms_Nm"] / floor,
-        "after_over_floor": after["weighted_rms_Nm"] / floor if after else None,
-        "nearest": top["effect"] if evidenced else "none",
-        "nearest_after_over_floor": top["weighted_rms_after_Nm"] / floor if evidenced else None,
-        "confident_wrong": confident_wrong,
-        "adequate_at_3_steps": missed,
-        "target_met": not confident_wrong and not missed,
-        "wall_s": result["cost"].get("wall_s"),
-    }
+        calibrated_over_floor=result["statistics"]["calibrated"]["weighted_rms_Nm"] / floor,
+        after_over_floor=after["weighted_rms_Nm"] / floor if after else None,
+        nearest=top["effect"] if evidenced else "none",
+        nearest_after_over_floor=top["weighted_rms_after_Nm"] / floor if evidenced else None,
+        confident_wrong=confident_wrong,
+        adequate_at_3_steps=missed,
+        target_met=not confident_wrong and not missed,
+        wall_s=result["cost"].get("wall_s"),
+    )
 
 
-def aggregate(truth_paths, diagnosis_paths, design: OutclassDesign | None = None) -> tuple[list[dict], dict]:
+def aggregate(truth_paths, diagnosis_paths, design: OutclassDesign | None = None
+              ) -> tuple[list[OutclassRow], dict]:
     """(one outcome per data set, the summary: confusion table, the target's misses, the closest-candidate table)."""
     rows = [outcome(truth, result)
             for truth, result in paired_results(truth_paths, diagnosis_paths, "out-of-class benchmark")]
-    rivals = [r for r in rows if r["kind"] == "rival"]
-    nulls = [r for r in rows if r["kind"] == "null"]
+    rivals = [r for r in rows if r.kind == "rival"]
+    nulls = [r for r in rows if r.kind == "null"]
     confusion: dict[str, dict[str, int]] = {}
     for r in rows:
-        confusion.setdefault(r["hidden"], {})
-        confusion[r["hidden"]][r["said"]] = confusion[r["hidden"]].get(r["said"], 0) + 1
-    count = {k: sum(r["relation"] == k for r in rivals) for k in ("closest", "related", "unrelated", "unexplained",
+        confusion.setdefault(r.hidden, {})
+        confusion[r.hidden][r.said] = confusion[r.hidden].get(r.said, 0) + 1
+    count = {k: sum(r.relation == k for r in rivals) for k in ("closest", "related", "unrelated", "unexplained",
                                                                   "adequate")}
     summary = {
         "data_sets": len(rows),
         "rivals": len(rivals),
         "nulls": len(nulls),
         "relations": count,
-        "confident_wrong": [r["name"] for r in rivals if r["confident_wrong"]],
-        "adequate_at_3_steps": [r["name"] for r in rivals if r["adequate_at_3_steps"]],
-        "target_met": all(r["target_met"] for r in rows),
-        "null_adequate": sum(r["said"] == "adequate" for r in nulls),
-        "cases": [{k: r[k] for k in ("name", "hidden", "steps_actual", "closest", "said", "relation", "bic_margin",
+        "confident_wrong": [r.name for r in rivals if r.confident_wrong],
+        "adequate_at_3_steps": [r.name for r in rivals if r.adequate_at_3_steps],
+        "target_met": all(r.target_met for r in rows),
+        "null_adequate": sum(r.said == "adequate" for r in nulls),
+        "cases": [{k: getattr(r, k) for k in ("name", "hidden", "steps_actual", "closest", "said", "relation", "bic_margin",
                                      "explained_fraction", "calibrated_over_floor", "after_over_floor", "nearest",
                                      "nearest_after_over_floor", "target_met")} for r in rows],
         "confusion": confusion,
@@ -136,7 +138,7 @@ def aggregate(truth_paths, diagnosis_paths, design: OutclassDesign | None = None
             "files": [list(f) for f in design.files], "rtol": design.rtol, "seed": design.seed,
             "logger": {k: getattr(design.logger, k) for k in design.logger.__dataclass_fields__},
         },
-        "cost": {"diagnosis_wall_s_median": float(np.median([r["wall_s"] for r in rows if r["wall_s"] is not None]))
+        "cost": {"diagnosis_wall_s_median": float(np.median([r.wall_s for r in rows if r.wall_s is not None]))
                  if rows else None},
     }
     return rows, summary

@@ -273,7 +273,7 @@ def case_result(truth: dict, diagnosis: Diagnosis, result: dict, wall_s: float, 
     answers = peer_answers(library)
     timings = diagnosis.timings_s
     # what the peers need and a diagnosis computes anyway: replay uncertainty, calibration, signatures
-    upstream = sum(timings.get(k, 0.0) for k in ("nominal_and_replay_uncertainty", "calibration",
+    upstream = sum(timings.get(k, 0.0) for k in ("nominal_and_replay_uncertainty", "calibration", "torque_lag",
                                                   "signatures_and_scores"))
     return {
         "name": truth["name"], "split": split, "benchmark": benchmark, "truth": truth,
@@ -295,7 +295,7 @@ def _benchmark_outcome(benchmark: str, truth: dict, result: dict) -> dict:
         from .variations import outcome
     row = outcome(truth, result)
     keep = ("named", "false_alarm", "relation", "confident_wrong", "adequate_at_3_steps", "said", "verdict")
-    return {k: row[k] for k in keep if k in row}
+    return {k: getattr(row, k) for k in keep if hasattr(row, k)}
 
 
 def diagnose_case(params, folder, truth: dict, benchmark: str, split: str) -> dict:

@@ -153,7 +153,7 @@ def diagnosis_dict(diagnosis: Diagnosis) -> dict:
             "samples": problem.n,
             "effective_samples": diagnosis.n_eff,
             "lag1_autocorrelation": diagnosis.rho,
-            "calibrated_weighted_rms_over_noise_floor": math.sqrt(diagnosis.calibration.rss / problem.n),
+            "calibrated_over_floor": math.sqrt(diagnosis.calibration.rss / problem.n),
             "explained_fraction": _finite(diagnosis.explained_fraction),
             "thresholds": {
                 "adequate_rms_factor": diagnosis.settings.adequate_rms_factor,
@@ -441,7 +441,7 @@ def html_report(result: dict, figures: list[tuple[str, str]], phases: list[dict]
         out.append("<h2>Error ladder</h2>")
         out += _table(["rung", "effects", "RMS (N m)", "weighted RMS (N m)", "weighted RMS / noise floor"],
                       [[r["label"], ", ".join(r["effects"]), _n(r["rms_Nm"]), _n(r["weighted_rms_Nm"]),
-                        _n(r["weighted_rms_over_noise_floor"])] for r in ladder["rungs"]])
+                        _n(r["over_floor"])] for r in ladder["rungs"]])
         out.append(f"<p>Noise floor {html.escape(_n(ladder['noise_floor_Nm']))} N m; with the replay's uncertainty "
                    f"{html.escape(_n(ladder['attainable_floor_Nm']))} N m.</p>")
     out.append("<h2>Fitted values</h2>")

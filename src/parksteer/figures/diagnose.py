@@ -183,7 +183,8 @@ def make_ladder_figure(case_study_json: str | Path, residuals_csv: str | Path, s
     rungs = ladder["rungs"]
     write_csv(csv, {"rung": [r["label"] for r in rungs], "rms_Nm": [r["rms_Nm"] for r in rungs],
                     "weighted_rms_Nm": [r["weighted_rms_Nm"] for r in rungs],
-                    "weighted_rms_over_noise_floor": [r["weighted_rms_over_noise_floor"] for r in rungs]},
+                    # the CSV column keeps its checksummed header
+                    "weighted_rms_over_noise_floor": [r["over_floor"] for r in rungs]},
               {"figure": "diag_ladder: error as the model grows (synthetic car data set)",
                "noise_floor_Nm": f"{ladder['noise_floor_Nm']:.6g}",
                "attainable_floor_Nm": f"{ladder['attainable_floor_Nm']:.6g}"})
@@ -192,12 +193,12 @@ def make_ladder_figure(case_study_json: str | Path, residuals_csv: str | Path, s
     return summary
 
 
-def benchmark_figure(rows: list[dict], summary: dict, path: str | Path) -> None:
+def benchmark_figure(rows: list, summary: dict, path: str | Path) -> None:
     """Confusion matrix of the hidden-effect benchmark, and accuracy against the hidden strength."""
-    truths = sorted({r["hidden"] for r in rows if r["kind"] == "candidate"})
-    truth_labels = truths + (["nothing"] if any(r["kind"] == "null" for r in rows) else []) + sorted(
-        {f"outside: {r['hidden']}" for r in rows if r["kind"] == "outside"})
-    said_labels = truths + sorted({r["said"] for r in rows} - set(truths) - {"adequate", "unexplained"}) + [
+    truths = sorted({r.hidden for r in rows if r.kind == "candidate"})
+    truth_labels = truths + (["nothing"] if any(r.kind == "null" for r in rows) else []) + sorted(
+        {f"outside: {r.hidden}" for r in rows if r.kind == "outside"})
+    said_labels = truths + sorted({r.said for r in rows} - set(truths) - {"adequate", "unexplained"}) + [
         "adequate", "unexplained"]
     counts = np.zeros((len(truth_labels), len(said_labels)))
     for truth, said in summary["confusion"].items():
@@ -242,12 +243,13 @@ def make_benchmark_figure(truth_paths, diagnosis_paths, svg: str | Path, csv: st
     """figures/diag_benchmark.svg (confusion matrix, accuracy against strength), its CSV, results JSON."""
     from ..diagnose.benchmark import aggregate
     from ..diagnose.report import MACHINE_TIME_KEYS, without_machine_times
+    from ..diagnose.rows import csv_columns
     from ..tables import write_csv, write_json
 
     rows, summary = aggregate(truth_paths, diagnosis_paths, design)
     benchmark_figure(rows, summary, svg)
     # machine times differ from run to run: out of the checksummed figure data and the key numbers
-    columns = {key: [r[key] for r in rows] for key in rows[0] if key not in MACHINE_TIME_KEYS} if rows else {}
+    columns = csv_columns(rows, MACHINE_TIME_KEYS)
     write_csv(csv, columns, {"figure": "diag_benchmark: one row per synthetic data set",
                              "steps": "hidden size as converter steps of torque RMS on the unladen ground file"})
     write_json(json_path, without_machine_times(summary))
@@ -285,25 +287,25 @@ OUTCLASS_SHADES = {"closest": "#4daf4a", "related": "#b8e186", "unrelated": "#e4
                    "adequate": "#ff7f00", "correct": "#4daf4a", "not adequate": "#bdbdbd", "false alarm": "#e41a1c"}
 
 
-def outclass_figure(rows: list[dict], path: str | Path) -> None:
+def outclass_figure(rows: list, path: str | Path) -> None:
     """The out-of-class confusion table: each hidden rival (a row, with its physically closest candidate) against
     what the diagnosis said (a column), the cell shaded by how the answer relates to the rival's physics and
     labelled with the BIC margin over the runner-up when a candidate was named, or with the nearest candidate when
     one was strongly evidenced but left the error too far above the floor to be named."""
-    truths = sorted({(r["hidden"], r["closest"]) for r in rows if r["kind"] == "rival"})
-    truth_labels = [h for h, _ in truths] + (["nothing"] if any(r["kind"] == "null" for r in rows) else [])
+    truths = sorted({(r.hidden, r.closest) for r in rows if r.kind == "rival"})
+    truth_labels = [h for h, _ in truths] + (["nothing"] if any(r.kind == "null" for r in rows) else [])
     closest = dict(truths)
-    named = sorted({r["said"] for r in rows} - {"adequate", "unexplained"})
+    named = sorted({r.said for r in rows} - {"adequate", "unexplained"})
     said_labels = named + ["adequate", "unexplained"]
     fig, ax = new_figure(7.0, 0.45 * len(truth_labels) + 2.2)
     for r in rows:
-        i, j = truth_labels.index(r["hidden"]), said_labels.index(r["said"])
-        ax.add_patch(_cell(j, i, OUTCLASS_SHADES[r["relation"]]))
-        text = f"{r['steps_actual']:.1f} st" if r["kind"] == "rival" else r["relation"]
-        if r["bic_margin"] is not None:
-            text += f"\nΔBIC {r['bic_margin']:.0f}"
-        elif r.get("nearest", "none") != "none":
-            text += f"\nnearest {r['nearest'].replace('_', ' ')}"
+        i, j = truth_labels.index(r.hidden), said_labels.index(r.said)
+        ax.add_patch(_cell(j, i, OUTCLASS_SHADES[r.relation]))
+        text = f"{r.steps_actual:.1f} st" if r.kind == "rival" else r.relation
+        if r.bic_margin is not None:
+            text += f"\nΔBIC {r.bic_margin:.0f}"
+        elif r.nearest != "none":
+            text += f"\nnearest {r.nearest.replace('_', ' ')}"
         ax.text(j, i, text, ha="center", va="center", fontsize=6)
     ax.set_xlim(-0.5, len(said_labels) - 0.5)
     ax.set_ylim(len(truth_labels) - 0.5, -0.5)
@@ -318,7 +320,7 @@ def outclass_figure(rows: list[dict], path: str | Path) -> None:
     from matplotlib.patches import Patch
 
     shown = [k for k in ("closest", "related", "unrelated", "unexplained", "adequate")
-             if any(r["relation"] == k for r in rows if r["kind"] == "rival")]
+             if any(r.relation == k for r in rows if r.kind == "rival")]
     ax.legend(handles=[Patch(color=OUTCLASS_SHADES[k], label=k) for k in shown], fontsize=7, loc="upper left",
               bbox_to_anchor=(1.01, 1.0))
     fig.tight_layout()
@@ -336,13 +338,13 @@ def make_outclass_figure(truth_paths, diagnosis_paths, svg: str | Path, csv: str
     """figures/diag_outclass.svg (the out-of-class confusion table), its CSV (one row per data set), results JSON."""
     from ..diagnose.outclass import aggregate
     from ..diagnose.report import MACHINE_TIME_KEYS, without_machine_times
+    from ..diagnose.rows import csv_columns
     from ..tables import write_csv, write_json
 
     rows, summary = aggregate(truth_paths, diagnosis_paths, design)
     outclass_figure(rows, svg)
     # machine times differ from run to run: out of the checksummed figure data and the key numbers
-    columns = {key: [("" if r[key] is None else r[key]) for r in rows] for key in rows[0]
-               if key not in MACHINE_TIME_KEYS} if rows else {}
+    columns = csv_columns(rows, MACHINE_TIME_KEYS, none="")
     write_csv(csv, columns, {"figure": "diag_outclass: one row per out-of-class data set",
                              "steps_actual": "hidden rival's RMS torque change in converter steps (all files)",
                              "bic_margin": "named candidate's BIC gain over the runner-up's",
@@ -413,14 +415,14 @@ def make_variations_figure(truth_paths, diagnosis_paths, svg: str | Path, csv: s
     """figures/diag_variations.svg (targets per variation, errors against the thresholds), its CSV (one row per
     record) and results/diag_variations.json (the per-variation table and the targets)."""
     from ..diagnose.report import MACHINE_TIME_KEYS, without_machine_times
+    from ..diagnose.rows import csv_columns
     from ..diagnose.variations import aggregate
     from ..tables import write_csv, write_json
 
     rows, summary = aggregate(truth_paths, diagnosis_paths, design)
     variations_figure(rows, summary, svg)
     # machine times differ from run to run: out of the checksummed figure data and the key numbers
-    columns = {key: [("" if r[key] is None else r[key]) for r in rows] for key in rows[0]
-               if key not in MACHINE_TIME_KEYS} if rows else {}
+    columns = csv_columns(rows, MACHINE_TIME_KEYS, none="")
     write_csv(csv, columns, {"figure": "diag_variations: one row per record set of the variation benchmark",
                              "steps": "hidden size requested, converter steps of torque RMS over the case's files",
                              "steps_actual": "the size the strength search reached",
