@@ -208,8 +208,8 @@ def effect_key(effects: list[Effect]) -> tuple[str, ...]:
 @dataclass(eq=False)
 class ReplayCache:
     """What every :class:`Problem` derived from one another shares: the replays made (one per effect set, file and
-    set of replay instants: with_files), the count of solves run in worker processes, and
-    the worker pool. A cache only: which entry a computation finds never changes its result."""
+    generation of replay instants, :meth:`Problem.with_files`), the count of solves run in worker processes, and
+    the worker pool. Each replay is made at its file's instants when first asked for in its generation."""
 
     workers: int = 1
     replays: dict = field(default_factory=dict)
