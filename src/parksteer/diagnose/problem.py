@@ -57,7 +57,7 @@ from ..model.symbolic.components import Effect
 from ..parameters import Parameters
 from ..synthetic.logger import add_noise, quantise
 from .parallel import fork_map, forks, worker_pool
-from .settings import DEFAULT_SETTINGS, DiagnosisSettings
+from .settings import DEFAULT_SETTINGS
 from .replay import Replay
 
 TORQUE = "handwheel_torque_Nm"
