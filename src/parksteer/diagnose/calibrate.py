@@ -65,7 +65,7 @@ class FitParameter:
         return self.lower, self.upper
 
 
-@dataclass
+@dataclass(frozen=True)
 class Fit:
     """A fitted model: values, predictions, weighted residuals, Jacobian and the fit's statistics."""
 

@@ -60,7 +60,7 @@ def candidate_effects(model_effects: list[Effect], registry: dict[str, Effect] |
     return [registry[n] for n in testable], untestable
 
 
-@dataclass
+@dataclass(frozen=True)
 class Signature:
     """A candidate's sensitivity at the calibrated base model."""
 
