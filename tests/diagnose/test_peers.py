@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from parksteer.diagnose.peers import (FROLS_SETTINGS, STLSQ_RIDGES, STLSQ_SETTINGS, STLSQ_THRESHOLDS, frols, frols_ranking, generic_terms,
-                                      library_from, peer_answers, score_method, setting_label, stlsq, tune,
+                                      library_from, peer_answers, portable_stlsq, score_method, setting_label, stlsq, tune,
                                       verdict_of)
 
 SAMPLES = 4000
@@ -44,6 +44,31 @@ def test_stlsq_selects_the_one_term_the_residual_holds_and_no_other(term):
     selected = stlsq(library, 0.2)
     assert list(selected) == [term]
     assert selected[term] == pytest.approx(0.3, abs=0.05)  # the term's RMS contribution, in noise floors
+
+
+@pytest.mark.parametrize("threshold, alpha", [(0.3, 0.05), (0.5, 50.0), (1.0, 500.0)])
+def test_the_portable_stlsq_selects_what_pysindys_own_does_with_the_same_coefficients(threshold, alpha):
+    """The same algorithm on other linear-algebra kernels: on sparse regressions with two nearly collinear terms,
+    PySINDy's STLSQ (scikit-learn's ridge and LAPACK) and the portable one select the same terms, and their
+    coefficients agree to rounding of the normal equations (1e-9 of coefficients of order 1)."""
+    import warnings
+
+    from pysindy.optimizers import STLSQ
+
+    rng = np.random.default_rng(1)
+    for _ in range(40):
+        x = rng.normal(size=(500, 12))
+        x[:, 3] = x[:, 2] + 0.1 * rng.normal(size=500)
+        truth = np.zeros(12)
+        truth[rng.choice(12, 3, replace=False)] = rng.normal(scale=2.0, size=3)
+        y = np.sum(x * truth, axis=1) + rng.normal(scale=0.5, size=500)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            theirs = STLSQ(threshold=threshold, alpha=alpha, max_iter=20).fit(x, y).coef_.ravel()
+            ours = portable_stlsq(threshold=threshold, alpha=alpha, max_iter=20,
+                                  initial_guess=np.ones((1, 12))).fit(x, y).coef_.ravel()
+        assert np.array_equal(theirs != 0.0, ours != 0.0)
+        assert np.max(np.abs(theirs - ours)) < 1e-9
 
 
 @pytest.mark.parametrize("term", ["sign(v)", "rack_stiction"])

@@ -128,15 +128,43 @@ def record_library(diagnosis: Diagnosis) -> Library:
     return library_from(diagnosis.calibration.weighted, terms, owners)
 
 
-def stlsq(library: Library, threshold: float, ridge: float = 0.0) -> dict[str, float]:
-    """PySINDy's STLSQ on the library, its ridge alpha `ridge` times the rows (PySINDy's default where 0):
-    {selected term: coefficient (its RMS contribution in noise floors)}."""
+def portable_stlsq(**options):
+    """PySINDy's ``STLSQ`` optimizer with its regressions on the project's fixed-order kernels.
+
+    PySINDy's thresholding loop runs as it is (regress on the terms left, zero the coefficients below the
+    threshold, until the support stops changing, then an unbiased least-squares refit on the support). Its three
+    linear solves, scikit-learn's ``ridge_regression`` (Cholesky on the normal equations), the initial
+    ``np.linalg.lstsq`` and the ``LinearRegression`` of the unbiasing step, go through LAPACK and the BLAS, whose
+    results depend on the CPU and the BLAS kernel; here they are the same equations solved by
+    :mod:`parksteer.portable`: (X^T X + alpha I) w = X^T y by Gaussian elimination with partial pivoting, and the
+    unbiased refit by Householder QR. The initial guess only seeds the first support comparison, where every
+    term is in: ones serve as the least-squares solution does."""
     from pysindy.optimizers import STLSQ
 
+    class PortableSTLSQ(STLSQ):
+        def _regress(self, x, y, dim, sparse_sub):
+            self.iters += 1
+            gram = pm.matmul(x.T, x) + self.alpha * np.eye(x.shape[1])
+            return pm.solve(gram, pm.matmul(x.T, y))
+
+        def _unbias(self, x, y):
+            coef = np.zeros((y.shape[1], x.shape[1]))
+            for i in range(self.ind_.shape[0]):
+                if np.any(self.ind_[i]):
+                    coef[i, self.ind_[i]] = pm.lstsq(x[:, self.ind_[i]], y[:, i])
+            self.coef_ = coef
+
+    return PortableSTLSQ(**options)
+
+
+def stlsq(library: Library, threshold: float, ridge: float = 0.0) -> dict[str, float]:
+    """PySINDy's STLSQ (:func:`portable_stlsq`) on the library, its ridge alpha `ridge` times the rows (PySINDy's
+    default where 0): {selected term: coefficient (its RMS contribution in noise floors)}."""
     if not library.names:
         return {}
     alpha = ridge * library.residual.size if ridge > 0.0 else STLSQ_DEFAULT_ALPHA
-    optimizer = STLSQ(threshold=threshold, alpha=alpha, max_iter=STLSQ_MAX_ITERATIONS, normalize_columns=False)
+    optimizer = portable_stlsq(threshold=threshold, alpha=alpha, max_iter=STLSQ_MAX_ITERATIONS,
+                               normalize_columns=False, initial_guess=np.ones((1, len(library.names))))
     with warnings.catch_warnings():  # "eliminated all coefficients" is the answer adequate, not a fault
         warnings.simplefilter("ignore", UserWarning)
         optimizer.fit(library.matrix, library.residual)
@@ -188,8 +216,8 @@ def frols_ranking(library: Library, max_terms: int = FROLS_MAX_TERMS) -> FrolsRa
         k = len(basis)
         names.append(library.names[best])
         errs.append(best_err)
-        aics.append(n * math.log(variance) + 2.0 * k)
-        bics.append(n * math.log(variance) + k * math.log(n))
+        aics.append(n * pm.log(variance) + 2.0 * k)
+        bics.append(n * pm.log(variance) + k * pm.log(n))
     return FrolsRanking(tuple(names), tuple(errs), tuple(aics), tuple(bics))
 
 
