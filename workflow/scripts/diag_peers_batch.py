@@ -1,0 +1,9 @@
+# Thin rule script: the logic is parksteer.diagnose.peers.run_peer_batch, once per job of cases.
+from parksteer.diagnose.peers import run_peer_batch, tuning_design
+from parksteer.diagnose.variations import VariationDesign
+from parksteer.rules import rule_log
+
+with rule_log(snakemake):
+    design = VariationDesign.from_config(snakemake.params.design, snakemake.params.benchmark)
+    run_peer_batch(snakemake.input.parameters, list(snakemake.params.jobs), snakemake.output[0],
+                   tuning_design(design, snakemake.params.tuning_seed))
