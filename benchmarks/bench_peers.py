@@ -52,14 +52,16 @@ def table(comparison: dict) -> str:
     lines = [f"{comparison['records']['evaluation']} evaluation records; peers tuned on "
              f"{comparison['records']['tuning']} records of another seed",
              f"{'method':32s} {'setting':28s} {'named':>7s} {'nulls ok':>8s} {'closest/rel':>11s} {'unrel':>5s} "
-             f"{'unexpl':>6s} {'adeq':>4s} {'conf.wrong':>10s} {'s/record':>9s} {'+upstream':>9s}"]
+             f"{'unexpl':>6s} {'adeq':>4s} {'conf.wrong':>10s} {'s/record':>9s} {'+upstream':>9s} {'replays':>7s} "
+             f"{'+upstream':>9s}"]
     for r in comparison["methods"]:
         o = r["outclass"]
         lines.append(f"{r['label']:32s} {r['setting'] or '':28s} {r['named'][0]:>3d}/{r['named'][1]:<3d} "
                      f"{r['null_adequate'][0]:>4d}/{r['null_adequate'][1]:<3d} {o['closest or related']:>11d} "
                      f"{o['unrelated']:>5d} {o['unexplained']:>6d} {o['adequate']:>4d} "
                      f"{r['confident_wrong']:>5d}/{r['outclass_rivals']:<4d} {r['time_s_median']:>9.3g} "
-                     f"{r['time_with_upstream_s_median']:>9.3g}")
+                     f"{r['time_with_upstream_s_median']:>9.3g} {r['replays_median']:>7} "
+                     f"{r['replays_with_upstream_median']:>9}")
     lines.append("where a peer wins: " + ("; ".join(comparison["peer_wins"]) or "nowhere"))
     for method, grid in comparison["grids"].items():
         lines.append(f"{method} tuning (score: mean of named rate and nulls adequate), best {grid['best']}:")

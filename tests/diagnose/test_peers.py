@@ -131,7 +131,8 @@ def _case(hidden, stlsq_answers, benchmark="variations", kind=None):
             "diagnosis": {"verdict": "adequate", "effect": None, "outcome": {"named": False, "confident_wrong": False}},
             "stlsq": {setting_label("stlsq", (t, r)): {"verdict": v, "effect": e}
                       for t, (v, e) in zip(STLSQ_THRESHOLDS, stlsq_answers) for r in STLSQ_RIDGES},
-            "time_s": {"diagnose": 10.0, "upstream": 5.0, "stlsq": 0.01, "frols": 0.01}}
+            "time_s": {"diagnose": 10.0, "upstream": 5.0, "stlsq": 0.01, "frols": 0.01},
+            "replays": {"diagnose": 200, "upstream": 120}}
 
 
 def test_tuning_takes_the_setting_that_names_the_hidden_effects_and_keeps_the_nulls_adequate():
@@ -175,6 +176,11 @@ def test_the_library_of_a_real_diagnosis_holds_its_residual_and_its_candidates_s
         assert np.allclose(column, w / np.sqrt(np.mean(w**2)))
     assert {"sign(v)", "x^3", "cos(2theta)"} <= set(library.names)
     assert library.matrix.shape == (diagnosis.problem.n, len(library.names))
+    # the replays are counted as they run: never fewer after a stage than before it, all of them by the end, and
+    # the peers' share (up to the signatures) short of the whole, since the refits replay the candidates again
+    counts = list(diagnosis.replays_by_stage.values())
+    assert counts == sorted(counts) and counts[-1] == diagnosis.problem.evaluations
+    assert 0 < diagnosis.replays_by_stage["signatures_and_scores"] < diagnosis.problem.evaluations
 
 
 def test_the_comparison_tunes_on_the_tuning_split_and_scores_on_the_evaluation_records():
@@ -203,3 +209,6 @@ def test_the_comparison_tunes_on_the_tuning_split_and_scores_on_the_evaluation_r
                                                          for t in STLSQ_THRESHOLDS[2:5] for r in STLSQ_RIDGES]
     assert comparison["grids"]["stlsq"]["tied_best_evaluation"]["named"] == [0, 0]
     assert frols_row["named"] == [0, 1]
+    # a peer replays nothing of its own: what it needs is the diagnosis's replays up to the signatures
+    assert (ours["replays_median"], stlsq_row["replays_median"], stlsq_row["replays_with_upstream_median"]) == \
+        (200, 0, 120)

@@ -165,7 +165,8 @@ def diagnosis_dict(diagnosis: Diagnosis) -> dict:
                 "confounded_fraction": diagnosis.settings.confounded_fraction,
             },
         },
-        "cost": {"replays": problem.evaluations, "timings_s": diagnosis.timings_s},
+        "cost": {"replays": problem.evaluations, "replays_by_stage": dict(diagnosis.replays_by_stage),
+                 "timings_s": diagnosis.timings_s},
     }
     if problem.uses_angle:  # the handwheel angle fitted as a second signal: which files, and its floor
         out["angle"] = {

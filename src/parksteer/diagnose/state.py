@@ -112,6 +112,7 @@ class DiagnosisState:
     confound_tests: Mapping[str, dict | None] = field(default_factory=frozen_mapping)
     outputs: Mapping[str, object] = field(default_factory=frozen_mapping)
     timings_s: Mapping[str, float] = field(default_factory=frozen_mapping)
+    replays_by_stage: Mapping[str, int] = field(default_factory=frozen_mapping)  # replays run when each ended
 
     @property
     def files(self):
@@ -132,11 +133,17 @@ class DiagnosisState:
     def with_timing(self, name: str, seconds: float) -> DiagnosisState:
         return replace(self, timings_s=frozen_mapping({**self.timings_s, name: seconds}))
 
+    def with_cost(self, name: str, seconds: float) -> DiagnosisState:
+        """This state with stage `name`'s time and the replays run so far when it ended (the count, unlike the
+        time, is the same on any machine)."""
+        return replace(self.with_timing(name, seconds),
+                       replays_by_stage=frozen_mapping({**self.replays_by_stage, name: self.problem.evaluations}))
+
     def result(self) -> Diagnosis:
         return Diagnosis(self.problem, self.base, self.nominal, self.calibration, self.candidates, self.untestable,
                          self.verdict, self.best_candidate, self.indistinguishable, self.n_eff, self.rho,
                          self.explained_fraction, self.timings_s, self.settings, self.identification,
-                         self.confound_tests, self.outputs)
+                         self.confound_tests, self.outputs, self.replays_by_stage)
 
 
 @dataclass(frozen=True)
@@ -162,6 +169,7 @@ class Diagnosis:
     # where each confounded candidate would show, by name (stages/confound.py; empty where the settings say not)
     confound_tests: Mapping[str, dict | None] = field(default_factory=frozen_mapping)
     outputs: Mapping[str, object] = field(default_factory=frozen_mapping)  # what added stages keep, by name
+    replays_by_stage: Mapping[str, int] = field(default_factory=frozen_mapping)  # replays run when each stage ended
 
     @property
     def effect(self) -> str | None:

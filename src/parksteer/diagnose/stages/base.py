@@ -31,14 +31,15 @@ class Stage:
 
 
 def run_table(state: DiagnosisState) -> DiagnosisState:
-    """Run the state's table of stages in order, each on the state the one before returned, timing each."""
+    """Run the state's table of stages in order, each on the state the one before returned, timing each and
+    counting the replays run by its end."""
     for stage in state.table:
         clock = time.perf_counter()
         line = stage.message(state)
         if line is not None:
             state.progress(line)
         state = stage.run(state)
-        state = state.with_timing(stage.name, time.perf_counter() - clock)
+        state = state.with_cost(stage.name, time.perf_counter() - clock)
     return state
 
 
