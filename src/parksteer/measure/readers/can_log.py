@@ -33,8 +33,11 @@ What a bus does to data is checked frame by frame, each finding a note on stderr
 
 from __future__ import annotations
 
+import gc
 import io
+import logging
 import re
+import sys
 import tomllib
 from collections import Counter
 from dataclasses import dataclass, field
@@ -203,6 +206,16 @@ def read_frames(raw: bytes, where: Path, fmt: str):
         raise UsageError(f"{where}: a raw CAN log; reading it needs the optional extra: pip install 'parksteer[bus]'") \
             from None
     times, ids, data, errors = [], [], [], 0
+    if fmt == "blf" and len(raw) >= 24:
+        # The file header states the file's size (uint64 at byte 16); python-can stops quietly at a cut
+        stated = int.from_bytes(raw[16:24], "little")
+        if stated > len(raw):
+            raise UsageError(f"{where}: the Vector BLF is cut short: {len(raw)} of the {stated} bytes its header "
+                             "states; copy the whole file from the logger")
+    # asammdf logs a damaged file's tracebacks and its half-built reader's finaliser fails: both silenced here
+    quiet = logging.getLogger("asammdf"), sys.unraisablehook
+    quiet[0].disabled, sys.unraisablehook = True, (lambda report: None)
+    problem = None
     try:
         if fmt == "blf":
             reader = blf.BLFReader(io.BytesIO(raw))
@@ -226,10 +239,17 @@ def read_frames(raw: bytes, where: Path, fmt: str):
         raise
     except Exception as exc:  # the readers raise many types for a damaged file; the user needs the gist
         problem = re.sub(r"<_io\.\w+ object at 0x[0-9a-f]+>", "it", f"{type(exc).__name__}: {exc}").splitlines()
+        problem = problem[0][:160] if problem else type(exc).__name__
+    finally:
+        reader = None
+    try:
+        gc.collect()  # the exception and its traceback are gone: a half-built reader is collected now, quietly
+    finally:
+        quiet[0].disabled, sys.unraisablehook = False, quiet[1]
+    if problem is not None:
         got = f" after {len(times)} frames" if times else ""
-        raise UsageError(f"{where}: cannot read as {FORMAT_NAMES[fmt]}{got} "
-                         f"({problem[0][:160] if problem else type(exc).__name__}); the file is damaged or cut short") \
-            from None
+        raise UsageError(f"{where}: cannot read as {FORMAT_NAMES[fmt]}{got} ({problem}); the file is damaged or "
+                         "cut short")
     if not times:
         raise UsageError(f"{where}: the {FORMAT_NAMES[fmt]} holds no CAN data frame")
     return np.asarray(times, dtype=float), np.asarray(ids, dtype=np.int64), data, errors
