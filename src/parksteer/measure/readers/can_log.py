@@ -333,7 +333,10 @@ def read_bus_log(raw: bytes, where: Path, channels) -> Record:
         raise UsageError(f"{where}: frame {k + 1} (id 0x{ids[k]:03X}) is stamped {times[k] - times[0]:.6f} s, before "
                          f"the frame ahead of it ({times[k - 1] - times[0]:.6f} s): the logger's clock jumped; cut "
                          "the log there or merge its parts in time order")
+    # Times from the first frame, to the microsecond: the resolution of candump and ASC, and what undoes the
+    # rounding of absolute (epoch) time stamps in a float (2.4e-7 s at 1.7e9 s)
     t0 = times[0]
+    times = t0 + np.round(times - t0, 6)
     if error_frames:
         notes.append(f"{error_frames} error frames on the bus")
     # Silences of the whole bus: longer than MAX_GAP_S with no frame of any id.
@@ -351,7 +354,7 @@ def read_bus_log(raw: bytes, where: Path, channels) -> Record:
         if not mask.any():
             raise UsageError(f"{where}: no frame of {name} (id {msg.frame_id} = 0x{msg.frame_id:03X}) in the log, "
                              f"which holds {_listing(ids)}: a log of another bus, or not this car's DBC")
-        t = times[mask] - t0
+        t = np.round(times[mask] - t0, 6)
         frames = [data[k] for k in np.nonzero(mask)[0]]
         keep = np.ones(len(t), dtype=bool)
         # exact duplicates: the same time stamp and data as the frame before
