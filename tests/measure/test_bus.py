@@ -192,3 +192,74 @@ def test_diagnosis_of_the_bus_log_is_the_diagnosis_of_the_record(tmp_path, hidde
     assert b["noise_floor_Nm"] == pytest.approx(q["noise_floor_Nm"], rel=1e-3)
     cq, cb = q["statistics"]["calibrated"], b["statistics"]["calibrated"]
     assert cb["weighted_rms_Nm"] == pytest.approx(cq["weighted_rms_Nm"], rel=1e-3)
+
+
+def test_map_options_parse_and_print_back():
+    """';sign=' and ';scale=' after a bus signal's target: parsed, printed back by spec() as given, and a wrong
+    option or a zero scale refused in one line naming the entry."""
+    from parksteer.errors import UsageError
+    from parksteer.measure.importers import parse_channel_map
+
+    (ch,) = parse_channel_map("LH_EPS_03.EPS_Lenkmoment[cN*m]=-handwheel_torque_Nm;sign=LH_EPS_03.EPS_VZ_Lenkmoment")
+    assert (ch.source, ch.unit, ch.negate, ch.sign, ch.scale) == (
+        "LH_EPS_03.EPS_Lenkmoment", "cN*m", True, "LH_EPS_03.EPS_VZ_Lenkmoment", None)
+    assert ch.spec() == "LH_EPS_03.EPS_Lenkmoment[cN*m]=-handwheel_torque_Nm;sign=LH_EPS_03.EPS_VZ_Lenkmoment"
+    (ch,) = parse_channel_map("S.T[N*m]=handwheel_torque_Nm;scale=0.0125")
+    assert ch.scale == 0.0125 and ch.spec().endswith(";scale=0.0125")
+    with pytest.raises(UsageError, match="scale=0 is not a finite non-zero number"):
+        parse_channel_map("S.T=handwheel_torque_Nm;scale=0")
+    with pytest.raises(UsageError, match="option 'sing=S.V' is neither"):
+        parse_channel_map("S.T=handwheel_torque_Nm;sing=S.V")
+
+
+TOYOTA_LIKE_DBC = '''VERSION ""
+
+NS_ :
+
+BS_:
+
+BU_: XXX
+
+BO_ 608 STEER_TORQUE_SENSOR: 8 XXX
+ SG_ STEER_TORQUE_EPS : 47|16@0- (1,0) [-32768|32767] "" XXX
+ SG_ STEER_TORQUE_DRIVER : 15|16@0- (1,0) [-32768|32767] "" XXX
+ SG_ STEER_ANGLE : 31|16@0- (0.0573,0) [-500|500] "" XXX
+ SG_ STEER_OVERRIDE : 0|1@0+ (1,0) [0|1] "" XXX
+ SG_ CHECKSUM : 63|8@0+ (1,0) [0|255] "" XXX
+'''
+
+
+def test_a_raw_count_with_a_scale_from_a_dbc_given_alone(tmp_path):
+    """Toyota's STEER_TORQUE_SENSOR layout (big-endian signed 16-bit raw counts, opendbc's toyota DBC): with
+    --dbc and 'scale=' a count of -321 at scale 0.01 N m reads -3.21 N m, the angle's 0.0573 deg factor is the
+    DBC's; with no algorithm known the checksum is said to be unchecked; the resolution is one count times the
+    scale."""
+    import cantools
+
+    dbc_path = tmp_path / "toyota_like.dbc"
+    dbc_path.write_text(TOYOTA_LIKE_DBC, encoding="utf-8")
+    message = cantools.database.load_file(str(dbc_path)).get_message_by_name("STEER_TORQUE_SENSOR")
+    rows = [(0.01 * k, 608, message.encode({"STEER_TORQUE_EPS": 0, "STEER_TORQUE_DRIVER": -321, "STEER_ANGLE": 1000,
+                                              "STEER_OVERRIDE": 0, "CHECKSUM": 0}, scaling=False)) for k in range(20)]
+    path = tmp_path / "toyota.log"
+    path.write_text(_log_text(rows), encoding="utf-8")
+    channels = bus_channel_map(None, str(dbc_path), "STEER_TORQUE_SENSOR.STEER_TORQUE_DRIVER[N*m]="
+                               "handwheel_torque_Nm;scale=0.01,STEER_TORQUE_SENSOR.STEER_ANGLE[deg]=handwheel_angle_rad",
+                               None)
+    record = read_bus_log(path.read_bytes(), path, channels)
+    torque, angle = record.sources
+    assert np.allclose(torque.values, -3.21) and torque.step == pytest.approx(0.01)
+    assert np.allclose(angle.values, 57.3) and angle.step == pytest.approx(0.0573)
+    assert "STEER_TORQUE_SENSOR checksum not checked" in record.metadata["bus_checks"]
+
+
+def test_a_bus_log_drives_the_rack_of_a_simulation(tmp_path):
+    """`simulate --rack-from` takes a bus log as compare does: the rack derived from the decoded angle and
+    torque drives the model (an entry point beside compare and diagnose)."""
+    record = _record()
+    channels = bus_channel_map("vw_mqb", None, None, None)
+    log = write_log(encode_frames(record, channels), tmp_path / "run.log", "candump")
+    out = tmp_path / "sim.csv"
+    assert main(["simulate", "--rack-from", str(log), "--bus", "vw_mqb", "--case", "unladen", "--surface", "ground",
+                 "--out", str(out)]) == 0
+    assert out.is_file()
