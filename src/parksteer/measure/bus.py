@@ -7,8 +7,8 @@ split into magnitude and sign flag where the map names a sign signal, converted 
 the map's scale and quantised to the nearest raw count of the DBC (``round((value - offset) / factor)``, clipped
 to the signal's bits: a torque beyond 1023 cN m reads back as saturated). Each message is sent at its nominal
 rate (the bus file's ``rates_hz``), with its counter running and its checksum where the bus file names the
-algorithm, at the record's instants shifted by a fixed phase per message (messages of a real bus are not sent
-together). A column the record lacks (speed in a parking test) is sent as 0.
+algorithm; the torque's message at the record's instants, the others optionally shifted by a fixed phase each (the
+messages of a real bus are not sent together). A column the record lacks (speed in a parking test) is sent as 0.
 """
 
 from __future__ import annotations
@@ -60,8 +60,9 @@ def _signal_values(ch: Channel, values: np.ndarray, message, name: str) -> dict[
 
 def encode_frames(record: Measurement, channels: BusMap, t0: float = 1_700_000_000.0, phase_s: float = 0.0):
     """The frames (python-can Messages, in time order) a car would send for `record` on the bus of `channels`:
-    each message from the record's first instant at its rate, the n-th message in name order `n phase_s` later
-    (0: the messages together, so a record at a message's rate is sent at its own instants)."""
+    each message from the record's first instant at its rate, the torque's message first, the n-th after it
+    `n phase_s` later in name order (0: the messages together, so a record at a message's rate is sent at its own
+    instants)."""
     import can
 
     bus: BusSpec = channels.bus
@@ -71,7 +72,11 @@ def encode_frames(record: Measurement, channels: BusMap, t0: float = 1_700_000_0
     for ch in channels:
         by_message.setdefault(ch.source.partition(".")[0], []).append(ch)
     frames = []
-    for phase, (name, chs) in enumerate(sorted(by_message.items())):
+    # The torque's message first: at the record's own instants, so its samples are sent as they are (resampled,
+    # a noisy record would have its noise averaged by the interpolation)
+    order = sorted(by_message.items(), key=lambda item: (all(c.target != "handwheel_torque_Nm" for c in item[1]),
+                                                         item[0]))
+    for phase, (name, chs) in enumerate(order):
         message = dbc.get_message_by_name(name)
         rate = bus.rates_hz.get(name)
         if rate is None:

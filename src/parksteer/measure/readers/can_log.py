@@ -489,8 +489,8 @@ def read_bus_log(raw: bytes, where: Path, channels) -> Record:
     text = f"the frames of {base.message} ({1.0 / periods[base.message]:.4g} Hz)"
     if others:
         text += "; " + ", ".join(f"{m} ({1.0 / periods[m]:.4g} Hz)" for m in others) + (
-            " interpolated linearly onto them, each value from frames at most half the period away (" +
-            ", ".join(f"{0.5 * periods[m] * 1000:.3g} ms" for m in others) + ")")
+            " interpolated linearly onto them, each value from frames at most half its period away, the most lag "
+            "this adds (" + ", ".join(f"{0.5 * periods[m] * 1000:.3g} ms" for m in others) + ")")
     metadata = {"format": FORMAT_NAMES[fmt], "bus": bus.name, "dbc": bus.dbc.name, "bus_time_base": text,
                 "bus_checks": "; ".join(checks)}
     if notes:
