@@ -19,11 +19,11 @@ Run:
     PYTHONPATH=src python benchmarks/bench_bus_roundtrip.py [out.json]
 
 Measured (2-core development machine, about 4 minutes): 18 of 18 verdicts and effects the CSV's; decoding within
-0.500 counts of torque and angle with the frames together, 0.58 with the messages 3 ms apart; largest change of
-the floor or calibrated error 7.2 % (null), 3.6 % (column friction), 25 % (Polo VI, whose 2e-4 rad angle noise is
-a ninth of the 0.1 deg step); with the messages 3 ms apart the noise floor falls by 45 to 47 % (the interpolated
-angle's noise averaged). Every record, CSV and log alike, is 'unexplained': an angle-only record (no rack on the
-MQB bus) of a null is not called adequate by the diagnosis, though the same record with its rack is.
+0.500 counts of torque and angle with the frames together, 0.69 (the interpolated angle) with the messages 3 ms
+apart; largest change of the floor or calibrated error 7.2 % (null), 3.6 % (column friction), 25 % (Polo VI, whose
+2e-4 rad angle noise is a ninth of the 0.1 deg step), 3.1, 3.8 and 25 % with the messages apart. Every record, CSV
+and log alike, is 'unexplained': an angle-only record (no rack on the MQB bus) of a null is not called adequate by
+the diagnosis, though the same record with its rack is.
 """
 
 from __future__ import annotations
