@@ -251,6 +251,7 @@ def test_a_raw_count_with_a_scale_from_a_dbc_given_alone(tmp_path):
     assert np.allclose(torque.values, -3.21) and torque.step == pytest.approx(0.01)
     assert np.allclose(angle.values, 57.3) and angle.step == pytest.approx(0.0573)
     assert "STEER_TORQUE_SENSOR checksum not checked" in record.metadata["bus_checks"]
+    assert any("checksum CHECKSUM not checked (no algorithm known for toyota_like.dbc" in n for n in record.notes)
 
 
 def test_a_bus_log_drives_the_rack_of_a_simulation(tmp_path):

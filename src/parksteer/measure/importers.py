@@ -460,7 +460,7 @@ def load_record(path: str | Path, channel_map: str | list[Channel] | None = None
                 surface: str | None = None, params: Parameters | None = None, *,
                 required: tuple[str, ...] = REQUIRED_COLUMNS) -> Measurement:
     """Read a measurement (any format of :data:`parksteer.measure.readers.READERS`: native CSV, logger CSV, ASAM
-    MDF) into native SI columns on one time base.
+    MDF, and a raw CAN log when `channel_map` carries its bus) into native SI columns on one time base.
 
     channel_map: a map spec (``"RackPos[mm]=rack_m,..."``) or parsed channels; without one, native column names
     and, when unambiguous, known aliases map the channels. case, surface: fill what the file does not state.

@@ -383,6 +383,9 @@ def read_bus_log(raw: bytes, where: Path, channels) -> Record:
             checks.append(f"{name} checksum {bus.checksum} checked")
         else:
             checks.append(f"{name} checksum not checked (no algorithm known for it)")
+            if crc is not None:
+                notes.append(f"{name}: checksum {crc.name} not checked (no algorithm known for {bus.dbc.name}; "
+                             "a bus file of parksteer/data/buses names one)")
         # decoding
         values: dict[str, list] = {s.name: [] for s in msg.signals}
         undecodable = np.zeros(len(t), dtype=bool)
