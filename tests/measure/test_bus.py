@@ -264,3 +264,26 @@ def test_a_bus_log_drives_the_rack_of_a_simulation(tmp_path):
     assert main(["simulate", "--rack-from", str(log), "--bus", "vw_mqb", "--case", "unladen", "--surface", "ground",
                  "--out", str(out)]) == 0
     assert out.is_file()
+
+
+def test_a_log_of_two_buses_is_read_from_the_channel_with_the_message(tmp_path):
+    """candump -l any writes every bus into one file; a gateway forwards LH_EPS_03 to the second bus with its own
+    delay. The message is read from the channel with most of its frames, and a note says so (two interleaved
+    copies would read as counters going back and forth)."""
+    record = _record()
+    channels = bus_channel_map("vw_mqb", None, None, None)
+    frames = encode_frames(record, channels)
+    import can
+
+    forwarded = [can.Message(timestamp=f.timestamp + 0.0004, arbitration_id=f.arbitration_id, data=f.data,
+                             is_extended_id=False, channel="can1") for f in frames[::2] if f.arbitration_id == 159]
+    for f in frames:
+        f.channel = "can0"
+    both = sorted(frames + forwarded, key=lambda f: f.timestamp)
+    log = write_log(both, tmp_path / "any.log", "candump")
+    decoded = load_record(log, channels, case="unladen", surface="ground")
+    assert "LH_EPS_03 is on channels can0" in decoded.metadata["bus_findings"]
+    assert "read from can0" in decoded.metadata["bus_findings"]
+    assert "jumps" not in decoded.metadata["bus_findings"]
+    assert np.abs(decoded.columns["handwheel_torque_Nm"] - record.columns["handwheel_torque_Nm"][: decoded.n_samples]
+                  ).max() <= 0.005 + 1e-9

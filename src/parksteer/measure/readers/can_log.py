@@ -198,14 +198,14 @@ CHECKSUMS = {"autosar_e2e_p2": e2e_p2_checksum}
 # ------------------------------------------------------------------------------------------------ frames
 
 def read_frames(raw: bytes, where: Path, fmt: str):
-    """(time stamps, ids, data, error frame count) of every data frame of the log, in file order."""
+    """(time stamps, ids, data, channels, error frame count) of every data frame of the log, in file order."""
     try:
         import can  # noqa: F401
         from can.io import asc, blf, canutils, trc
     except ImportError:
         raise UsageError(f"{where}: a raw CAN log; reading it needs the optional extra: pip install 'parksteer[bus]'") \
             from None
-    times, ids, data, errors = [], [], [], 0
+    times, ids, data, channels, errors = [], [], [], [], 0
     if fmt == "blf" and len(raw) >= 24:
         # The file header states the file's size (uint64 at byte 16); python-can stops quietly at a cut
         stated = int.from_bytes(raw[16:24], "little")
@@ -235,6 +235,7 @@ def read_frames(raw: bytes, where: Path, fmt: str):
             times.append(message.timestamp)
             ids.append(message.arbitration_id)
             data.append(bytes(message.data))
+            channels.append(str(message.channel))
     except UsageError:
         raise
     except Exception as exc:  # the readers raise many types for a damaged file; the user needs the gist
@@ -252,7 +253,7 @@ def read_frames(raw: bytes, where: Path, fmt: str):
                          "cut short")
     if not times:
         raise UsageError(f"{where}: the {FORMAT_NAMES[fmt]} holds no CAN data frame")
-    return np.asarray(times, dtype=float), np.asarray(ids, dtype=np.int64), data, errors
+    return np.asarray(times, dtype=float), np.asarray(ids, dtype=np.int64), data, np.asarray(channels), errors
 
 
 def _listing(ids: np.ndarray, count: int = 5) -> str:
@@ -324,7 +325,7 @@ def read_bus_log(raw: bytes, where: Path, channels) -> Record:
         message, signal = _split_signal(ch.source, where, dbc, bus.dbc, "channel")
         sign = _split_signal(ch.sign, where, dbc, bus.dbc, "sign") if ch.sign else None
         signals.append(_Signal(message, signal, sign, ch.scale if ch.scale is not None else 1.0, ch.source))
-    times, ids, data, error_frames = read_frames(raw, where, fmt)
+    times, ids, data, buses, error_frames = read_frames(raw, where, fmt)
     notes: list[str] = []
     checks: list[str] = []
     steps = np.diff(times)
@@ -354,6 +355,14 @@ def read_bus_log(raw: bytes, where: Path, channels) -> Record:
         if not mask.any():
             raise UsageError(f"{where}: no frame of {name} (id {msg.frame_id} = 0x{msg.frame_id:03X}) in the log, "
                              f"which holds {_listing(ids)}: a log of another bus, or not this car's DBC")
+        # A log of two buses (candump -l any, a logger's two channels) may hold a message on both, as a gateway
+        # forwards it: the channel with the most of its frames is read
+        on = Counter(buses[mask].tolist())
+        if len(on) > 1:
+            chosen, count = on.most_common(1)[0]
+            notes.append(f"{name} is on channels {', '.join(f'{c} ({n} frames)' for c, n in on.most_common())}: "
+                         f"read from {chosen}")
+            mask &= buses == chosen
         t = np.round(times[mask] - t0, 6)
         frames = [data[k] for k in np.nonzero(mask)[0]]
         keep = np.ones(len(t), dtype=bool)
