@@ -46,9 +46,10 @@ from ..tables import atomic_path, format_number
 
 REQUIRED_COLUMNS = ("time_s", "rack_m", "handwheel_torque_Nm")
 OPTIONAL_COLUMNS = ("handwheel_angle_rad", "load_left_N", "load_right_N")
-# The car's speed (a bus log's wheel-speed signal): 0 in a standstill parking test.
-OPTIONAL_COLUMNS += ("vehicle_speed_mps",)
-ALLOWED_COLUMNS = REQUIRED_COLUMNS + OPTIONAL_COLUMNS
+# The car's speed (a CAN log's speed signal; 0 in a standstill parking test): a column of measured records only,
+# kept out of OPTIONAL_COLUMNS, which the synthetic records take as the model's recorded channels.
+MEASURED_ONLY_COLUMNS = ("vehicle_speed_mps",)
+ALLOWED_COLUMNS = REQUIRED_COLUMNS + OPTIONAL_COLUMNS + MEASURED_ONLY_COLUMNS
 UNITS = {
     "time_s": "s",
     "rack_m": "m",
