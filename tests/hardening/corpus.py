@@ -590,6 +590,108 @@ def mdf_cases() -> list[Case]:
     ]
 
 
+# ------------------------------------------------------------------------------------------------ CAN bus logs
+
+def _bus_frames(torque_factor: float = 0.5):
+    """The example record's torque (times `torque_factor`, so that it fits the 10.23 N m of LH_EPS_03) and angle
+    as the frames of a VW MQB car (parksteer.measure.bus.encode_frames), and the bus map."""
+    from parksteer.measure.bus import bus_channel_map, encode_frames
+    from parksteer.measure.io import Measurement
+
+    _, h, d = base_record(step=1)
+    columns = {"time_s": d[:, h.index("time_s")], "handwheel_torque_Nm": torque_factor * d[:, h.index("handwheel_torque_Nm")],
+               "handwheel_angle_rad": d[:, h.index("handwheel_angle_rad")]}
+    channels = bus_channel_map("vw_mqb", None, None, None)
+    return encode_frames(Measurement(None, columns), channels), channels
+
+
+def _reframe(frame, data: bytes | None = None, timestamp: float | None = None, arbitration_id: int | None = None):
+    import can
+
+    return can.Message(timestamp=frame.timestamp if timestamp is None else timestamp,
+                       arbitration_id=frame.arbitration_id if arbitration_id is None else arbitration_id,
+                       data=frame.data if data is None else data, is_extended_id=False, channel=0)
+
+
+def _with_crc(data: bytearray, frame_id: int) -> bytes:
+    from parksteer.measure.readers.can_log import e2e_p2_checksum, load_bus
+
+    data[0] = e2e_p2_checksum(bytes(data), load_bus("vw_mqb").data_ids[frame_id])
+    return bytes(data)
+
+
+def _bus_log(folder: Path, fault: str = "", fmt: str = "candump", torque_factor: float = 0.5) -> Path:
+    """A VW MQB bus log of the example record with one fault of a real bus."""
+    from parksteer.measure.bus import WRITERS, write_log
+
+    frames, channels = _bus_frames(torque_factor)
+    start = frames[0].timestamp
+    at = [f.timestamp - start for f in frames]
+    if fault == "other_bus":  # every id moved: a log of another bus
+        frames = [_reframe(f, arbitration_id=f.arbitration_id + 0x300) for f in frames]
+    elif fault == "clock_back":
+        k = len(frames) // 2
+        frames[k] = _reframe(frames[k], timestamp=frames[k - 5].timestamp)
+    elif fault == "torque_gap":  # 0.3 s of LH_EPS_03 lost while the rest of the bus goes on
+        frames = [f for f, t in zip(frames, at) if not (f.arbitration_id == 159 and 5.0 < t < 5.3)]
+    elif fault == "bus_off":  # 0.3 s without any frame
+        frames = [f for t, f in zip(at, frames) if not 5.0 < t < 5.3]
+    elif fault == "checksum":  # every LWI_01 frame's checksum wrong
+        frames = [_reframe(f, data=bytes([f.data[0] ^ 0x55]) + bytes(f.data[1:])) if f.arbitration_id == 134 else f
+                  for f in frames]
+    elif fault == "qbit":  # the torque sensor's quality bit set in every frame (a substitute value)
+        frames = [_reframe(f, data=_with_crc(bytearray(f.data[:6]) + bytes([f.data[6] | 0x40]) + f.data[7:], 159))
+                  if f.arbitration_id == 159 else f for f in frames]
+    elif fault == "dropped":  # a few frames lost, one duplicated, one with a bad checksum: noted, accepted
+        frames = [f for k, f in enumerate(frames) if k not in (300, 301, 900)]
+        frames.insert(500, frames[499])
+        frames[700] = _reframe(frames[700], data=bytes([frames[700].data[0] ^ 1]) + bytes(frames[700].data[1:]))
+    path = write_log(frames, folder / f"run{WRITERS[fmt]}", fmt, channels.bus.dbc)
+    if fault == "truncated":
+        raw = path.read_bytes()
+        path.write_bytes(raw[: len(raw) // 2])
+    return path
+
+
+def bus_cases() -> list[Case]:
+    """Raw CAN logs of a VW MQB car (the example record's angle and half its torque, encoded with
+    parksteer.measure.bus): read in each format, and each fault of a bus with its one line."""
+    fill = ["--case", "unladen", "--surface", "ground"]
+    svg = ("out.svg",)
+
+    def argv(path: Path, f: Path, *extra: str) -> list[str]:
+        return ["compare", str(path), *fill, *extra, "--plot", str(f / "out.svg")]
+
+    def bus(fault: str = "", fmt: str = "candump", **kw):
+        return lambda f: argv(_bus_log(f, fault, fmt, **kw), f, "--bus", "vw_mqb")
+
+    return [
+        Case("compare:bus_candump", "compare", bus(), ACCEPTED),
+        Case("compare:bus_blf_dropped_frames", "compare", bus("dropped", "blf"), ACCEPTED),
+        Case("compare:bus_without_dbc", "compare", lambda f: argv(_bus_log(f), f), "decoding it needs the car's DBC",
+             svg),
+        Case("compare:bus_unknown", "compare",
+             lambda f: argv(_bus_log(f), f, "--bus", "vw_nope"), "--bus vw_nope: no such bus (known: vw_mqb)", svg),
+        Case("compare:bus_csv_given_a_dbc", "compare",
+             lambda f: argv(_write(f, "r.csv", record_text()), f, "--bus", "vw_mqb"), "not a CAN log", svg),
+        Case("compare:bus_map_unknown_signal", "compare",
+             lambda f: argv(_bus_log(f), f, "--bus", "vw_mqb", "--map", "LH_EPS_03.EPS_Moment[N*m]=handwheel_torque_Nm"),
+             "message LH_EPS_03 has no signal 'EPS_Moment'", svg),
+        Case("compare:bus_other_bus", "compare", bus("other_bus"),
+             "no frame of LH_EPS_03 (id 159 = 0x09F) in the log, which holds 0x", svg),
+        Case("compare:bus_clock_back", "compare", bus("clock_back", "asc"), "the logger's clock jumped", svg),
+        Case("compare:bus_torque_gap", "compare", bus("torque_gap", "trc"), "frames of this one lost", svg),
+        Case("compare:bus_off", "compare", bus("bus_off"), "bus off or a logger pause", svg),
+        Case("compare:bus_checksum", "compare", bus("checksum"), "LWI_01: the checksum fails in", svg),
+        Case("compare:bus_quality_bit", "compare", bus("qbit"), "quality bit EPS_Lenkmoment_QBit set", svg),
+        Case("compare:bus_torque_saturated", "compare", bus(torque_factor=1.0),
+             "LH_EPS_03.EPS_Lenkmoment sits at its largest raw value 1023", svg),
+        Case("compare:bus_blf_truncated", "compare", bus("truncated", "blf"), "the Vector BLF is cut short", svg),
+        Case("compare:bus_mf4_truncated", "compare", bus("truncated", "mf4"),
+             "cannot read as ASAM MDF4 bus logging", svg),
+    ]
+
+
 def all_cases() -> list[Case]:
     return (record_cases() + odd_record_cases() + parameter_cases() + checksum_cases() + finding_cases()
-            + map_cases() + vehicle_cases() + diagnose_option_cases() + mdf_cases())
+            + map_cases() + vehicle_cases() + diagnose_option_cases() + mdf_cases() + bus_cases())

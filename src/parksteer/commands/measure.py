@@ -14,7 +14,8 @@ from .vehicle import add_vehicle_option, parameters_of
 
 def _common(p) -> None:
     p.add_argument("files", nargs="+", metavar="FILE",
-                   help="measurement files: native CSV (data/measurements/README.md), a logger's CSV or ASAM MDF")
+                   help="measurement files: native CSV (data/measurements/README.md), a logger's CSV, ASAM MDF or a raw CAN "
+                        "log with --bus/--dbc")
     p.add_argument("--case", default=None, help="Table B1 case for every file (default: each file's own)")
     p.add_argument("--surface", choices=("ground", "air_bearing"), default=None,
                    help="the surface of files that do not state one")
@@ -35,12 +36,24 @@ def add_import_options(p) -> None:
                         "SWA[deg]=handwheel_angle_rad' (units converted with pint; '=-column' negates a channel)")
     p.add_argument("--map-file", default=None, metavar="MAP.txt",
                    help="the same channel map in a file, one 'SRC[unit]=COLUMN' per line, '#' comments")
+    # A raw CAN log (candump, ASC, BLF, TRC, MDF4 bus logging): the DBC and its signals (docs/bus.md)
+    p.add_argument("--bus", default=None, metavar="NAME",
+                   help="a car's bus: its DBC and ready channel map (parksteer/data/buses/NAME.toml, e.g. vw_mqb); "
+                        "--map entries replace the ready map's for their column")
+    p.add_argument("--dbc", default=None, metavar="CAR.dbc",
+                   help="decode a raw CAN log with this DBC; --map names the signals, e.g. "
+                        "'LH_EPS_03.EPS_Lenkmoment[cN*m]=-handwheel_torque_Nm;sign=LH_EPS_03.EPS_VZ_Lenkmoment'")
 
 
 def channel_map_of(args):
-    """The channel map of --map and --map-file (None when neither is given)."""
+    """The channel map of --map and --map-file (None when neither is given); with --bus or --dbc, one that carries
+    the bus its signals are decoded with."""
     from ..measure.importers import channel_map_from_options
 
+    if getattr(args, "bus", None) is not None or getattr(args, "dbc", None) is not None:
+        from ..measure.bus import bus_channel_map
+
+        return bus_channel_map(args.bus, args.dbc, args.map, args.map_file)
     return channel_map_from_options(args.map, args.map_file)
 
 

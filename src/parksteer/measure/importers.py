@@ -17,6 +17,13 @@ Channel map syntax (``--map`` or one entry per line in a map file)::
 
 A unit in brackets is the source channel's unit; a leading minus on the target negates the channel (a logger with
 the opposite sign convention). A target without a source unit is taken in its own SI unit (``rack_m``: metres).
+
+A signal of a raw CAN log (``--dbc CAR.dbc`` or ``--bus NAME``, :mod:`parksteer.measure.readers.can_log`) is
+named ``MESSAGE.SIGNAL``, and its entry may end in options after semicolons: ``sign=MESSAGE.SIGNAL`` (the value
+is a magnitude whose sign is that flag signal: set means negative) and ``scale=FACTOR`` (the decoded value, a raw
+count where the DBC gives no factor, times FACTOR, before the unit)::
+
+    LH_EPS_03.EPS_Lenkmoment[cN*m]=-handwheel_torque_Nm;sign=LH_EPS_03.EPS_VZ_Lenkmoment
 """
 
 from __future__ import annotations
@@ -33,17 +40,19 @@ from .. import portable as pm
 from ..errors import UsageError
 from ..geometry import rack_from_handwheel
 from ..parameters import Parameters, load_parameters
-from .io import ALLOWED_COLUMNS, REQUIRED_COLUMNS, UNITS, Measurement, validate_record
+from .io import ALLOWED_COLUMNS, REQUIRED_COLUMNS, UNITS, Measurement, metadata_text, validate_record
 from .readers import Record, Source, reader_for
 from .readers.base import TIME_ALIASES, name_and_unit, normal_name
+from .readers.can_log import read_bus_log
 
 RACK, TORQUE, ANGLE, TIME = "rack_m", "handwheel_torque_Nm", "handwheel_angle_rad", "time_s"
 RACK_DRIVE_COLUMNS = (TIME, RACK)
 
 # The pint unit each native column is converted to.
-SI_UNITS = {TIME: "s", RACK: "m", TORQUE: "N*m", ANGLE: "rad", "load_left_N": "N", "load_right_N": "N"}
+SI_UNITS = {TIME: "s", RACK: "m", TORQUE: "N*m", ANGLE: "rad", "load_left_N": "N", "load_right_N": "N",
+            "vehicle_speed_mps": "m/s"}
 UNIT_DIMENSIONS = {TIME: "time", RACK: "length", TORQUE: "torque", ANGLE: "angle", "load_left_N": "force",
-                   "load_right_N": "force"}
+                   "load_right_N": "force", "vehicle_speed_mps": "speed"}
 
 # Logger spellings pint reads as something else: "Nm" is pint's number-metre, never a torque on a logger.
 UNIT_SPELLINGS = {"Nm": "N*m", "rev": "revolution", "Nmm": "N*mm", "kNm": "kN*m", "deg.": "deg", "sec": "s", "kph": "km/h"}
@@ -95,11 +104,14 @@ class Channel:
     target: str
     negate: bool = False
     origin: str = "--map"
+    sign: str | None = None  # a bus log's flag signal holding the sign of this magnitude (set: negative)
+    scale: float | None = None  # a bus log's signal times this factor before the unit (a raw count's scale)
 
     def spec(self, negate: bool | None = None) -> str:
         negate = self.negate if negate is None else negate
         unit = f"[{self.unit}]" if self.unit else ""
-        return f"{self.source}{unit}={'-' if negate else ''}{self.target}"
+        options = (f";sign={self.sign}" if self.sign else "") + (f";scale={self.scale:g}" if self.scale else "")
+        return f"{self.source}{unit}={'-' if negate else ''}{self.target}{options}"
 
 
 def _split_entries(text: str) -> list[str]:
@@ -122,7 +134,8 @@ def parse_channel_map(text: str, origin: str = "--map") -> list[Channel]:
     channels: list[Channel] = []
     for entry in _split_entries(text):
         source_text, eq, target = entry.partition("=")
-        target = target.strip()
+        target, *options = [part.strip() for part in target.split(";")]
+        sign, scale = _bus_options(options, entry, origin)
         negate = target.startswith("-")
         target = target.lstrip("-").strip()
         source, unit = name_and_unit(source_text)
@@ -135,10 +148,30 @@ def parse_channel_map(text: str, origin: str = "--map") -> list[Channel]:
                 raise UsageError(f"{origin}: entries {other.spec()!r} and {entry!r} both map to {target!r}")
             if other.source == source:
                 raise UsageError(f"{origin}: channel {source!r} is mapped twice")
-        channels.append(Channel(source, unit or None, target, negate, origin))
+        channels.append(Channel(source, unit or None, target, negate, origin, sign, scale))
     if not channels:
         raise UsageError(f"{origin}: empty channel map")
     return channels
+
+
+def _bus_options(options: list[str], entry: str, origin: str) -> tuple[str | None, float | None]:
+    """The ';sign=MESSAGE.SIGNAL' and ';scale=FACTOR' options of a bus signal's map entry."""
+    sign = scale = None
+    for option in options:
+        key, eq, value = (part.strip() for part in option.partition("="))
+        if key == "sign" and eq and value:
+            sign = value
+        elif key == "scale" and eq:
+            try:
+                scale = float(value)
+            except ValueError:
+                scale = math.nan
+            if not math.isfinite(scale) or scale == 0.0:
+                raise UsageError(f"{origin}: entry {entry!r}: scale={value} is not a finite non-zero number")
+        else:
+            raise UsageError(f"{origin}: entry {entry!r}: option {option!r} is neither 'sign=MESSAGE.SIGNAL' nor "
+                             "'scale=FACTOR'")
+    return sign, scale
 
 
 def read_channel_map(path: str | Path) -> list[Channel]:
@@ -427,7 +460,7 @@ def load_record(path: str | Path, channel_map: str | list[Channel] | None = None
                 surface: str | None = None, params: Parameters | None = None, *,
                 required: tuple[str, ...] = REQUIRED_COLUMNS) -> Measurement:
     """Read a measurement (any format of :data:`parksteer.measure.readers.READERS`: native CSV, logger CSV, ASAM
-    MDF) into native SI columns on one time base.
+    MDF, and a raw CAN log when `channel_map` carries its bus) into native SI columns on one time base.
 
     channel_map: a map spec (``"RackPos[mm]=rack_m,..."``) or parsed channels; without one, native column names
     and, when unambiguous, known aliases map the channels. case, surface: fill what the file does not state.
@@ -441,9 +474,17 @@ def load_record(path: str | Path, channel_map: str | list[Channel] | None = None
     if isinstance(channel_map, str):
         channel_map = parse_channel_map(channel_map)
     raw = read_record_bytes(path)
-    record = reader_for(raw).read(raw, path)
+    # A raw CAN log is decoded with the DBC its channel map carries (--dbc, --bus); sign= and scale= are its own.
+    if getattr(channel_map, "bus", None) is not None:
+        record = read_bus_log(raw, path, channel_map)
+    else:
+        bus_only = next((ch for ch in channel_map or [] if ch.sign or ch.scale), None)
+        if bus_only is not None:
+            raise UsageError(f"{bus_only.origin}: {bus_only.spec()!r}: sign= and scale= apply to a CAN log's "
+                             "signals; give the car's DBC (--dbc or --bus)")
+        record = reader_for(raw).read(raw, path)
     sources, metadata, line_numbers = record.sources, dict(record.metadata), record.line_numbers
-    notes: list[str] = []
+    notes: list[str] = list(record.notes)
 
     chosen = _map_sources(path, sources, channel_map)
     listing = ", ".join(s.name for s in sources)
@@ -471,6 +512,10 @@ def load_record(path: str | Path, channel_map: str | list[Channel] | None = None
         if ch.unit is not None and src.unit is not None and ch.unit != src.unit and not same:
             raise UsageError(f"{at}: {ch.origin} says [{ch.unit}] but the file says [{src.unit}]; give one unit")
         columns[target] = -values if ch.negate else values
+        if src.step and src.full_scale and target != TIME:  # a bus signal's resolution: the quantisation step
+            step, full = (abs(float(to_si(np.array([x]), unit, target, at)[0])) for x in (src.step, src.full_scale))
+            metadata[f"full_scale_{target}"] = metadata_text(full)
+            metadata[f"bits_{target}"] = str(min(32, (round(2.0 * full / step) + 1).bit_length()))
     renamed = [Channel(src.name, ch.unit or src.unit, ch.target, ch.negate).spec() for src, ch in chosen.values()
                if (src.name != ch.target or ch.negate) and ch.origin != "master"]
     if renamed:

@@ -14,7 +14,7 @@ Columns (SI units; the unit is part of the name):
 
 - required: ``time_s`` (strictly increasing), ``rack_m`` (positive to the right),
   ``handwheel_torque_Nm``;
-- optional: ``handwheel_angle_rad``, ``load_left_N``, ``load_right_N``.
+- optional: ``handwheel_angle_rad``, ``load_left_N``, ``load_right_N``, ``vehicle_speed_mps``.
 
 Metadata: ``case`` (a case of the parameter file) and ``surface`` (``ground`` or
 ``air_bearing``) are required, because a comparison with the model needs both;
@@ -46,7 +46,10 @@ from ..tables import atomic_path, format_number
 
 REQUIRED_COLUMNS = ("time_s", "rack_m", "handwheel_torque_Nm")
 OPTIONAL_COLUMNS = ("handwheel_angle_rad", "load_left_N", "load_right_N")
-ALLOWED_COLUMNS = REQUIRED_COLUMNS + OPTIONAL_COLUMNS
+# The car's speed (a CAN log's speed signal; 0 in a standstill parking test): a column of measured records only,
+# kept out of OPTIONAL_COLUMNS, which the synthetic records take as the model's recorded channels.
+MEASURED_ONLY_COLUMNS = ("vehicle_speed_mps",)
+ALLOWED_COLUMNS = REQUIRED_COLUMNS + OPTIONAL_COLUMNS + MEASURED_ONLY_COLUMNS
 UNITS = {
     "time_s": "s",
     "rack_m": "m",
@@ -54,6 +57,7 @@ UNITS = {
     "handwheel_angle_rad": "rad",
     "load_left_N": "N",
     "load_right_N": "N",
+    "vehicle_speed_mps": "m/s",
 }
 SURFACES = ("ground", "air_bearing")
 REQUIRED_METADATA = ("case", "surface")

@@ -4,18 +4,21 @@ entry in the table.
 
 - :mod:`.native_csv`: the native format (data/measurements/README.md);
 - :mod:`.logger_csv`: a logger's or spreadsheet's text export (own names, units, dialect);
-- :mod:`.mdf`: ASAM MDF through the optional asammdf.
+- :mod:`.mdf`: ASAM MDF through the optional asammdf;
+- :mod:`.can_log`: raw CAN logs (candump, ASC, BLF, TRC, MDF4 bus logging), decoded with a DBC.
 """
 
 from __future__ import annotations
 
 from .base import Reader, Record, Source
+from .can_log import CanLogReader
 from .logger_csv import LoggerCsvReader
 from .mdf import MdfReader
 from .native_csv import NativeCsvReader
 
 # Asked in this order; the first whose sniff accepts a file reads it (the logger CSV reader accepts any file).
 READERS: dict[str, type[Reader]] = {
+    "can_log": CanLogReader,
     "mdf": MdfReader,
     "native_csv": NativeCsvReader,
     "logger_csv": LoggerCsvReader,

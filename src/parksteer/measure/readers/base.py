@@ -33,6 +33,8 @@ class Source:
     values: np.ndarray | None = None  # filled when the channel is used
     timestamps: np.ndarray | None = None
     column: int | None = None  # position in a text table
+    step: float | None = None  # a bus signal's resolution in `unit`, and its largest magnitude (full scale)
+    full_scale: float | None = None
 
 
 @dataclass
@@ -49,6 +51,7 @@ class Record:
     metadata: dict[str, str] = field(default_factory=dict)
     line_numbers: list[int] | None = None
     samples: Callable[[Source], np.ndarray] | None = None
+    notes: list[str] = field(default_factory=list)  # findings for stderr once the record is read (a bus log's)
 
     @property
     def shared_time_base(self) -> bool:
