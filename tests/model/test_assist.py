@@ -126,3 +126,65 @@ def test_bad_combinations_are_refused_in_one_line():
         resolve_effects("+electric_assist_column,+electric_assist_rack")
     with pytest.raises(UsageError, match="both fill the slot column_deflection"):
         resolve_effects("+electric_assist_pinion,+rack_lash")
+
+
+HYDRAULIC = "hydraulic_assist"
+VALVE_IDEAL = {f"{HYDRAULIC}.seal_friction_force": 0.0, f"{HYDRAULIC}.dead_band": 0.0}
+
+
+def test_closed_valve_is_the_manual_steering(params):
+    """A valve that never builds pressure (slope 0) and seals without friction add no torque: the handwheel
+    torque is the manual steering's with the valve's torsion bar in series with the column."""
+    manual = simulate("unladen", overrides=series_column(params, HYDRAULIC), params=params)
+    assisted = simulate("unladen", effects=f"+{HYDRAULIC}",
+                        overrides={**VALVE_IDEAL, f"{HYDRAULIC}.valve_slope": 0.0}, params=params)
+    assert np.max(np.abs(assisted.columns["pressure_Pa"])) == 0.0
+    reference = manual.columns["handwheel_torque_Nm"]
+    assert np.max(np.abs(assisted.columns["handwheel_torque_Nm"] - reference)) < 1e-4 * np.max(np.abs(reference))
+
+
+def test_valve_slope_divides_the_driver_torque_by_one_plus_its_gain(params):
+    """In the valve's linear range the piston adds A k_v T_s on the rack, a pinion torque A k_v T_s / G_hr: the
+    driver's torque is the manual one divided by 1 + A k_v / G_hr (without the Hooke joint)."""
+    slope = 1.0e6
+    gain = params[f"{HYDRAULIC}.piston_area"] * slope / params["steering.handwheel_to_rack_ratio"]
+    manual = simulate("unladen", effects="-hooke_joint", overrides=series_column(params, HYDRAULIC), params=params)
+    assisted = simulate("unladen", effects=f"-hooke_joint,+{HYDRAULIC}",
+                        overrides={**VALVE_IDEAL, f"{HYDRAULIC}.valve_slope": slope,
+                                   f"{HYDRAULIC}.relief_pressure": 3.0e7}, params=params)
+    ramp, at = first_ramp(manual), first_ramp(assisted)
+    manual_torque = np.interp(assisted.columns["rack_m"][at], manual.columns["rack_m"][ramp],
+                              manual.columns["handwheel_torque_Nm"][ramp])
+    assert 2.0 < gain < 6.0  # a real division
+    assert np.max(np.abs(assisted.columns["handwheel_torque_Nm"][at] * (1 + gain) / manual_torque - 1)) < 0.01
+
+
+def test_relief_pressure_leaves_the_unassisted_slope(params):
+    """At the relief pressure the piston pushes A p_relief, a constant pinion torque A p_relief / G_hr: the
+    driver's torque is the manual one less that constant, at the unassisted slope."""
+    relief = 1.0e6
+    manual = simulate("unladen", effects="-hooke_joint", overrides=series_column(params, HYDRAULIC), params=params)
+    assisted = simulate("unladen", effects=f"-hooke_joint,+{HYDRAULIC}",
+                        overrides={**VALVE_IDEAL, f"{HYDRAULIC}.valve_slope": 2.0e7,
+                                   f"{HYDRAULIC}.relief_pressure": relief}, params=params)
+    c, m = assisted.columns, manual.columns
+    at, ramp = first_ramp(assisted), first_ramp(manual)
+    assert np.all(c["pressure_Pa"][at] > 0.99 * relief)
+    offset = params[f"{HYDRAULIC}.piston_area"] * relief / params["steering.handwheel_to_rack_ratio"]
+    manual_torque = np.interp(c["rack_m"][at], m["rack_m"][ramp], m["handwheel_torque_Nm"][ramp])
+    assert np.max(np.abs(manual_torque - c["handwheel_torque_Nm"][at] - offset)) < 0.01 * offset
+
+
+def test_energy_balance_with_the_pump_as_a_source(params):
+    """Without friction and dampers (air bearings), the driver's work plus the piston's (A dp times the rack
+    speed, the pump's hydraulic work) equals the change of kinetic and potential energy."""
+    overrides = {**DISSIPATION_OFF, **VALVE_IDEAL}
+    result = simulate("unladen", effects=f"+{HYDRAULIC}", overrides=overrides, surface="air_bearing", params=params,
+                      t_end_s=3.0, output_dt_s=0.0005, rtol=1e-10)
+    c = result.columns
+    out = result.model.evaluate_outputs(c["time_s"], result.states, result.parameter_vector)
+    energy = out["kinetic_energy_J"] + out["potential_energy_J"] + out["column_energy_J"]
+    driver = cumulative_trapezoid(c["handwheel_torque_Nm"] * c["handwheel_rate_rad_s"], c["time_s"], initial=0.0)
+    pump = cumulative_trapezoid(c["assist_force_N"] * c["rack_speed_m_s"], c["time_s"], initial=0.0)
+    assert pump[-1] > 0.5 * driver[-1] > 0
+    assert np.max(np.abs(driver + pump - (energy - energy[0]))) < 1e-4 * (driver[-1] + pump[-1])
