@@ -79,7 +79,9 @@ def _simulate(args) -> int:
     if not (args.output_dt > 0):
         raise UsageError(f"--output-dt {args.output_dt:g}: the output step must be positive")
     with naming(f"--rack-from {args.rack_from}") if args.rack_from is not None else nullcontext():
-        result = simulate(case, effects=args.effects, overrides=overrides, surface=surface,
+        from ..model.numeric.assist import effects_with_assist
+
+        result = simulate(case, effects=effects_with_assist(args.effects, params), overrides=overrides, surface=surface,
                           rack_drive=rack, params=params, output_dt_s=args.output_dt)
     if drive is not None:
         result.header["drive"] = drive
