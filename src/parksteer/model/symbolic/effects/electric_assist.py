@@ -38,6 +38,8 @@ the quantity; a vehicle file's ``[assist]`` gives the car's own.
 
 from __future__ import annotations
 
+from typing import ClassVar
+
 import sympy as sp
 import sympy.physics.mechanics as me
 
@@ -104,25 +106,35 @@ def assist_quantities(name: str, location: str) -> tuple[Quantity, ...]:
 
 
 class ElectricAssist(Effect):
-    """An electric assist at one point of action: ``column``, ``pinion`` or ``rack`` (module docstring)."""
+    """An electric assist; its point of action (``column``, ``pinion``, ``rack``) is chosen by :meth:`at`, which
+    gives the effect class of that point (its name, quantities and description are class attributes, so that an
+    instance keeps no state; module docstring)."""
 
+    location: ClassVar[str] = ""
     in_default_set = False
     diagnosis_candidate = False
     power_assist = True  # the simulation's rack force leaves its contribution out (the gear's own push)
     replaces = "column_deflection"
 
-    def __init__(self, location: str = "column"):
+    @classmethod
+    def at(cls, location: str) -> type[ElectricAssist]:
+        """The electric assist acting at `location`, one of :data:`LOCATIONS`."""
         if location not in LOCATIONS:
             raise ValueError(f"electric assist at {location!r}: the point of action is one of {', '.join(LOCATIONS)}")
-        self.location = location
-        self.name = f"electric_assist_{location}"
-        self.description = (
-            f"Electric power assistance at the {location}: torsion bar in series with the column, boost curve "
-            "(gain beyond a dead band, motor torque limit) through a reduction with its efficiency, rotor inertia "
-            "and friction; off by default")
-        self.quantities = assist_quantities(self.name, location)
-        self.uses = (*(q.key for q in self.quantities), "steering.column_torsional_stiffness",
-                     "steering.handwheel_to_rack_ratio", "steering.friction_smoothing")
+        name = f"electric_assist_{location}"
+        quantities = assist_quantities(name, location)
+        return type(f"ElectricAssist{location.title()}", (cls,), {
+            "location": location,
+            "name": name,
+            "description": (
+                f"Electric power assistance at the {location}: torsion bar in series with the column, boost curve "
+                "(gain beyond a dead band, motor torque limit) through a reduction with its efficiency, rotor "
+                "inertia and friction; off by default"),
+            "quantities": quantities,
+            "uses": (*(q.key for q in quantities), "steering.column_torsional_stiffness",
+                     "steering.handwheel_to_rack_ratio", "steering.friction_smoothing"),
+            "__module__": cls.__module__,
+        })
 
     def q(self, model, name: str):
         return model.p(f"{self.name}.{name}")
@@ -183,4 +195,4 @@ class ElectricAssist(Effect):
         ]
 
 
-EFFECT = ElectricAssist("column")
+EFFECT = ElectricAssist.at("column")()

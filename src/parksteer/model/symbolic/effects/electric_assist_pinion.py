@@ -4,4 +4,4 @@ from __future__ import annotations
 
 from .electric_assist import ElectricAssist
 
-EFFECT = ElectricAssist("pinion")
+EFFECT = ElectricAssist.at("pinion")()
