@@ -9,6 +9,7 @@ from parksteer.cli import main
 from parksteer.model.numeric.assist import check_assist, max_rack_force_N
 from parksteer.model.numeric.simulate import simulate
 from parksteer.parameters import ParameterError
+from parksteer.tables import read_csv
 from parksteer.vehicle import load_vehicle
 
 # A Golf-sized car (the issue's: 860 kg front axle, ratio 14.1, 2.1 turns; VW Golf VII track, axis and tyre).
@@ -64,3 +65,24 @@ def test_golf_with_default_column_assist_meets_the_service_manuals(tmp_path):
     assert peak_manual > 4 * peak_assisted
     # the motor stays below its limit: the boost curve's linear range sets the torque, not the saturation
     assert np.max(np.abs(assisted.columns["motor_torque_Nm"])) < params["electric_assist_column.motor_torque_limit"]
+
+
+def test_sizing_study_of_the_polo(tmp_path, capsys):
+    """The sizing study of the shipped Polo: the rack force falls as the car creeps (the rolling tyre), the motor
+    torque follows the excess over the target through the worm gear (quasi-statically E / (eta N) plus the motor's
+    friction over eta), and running the cycle again with the assist sized so leaves the driver within 5 % of the
+    target: the quasi-static sizing holds in the dynamic model."""
+    from pathlib import Path
+
+    out = tmp_path / "sizing"
+    assert main(["assist", "size", "--vehicle", str(Path(__file__).resolve().parents[2] / "data/vehicles/polo_vi.toml"),
+                 "--target-torque", "3", "--out-dir", str(out)]) == 0
+    assert "electric_assist_column" in capsys.readouterr().out
+    table, _ = read_csv(out / "sizing.csv")
+    assert list(table["speed_kmh"]) == [0.0, 1.0, 3.0, 5.0]
+    assert np.all(np.diff(table["peak_rack_force_N"]) < 0)
+    assert np.all(np.abs(table["peak_handwheel_assisted_Nm"] / 3.0 - 1) < 0.05)
+    eta, n, friction = 0.85, 18.0, 0.02  # the column assist's assumed defaults
+    excess = table["peak_handwheel_manual_Nm"] - 3.0
+    assert np.allclose(table["motor_torque_Nm"], (excess / n + friction) / eta, rtol=1e-6)
+    assert (out / "torque_against_rack.svg").stat().st_size > 0 and (out / "rack_force_against_speed.svg").exists()
