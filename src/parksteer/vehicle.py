@@ -62,6 +62,11 @@ ASSIST_SECTION = "assist"
 ASSIST_EFFECTS = {"column": "electric_assist_column", "pinion": "electric_assist_pinion",
                   "rack": "electric_assist_rack", "hydraulic": "hydraulic_assist"}
 
+# The effects specs of an assist sizing study (parksteer.sweep.assist_sizing, rule vehicle_assist_size): the car
+# rolling at the study's speeds (turn_slip), without and with its assist.
+CREEPING_EFFECTS = "+turn_slip"
+ASSISTED_EFFECTS = {kind: f"{CREEPING_EFFECTS},+{name}" for kind, name in ASSIST_EFFECTS.items()}
+
 
 def assist_of(params: Parameters) -> str | None:
     """The assist effect a vehicle's parameters carry (from ``[assist]``), or None."""

@@ -49,12 +49,12 @@ def vehicle_study_files(wildcards):
 
 
 # --- the assist sizing study (workflow/rules/assist.smk) ---
-from parksteer.vehicle import ASSIST_EFFECTS as _ASSIST_EFFECTS, assist_of as _assist_of
+from parksteer.vehicle import (ASSIST_EFFECTS as _ASSIST_EFFECTS, ASSISTED_EFFECTS as _ASSISTED_EFFECTS,
+                               CREEPING_EFFECTS as _CREEPING_EFFECTS, assist_of as _assist_of)
 
 # one model per assist kind, each with the rolling tyre; and the rolling tyre alone (the unassisted car)
-ASSIST_MODELS = {kind: model_manifest(f"assist_{kind}", f"+turn_slip,+{effect}"  # an effects spec, not a path)
-                 for kind, effect in _ASSIST_EFFECTS.items()}
-CREEPING_MODEL = model_manifest("turn_slip", "+turn_slip")
+ASSIST_MODELS = {kind: model_manifest(f"assist_{kind}", spec) for kind, spec in _ASSISTED_EFFECTS.items()}
+CREEPING_MODEL = model_manifest("turn_slip", _CREEPING_EFFECTS)
 
 
 def assist_models(wildcards):

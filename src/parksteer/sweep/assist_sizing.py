@@ -28,7 +28,7 @@ from ..model.numeric.assist import check_assist
 from ..model.numeric.simulate import SimulationResult, simulate
 from ..model.symbolic.components import discover_effects
 from ..parameters import Parameters
-from ..vehicle import ASSIST_EFFECTS
+from ..vehicle import ASSIST_EFFECTS, ASSISTED_EFFECTS, CREEPING_EFFECTS
 
 SPEEDS_KMH = (0.0, 1.0, 3.0, 5.0)
 MARGIN = 1.1  # the sized motor limit or relief pressure over the quasi-static demand
@@ -94,7 +94,7 @@ def size_assist(params: Parameters, case: str, target_torque_Nm: float, speeds_k
     ratio = float(params["steering.handwheel_to_rack_ratio"])
     rows, manual0, assisted0 = [], None, None
     for speed in speeds_kmh:
-        manual = simulate(case, effects="+turn_slip", overrides=_speed(speed), params=params)
+        manual = simulate(case, effects=CREEPING_EFFECTS, overrides=_speed(speed), params=params)
         c = manual.columns
         per_rack = manual.model.evaluate_outputs(c["time_s"], manual.states, manual.parameter_vector)[
             "column_angle_per_rack_rad_per_m"]
@@ -113,7 +113,8 @@ def size_assist(params: Parameters, case: str, target_torque_Nm: float, speeds_k
             motor = (demand / v("reduction_ratio") + v("motor_friction_torque")) / v("efficiency")
             current = motor / v("torque_constant")
             sized = {f"{name}.gain": gain, f"{name}.motor_torque_limit": MARGIN * motor}
-        assisted = simulate(case, effects=f"+turn_slip,+{name}", overrides={**_speed(speed), **sized}, params=params)
+        kind = next(k for k, e in ASSIST_EFFECTS.items() if e == name)
+        assisted = simulate(case, effects=ASSISTED_EFFECTS[kind], overrides={**_speed(speed), **sized}, params=params)
         rows.append(SizingRow(speed, _peak(torque * per_rack), peak_manual, demand, motor, current, pressure, gain,
                               _peak(assisted.columns["handwheel_torque_Nm"])))
         if manual0 is None:
