@@ -120,6 +120,18 @@ def test_energy_balance_with_the_motor_as_a_source(params, name):
     assert np.max(np.abs(driver + motor - (energy - energy[0]))) < 1e-4 * (driver[-1] + motor[-1])
 
 
+def test_a_prescribed_rack_cannot_drive_an_assisted_car(params):
+    """The rack-driven solve takes the column torque as its unknown, linear in the equations; an assist feeds that
+    torque back through its boost curve, so the solve is refused in one line instead of solving the wrong
+    equations (an assisted car is driven by its handwheel angle)."""
+    from parksteer.measure.smoothing import interpolate_rack
+
+    t = np.linspace(0.0, 2.0, 21)
+    with pytest.raises(UsageError, match="a prescribed rack cannot drive the effects .*electric_assist_column"):
+        simulate("unladen", effects="+electric_assist_column", params=params,
+                 rack_drive=interpolate_rack(t, 0.01 * t))
+
+
 def test_bad_combinations_are_refused_in_one_line():
     """Two assists in one set, or an assist with the rack lash (both shape the column's spring), are refused."""
     with pytest.raises(UsageError, match="both fill the slot column_deflection"):
