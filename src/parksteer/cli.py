@@ -24,6 +24,7 @@ COMMAND_MODULES = [
     "parksteer.commands.sweep",
     "parksteer.commands.measure",
     "parksteer.commands.vehicle",
+    "parksteer.commands.assist",
 ]
 
 

@@ -55,6 +55,48 @@ MAX_LOCK_STEER_RAD = 1.0
 UNSPRUNG_TOLERANCE_KG = 0.5
 
 
+# ``[assist]`` of a vehicle file: its ``type`` and the assist effect (parksteer.model.symbolic.effects) it names. The
+# entries ({value, unit, source}, the effect's quantities by name) go into that effect's section; the model layer,
+# which knows the quantities, checks them (parksteer.model.numeric.assist.check_assist).
+ASSIST_SECTION = "assist"
+ASSIST_EFFECTS = {"column": "electric_assist_column", "pinion": "electric_assist_pinion",
+                  "rack": "electric_assist_rack", "hydraulic": "hydraulic_assist"}
+
+# The effects specs of an assist sizing study (parksteer.sweep.assist_sizing, rule vehicle_assist_size): the car
+# rolling at the study's speeds (turn_slip), without and with its assist.
+CREEPING_EFFECTS = "+turn_slip"
+ASSISTED_EFFECTS = {kind: f"{CREEPING_EFFECTS},+{name}" for kind, name in ASSIST_EFFECTS.items()}
+
+
+def assist_of(params: Parameters) -> str | None:
+    """The assist effect a vehicle's parameters carry (from ``[assist]``), or None."""
+    found = [name for name in ASSIST_EFFECTS.values() if name in params.sections]
+    return found[0] if found else None
+
+
+def _read_assist(path: Path, table: Any, sections: dict, sources: dict) -> None:
+    """``[assist]`` into the section of the effect its type names; each entry a finite {value, unit, source}."""
+    if not isinstance(table, dict):
+        raise ParameterError(f"{path}: assist: expected a table")
+    kind = table.get("type")
+    if kind not in ASSIST_EFFECTS:
+        raise ParameterError(f"{path}: assist.type: {kind!r}, expected one of {', '.join(ASSIST_EFFECTS)}")
+    name = ASSIST_EFFECTS[kind]
+    values = {}
+    for key, entry in table.items():
+        if key == "type":
+            continue
+        if not isinstance(entry, dict) or set(entry) != {"value", "unit", "source"}:
+            raise ParameterError(f"{path}: assist.{key}: expected {{ value, unit, source }}")
+        value = entry["value"]
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+            raise ParameterError(f"{path}: assist.{key}: value {value!r} is not a finite number")
+        values[key] = float(value)
+        sources[f"{name}.{key}"] = str(entry["source"])
+        sources[f"{name}.{key}.unit"] = str(entry["unit"])
+    sections[name] = values
+
+
 def vehicle_name(path: str | Path) -> str:
     """A vehicle's name: its file's stem (``data/vehicles/small_hatch.toml`` -> ``small_hatch``)."""
     return Path(path).stem
@@ -80,7 +122,7 @@ def vehicle_from_text(text: str, path: str | Path, base: str | Path | Parameters
     except tomllib.TOMLDecodeError as exc:
         raise ParameterError(f"{path}: not valid TOML ({exc})") from None
 
-    unknown = sorted(doc.keys() - (set(SCHEMA) | {"cases"}))
+    unknown = sorted(doc.keys() - (set(SCHEMA) | {"cases", ASSIST_SECTION}))
     if unknown:
         raise ParameterError(f"{path}: {unknown[0]}: unknown key (a section of the parameter file, or cases)")
     sections = {name: dict(values) for name, values in base_params.sections.items()}
@@ -91,6 +133,9 @@ def vehicle_from_text(text: str, path: str | Path, base: str | Path | Parameters
         if not isinstance(table, dict) or name not in table:
             raise ParameterError(f"{path}: {key}: missing value (a vehicle file gives every value of the car)")
     for section, table in doc.items():
+        if section == ASSIST_SECTION:
+            _read_assist(path, table, sections, sources)
+            continue
         if section == "cases":
             continue
         if not isinstance(table, dict):

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import json
 
+import numpy as np
+
 import pytest
 
 from parksteer.cli import main
@@ -94,3 +96,20 @@ def test_renamed_key_is_refused_naming_the_key(tmp_path, capsys):
     assert len(lines) == 1
     assert "tyre_friction.tyre_pressure" in lines[0] and "this quantity is tyre.tyre_pressure" in lines[0]
     assert not out.exists()
+
+
+def test_speed_option_runs_the_rolling_tyre(tmp_path, capsys):
+    """simulate --speed-kmh adds the rolling tyre at that speed: at 3 km/h the peak handwheel torque is well below
+    the standstill's (the wheel rolls about 2 m per radian of steer on the paper's cycle); out of 0-10.8 km/h it
+    is refused in one line."""
+
+    peaks = {}
+    for speed in ("0", "3"):
+        out = tmp_path / f"run_{speed}.csv"
+        assert main(["simulate", "--case", "unladen", "--speed-kmh", speed, "--out", str(out)]) == 0
+        columns, header = read_csv(out)
+        assert "turn_slip" in header["components"]
+        peaks[speed] = float(np.max(np.abs(columns["handwheel_torque_Nm"])))
+    assert peaks["3"] < 0.5 * peaks["0"]
+    assert main(["simulate", "--case", "unladen", "--speed-kmh", "20", "--out", str(tmp_path / "x.csv")]) == 2
+    assert "--speed-kmh 20: outside 0-10.8 km/h" in capsys.readouterr().err

@@ -46,3 +46,30 @@ def vehicle_study_files(wildcards):
         f"results/vehicles/{name}/report.md",
         f"results/vehicles/{name}/report.html",
     ]
+
+
+# --- the assist sizing study (workflow/rules/assist.smk) ---
+from parksteer.vehicle import (ASSIST_EFFECTS as _ASSIST_EFFECTS, ASSISTED_EFFECTS as _ASSISTED_EFFECTS,
+                               CREEPING_EFFECTS as _CREEPING_EFFECTS, assist_of as _assist_of)
+
+# one model per assist kind, each with the rolling tyre; and the rolling tyre alone (the unassisted car)
+ASSIST_MODELS = {kind: model_manifest(f"assist_{kind}", spec) for kind, spec in _ASSISTED_EFFECTS.items()}
+CREEPING_MODEL = model_manifest("turn_slip", _CREEPING_EFFECTS)
+
+
+def assist_models(wildcards):
+    """The unassisted and the assisted model of the vehicle's sizing study."""
+    effect = _assist_of(_load_vehicle(vehicle_file(wildcards.vehicle), PARAMETERS)) or _ASSIST_EFFECTS["column"]
+    kind = next(k for k, e in _ASSIST_EFFECTS.items() if e == effect)
+    return [CREEPING_MODEL, ASSIST_MODELS[kind]]
+
+
+def vehicle_assist_files(wildcards):
+    name = config.get("vehicle")
+    if name is None:
+        raise ValueError("vehicle_assist needs the vehicle's name: --config vehicle=<name> (data/vehicles/<name>.toml)")
+    return [
+        f"results/vehicles/{name}/assist/sizing.csv",
+        f"figures/vehicles/{name}/assist_torque_against_rack.svg",
+        f"figures/vehicles/{name}/assist_rack_force_against_speed.svg",
+    ]

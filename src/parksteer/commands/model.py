@@ -25,6 +25,9 @@ def register(sub) -> None:
                    help="override a quantity by its key, e.g. tyre.tyre_pressure=180000 or rack_lash.lash=0.0002 (keys: `parksteer effects`, the parameter file; case.<name> for the case; repeatable)")
     p.add_argument("--surface", choices=("ground", "air_bearing"), default=None,
                    help="default ground (with --rack-from: the file's surface)")
+    p.add_argument("--speed-kmh", type=float, default=None,
+                   help="the car creeps at this constant speed while it steers, 0-10.8 km/h (adds the turn_slip "
+                        "effect: the tyre moment of a rolling wheel; 0 = the standstill torque)")
     p.add_argument("--rack-from", default=None, metavar="FILE.csv",
                    help="prescribe the rack of a measurement file (data/measurements/README.md) and solve for the "
                         "handwheel torque; the measured rack is smoothed as `parksteer compare` smooths it (a "
@@ -79,12 +82,27 @@ def _simulate(args) -> int:
     if not (args.output_dt > 0):
         raise UsageError(f"--output-dt {args.output_dt:g}: the output step must be positive")
     with naming(f"--rack-from {args.rack_from}") if args.rack_from is not None else nullcontext():
-        result = simulate(case, effects=args.effects, overrides=overrides, surface=surface,
+        from ..model.numeric.assist import effects_with_assist
+
+        effects = effects_with_assist(args.effects, params)
+        if args.speed_kmh is not None:
+            effects, overrides = with_speed(effects, overrides, args.speed_kmh)
+        result = simulate(case, effects=effects, overrides=overrides, surface=surface,
                           rack_drive=rack, params=params, output_dt_s=args.output_dt)
     if drive is not None:
         result.header["drive"] = drive
     result.write_csv(args.out)
     return 0
+
+
+def with_speed(effects: str | None, overrides: dict, speed_kmh: float) -> tuple[str, dict]:
+    """The effects spec with turn_slip and the overrides with its vehicle speed (m/s) of `speed_kmh`."""
+    if not 0.0 <= speed_kmh <= 10.8:
+        raise UsageError(f"--speed-kmh {speed_kmh:g}: outside 0-10.8 km/h (parking and creeping)")
+    if not (effects and "turn_slip" in effects):
+        signed = not effects or all(s.strip()[:1] in "+-" for s in effects.split(",") if s.strip())
+        effects = (f"{effects}," if effects else "") + ("+turn_slip" if signed else "turn_slip")
+    return effects, {**overrides, "turn_slip.vehicle_speed": speed_kmh / 3.6}
 
 
 def _measured_rack(path: str, params, raw: bool, channel_map=None, case=None, surface=None):

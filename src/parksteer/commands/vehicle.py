@@ -42,6 +42,17 @@ def register(sub) -> None:
     n.add_argument("--tyre-pressure-bar", type=float, required=True, help="front tyre pressure, gauge (bar)")
     n.add_argument("--steering-ratio", type=float, required=True, help="overall steering ratio (handwheel/road wheel)")
     n.add_argument("--lock-turns", type=float, required=True, help="handwheel turns lock to lock")
+    n.add_argument("--assist", choices=("column", "pinion", "rack", "hydraulic"), default=None,
+                   help="power assistance: electric at the column, pinion or rack, or hydraulic; writes [assist] "
+                        "with the values given below and the rest assumed (typical, with ranges and sources)")
+    n.add_argument("--assist-reduction", type=float, default=None,
+                   help="electric: the motor's reduction (worm gear ratio; rack: rad of motor per m of rack)")
+    n.add_argument("--assist-motor-torque-Nm", type=float, default=None, help="electric: the motor's peak torque (N m)")
+    n.add_argument("--assist-relief-pressure-bar", type=float, default=None,
+                   help="hydraulic: the relief valve's pressure (bar)")
+    n.add_argument("--assist-boost", default=None, metavar="T:A,T:A",
+                   help="boost-curve points, torsion-bar torque (N m) : assist (electric: N m at the pinion; "
+                        "hydraulic: pressure in bar); the least-squares line gives the gain and dead band")
     n.add_argument("--case", default="kerb", help="name of the load case (default kerb)")
     n.add_argument("--force", action="store_true", help="overwrite an existing file")
     n.add_argument("--parameters", default=str(DEFAULT_PATH),
@@ -117,25 +128,70 @@ def _new(args) -> int:
     base = load_parameters(args.parameters)
     spec = specification(args, base["vehicle.gravity"])
     values = derive(spec, base)
-    text = template_text(vehicle_name(out), spec, values)
+    text = template_text(vehicle_name(out), spec, values) + assist_section(args, base)
     try:
         vehicle_from_text(text, out, base)  # checked as a vehicle file before anything is written
     except UsageError as exc:
         raise UsageError(f"the specification gives no valid car, nothing written: {exc}") from None
     with atomic_path(out) as tmp:
         tmp.write_text(text, encoding="utf-8")
-    print(f"{out}: vehicle {vehicle_name(out)}, case {spec.case}")
+    if args.assist is not None:
+        from ..model.numeric.assist import check_assist
+
+        check_assist(vehicle_from_text(text, out, base))
+    print(f"{out}: vehicle {vehicle_name(out)}, case {spec.case}" + (f", {args.assist} assist" if args.assist else ""))
     for d in values:
         how = f" = {d.how}" if d.how else ""
         print(f"  {d.key} = {d.value:.6g} {d.unit}  [{d.source}]{how}")
     return 0
 
 
+def assist_section(args, base) -> str:
+    """The ``[assist]`` section of `args` (empty without --assist): given values from the options, the rest assumed."""
+    electric_only = (("--assist-reduction", args.assist_reduction), ("--assist-motor-torque-Nm", args.assist_motor_torque_Nm))
+    if args.assist is None:
+        given = [o for o, v in (*electric_only, ("--assist-relief-pressure-bar", args.assist_relief_pressure_bar),
+                                ("--assist-boost", args.assist_boost)) if v is not None]
+        if given:
+            raise UsageError(f"{given[0]} needs --assist")
+        return ""
+    from ..model.numeric.assist import assist_template, boost_line
+
+    hydraulic = args.assist == "hydraulic"
+    wrong = [o for o, v in electric_only if v is not None] if hydraulic else (
+        ["--assist-relief-pressure-bar"] if args.assist_relief_pressure_bar is not None else [])
+    if wrong:
+        raise UsageError(f"{wrong[0]}: not a value of a {args.assist} assist")
+    given: dict[str, tuple[float, str]] = {}
+    if args.assist_reduction is not None:
+        given["reduction_ratio"] = (args.assist_reduction, "specification")
+    if args.assist_motor_torque_Nm is not None:
+        given["motor_torque_limit"] = (args.assist_motor_torque_Nm, "specification")
+    if args.assist_relief_pressure_bar is not None:
+        given["relief_pressure"] = (args.assist_relief_pressure_bar * BAR_PA, "specification (bar x 1e5)")
+    if args.assist_boost is not None:
+        try:
+            points = [tuple(float(x) for x in item.split(":")) for item in args.assist_boost.split(",")]
+        except ValueError:
+            points = [()]
+        if any(len(pt) != 2 for pt in points):
+            raise UsageError(f"--assist-boost {args.assist_boost}: expected points T:A separated by commas")
+        scale = BAR_PA if hydraulic else 1.0
+        slope, band = boost_line([(t, a * scale) for t, a in points], f"--assist-boost {args.assist_boost}")
+        source = f"specification: least-squares line through the boost-curve points {args.assist_boost}"
+        given["valve_slope" if hydraulic else "gain"] = (slope, source)
+        given["dead_band"] = (max(band, 0.0), source)
+    return assist_template(args.assist, given)
+
+
 def _check(args) -> int:
     from ..vehicle import load_vehicle
 
+    from ..model.numeric.assist import check_assist
+
     params = load_vehicle(args.path, args.parameters)
-    print(f"{args.path}: vehicle valid; cases: {', '.join(params.case_names)}")
+    assist = check_assist(params)
+    print(f"{args.path}: vehicle valid; cases: {', '.join(params.case_names)}" + (f"; assist {assist}" if assist else ""))
     return 0
 
 
@@ -153,4 +209,8 @@ def parameters_of(args):
         return params
     from ..vehicle import load_vehicle
 
-    return load_vehicle(args.vehicle, params)
+    from ..model.numeric.assist import check_assist
+
+    params = load_vehicle(args.vehicle, params)
+    check_assist(params)
+    return params

@@ -166,6 +166,13 @@ def generate(derivation: Derivation) -> tuple[str, dict]:
     jac_targets = [[f"dFdq[{i * n + j}]" for j in range(n)] + [f"dFdu[{i * n + j}]" for j in range(n)]
                    for i in range(n)]
     drive = [(f"M[{i * n + j}]", M[i, j]) for i in range(n) for j in range(i, n)]
+    # The prescribed-rack drive takes the column torque as its unknown, so the forcing without the column must not
+    # hold it; an effect that feeds the column torque back (a power assist's torsion bar) is driven by the
+    # handwheel only, and its drive is written at zero handwheel input (prescribed.solve refuses it).
+    hand = {plain[space.handwheel_angle], plain[space.handwheel_rate]}
+    drive_hand = any(F_nocol[i].free_symbols & hand for i in range(n))
+    if drive_hand:
+        F_nocol = F_nocol.xreplace({h: 0 for h in hand})
     drive += [(f"F[{i}]", F_nocol[i]) for i in range(n)] + [(f"b[{i}]", bcol[i]) for i in range(n)]
     timings["expressions_s"] = time.perf_counter() - start
 
@@ -195,6 +202,13 @@ def generate(derivation: Derivation) -> tuple[str, dict]:
         ("potential_energy_J", c(derivation.potential_energy)),
         ("column_energy_J", c(space.column_potential_energy())),
     ]
+    effect_outputs = [(name, c(expr)) for effect in space.effects for name, expr in effect.outputs(space)]
+    taken = {name for name, _ in outputs}
+    for name, _ in effect_outputs:
+        if name in taken:
+            raise ValueError(f"output {name} is given twice (an effect's outputs must have names of their own)")
+        taken.add(name)
+    outputs += effect_outputs
     out_assign = [(f"out[{i}]", e) for i, (_, e) in enumerate(outputs)]
 
     start = time.perf_counter()
@@ -223,6 +237,8 @@ def generate(derivation: Derivation) -> tuple[str, dict]:
         "max_input_pieces": MAX_INPUT_PIECES,
         "n_parameter_vector": n_params + 1 + INPUT_FIELDS * MAX_INPUT_PIECES,
         "outputs": [name for name, _ in outputs],
+        "effect_outputs": [name for name, _ in effect_outputs],
+        "rack_drive": not drive_hand,
         "rack_index": rack,
     }
     header = (

@@ -36,6 +36,7 @@ from typing import Protocol
 import numpy as np
 
 from ... import portable as pm
+from ...errors import UsageError
 from .statics import static_state
 from .tolerances import (PRESCRIBED_ATOL_FACTOR, PRESCRIBED_RTOL, absolute_tolerances, integrator_failure,
                          max_steps)
@@ -145,6 +146,9 @@ def solve(run, p: np.ndarray, rack: RackMotion, t_out, rtol: float = PRESCRIBED_
     `atol_factor` times the model's own (:mod:`parksteer.model.numeric.tolerances`).
     """
     model = run.model
+    if not model.info.get("rack_drive", True):
+        raise UsageError(f"a prescribed rack cannot drive the effects {', '.join(model.effects)}: an assist feeds the "
+                         "torsion-bar torque back into the load, so drive it by the handwheel angle")
     lib = model.lib
     n = model.n_q
     i_rack = model.index("rack")

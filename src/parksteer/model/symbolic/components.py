@@ -82,6 +82,10 @@ class Effect:
         """Potential energy (J) of the conservative part of this effect's loads (for the energy balance)."""
         return 0
 
+    def outputs(self, model: ModelSpace) -> list[tuple[str, Any]]:
+        """Extra named outputs of every run (name with its SI unit, expression), e.g. an assist's motor current."""
+        return []
+
     def own_keys(self) -> tuple[str, ...]:
         """The keys of the quantities only this effect has (its section of the parameter file, or declared)."""
         return tuple(k for k in self.uses if k.partition(".")[0] == self.name)

@@ -1,0 +1,111 @@
+"""A vehicle's power assist: the ``[assist]`` section of a vehicle file, checked against the assist effects.
+
+The vehicle layer reads ``[assist]`` (``type`` and entries of ``{value, unit, source}``) into the section of the
+effect its type names (:data:`parksteer.vehicle.ASSIST_EFFECTS`); it cannot know the effects' quantities, which
+live in the model. Here, with the effects loaded, every entry is checked against its quantity (unit and bounds),
+the assist is checked as a whole (the largest rack force it can give), and the effects spec of a run gains the
+assist. :func:`assist_template` writes the section for ``parksteer vehicle new --assist``.
+"""
+
+from __future__ import annotations
+
+from ...errors import UsageError
+from ...parameters import ParameterError, Parameters
+from ...vehicle import ASSIST_EFFECTS, assist_of
+from ..symbolic.components import discover_effects
+
+# The largest rack force an assist can give (its motor limit or relief pressure through its gear), N. Rack
+# forces at standstill are 3-8 kN for small and medium cars and up to 15 kN for large ones; electric racks are
+# rated 6-16 kN (Harrer & Pfeffer, Steering Handbook, Springer 2017, ch. 8). An assist outside these bounds is a
+# unit slip (bar for Pa, a reduction per degree) rather than a car.
+MAX_ASSIST_RACK_FORCE_RANGE_N = (1.0e3, 3.0e4)
+
+
+def _quantities(name: str) -> dict:
+    effect = discover_effects()[name]
+    return {q.name: q for q in effect.quantities}
+
+
+def check_assist(params: Parameters) -> str | None:
+    """The assist effect of `params` (None without one), its entries checked against the effect's quantities and
+    the largest rack force it can give checked for plausibility; one-line :class:`ParameterError` otherwise."""
+    name = assist_of(params)
+    if name is None:
+        return None
+    path = params.path
+    known = _quantities(name)
+    for key, value in params.sections[name].items():
+        q = known.get(key)
+        if q is None:
+            raise ParameterError(f"{path}: assist.{key}: unknown key for a {name} (keys: {', '.join(known)})")
+        unit = params.sources.get(f"{name}.{key}.unit")
+        if unit is not None and unit != q.unit:
+            raise ParameterError(f"{path}: assist.{key}: unit {unit!r}, expected {q.unit!r}")
+        q.check(value, where=f"{path}: assist.{key}")
+    force = max_rack_force_N(params, name)
+    low, high = MAX_ASSIST_RACK_FORCE_RANGE_N
+    if not low <= force <= high:
+        raise ParameterError(f"{path}: assist: the largest rack force the assist can give is {force:.0f} N, outside "
+                             f"the {low:.0f}-{high:.0f} N of real cars (check the reduction, the motor torque limit "
+                             "or the relief pressure and their units)")
+    return name
+
+
+def max_rack_force_N(params: Parameters, name: str) -> float:
+    """The largest rack force of the assist: eta N T_max through the pinion (column, pinion), eta N T_max (rack),
+    A p_relief (hydraulic)."""
+    v = lambda key: float(params[f"{name}.{key}"])  # noqa: E731
+    if name == ASSIST_EFFECTS["hydraulic"]:
+        return v("piston_area") * v("relief_pressure")
+    force = v("efficiency") * v("reduction_ratio") * v("motor_torque_limit")
+    if name != ASSIST_EFFECTS["rack"]:
+        force *= float(params["steering.handwheel_to_rack_ratio"])
+    return force
+
+
+def effects_with_assist(spec: str | None, params: Parameters) -> str | None:
+    """The effects spec `spec` with the vehicle's assist added (unchanged without one, or if it names it)."""
+    name = check_assist(params)
+    if name is None or (spec and name in spec):
+        return spec
+    if spec and not all(s.strip()[:1] in "+-" for s in spec.split(",") if s.strip()):
+        return f"{spec},{name}"  # an exact list
+    return f"{spec},+{name}" if spec else f"+{name}"
+
+
+def boost_line(points: list[tuple[float, float]], what: str) -> tuple[float, float]:
+    """Slope and dead band of the straight line through boost-curve points (torsion-bar torque, output): the least
+    squares line, whose zero crossing is the dead band."""
+    if len(points) < 2:
+        raise UsageError(f"{what}: give at least two points T:A")
+    n = float(len(points))
+    mean_t = sum(t for t, _ in points) / n
+    mean_a = sum(a for _, a in points) / n
+    sxx = sum((t - mean_t) ** 2 for t, _ in points)
+    if sxx == 0.0:
+        raise UsageError(f"{what}: the points need two different torsion-bar torques")
+    slope = sum((t - mean_t) * (a - mean_a) for t, a in points) / sxx
+    if not slope > 0.0:
+        raise UsageError(f"{what}: the assist must grow with the torsion-bar torque (slope {slope:g})")
+    return slope, mean_t - mean_a / slope
+
+
+def assist_template(kind: str, given: dict[str, tuple[float, str]]) -> str:
+    """The ``[assist]`` section of a vehicle file: `given` values ({quantity: (value, source)}) and every other
+    quantity of the assist at its assumed default, marked as assumed with its range and source."""
+    if kind not in ASSIST_EFFECTS:
+        raise UsageError(f"--assist {kind}: one of {', '.join(ASSIST_EFFECTS)}")
+    name = ASSIST_EFFECTS[kind]
+    known = _quantities(name)
+    lines = ["", "# Power assistance: the effect " + name + "; values marked assumed are typical of current cars.",
+             "[assist]", f'type = "{kind}"']
+    for key, q in known.items():
+        if key in given:
+            value, source = given[key]
+            q.check(value, where=f"assist.{key}")
+        else:
+            value, source = q.default, q.source
+        text = repr(float(value))
+        source = source.replace("\\", "\\\\").replace('"', '\\"')
+        lines.append(f'{key} = {{ value = {text}, unit = "{q.unit}", source = "{source}" }}')
+    return "\n".join(lines) + "\n"

@@ -1,0 +1,198 @@
+"""Electric power assistance (EPS), acting at the column (EPS-C); the pinion and rack variants use the same class.
+
+Mechanism. A torsion bar between the handwheel and the gear measures the driver's torque T_s; the control unit
+asks the motor for an assist by a boost curve of T_s; the motor drives the point of action x through a
+reduction of ratio N (motor angle theta_m = N x) with the efficiency eta: a worm gear on the column
+(x = column angle, rad) or on a second pinion (x = pinion angle, rad), a ball nut and belt on the rack
+(x = rack travel, m; N in rad/m). The point of action is the effect's option: ``electric_assist_column`` (this
+module), ``electric_assist_pinion``, ``electric_assist_rack``; each fills the column_deflection slot with its
+torsion bar (see :mod:`.assist_common`), so two assists in one set, or an assist with the rack lash (which
+fills the same slot), are refused in one line.
+
+Boost curve (quasi-static, speed-independent: parking). The demand at the point of action is
+
+    A_cmd = G deadband(T_s, D) c,     c = 1 (torque at column or pinion), c = G_hr (force at the rack)
+
+with the gain G (assist per driver torque beyond the dead band D), c turning a pinion torque into a rack force
+(G_hr = handwheel_to_rack_ratio, rad/m). The motor torque is the demand through the reduction, limited:
+
+    T_m = clamp(A_cmd / (eta N), T_max),     i = T_m / k_t (the motor current, torque constant k_t),
+
+and the torque eta T_m acts on the motor's rotor (reacted on the body): its generalized force on the rack is
+eta N T_m dx/d(rack), the assist eta N T_m at the point of action; (1 - eta) T_m N dx/dt is lost in the gear
+(a constant efficiency, also when the gear is back-driven). The rotor's inertia J_m turns at N dx/dt (kinetic
+energy J_m (N dx/dt)^2 / 2, N^2 J_m reflected to x), its bearings' Coulomb friction T_f tanh(beta v) opposes it
+(v the rack speed it corresponds to, beta the project's friction smoothing).
+
+Quasi-static consequences (the tests): with no dead band and the motor below its limit, the column carries
+T_s + G T_s = T_road, so the driver's torque is T_road / (1 + G); at the limit, T_s = T_road - eta N T_max
+(column) rises with the road torque at the manual steering's slope; a zero gain adds no torque at all.
+
+Outputs: torsion_bar_torque_Nm (T_s), assist_torque_Nm or assist_force_N (eta N T_m at x), motor_torque_Nm,
+motor_current_A; the simulation adds rack_force_N (the force the pinion and the assist together put on the
+rack). The model has no tie rods (a linear linkage), so no tie-rod force.
+
+Values: every default is assumed, a typical value of current production gears with its range and source in
+the quantity; a vehicle file's ``[assist]`` gives the car's own.
+"""
+
+from __future__ import annotations
+
+from typing import ClassVar
+
+import sympy as sp
+import sympy.physics.mechanics as me
+
+from ....parameters import Quantity
+from ..components import Effect
+from ..system import torque_between
+from .assist_common import LOCATIONS, clamp, deadband, point_of_action, series_deflection, torsion_bar_torque
+
+# Typical values by point of action: (reduction N, its unit, bounds, efficiency, motor torque limit N m,
+# motor inertia kg m^2, source of the reduction). Column and pinion: a worm gear; rack: a ball nut driven through
+# a belt (N = 2 pi / lead x belt ratio).
+_GEARS = {
+    "column": (18.0, "1", (1.0, 100.0), 0.85, 4.0, 2.0e-4,
+               "assumed: worm gear of column EPS, 15-22:1 (Harrer & Pfeffer, Steering Handbook, Springer 2017, "
+               "ch. 8.3; Kim, Mech. Sci. 9, 201, 2018)"),
+    "pinion": (20.0, "1", (1.0, 100.0), 0.85, 4.5, 2.0e-4,
+               "assumed: worm gear of pinion and dual-pinion EPS, 15-25:1 (Harrer & Pfeffer, Steering Handbook, "
+               "ch. 8.3)"),
+    "rack": (2400.0, "rad/m", (100.0, 20000.0), 0.90, 5.0, 3.0e-4,
+             "assumed: ball nut of 7 mm lead through a 2.7:1 belt, 2 pi / 0.007 x 2.7 = 2420 rad/m; rack EPS "
+             "1500-3500 rad/m (Harrer & Pfeffer, Steering Handbook, ch. 8.4)"),
+}
+
+
+def assist_quantities(name: str, location: str) -> tuple[Quantity, ...]:
+    ratio, ratio_unit, (lo, hi), efficiency, limit, inertia, ratio_source = _GEARS[location]
+    return (
+        Quantity(f"{name}.gain", "1", 0.0, 50.0, lower_inclusive=True, default=6.0,
+                 description="boost curve: assist per driver torque beyond the dead band",
+                 source="assumed: the parking gain of EPS boost curves, 4-10 (assist 80-90 % of the load at "
+                        "standstill; Harrer & Pfeffer, Steering Handbook, ch. 8.2); 0 = a motor that never "
+                        "pushes"),
+        Quantity(f"{name}.dead_band", "N m", 0.0, 10.0, lower_inclusive=True, default=0.5,
+                 description="boost curve: torsion-bar torque below which the motor does not assist",
+                 source="assumed: 0.3-1.5 N m on published EPS boost curves (Harrer & Pfeffer, ch. 8.2)"),
+        Quantity(f"{name}.dead_band_smoothing", "N m", 0.0, 1.0, default=0.05,
+                 description="width over which the dead band's corners are rounded",
+                 source="numerical: a fraction of the dead band, keeps the Jacobian continuous"),
+        Quantity(f"{name}.torsion_bar_stiffness", "N m/rad", 10.0, 10000.0, default=115.0,
+                 description="torsion bar of the torque sensor, in series with the column",
+                 source="assumed: 2 N m/deg; EPS torsion bars 1.5-3 N m/deg, 85-170 N m/rad (Harrer & Pfeffer, "
+                        "ch. 8.5)"),
+        Quantity(f"{name}.reduction_ratio", ratio_unit, lo, hi, default=ratio,
+                 description="motor angle per unit of the point of action's travel", source=ratio_source),
+        Quantity(f"{name}.efficiency", "1", 0.0, 1.0, default=efficiency,
+                 description="forward efficiency of the reduction (worm gear or ball nut)",
+                 source="assumed: worm gears of EPS 0.75-0.9 (Kim, Mech. Sci. 9, 201, 2018), ball nuts 0.9-0.95"),
+        Quantity(f"{name}.motor_torque_limit", "N m", 0.0, 30.0, default=limit,
+                 description="peak torque of the motor (the boost curve's saturation)",
+                 source="assumed: EPS motors 3-6 N m peak at 60-100 A on 12 V (Harrer & Pfeffer, ch. 8.6)"),
+        Quantity(f"{name}.limit_smoothing", "N m", 0.0, 1.0, default=0.05,
+                 description="width over which the motor limit's corners are rounded (motor torque)",
+                 source="numerical: about 1 % of the limit"),
+        Quantity(f"{name}.torque_constant", "N m/A", 0.0, 1.0, default=0.05,
+                 description="motor torque per ampere of current",
+                 source="assumed: 12 V EPS motors 0.03-0.07 N m/A (4 N m at 80 A; Harrer & Pfeffer, ch. 8.6)"),
+        Quantity(f"{name}.motor_inertia", "kg m^2", 0.0, 0.01, lower_inclusive=True, default=inertia,
+                 description="rotor inertia about its axis",
+                 source="assumed: brushless EPS rotors 1-5e-4 kg m^2 (Harrer & Pfeffer, ch. 8.6)"),
+        Quantity(f"{name}.motor_friction_torque", "N m", 0.0, 1.0, lower_inclusive=True, default=0.02,
+                 description="Coulomb friction of the rotor's bearings and seals, at the motor",
+                 source="assumed: 0.01-0.05 N m for EPS motors (Harrer & Pfeffer, ch. 8.6)"),
+    )
+
+
+class ElectricAssist(Effect):
+    """An electric assist; its point of action (``column``, ``pinion``, ``rack``) is chosen by :meth:`at`, which
+    gives the effect class of that point (its name, quantities and description are class attributes, so that an
+    instance keeps no state; module docstring)."""
+
+    location: ClassVar[str] = ""
+    in_default_set = False
+    diagnosis_candidate = False
+    power_assist = True  # the simulation's rack force leaves its contribution out (the gear's own push)
+    replaces = "column_deflection"
+
+    @classmethod
+    def at(cls, location: str) -> type[ElectricAssist]:
+        """The electric assist acting at `location`, one of :data:`LOCATIONS`."""
+        if location not in LOCATIONS:
+            raise ValueError(f"electric assist at {location!r}: the point of action is one of {', '.join(LOCATIONS)}")
+        name = f"electric_assist_{location}"
+        quantities = assist_quantities(name, location)
+        return type(f"ElectricAssist{location.title()}", (cls,), {
+            "location": location,
+            "name": name,
+            "description": (
+                f"Electric power assistance at the {location}: torsion bar in series with the column, boost curve "
+                "(gain beyond a dead band, motor torque limit) through a reduction with its efficiency, rotor "
+                "inertia and friction; off by default"),
+            "quantities": quantities,
+            "uses": (*(q.key for q in quantities), "steering.column_torsional_stiffness",
+                     "steering.handwheel_to_rack_ratio", "steering.friction_smoothing"),
+            "__module__": cls.__module__,
+        })
+
+    def q(self, model, name: str):
+        return model.p(f"{self.name}.{name}")
+
+    def deflection(self, model, twist):
+        return series_deflection(model, twist, f"{self.name}.torsion_bar_stiffness")
+
+    def configure(self, model):
+        model.state(self).frame = None
+
+    def _motor_frame(self, model):
+        state = model.state(self)
+        if state.frame is None:
+            k = model.kinematics
+            x, rate = point_of_action(model, self.location)
+            frame = me.ReferenceFrame(f"motor_{self.name}")
+            frame.orient_axis(k.B, k.B.y, self.q(model, "reduction_ratio") * x)
+            frame.set_ang_vel(k.B, self.q(model, "reduction_ratio") * rate * k.B.y)
+            state.frame = frame
+        return state.frame
+
+    def sensor_torque(self, model):
+        return torsion_bar_torque(model, self.location)
+
+    def motor_torque(self, model):
+        scale = model.p("steering.handwheel_to_rack_ratio") if self.location == "rack" else 1
+        demand = self.q(model, "gain") * deadband(self.sensor_torque(model), self.q(model, "dead_band"),
+                                                  self.q(model, "dead_band_smoothing")) * scale
+        at_motor = demand / (self.q(model, "efficiency") * self.q(model, "reduction_ratio"))
+        return clamp(at_motor, self.q(model, "motor_torque_limit"), self.q(model, "limit_smoothing"))
+
+    def bodies(self, model):
+        k = model.kinematics
+        rotor = me.RigidBody(f"rotor_{self.name}", k.rack_housing_point, self._motor_frame(model), sp.S.Zero,
+                             (self.q(model, "motor_inertia") * me.outer(k.B.y, k.B.y), k.rack_housing_point))
+        return [rotor]
+
+    def loads(self, model):
+        k = model.kinematics
+        frame = self._motor_frame(model)
+        _, rate = point_of_action(model, self.location)
+        # the friction is smoothed over the rack speed the rotor's speed corresponds to
+        rack_speed = rate if self.location == "rack" else rate / model.p("steering.handwheel_to_rack_ratio")
+        friction = self.q(model, "motor_friction_torque") * sp.tanh(model.p("steering.friction_smoothing")
+                                                                     * rack_speed)
+        delivered = self.q(model, "efficiency") * self.motor_torque(model)
+        # Motor torque (less the gear's loss) and bearing friction on the rotor, reacted on the body.
+        return torque_between(delivered - friction, k.B.y, frame, k.B)
+
+    def outputs(self, model):
+        motor = self.motor_torque(model)
+        at_x = self.q(model, "efficiency") * self.q(model, "reduction_ratio") * motor
+        return [
+            ("torsion_bar_torque_Nm", self.sensor_torque(model)),
+            ("assist_force_N" if self.location == "rack" else "assist_torque_Nm", at_x),
+            ("motor_torque_Nm", motor),
+            ("motor_current_A", motor / self.q(model, "torque_constant")),
+        ]
+
+
+EFFECT = ElectricAssist.at("column")()

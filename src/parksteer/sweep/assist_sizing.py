@@ -1,0 +1,122 @@
+"""Assist sizing: the rack force a car needs at standstill and creeping, and the motor (or pressure) that keeps
+the driver's torque under a target over the lock-to-lock cycle.
+
+For each speed the car runs the cycle without assistance, the tyre rolling at that speed (the turn_slip effect,
+exactly today's model at 0 km/h). The rack force is the handwheel torque through the gear,
+F = T d(theta_c)/d(rack): quasi-statically the force the pinion must put on the rack. To leave the driver at most
+T_target, the assist must carry the excess E = max(|T| - T_target, 0) of the column torque; at its point of action
+
+    column: E (N m),   pinion: E d(theta_c)/d(rack) / G_hr (N m),   rack: E d(theta_c)/d(rack) (N),
+
+and its motor, through the reduction N of efficiency eta and against its own friction T_f, must give
+T_m = (A / N + T_f) / eta with A the peak of that demand; the current is T_m / k_t. A hydraulic gear needs the
+pressure E d(theta_c)/d(rack) / A_piston. This is the quasi-static demand; the check runs the cycle again with the
+assist sized so (a boost gain that meets the target at the peak beyond the file's dead band, the motor limit or
+relief pressure 10 % above the demand) and gives the driver's peak torque that results.
+
+The assist's values are the vehicle file's ``[assist]``, else the assumed defaults of a column assist.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from ..errors import UsageError
+from ..model.numeric.assist import check_assist
+from ..model.numeric.simulate import SimulationResult, simulate
+from ..model.symbolic.components import discover_effects
+from ..parameters import Parameters
+from ..vehicle import ASSIST_EFFECTS, ASSISTED_EFFECTS, CREEPING_EFFECTS
+
+SPEEDS_KMH = (0.0, 1.0, 3.0, 5.0)
+MARGIN = 1.1  # the sized motor limit or relief pressure over the quasi-static demand
+
+
+@dataclasses.dataclass
+class SizingRow:
+    speed_kmh: float
+    peak_rack_force_N: float
+    peak_handwheel_manual_Nm: float
+    demand: float  # the peak assist at its point of action: N m (column, pinion) or N (rack, hydraulic)
+    motor_torque_Nm: float  # electric; NaN for hydraulic
+    motor_current_A: float  # electric; NaN for hydraulic
+    pressure_Pa: float  # hydraulic; NaN for electric
+    gain: float  # the boost gain (electric) or the valve's equivalent gain A k_v / G_hr (hydraulic) of the check
+    peak_handwheel_assisted_Nm: float
+
+
+@dataclasses.dataclass
+class SizingStudy:
+    assist: str
+    case: str
+    target_torque_Nm: float
+    rows: list[SizingRow]
+    standstill_manual: SimulationResult
+    standstill_assisted: SimulationResult
+
+    def columns(self) -> dict[str, np.ndarray]:
+        return {f.name: np.array([getattr(r, f.name) for r in self.rows]) for f in dataclasses.fields(SizingRow)}
+
+
+def _peak(values: np.ndarray) -> float:
+    return float(np.max(np.abs(values)))
+
+
+def _speed(speed_kmh: float) -> dict:
+    return {"turn_slip.vehicle_speed": speed_kmh / 3.6}
+
+
+def demand_at_action(name: str, params: Parameters, torque_Nm: np.ndarray, per_rack: np.ndarray,
+                     target_Nm: float) -> np.ndarray:
+    """The assist at its point of action that leaves the driver `target_Nm` (module docstring), per sample."""
+    excess = np.maximum(np.abs(torque_Nm) - target_Nm, 0.0)
+    if name == ASSIST_EFFECTS["column"]:
+        return excess
+    if name == ASSIST_EFFECTS["pinion"]:
+        return excess * per_rack / params["steering.handwheel_to_rack_ratio"]
+    return excess * per_rack  # a force on the rack: rack motor or piston
+
+
+def size_assist(params: Parameters, case: str, target_torque_Nm: float, speeds_kmh=SPEEDS_KMH,
+                assist: str | None = None) -> SizingStudy:
+    """The sizing study of the car of `params` in load case `case` (module docstring)."""
+    if not target_torque_Nm > 0:
+        raise UsageError(f"--target-torque {target_torque_Nm:g}: must be positive (N m)")
+    discover_effects()  # the assists' own quantities, with their assumed defaults
+    name = assist or check_assist(params) or ASSIST_EFFECTS["column"]
+    v = lambda key: float(params[f"{name}.{key}"])  # noqa: E731
+    hydraulic = name == ASSIST_EFFECTS["hydraulic"]
+    band = v("dead_band")
+    if not target_torque_Nm > band:
+        raise UsageError(f"--target-torque {target_torque_Nm:g}: must exceed the assist's dead band {band:g} N m")
+    ratio = float(params["steering.handwheel_to_rack_ratio"])
+    rows, manual0, assisted0 = [], None, None
+    for speed in speeds_kmh:
+        manual = simulate(case, effects=CREEPING_EFFECTS, overrides=_speed(speed), params=params)
+        c = manual.columns
+        per_rack = manual.model.evaluate_outputs(c["time_s"], manual.states, manual.parameter_vector)[
+            "column_angle_per_rack_rad_per_m"]
+        torque = c["handwheel_torque_Nm"]
+        peak_manual = _peak(torque)
+        demand = float(np.max(demand_at_action(name, params, torque, per_rack, target_torque_Nm)))
+        # the boost gain that meets the target at the peak: T = (T_peak + G D) / (1 + G)
+        gain = max(peak_manual - target_torque_Nm, 0.0) / (target_torque_Nm - band)
+        if hydraulic:
+            motor = current = float("nan")
+            pressure = demand / v("piston_area")
+            sized = {f"{name}.valve_slope": gain * ratio / v("piston_area"),
+                     f"{name}.relief_pressure": max(MARGIN * pressure, 1.0e5)}
+        else:
+            pressure = float("nan")
+            motor = (demand / v("reduction_ratio") + v("motor_friction_torque")) / v("efficiency")
+            current = motor / v("torque_constant")
+            sized = {f"{name}.gain": gain, f"{name}.motor_torque_limit": MARGIN * motor}
+        kind = next(k for k, e in ASSIST_EFFECTS.items() if e == name)
+        assisted = simulate(case, effects=ASSISTED_EFFECTS[kind], overrides={**_speed(speed), **sized}, params=params)
+        rows.append(SizingRow(speed, _peak(torque * per_rack), peak_manual, demand, motor, current, pressure, gain,
+                              _peak(assisted.columns["handwheel_torque_Nm"])))
+        if manual0 is None:
+            manual0, assisted0 = manual, assisted
+    return SizingStudy(name, case, target_torque_Nm, rows, manual0, assisted0)
