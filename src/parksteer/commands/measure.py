@@ -206,7 +206,8 @@ def _with_signature(args, result: dict, diagnosis, params, settings) -> dict:
     from ..diagnose.signature import signature_of
 
     calibration = diagnosis.calibration
-    signature = signature_of(diagnosis.problem.files, calibration.predictions, params, calibration.overrides)
+    signature = signature_of(diagnosis.problem.files, calibration.predictions, params, calibration.overrides,
+                             calibration.jacobian)
     suggestion = None
     if args.suggest_effect and diagnosis.verdict == "unexplained" and signature.effect_class is not None:
         from ..diagnose.suggest import suggest

@@ -123,7 +123,7 @@ def run_case(params: Parameters, case: SignatureCase, design: SignatureDesign, f
     diagnosis = diagnose(load_files([path], params), params, settings=BENCHMARK_SETTINGS)
     diagnosed = time.perf_counter()
     sig = signature_of(diagnosis.problem.files, diagnosis.calibration.predictions, params,
-                       diagnosis.calibration.overrides)
+                       diagnosis.calibration.overrides, diagnosis.calibration.jacobian)
     signed = time.perf_counter()
     suggestion = None
     if sig.effect_class is not None and (truth["form"] is not None or diagnosis.verdict == "unexplained"):

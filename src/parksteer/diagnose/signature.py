@@ -66,7 +66,7 @@ class SignatureSettings:
     """The bases and thresholds of the signature.
 
     ``position_knots``: the knot counts of the position bases, nested (5 knots resolve a force that grows toward
-    lock, 15 one localised over a sixth of the stroke). ``speed_knots``: knots of the speed-magnitude basis.
+    lock, 15 one localised over a sixth of the stroke, 27 a notch a few millimetres wide). ``speed_knots``: knots of the speed-magnitude basis.
     ``column_orders``: the column-angle orders tried, each tuple one model: once per turn (an out-of-balance
     part, an eccentric bearing), twice (a joint), both, and a tooth-mesh order (``mesh_order``: a pinion of
     7 teeth, the middle of the 6-8 of passenger-car rack-and-pinion gears, ripples 7 times per pinion turn).
@@ -74,7 +74,7 @@ class SignatureSettings:
     ``significance``: the p-value below which an axis counts as significant.
     """
 
-    position_knots: tuple[int, ...] = (5, 9, 15)
+    position_knots: tuple[int, ...] = (5, 9, 15, 27)
     speed_knots: int = 6
     mesh_order: int = 7
     column_orders: tuple[tuple[int, ...], ...] = ((1,), (2,), (1, 2))
@@ -244,12 +244,17 @@ def bases(axes: Axes, settings: SignatureSettings = DEFAULT_SIGNATURE_SETTINGS) 
     return out
 
 
-def _fit(columns: np.ndarray, weighted: np.ndarray, sigma: np.ndarray) -> tuple[np.ndarray, float]:
-    """Weighted least squares of the weighted residual on `columns` / sigma: (coefficients, leftover RSS)."""
+def _fit(columns: np.ndarray, weighted: np.ndarray, sigma: np.ndarray, nuisance: np.ndarray | None = None
+         ) -> tuple[np.ndarray, float]:
+    """Weighted least squares of the weighted residual on `columns` / sigma and the `nuisance` columns (already
+    weighted): (the coefficients of `columns`, leftover RSS)."""
     design = columns / sigma[:, None]
+    k = design.shape[1]
+    if nuisance is not None and nuisance.shape[1]:
+        design = np.column_stack([design, nuisance])
     coefficients = pm.lstsq(design, weighted)
     left = weighted - pm.matmul(design, coefficients)
-    return coefficients, pm.dot(left, left)
+    return coefficients[:k], pm.dot(left, left)
 
 
 def _lag1(values: np.ndarray, record: np.ndarray) -> float:
@@ -288,22 +293,32 @@ def _axis_groups(axes: Axes, models: list[Basis]) -> list[tuple[str, np.ndarray]
 
 
 def signature_from_axes(axes: Axes, settings: SignatureSettings = DEFAULT_SIGNATURE_SETTINGS,
-                        calibrated_rack_friction_N: float | None = None) -> Signature:
+                        calibrated_rack_friction_N: float | None = None, nuisance: np.ndarray | None = None
+                        ) -> Signature:
     """The signature of the residual on `axes` (module docstring). `calibrated_rack_friction_N`, if given, is
-    what a dissipative change along the stroke is stated relative to."""
+    what a dissipative change along the stroke is stated relative to.
+
+    `nuisance` (samples x p, in weighted units): the calibration's sensitivities d(model / sigma)/d(theta). Every
+    basis is fitted beside them, so that a shape counts by what the calibrated parameters cannot take up when
+    they are fitted again with it (as the suggested effect will be): the calibration has already absorbed the
+    part of the truth along its own directions, and the residual is the truth less that projection, which a
+    basis alone would have to mimic."""
     sigma = np.asarray(axes.sigma_Nm, dtype=float)
     weighted = np.asarray(axes.residual_Nm, dtype=float) / sigma
     n = weighted.size
-    rss0 = pm.dot(weighted, weighted)
+    if nuisance is not None and nuisance.shape[0] != n:
+        raise UsageError(f"signature: {nuisance.shape[0]} rows of sensitivities for {n} samples")
+    _, rss0 = _fit(np.zeros((n, 0)), weighted, sigma, nuisance)
     models = bases(axes, settings)
     groups = _axis_groups(axes, models)
-    union = np.column_stack([b.columns for b in models])
-    design = union / sigma[:, None]
+    design = np.column_stack([b.columns for b in models]) / sigma[:, None]
+    if nuisance is not None:
+        design = np.column_stack([design, nuisance])
     left = weighted - pm.matmul(design, pm.lstsq(design, weighted))
     rho = _lag1(left, axes.record)
     n_eff = effective_samples(n, rho)
 
-    fits = [_fit(b.columns, weighted, sigma) for b in models]
+    fits = [_fit(b.columns, weighted, sigma, nuisance) for b in models]
     scores = []
     for b, (_, rss) in zip(models, fits):
         k = b.columns.shape[1]
@@ -312,7 +327,7 @@ def signature_from_axes(axes: Axes, settings: SignatureSettings = DEFAULT_SIGNAT
     shares = []
     excess = rss0 - n
     for name, columns in groups:
-        _, rss = _fit(columns, weighted, sigma)
+        _, rss = _fit(columns, weighted, sigma, nuisance)
         k = columns.shape[1]
         statistic = (rss0 - rss) * n_eff / n
         p = float(chi2.sf(statistic, k))
@@ -409,13 +424,22 @@ def describe(axes: Axes, best: Basis, coefficients, friction_N: float | None) ->
 
 
 def signature_of(files, predictions: list[np.ndarray], params: Parameters, overrides: dict[str, float] | None = None,
-                 settings: SignatureSettings = DEFAULT_SIGNATURE_SETTINGS) -> Signature:
+                 jacobian: np.ndarray | None = None, settings: SignatureSettings = DEFAULT_SIGNATURE_SETTINGS
+                 ) -> Signature:
     """The signature of the torque residual of a diagnosis's files (:class:`parksteer.diagnose.problem.FileData`)
     under the calibrated model's `predictions`, with the model's parameters `params` and `overrides` (the
-    calibration's values)."""
+    calibration's values) and, if given, the calibration's `jacobian` (``Fit.jacobian``: its sensitivities,
+    fitted beside every basis, :func:`signature_from_axes`)."""
     axes = axes_of(files, predictions, params, overrides)
     values = {**_steering(params), **(overrides or {})}
-    return signature_from_axes(axes, settings, values.get("steering.rack_friction_force"))
+    nuisance = None
+    if jacobian is not None:  # the torque's rows of each file's block (a fitted angle's rows follow them)
+        rows, start = [], 0
+        for f in files:
+            rows.append(np.arange(start, start + f.n))
+            start += f.m
+        nuisance = np.asarray(jacobian, dtype=float)[np.concatenate(rows)]
+    return signature_from_axes(axes, settings, values.get("steering.rack_friction_force"), nuisance)
 
 
 def _steering(params: Parameters) -> dict[str, float]:
