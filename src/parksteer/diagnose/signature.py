@@ -378,7 +378,7 @@ def describe(axes: Axes, best: Basis, coefficients, friction_N: float | None) ->
     G = axes.ratio_rad_m
     c = np.asarray(coefficients, dtype=float)
     if best.family == "column":
-        amplitudes = {m: float(np.hypot(c[2 * i], c[2 * i + 1])) for i, m in enumerate(best.orders)}
+        amplitudes = {m: float(pm.hypot(c[2 * i], c[2 * i + 1])) for i, m in enumerate(best.orders)}
         top = max(amplitudes, key=amplitudes.get)
         orders = " and ".join(f"{m} per column turn ({amplitudes[m]:.3g} N m)" for m in best.orders)
         return (f"a torque on the steering column periodic in the column angle, {orders}",
