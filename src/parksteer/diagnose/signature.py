@@ -470,7 +470,3 @@ def axes_of(files, predictions: list[np.ndarray], params: Parameters, overrides:
                 np.concatenate(parts["phase"]), np.concatenate(parts["record"]), np.concatenate(parts["r"]),
                 np.concatenate(parts["sigma"]), tuple((f.case, f.surface) for f in files),
                 values["steering.friction_smoothing"], ratio)
-
-
-def rms_over_floor(weighted: np.ndarray) -> float:
-    return math.sqrt(float(np.mean(np.asarray(weighted) ** 2)))

@@ -14,7 +14,8 @@ used), written as sympy expressions code generation takes (exp, tanh, sin, cos; 
 - column: a torque on the column ``sum_m a_m sin(m theta_c) + b_m cos(m theta_c)`` (its phase free).
 
 Every strength is 0 by default, so that the file loaded as it stands is the base model exactly; the fitted
-values are written beside them (``FITTED``, and a ``--set`` line in the docstring). The strengths are signed
+values are written beside them (``FITTED``, used as the defaults when the file's ``FITTED_AS_DEFAULTS`` is set
+to True, and a ``--set`` line for ``parksteer compare`` in the docstring). The strengths are signed
 (a force may be larger or smaller than the calibrated model's along the axis); each is fitted as it stands,
 together with the calibrated parameters, by the diagnosis's Levenberg-Marquardt
 (:func:`parksteer.diagnose.calibrate.least_squares`), from the calibrated values and zero strengths.
@@ -84,14 +85,15 @@ def effect_source(signature: Signature, fitted: dict[str, float] | None = None, 
     fitted_line = ""
     if fitted:
         fitted_line = ("\nFitted with the calibrated parameters to the records it was suggested for (weighted RMS "
-                       "{before:.2f} -> {after:.2f} noise floors)::\n\n    --effects=+THIS_FILE.py "
+                       "{before:.2f} -> {after:.2f} noise floors)::\n\n    parksteer compare RUN.csv "
+                       "--effects=+THIS_FILE.py "
                        + " ".join(f"--set {k}={v:.6g}" for k, v in fitted.items() if k in keys) + "\n")
     header = f'''"""Suggested by parksteer diagnose --suggest-effect from the residual's signature: {signature.sentence}.
 
 A {kind} effect (class {kind!r} of parksteer.diagnose.signature), its magnitude shaped by {len(keys)} strength(s)
 along the axis the signature found. Every strength is 0 by default: loaded as it stands, this file is the base
-model exactly. Edit the form as the physics you know suggests; fit the strengths with
-``parksteer diagnose RUN.csv --effects=+THIS_FILE.py`` (as strengths) or set them with ``--set``.
+model exactly. Set FITTED_AS_DEFAULTS below to True and it is the fitted model (FITTED); or replay it with
+``parksteer compare RUN.csv`` and the ``--set`` line below. Edit the form as the physics you know suggests.
 {{fitted}}"""
 
 from __future__ import annotations
@@ -104,6 +106,9 @@ from parksteer.parameters import Quantity
 
 NAME = {name!r}
 STRENGTHS = {tuple(keys)!r}
+# Fitted with the calibrated parameters to the records it was suggested for; the defaults when True.
+FITTED = {{fitted_values}}
+FITTED_AS_DEFAULTS = False
 '''
     if kind == "column":
         body = f'''ORDERS = {tuple(best.orders)!r}  # per column turn
@@ -115,7 +120,8 @@ class Suggested(Effect):
         str(m) for m in ORDERS) + " (per turn); 0 = absent"
     in_default_set = False
     diagnosis_candidate = False
-    quantities = tuple(Quantity(key, "N m", -{bound!r}, {bound!r}, lower_inclusive=True, default=0.0,
+    quantities = tuple(Quantity(key, "N m", -{bound!r}, {bound!r}, lower_inclusive=True,
+                                default=FITTED.get(key, 0.0) if FITTED_AS_DEFAULTS else 0.0,
                                 source="suggested from the residual's signature; 0 = absent") for key in STRENGTHS)
     uses = STRENGTHS
 
@@ -154,7 +160,8 @@ class Suggested(Effect):
     description = "Suggested: a force on the rack, {what}; 0 = absent"
     in_default_set = False
     diagnosis_candidate = False
-    quantities = tuple(Quantity(key, "N", -{bound!r}, {bound!r}, lower_inclusive=True, default=0.0,
+    quantities = tuple(Quantity(key, "N", -{bound!r}, {bound!r}, lower_inclusive=True,
+                                default=FITTED.get(key, 0.0) if FITTED_AS_DEFAULTS else 0.0,
                                 source="suggested from the residual's signature; 0 = absent") for key in STRENGTHS)
     uses = STRENGTHS + ("steering.friction_smoothing",)
 
@@ -168,8 +175,8 @@ class Suggested(Effect):
         return action_reaction(k.rack_point, -force * k.B.y, k.rack_housing_point)
 '''
     text = header + body + "\n\nEFFECT = Suggested()\n"
-    if fitted:
-        text += "\nFITTED = {" + ", ".join(f"{k!r}: {fitted[k]!r}" for k in keys) + "}\n"
+    values = "{" + ", ".join(f"{k!r}: {fitted[k]!r}" for k in keys) + "}" if fitted else "{}"
+    text = text.replace("{fitted_values}", values)
     return text.replace("{fitted}", fitted_line.format(before=fitted.get("_before", math.nan),
                                                          after=fitted.get("_after", math.nan)) if fitted else "")
 
