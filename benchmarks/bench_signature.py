@@ -1,7 +1,7 @@
 """The signature benchmark: out-of-library effects and nulls, diagnosed; the signature's class and the suggested
 effect scored per signature class, and the time the signature and the suggestion add to one diagnosis.
 
-    python benchmarks/bench_signature.py [--steps 5] [--nulls 4] [--json OUT.json]
+    python benchmarks/bench_signature.py [--steps 5] [--nulls 4] [--seed 2411] [--first-variation 0] [--json OUT.json]
 
 The grid (parksteer.diagnose.outoflibrary.SignatureDesign): the ten truth forms of
 parksteer.synthetic.outoflibrary at each size, on the first six variations of the variation benchmark in
@@ -24,12 +24,16 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--steps", type=float, nargs="+", default=[5.0], help="truth sizes, converter steps RMS")
     parser.add_argument("--nulls", type=int, default=4)
+    parser.add_argument("--seed", type=int, default=2411, help="hands, noise and base perturbation: seed + k")
+    parser.add_argument("--first-variation", type=int, default=0,
+                        help="the records take the six variations from this place of VARIATIONS on (0 or 6)")
     parser.add_argument("--only", nargs="*", help="case names to run (default: all)")
     parser.add_argument("--json", help="write the rows and the summary here")
     parser.add_argument("--keep", help="write the records into this folder (default: a temporary one)")
     args = parser.parse_args(argv)
     params = load_parameters()
-    design = SignatureDesign(steps=tuple(args.steps), nulls=args.nulls)
+    design = SignatureDesign(steps=tuple(args.steps), nulls=args.nulls, seed=args.seed,
+                             first_variation=args.first_variation)
     cases = [c for c in design.cases() if not args.only or c.name in args.only]
     rows = []
     start = time.perf_counter()
