@@ -50,9 +50,10 @@ def main(argv=None) -> int:
     summary = summarise(rows)
     print(f"\n{len(rows)} records ({summary['out_of_library']} out of library, {summary['nulls']} nulls), "
           f"{time.perf_counter() - start:.0f} s")
-    print(f"{'class':12s} {'records':>7s} {'class right':>11s} {'within ' + str(AFTER_LIMIT):>10s}  said")
+    print(f"{'class':12s} {'records':>7s} {'class right':>11s} {'or in group':>11s} {'within ' + str(AFTER_LIMIT):>10s}  said")
     for cls, t in summary["table"].items():
-        print(f"{cls:12s} {t['records']:7d} {t['class_right']:11d} {t['within']:10d}  {', '.join(t['said'])}")
+        print(f"{cls:12s} {t['records']:7d} {t['class_right']:11d} {t['class_in_group']:11d} {t['within']:10d}  "
+              f"{', '.join(t['said'])}")
     print(f"class right {summary['class_right_rate']:.0%} (target 80 %), suggestion within {AFTER_LIMIT} floors "
           f"{summary['within_rate']:.0%} (target 70 %), suggestions on nulls: {summary['suggestions_on_nulls'] or 'none'}")
     t = summary["time_s"]

@@ -187,7 +187,8 @@ def test_the_benchmark_summary_counts_per_class_and_flags_a_suggestion_on_a_null
     rows = [row("column", "column", True), row("column", "elastic", True), row("speed", "speed", False),
             row(None, None, False, form=None, written=True)]
     summary = summarise(rows)
-    assert summary["table"]["column"] == {"records": 2, "class_right": 1, "within": 2, "said": ["column", "elastic"],
+    assert summary["table"]["column"] == {"records": 2, "class_right": 1, "class_in_group": 1, "within": 2,
+                                          "said": ["column", "elastic"],
                                           "verdicts": ["unexplained", "unexplained"]}
     assert summary["class_right_rate"] == pytest.approx(2 / 3)
     assert summary["within_rate"] == pytest.approx(2 / 3)

@@ -142,6 +142,8 @@ def run_case(params: Parameters, case: SignatureCase, design: SignatureDesign, f
         "said_class": sig.effect_class,
         "sentence": sig.sentence,
         "class_right": truth["class"] is not None and sig.effect_class == truth["class"],
+        "class_in_group": truth["class"] is not None and truth["class"] in (sig.effect_class, *sig.indistinguishable),
+        "indistinguishable": list(sig.indistinguishable),
         "calibrated_over_floor": stats["weighted_rms_Nm"] / stats["noise_floor_Nm"],
         "after_over_floor": suggestion.after_over_floor if suggestion else None,
         "within": bool(suggestion and suggestion.after_over_floor <= AFTER_LIMIT),
@@ -160,6 +162,7 @@ def summarise(rows: list[dict]) -> dict:
     for cls in sorted({r["class"] for r in hidden}):
         rs = [r for r in hidden if r["class"] == cls]
         table[cls] = {"records": len(rs), "class_right": sum(r["class_right"] for r in rs),
+                      "class_in_group": sum(r.get("class_in_group", r["class_right"]) for r in rs),
                       "within": sum(r["within"] for r in rs),
                       "said": [r["said_class"] or "none" for r in rs],
                       "verdicts": [r["verdict"] + (f" {r['named']}" if r["named"] else "") for r in rs]}

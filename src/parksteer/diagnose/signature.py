@@ -70,7 +70,9 @@ class SignatureSettings:
     ``column_orders``: the column-angle orders tried, each tuple one model: once per turn (an out-of-balance
     part, an eccentric bearing), twice (a joint), both, and a tooth-mesh order (``mesh_order``: a pinion of
     7 teeth, the middle of the 6-8 of passenger-car rack-and-pinion gears, ripples 7 times per pinion turn).
-    ``bic_threshold``: the BIC gain over the null that names a class (the diagnosis's bic_missing_threshold).
+    ``bic_threshold``: the BIC gain over the null that names a class (the diagnosis's bic_missing_threshold);
+    ``bic_indistinguishable``: another class whose best model comes within this of the best is reported as
+    indistinguishable by these data (the diagnosis's band).
     ``significance``: the p-value below which an axis counts as significant.
     """
 
@@ -79,6 +81,7 @@ class SignatureSettings:
     mesh_order: int = 7
     column_orders: tuple[tuple[int, ...], ...] = ((1,), (2,), (1, 2))
     bic_threshold: float = 10.0
+    bic_indistinguishable: float = 6.0
     significance: float = 1e-3
 
 
@@ -168,6 +171,7 @@ class Signature:
     coefficients: tuple[float, ...]  # of the best basis, N m per unit column
     sentence: str
     numbers: dict = field(default_factory=dict)
+    indistinguishable: tuple[str, ...] = ()  # other classes within bic_indistinguishable of the best
 
     def as_dict(self) -> dict:
         """Plain JSON."""
@@ -177,6 +181,7 @@ class Signature:
             "model": self.best.label if self.best is not None else None,
             "sentence": self.sentence,
             "numbers": self.numbers,
+            "indistinguishable": list(self.indistinguishable),
             "samples": self.samples,
             "rho": self.rho,
             "n_eff": self.n_eff,
@@ -343,11 +348,16 @@ def signature_from_axes(axes: Axes, settings: SignatureSettings = DEFAULT_SIGNAT
     best = models[best_index]
     coefficients = fits[best_index][0]
     sentence, numbers = describe(axes, best, coefficients, calibrated_rack_friction_N)
+    group = tuple(sorted({m.family for m in scores if m.family != best.family
+                          and m.delta_bic >= best_score.delta_bic - settings.bic_indistinguishable}))
+    if group:
+        sentence += (f"; these data cannot tell it from the {' or '.join(group)} class (BIC within "
+                     f"{settings.bic_indistinguishable:g})")
     numbers.update({"delta_bic": best_score.delta_bic,
                     "share": float((rss0 - best_score.rss) / rss0),
                     "excess_share": float((rss0 - best_score.rss) / excess) if excess > 0 else None})
     return Signature(n, float(rss0), float(rho), float(n_eff), tuple(shares), tuple(scores), best.family, best,
-                     tuple(float(c) for c in coefficients), sentence, numbers)
+                     tuple(float(c) for c in coefficients), sentence, numbers, group)
 
 
 def shape_on(best: Basis, coefficients, grid: np.ndarray) -> np.ndarray:
