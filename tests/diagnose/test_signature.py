@@ -102,6 +102,18 @@ def test_a_position_force_the_same_both_ways_is_elastic():
     assert _axis(sig, "rack position").excess_share > 0.99
 
 
+def test_a_force_growing_with_the_speed_is_read_as_viscous():
+    """A rack drag c v |v| (quadratic in the speed, 0 at rest): the speed class, growing with the speed, its
+    force near the 90th-percentile speed larger than at low speed."""
+    x, v, noise = _cycle(seed=4)
+    scale = float(np.quantile(np.abs(v), 0.9))
+    residual = 80.0 / G * (v / scale) * np.abs(v / scale) + noise
+    sig = signature_from_axes(_axes(x, v, residual))
+    assert sig.effect_class == "speed"
+    assert "viscous-like" in sig.numbers["kind"]
+    assert sig.numbers["high_speed_force_N"] > 3.0 * sig.numbers["low_speed_force_N"] > 0.0
+
+
 def test_white_noise_at_the_floor_has_no_signature():
     """A perfect model leaves white noise at the floor: no class, and no axis significant at p < 1e-3 (five
     seeds)."""
