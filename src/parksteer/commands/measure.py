@@ -78,12 +78,19 @@ def register(sub) -> None:
     p.add_argument("--torque-lag", action="store_true",
                    help="search each file for a lag of the torque channel behind the rack channel (up to 40 ms) and "
                         "replay the model at the instants the torque was sampled (for a logger known to delay it)")
+    p.add_argument("--suggest-effect", default=None, metavar="OUT.py",
+                   help="when the verdict is unexplained, write the effect the residual's signature points to as a "
+                        "user-effect file (its strengths fitted with the calibrated parameters; pass it back with "
+                        "--effects=+OUT.py); no file when the verdict is adequate or names a candidate")
     p.set_defaults(func=_diagnose)
 
 
 def _check_outputs(args) -> None:
-    for option in ("plot", "report", "html"):
+    if getattr(args, "suggest_effect", None) is not None and not args.suggest_effect.endswith(".py"):
+        raise UsageError(f"--suggest-effect {args.suggest_effect}: the effect is a Python module; name it .py")
+    for option in ("plot", "report", "html", "suggest_effect"):
         value = getattr(args, option, None)
+        option = option.replace("_", "-")
         if value is not None:
             if Path(value).is_dir():
                 raise UsageError(f"--{option} {value}: is a directory; name a file to write")
@@ -152,8 +159,9 @@ def _diagnose(args) -> int:
     from ..model.symbolic.components import resolve_effects
 
     _check_outputs(args)
-    if not (args.json or args.report or args.plot or args.html):
-        raise UsageError("say where the result goes: --json, --report OUT.md, --html OUT.html and/or --plot OUT.svg")
+    if not (args.json or args.report or args.plot or args.html or args.suggest_effect):
+        raise UsageError("say where the result goes: --json, --report OUT.md, --html OUT.html, --plot OUT.svg and/or "
+                         "--suggest-effect OUT.py")
     params = parameters_of(args)
     effects = resolve_effects(args.effects)
     files = load_files(args.files, params, args.case, args.surface, channel_map_of(args))
@@ -186,7 +194,7 @@ def _diagnose(args) -> int:
             print(f"handwheel angle fitted beside the torque in {len(with_angle)} of {len(files)} file(s): "
                   + ", ".join(with_angle), file=sys.stderr)
     diagnosis = diagnose(files, params, effects, workers=workers, quiet=args.quiet, settings=settings)
-    result = diagnosis_dict(diagnosis)
+    result = _with_signature(args, diagnosis_dict(diagnosis), diagnosis, params, settings)
     if args.plot:
         from ..figures.diagnose import diagnosis_figure
 
@@ -202,6 +210,30 @@ def _diagnose(args) -> int:
     if args.json:
         _print_json(result)
     return 0
+
+
+def _with_signature(args, result: dict, diagnosis, params, settings) -> dict:
+    """The residual's signature beside any verdict; with --suggest-effect and an unexplained verdict, the
+    suggested effect written and fitted (parksteer.diagnose.signature, parksteer.diagnose.suggest)."""
+    from ..diagnose.report import with_signature
+    from ..diagnose.signature import signature_of
+
+    calibration = diagnosis.calibration
+    signature = signature_of(diagnosis.problem.files, calibration.predictions, params, calibration.overrides,
+                             calibration.jacobian)
+    suggestion = None
+    if args.suggest_effect and diagnosis.verdict == "unexplained" and signature.effect_class is not None:
+        from ..diagnose.suggest import suggest
+
+        suggestion = suggest(diagnosis.problem, calibration, signature, args.suggest_effect, settings)
+        if not args.quiet:
+            print(f"suggested effect {suggestion.effect_name} written to {args.suggest_effect}: weighted RMS "
+                  f"{suggestion.before_over_floor:.2f} -> {suggestion.after_over_floor:.2f} noise floors",
+                  file=sys.stderr)
+    elif args.suggest_effect and not args.quiet:
+        print(f"no effect suggested (verdict {diagnosis.verdict}"
+              + (", no structure in the residual" if signature.effect_class is None else "") + ")", file=sys.stderr)
+    return with_signature(result, signature, suggestion)
 
 
 def _write_html(path: str, diagnosis, result: dict, files, params, workers: int = 1) -> None:

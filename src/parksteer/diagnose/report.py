@@ -335,10 +335,42 @@ def markdown_report(result: dict, figure: str | None = None) -> str:
                   f"by less than a tenth of the noise floor): {', '.join(result['unobservable'])}."]
     if result["untestable"]:
         lines += ["", f"Not testable (no strength parameter): {', '.join(result['untestable'])}."]
+    if result.get("signature"):
+        lines += ["", "## The residual's signature", ""] + [f"- {line}" for line in signature_lines(result)]
     if figure:
         lines += ["", f"![diagnosis]({figure})"]
     lines += ["", f"Cost: {result['cost']['replays']} replays."]
     return "\n".join(lines) + "\n"
+
+
+# --- the residual's signature and the suggested effect (parksteer.diagnose.signature, parksteer.diagnose.suggest)
+def with_signature(result: dict, signature, suggestion=None) -> dict:
+    """`result` (the JSON of a diagnosis) with its residual's signature and, where one was made, the suggested
+    effect and its error ladder (calibrated, then with the suggested effect)."""
+    out = {**result, "signature": _json_safe(signature.as_dict())}
+    if suggestion is not None:
+        out["suggestion"] = _json_safe(suggestion.as_dict())
+    return out
+
+
+def signature_lines(result: dict) -> list[str]:
+    """The signature (and the suggestion) as readable lines."""
+    sig = result["signature"]
+    lines = [f"What kind of effect: {sig['sentence']}."
+             + (f" (class {sig['class']}, basis {sig['model']}, at the {sig['where']})" if sig["class"] else "")]
+    for a in sig["axes"]:
+        excess = f", {_n(100 * a['excess_share'], 2)} % of the part above the noise" \
+            if a["excess_share"] is not None else ""
+        lines.append(f"{a['axis']}: {_n(100 * a['share'], 2)} % of the weighted residual sum of squares{excess} "
+                     f"(likelihood ratio {_n(a['statistic'])} on {a['columns']} columns, p = {_n(a['p_value'], 2)}"
+                     f"{', significant' if a['significant'] else ''})")
+    suggestion = result.get("suggestion")
+    if suggestion:
+        where = f" written to {suggestion['path']}" if suggestion.get("path") else ""
+        lines.append(f"Suggested effect `{suggestion['effect']}`{where}: fitted with the calibrated parameters it "
+                     f"takes the weighted RMS error from {_n(suggestion['before_over_noise_floor'])} to "
+                     f"{_n(suggestion['after_over_noise_floor'])} noise floors (ΔBIC {_n(suggestion['delta_bic'])}).")
+    return lines
 
 
 def write_markdown(path: str | Path, text: str) -> None:
@@ -452,6 +484,9 @@ def html_report(result: dict, figures: list[tuple[str, str]], phases: list[dict]
     if result.get("identification"):
         out.append("<h2>What these data fix</h2>")
         out += ["<ul>"] + [f"<li>{html.escape(line)}</li>" for line in _identification_lines(result)] + ["</ul>"]
+    if result.get("signature"):
+        out.append("<h2>The residual's signature</h2>")
+        out += ["<ul>"] + [f"<li>{html.escape(line)}</li>" for line in signature_lines(result)] + ["</ul>"]
     out.append("<h2>Ranking of the candidate effects</h2>")
     rows = []
     for c in result["ranking"]:

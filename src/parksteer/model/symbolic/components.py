@@ -25,6 +25,7 @@ taken numerically.
 
 from __future__ import annotations
 
+import hashlib
 import importlib
 import importlib.util
 import inspect
@@ -149,7 +150,10 @@ def load_effect_module(ref: str) -> Effect:
         path = Path(ref)
         if not path.is_file():
             raise UsageError(f"effect module {ref}: no such file")
-        mod_name = f"parksteer_effect_{path.stem}"
+        # The module's name carries a hash of the file's text: the compiled model's cache key names the effect's
+        # class by it (a module loaded from a file is not in sys.modules, so its source cannot be read back), and
+        # an edited file must build its own model.
+        mod_name = f"parksteer_effect_{path.stem}_{hashlib.sha256(path.read_bytes()).hexdigest()[:16]}"
         spec = importlib.util.spec_from_file_location(mod_name, path)
         module = importlib.util.module_from_spec(spec)
         try:

@@ -1,0 +1,482 @@
+"""The residual's signature: what kind of effect the calibrated model lacks, read off the residual's shape.
+
+When no candidate explains the residual, the residual itself still says much about the mechanism behind it.
+A force that opposes the motion reverses with the rack speed (it is *odd* in the speed: dissipative); one that
+depends on where the rack is and not on where it is going is *even* in the speed (elastic); one that acts while
+the rack moves but points the same way whichever way it moves does not reverse (direction-dependent, the even
+part of a moving force). Along the stroke it may be the same everywhere, grow toward lock or sit in one place;
+it may repeat with the column angle (once per turn: an out-of-balance or an eccentric part; twice: a joint; a
+tooth-mesh order); it may grow with the speed (viscous) or fall with it (Stribeck-like).
+
+The decomposition (:func:`signature_from_axes`) regresses the calibrated model's weighted torque residual
+``w_i = (measured_i - model_i) / sigma_i`` on nested bases along these axes, each basis column weighted the
+same way (weighted least squares, :func:`parksteer.portable.lstsq`). With ``s = tanh(beta v)`` the smoothed
+sign of the rack speed (beta the model's friction smoothing), ``x`` the rack position, ``theta`` the column
+angle and radial basis functions ``phi_k(z) = exp(-((z - c_k) / h)^2)`` on knots ``c_k`` spaced ``h``:
+
+- dissipative: ``s``, ``s phi_k(x)`` (K knots over the stroke);
+- elastic: ``phi_k(x)``;
+- direction-dependent: ``s^2``, ``s^2 phi_k(x)`` (zero at rest, the same sign both ways);
+- speed: ``s phi_k(|v| / v_90)`` (v_90 the 90th percentile of |v|): viscous when the shape grows with the
+  speed, Stribeck-like when it falls;
+- column: ``sin(m theta), cos(m theta)`` for the orders m of the settings (once, twice per turn, a mesh
+  order).
+
+Each family member is one model; they compete with the null (no structure) by the information criterion of the
+diagnosis, ``BIC = n_eff ln(RSS / n) + k ln(n_eff)`` with ``n_eff = n (1 - rho) / (1 + rho)`` and rho the lag-1
+autocorrelation of the weighted residual left by all bases together (neighbouring samples of a smooth misfit are
+not independent evidence, :func:`parksteer.diagnose.problem.effective_samples`). The member with the lowest BIC
+names the class; none, when no member beats the null by ``bic_threshold``.
+
+Beside the class, every *axis* (the richest basis of each family, and the cycle phase and the record where
+records differ in load or surface) gets its share of the residual's weighted sum of squares and its
+significance against the noise floor: a perfect model leaves weighted residuals of unit variance, so the sum of
+squares an axis of k columns removes is, without any structure, chi-square with k degrees of freedom -- for
+independent samples. Autocorrelated noise inflates that sum by about n / n_eff (the variance of a slowly varying
+projection of an AR(1) sequence), so the likelihood-ratio statistic is ``LR = Delta RSS n_eff / n`` against
+chi-square(k) (:func:`scipy.stats.chi2.sf`).
+
+A torque residual at the handwheel is turned into a force on the rack by the handwheel-to-rack ratio (a rack
+force F gives a handwheel torque F / G through the rigid column; the Hooke joint's ripple of a few per cent is
+left out of this reading, and in the suggested effect the model has it back).
+
+:func:`signature_of` reads the axes off a diagnosis's files and calibrated predictions; the result is frozen.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.stats import chi2
+
+from .. import portable as pm
+from ..errors import UsageError
+from ..measure.phases import PHASES
+from ..parameters import Parameters
+from .problem import effective_samples
+
+CLASSES = ("dissipative", "elastic", "direction", "speed", "column")
+WHERE = {"dissipative": "rack", "elastic": "rack", "direction": "rack", "speed": "rack", "column": "column"}
+
+
+@dataclass(frozen=True)
+class SignatureSettings:
+    """The bases and thresholds of the signature.
+
+    ``position_knots``: the knot counts of the position bases, nested (5 knots resolve a force that grows toward
+    lock, 15 one localised over a sixth of the stroke, 27 a notch a few millimetres wide). ``speed_knots``: knots of the speed-magnitude basis.
+    ``column_orders``: the column-angle orders tried, each tuple one model: once per turn (an out-of-balance
+    part, an eccentric bearing), twice (a joint), both, and a tooth-mesh order (``mesh_order``: a pinion of
+    7 teeth, the middle of the 6-8 of passenger-car rack-and-pinion gears, ripples 7 times per pinion turn).
+    ``bic_threshold``: the BIC gain over the null that names a class (the diagnosis's bic_missing_threshold);
+    ``bic_indistinguishable``: another class whose best model comes within this of the best is reported as
+    indistinguishable by these data (the diagnosis's band).
+    ``significance``: the p-value below which an axis counts as significant.
+    """
+
+    position_knots: tuple[int, ...] = (5, 9, 15, 27)
+    speed_knots: int = 6
+    mesh_order: int = 7
+    column_orders: tuple[tuple[int, ...], ...] = ((1,), (2,), (1, 2))
+    bic_threshold: float = 10.0
+    bic_indistinguishable: float = 6.0
+    significance: float = 1e-3
+
+
+DEFAULT_SIGNATURE_SETTINGS = SignatureSettings()
+
+
+@dataclass(frozen=True)
+class Axes:
+    """Per-sample coordinates of every record, concatenated: what the residual is decomposed along.
+
+    ``residual_Nm``: measured minus calibrated model torque; ``sigma_Nm``: each sample's attainable error;
+    ``phase``: the cycle-phase label; ``record``: the index of the record; ``conditions``: each record's
+    (load case, surface). ``smoothing_s_m``: beta of the smoothed sign; ``ratio_rad_m``: handwheel-to-rack ratio.
+    """
+
+    rack_m: np.ndarray
+    speed_m_s: np.ndarray
+    column_rad: np.ndarray
+    phase: np.ndarray
+    record: np.ndarray
+    residual_Nm: np.ndarray
+    sigma_Nm: np.ndarray
+    conditions: tuple[tuple[str, str], ...]
+    smoothing_s_m: float
+    ratio_rad_m: float
+
+    def __post_init__(self):
+        n = len(self.residual_Nm)
+        for name in ("rack_m", "speed_m_s", "column_rad", "phase", "record", "sigma_Nm"):
+            if len(getattr(self, name)) != n:
+                raise UsageError(f"signature: axis {name} has {len(getattr(self, name))} samples, the residual {n}")
+        if n < 20:
+            raise UsageError(f"signature: {n} samples are too few to decompose a residual")
+        if not np.all(np.isfinite(self.residual_Nm)) or not np.all(self.sigma_Nm > 0):
+            bad = int(np.flatnonzero(~np.isfinite(self.residual_Nm) | ~(self.sigma_Nm > 0))[0])
+            raise UsageError(f"signature: sample {bad}: residual not finite or attainable error not positive")
+
+
+@dataclass(frozen=True)
+class Basis:
+    """One model of the decomposition: its class, label, columns (samples x k, N m per unit coefficient)."""
+
+    family: str
+    label: str
+    columns: np.ndarray
+    # knots of the shape (m for the rack position, 1 for the speed over v_90) and their spacing; or the orders
+    knots: tuple[float, ...] = ()
+    width: float = 0.0
+    orders: tuple[int, ...] = ()
+
+
+@dataclass(frozen=True)
+class AxisShare:
+    """One axis: the share of the residual's weighted sum of squares it removes, and its significance."""
+
+    axis: str
+    columns: int
+    share: float  # of the weighted residual sum of squares
+    excess_share: float | None  # of the part above the noise (RSS - n); None when there is none
+    statistic: float  # LR = Delta RSS n_eff / n
+    p_value: float
+    significant: bool
+
+
+@dataclass(frozen=True)
+class ModelScore:
+    family: str
+    label: str
+    columns: int
+    rss: float
+    delta_bic: float  # gain over the null (positive: better)
+
+
+@dataclass(frozen=True)
+class Signature:
+    """The residual's signature (module docstring): the axes' shares, the models' BIC gains, the class, its
+    fitted shape and one sentence."""
+
+    samples: int
+    rss: float  # weighted residual sum of squares of the calibrated model
+    rho: float
+    n_eff: float
+    axes: tuple[AxisShare, ...]
+    models: tuple[ModelScore, ...]
+    effect_class: str | None  # one of CLASSES, or None: no structure beyond the noise
+    best: Basis | None
+    coefficients: tuple[float, ...]  # of the best basis, N m per unit column
+    sentence: str
+    numbers: dict = field(default_factory=dict)
+    indistinguishable: tuple[str, ...] = ()  # other classes within bic_indistinguishable of the best
+
+    def as_dict(self) -> dict:
+        """Plain JSON."""
+        return {
+            "class": self.effect_class,
+            "where": WHERE.get(self.effect_class) if self.effect_class else None,
+            "model": self.best.label if self.best is not None else None,
+            "sentence": self.sentence,
+            "numbers": self.numbers,
+            "indistinguishable": list(self.indistinguishable),
+            "samples": self.samples,
+            "rho": self.rho,
+            "n_eff": self.n_eff,
+            "axes": [{"axis": a.axis, "columns": a.columns, "share": a.share, "excess_share": a.excess_share,
+                      "statistic": a.statistic, "p_value": a.p_value, "significant": a.significant}
+                     for a in self.axes],
+            "models": [{"family": m.family, "label": m.label, "columns": m.columns, "delta_bic": m.delta_bic}
+                       for m in self.models],
+        }
+
+
+def rbf(z: np.ndarray, knots, width: float) -> np.ndarray:
+    """Radial basis columns exp(-((z - c_k) / h)^2), one per knot (samples x knots)."""
+    z = np.asarray(z, dtype=float)
+    return np.column_stack([pm.exp(-(((z - c) / width) ** 2)) for c in knots])
+
+
+def position_knots(rack_m: np.ndarray, count: int) -> tuple[tuple[float, ...], float]:
+    """`count` knots evenly over the rack travel the records cover, and their spacing (the functions' width)."""
+    # whole millimetres outward, so that records over the same travel share their knots (and a suggested
+    # effect's source, and its compiled model)
+    low, high = math.floor(1000.0 * float(np.min(rack_m))) / 1000.0, math.ceil(1000.0 * float(np.max(rack_m))) / 1000.0
+    if not high > low:
+        raise UsageError("signature: the rack does not move in these records")
+    knots = tuple(float(v) for v in np.linspace(low, high, count))
+    return knots, (high - low) / (count - 1)
+
+
+def column_angle(rack_m: np.ndarray, ratio_rad_m: float, joint_rad: float, phase_rad: float) -> np.ndarray:
+    """Column angle of a rack position through the pinion and the Hooke joint: the pinion turns G x, and
+    tan(theta_c - phase) = tan(theta_p - phase) cos(joint) (the inverse of the joint's
+    tan(theta_p - phase) = tan(theta_c - phase) / cos(joint)), continuous in theta_p."""
+    pinion = ratio_rad_m * np.asarray(rack_m, dtype=float)
+    u = pinion - phase_rad
+    lead = pm.atan2(pm.sin(u) * pm.cos(joint_rad), pm.cos(u)) - u
+    lead = (lead + np.pi) % (2.0 * np.pi) - np.pi
+    return pinion + lead
+
+
+def smooth_sign(axes: Axes) -> np.ndarray:
+    return pm.tanh(axes.smoothing_s_m * axes.speed_m_s)
+
+
+def bases(axes: Axes, settings: SignatureSettings = DEFAULT_SIGNATURE_SETTINGS) -> list[Basis]:
+    """Every model of the decomposition (module docstring), simplest first within each family."""
+    s = smooth_sign(axes)
+    out = [Basis("dissipative", "uniform", s[:, None]), Basis("direction", "uniform", (s * s)[:, None])]
+    for count in settings.position_knots:
+        knots, width = position_knots(axes.rack_m, count)
+        phi = rbf(axes.rack_m, knots, width)
+        out.append(Basis("dissipative", f"{count} knots", s[:, None] * phi, knots, width))
+        out.append(Basis("elastic", f"{count} knots", phi, knots, width))
+        out.append(Basis("direction", f"{count} knots", (s * s)[:, None] * phi, knots, width))
+    speed = np.abs(axes.speed_m_s)
+    scale = float(np.quantile(speed, 0.9))
+    if scale > 0.0:
+        knots = tuple(float(v) for v in np.linspace(0.0, 1.25, settings.speed_knots))
+        width = knots[1] - knots[0]
+        out.append(Basis("speed", f"{settings.speed_knots} knots", s[:, None] * rbf(speed / scale, knots, width),
+                         knots, width))
+    for orders in (*settings.column_orders, (settings.mesh_order,)):
+        columns = np.column_stack([f(m * axes.column_rad) for m in orders for f in (pm.sin, pm.cos)])
+        label = " + ".join(f"{m} per turn" for m in orders)
+        out.append(Basis("column", label, columns, orders=tuple(orders)))
+    return out
+
+
+def _fit(columns: np.ndarray, weighted: np.ndarray, sigma: np.ndarray, nuisance: np.ndarray | None = None
+         ) -> tuple[np.ndarray, float]:
+    """Weighted least squares of the weighted residual on `columns` / sigma and the `nuisance` columns (already
+    weighted): (the coefficients of `columns`, leftover RSS)."""
+    design = columns / sigma[:, None]
+    k = design.shape[1]
+    if nuisance is not None and nuisance.shape[1]:
+        design = np.column_stack([design, nuisance])
+    coefficients = pm.lstsq(design, weighted)
+    left = weighted - pm.matmul(design, coefficients)
+    return coefficients[:k], pm.dot(left, left)
+
+
+def _lag1(values: np.ndarray, record: np.ndarray) -> float:
+    num = den = 0.0
+    for r in np.unique(record):
+        v = values[record == r]
+        v = v - v.mean()
+        num += float(np.sum(v[1:] * v[:-1]))
+        den += float(np.sum(v * v))
+    return num / den if den > 0 else 0.0
+
+
+def _axis_groups(axes: Axes, models: list[Basis]) -> list[tuple[str, np.ndarray]]:
+    """The axes reported with their shares: each family's richest basis, the column orders one by one, the cycle
+    phase (each phase's mean and its mean times the sign of the speed) and, where the records differ in load
+    case or surface, the record (each record's mean and mean times the sign)."""
+    richest: dict[str, Basis] = {}
+    for b in models:
+        if b.family != "column" and (b.family not in richest or b.columns.shape[1] > richest[b.family].columns.shape[1]):
+            richest[b.family] = b
+    names = {"dissipative": "odd in rack speed (dissipative), along the stroke",
+             "elastic": "rack position, even in speed (elastic)",
+             "direction": "while moving, not reversing (direction-dependent)",
+             "speed": "odd in rack speed, by speed magnitude"}
+    out = [(names[f], richest[f].columns) for f in ("dissipative", "elastic", "direction", "speed") if f in richest]
+    out += [(f"column angle, {b.label}", b.columns) for b in models if b.family == "column" and len(b.orders) == 1]
+    s = smooth_sign(axes)
+    present = [p for p in PHASES if np.any(axes.phase == p)]
+    if present:
+        indicator = np.column_stack([(axes.phase == p).astype(float) for p in present])
+        out.append(("cycle phase (" + ", ".join(present) + ")", np.column_stack([indicator, indicator * s[:, None]])))
+    if len(set(axes.conditions)) > 1:
+        records = np.column_stack([(axes.record == r).astype(float) for r in range(len(axes.conditions))])
+        out.append(("load case and surface across records", np.column_stack([records, records * s[:, None]])))
+    return out
+
+
+def signature_from_axes(axes: Axes, settings: SignatureSettings = DEFAULT_SIGNATURE_SETTINGS,
+                        calibrated_rack_friction_N: float | None = None, nuisance: np.ndarray | None = None
+                        ) -> Signature:
+    """The signature of the residual on `axes` (module docstring). `calibrated_rack_friction_N`, if given, is
+    what a dissipative change along the stroke is stated relative to.
+
+    `nuisance` (samples x p, in weighted units): the calibration's sensitivities d(model / sigma)/d(theta). Every
+    basis is fitted beside them, so that a shape counts by what the calibrated parameters cannot take up when
+    they are fitted again with it (as the suggested effect will be): the calibration has already absorbed the
+    part of the truth along its own directions, and the residual is the truth less that projection, which a
+    basis alone would have to mimic."""
+    sigma = np.asarray(axes.sigma_Nm, dtype=float)
+    weighted = np.asarray(axes.residual_Nm, dtype=float) / sigma
+    n = weighted.size
+    if nuisance is not None and nuisance.shape[0] != n:
+        raise UsageError(f"signature: {nuisance.shape[0]} rows of sensitivities for {n} samples")
+    _, rss0 = _fit(np.zeros((n, 0)), weighted, sigma, nuisance)
+    models = bases(axes, settings)
+    groups = _axis_groups(axes, models)
+    design = np.column_stack([b.columns for b in models]) / sigma[:, None]
+    if nuisance is not None:
+        design = np.column_stack([design, nuisance])
+    left = weighted - pm.matmul(design, pm.lstsq(design, weighted))
+    rho = _lag1(left, axes.record)
+    n_eff = effective_samples(n, rho)
+
+    fits = [_fit(b.columns, weighted, sigma, nuisance) for b in models]
+    scores = []
+    for b, (_, rss) in zip(models, fits):
+        k = b.columns.shape[1]
+        gain = n_eff * pm.log(rss0 / max(rss, 1e-300)) - k * pm.log(n_eff)
+        scores.append(ModelScore(b.family, b.label, k, float(rss), float(gain)))
+    shares = []
+    excess = rss0 - n
+    for name, columns in groups:
+        _, rss = _fit(columns, weighted, sigma, nuisance)
+        k = columns.shape[1]
+        statistic = (rss0 - rss) * n_eff / n
+        p = float(chi2.sf(statistic, k))
+        shares.append(AxisShare(name, k, float((rss0 - rss) / rss0), float((rss0 - rss) / excess) if excess > 0 else None,
+                                float(statistic), p, p < settings.significance))
+    best_index = max(range(len(models)), key=lambda i: (scores[i].delta_bic, -scores[i].columns))
+    best_score = scores[best_index]
+    if best_score.delta_bic <= settings.bic_threshold:
+        sentence = (f"no structure beyond the noise: no basis gains more than {settings.bic_threshold:g} in BIC "
+                    f"(best: {best_score.family}, {best_score.label}, {best_score.delta_bic:.1f})")
+        return Signature(n, float(rss0), float(rho), float(n_eff), tuple(shares), tuple(scores), None, None, (),
+                         sentence, {"best_delta_bic": best_score.delta_bic})
+    best = models[best_index]
+    coefficients = fits[best_index][0]
+    sentence, numbers = describe(axes, best, coefficients, calibrated_rack_friction_N)
+    group = tuple(sorted({m.family for m in scores if m.family != best.family
+                          and m.delta_bic >= best_score.delta_bic - settings.bic_indistinguishable}))
+    if group:
+        sentence += (f"; these data cannot tell it from the {' or '.join(group)} class (BIC within "
+                     f"{settings.bic_indistinguishable:g})")
+    numbers.update({"delta_bic": best_score.delta_bic,
+                    "share": float((rss0 - best_score.rss) / rss0),
+                    "excess_share": float((rss0 - best_score.rss) / excess) if excess > 0 else None})
+    return Signature(n, float(rss0), float(rho), float(n_eff), tuple(shares), tuple(scores), best.family, best,
+                     tuple(float(c) for c in coefficients), sentence, numbers, group)
+
+
+def shape_on(best: Basis, coefficients, grid: np.ndarray) -> np.ndarray:
+    """The fitted shape (N m at the handwheel) of a knotted basis on `grid` (its axis's units)."""
+    return pm.matmul(rbf(grid, best.knots, best.width), np.asarray(coefficients, dtype=float))
+
+
+def _localised(grid: np.ndarray, values: np.ndarray) -> tuple[float, float, float, float]:
+    """(where the shape departs most from its median, by how much, its half width at half that departure, the
+    median): a bump (or a dip) and its extent."""
+    median = float(np.median(values))
+    departure = values - median
+    i = int(np.argmax(np.abs(departure)))
+    peak = float(departure[i])
+    inside = np.abs(departure) >= 0.5 * abs(peak)
+    lo = i
+    while lo > 0 and inside[lo - 1]:
+        lo -= 1
+    hi = i
+    while hi < len(grid) - 1 and inside[hi + 1]:
+        hi += 1
+    return float(grid[i]), peak, 0.5 * float(grid[hi] - grid[lo]), median
+
+
+def describe(axes: Axes, best: Basis, coefficients, friction_N: float | None) -> tuple[str, dict]:
+    """One sentence for the best model, and the numbers behind it (rack forces in N: G times the handwheel
+    torque)."""
+    G = axes.ratio_rad_m
+    c = np.asarray(coefficients, dtype=float)
+    if best.family == "column":
+        amplitudes = {m: float(pm.hypot(c[2 * i], c[2 * i + 1])) for i, m in enumerate(best.orders)}
+        top = max(amplitudes, key=amplitudes.get)
+        orders = " and ".join(f"{m} per column turn ({amplitudes[m]:.3g} N m)" for m in best.orders)
+        return (f"a torque on the steering column periodic in the column angle, {orders}",
+                {"orders": list(best.orders), "amplitudes_Nm": {str(m): a for m, a in amplitudes.items()},
+                 "dominant_order": top})
+    if best.family == "speed":
+        grid = np.linspace(0.0, 1.25, 26)
+        values = G * shape_on(best, c, grid)
+        scale = float(np.quantile(np.abs(axes.speed_m_s), 0.9))
+        low, high = float(np.mean(values[grid <= 0.3])), float(np.mean(values[(grid >= 0.7) & (grid <= 1.0)]))
+        kind = "growing with the speed (viscous-like)" if abs(high) > abs(low) else \
+            "falling with the speed (Stribeck-like)"
+        return (f"a dissipative force on the rack {kind}: {low:.3g} N at low speed, {high:.3g} N near "
+                f"{1000 * scale:.3g} mm/s", {"low_speed_force_N": low, "high_speed_force_N": high,
+                                             "speed_90_m_s": scale, "kind": kind})
+    low, high = float(np.min(axes.rack_m)), float(np.max(axes.rack_m))
+    grid = np.linspace(low, high, 121)
+    values = G * (np.full(grid.size, c[0]) if not best.knots else shape_on(best, c, grid))
+    where, peak, half, median = _localised(grid, values)
+    what = {"dissipative": "a dissipative force on the rack (reversing with the rack speed)",
+            "direction": "a force on the rack while it moves that does not reverse with the direction "
+                         "(direction-dependent)",
+            "elastic": "a force on the rack set by its position alone, the same both ways (elastic)"}[best.family]
+    numbers = {"peak_at_m": where, "departure_N": peak, "half_width_m": half, "median_N": median,
+               "range_m": [low, high]}
+    if not best.knots:
+        return f"{what}, uniform along the stroke: {values[0]:.3g} N", {"uniform_N": float(values[0])}
+    if best.family == "elastic":
+        odd = float(np.mean(values[grid > 0]) - np.mean(values[grid < 0])) / 2.0
+        numbers["odd_part_N"] = odd
+        return (f"{what}, up to {float(np.max(np.abs(values))):.3g} N, departing most ({peak:+.3g} N from its "
+                f"median) at {1000 * where:+.0f} mm, within +-{1000 * half:.0f} mm of it; on average "
+                f"{odd:+.3g} N more to the right than to the left", numbers)
+    edge = abs(where - low) < 0.1 * (high - low) or abs(high - where) < 0.1 * (high - low)
+    relative = ""
+    if friction_N:
+        numbers["relative_to_rack_friction"] = peak / friction_N
+        relative = f" ({100 * peak / friction_N:+.0f} % of the calibrated rack friction)"
+    if edge:
+        return (f"{what}, growing toward the lock at {1000 * where:+.0f} mm by {peak:+.3g} N{relative}", numbers)
+    return (f"{what}, larger by {peak:+.3g} N{relative} within +-{1000 * half:.0f} mm of {1000 * where:+.0f} mm",
+            numbers)
+
+
+def signature_of(files, predictions: list[np.ndarray], params: Parameters, overrides: dict[str, float] | None = None,
+                 jacobian: np.ndarray | None = None, settings: SignatureSettings = DEFAULT_SIGNATURE_SETTINGS
+                 ) -> Signature:
+    """The signature of the torque residual of a diagnosis's files (:class:`parksteer.diagnose.problem.FileData`)
+    under the calibrated model's `predictions`, with the model's parameters `params` and `overrides` (the
+    calibration's values) and, if given, the calibration's `jacobian` (``Fit.jacobian``: its sensitivities,
+    fitted beside every basis, :func:`signature_from_axes`)."""
+    axes = axes_of(files, predictions, params, overrides)
+    values = {**_steering(params), **(overrides or {})}
+    nuisance = None
+    if jacobian is not None:  # the torque's rows of each file's block (a fitted angle's rows follow them)
+        rows, start = [], 0
+        for f in files:
+            rows.append(np.arange(start, start + f.n))
+            start += f.m
+        nuisance = np.asarray(jacobian, dtype=float)[np.concatenate(rows)]
+    return signature_from_axes(axes, settings, values.get("steering.rack_friction_force"), nuisance)
+
+
+def _steering(params: Parameters) -> dict[str, float]:
+    s = params.sections["steering"]
+    return {f"steering.{k}": float(s[k]) for k in ("handwheel_to_rack_ratio", "friction_smoothing",
+                                                   "hooke_joint_angle", "hooke_joint_phase", "rack_friction_force")}
+
+
+def axes_of(files, predictions: list[np.ndarray], params: Parameters, overrides: dict[str, float] | None = None
+            ) -> Axes:
+    """The axes of every file, concatenated: its smoothed rack's position and speed at the torque's instants,
+    the column angle through the pinion and the Hooke joint, the phase labels, the torque residual and each
+    sample's attainable error."""
+    values = {**_steering(params), **(overrides or {})}
+    ratio = values["steering.handwheel_to_rack_ratio"]
+    parts: dict[str, list] = {k: [] for k in ("x", "v", "phase", "record", "r", "sigma")}
+    for i, (f, prediction) in enumerate(zip(files, predictions)):
+        x, v, _ = f.rack.evaluate(f.replay_time_s)
+        parts["x"].append(x)
+        parts["v"].append(v)
+        parts["phase"].append(np.asarray(f.phases.labels))
+        parts["record"].append(np.full(f.n, i))
+        parts["r"].append(f.torque_Nm - np.asarray(prediction)[: f.n])
+        parts["sigma"].append(f.sigma_Nm)
+    x = np.concatenate(parts["x"])
+    return Axes(x, np.concatenate(parts["v"]),
+                column_angle(x, ratio, values["steering.hooke_joint_angle"], values["steering.hooke_joint_phase"]),
+                np.concatenate(parts["phase"]), np.concatenate(parts["record"]), np.concatenate(parts["r"]),
+                np.concatenate(parts["sigma"]), tuple((f.case, f.surface) for f in files),
+                values["steering.friction_smoothing"], ratio)

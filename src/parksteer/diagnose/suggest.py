@@ -1,0 +1,236 @@
+"""A starting effect: from the residual's signature, a user-effect file with the form it points to, fitted.
+
+The signature (:mod:`parksteer.diagnose.signature`) names a class and a shape along one axis. The suggested
+effect is that shape as a mechanism of the model, in the format of ``examples/user_effect/``: one module that
+defines ``EFFECT`` (a :class:`parksteer.model.symbolic.components.Effect`) with its own quantities, which a user
+reads, edits, and passes back with ``--effects=+FILE.py``. Its magnitude is a sum of knot strengths ``a_k``
+times smooth bumps ``exp(-((z - c_k) / h)^2)`` along the axis the signature found (the knots its best basis
+used), written as sympy expressions code generation takes (exp, tanh, sin, cos; no Piecewise):
+
+- dissipative: a force on the rack ``-tanh(beta v) sum_k a_k phi_k(x)`` (uniform: ``-a_0 tanh(beta v)``);
+- direction: ``-tanh(beta v)^2 sum_k a_k phi_k(x)`` (zero at rest, the same sign both ways);
+- elastic: ``-sum_k a_k phi_k(x)``;
+- speed: ``-tanh(beta v) sum_k a_k phi_k(|v| / v_90)``, ``|v|`` smoothed as ``v tanh(beta v)``;
+- column: a torque on the column ``sum_m a_m sin(m theta_c) + b_m cos(m theta_c)`` (its phase free).
+
+Every strength is 0 by default, so that the file loaded as it stands is the base model exactly; the fitted
+values are written beside them (``FITTED``, used as the defaults when the file's ``FITTED_AS_DEFAULTS`` is set
+to True, and a ``--set`` line for ``parksteer compare`` in the docstring). The strengths are signed
+(a force may be larger or smaller than the calibrated model's along the axis); each is fitted as it stands,
+together with the calibrated parameters, by the diagnosis's Levenberg-Marquardt
+(:func:`parksteer.diagnose.calibrate.least_squares`), from the calibrated values and zero strengths.
+:func:`suggest` returns the error before and after in noise floors and the BIC gain over the calibrated model.
+"""
+
+from __future__ import annotations
+
+import math
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from .. import portable as pm
+from ..errors import UsageError
+from ..model.symbolic.components import load_effect_module
+from .calibrate import Fit, FitParameter, calibration_parameters, least_squares
+from .problem import Problem, effective_samples, fit_statistics, lag1_autocorrelation
+from .settings import DEFAULT_SETTINGS, DiagnosisSettings
+from .signature import Signature
+
+FORCE_BOUND_N = 20000.0  # a knot's rack force: far above any steering-gear force at parking speed
+TORQUE_BOUND_NM = 50.0  # a column torque's amplitude: far above any handwheel torque at parking speed
+
+
+@dataclass(frozen=True)
+class Suggestion:
+    """A written effect and how far it takes the error: weighted RMS over the noise floor, before (the calibrated
+    base model) and after (with the effect, its strengths and the calibrated parameters fitted together)."""
+
+    effect_name: str
+    effect_class: str
+    path: str | None
+    source: str
+    strengths: dict[str, float]
+    before_over_floor: float
+    after_over_floor: float
+    delta_bic: float
+    fit: Fit | None = None
+
+    def as_dict(self) -> dict:
+        return {"effect": self.effect_name, "class": self.effect_class, "path": self.path,
+                "strengths": self.strengths, "before_over_noise_floor": self.before_over_floor,
+                "after_over_noise_floor": self.after_over_floor, "delta_bic": self.delta_bic}
+
+
+def _tuple(values) -> str:
+    return "(" + ", ".join(repr(float(v)) for v in values) + ("," if len(values) == 1 else "") + ")"
+
+
+def effect_source(signature: Signature, fitted: dict[str, float] | None = None, speed_90_m_s: float | None = None
+                  ) -> str:
+    """The text of the effect file for `signature`'s class and shape (module docstring)."""
+    if signature.effect_class is None or signature.best is None:
+        raise UsageError("suggest: the residual shows no structure beyond the noise; there is no effect to suggest")
+    kind, best = signature.effect_class, signature.best
+    name = f"suggested_{kind}"
+    if kind == "column":
+        keys = [f"{name}.{f}{m}" for m in best.orders for f in ("sin", "cos")]
+        unit, bound = "N m", TORQUE_BOUND_NM
+    else:
+        count = max(len(best.knots), 1)
+        keys = [f"{name}.s{k}" for k in range(count)]
+        unit, bound = "N", FORCE_BOUND_N
+    fitted_line = ""
+    if fitted:
+        fitted_line = ("\nFitted with the calibrated parameters to the records it was suggested for (weighted RMS "
+                       "{before:.2f} -> {after:.2f} noise floors)::\n\n    parksteer compare RUN.csv "
+                       "--effects=+THIS_FILE.py "
+                       + " ".join(f"--set {k}={v:.6g}" for k, v in fitted.items() if k in keys) + "\n")
+    header = f'''"""Suggested by parksteer diagnose --suggest-effect from the residual's signature: {signature.sentence}.
+
+A {kind} effect (class {kind!r} of parksteer.diagnose.signature), its magnitude shaped by {len(keys)} strength(s)
+along the axis the signature found. Every strength is 0 by default: loaded as it stands, this file is the base
+model exactly. Set FITTED_AS_DEFAULTS below to True and it is the fitted model (FITTED); or replay it with
+``parksteer compare RUN.csv`` and the ``--set`` line below. Edit the form as the physics you know suggests.
+{{fitted}}"""
+
+from __future__ import annotations
+
+import sympy as sp
+
+from parksteer.model.symbolic.components import Effect
+from parksteer.model.symbolic.system import action_reaction, torque_between
+from parksteer.parameters import Quantity
+
+NAME = {name!r}
+STRENGTHS = {tuple(keys)!r}
+# Fitted with the calibrated parameters to the records it was suggested for; the defaults when True.
+FITTED = {{fitted_values}}
+FITTED_AS_DEFAULTS = False
+'''
+    if kind == "column":
+        body = f'''ORDERS = {tuple(best.orders)!r}  # per column turn
+
+
+class Suggested(Effect):
+    name = NAME
+    description = "Suggested: a torque on the column, sum of sin and cos of the column angle times " + ", ".join(
+        str(m) for m in ORDERS) + " (per turn); 0 = absent"
+    in_default_set = False
+    diagnosis_candidate = False
+    quantities = tuple(Quantity(key, "N m", -{bound!r}, {bound!r}, lower_inclusive=True,
+                                default=FITTED.get(key, 0.0) if FITTED_AS_DEFAULTS else 0.0,
+                                source="suggested from the residual's signature; 0 = absent") for key in STRENGTHS)
+    uses = STRENGTHS
+
+    def loads(self, model):
+        k = model.kinematics
+        theta = k.column_angle
+        torque = sum(model.p(f"{{NAME}}.sin{{m}}") * sp.sin(m * theta) + model.p(f"{{NAME}}.cos{{m}}") * sp.cos(m * theta)
+                     for m in ORDERS)
+        return torque_between(torque, k.B.y, k.column_frame, k.B)
+'''
+    else:
+        if kind == "speed":
+            knots, width = best.knots, best.width
+            coordinate = "v * sp.tanh(beta * v) / SPEED_SCALE_M_S"
+            scale = round(float(speed_90_m_s or 0.05), 3)
+            extra = f"SPEED_SCALE_M_S = {scale!r}  # 90th percentile of the rack speed, to 1 mm/s\n"
+            what = "sign(v) times a shape in the rack speed magnitude"
+        else:
+            knots, width = best.knots, best.width
+            coordinate = "model.rack_q"
+            extra = ""
+            what = {"dissipative": "sign(v) times a shape along the rack position",
+                    "direction": "sign(v)^2 (moving, either way) times a shape along the rack position",
+                    "elastic": "a shape along the rack position"}[kind]
+        if knots:
+            shape = (f"sum(model.p(key) * sp.exp(-((z - c) / WIDTH) ** 2) for key, c in zip(STRENGTHS, KNOTS))")
+            extra += f"KNOTS = {_tuple(knots)}  # along the axis\nWIDTH = {float(width)!r}\n"
+        else:
+            shape = "model.p(STRENGTHS[0])"
+        factor = {"dissipative": " * sp.tanh(beta * v)", "speed": " * sp.tanh(beta * v)",
+                  "direction": " * sp.tanh(beta * v) ** 2", "elastic": ""}[kind]
+        body = f'''{extra}
+
+class Suggested(Effect):
+    name = NAME
+    description = "Suggested: a force on the rack, {what}; 0 = absent"
+    in_default_set = False
+    diagnosis_candidate = False
+    quantities = tuple(Quantity(key, "N", -{bound!r}, {bound!r}, lower_inclusive=True,
+                                default=FITTED.get(key, 0.0) if FITTED_AS_DEFAULTS else 0.0,
+                                source="suggested from the residual's signature; 0 = absent") for key in STRENGTHS)
+    uses = STRENGTHS + ("steering.friction_smoothing",)
+
+    def loads(self, model):
+        k = model.kinematics
+        v = model.rack_u
+        beta = model.p("steering.friction_smoothing")
+        z = {coordinate}
+        force = ({shape}){factor}
+        # Between rack and housing: equal and opposite on the rack and on the body.
+        return action_reaction(k.rack_point, -force * k.B.y, k.rack_housing_point)
+'''
+    text = header + body + "\n\nEFFECT = Suggested()\n"
+    values = "{" + ", ".join(f"{k!r}: {fitted[k]!r}" for k in keys) + "}" if fitted else "{}"
+    text = text.replace("{fitted_values}", values)
+    return text.replace("{fitted}", fitted_line.format(before=fitted.get("_before", math.nan),
+                                                         after=fitted.get("_after", math.nan)) if fitted else "")
+
+
+def strength_keys(source: str) -> tuple[str, ...]:
+    namespace: dict = {}
+    line = next(l for l in source.splitlines() if l.startswith("STRENGTHS = "))
+    exec(line, namespace)  # a literal tuple written by effect_source
+    return namespace["STRENGTHS"]
+
+
+def suggest(problem: Problem, calibration: Fit, signature: Signature, path: str | Path | None = None,
+            settings: DiagnosisSettings = DEFAULT_SETTINGS) -> Suggestion:
+    """Write the effect `signature` points to, fit its strengths with the calibrated parameters on `problem`, and
+    write it again with the fitted values beside the zero defaults (to `path`, or a temporary file)."""
+    speed_90 = signature.numbers.get("speed_90_m_s")
+    if signature.effect_class == "speed" and speed_90 is None:
+        speed_90 = float(np.quantile(np.abs(np.concatenate([f.rack.evaluate(f.replay_time_s)[1]
+                                                            for f in problem.files])), 0.9))
+    source = effect_source(signature, speed_90_m_s=speed_90)
+    keys = strength_keys(source)
+    folder = None
+    if path is None:
+        folder = tempfile.TemporaryDirectory(prefix="parksteer_suggest_")
+        target = Path(folder.name) / "suggested_effect.py"
+    else:
+        target = Path(path)
+    try:
+        target.write_text(source, encoding="utf-8")
+        effect = load_effect_module(str(target))
+        model = sorted([*calibration.effects, effect], key=lambda e: e.name)
+        floor = fit_statistics(problem, calibration.predictions)["noise_floor_Nm"]
+        ratio = problem.params.sections["steering"]["handwheel_to_rack_ratio"]
+        column = signature.effect_class == "column"
+        bound = TORQUE_BOUND_NM if column else FORCE_BOUND_N
+        step = floor if column else floor * ratio  # a strength moving the torque by about a noise floor
+        parameters = calibration_parameters(problem, model, settings=settings)
+        parameters += [FitParameter(key, "linear", 1.0, -bound, bound, step) for key in keys]
+        theta0 = np.concatenate([calibration.theta, np.zeros(len(keys))])
+        fit = least_squares(problem, model, parameters, theta0, calibration.fixed, settings=settings)
+        before = fit_statistics(problem, calibration.predictions)
+        after = fit_statistics(problem, fit.predictions)
+        rho = lag1_autocorrelation(problem, fit.weighted)
+        n_eff = effective_samples(problem.n, rho)
+        gain = n_eff * pm.log(calibration.rss / fit.rss) - len(keys) * pm.log(n_eff)
+        values = fit.values if isinstance(fit.values, dict) else {}
+        strengths = {k: float(values.get(k, fit.theta[len(calibration.theta) + i])) for i, k in enumerate(keys)}
+        before_ratio = before["weighted_rms_Nm"] / floor
+        after_ratio = after["weighted_rms_Nm"] / floor
+        final = effect_source(signature, {**strengths, "_before": before_ratio, "_after": after_ratio}, speed_90)
+        if path is not None:
+            target.write_text(final, encoding="utf-8")
+        return Suggestion(effect.name, signature.effect_class, str(path) if path is not None else None, final,
+                          strengths, float(before_ratio), float(after_ratio), float(gain), fit)
+    finally:
+        if folder is not None:
+            folder.cleanup()

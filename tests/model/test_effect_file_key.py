@@ -1,0 +1,43 @@
+"""An effect loaded from a file is keyed by its text: an edited file (or another file of the same name) builds its
+own compiled model instead of replaying the one built for the old text."""
+
+from __future__ import annotations
+
+from parksteer.model.codegen.cache import model_key
+from parksteer.model.symbolic.components import load_effect_module
+
+TEXT = '''
+from parksteer.model.symbolic.components import Effect
+from parksteer.model.symbolic.system import action_reaction
+from parksteer.parameters import Quantity
+
+
+class Push(Effect):
+    name = "file_key_push"
+    description = "a constant push on the rack"
+    in_default_set = False
+    quantities = (Quantity("file_key_push.force", "N", 0.0, 100.0, lower_inclusive=True, default=0.0,
+                           source="test"),)
+    uses = ("file_key_push.force",)
+
+    def loads(self, model):
+        k = model.kinematics
+        return action_reaction(k.rack_point, -SCALE * model.p("file_key_push.force") * k.B.y, k.rack_housing_point)
+
+
+EFFECT = Push()
+'''
+
+
+def test_two_files_of_one_name_and_class_but_different_text_have_different_model_keys(tmp_path):
+    """The same stem, class and effect name, a force scaled by 1 in one file and by 2 in the other: different
+    physics, so different keys; the same text in another folder: the same key."""
+    paths = []
+    for folder, scale in (("a", 1.0), ("b", 2.0), ("c", 1.0)):
+        (tmp_path / folder).mkdir()
+        path = tmp_path / folder / "push.py"
+        path.write_text(f"SCALE = {scale}\n" + TEXT, encoding="utf-8")
+        paths.append(path)
+    keys = [model_key([load_effect_module(str(p))]) for p in paths]
+    assert keys[0] != keys[1]
+    assert keys[0] == keys[2]
