@@ -194,7 +194,7 @@ def _diagnose(args) -> int:
             print(f"handwheel angle fitted beside the torque in {len(with_angle)} of {len(files)} file(s): "
                   + ", ".join(with_angle), file=sys.stderr)
     diagnosis = diagnose(files, params, effects, workers=workers, quiet=args.quiet, settings=settings)
-    result = _with_signature(args, diagnosis_dict(diagnosis), diagnosis, params, settings)
+    result = _with_suggestion(args, diagnosis_dict(diagnosis), diagnosis, settings)
     if args.plot:
         from ..figures.diagnose import diagnosis_figure
 
@@ -212,28 +212,26 @@ def _diagnose(args) -> int:
     return 0
 
 
-def _with_signature(args, result: dict, diagnosis, params, settings) -> dict:
-    """The residual's signature beside any verdict; with --suggest-effect and an unexplained verdict, the
-    suggested effect written and fitted (parksteer.diagnose.signature, parksteer.diagnose.suggest)."""
-    from ..diagnose.report import with_signature
-    from ..diagnose.signature import signature_of
-
-    calibration = diagnosis.calibration
-    signature = signature_of(diagnosis.problem.files, calibration.predictions, params, calibration.overrides,
-                             calibration.jacobian)
-    suggestion = None
-    if args.suggest_effect and diagnosis.verdict == "unexplained" and signature.effect_class is not None:
-        from ..diagnose.suggest import suggest
-
-        suggestion = suggest(diagnosis.problem, calibration, signature, args.suggest_effect, settings)
+def _with_suggestion(args, result: dict, diagnosis, settings) -> dict:
+    """With --suggest-effect and an unexplained verdict, the effect the residual's signature points to, written
+    and fitted (parksteer.diagnose.suggest)."""
+    if not args.suggest_effect:
+        return result
+    signature = diagnosis.outputs.get("signature")
+    if diagnosis.verdict != "unexplained" or signature is None or signature.effect_class is None:
         if not args.quiet:
-            print(f"suggested effect {suggestion.effect_name} written to {args.suggest_effect}: weighted RMS "
-                  f"{suggestion.before_over_floor:.2f} -> {suggestion.after_over_floor:.2f} noise floors",
-                  file=sys.stderr)
-    elif args.suggest_effect and not args.quiet:
-        print(f"no effect suggested (verdict {diagnosis.verdict}"
-              + (", no structure in the residual" if signature.effect_class is None else "") + ")", file=sys.stderr)
-    return with_signature(result, signature, suggestion)
+            print(f"no effect suggested (verdict {diagnosis.verdict}"
+                  + (", no structure in the residual" if signature is not None and signature.effect_class is None
+                     else "") + ")", file=sys.stderr)
+        return result
+    from ..diagnose.report import with_suggestion
+    from ..diagnose.suggest import suggest
+
+    suggestion = suggest(diagnosis.problem, diagnosis.calibration, signature, args.suggest_effect, settings)
+    if not args.quiet:
+        print(f"suggested effect {suggestion.effect_name} written to {args.suggest_effect}: weighted RMS "
+              f"{suggestion.before_over_floor:.2f} -> {suggestion.after_over_floor:.2f} noise floors", file=sys.stderr)
+    return with_suggestion(result, suggestion)
 
 
 def _write_html(path: str, diagnosis, result: dict, files, params, workers: int = 1) -> None:

@@ -40,7 +40,7 @@ from .settings import DEFAULT_SETTINGS, DiagnosisSettings
 
 # The benchmarks' diagnoses: a user's, without the confound tests (where a confounded candidate would show), which
 # change no verdict, name or interval the benchmarks score. bench_variations.py --confound-tests turns them on.
-BENCHMARK_SETTINGS = replace(DEFAULT_SETTINGS, confound_tests=False)
+BENCHMARK_SETTINGS = replace(DEFAULT_SETTINGS, confound_tests=False, residual_signature=False)
 
 TARGETS = {"named_or_group_at_2_steps": 0.90, "false_alarm_rate": 0.05, "outside_unexplained": 0.80,
            "after_over_floor": 1.2}

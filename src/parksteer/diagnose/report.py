@@ -175,6 +175,8 @@ def diagnosis_dict(diagnosis: Diagnosis) -> dict:
             "attainable_floor_rad": calibrated["angle"]["attainable_floor_rad"],
             "offset_fitted": diagnosis.settings.angle_offset_fitted,
         }
+    if "signature" in diagnosis.outputs:  # the residual's signature (stages/signature.py)
+        out["signature"] = diagnosis.outputs["signature"].as_dict()
     return _json_safe(out)
 
 
@@ -344,13 +346,10 @@ def markdown_report(result: dict, figure: str | None = None) -> str:
 
 
 # --- the residual's signature and the suggested effect (parksteer.diagnose.signature, parksteer.diagnose.suggest)
-def with_signature(result: dict, signature, suggestion=None) -> dict:
-    """`result` (the JSON of a diagnosis) with its residual's signature and, where one was made, the suggested
-    effect and its error ladder (calibrated, then with the suggested effect)."""
-    out = {**result, "signature": _json_safe(signature.as_dict())}
-    if suggestion is not None:
-        out["suggestion"] = _json_safe(suggestion.as_dict())
-    return out
+def with_suggestion(result: dict, suggestion) -> dict:
+    """`result` (the JSON of a diagnosis) with the suggested effect and its error ladder (calibrated, then with the
+    suggested effect)."""
+    return {**result, "suggestion": _json_safe(suggestion.as_dict())}
 
 
 def signature_lines(result: dict) -> list[str]:
@@ -368,8 +367,8 @@ def signature_lines(result: dict) -> list[str]:
     if suggestion:
         where = f" written to {suggestion['path']}" if suggestion.get("path") else ""
         lines.append(f"Suggested effect `{suggestion['effect']}`{where}: fitted with the calibrated parameters it "
-                     f"takes the weighted RMS error from {_n(suggestion['before_over_noise_floor'])} to "
-                     f"{_n(suggestion['after_over_noise_floor'])} noise floors (ΔBIC {_n(suggestion['delta_bic'])}).")
+                     f"takes the weighted RMS error from {_n(suggestion['before_over_floor'])} to "
+                     f"{_n(suggestion['after_over_floor'])} noise floors (ΔBIC {_n(suggestion['delta_bic'])}).")
     return lines
 
 

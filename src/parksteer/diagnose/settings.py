@@ -19,6 +19,30 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+
+@dataclass(frozen=True)
+class SignatureSettings:
+    """The bases and thresholds of the signature.
+
+    ``position_knots``: the knot counts of the position bases, nested (5 knots resolve a force that grows toward
+    lock, 15 one localised over a sixth of the stroke, 27 a notch a few millimetres wide). ``speed_knots``: knots of the speed-magnitude basis.
+    ``column_orders``: the column-angle orders tried, each tuple one model: once per turn (an out-of-balance
+    part, an eccentric bearing), twice (a joint), both, and a tooth-mesh order (``mesh_order``: a pinion of
+    7 teeth, the middle of the 6-8 of passenger-car rack-and-pinion gears, ripples 7 times per pinion turn).
+    A class is named when its best basis gains more than the diagnosis's ``bic_missing_threshold`` in BIC over
+    the null, and another class within the diagnosis's ``bic_indistinguishable`` of it is named beside it.
+    ``significance``: the p-value below which an axis counts as significant.
+    """
+
+    position_knots: tuple[int, ...] = (5, 9, 15, 27)
+    speed_knots: int = 6
+    mesh_order: int = 7
+    column_orders: tuple[tuple[int, ...], ...] = ((1,), (2,), (1, 2))
+    significance: float = 1e-3
+
+
+
+
 @dataclass(frozen=True)
 class DiagnosisSettings:
     """The settings of one diagnosis (units: 1 unless named)."""
@@ -164,6 +188,13 @@ class DiagnosisSettings:
     # five models replayed. The diagnosis benchmarks, which score verdicts, names and intervals (none of which this
     # changes), leave it off (parksteer.diagnose.benchmark.BENCHMARK_SETTINGS).
     confound_tests: bool = True
+
+    # --- the residual's signature (parksteer.diagnose.stages.signature) ---------------------------------------
+    # What kind of effect the calibrated model lacks, read off its residual beside any verdict (about 0.2 s a
+    # record). The diagnosis benchmarks, which score verdicts, names and intervals (none of which it changes),
+    # leave it off (parksteer.diagnose.benchmark.BENCHMARK_SETTINGS).
+    residual_signature: bool = True
+    signature: SignatureSettings = SignatureSettings()
 
     # --- the error ladder and the reports ------------------------------------------------------------------
     ladder_max_steps: int = 3  # effects added one at a time beyond the calibrated base

@@ -26,7 +26,7 @@ Each family member is one model; they compete with the null (no structure) by th
 diagnosis, ``BIC = n_eff ln(RSS / n) + k ln(n_eff)`` with ``n_eff = n (1 - rho) / (1 + rho)`` and rho the lag-1
 autocorrelation of the weighted residual left by all bases together (neighbouring samples of a smooth misfit are
 not independent evidence, :func:`parksteer.diagnose.problem.effective_samples`). The member with the lowest BIC
-names the class; none, when no member beats the null by ``bic_threshold``.
+names the class; none, when no member beats the null by the diagnosis's ``bic_missing_threshold``.
 
 Beside the class, every *axis* (the richest basis of each family, and the cycle phase and the record where
 records differ in load or surface) gets its share of the residual's weighted sum of squares and its
@@ -56,36 +56,12 @@ from ..errors import UsageError
 from ..measure.phases import PHASES
 from ..parameters import Parameters
 from .problem import effective_samples
+from .settings import DEFAULT_SETTINGS, DiagnosisSettings
 
 CLASSES = ("dissipative", "elastic", "direction", "speed", "column")
 WHERE = {"dissipative": "rack", "elastic": "rack", "direction": "rack", "speed": "rack", "column": "column"}
 
 
-@dataclass(frozen=True)
-class SignatureSettings:
-    """The bases and thresholds of the signature.
-
-    ``position_knots``: the knot counts of the position bases, nested (5 knots resolve a force that grows toward
-    lock, 15 one localised over a sixth of the stroke, 27 a notch a few millimetres wide). ``speed_knots``: knots of the speed-magnitude basis.
-    ``column_orders``: the column-angle orders tried, each tuple one model: once per turn (an out-of-balance
-    part, an eccentric bearing), twice (a joint), both, and a tooth-mesh order (``mesh_order``: a pinion of
-    7 teeth, the middle of the 6-8 of passenger-car rack-and-pinion gears, ripples 7 times per pinion turn).
-    ``bic_threshold``: the BIC gain over the null that names a class (the diagnosis's bic_missing_threshold);
-    ``bic_indistinguishable``: another class whose best model comes within this of the best is reported as
-    indistinguishable by these data (the diagnosis's band).
-    ``significance``: the p-value below which an axis counts as significant.
-    """
-
-    position_knots: tuple[int, ...] = (5, 9, 15, 27)
-    speed_knots: int = 6
-    mesh_order: int = 7
-    column_orders: tuple[tuple[int, ...], ...] = ((1,), (2,), (1, 2))
-    bic_threshold: float = 10.0
-    bic_indistinguishable: float = 6.0
-    significance: float = 1e-3
-
-
-DEFAULT_SIGNATURE_SETTINGS = SignatureSettings()
 
 
 @dataclass(frozen=True)
@@ -225,11 +201,11 @@ def smooth_sign(axes: Axes) -> np.ndarray:
     return pm.tanh(axes.smoothing_s_m * axes.speed_m_s)
 
 
-def bases(axes: Axes, settings: SignatureSettings = DEFAULT_SIGNATURE_SETTINGS) -> list[Basis]:
+def bases(axes: Axes, settings: DiagnosisSettings = DEFAULT_SETTINGS) -> list[Basis]:
     """Every model of the decomposition (module docstring), simplest first within each family."""
     s = smooth_sign(axes)
     out = [Basis("dissipative", "uniform", s[:, None]), Basis("direction", "uniform", (s * s)[:, None])]
-    for count in settings.position_knots:
+    for count in settings.signature.position_knots:
         knots, width = position_knots(axes.rack_m, count)
         phi = rbf(axes.rack_m, knots, width)
         out.append(Basis("dissipative", f"{count} knots", s[:, None] * phi, knots, width))
@@ -238,11 +214,11 @@ def bases(axes: Axes, settings: SignatureSettings = DEFAULT_SIGNATURE_SETTINGS) 
     speed = np.abs(axes.speed_m_s)
     scale = float(np.quantile(speed, 0.9))
     if scale > 0.0:
-        knots = tuple(float(v) for v in np.linspace(0.0, 1.25, settings.speed_knots))
+        knots = tuple(float(v) for v in np.linspace(0.0, 1.25, settings.signature.speed_knots))
         width = knots[1] - knots[0]
-        out.append(Basis("speed", f"{settings.speed_knots} knots", s[:, None] * rbf(speed / scale, knots, width),
+        out.append(Basis("speed", f"{settings.signature.speed_knots} knots", s[:, None] * rbf(speed / scale, knots, width),
                          knots, width))
-    for orders in (*settings.column_orders, (settings.mesh_order,)):
+    for orders in (*settings.signature.column_orders, (settings.signature.mesh_order,)):
         columns = np.column_stack([f(m * axes.column_rad) for m in orders for f in (pm.sin, pm.cos)])
         label = " + ".join(f"{m} per turn" for m in orders)
         out.append(Basis("column", label, columns, orders=tuple(orders)))
@@ -297,7 +273,7 @@ def _axis_groups(axes: Axes, models: list[Basis]) -> list[tuple[str, np.ndarray]
     return out
 
 
-def signature_from_axes(axes: Axes, settings: SignatureSettings = DEFAULT_SIGNATURE_SETTINGS,
+def signature_from_axes(axes: Axes, settings: DiagnosisSettings = DEFAULT_SETTINGS,
                         calibrated_rack_friction_N: float | None = None, nuisance: np.ndarray | None = None
                         ) -> Signature:
     """The signature of the residual on `axes` (module docstring). `calibrated_rack_friction_N`, if given, is
@@ -337,11 +313,11 @@ def signature_from_axes(axes: Axes, settings: SignatureSettings = DEFAULT_SIGNAT
         statistic = (rss0 - rss) * n_eff / n
         p = float(chi2.sf(statistic, k))
         shares.append(AxisShare(name, k, float((rss0 - rss) / rss0), float((rss0 - rss) / excess) if excess > 0 else None,
-                                float(statistic), p, p < settings.significance))
+                                float(statistic), p, p < settings.signature.significance))
     best_index = max(range(len(models)), key=lambda i: (scores[i].delta_bic, -scores[i].columns))
     best_score = scores[best_index]
-    if best_score.delta_bic <= settings.bic_threshold:
-        sentence = (f"no structure beyond the noise: no basis gains more than {settings.bic_threshold:g} in BIC "
+    if best_score.delta_bic <= settings.bic_missing_threshold:
+        sentence = (f"no structure beyond the noise: no basis gains more than {settings.bic_missing_threshold:g} in BIC "
                     f"(best: {best_score.family}, {best_score.label}, {best_score.delta_bic:.1f})")
         return Signature(n, float(rss0), float(rho), float(n_eff), tuple(shares), tuple(scores), None, None, (),
                          sentence, {"best_delta_bic": best_score.delta_bic})
@@ -434,7 +410,7 @@ def describe(axes: Axes, best: Basis, coefficients, friction_N: float | None) ->
 
 
 def signature_of(files, predictions: list[np.ndarray], params: Parameters, overrides: dict[str, float] | None = None,
-                 jacobian: np.ndarray | None = None, settings: SignatureSettings = DEFAULT_SIGNATURE_SETTINGS
+                 jacobian: np.ndarray | None = None, settings: DiagnosisSettings = DEFAULT_SETTINGS
                  ) -> Signature:
     """The signature of the torque residual of a diagnosis's files (:class:`parksteer.diagnose.problem.FileData`)
     under the calibrated model's `predictions`, with the model's parameters `params` and `overrides` (the

@@ -60,8 +60,8 @@ class Suggestion:
 
     def as_dict(self) -> dict:
         return {"effect": self.effect_name, "class": self.effect_class, "path": self.path,
-                "strengths": self.strengths, "before_over_noise_floor": self.before_over_floor,
-                "after_over_noise_floor": self.after_over_floor, "delta_bic": self.delta_bic}
+                "strengths": self.strengths, "before_over_floor": self.before_over_floor,
+                "after_over_floor": self.after_over_floor, "delta_bic": self.delta_bic}
 
 
 def _tuple(values) -> str:

@@ -33,6 +33,7 @@ from .replay_uncertainty import ReplayUncertainty
 from .score import Score
 from .select import Select
 from .separate import Separate
+from .signature import ResidualSignature
 from .torque_lag import TorqueLag, TorqueLagWithEffect
 from .verdict import Verdict
 
@@ -47,6 +48,7 @@ STAGES: tuple[Stage, ...] = (
     Separate(),  # where the indistinguishable candidates would differ
     Identify(),  # what these data fix, and the test that would fix the rest
     Confound(),  # where the confounded candidates would show
+    ResidualSignature(),  # what kind of effect the calibrated model lacks, from its residual's shape
     TorqueLagWithEffect(),  # the lags searched again with the named effect; if one moved, the table again
 )
 
