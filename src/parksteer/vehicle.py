@@ -23,6 +23,7 @@ from pathlib import Path
 from typing import Any
 
 from . import portable as pm
+from .errors import UsageError
 from .geometry import lock_steer_angle, steer_axis
 from .parameters import (
     CASE_SCHEMA,
@@ -34,6 +35,7 @@ from .parameters import (
     check_statics,
     check_table,
     load_parameters,
+    quantity,
 )
 
 # Keys every vehicle file must give: everything the model takes from the car itself.
@@ -80,9 +82,6 @@ def vehicle_from_text(text: str, path: str | Path, base: str | Path | Parameters
     except tomllib.TOMLDecodeError as exc:
         raise ParameterError(f"{path}: not valid TOML ({exc})") from None
 
-    unknown = sorted(doc.keys() - (set(SCHEMA) | {"cases"}))
-    if unknown:
-        raise ParameterError(f"{path}: {unknown[0]}: unknown key (a section of the parameter file, or cases)")
     sections = {name: dict(values) for name, values in base_params.sections.items()}
     sources = {k: v for k, v in base_params.sources.items() if not k.startswith("cases.")}
     for key in REQUIRED:
@@ -96,10 +95,8 @@ def vehicle_from_text(text: str, path: str | Path, base: str | Path | Parameters
         if not isinstance(table, dict):
             raise ParameterError(f"{path}: {section}: expected a table")
         for name, entry in table.items():
-            spec = SCHEMA[section].get(name)
-            if spec is None:
-                raise ParameterError(f"{path}: {section}.{name}: unknown key")
-            sections[section][name] = check_entry(path, f"{section}.{name}", spec, entry)
+            spec = _file_or_effect_quantity(path, section, name)
+            sections.setdefault(section, {})[name] = check_entry(path, f"{section}.{name}", spec, entry)
             sources[f"{section}.{name}"] = entry["source"]
 
     cases_doc = doc.get("cases")
@@ -110,6 +107,21 @@ def vehicle_from_text(text: str, path: str | Path, base: str | Path | Parameters
     params = Parameters(path=path, sections=sections, cases=cases, sources=sources)
     check_car(params)
     return params
+
+
+def _file_or_effect_quantity(path: Path, section: str, name: str):
+    """The quantity of ``section.name``: a key of the parameter file, or an effect's own quantity (a car's value of
+    it, e.g. ``ackermann.track_to_wheelbase``, declared on the effect)."""
+    if section in SCHEMA:
+        spec = SCHEMA[section].get(name)
+        if spec is None:
+            raise ParameterError(f"{path}: {section}.{name}: unknown key")
+        return spec
+    try:
+        return quantity(f"{section}.{name}")
+    except UsageError:
+        raise ParameterError(f"{path}: {section}.{name}: unknown key (a key of the parameter file, cases, or an "
+                             "effect's own quantity)") from None
 
 
 def check_car(params: Parameters) -> None:
