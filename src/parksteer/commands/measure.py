@@ -7,6 +7,7 @@ import json
 import sys
 from pathlib import Path
 
+from ..names import SURFACES
 from ..errors import UsageError
 from ..parameters import DEFAULT_PATH
 from .vehicle import add_vehicle_option, parameters_of
@@ -16,7 +17,7 @@ def _common(p) -> None:
     p.add_argument("files", nargs="+", metavar="FILE",
                    help="measurement files: native CSV (data/measurements/README.md), a logger's CSV or ASAM MDF")
     p.add_argument("--case", default=None, help="Table B1 case for every file (default: each file's own)")
-    p.add_argument("--surface", choices=("ground", "air_bearing"), default=None,
+    p.add_argument("--surface", choices=tuple(SURFACES), default=None,
                    help="the surface of files that do not state one")
     add_import_options(p)
     p.add_argument("--effects", default=None,

@@ -8,6 +8,7 @@ import time
 from contextlib import nullcontext
 from pathlib import Path
 
+from ..names import SURFACES
 from ..errors import UsageError, naming
 from ..parameters import DEFAULT_PATH, load_parameters
 from ..progress import set_quiet
@@ -23,7 +24,7 @@ def register(sub) -> None:
     p.add_argument("--effects", default=None, help="effects spec, e.g. --effects=-rack_friction,+hooke_joint (default: the paper's five)")
     p.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
                    help="override a quantity by its key, e.g. tyre.tyre_pressure=180000 or rack_lash.lash=0.0002 (keys: `parksteer effects`, the parameter file; case.<name> for the case; repeatable)")
-    p.add_argument("--surface", choices=("ground", "air_bearing"), default=None,
+    p.add_argument("--surface", choices=tuple(SURFACES), default=None,
                    help="default ground (with --rack-from: the file's surface)")
     p.add_argument("--rack-from", default=None, metavar="FILE.csv",
                    help="prescribe the rack of a measurement file (data/measurements/README.md) and solve for the "

@@ -56,7 +56,7 @@ import numpy as np
 
 from .. import portable as pm
 from ..model.symbolic.components import Effect, discover_effects, resolve_effects
-from ..model.numeric.values import SURFACES
+from ..names import SURFACES
 from ..errors import SolverError
 from ..parameters import Parameters
 from .settings import DEFAULT_SETTINGS, DiagnosisSettings

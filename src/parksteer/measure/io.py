@@ -41,6 +41,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import UsageError
+from ..names import SURFACES
 from ..parameters import Parameters, load_parameters
 from ..tables import atomic_path, format_number
 
@@ -55,7 +56,6 @@ UNITS = {
     "load_left_N": "N",
     "load_right_N": "N",
 }
-SURFACES = ("ground", "air_bearing")
 REQUIRED_METADATA = ("case", "surface")
 
 # A lock-to-lock cycle has up to nine phase segments (initial rise; wind-up and sliding on

@@ -40,9 +40,9 @@ from __future__ import annotations
 import sympy as sp
 import sympy.physics.mechanics as me
 
+from ....names import SIDES
 from ....parameters import Quantity
 from ..components import Effect
-from ..system import SIDES
 from .tyre_friction import EFFECT as TYRE_FRICTION
 
 # f(k) - 1 inside the patch, as a polynomial in m = k^2 (series of the elliptic closed form)

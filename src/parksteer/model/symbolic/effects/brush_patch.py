@@ -40,9 +40,10 @@ from __future__ import annotations
 import sympy as sp
 import sympy.physics.mechanics as me
 
+from ....names import SIDES
 from ....parameters import Quantity
 from ..components import Effect
-from ..system import SIDES, torque_between
+from ..system import torque_between
 from .carcass_compliance import EFFECT as CARCASS
 from .tyre_friction import EFFECT as TYRE_FRICTION
 

@@ -32,9 +32,10 @@ from __future__ import annotations
 import sympy as sp
 import sympy.physics.mechanics as me
 
+from ....names import SIDES
 from ....parameters import Quantity
 from ..components import Effect, Rival
-from ..system import SIDES, torque_between
+from ..system import torque_between
 from .carcass_compliance import EFFECT as CARCASS
 
 NODE_INERTIA_SHARE = sp.Rational(1, 100)  # of the tread ring's yaw inertia: the branch's node is nearly massless

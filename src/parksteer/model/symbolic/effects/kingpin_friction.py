@@ -4,9 +4,10 @@ from __future__ import annotations
 
 import sympy as sp
 
+from ....names import SIDES
 from ....parameters import Quantity
 from ..components import Effect
-from ..system import SIDES, torque_between
+from ..system import torque_between
 
 
 class KingpinFriction(Effect):

@@ -27,9 +27,9 @@ from __future__ import annotations
 import sympy as sp
 import sympy.physics.mechanics as me
 
+from ....names import SIDES
 from ....parameters import Quantity
 from ..components import Effect, Rival
-from ..system import SIDES
 from .braked_wheels import EFFECT as BRAKED_WHEELS
 
 

@@ -21,9 +21,10 @@ with the offset. Provenance: a candidate beyond the paper.
 
 from __future__ import annotations
 
+from ....names import SIDES
 from ....parameters import Quantity
 from ..components import Effect, Rival
-from ..system import SIDES, torque_between
+from ..system import torque_between
 
 
 class TopMountWindup(Effect):
