@@ -205,7 +205,7 @@ GROUND_Z_M = 0.5
 STRUT_HEIGHT_M = 0.4
 
 
-def derive(spec: Specification, base: Parameters | None = None) -> list[Derived]:
+def vehicle_values(spec: Specification, base: Parameters | None = None) -> list[Derived]:
     """Every value of a vehicle file from `spec`: given values, values derived by statics and geometry, and the
     paper car's values for what a specification does not give (each marked assumed)."""
     base = base or load_parameters(DEFAULT_PATH)
@@ -317,7 +317,7 @@ def _toml_string(text: str) -> str:
 
 
 def template_text(name: str, spec: Specification, values: list[Derived]) -> str:
-    """The commented vehicle file of `values` (from :func:`derive`)."""
+    """The commented vehicle file of `values` (from :func:`vehicle_values`)."""
     lines = [
         f"# parksteer vehicle file: {name}",
         "# Written by `parksteer vehicle new` from a specification; check every value marked `assumed` against",

@@ -105,7 +105,7 @@ def specification(args, gravity: float):
 
 def _new(args) -> int:
     from ..tables import atomic_path
-    from ..vehicle import derive, template_text, vehicle_from_text, vehicle_name
+    from ..vehicle import template_text, vehicle_from_text, vehicle_name, vehicle_values
 
     out = Path(args.out)
     if out.suffix != ".toml":
@@ -116,7 +116,7 @@ def _new(args) -> int:
         raise UsageError(f"--out {args.out}: exists (--force to overwrite)")
     base = load_parameters(args.parameters)
     spec = specification(args, base["vehicle.gravity"])
-    values = derive(spec, base)
+    values = vehicle_values(spec, base)
     text = template_text(vehicle_name(out), spec, values)
     try:
         vehicle_from_text(text, out, base)  # checked as a vehicle file before anything is written
