@@ -10,6 +10,7 @@ from pathlib import Path
 from ..names import SURFACES
 from ..errors import UsageError
 from ..parameters import DEFAULT_PATH
+from . import add_quiet_option
 from .vehicle import add_vehicle_option, parameters_of
 
 
@@ -50,6 +51,7 @@ def register(sub) -> None:
     _common(p)
     p.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
                    help="override a quantity by its key, e.g. tyre.tyre_pressure=180000 or rack_lash.lash=0.0002 (keys: `parksteer effects`, the parameter file; case.<name> for the case; repeatable)")
+    add_quiet_option(p)
     p.set_defaults(func=_compare)
 
     p = sub.add_parser("diagnose", help="calibrate the model, rank the candidate effects it lacks, give a verdict")
@@ -59,7 +61,7 @@ def register(sub) -> None:
                    help="write one self-contained HTML page: overlay, residual by phase, fitted values, ranking")
     p.add_argument("--jobs", type=int, default=None, metavar="N",
                    help="replays run side by side on N processes (default: the CPUs available; same result)")
-    p.add_argument("--quiet", action="store_true", help="no progress lines on stderr")
+    add_quiet_option(p)
     p.add_argument("--angle", action="store_true",
                    help="fit the measured handwheel angle beside the torque, in files that have one beside a measured "
                         "rack (the column stiffness and Hooke joint phase are then calibrated, a rack lash observable)")

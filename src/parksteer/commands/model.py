@@ -11,8 +11,8 @@ from pathlib import Path
 from ..names import SURFACES
 from ..errors import UsageError, naming
 from ..parameters import DEFAULT_PATH, load_parameters
-from ..progress import set_quiet
 from ..tables import write_json
+from . import add_quiet_option
 from .measure import add_import_options, channel_map_of
 from .vehicle import add_vehicle_option, parameters_of
 
@@ -40,6 +40,7 @@ def register(sub) -> None:
     add_vehicle_option(p)
     p.add_argument("--output-dt", type=float, default=0.01, help="output spacing, s (default 0.01)")
     p.add_argument("--out", required=True, help="output CSV")
+    add_quiet_option(p)
     p.set_defaults(func=_simulate)
 
     p = sub.add_parser("effects", help="list the model's effects, their slots and needs, and the quantities each uses")
@@ -50,8 +51,7 @@ def register(sub) -> None:
     p = sub.add_parser("derive", help="derive, generate and compile the model for an effect set (cached)")
     p.add_argument("--effects", default=None, help="effects spec (default: all five)")
     p.add_argument("--out", default=None, help="also write a JSON manifest of the cache entry here")
-    p.add_argument("--quiet", action="store_true",
-                   help="no progress on stderr (derivation, code generation, compilation, their times)")
+    add_quiet_option(p)
     p.set_defaults(func=_derive)
 
 
@@ -130,7 +130,6 @@ def _derive(args) -> int:
     from ..model.codegen.cache import ensure
     from ..model.symbolic.components import resolve_effects
 
-    set_quiet(args.quiet)
     start = time.perf_counter()
     manifest = ensure(resolve_effects(args.effects), note_cached=True)
     if args.out:
