@@ -47,15 +47,3 @@ def build(main_typ: str | Path, out_pdf: str | Path, root: str | Path = ".", com
 def page_count(pdf: bytes) -> int:
     """Number of page objects in a PDF (uncompressed object dictionaries, as Typst writes them)."""
     return len(re.findall(rb"/Type\s*/Page(?![s\w])", pdf))
-
-
-def write_effect_quantities(parameters_path: str | Path, json_path: str | Path) -> None:
-    """Every effect the registry finds with its own quantities' values and sources (``parksteer effects --json``),
-    for the article's table of chosen values: an effect's quantities are declared in its file, not the parameter
-    file."""
-    from .model.symbolic.components import discover_effects
-    from .parameters import load_parameters
-    from .tables import write_json
-
-    params = load_parameters(parameters_path)
-    write_json(json_path, [effect.describe(params) for effect in discover_effects().values()])

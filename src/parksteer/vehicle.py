@@ -111,7 +111,8 @@ def vehicle_from_text(text: str, path: str | Path, base: str | Path | Parameters
 
 def _file_or_effect_quantity(path: Path, section: str, name: str):
     """The quantity of ``section.name``: a key of the parameter file, or an effect's own quantity (a car's value of
-    it, e.g. ``ackermann.track_to_wheelbase``, declared on the effect)."""
+    it, e.g. ``ackermann.track_to_wheelbase``, declared on the effect; known once :mod:`parksteer.model` is
+    imported, as the command line does)."""
     if section in SCHEMA:
         spec = SCHEMA[section].get(name)
         if spec is None:

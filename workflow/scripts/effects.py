@@ -1,5 +1,5 @@
-# Thin rule script: the logic is parksteer.paper.write_effect_quantities.
-from parksteer.paper import write_effect_quantities
+# Thin rule script: the logic is parksteer.effect_table.write_effect_quantities.
+from parksteer.effect_table import write_effect_quantities
 from parksteer.rules import rule_log
 
 with rule_log(snakemake):
