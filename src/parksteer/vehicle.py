@@ -64,7 +64,9 @@ def vehicle_name(path: str | Path) -> str:
 
 def load_vehicle(path: str | Path, base: str | Path | Parameters = DEFAULT_PATH) -> Parameters:
     """The base parameters with the car of the vehicle file `path`: its values replace the base's, its cases
-    replace the base's cases. Raises :class:`ParameterError` (one line, file and key) on any defect."""
+    replace the base's cases. Raises :class:`ParameterError` (one line, file and key) on any defect. A value of an
+    effect's own quantity (``[ackermann] track_to_wheelbase``) is checked against the effect's declaration, which
+    the registry knows once :mod:`parksteer.model` is imported (the command line and the workflow import it)."""
     path = Path(path)
     try:
         text = path.read_text(encoding="utf-8")
