@@ -114,7 +114,8 @@ def planned(function, *args, files=()):
     try:  # a configuration naming what is not defined (a rival that is not one): one line, before any job
         value = json.loads(json.dumps(getattr(parksteer.plan, function)(*args)))
     except UsageError as error:
-        sys.exit(f"parksteer: error: {error}")
+        print(f"parksteer: error: {error}", file=sys.stderr)
+        sys.exit(2)
     _PLANNED[key] = value
     return value
 
