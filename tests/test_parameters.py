@@ -11,6 +11,7 @@ from pathlib import Path
 
 import pytest
 
+from parksteer.errors import UsageError
 from parksteer.parameters import DEFAULT_PATH, ParameterError, load_parameters
 
 BIN = Path(sys.executable).parent
@@ -109,12 +110,13 @@ DEFECTS = {
         None,
         "tyre.tyre_pressure",
     ),
-    "candidate strength out of bounds": ("lash = { value = 0.0,", "lash = { value = 0.5,", None, "rack_lash.lash"),
-    "candidate quantity missing": (
-        'damping = { value = 0.0, unit = "N s/m"',
-        'viscosity = { value = 0.0, unit = "N s/m"',
-        "[rack_damping]",
-        "rack_damping.viscosity",
+    # An effect's own quantities are declared on the effect, not in the parameter file: a section for one, as files
+    # had before, is refused naming it.
+    "effect section in the file": (
+        "\n[synthetic]\n",
+        '\n[rack_damping]\ndamping = { value = 0.0, unit = "N s/m", source = "x" }\n\n[synthetic]\n',
+        None,
+        "rack_damping",
     ),
     # Statics: the two wheel loads carry (chassis_mass + unsprung_mass) g, about 6.3 kN for the part-laden car's
     # 540 kg chassis; a 29 kN wheel load cannot be.
@@ -196,6 +198,17 @@ def test_table_b1_loads_satisfy_the_chassis_statics_to_printing_precision(params
         implied_cg_y_m = (c["load_right"] - c["load_left"]) * c["wheel_centre_y"] / (c["chassis_mass"] * g)
         tolerance_m = 0.05e-3 + 1.0 * c["wheel_centre_y"] / (c["chassis_mass"] * g)
         assert implied_cg_y_m == pytest.approx(c["chassis_cg_y"], abs=tolerance_m)
+
+
+def test_an_effect_quantity_out_of_its_declared_bounds_is_refused(params):
+    """An effect's own quantity is declared on the effect with its bounds (a rack's lash, half the free play of the
+    mesh, is 0-0.5 mm in a worn rack; the bound is 5 mm): a lash of 0.5 m is refused in one line naming the key,
+    as a value of the parameter file out of its bounds is."""
+    assert params["rack_lash.lash"] == 0.0  # declared default: absent
+    with pytest.raises(UsageError) as info:
+        params.with_overrides({"rack_lash.lash": 0.5})
+    message = str(info.value)
+    assert "\n" not in message and message.startswith("rack_lash.lash:") and "non-physical" in message
 
 
 def test_a_load_sum_two_newtons_off_is_refused(tmp_path):

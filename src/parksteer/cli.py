@@ -15,6 +15,7 @@ import sys
 from importlib import metadata
 
 from .errors import UsageError
+from .progress import quiet_while
 
 # Modules that add subcommands, in the order they appear in --help.
 COMMAND_MODULES = [
@@ -72,7 +73,8 @@ def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(_join_dash_values(sys.argv[1:] if argv is None else list(argv)))
     try:
-        status = int(args.func(args) or 0)
+        with quiet_while(getattr(args, "quiet", False)):  # --quiet means the same in every subcommand that has it
+            status = int(args.func(args) or 0)
         sys.stdout.flush()  # a closed pipe shows here, inside the handler, not at interpreter exit
         return status
     except UsageError as exc:

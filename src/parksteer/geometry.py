@@ -20,9 +20,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import portable as pm
+from .names import SIDES
 from .parameters import Parameters
-
-SIDES = ("left", "right")
 
 
 def _rot_x(a: float) -> np.ndarray:

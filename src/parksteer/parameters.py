@@ -1,8 +1,9 @@
 """The registry of quantities, and the parameter file (src/parksteer/data/parameters.toml, shipped as package data) that gives their values.
 
-Every quantity has one key (``section.name``), one SI unit and one pair of physical bounds, listed here
-(:data:`SCHEMA`, :func:`registry`); the file gives each its value and source as ``{value, unit, source}``.
-The candidate effects' own quantities are sections of the file named after the effect. Overrides (``--set``,
+Every quantity has one key (``section.name``), one SI unit and one pair of physical bounds. The car's quantities
+are listed here (:data:`SCHEMA`) and the file gives each its value and source as ``{value, unit, source}``; an
+effect's own quantities (``<effect>.<name>``) are declared on the effect, with default and source, and join the
+registry (:func:`registry`) when the effect is loaded (:func:`declare`). Overrides (``--set``,
 sweeps, diagnosis, the workflow's config) use the same keys, plus ``case.<name>`` for the active Table B1
 case (:meth:`Parameters.with_overrides`). Any unknown key, missing key, wrong unit, non-physical value or
 wheel loads that contradict the chassis statics are refused with a :class:`ParameterError` whose message is
@@ -17,6 +18,7 @@ import dataclasses
 import math
 import tomllib
 from dataclasses import dataclass, field
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -34,8 +36,8 @@ class Quantity:
 
     ``key`` is ``section.name`` of the parameter file (``tyre.tyre_pressure``), ``case.<name>`` for a
     value of the active Table B1 case, or ``<effect>.<name>`` for a quantity only that effect has.
-    ``default`` and ``source`` are given only by quantities declared in code (an effect from outside the
-    package); every other quantity takes its value and source from the parameter file.
+    ``default`` and ``source`` are given only by quantities declared in code (an effect's own, on the effect's
+    class); every other quantity takes its value and source from the parameter file.
     """
 
     key: str
@@ -211,47 +213,6 @@ _SCHEMA: dict[str, dict[str, dict[str, Any]]] = {
         "hand_knots_per_stroke": _pos("1", upper=8.0),
         "hand_seed": _nonneg("1"),
     },
-    # The candidate effects' own quantities (sections named after the effect; value 0 of a strength = absent).
-    "ackermann": {
-        "ackermann_fraction": _range("1", 0.0, 1.5),
-        "track_to_wheelbase": _range("1", 0.1, 2.0),
-    },
-    "braked_wheels": {"brake_fraction": _range("1", 0.0, 1.0)},
-    "brush_patch": {"brush_fraction": _range("1", 0.0, 1.0)},
-    "column_friction": {"friction_torque": _range("N m", 0.0, 20.0)},
-    "kingpin_friction": {"friction_radius": _range("m", 0.0, 0.05)},
-    "rack_damping": {"damping": _range("N s/m", 0.0, 1.0e5)},
-    "rack_lash": {
-        "lash": _range("m", 0.0, 0.005),
-        "smoothing_width": _range("m", 1.0e-7, 1.0e-3),
-    },
-    "rack_stiction": {
-        "breakaway_excess": _range("N", 0.0, 5000.0),
-        "stribeck_speed": _range("m/s", 1.0e-4, 0.1),
-    },
-    # Rivals of the paper's mechanisms (effects with diagnosis_candidate = False).
-    "carcass_hysteresis": {
-        "stiffness_fraction": _range("1", 0.0, 5.0),
-        "relaxation_time": _range("s", 1.0e-3, 10.0),
-    },
-    "gear_efficiency": {
-        "inefficiency": _range("1", 0.0, 0.5),
-        "smoothing_force": _range("N", 1.0e-3, 100.0),
-    },
-    "linkage_nonlinearity": {"cubic_coefficient": _range("1", 0.0, 1.0)},
-    "rolling_resistance": {"coefficient": _range("1", 0.0, 0.1)},
-    "rack_presliding": {
-        "force": _range("N", 0.0, 2000.0),
-        "presliding_displacement": _range("m", 1.0e-6, 1.0e-2),
-        "slip_smoothing": _range("s/m", 10.0, 1.0e6),
-        "node_mass": _range("kg", 1.0e-4, 10.0),
-        "damping_ratio": _range("1", 0.0, 10.0),
-    },
-    "top_mount_windup": {"stiffness": _range("N m/rad", 0.0, 1000.0)},
-    "tyre_stribeck": {
-        "breakaway_excess": _range("1", 0.0, 1.0),
-        "stribeck_rate": _range("rad/s", 1.0e-4, 1.0),
-    },
 }
 
 _CASE_SCHEMA: dict[str, dict[str, Any]] = {
@@ -272,8 +233,23 @@ SCHEMA: dict[str, dict[str, Quantity]] = {
 }
 CASE_SCHEMA: dict[str, Quantity] = {name: Quantity(f"{CASE}.{name}", **spec) for name, spec in _CASE_SCHEMA.items()}
 
-# Quantities declared in code by effects from outside the package (key <effect>.<name>), joined when loaded.
+# Quantities declared in code by effects (key <effect>.<name>), joined when the effect is loaded.
 _DECLARED: dict[str, Quantity] = {}
+# Functions that load what declares quantities (the model's effect registry adds one when it is imported), each
+# called once, the first time a key is not found: a key of an effect not loaded yet is found all the same.
+_DECLARERS: list[Callable[[], object]] = []
+
+
+def add_declarer(load: Callable[[], object]) -> None:
+    """Register `load`, called once when a key is first not found, to declare quantities (load effects)."""
+    _DECLARERS.append(load)
+
+
+def _declared(key: str) -> Quantity | None:
+    if key not in _DECLARED and _DECLARERS:
+        while _DECLARERS:
+            _DECLARERS.pop(0)()
+    return _DECLARED.get(key)
 
 # Keys of earlier versions, each now one quantity of the file: refused with a pointer to the key.
 RENAMED: dict[str, str] = {
@@ -309,9 +285,7 @@ def registry() -> dict[str, Quantity]:
 
 def quantity(key: str) -> Quantity:
     """The quantity of `key`; an unknown or renamed key is a one-line UsageError."""
-    found = _DECLARED.get(key)
-    if found is None:
-        found = _file_and_case_keys().get(key)
+    found = _file_and_case_keys().get(key) or _declared(key)
     if found is None:
         raise UsageError(unknown_key_message(key))
     return found
@@ -374,7 +348,7 @@ class Parameters:
             return self.case(parts[1])[parts[2]]
         if len(parts) == 2 and parts[0] in self.sections and parts[1] in self.sections[parts[0]]:
             return self.sections[parts[0]][parts[1]]
-        declared = _DECLARED.get(dotted)
+        declared = _declared(dotted)
         if declared is not None:
             return declared.default
         raise KeyError(dotted)
@@ -393,7 +367,7 @@ class Parameters:
         return dict(self.cases[name])
 
     def source(self, dotted: str) -> str:
-        if dotted not in self.sources and dotted in _DECLARED:
+        if dotted not in self.sources and _declared(dotted) is not None:
             return _DECLARED[dotted].source
         return self.sources[dotted]
 
@@ -526,7 +500,8 @@ def load_parameters(path: str | Path = DEFAULT_PATH) -> Parameters:
     known_top = set(SCHEMA) | {"cases"}
     unknown = sorted(doc.keys() - known_top)
     if unknown:
-        raise ParameterError(f"{path}: {unknown[0]}: unknown key")
+        raise ParameterError(f"{path}: {unknown[0]}: unknown key (an effect's own quantities are declared on the "
+                             "effect, see `parksteer effects`; change one with --set <effect>.<name>=<value>)")
     sections = {}
     for name, schema in SCHEMA.items():
         if name not in doc:

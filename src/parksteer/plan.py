@@ -24,11 +24,12 @@ def model_set(spec: Any) -> dict:
     return {"effects": [e.name for e in effects], "key": model_key(effects)}
 
 
-def rival_names() -> list[str]:
-    """The rival effects the rivals figure compares (parksteer.figures.rivals.RIVALS)."""
-    from .figures.rivals import RIVALS
+def rival_names(selection: list | None = None) -> list[str]:
+    """The rival effects the rivals figure compares: the configuration's `selection` checked to be rivals, or
+    every effect that declares a rival (parksteer.model.symbolic.components.chosen_rivals)."""
+    from .model.symbolic.components import chosen_rivals
 
-    return list(RIVALS)
+    return list(chosen_rivals(selection, "config rivals"))
 
 
 def case_file(folder: str, name: str, part: str) -> str:

@@ -18,6 +18,19 @@ def set_quiet(quiet: bool) -> None:
     _quiet = bool(quiet)
 
 
+@contextmanager
+def quiet_while(quiet: bool) -> Iterator[None]:
+    """Silence the progress lines inside the block when `quiet` (a subcommand's ``--quiet``), then restore what
+    was set before it (a command run in-process, as the tests run them, leaves the next one as it found it)."""
+    global _quiet
+    before = _quiet
+    _quiet = before or bool(quiet)
+    try:
+        yield
+    finally:
+        _quiet = before
+
+
 def note(message: str) -> None:
     """One progress line on the current stderr (looked up at each call: a rule redirects it to its log)."""
     if not _quiet:

@@ -23,6 +23,7 @@ from pathlib import Path
 from typing import Any
 
 from . import portable as pm
+from .errors import UsageError
 from .geometry import lock_steer_angle, steer_axis
 from .parameters import (
     CASE_SCHEMA,
@@ -34,6 +35,7 @@ from .parameters import (
     check_statics,
     check_table,
     load_parameters,
+    quantity,
 )
 
 # Keys every vehicle file must give: everything the model takes from the car itself.
@@ -104,7 +106,9 @@ def vehicle_name(path: str | Path) -> str:
 
 def load_vehicle(path: str | Path, base: str | Path | Parameters = DEFAULT_PATH) -> Parameters:
     """The base parameters with the car of the vehicle file `path`: its values replace the base's, its cases
-    replace the base's cases. Raises :class:`ParameterError` (one line, file and key) on any defect."""
+    replace the base's cases. Raises :class:`ParameterError` (one line, file and key) on any defect. A value of an
+    effect's own quantity (``[ackermann] track_to_wheelbase``) is checked against the effect's declaration, which
+    the registry knows once :mod:`parksteer.model` is imported (the command line and the workflow import it)."""
     path = Path(path)
     try:
         text = path.read_text(encoding="utf-8")
@@ -122,9 +126,6 @@ def vehicle_from_text(text: str, path: str | Path, base: str | Path | Parameters
     except tomllib.TOMLDecodeError as exc:
         raise ParameterError(f"{path}: not valid TOML ({exc})") from None
 
-    unknown = sorted(doc.keys() - (set(SCHEMA) | {"cases", ASSIST_SECTION}))
-    if unknown:
-        raise ParameterError(f"{path}: {unknown[0]}: unknown key (a section of the parameter file, or cases)")
     sections = {name: dict(values) for name, values in base_params.sections.items()}
     sources = {k: v for k, v in base_params.sources.items() if not k.startswith("cases.")}
     for key in REQUIRED:
@@ -141,10 +142,8 @@ def vehicle_from_text(text: str, path: str | Path, base: str | Path | Parameters
         if not isinstance(table, dict):
             raise ParameterError(f"{path}: {section}: expected a table")
         for name, entry in table.items():
-            spec = SCHEMA[section].get(name)
-            if spec is None:
-                raise ParameterError(f"{path}: {section}.{name}: unknown key")
-            sections[section][name] = check_entry(path, f"{section}.{name}", spec, entry)
+            spec = _file_or_effect_quantity(path, section, name)
+            sections.setdefault(section, {})[name] = check_entry(path, f"{section}.{name}", spec, entry)
             sources[f"{section}.{name}"] = entry["source"]
 
     cases_doc = doc.get("cases")
@@ -155,6 +154,22 @@ def vehicle_from_text(text: str, path: str | Path, base: str | Path | Parameters
     params = Parameters(path=path, sections=sections, cases=cases, sources=sources)
     check_car(params)
     return params
+
+
+def _file_or_effect_quantity(path: Path, section: str, name: str):
+    """The quantity of ``section.name``: a key of the parameter file, or an effect's own quantity (a car's value of
+    it, e.g. ``ackermann.track_to_wheelbase``, declared on the effect; known once :mod:`parksteer.model` is
+    imported, as the command line does)."""
+    if section in SCHEMA:
+        spec = SCHEMA[section].get(name)
+        if spec is None:
+            raise ParameterError(f"{path}: {section}.{name}: unknown key")
+        return spec
+    try:
+        return quantity(f"{section}.{name}")
+    except UsageError:
+        raise ParameterError(f"{path}: {section}.{name}: unknown key (a key of the parameter file, cases, or an "
+                             "effect's own quantity)") from None
 
 
 def check_car(params: Parameters) -> None:
@@ -238,7 +253,7 @@ GROUND_Z_M = 0.5
 STRUT_HEIGHT_M = 0.4
 
 
-def derive(spec: Specification, base: Parameters | None = None) -> list[Derived]:
+def vehicle_values(spec: Specification, base: Parameters | None = None) -> list[Derived]:
     """Every value of a vehicle file from `spec`: given values, values derived by statics and geometry, and the
     paper car's values for what a specification does not give (each marked assumed)."""
     base = base or load_parameters(DEFAULT_PATH)
@@ -350,7 +365,7 @@ def _toml_string(text: str) -> str:
 
 
 def template_text(name: str, spec: Specification, values: list[Derived]) -> str:
-    """The commented vehicle file of `values` (from :func:`derive`)."""
+    """The commented vehicle file of `values` (from :func:`vehicle_values`)."""
     lines = [
         f"# parksteer vehicle file: {name}",
         "# Written by `parksteer vehicle new` from a specification; check every value marked `assumed` against",

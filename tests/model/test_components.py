@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from parksteer.errors import UsageError
-from parksteer.model.symbolic.components import Effect, discover_effects, resolve_effects
+from parksteer.model.symbolic.components import Effect, discover_effects, resolve_effects, strength_parameter
 from parksteer.model.symbolic.derive import build_space
 from parksteer.model.numeric.simulate import simulate
 from parksteer.model.numeric.values import parse_overrides
@@ -49,17 +49,24 @@ def test_overrides_are_checked():
 
 def test_every_effect_declares_its_parameters(params):
     """Each effect has a description and uses quantities of the registry, each with SI unit, bounds containing
-    the file's value, and a source; a candidate's own quantities are a section of the file named after it or are
-    declared on its class."""
-    for effect in discover_effects().values():
+    the file's value, and a source; an effect's own quantities are declared on the effect (none of them is in the
+    parameter file, which holds the car's), and every rival names diagnosis candidates as its closest and related
+    mechanisms and a probe strength within its strength quantity's bounds."""
+    effects = discover_effects()
+    for effect in effects.values():
         described = effect.describe(params)
         assert described["description"]
         for p in described["parameters"]:
             assert p["unit"] and p["source"]
             assert p["min"] <= p["default"] <= p["max"]
-        declared = {q.key for q in effect.quantities}  # declared on the class, with default and source
+        declared = {q.key for q in effect.quantities}
         for key in effect.own_keys():
-            assert key in params.sources or key in declared, key
+            assert key in declared and key not in params.sources, key
+        if effect.rival is not None:
+            assert not effect.diagnosis_candidate and effect.rival.why
+            for name in filter(None, (effect.rival.closest, *effect.rival.related)):
+                assert effects[name].diagnosis_candidate, (effect.name, name)
+            assert strength_parameter(effect, params).within(effect.rival.probe_strength), effect.name
     assert discover_effects()["rack_lash"].own_keys() == ("rack_lash.lash", "rack_lash.smoothing_width")
 
 

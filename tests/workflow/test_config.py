@@ -59,3 +59,24 @@ def test_a_sweep_batch_size_that_is_not_a_positive_integer_is_refused(config, sc
     bad["sweep_batch_size"] = size
     with pytest.raises(WorkflowError):
         validate(bad, schema)
+
+
+def test_the_rivals_are_a_selection_of_the_effects_that_declare_one(config):
+    """The configuration selects rivals, it does not define them: its lists are effects that declare a rival, in
+    the order given (the rows of the rivals figure, the seeds of the out-of-class data sets), every rival when a
+    list is left out; rack_lash is a diagnosis candidate, not a rival, and naming it is refused in one line naming
+    the entry."""
+    from parksteer.model.symbolic.components import rival_effects
+    from parksteer.plan import rival_names
+    from parksteer.synthetic.datasets import OutclassDesign
+
+    assert rival_names(config["rivals"]) == config["rivals"]
+    assert rival_names(None) == sorted(rival_effects())
+    without = {k: v for k, v in config["outclass"].items() if k != "rivals"}
+    assert OutclassDesign.from_config(without, config["benchmark"]).rivals == tuple(sorted(rival_effects()))
+    for call, entry in ((lambda: rival_names([*config["rivals"], "rack_lash"]), "config rivals"),
+                        (lambda: OutclassDesign.from_config({**without, "rivals": ["rack_lash"]}, config["benchmark"]),
+                         "config outclass.rivals")):
+        with pytest.raises(UsageError, match=entry) as info:
+            call()
+        assert "\n" not in str(info.value) and "'rack_lash' is not a rival" in str(info.value)

@@ -11,7 +11,7 @@ A copy of the repository (its tracked and new files) gets the compiled models of
   stored sums by the next ordinary run;
 - two rebuilds from clean give the same bytes in every figure, table and key-number file.
 Each run takes well under a minute on two cores; the three rebuilds of the whole paper are
-benchmarks/three_rebuilds.py (see the README).
+benchmarks/three_rebuilds.py (see docs/targets.md).
 """
 
 from __future__ import annotations

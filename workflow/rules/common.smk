@@ -110,8 +110,13 @@ def planned(function, *args, files=()):
     if key in _PLAN_KNOWN:
         return _PLAN_KNOWN[key]
     import parksteer.plan
+    from parksteer.errors import UsageError
 
-    value = json.loads(json.dumps(getattr(parksteer.plan, function)(*args)))
+    try:  # a configuration naming what is not defined (a rival that is not one): one line, before any job
+        value = json.loads(json.dumps(getattr(parksteer.plan, function)(*args)))
+    except UsageError as error:
+        print(f"parksteer: error: {error}", file=sys.stderr)
+        sys.exit(2)
     _PLANNED[key] = value
     return value
 

@@ -1,10 +1,26 @@
 # The reproduction article: every number it quotes is read from results/*.json and figures/*.csv.
 
 
+# Every effect with its own quantities (declared in the effect's file), for the article's table of chosen values.
+rule effects:
+    input:
+        parameters=PARAMETERS,
+        code=script_sources("effects"),
+    output:
+        json="results/effects.json",
+    log:
+        "logs/effects.log",
+    conda:
+        "../envs/parksteer.yaml"
+    script:
+        "../scripts/effects.py"
+
+
 rule paper:
     input:
         source=paper_sources(),
         parameters=PARAMETERS,
+        effects="results/effects.json",
         figures=all_figure_files(),
         numbers=all_number_files(),
         code=script_sources("paper"),

@@ -1,8 +1,9 @@
 # Rivals of lifting: each rival effect of the library given the strength that matches lifting's rise toward lock
 # in the unladen ground test, then the source's other tests (part laden, air bearings, 68.5 mm spacers) simulated
 # with it, to name the test that tells it from lifting (parksteer.figures.rivals). Writes the figure (SVG), the
-# table (CSV) and the numbers the paper quotes (results/rivals.json).
-_RIVALS = planned("rival_names")
+# table (CSV) and the numbers the paper quotes (results/rivals.json). The rivals are config["rivals"], a selection
+# of the effects that declare one.
+_RIVALS = planned("rival_names", config.get("rivals"))
 
 
 rule rivals:
@@ -14,6 +15,8 @@ rule rivals:
         svg=figure_report("figures/rivals.svg", "bands"),
         csv=figure_report("figures/rivals.csv", "bands"),
         json="results/rivals.json",
+    params:
+        rivals=_RIVALS,
     log:
         "logs/rivals.log",
     benchmark:

@@ -7,8 +7,10 @@ import json
 import sys
 from pathlib import Path
 
+from ..names import SURFACES
 from ..errors import UsageError
 from ..parameters import DEFAULT_PATH
+from . import add_quiet_option
 from .vehicle import add_vehicle_option, parameters_of
 
 
@@ -17,7 +19,7 @@ def _common(p) -> None:
                    help="measurement files: native CSV (data/measurements/README.md), a logger's CSV, ASAM MDF or a raw CAN "
                         "log with --bus/--dbc")
     p.add_argument("--case", default=None, help="Table B1 case for every file (default: each file's own)")
-    p.add_argument("--surface", choices=("ground", "air_bearing"), default=None,
+    p.add_argument("--surface", choices=tuple(SURFACES), default=None,
                    help="the surface of files that do not state one")
     add_import_options(p)
     p.add_argument("--effects", default=None,
@@ -62,6 +64,7 @@ def register(sub) -> None:
     _common(p)
     p.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
                    help="override a quantity by its key, e.g. tyre.tyre_pressure=180000 or rack_lash.lash=0.0002 (keys: `parksteer effects`, the parameter file; case.<name> for the case; repeatable)")
+    add_quiet_option(p)
     p.set_defaults(func=_compare)
 
     p = sub.add_parser("diagnose", help="calibrate the model, rank the candidate effects it lacks, give a verdict")
@@ -71,7 +74,7 @@ def register(sub) -> None:
                    help="write one self-contained HTML page: overlay, residual by phase, fitted values, ranking")
     p.add_argument("--jobs", type=int, default=None, metavar="N",
                    help="replays run side by side on N processes (default: the CPUs available; same result)")
-    p.add_argument("--quiet", action="store_true", help="no progress lines on stderr")
+    add_quiet_option(p)
     p.add_argument("--angle", action="store_true",
                    help="fit the measured handwheel angle beside the torque, in files that have one beside a measured "
                         "rack (the column stiffness and Hooke joint phase are then calibrated, a rack lash observable)")

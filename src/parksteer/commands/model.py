@@ -8,10 +8,11 @@ import time
 from contextlib import nullcontext
 from pathlib import Path
 
+from ..names import SURFACES
 from ..errors import UsageError, naming
 from ..parameters import DEFAULT_PATH, load_parameters
-from ..progress import set_quiet
 from ..tables import write_json
+from . import add_quiet_option
 from .measure import add_import_options, channel_map_of
 from .vehicle import add_vehicle_option, parameters_of
 
@@ -23,7 +24,7 @@ def register(sub) -> None:
     p.add_argument("--effects", default=None, help="effects spec, e.g. --effects=-rack_friction,+hooke_joint (default: the paper's five)")
     p.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
                    help="override a quantity by its key, e.g. tyre.tyre_pressure=180000 or rack_lash.lash=0.0002 (keys: `parksteer effects`, the parameter file; case.<name> for the case; repeatable)")
-    p.add_argument("--surface", choices=("ground", "air_bearing"), default=None,
+    p.add_argument("--surface", choices=tuple(SURFACES), default=None,
                    help="default ground (with --rack-from: the file's surface)")
     p.add_argument("--speed-kmh", type=float, default=None,
                    help="the car creeps at this constant speed while it steers, 0-10.8 km/h (adds the turn_slip "
@@ -42,6 +43,7 @@ def register(sub) -> None:
     add_vehicle_option(p)
     p.add_argument("--output-dt", type=float, default=0.01, help="output spacing, s (default 0.01)")
     p.add_argument("--out", required=True, help="output CSV")
+    add_quiet_option(p)
     p.set_defaults(func=_simulate)
 
     p = sub.add_parser("effects", help="list the model's effects, their slots and needs, and the quantities each uses")
@@ -52,8 +54,7 @@ def register(sub) -> None:
     p = sub.add_parser("derive", help="derive, generate and compile the model for an effect set (cached)")
     p.add_argument("--effects", default=None, help="effects spec (default: all five)")
     p.add_argument("--out", default=None, help="also write a JSON manifest of the cache entry here")
-    p.add_argument("--quiet", action="store_true",
-                   help="no progress on stderr (derivation, code generation, compilation, their times)")
+    add_quiet_option(p)
     p.set_defaults(func=_derive)
 
 
@@ -147,7 +148,6 @@ def _derive(args) -> int:
     from ..model.codegen.cache import ensure
     from ..model.symbolic.components import resolve_effects
 
-    set_quiet(args.quiet)
     start = time.perf_counter()
     manifest = ensure(resolve_effects(args.effects), note_cached=True)
     if args.out:

@@ -10,6 +10,7 @@ import json
 import sys
 
 from ..parameters import DEFAULT_PATH, load_parameters
+from . import add_quiet_option
 
 
 def register(sub) -> None:
@@ -29,6 +30,7 @@ def register(sub) -> None:
     q.add_argument("--out", required=True, help="output JSON")
     q.add_argument("--full", action="store_true")
     q.add_argument("--parameters", default=str(DEFAULT_PATH))
+    add_quiet_option(q)
     q.set_defaults(func=_point)
 
     q = actions.add_parser("gather", help="write the table, key numbers and torque maps from point JSONs")
@@ -39,6 +41,7 @@ def register(sub) -> None:
     q.add_argument("--json", required=True)
     q.add_argument("--full", action="store_true")
     q.add_argument("--parameters", default=str(DEFAULT_PATH))
+    add_quiet_option(q)
     q.set_defaults(func=_gather)
 
 

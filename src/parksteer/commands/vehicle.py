@@ -6,6 +6,7 @@ import math
 import re
 from pathlib import Path
 
+from .. import model  # noqa: F401  (its effects declare their quantities, which a vehicle file may give)
 from .. import portable as pm
 from ..errors import UsageError
 from ..parameters import DEFAULT_PATH, load_parameters
@@ -116,7 +117,7 @@ def specification(args, gravity: float):
 
 def _new(args) -> int:
     from ..tables import atomic_path
-    from ..vehicle import derive, template_text, vehicle_from_text, vehicle_name
+    from ..vehicle import template_text, vehicle_from_text, vehicle_name, vehicle_values
 
     out = Path(args.out)
     if out.suffix != ".toml":
@@ -127,7 +128,7 @@ def _new(args) -> int:
         raise UsageError(f"--out {args.out}: exists (--force to overwrite)")
     base = load_parameters(args.parameters)
     spec = specification(args, base["vehicle.gravity"])
-    values = derive(spec, base)
+    values = vehicle_values(spec, base)
     text = template_text(vehicle_name(out), spec, values) + assist_section(args, base)
     try:
         vehicle_from_text(text, out, base)  # checked as a vehicle file before anything is written

@@ -35,8 +35,8 @@ class ColumnImbalance(Effect):
     name = "column_imbalance"
     description = "Out-of-balance mass on the inclined column: torque -T_u sin(column angle - phase), once per turn"
     in_default_set = False
-    # Quantities only this effect has, declared here (an effect from outside the package has no section of the
-    # parameter file): they join the registry when the effect is loaded.
+    # Quantities only this effect has, declared here as every effect declares its own (the parameter file holds the
+    # car's): they join the registry when the effect is loaded.
     quantities = (
         Quantity("column_imbalance.strength", "N m", 0.0, 20.0, lower_inclusive=True, default=0.0,
                  source="example: m g e sin(lambda); 0.2 kg at 30 mm on a column inclined 25 deg gives 0.025 N m "

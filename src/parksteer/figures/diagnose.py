@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..names import SURFACES
 from ..measure.phases import PHASES
 from ..plotting import COLOURS, new_figure, save_svg
 
@@ -32,7 +33,7 @@ def _phase_bars(ax, comparisons, labels, floors) -> None:
 def shown_files(files, limit: int = 2) -> list[int]:
     """Indices of the files a figure overlays: the first on the ground and the first on air bearings."""
     picked = []
-    for surface in ("ground", "air_bearing"):
+    for surface in SURFACES:
         picked += [i for i, f in enumerate(files) if f.surface == surface][:1]
     return (picked or list(range(len(files))))[:limit]
 

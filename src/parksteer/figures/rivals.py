@@ -34,13 +34,11 @@ from pathlib import Path
 
 import numpy as np
 
-from ..model.symbolic.components import discover_effects, strength_parameter
+from ..model.symbolic.components import chosen_rivals, discover_effects, strength_parameter
 from ..parameters import Parameters, load_parameters
 from ..tables import write_csv, write_json
 from .model import cycle_summary
 
-RIVALS = ("gear_efficiency", "tyre_stribeck", "carcass_hysteresis", "top_mount_windup", "linkage_nonlinearity",
-          "rolling_resistance", "rack_presliding")
 # The matched test, then the source's other tests: (key, case, surface, label).
 TESTS = (
     ("unladen_ground", "unladen", "ground", "unladen, ground"),
@@ -48,12 +46,6 @@ TESTS = (
     ("unladen_air", "unladen", "air_bearing", "unladen, air bearings"),
     ("spacer_68_5_ground", "offset_68_5mm", "ground", "68.5 mm spacers, ground"),
 )
-# First strength of each rival's secant search, inside the range its parameter's source gives; the matched
-# strength does not depend on it.
-PROBE_STRENGTH = {
-    "gear_efficiency": 0.1, "tyre_stribeck": 0.2, "carcass_hysteresis": 0.3, "top_mount_windup": 30.0,
-    "linkage_nonlinearity": 0.1, "rolling_resistance": 0.015, "rack_presliding": 100.0,
-}
 MATCH_RELATIVE = 0.01  # the search stops when the matched torque is within 1 % of lifting's
 MATCH_STEPS = 6
 # A rival whose rise toward lock at its probe strength is below this fraction of lifting's does not rise toward
@@ -75,12 +67,14 @@ def converter_step_Nm(params: Parameters) -> float:
     return 2.0 * params["synthetic.full_scale_torque"] / 2.0 ** params["synthetic.logger_bits"]
 
 
-def compare_rivals(params: Parameters, simulate=None, rivals=RIVALS, progress=None) -> dict:
+def compare_rivals(params: Parameters, simulate=None, rivals=None, progress=None) -> dict:
     """Lifting's rise toward lock in each test, each rival's matched strength and rise in each test, and the
-    separating test (see the module docstring)."""
+    separating test (see the module docstring). `rivals` selects effects that declare a rival (every one in name
+    order when None); each rival's search starts at its declared probe strength."""
     if simulate is None:
         from ..model.numeric.simulate import simulate
     registry = discover_effects()
+    rivals = chosen_rivals(rivals, "rivals", registry)
     base = {key: simulate(case, params=params, surface=surface).columns for key, case, surface, _ in TESTS}
     base_numbers = {key: _near_and_plateau(c, params) for key, c in base.items()}
 
@@ -112,7 +106,7 @@ def compare_rivals(params: Parameters, simulate=None, rivals=RIVALS, progress=No
         upper = quantity.upper if math.isfinite(quantity.upper) else math.inf
         # Secant on the strength for the added rise toward lock (zero at zero strength), kept in the bounds.
         s0, f0 = 0.0, -target
-        s1 = PROBE_STRENGTH[rival]
+        s1 = registry[rival].rival.probe_strength
         first = added(rival, "unladen_ground", s1)
         f1 = first["rise_Nm"] - target
         if first["rise_Nm"] * math.copysign(1.0, target) < NO_RISE_FRACTION * abs(target):
@@ -215,12 +209,13 @@ def plot_rivals(result: dict):
 
 
 def make_rivals(parameters_path: str | Path, svg_path: str | Path, csv_path: str | Path, json_path: str | Path,
-                progress=None) -> dict:
-    """Write the rivals figure (SVG), its table (CSV) and the numbers the paper quotes (JSON)."""
+                rivals=None, progress=None) -> dict:
+    """Write the rivals figure (SVG), its table (CSV) and the numbers the paper quotes (JSON) for `rivals` (a
+    selection of the rival effects, every one when None)."""
     from ..plotting import save_svg  # matplotlib only where a figure is drawn (the Snakefile imports this module)
 
     params = load_parameters(parameters_path)
-    result = compare_rivals(params, progress=progress)
+    result = compare_rivals(params, rivals=rivals, progress=progress)
     header = {
         "table": "lifting and each rival matched to its rise toward lock in the unladen ground test: the rise "
                  "(near right lock minus plateau) each adds in each of the source's tests",

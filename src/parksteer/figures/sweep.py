@@ -23,7 +23,7 @@ from ..sweep.aggregate import (
     gather_points,
     matching,
     point_quantity,
-    summarize,
+    summarise,
 )
 from ..sweep.declaration import Sweep, load_sweep, parameter_bounds
 from ..tables import write_json
@@ -192,7 +192,7 @@ def make_sweep_figure(sweep_path: str | Path, parameters: Parameters | str | Pat
 
     # the table is written as the point files are read; only what the summary and the maps select is kept
     records, totals = gather_points(point_paths, sweep, params, out_csv, header, threshold)
-    summary = summarize(sweep, params, records, totals)
+    summary = summarise(sweep, params, records, totals)
     write_json(out_json, summary)
     plot_sweep(sweep, params, records, out_svg, totals)
     return summary

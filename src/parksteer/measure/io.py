@@ -41,6 +41,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import UsageError
+from ..names import SURFACES
 from ..parameters import Parameters, load_parameters
 from ..tables import atomic_path, format_number
 
@@ -59,7 +60,6 @@ UNITS = {
     "load_right_N": "N",
     "vehicle_speed_mps": "m/s",
 }
-SURFACES = ("ground", "air_bearing")
 REQUIRED_METADATA = ("case", "surface")
 
 # A lock-to-lock cycle has up to nine phase segments (initial rise; wind-up and sliding on

@@ -53,9 +53,9 @@ import numpy as np
 from scipy.ndimage import median_filter
 
 from ..errors import UsageError
+from ..names import SURFACES
 
 PHASES = ("initial_rise", "wind_up", "plateau", "reversal", "return")
-SURFACES = ("ground", "air_bearing")
 
 
 def local_linear_fit(time_s: np.ndarray, values: np.ndarray, window_s: float) -> tuple[np.ndarray, np.ndarray]:

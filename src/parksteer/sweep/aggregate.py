@@ -174,7 +174,7 @@ def threshold_crossings(sweep: Sweep, records: list[dict], design: dict, quantit
     return out
 
 
-def summarize(sweep: Sweep, params: Parameters, records: list[dict], totals: Totals | None = None
+def summarise(sweep: Sweep, params: Parameters, records: list[dict], totals: Totals | None = None
               ) -> dict[str, Any]:
     """The key numbers of a sweep (results/sweep_<name>.json), from its records in the sweep's order: all of them,
     or those gather_points keeps with the totals it counts over all."""

@@ -42,6 +42,7 @@ import numpy as np
 import yaml
 
 from ..errors import UsageError
+from ..names import SURFACES
 from ..parameters import Parameters, quantity, registry
 from .design import SweepError, point_overrides
 
@@ -54,7 +55,6 @@ MAP_QUANTITIES = (
     "plateau_torque_braked_Nm",
     "peak_torque_braked_Nm",
 )
-SURFACES = ("ground", "air_bearing")
 TOP_LEVEL_KEYS = {"name", "description", "base_case", "effects", "surface", "axes", "full_axes", "points", "map",
                   "assistance", "braked"}
 # How a point compares its wheels braked: not at all, the post-hoc rig-theory estimate, or (any other value) a

@@ -32,9 +32,9 @@ import numpy as np
 
 from .. import portable as pm
 from ..geometry import steer_axis
+from ..names import SIDES
 from ..rig import disc_distance_integral_m3, patch_radius_m, pressure_correction
 
-SIDES = ("left", "right")
 MOVING_FRACTION = 0.5  # of the reference speed, for "moving", "arriving at lock" and "returning"
 SLIDING_FRACTION = 0.5  # tread turning at least this fraction of the wheel's steer rate
 RIPPLE_PERIOD_RAD = math.pi  # Hooke joint: two torque cycles per column revolution

@@ -47,7 +47,7 @@ from .hand import HandProfile, irregular_hand_profile
 from .logger import quantisation_step, synthetic_measurement
 from .example import example_hand, example_logger
 from ..measure.io import OPTIONAL_COLUMNS, REQUIRED_COLUMNS, Measurement
-from ..model.symbolic.components import discover_effects, load_effect_module
+from ..model.symbolic.components import chosen_rivals, discover_effects, load_effect_module, rival_effects
 from ..model.numeric.simulate import simulate
 from ..parameters import Parameters
 from ..resources import example_effect
@@ -445,47 +445,19 @@ def write_car_dataset(parameters_path: str | Path, design: CarDesign, paths: lis
 
 
 # ------------------------------------------------------------------------------ the out-of-class benchmark
-# Which library candidate is physically closest to each rival effect (one per rival, or None), the others that
-# share its physics ("related"), and why. A diagnosis that names the closest or a related candidate, or says
-# `unexplained`, has answered honestly; one that names any other candidate beyond the indistinguishable band has
-# given a confident wrong answer.
-OUTCLASS_RIVALS: dict[str, dict] = {
-    "gear_efficiency": {
-        "closest": "column_friction", "related": ("kingpin_friction", "rack_stiction"),
-        "reason": "friction in the steering transmission, reversing with the motion; the mesh's grows with the "
-                  "load it carries, the column's does not",
-    },
-    "tyre_stribeck": {
-        "closest": "brush_patch", "related": ("rack_stiction",),
-        "reason": "both reshape the tread's moment where the patch goes from sticking to sliding (start and each "
-                  "reversal); rack_stiction has the same breakaway form at the rack",
-    },
-    "carcass_hysteresis": {
-        "closest": "brush_patch", "related": ("rack_damping",),
-        "reason": "both change the tyre's wind-up at the start and each reversal and keep the sliding plateau; "
-                  "its damper makes it rate dependent, as rack_damping is",
-    },
-    "top_mount_windup": {
-        "closest": None, "related": (),
-        "reason": "an elastic centring torque about the king-pin axis; the only conservative rack-position term "
-                  "of the model is lifting, which is in the base model, not a candidate",
-    },
-    "linkage_nonlinearity": {
-        "closest": "ackermann", "related": (),
-        "reason": "both change the map from rack travel to steer angle, and with it the road-wheel torque seen "
-                  "at the handwheel towards lock",
-    },
-    "rack_presliding": {
-        "closest": "rack_stiction", "related": ("column_friction", "kingpin_friction"),
-        "reason": "rack friction departing from the tanh law near each reversal; rack_stiction's excess lives at "
-                  "low speed, the bristle's in the first tenths of a millimetre of travel",
-    },
-    "rolling_resistance": {
-        "closest": "braked_wheels", "related": ("kingpin_friction",),
-        "reason": "both are a force at the contact patch acting on the scrub radius, W |e|, against the steer "
-                  "rate; kingpin_friction is a friction moment about the same axis growing with W",
-    },
-}
+def outclass_rivals(registry=None) -> dict[str, dict]:
+    """Each rival effect's closest library candidate (or None), the others that share its physics ("related") and
+    why, as each rival declares them (:class:`parksteer.model.symbolic.components.Rival`). A diagnosis that names
+    the closest or a related candidate, or says `unexplained`, has answered honestly; one that names any other
+    candidate beyond the indistinguishable band has given a confident wrong answer."""
+    return {name: {"closest": e.rival.closest, "related": tuple(e.rival.related), "reason": e.rival.why}
+            for name, e in rival_effects(registry).items()}
+
+
+def __getattr__(name: str):
+    if name == "OUTCLASS_RIVALS":  # the table above under its former name, derived each time from the effects
+        return outclass_rivals()
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 @dataclass(frozen=True)
@@ -515,7 +487,8 @@ class ChainLogger:
 @dataclass(frozen=True)
 class OutclassDesign:
     """The out-of-class benchmark's design (config/config.yaml, section ``outclass``, where each value's reason
-    is): rival effects, their sizes in converter steps (the small grid, or the full one when ``full_grid``), the
+    is): rival effects (a selection of the effects that declare ``rival``, in the order of the data sets; every
+    one in name order when the section names none), their sizes in converter steps (the small grid, or the full one when ``full_grid``), the
     nulls, the files, the truth integrator's relative tolerance, the logger chain and the seed. The base
     perturbation and the size search are the in-class benchmark's."""
 
@@ -533,25 +506,20 @@ class OutclassDesign:
     def from_config(cls, section: dict, benchmark: dict) -> OutclassDesign:
         grid = section["full"] if section["full_grid"] else section["small"]
         bench = BenchmarkDesign.from_config(benchmark)
-        return cls(tuple(str(r) for r in section["rivals"]), tuple(float(s) for s in grid["steps"]),
-                   int(grid["nulls"]), _files(section["files"]), float(section["rtol"]),
-                   ChainLogger.from_config(section["logger"]), int(section["seed"]), bench.perturbation, bench.search)
+        rivals = chosen_rivals(section.get("rivals"), "config outclass.rivals")
+        return cls(rivals, tuple(float(s) for s in grid["steps"]), int(grid["nulls"]), _files(section["files"]),
+                   float(section["rtol"]), ChainLogger.from_config(section["logger"]), int(section["seed"]), bench.perturbation, bench.search)
 
 
 def outclass_specs(params: Parameters, design: OutclassDesign, registry=None) -> list[DatasetSpec]:
     """Every data set of the out-of-class benchmark: each rival at each size, then the nulls.
 
-    A rival must be a registered effect that is not a diagnosis candidate (so the truth is never one of the
-    forms the diagnosis fits) and must be in :data:`OUTCLASS_RIVALS` (so its answer can be judged).
+    A rival must be an effect that declares itself one (``rival``: never a diagnosis candidate, so the truth is
+    never one of the forms the diagnosis fits, and with its closest candidate, so its answer can be judged).
     """
     registry = registry if registry is not None else discover_effects()
+    chosen_rivals(design.rivals, "config outclass.rivals", registry)
     specs: list[DatasetSpec] = []
-    for rival in design.rivals:
-        if rival not in registry:
-            raise UsageError(f"config outclass.rivals: unknown effect {rival!r}")
-        if registry[rival].diagnosis_candidate or rival not in OUTCLASS_RIVALS:
-            raise UsageError(f"config outclass.rivals: {rival!r} is a diagnosis candidate or has no closest-candidate "
-                             "entry (parksteer.synthetic.datasets.OUTCLASS_RIVALS)")
 
     def add(kind, hidden, steps):
         index = len(specs)
@@ -651,7 +619,7 @@ def make_outclass_dataset(params: Parameters, spec: DatasetSpec, design: Outclas
         steps = rms_difference(np.concatenate([r["handwheel_torque_Nm"] for r in clean]), torque(None, base)) / step
     measurements = [chain_logged(params, columns, design.logger, case, surface, spec.seed * 100 + 50 + i, h)
                     for i, (columns, (case, surface), h) in enumerate(zip(clean, spec.files, hands))]
-    rival = OUTCLASS_RIVALS.get(spec.hidden, {})
+    rival = outclass_rivals().get(spec.hidden, {})
     truth = {
         "name": spec.name, "kind": spec.kind, "hidden": spec.hidden, "steps_requested": spec.steps, "steps": steps,
         "torque_step_Nm": step, "strength_key": strength_key, "strength": strength,

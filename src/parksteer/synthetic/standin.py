@@ -24,10 +24,10 @@ import numpy as np
 
 from .. import portable as pm
 from ..geometry import lifting_torque_a1, overall_steering_ratio
+from ..names import SURFACES
 from ..parameters import Parameters
 from ..rig import limiting_torque_Nm
 from .hand import HandProfile
-from ..measure.io import SURFACES
 
 
 def hooke_speed_ratio(column_angle_rad: np.ndarray, joint_angle_rad: float, phase_rad: float) -> np.ndarray:
@@ -69,7 +69,7 @@ def quasi_static_cycle(
 ) -> dict[str, np.ndarray]:
     """Columns (time_s, handwheel_angle_rad, rack_m, handwheel_torque_Nm, load_left_N, load_right_N)."""
     if surface not in SURFACES:
-        raise ValueError(f"surface must be one of {SURFACES}, got {surface!r}")
+        raise ValueError(f"surface must be one of {', '.join(SURFACES)}, got {surface!r}")
     s = params.sections["steering"]
     c = params.case(case)
     joint, phase = s["hooke_joint_angle"], s["hooke_joint_phase"]

@@ -7,7 +7,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from ...model.numeric.values import SURFACES
+from ...names import SURFACES
 from ...model.symbolic.components import Effect
 from ..problem import Problem
 from ..replay import Replay

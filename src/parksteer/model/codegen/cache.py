@@ -40,6 +40,8 @@ FORMAT_VERSION = "1"
 MODEL_DIR = Path(__file__).resolve().parents[1]
 # The symbolic half: what the generated code depends on. numeric/ is not hashed, so editing it never re-derives.
 SYMBOLIC_DIRS = (MODEL_DIR / "symbolic", MODEL_DIR / "codegen")
+# Files outside the two halves whose names the symbolic model builds on (the sides a coordinate is made for).
+KEYED_FILES = (MODEL_DIR.parent / "names.py",)
 # This module stores entries and generates nothing, so its source is not part of the key.
 KEYLESS_SOURCE = Path(__file__).resolve()
 # How the generated C is compiled; part of the model key. -O1: the same integration time as -O2 on the default
@@ -95,11 +97,12 @@ def _effect_source(effect: Effect) -> str:
 
 @lru_cache(maxsize=1)
 def _symbolic_half_source() -> bytes:
-    """The symbolic half's files (symbolic/ and codegen/, Python and C), each with its path: read once per process
-    (a simulation loads its model by key, and re-reading some thirty files each time was a fifth of a cycle)."""
-    sources = (p for d in SYMBOLIC_DIRS for pattern in ("*.py", "*.c") for p in d.rglob(pattern))
-    return b"".join(str(path.relative_to(MODEL_DIR)).encode() + b"\0" + path.read_bytes() + b"\0"
-                    for path in sorted(p for p in sources if p != KEYLESS_SOURCE))
+    """The symbolic half's files (symbolic/ and codegen/, Python and C) and :data:`KEYED_FILES`, each with its path:
+    read once per process (a simulation loads its model by key, and re-reading some thirty files each time was a
+    fifth of a cycle)."""
+    sources = [p for d in SYMBOLIC_DIRS for pattern in ("*.py", "*.c") for p in d.rglob(pattern)]
+    return b"".join(str(path.relative_to(MODEL_DIR.parent)).encode() + b"\0" + path.read_bytes() + b"\0"
+                    for path in sorted(p for p in [*sources, *KEYED_FILES] if p != KEYLESS_SOURCE))
 
 
 def model_key(effects: list[Effect]) -> str:

@@ -10,8 +10,7 @@ import numpy as np
 # Handwheel-driven integration (parksteer.model.numeric.simulate.integrate): relative, and absolute per unit of
 # each coordinate (m or rad) and its rate. The column damping turns rack-speed error into handwheel torque at
 # c * G^2 (about 37,000 N m per m/s), so the speeds need tight absolute tolerances: with these the nominal
-# cycle's torque is within 0.0004 N m of a run at rtol 1e-11 and a ten-thousandth of these atol (LSODA, which
-# integrated the cycle before the generated integrator: 0.0008 N m).
+# cycle's torque is within 0.0004 N m of a run at rtol 1e-11 and a ten-thousandth of these atol.
 RTOL = 1e-7
 ATOL_Q = {"m": 1e-10, "rad": 1e-9}
 ATOL_U = {"m": 1e-8, "rad": 1e-7}
@@ -22,8 +21,7 @@ ATOL_U = {"m": 1e-8, "rad": 1e-7}
 # 0.0005 N m (RMS 0.00014 N m) of a solve at rtol 1e-10 and a hundredth of ATOL_Q/ATOL_U, a quarter of a per cent
 # of an 8-bit converter step (0.2 N m); the solve takes 4.0 ms, against 6.7 ms at RTOL and ATOL_Q/ATOL_U. On the
 # exact rack of a free run (tests/model/test_rack_drive.py) the largest error is 0.003 N m, where a solve at rtol
-# 1e-8 gives the free run's torque back to 2e-5 N m. (LSODA, which ran this solve before, was within 0.004 N m on
-# the record and 0.09 N m on the free run's rack at these tolerances.)
+# 1e-8 gives the free run's torque back to 2e-5 N m.
 PRESCRIBED_RTOL = 1e-5  # 1
 PRESCRIBED_ATOL_FACTOR = 100.0  # 1
 
@@ -31,14 +29,11 @@ PRESCRIBED_ATOL_FACTOR = 100.0  # 1
 # Work budget of both integrations: at most this many steps per simulated second between two output times
 # (ps_integrate's and ps_integrate_prescribed's max_steps, scaled by the output spacing, never below
 # MIN_STEPS_PER_OUTPUT).
-# Measured with LSODA: the paper's cycles take about 170 steps per second (3,000 over 18 s, the generated
-# integrator 1,800; at most 47 between 10 ms outputs), a tyre a hundred times stiffer
-# radially than any car tyre (1e10 N/m) about 7,000, and the pre-sliding rack friction with its bristle root's
-# mode undamped (rack_presliding.damping_ratio = 0), about 100,000 (234,000 in its busiest 10 ms, at 1,560 N;
-# damped, as by default, its cycle takes 12 ms like the paper's). Values that need
-# more than twice that are far outside what the model is for: without the budget a 1e14 N/m tyre ran LSODA for
-# minutes (the generated integrator follows it in 9 s, within 0.002 N m of a 1e10 N/m tyre); with it a 1e16 N/m
-# tyre fails in one line within two seconds.
+# The budget is about twice the busiest case the model is for: the paper's cycles take about 100 steps per second,
+# a tyre a hundred times stiffer radially than any car tyre (1e10 N/m) thousands, and the pre-sliding rack
+# friction with its bristle root's mode undamped (rack_presliding.damping_ratio = 0) about 100,000, up to 234,000
+# in its busiest 10 ms. Values that need more are far outside what the model is for, and fail in one line within
+# seconds (a 1e16 N/m tyre) instead of running for minutes.
 STEP_BUDGET_PER_S = 500_000
 MIN_STEPS_PER_OUTPUT = 2_000
 

@@ -18,11 +18,10 @@ import numpy as np
 from ... import portable as pm
 from ...errors import UsageError
 from ...geometry import steer_axis
+from ...names import SIDES, SURFACES
 from ...parameters import CASE_SCHEMA, SCHEMA, Parameters, quantity
 from ..symbolic.components import Effect
-from ..symbolic.system import CORE_PARAMETERS, DERIVED, SIDES
-
-SURFACES = {"ground": 1.0, "air_bearing": 0.0}
+from ..symbolic.system import CORE_PARAMETERS, DERIVED
 
 
 def parse_overrides(items: list[str] | None) -> dict[str, float]:
@@ -142,4 +141,4 @@ def parameter_vector(names: list[str], values: RunValues, input_table: np.ndarra
     return vector
 
 
-__all__ = ["RunValues", "resolve_values", "derived_values", "parameter_vector", "parse_overrides", "SURFACES"]
+__all__ = ["RunValues", "resolve_values", "derived_values", "parameter_vector", "parse_overrides"]

@@ -31,6 +31,7 @@ import importlib.util
 import inspect
 import os
 import pkgutil
+from dataclasses import dataclass
 from functools import lru_cache
 from importlib.metadata import entry_points
 from pathlib import Path
@@ -47,15 +48,34 @@ if TYPE_CHECKING:  # pragma: no cover
 ENTRY_POINT_GROUP = "parksteer.effects"
 MODULES_ENV = "PARKSTEER_EFFECT_MODULES"
 
+@dataclass(frozen=True)
+class Rival:
+    """What makes an effect a rival of the paper's mechanisms, studied on its own and never a diagnosis candidate.
+
+    ``closest`` is the diagnosis candidate physically closest to it (None when none is), ``related`` the other
+    candidates that share its physics, ``why`` the physics they share. A diagnosis of records with the rival hidden
+    that names the closest or a related candidate, or says ``unexplained``, has answered honestly; one that names
+    any other candidate beyond the indistinguishable band has given a confident wrong answer (the out-of-class
+    benchmark). ``probe_strength`` is the first strength of the rivals figure's secant search (in the unit of the
+    effect's strength quantity, inside the range its source gives); the matched strength does not depend on it.
+    """
+
+    closest: str | None
+    related: tuple[str, ...]
+    why: str
+    probe_strength: float
+
+
 class Effect:
     """A physical mechanism of the model. Subclasses set the class attributes and override hooks.
 
-    ``uses`` lists every quantity key the effect reads (``tyre.tyre_pressure``, ``rack_lash.lash``); the
-    package's effects find their own quantities in the parameter file, under a section named after the
-    effect. An effect from outside the package declares its own in ``quantities`` (key ``<name>.<quantity>``,
-    with unit, bounds, default and source); they join the registry when the effect is loaded.
-    ``requires`` names the effects it needs; ``replaces`` names the slot it fills (see :data:`SLOTS`).
-    Per-build state lives on the model being built (``model.state(self)``), never on the effect.
+    ``uses`` lists every quantity key the effect reads (``tyre.tyre_pressure``, ``rack_lash.lash``). The car's
+    quantities (``tyre.*``, ``steering.*``, ...) are in the parameter file; an effect declares its own in
+    ``quantities`` (key ``<name>.<quantity>``, with unit, bounds, default and source), the package's effects and a
+    user's alike; they join the registry when the effect is loaded. ``requires`` names the effects it needs;
+    ``replaces`` names the slot it fills (see :data:`SLOTS`). A rival of the paper's mechanisms sets ``rival``
+    (:class:`Rival`), which keeps it out of the diagnosis' candidates. Per-build state lives on the model being
+    built (``model.state(self)``), never on the effect.
     """
 
     name: ClassVar[str] = ""
@@ -65,8 +85,14 @@ class Effect:
     requires: ClassVar[tuple[str, ...]] = ()
     replaces: ClassVar[str | None] = None
     in_default_set: ClassVar[bool] = True  # the paper's five are; candidate mechanisms are not
-    # False keeps an effect out of the diagnosis' candidates (rivals of the paper's mechanisms, studied alone)
+    # False keeps an effect out of the diagnosis' candidates; a rival (``rival`` set) is never one
     diagnosis_candidate: ClassVar[bool] = True
+    rival: ClassVar[Rival | None] = None
+
+    def __init_subclass__(cls, **kwargs: Any) -> None:
+        super().__init_subclass__(**kwargs)
+        if cls.rival is not None:
+            cls.diagnosis_candidate = False
 
     def configure(self, model: ModelSpace) -> None:
         """Before the kinematics are built: add coordinates (keep them in ``model.state(self)``)."""
@@ -88,7 +114,7 @@ class Effect:
         return []
 
     def own_keys(self) -> tuple[str, ...]:
-        """The keys of the quantities only this effect has (its section of the parameter file, or declared)."""
+        """The keys of the quantities only this effect has (``<name>.*``, declared in ``quantities``)."""
         return tuple(k for k in self.uses if k.partition(".")[0] == self.name)
 
     def describe(self, params) -> dict:
@@ -100,6 +126,8 @@ class Effect:
             "in_default_set": self.in_default_set,
             "requires": list(self.requires),
             "replaces": self.replaces,
+            **({"rival": {"closest": self.rival.closest, "related": list(self.rival.related), "why": self.rival.why,
+                          "probe_strength": self.rival.probe_strength}} if self.rival is not None else {}),
             "parameters": [
                 {
                     "key": key,
@@ -120,6 +148,8 @@ def _register_quantities(effect: Effect, where: str) -> Effect:
         if q.section != effect.name:
             raise UsageError(f"{where}: quantity {q.key} must be named {effect.name}.<name>")
         declare(q)
+    if effect.rival is not None and effect.diagnosis_candidate:
+        raise UsageError(f"{where}: effect {effect.name} is a rival, so it cannot be a diagnosis candidate")
     if effect.replaces is not None and effect.replaces not in SLOTS:
         raise UsageError(f"{where}: effect {effect.name} replaces unknown slot {effect.replaces!r} "
                          f"(slots: {', '.join(SLOTS)})")
@@ -193,6 +223,25 @@ def discover_effects() -> dict[str, Effect]:
         effect = load_effect_module(ref)
         found[effect.name] = effect
     return found
+
+
+def rival_effects(registry: dict[str, Effect] | None = None) -> dict[str, Effect]:
+    """The effects that declare themselves rivals of the paper's mechanisms (``rival`` set), in name order."""
+    registry = registry if registry is not None else discover_effects()
+    return {name: registry[name] for name in sorted(registry) if registry[name].rival is not None}
+
+
+def chosen_rivals(names, where: str, registry: dict[str, Effect] | None = None) -> tuple[str, ...]:
+    """`names` (a selection, e.g. a configuration's list) checked to be rival effects; None is every rival in name
+    order. A name that is no rival is a one-line UsageError naming `where`."""
+    rivals = rival_effects(registry)
+    if names is None:
+        return tuple(rivals)
+    for name in names:
+        if name not in rivals:
+            raise UsageError(f"{where}: {name!r} is not a rival effect (the rivals: {', '.join(rivals)}; an effect "
+                             "is one when it declares `rival`)")
+    return tuple(str(n) for n in names)
 
 
 STRENGTH_NAME = "strength"

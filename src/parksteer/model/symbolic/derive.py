@@ -20,7 +20,7 @@ import sympy as sp
 import sympy.physics.mechanics as me
 
 from .components import Effect
-from .system import INPUT_NAMES, SIDES, ModelSpace
+from .system import INPUT_NAMES, ModelSpace
 
 
 @dataclass
@@ -122,4 +122,4 @@ def derive(effects: list[Effect]) -> Derivation:
     )
 
 
-__all__ = ["Derivation", "derive", "build_space", "generalized_forces", "INPUT_NAMES", "SIDES"]
+__all__ = ["Derivation", "derive", "build_space", "generalized_forces", "INPUT_NAMES"]

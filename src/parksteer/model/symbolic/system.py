@@ -45,7 +45,8 @@ from typing import Any
 import sympy as sp
 import sympy.physics.mechanics as me
 
-SIDES = ("left", "right")
+from ...names import SIDES
+
 DERIVED = "derived"
 
 # The slots of the core an effect may fill (``Effect.replaces``), each with the method the effect defines to

@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import sympy as sp
 
+from ....parameters import Quantity
 from ..components import Effect
 
 SIDE_SIGN = {"left": -1, "right": 1}  # the right wheel is the inner one in a right turn (positive rack)
@@ -36,6 +37,14 @@ class Ackermann(Effect):
         "wheelbase) / 2, delta_m = roadwheel_to_rack_ratio * rack; 0 = the paper's parallel linkage"
     )
     in_default_set = False
+    quantities = (
+        Quantity("ackermann.ackermann_fraction", "1", 0.0, 1.5, lower_inclusive=True, default=0.0,
+                 source="candidate: fraction of the ideal Ackermann toe-out on turns; road cars typically have a "
+                        "partial Ackermann, roughly 0.3-1; 0 = the paper's equal steer angles (absent)"),
+        Quantity("ackermann.track_to_wheelbase", "1", 0.1, 2.0, lower_inclusive=True, default=0.582,
+                 source="candidate: Austin Maestro front track 1.46 m (twice Table B1 y2) over wheelbase 2.507 m "
+                        "(manufacturer's data), 0.582"),
+    )
     uses = ("steering.roadwheel_to_rack_ratio", "ackermann.ackermann_fraction", "ackermann.track_to_wheelbase")
     replaces = "steer_function"
 

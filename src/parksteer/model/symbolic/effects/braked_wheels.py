@@ -40,8 +40,9 @@ from __future__ import annotations
 import sympy as sp
 import sympy.physics.mechanics as me
 
+from ....names import SIDES
+from ....parameters import Quantity
 from ..components import Effect
-from ..system import SIDES
 from .tyre_friction import EFFECT as TYRE_FRICTION
 
 # f(k) - 1 inside the patch, as a polynomial in m = k^2 (series of the elliptic closed form)
@@ -67,6 +68,13 @@ class BrakedWheels(Effect):
         "theory, the drag part without the pressure correction); 0 = free to roll"
     )
     in_default_set = False
+    quantities = (
+        Quantity("braked_wheels.brake_fraction", "1", 0.0, 1.0, lower_inclusive=True, default=0.0,
+                 source="candidate: share of the braked (non-rolling) excess moment, 0 = wheels free to roll as in "
+                        "the paper (absent), 1 = wheels locked (brakes held on the front wheels; not a front-drive "
+                        "car in gear: an open differential leaves the wheels free to turn in opposite senses, which "
+                        "is all the scrub of a steered pair needs)"),
+    )
     uses = ("braked_wheels.brake_fraction", *TYRE_FRICTION.uses)
     requires = ("tyre_friction",)
 

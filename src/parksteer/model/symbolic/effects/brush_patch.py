@@ -40,8 +40,10 @@ from __future__ import annotations
 import sympy as sp
 import sympy.physics.mechanics as me
 
+from ....names import SIDES
+from ....parameters import Quantity
 from ..components import Effect
-from ..system import SIDES, torque_between
+from ..system import torque_between
 from .carcass_compliance import EFFECT as CARCASS
 from .tyre_friction import EFFECT as TYRE_FRICTION
 
@@ -64,6 +66,12 @@ class BrushPatch(Effect):
     )
     in_default_set = False
     requires = ("carcass_compliance", "tyre_friction")
+    quantities = (
+        Quantity("brush_patch.brush_fraction", "1", 0.0, 1.0, lower_inclusive=True, default=0.0,
+                 source="candidate: blend of the brush law (1) into the paper's lumped spring and Coulomb slider "
+                        "(0, absent); the brush shape follows from uniform pressure (the paper's patch) and uniform "
+                        "bristle stiffness"),
+    )
     uses = ("brush_patch.brush_fraction", "tyre.tread_ring_yaw_inertia", *CARCASS.uses, *TYRE_FRICTION.uses)
 
     def configure(self, model):

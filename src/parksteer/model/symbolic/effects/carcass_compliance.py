@@ -2,8 +2,9 @@
 
 from __future__ import annotations
 
+from ....names import SIDES
 from ..components import Effect
-from ..system import SIDES, torque_between
+from ..system import torque_between
 
 
 class CarcassCompliance(Effect):

@@ -32,8 +32,10 @@ from __future__ import annotations
 import sympy as sp
 import sympy.physics.mechanics as me
 
-from ..components import Effect
-from ..system import SIDES, torque_between
+from ....names import SIDES
+from ....parameters import Quantity
+from ..components import Effect, Rival
+from ..system import torque_between
 from .carcass_compliance import EFFECT as CARCASS
 
 NODE_INERTIA_SHARE = sp.Rational(1, 100)  # of the tread ring's yaw inertia: the branch's node is nearly massless
@@ -47,8 +49,22 @@ class CarcassHysteresis(Effect):
         "one node coordinate per side; 0 = the paper's Kelvin-Voigt carcass (absent)"
     )
     in_default_set = False
-    diagnosis_candidate = False  # a rival of the paper's mechanisms, studied on its own this round
+    rival = Rival(closest="brush_patch", related=("rack_damping",),
+                  why="both change the tyre's wind-up at the start and each reversal and keep the sliding plateau; "
+                      "its damper makes it rate dependent, as rack_damping is",
+                  probe_strength=0.3)
     requires = ("carcass_compliance",)
+    quantities = (
+        Quantity("carcass_hysteresis.stiffness_fraction", "1", 0.0, 5.0, lower_inclusive=True, default=0.0,
+                 source="candidate: stiffness of the carcass's Maxwell branch (spring in series with a damper) as a "
+                        "fraction of the carcass torsional stiffness; rubber's dynamic to static stiffness ratio is "
+                        "about 1.2-2, so 0.2-1; 0 = the paper's Kelvin-Voigt carcass (absent)"),
+        Quantity("carcass_hysteresis.relaxation_time", "s", 0.001, 10.0, lower_inclusive=True, default=0.2,
+                 source="candidate: relaxation time c_m / k_m of the Maxwell branch; tyre relaxation times of "
+                        "0.05-0.5 s at parking speed; 0.2 s, a fraction of the carcass wind-up in the cycle (about "
+                        "1.4 s: M cos / k at the steer rate of 0.12 rad/s), so the branch shows in the wind-up and "
+                        "relaxes in steady sliding"),
+    )
     uses = ("carcass_hysteresis.stiffness_fraction", "carcass_hysteresis.relaxation_time",
             "tyre.tread_ring_yaw_inertia", *CARCASS.uses)
 

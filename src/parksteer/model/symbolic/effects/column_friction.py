@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import sympy as sp
 
+from ....parameters import Quantity
 from ..components import Effect
 from ..system import torque_between
 
@@ -15,6 +16,11 @@ class ColumnFriction(Effect):
         "-T_c tanh(beta * column rate / handwheel_to_rack_ratio); 0 = absent"
     )
     in_default_set = False
+    quantities = (
+        Quantity("column_friction.friction_torque", "N m", 0.0, 20.0, lower_inclusive=True, default=0.0,
+                 source="candidate: breakaway torque of the column's bearings and seals, typically 0-2 N m at the "
+                        "handwheel; 0 = absent"),
+    )
     uses = ("column_friction.friction_torque", "steering.friction_smoothing", "steering.handwheel_to_rack_ratio")
 
     def loads(self, model):

@@ -37,7 +37,8 @@ from __future__ import annotations
 import sympy as sp
 import sympy.physics.mechanics as me
 
-from ..components import Effect
+from ....parameters import Quantity
+from ..components import Effect, Rival
 from ..system import action_reaction
 
 
@@ -48,7 +49,20 @@ class GearEfficiency(Effect):
         "tanh(beta * rack speed) on the rack; 0 = lossless (absent)"
     )
     in_default_set = False
-    diagnosis_candidate = False  # a rival of the paper's mechanisms, studied on its own this round
+    rival = Rival(closest="column_friction", related=("kingpin_friction", "rack_stiction"),
+                  why="friction in the steering transmission, reversing with the motion; the mesh's grows with the "
+                      "load it carries, the column's does not",
+                  probe_strength=0.1)
+    quantities = (
+        Quantity("gear_efficiency.inefficiency", "1", 0.0, 0.5, lower_inclusive=True, default=0.0,
+                 source="candidate: 1 - eta, the share of the transmitted torque the rack-and-pinion mesh (and the "
+                        "column joints under load) loses to friction; forward efficiencies of rack-and-pinion "
+                        "steering gears are about 0.8-0.9, so 0.1-0.2; 0 = lossless (absent)"),
+        Quantity("gear_efficiency.smoothing_force", "N", 0.001, 100.0, lower_inclusive=True, default=1.0,
+                 source="choice: force width w over which the mesh load |F| is smoothed as sqrt(F^2 + w^2) - w, so "
+                        "the mesh friction is zero at zero load; 1 N is below 0.1 % of the rack load in steady "
+                        "steering (about 3 kN)"),
+    )
     uses = ("gear_efficiency.inefficiency", "gear_efficiency.smoothing_force", "steering.friction_smoothing")
 
     def road_force(self, model):

@@ -4,8 +4,10 @@ from __future__ import annotations
 
 import sympy as sp
 
+from ....names import SIDES
+from ....parameters import Quantity
 from ..components import Effect
-from ..system import SIDES, torque_between
+from ..system import torque_between
 
 
 class KingpinFriction(Effect):
@@ -15,6 +17,13 @@ class KingpinFriction(Effect):
         "-r_f W tanh(beta * steer rate), r_f = mu_bearing * bearing radius; 0 = absent"
     )
     in_default_set = False
+    quantities = (
+        Quantity("kingpin_friction.friction_radius", "m", 0.0, 0.05, lower_inclusive=True, default=0.0,
+                 source="candidate: effective friction radius mu_k * r_b of the strut's top-mount bearing and lower "
+                        "ball joint, which carry the wheel load; e.g. mu 0.05-0.1 at radii 25-50 mm gives 0-5 mm, "
+                        "i.e. up to about 14 N m per wheel at 2.8 kN (1.3 N m at the handwheel for both); 0 = "
+                        "absent"),
+    )
     uses = ("kingpin_friction.friction_radius", "steering.friction_smoothing")
 
     def loads(self, model):

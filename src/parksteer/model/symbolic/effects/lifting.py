@@ -2,8 +2,9 @@
 
 from __future__ import annotations
 
+from ....names import SIDES
 from ..components import Effect
-from ..system import SIDES, action_reaction
+from ..system import action_reaction
 
 
 class Lifting(Effect):

@@ -26,7 +26,8 @@ Provenance: a candidate beyond the paper; c is chosen, the linkage's geometry is
 
 from __future__ import annotations
 
-from ..components import Effect
+from ....parameters import Quantity
+from ..components import Effect, Rival
 
 
 class LinkageNonlinearity(Effect):
@@ -36,7 +37,17 @@ class LinkageNonlinearity(Effect):
         "roadwheel_to_rack_ratio, at both wheels; 0 = the paper's constant ratio (absent)"
     )
     in_default_set = False
-    diagnosis_candidate = False  # a rival of the paper's mechanisms, studied on its own this round
+    rival = Rival(closest="ackermann", related=(),
+                  why="both change the map from rack travel to steer angle, and with it the road-wheel torque seen "
+                      "at the handwheel towards lock",
+                  probe_strength=0.1)
+    quantities = (
+        Quantity("linkage_nonlinearity.cubic_coefficient", "1", 0.0, 1.0, lower_inclusive=True, default=0.0,
+                 source="candidate: c in steer = G x (1 + c (G x)^2), the linkage ratio rising towards lock by 1 + "
+                        "3 c delta^2; rack-and-arm linkages vary their ratio by some per cent over the travel, so "
+                        "0-0.3 (0.1 raises the ratio at the 0.56 rad lock by 9 %); 0 = the paper's constant ratio "
+                        "(absent)"),
+    )
     uses = ("steering.roadwheel_to_rack_ratio", "linkage_nonlinearity.cubic_coefficient")
     replaces = "steer_function"
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from ....parameters import Quantity
 from ..components import Effect
 from ..system import action_reaction
 
@@ -10,6 +11,12 @@ class RackDamping(Effect):
     name = "rack_damping"
     description = "Viscous force on the rack along its axis, -c * rack speed (grease and seals); 0 = absent"
     in_default_set = False
+    quantities = (
+        Quantity("rack_damping.damping", "N s/m", 0.0, 1.0e5, lower_inclusive=True, default=0.0,
+                 source="candidate: grease shear and seal drag of the rack; 0 = absent; a few thousand N s/m gives "
+                        "a few N m at the handwheel at the cycle's 15 mm/s (c v / 186.47 rad/m: 5000 N s/m -> 0.4 N "
+                        "m)"),
+    )
     uses = ("rack_damping.damping",)
 
     def loads(self, model):

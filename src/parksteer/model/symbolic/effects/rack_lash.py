@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import sympy as sp
 
+from ....parameters import Quantity
 from ..components import Effect
 
 
@@ -36,6 +37,16 @@ class RackLash(Effect):
         "column twist, +-b * handwheel_to_rack_ratio; 0 = absent"
     )
     in_default_set = False
+    quantities = (
+        Quantity("rack_lash.lash", "m", 0.0, 0.005, lower_inclusive=True, default=0.0,
+                 source="candidate: half the free play of the rack-and-pinion mesh, as rack travel; a worn or badly "
+                        "adjusted rack has 0-0.5 mm (0-5.4 degrees at the handwheel through 186.47 rad/m); 0 = "
+                        "absent"),
+        Quantity("rack_lash.smoothing_width", "m", 1.0e-7, 0.001, lower_inclusive=True, default=1.0e-5,
+                 source="candidate: rack travel over which the tooth contact takes up the load (the dead band's "
+                        "corners are rounded over it); 0.01 mm keeps the corners sharp beside a lash of 0.1-0.5 mm "
+                        "and the residual stiffness in the band below 0.1 % of the column's"),
+    )
     uses = ("steering.handwheel_to_rack_ratio", "rack_lash.lash", "rack_lash.smoothing_width")
     replaces = "column_deflection"
 

@@ -39,7 +39,8 @@ from __future__ import annotations
 import sympy as sp
 import sympy.physics.mechanics as me
 
-from ..components import Effect
+from ....parameters import Quantity
+from ..components import Effect, Rival
 from ..system import action_reaction
 
 
@@ -50,7 +51,29 @@ class RackPresliding(Effect):
         "rack and housing; one root coordinate; 0 = absent"
     )
     in_default_set = False
-    diagnosis_candidate = False  # a rival of the paper's tanh rack friction, not a candidate
+    rival = Rival(closest="rack_stiction", related=("column_friction", "kingpin_friction"),
+                  why="rack friction departing from the tanh law near each reversal; rack_stiction's excess lives "
+                      "at low speed, the bristle's in the first tenths of a millimetre of travel",
+                  probe_strength=100.0)
+    quantities = (
+        Quantity("rack_presliding.force", "N", 0.0, 2000.0, lower_inclusive=True, default=0.0,
+                 source="candidate: rival of the tanh rack friction, a pre-sliding (Dahl-type) rack friction force "
+                        "F_d added to the tanh rack friction; chosen, 0 = absent"),
+        Quantity("rack_presliding.presliding_displacement", "m", 1.0e-6, 0.01, lower_inclusive=True, default=2.0e-4,
+                 source="choice: pre-sliding displacement x_p of the rack's bristle (0.2 mm; steel-on-polymer "
+                        "contacts show 0.01-1 mm)"),
+        Quantity("rack_presliding.slip_smoothing", "s/m", 10.0, 1.0e6, lower_inclusive=True, default=10000.0,
+                 source="choice: tanh smoothing of the bristle's slider; ten times the rack friction's, so the "
+                        "slider slides fully at 0.1 mm/s"),
+        Quantity("rack_presliding.node_mass", "kg", 1.0e-4, 10.0, lower_inclusive=True, default=0.01,
+                 source="choice: mass of the bristle root, small so that its time sqrt(m x_p / F_d) is below 0.1 ms "
+                        "at 100 N"),
+        Quantity("rack_presliding.damping_ratio", "1", 0.0, 10.0, lower_inclusive=True, default=1.0,
+                 source="choice: damping ratio of the root's mode on the bristle, a damper 2 zeta sqrt(k m) in "
+                        "parallel with the spring (the bristle damping of the LuGre model); the mode exists only "
+                        "because the root has a mass, and critical damping ends its oscillation within a period; "
+                        "the damper's force is zero in steady sliding and vanishes with the node mass"),
+    )
     uses = ("rack_presliding.force", "rack_presliding.presliding_displacement", "rack_presliding.slip_smoothing",
             "rack_presliding.node_mass", "rack_presliding.damping_ratio")
 

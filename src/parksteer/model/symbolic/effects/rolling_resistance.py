@@ -27,8 +27,9 @@ from __future__ import annotations
 import sympy as sp
 import sympy.physics.mechanics as me
 
-from ..components import Effect
-from ..system import SIDES
+from ....names import SIDES
+from ....parameters import Quantity
+from ..components import Effect, Rival
 from .braked_wheels import EFFECT as BRAKED_WHEELS
 
 
@@ -39,7 +40,16 @@ class RollingResistance(Effect):
         "tanh(beta * steer rate); 0 = absent"
     )
     in_default_set = False
-    diagnosis_candidate = False  # a rival of the paper's mechanisms, studied on its own this round
+    rival = Rival(closest="braked_wheels", related=("kingpin_friction",),
+                  why="both are a force at the contact patch acting on the scrub radius, W |e|, against the steer "
+                      "rate; kingpin_friction is a friction moment about the same axis growing with W",
+                  probe_strength=0.015)
+    quantities = (
+        Quantity("rolling_resistance.coefficient", "1", 0.0, 0.1, lower_inclusive=True, default=0.0,
+                 source="candidate: rolling-resistance coefficient C_rr of the tyre rolling on the floor as the "
+                        "patch travels round the steer axis; car tyres have 0.01-0.015 on hard floors, more at low "
+                        "pressure; 0 = absent"),
+    )
     uses = ("rolling_resistance.coefficient", "steering.friction_smoothing")
 
     def loads(self, model):

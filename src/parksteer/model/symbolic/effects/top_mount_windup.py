@@ -21,8 +21,10 @@ with the offset. Provenance: a candidate beyond the paper.
 
 from __future__ import annotations
 
-from ..components import Effect
-from ..system import SIDES, torque_between
+from ....names import SIDES
+from ....parameters import Quantity
+from ..components import Effect, Rival
+from ..system import torque_between
 
 
 class TopMountWindup(Effect):
@@ -32,7 +34,17 @@ class TopMountWindup(Effect):
         "0 = absent"
     )
     in_default_set = False
-    diagnosis_candidate = False  # a rival of the paper's mechanisms, studied on its own this round
+    rival = Rival(closest=None, related=(),
+                  why="an elastic centring torque about the king-pin axis; the only conservative rack-position term "
+                      "of the model is lifting, which is in the base model, not a candidate",
+                  probe_strength=30.0)
+    quantities = (
+        Quantity("top_mount_windup.stiffness", "N m/rad", 0.0, 1000.0, lower_inclusive=True, default=0.0,
+                 source="candidate: torsional stiffness about the king-pin axis of each strut's top-mount rubber "
+                        "and road-spring wind-up; not given by the paper, chosen 0-100 N m/rad per wheel (50 N "
+                        "m/rad gives 28 N m per wheel at the 0.56 rad lock, about 2.7 N m at the handwheel for "
+                        "both, the size of the lifting torque); 0 = absent"),
+    )
     uses = ("top_mount_windup.stiffness",)
 
     def loads(self, model):

@@ -34,7 +34,7 @@ import sympy.physics.mechanics as me
 
 from ....parameters import Quantity
 from ..components import Effect
-from ..system import SIDES
+from ....names import SIDES
 
 MF_SOURCE = ("MF 6.1 default tyre property file (MFeval readTIR defaults; Pacejka, Tire and Vehicle Dynamics, 3rd ed., "
              "2012, sec. 4.3.3)")

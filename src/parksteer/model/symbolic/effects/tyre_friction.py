@@ -5,8 +5,8 @@ from __future__ import annotations
 import sympy as sp
 import sympy.physics.mechanics as me
 
+from ....names import SIDES
 from ..components import Effect
-from ..system import SIDES
 
 
 class TyreFriction(Effect):

@@ -28,8 +28,9 @@ from __future__ import annotations
 import sympy as sp
 import sympy.physics.mechanics as me
 
-from ..components import Effect
-from ..system import SIDES
+from ....names import SIDES
+from ....parameters import Quantity
+from ..components import Effect, Rival
 from .tyre_friction import EFFECT as TYRE_FRICTION
 
 
@@ -40,7 +41,20 @@ class TyreStribeck(Effect):
         "omega; 0 = Coulomb tread (absent)"
     )
     in_default_set = False
-    diagnosis_candidate = False  # a rival of the paper's mechanisms, studied on its own this round
+    rival = Rival(closest="brush_patch", related=("rack_stiction",),
+                  why="both reshape the tread's moment where the patch goes from sticking to sliding (start and "
+                      "each reversal); rack_stiction has the same breakaway form at the rack",
+                  probe_strength=0.2)
+    quantities = (
+        Quantity("tyre_stribeck.breakaway_excess", "1", 0.0, 1.0, lower_inclusive=True, default=0.0,
+                 source="candidate: a, the breakaway excess of the tread's friction moment over the sliding one, 1 "
+                        "+ a exp(-(omega / omega_s)^2); rubber's static to sliding friction on dry floors is about "
+                        "1-1.3, so 0-0.3; 0 = Coulomb (absent)"),
+        Quantity("tyre_stribeck.stribeck_rate", "rad/s", 1.0e-4, 1.0, lower_inclusive=True, default=0.02,
+                 source="choice: Stribeck rate omega_s of the tread's yaw; 0.02 rad/s is a sliding speed of about "
+                        "1.6 mm/s at the patch rim (R about 0.08 m), a sixth of the cycle's steady 0.12 rad/s, so "
+                        "the peak has vanished (exp(-36)) in steady sliding"),
+    )
     uses = ("tyre_stribeck.breakaway_excess", "tyre_stribeck.stribeck_rate", *TYRE_FRICTION.uses)
     requires = ("tyre_friction",)
 
