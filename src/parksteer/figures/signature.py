@@ -52,6 +52,25 @@ def design_dict(design: SignatureDesign) -> dict:
             "seed": design.seed, "first_variation": design.first_variation}
 
 
+def method_dict() -> dict:
+    """The signature's bases and thresholds as the benchmark's diagnoses use them (the paper quotes them)."""
+    from ..diagnose.benchmark import BENCHMARK_SETTINGS
+
+    sig = BENCHMARK_SETTINGS.signature
+    return {"position_knots": list(sig.position_knots), "speed_knots": sig.speed_knots,
+            "column_orders": [list(o) for o in sig.column_orders], "mesh_order": sig.mesh_order,
+            "significance": sig.significance, "bic_missing_threshold": BENCHMARK_SETTINGS.bic_missing_threshold,
+            "bic_indistinguishable": BENCHMARK_SETTINGS.bic_indistinguishable, "after_limit": AFTER_LIMIT}
+
+
+def forms_dict() -> dict:
+    """Each truth form: its class, what it is, the mechanism it stands for."""
+    from ..synthetic.outoflibrary import FORMS
+
+    return {f.effect.name: {"class": f.signature_class, "description": f.effect.description, "why": f.effect.why}
+            for f in FORMS}
+
+
 def case_names(design: SignatureDesign) -> list[str]:
     return [c.name for c in design.cases()]
 
@@ -131,6 +150,8 @@ def aggregate(rows: list[dict]) -> dict:
         "null_over_floor": [r["calibrated_over_floor"] for r in nulls],
         "verdicts": {v: sum(r["verdict"] == v for r in hidden) for v in sorted({r["verdict"] for r in hidden})}
         if all("verdict" in r for r in hidden) else {},
+        "named_missing": [{"name": r["name"], "class": r["class"], "named": r.get("named")}
+                          for r in hidden if r.get("verdict") == "missing"],
         "misses": [{"name": r["name"], "class": r["class"], "said": r["said_class"] or "none",
                     "in_group": r["class"] in r.get("indistinguishable", ()),
                     "after_over_floor": r["after_over_floor"]}
@@ -248,6 +269,8 @@ def make_signature_figure(row_paths, svg: str | Path, csv: str | Path, json_path
                "suggestion_written": "the diagnosis would write the effect (verdict unexplained and a class)"})
     times = [r.get("timings_s", {}) for r in rows]
     summary["settings"] = design_dict(design) if design is not None else None
+    summary["method"] = method_dict()
+    summary["forms"] = forms_dict()
     summary["sentences"] = {r["name"]: r["sentence"] for r in rows}
     summary["timings_s"] = {k: float(np.median([t[k] for t in times])) for k in (*TIME_KEYS, "case_s")
                             if times and all(k in t for t in times)}
