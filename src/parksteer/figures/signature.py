@@ -131,7 +131,7 @@ def aggregate(rows: list[dict]) -> dict:
     before = [r["calibrated_over_floor"] for r in hidden]
     return {
         "records": len(rows), "out_of_library": len(hidden), "nulls": len(nulls),
-        "table": table, "confusion": confusion,
+        "classes": list(table), "table": table, "confusion": confusion,
         "all": {"records": len(hidden), "class_right": right, "class_in_group":
                 sum(t["class_in_group"] for t in table.values()), "within": inside},
         "targets": {
@@ -178,13 +178,28 @@ def signature_figure(rows: list[dict], summary: dict, path: str | Path) -> None:
                         arrowprops={"arrowstyle": "->", "color": colour, "linewidth": 1.2})
             ax.plot([after], [y], "o", color=colour, markersize=5)
         ax.plot([before], [y], "o", markerfacecolor="white", markeredgecolor=colour, markersize=5)
-        if r["form"] is None and r["suggestion_written"]:
-            ax.plot([before], [y], "x", color="#e41a1c", markersize=8)
+        if r["form"] is None:
+            if r["suggestion_written"]:
+                ax.plot([before], [y], "x", color="#e41a1c", markersize=8)
+            note = "suggestion written" if r["suggestion_written"] else "no suggestion"
+            if r["said_class"]:
+                note += f" (signature: {r['said_class']})"
+            ax.text(before * 1.08, y, note, va="center", fontsize=6, color=NULL_COLOUR)
         if r["form"] is not None and r["said_class"] != r["class"]:
             ax.text(before * 1.08, y, f"named {r['said_class'] or 'none'}", va="center", fontsize=6)
     ax.axvline(AFTER_LIMIT, color="black", linestyle="--", linewidth=1.0)
-    ax.text(AFTER_LIMIT * 1.03, len(rows) - 0.6, f"{AFTER_LIMIT:g} floors", fontsize=6.5, va="bottom")
+    ax.text(AFTER_LIMIT, 1.005, f"{AFTER_LIMIT:g} floors", fontsize=6.5, ha="center", va="bottom",
+            transform=ax.get_xaxis_transform())
     ax.set_xscale("log")
+    from matplotlib.ticker import FixedLocator, NullFormatter, NullLocator
+
+    values = [v for r in rows for v in (r["calibrated_over_floor"], r["after_over_floor"]) if v is not None]
+    ticks = [t for t in (0.8, 1.0, AFTER_LIMIT, 2.0, 3.0, 5.0, 10.0, 20.0, 50.0, 100.0)
+             if min(values + [1.0]) / 1.3 <= t <= max(values) * 1.3]
+    ax.xaxis.set_major_locator(FixedLocator(ticks))
+    ax.xaxis.set_minor_locator(NullLocator())
+    ax.xaxis.set_minor_formatter(NullFormatter())
+    ax.set_xticks(ticks, [f"{t:g}" for t in ticks], fontsize=7)
     ax.set_ylim(len(rows) - 0.5, -0.5)
     labels = [rows[i]["name"].removeprefix("oolib_").rsplit("_", 1)[0].replace("_", " ")
               if rows[i]["form"] is not None else rows[i]["name"].replace("_", " ") for i in order]
