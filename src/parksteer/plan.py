@@ -43,11 +43,12 @@ def case_file(folder: str, name: str, part: str) -> str:
 def diagnosis(config: dict, parameters_path: str, user_effect: str) -> dict:
     """What the diagnosis rules need of the configuration's car data set and its three benchmarks:
     candidate model specs by name, the car data set's files, and the case names (and rivals) of the hidden-effect,
-    out-of-class and variation benchmarks."""
+    out-of-class, variation and signature benchmarks."""
     from .diagnose.benchmark import case_names as bench_case_names
     from .diagnose.candidates import candidate_models
     from .diagnose.outclass import case_names as outclass_case_names
     from .diagnose.variations import VariationDesign, case_names as variation_case_names
+    from .figures.signature import case_names as signature_case_names, design_from_config as signature_design
     from .parameters import load_parameters
     from .synthetic.datasets import BenchmarkDesign, CarDesign, OutclassDesign, file_name
 
@@ -63,6 +64,7 @@ def diagnosis(config: dict, parameters_path: str, user_effect: str) -> dict:
         "outclass_cases": outclass_case_names(outclass, params),
         "outclass_rivals": list(outclass.rivals),
         "variation_cases": variation_case_names(variations),
+        "signature_cases": signature_case_names(signature_design(config["signature"])),
     }
 
 

@@ -38,7 +38,7 @@ from IPython.display import SVG, Markdown, display
 from parksteer.diagnose.compare import compare_files
 from parksteer.diagnose.ladder import error_ladder
 from parksteer.diagnose.problem import load_files
-from parksteer.diagnose.report import diagnosis_dict, without_machine_times
+from parksteer.diagnose.report import diagnosis_dict, signature_lines, without_machine_times
 from parksteer.diagnose.select import diagnose
 from parksteer.figures.diagnose import compare_figure, diagnosis_figure, ladder_figure, shown_files
 from parksteer.measure.phases import PHASES
@@ -141,6 +141,17 @@ for s in result["indistinguishable"]:
 for c in result["confounded"]:
     print(f"confounded with {c['confounded_with']}: {c['effect']} ({100 * c['identifiable_fraction']:.0f} % identifiable)")
 show(diagnosis_figure, diagnosis)
+
+# %% [markdown]
+# Beside the verdict, the residual's signature (docs/signature.md): the calibrated model's residual decomposed
+# along the axes that tell mechanisms apart (odd or even in the rack speed, along the stroke, by speed, in the
+# column angle), each with its share and its significance. When the verdict is `unexplained`, this is what says
+# which kind of effect to write (`parksteer diagnose --suggest-effect`); here, where a candidate may be named,
+# it is read from the calibrated residual alone, with no candidate in view. Computed with the diagnosis, it costs
+# nothing more here.
+
+# %%
+print("\n".join(signature_lines(result)) if result.get("signature") else "no signature computed")
 
 # %% [markdown]
 # ## 4. Add it and watch the error fall

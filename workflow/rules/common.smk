@@ -25,6 +25,7 @@ FIGURES = {
     "diag_benchmark": ["figures/diag_benchmark.svg", "figures/diag_benchmark.csv"],
     "diag_outclass": ["figures/diag_outclass.svg", "figures/diag_outclass.csv"],
     "diag_variations": ["figures/diag_variations.svg", "figures/diag_variations.csv"],
+    "diag_signature": ["figures/diag_signature.svg", "figures/diag_signature.csv"],
     "diag_peers": ["figures/diag_peers.svg", "figures/diag_peers.csv"],
     "bands": ["figures/bands.svg", "figures/bands.csv"],
     "rivals": ["figures/rivals.svg", "figures/rivals.csv"],

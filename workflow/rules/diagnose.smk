@@ -9,12 +9,14 @@
 # (config["outclass"]): rival effects that are not candidates, hidden by a truth generator that is not the
 # diagnosis model, scored against the physically closest candidate. diag_variation_batch and diag_variations are
 # the variation benchmark (config["variations"]): records of other hands, loggers and drives, with nothing or a
-# library effect hidden, scored against the targets of parksteer.diagnose.variations.
+# library effect hidden, scored against the targets of parksteer.diagnose.variations. diag_signature_batch and
+# diag_signature are the signature benchmark (config["signature"]): out-of-library effects and nulls, the
+# residual's signature and the suggested effect scored per signature class (parksteer.figures.signature).
 DIAG_USER_EFFECT = os.path.relpath(PACKAGE_DIR / "examples" / "column_imbalance.py")
 # candidate model specs, the car data set's files, the three benchmarks' case names (parksteer.plan.diagnosis)
 DIAG_PLAN = planned(
     "diagnosis",
-    {key: config[key] for key in ("car", "benchmark", "outclass", "variations")},
+    {key: config[key] for key in ("car", "benchmark", "outclass", "variations", "signature")},
     PARAMETERS,
     DIAG_USER_EFFECT,
     files=[PARAMETERS],
@@ -30,6 +32,8 @@ DIAG_PER_JOB = int(config.get("diagnosis_cases_per_job", 6))
 DIAG_BENCH_BATCHES = case_batches("bench_", DIAG_BENCH_CASES, DIAG_PER_JOB)
 DIAG_OUTCLASS_BATCHES = case_batches("outclass_", DIAG_OUTCLASS_CASES, DIAG_PER_JOB)
 DIAG_VARIATION_BATCHES = case_batches("variations_", DIAG_VARIATION_CASES, DIAG_PER_JOB)
+DIAG_SIGNATURE_CASES = DIAG_PLAN["signature_cases"]
+DIAG_SIGNATURE_BATCHES = case_batches("signature_", DIAG_SIGNATURE_CASES, DIAG_PER_JOB)
 
 
 rule diag_car_data:
@@ -248,3 +252,46 @@ rule diag_variations:
         "../envs/parksteer.yaml"
     script:
         "../scripts/diag_variations.py"
+
+
+rule diag_signature_batch:
+    input:
+        parameters=PARAMETERS,
+        models=DIAG_MODELS,
+        code=script_sources("diag_signature_batch"),
+    output:
+        directory("results/diagnose/signature/{batch}"),
+    params:
+        design=config["signature"],
+        cases=lambda wildcards: DIAG_SIGNATURE_BATCHES[wildcards.batch],
+    wildcard_constraints:
+        batch="|".join(DIAG_SIGNATURE_BATCHES) if DIAG_SIGNATURE_BATCHES else "none",
+    log:
+        "logs/diag_signature_batch/{batch}.log",
+    benchmark:
+        benchmark_file("diag_signature_batch", "batch")
+    conda:
+        "../envs/parksteer.yaml"
+    script:
+        "../scripts/diag_signature_batch.py"
+
+
+rule diag_signature:
+    input:
+        batches=expand("results/diagnose/signature/{batch}", batch=DIAG_SIGNATURE_BATCHES),
+        code=script_sources("diag_signature"),
+    output:
+        svg=figure_report("figures/diag_signature.svg", "diagnose"),
+        csv=figure_report("figures/diag_signature.csv", "diagnose"),
+        json="results/diag_signature.json",
+    params:
+        design=config["signature"],
+        rows=case_outputs("results/diagnose/signature", DIAG_SIGNATURE_CASES, DIAG_SIGNATURE_BATCHES, "diagnosis"),
+    log:
+        "logs/diag_signature.log",
+    benchmark:
+        benchmark_file("diag_signature")
+    conda:
+        "../envs/parksteer.yaml"
+    script:
+        "../scripts/diag_signature.py"
