@@ -69,7 +69,8 @@ FAMILIES: tuple[Family, ...] = (
                                      "micrometres) is invisible and far above a last-bit difference"),
     ),
     Family(
-        "model", ("fig12", "fig13", "fig14", "fig15", "fig16", "figContrib", "bands", "rivals", "sweep_*"),
+        "model", ("fig12", "fig13", "fig14", "fig15", "fig16", "figContrib", "bands", "rivals", "assist_study",
+         "sweep_*"),
         f"the multibody model integrated at rtol {RTOL:g} (parksteer.model.numeric.tolerances)",
         default=Tolerance(_MODEL_RTOL, _MODEL_TORQUE_ATOL_Nm / _TYPICAL_PARKING_TORQUE_Nm,
                           f"a ratio of torques (share, factor): the torque tolerance over a "
