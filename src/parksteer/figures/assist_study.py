@@ -25,7 +25,9 @@ less smallest) of the plateau torque and of the peak torque over the four is rep
 standard car's.
 
 Creeping. The peak rack force over the cycle (handwheel torque through the gear, F = T d(theta_c)/d(rack), for the
-car without assist; the force the pinion and the assist together put on the rack, with it) at 0, 1, 3 and 5 km/h.
+car without assist; the force the pinion and the assist together put on the rack, with it) at 0, 1, 3 and 5 km/h,
+and the plateau's shares at each speed (the tyre's: its friction moment times the turn-slip factor, the sum of the
+tyre_friction and turn_slip terms).
 
 Numbers on this path reach a checksummed figure: elementwise arithmetic, means and extrema only.
 """
@@ -123,6 +125,21 @@ def peak_rack_force_N(result: SimulationResult) -> float:
     return float(np.max(np.abs(force)))
 
 
+def _plateau_by_speed(plateaus: list[dict]) -> dict:
+    """The plateau's road and driver torque and the mechanisms' shares at each speed; the tyre's share is its
+    friction moment with the turn-slip factor applied (turn_slip's own term is the moment the rolling removes)."""
+    out = {"plateau_road_torque_Nm": [p["road_torque_Nm"] for p in plateaus],
+           "plateau_driver_torque_Nm": [p["driver_torque_Nm"] for p in plateaus]}
+    share = {name: [] for name in ("tyre", "rack_friction", "lifting")}
+    for p in plateaus:
+        m = p["mechanism_shares"]
+        share["tyre"].append(m["tyre_friction"] + m.get("turn_slip", 0.0))
+        share["rack_friction"].append(m["rack_friction"])
+        share["lifting"].append(m["lifting"])
+    out["plateau_shares"] = share
+    return out
+
+
 def _spread(values: dict) -> float:
     return max(values.values()) - min(values.values())
 
@@ -167,6 +184,8 @@ def assist_study(params: Parameters, run=simulate, progress=None) -> dict:
                 "peak_rack_force_N": [peak_rack_force_N(results[(kind, CASE, s)]) for s in SPEEDS_KMH],
                 "peak_handwheel_torque_Nm": [float(np.max(np.abs(results[(kind, CASE, s)].columns[
                     "handwheel_torque_Nm"]))) for s in SPEEDS_KMH],
+                **_plateau_by_speed([shares(results[(kind, CASE, s)].columns, params)["plateau"]
+                                     for s in SPEEDS_KMH]),
             },
         }
     force = numbers["runs"]["none"]["speeds"]["peak_rack_force_N"]
