@@ -55,6 +55,8 @@ QUOTED = {
     "hydraulic": ("valve_slope", "dead_band", "torsion_bar_stiffness", "piston_area", "relief_pressure"),
 }
 SPEED_KEY = "turn_slip.vehicle_speed"
+# The rolling tyre's assumed coefficients the paper quotes (MF 6.1 defaults, in the turn_slip effect's file).
+TURN_SLIP_QUOTED = ("spin_slope_coefficient", "camber_reduction")
 
 
 def _speed(speed_kmh: float) -> dict:
@@ -70,6 +72,13 @@ def assumed_values(kind: str) -> dict:
     quantities = {q.name: q for q in discover_effects()[ASSIST_EFFECTS[kind]].quantities}
     return {key: {"value": float(quantities[key].default), "unit": quantities[key].unit,
                   "source": quantities[key].source} for key in QUOTED[kind]}
+
+
+def turn_slip_values() -> dict:
+    """The rolling tyre's quoted coefficients at their defaults: {key: {value, unit, source}}."""
+    quantities = {q.name: q for q in discover_effects()["turn_slip"].quantities}
+    return {key: {"value": float(quantities[key].default), "unit": quantities[key].unit,
+                  "source": quantities[key].source} for key in TURN_SLIP_QUOTED}
 
 
 def equivalent_gain(kind: str, params: Parameters) -> float:
@@ -162,7 +171,7 @@ def assist_study(params: Parameters, run=simulate, progress=None) -> dict:
             results[(kind, CASE, speed)] = run(CASE, effects=_effects(kind), overrides=_speed(speed), params=params)
 
     numbers: dict = {"case": CASE, "surface": "ground", "speeds_kmh": list(SPEEDS_KMH), "offset_cases": list(OFFSET_CASES),
-                     "assists": {}, "runs": {}}
+                     "turn_slip": turn_slip_values(), "assists": {}, "runs": {}}
     for kind in ASSISTS:
         gain = equivalent_gain(kind, params)
         numbers["assists"][kind] = {"effect": ASSIST_EFFECTS[kind], "assumed": assumed_values(kind),
@@ -222,11 +231,12 @@ def plot_study(numbers: dict, params: Parameters):
 
     fig, (left, right) = new_figure(9.0, 3.8, ncols=2)
     names = {"none": "without assist", "column": "column electric assist", "hydraulic": "hydraulic assist"}
+    styles = {"none": ("-", "o"), "column": ("--", "s"), "hydraulic": (":", "^")}  # the assisted curves nearly meet
     for colour, kind in zip(COLOURS, (None, *ASSISTS)):
         c = numbers["_results"][(kind, CASE, 0.0)].columns
         keep = until_hand_stops(c, params)
         left.plot(1000 * c["rack_m"][keep], c["handwheel_torque_Nm"][keep], color=colour, linewidth=1.0,
-                  label=names[kind or "none"])
+                  linestyle=styles[kind or "none"][0], label=names[kind or "none"])
     left.axhline(0.0, color="0.5", linewidth=0.6)
     left.axvline(0.0, color="0.5", linewidth=0.6)
     left.set_xlabel("rack displacement (mm), positive steering right")
@@ -235,11 +245,12 @@ def plot_study(numbers: dict, params: Parameters):
     left.legend(loc="upper left", fontsize=7)
     for colour, kind in zip(COLOURS, ("none", *ASSISTS)):
         right.plot(numbers["speeds_kmh"], np.asarray(numbers["runs"][kind]["speeds"]["peak_rack_force_N"]) / 1000.0,
-                   marker="o", color=colour, linewidth=1.0, label=names[kind])
+                   marker=styles[kind][1], markerfacecolor="none", linestyle=styles[kind][0], color=colour,
+                   linewidth=1.0, label=names[kind])
     right.set_xlabel("vehicle speed (km/h)")
     right.set_ylabel("peak rack force over the cycle (kN)")
     right.set_ylim(bottom=0.0)
-    right.set_title("(b) rolling while steering (turn slip)", fontsize=9)
+    right.set_title("(b) rolling while steering (turn slip); the three nearly coincide", fontsize=9)
     right.legend(loc="lower left", fontsize=7)
     fig.tight_layout()
     return fig
