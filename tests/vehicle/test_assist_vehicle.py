@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -86,3 +88,21 @@ def test_sizing_study_of_the_polo(tmp_path, capsys):
     excess = table["peak_handwheel_manual_Nm"] - 3.0
     assert np.allclose(table["motor_torque_Nm"], (excess / n + friction) / eta, rtol=1e-6)
     assert (out / "torque_against_rack.svg").stat().st_size > 0 and (out / "rack_force_against_speed.svg").exists()
+
+
+def test_the_polos_assist_is_used_only_when_asked(tmp_path):
+    """The shipped Polo carries a column assist, but a run of the file is the car without assistance unless
+    --with-assist asks for it (its existing outputs unchanged). Asked for, the assist carries most of the road
+    torque: beyond the dead band the driver keeps about 1/(1 + G) of it, so the peak falls below a third of the
+    unassisted peak at the default gain of 6 (1/7 plus the dead band's share)."""
+    polo = str(Path(__file__).resolve().parents[2] / "data/vehicles/polo_vi.toml")
+    manual, assisted = tmp_path / "manual.csv", tmp_path / "assisted.csv"
+    assert main(["simulate", "--vehicle", polo, "--out", str(manual)]) == 0
+    assert main(["simulate", "--vehicle", polo, "--with-assist", "--out", str(assisted)]) == 0
+    columns, header = read_csv(manual)
+    assert "electric_assist_column" not in header["components"]
+    peak = float(np.max(np.abs(columns["handwheel_torque_Nm"])))
+    with_assist, header = read_csv(assisted)
+    assert "electric_assist_column" in header["components"]
+    assert float(np.max(np.abs(with_assist["handwheel_torque_Nm"]))) < peak / 3.0
+    assert main(["simulate", "--case", "unladen", "--with-assist", "--out", str(assisted)]) == 2

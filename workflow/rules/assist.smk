@@ -31,3 +31,26 @@ rule vehicle_assist_size:
 rule vehicle_assist:
     input:
         vehicle_assist_files,
+
+
+# The paper's car with today's steering (parksteer.figures.assist_study): the lock-to-lock cycle without
+# assistance, with the column electric assist and with the hydraulic assist at their assumed defaults, for the four
+# wheel offsets at standstill and the unladen car at creeping speeds. Writes the figure (SVG), the table (CSV) and
+# the numbers the paper quotes (results/assist_study.json); part of `all` (FIGURES).
+rule assist_study:
+    input:
+        parameters=PARAMETERS,
+        models=[CREEPING_MODEL, ASSIST_MODELS["column"], ASSIST_MODELS["hydraulic"]],
+        code=script_sources("assist_study"),
+    output:
+        svg=figure_report("figures/assist_study.svg", "model"),
+        csv=figure_report("figures/assist_study.csv", "model"),
+        json="results/assist_study.json",
+    log:
+        "logs/assist_study.log",
+    benchmark:
+        benchmark_file("assist_study")
+    conda:
+        "../envs/parksteer.yaml"
+    script:
+        "../scripts/assist_study.py"

@@ -29,6 +29,7 @@ FIGURES = {
     "diag_peers": ["figures/diag_peers.svg", "figures/diag_peers.csv"],
     "bands": ["figures/bands.svg", "figures/bands.csv"],
     "rivals": ["figures/rivals.svg", "figures/rivals.csv"],
+    "assist_study": ["figures/assist_study.svg", "figures/assist_study.csv"],
 }
 
 

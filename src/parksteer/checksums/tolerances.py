@@ -15,7 +15,7 @@ a change of one is beyond every tolerance here for any count below 10,000, so a 
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 from ..model.numeric.tolerances import ATOL_Q, ATOL_U, RTOL
 
@@ -116,6 +116,17 @@ FAMILIES: tuple[Family, ...] = (
         },
     ),
 )
+
+# The assist study's rack forces are handwheel torques through the gear, d(column angle)/d(rack) about 125-190
+# rad/m on the paper's car and the shipped vehicles: the model's torque tolerance through 250 rad/m. Otherwise the
+# model's.
+_GEAR_RAD_PER_m = 250.0
+FAMILIES = (*FAMILIES, replace(
+    FAMILIES[1], name="model, rack force", figures=("assist_study",),
+    by_unit={**FAMILIES[1].by_unit,
+             "N": Tolerance(_MODEL_RTOL, _MODEL_TORQUE_ATOL_Nm * _GEAR_RAD_PER_m,
+                            f"a rack force is a handwheel torque through the gear: the torque tolerance through "
+                            f"{_GEAR_RAD_PER_m:g} rad/m")}))
 
 # Text (verdicts, names, mechanisms, units) has no tolerance: a verdict that changes is "changed".
 TEXT = "exact: text (verdicts, names) must match"

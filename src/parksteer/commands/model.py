@@ -41,6 +41,9 @@ def register(sub) -> None:
     add_import_options(p)
     p.add_argument("--parameters", default=str(DEFAULT_PATH), help="parameter file (default: the packaged parksteer/data/parameters.toml)")
     add_vehicle_option(p)
+    p.add_argument("--with-assist", action="store_true",
+                   help="with --vehicle: add the vehicle file's [assist] to the effects (without it a file's runs "
+                        "are the car without assistance, as before the file had one)")
     p.add_argument("--output-dt", type=float, default=0.01, help="output spacing, s (default 0.01)")
     p.add_argument("--out", required=True, help="output CSV")
     add_quiet_option(p)
@@ -67,6 +70,8 @@ def _simulate(args) -> int:
         raise UsageError(f"--out {args.out}: is a directory; name a file to write")
     if args.raw_rack and args.rack_from is None:
         raise UsageError("--raw-rack needs --rack-from FILE")
+    if args.with_assist and args.vehicle is None:
+        raise UsageError("--with-assist needs --vehicle FILE (the assist is the vehicle file's [assist])")
     if args.rack_from is not None and not Path(args.rack_from).exists() and not Path(args.rack_from).is_symlink():
         raise UsageError(f"--rack-from {args.rack_from}: no such file")  # a link that leads nowhere: said on reading
     params = parameters_of(args)
@@ -83,9 +88,11 @@ def _simulate(args) -> int:
     if not (args.output_dt > 0):
         raise UsageError(f"--output-dt {args.output_dt:g}: the output step must be positive")
     with naming(f"--rack-from {args.rack_from}") if args.rack_from is not None else nullcontext():
-        from ..model.numeric.assist import effects_with_assist
+        from ..model.numeric.assist import check_assist, effects_with_assist
 
-        effects = effects_with_assist(args.effects, params)
+        effects = effects_with_assist(args.effects, params) if args.with_assist else args.effects
+        if args.with_assist and effects == args.effects and check_assist(params) is None:
+            raise UsageError(f"--with-assist: {args.vehicle} has no [assist] section")
         if args.speed_kmh is not None:
             effects, overrides = with_speed(effects, overrides, args.speed_kmh)
         result = simulate(case, effects=effects, overrides=overrides, surface=surface,

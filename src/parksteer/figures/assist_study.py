@@ -1,0 +1,273 @@
+"""Today's steering on the paper's car: what power assistance and creeping change in the source's conclusions.
+
+The paper's car (the pipeline's parameter file) runs the source's lock-to-lock cycle, unladen on the ground, with
+the tyre rolling (the turn_slip effect: exactly the paper's model at 0 km/h), three ways: without assistance,
+with the column electric assist at its assumed defaults, with the hydraulic assist at its assumed defaults
+(each default with its range and source in the effect's file, copied into the JSON).
+
+Shares. The model's contribution outputs split the handwheel torque into one term per mechanism, the generalized
+force of each on the rack referred to the handwheel through d(column angle)/d(rack) (as the figContrib figure
+does). With an assist one term is the assist's own, negative: the motor (or piston) pushes the rack. What the
+column must carry is the road torque
+
+    T_road = sum of the mechanisms' terms (all but the assist's, inertia included) = T_driver + T_assist,
+
+so each mechanism's share is its term over T_road (the shares add up to one, with and without assist), and the
+driver and the motor split T_road between them. Quasi-statically, beyond the dead band D of a boost curve of gain
+G below its limit, T_driver = (T_road + G D) / (1 + G): the driver's share tends to 1 / (1 + G) as T_road grows.
+For the hydraulic gear the equivalent gain is A k_v / G_hr (piston area A, valve slope k_v in Pa per N m of
+torsion-bar torque, G_hr the handwheel-to-rack ratio). Shares are taken over the plateau (the mean over the rack
+window of the figContrib figure, before right lock) and at the sample before the right-lock reversal.
+
+Offsets. The source found the king-pin offset hardly matters on the ground: the cycle is run for the paper's four
+wheel offsets (the standard car and its three spacers) with and without each assist, and the spread (largest
+less smallest) of the plateau torque and of the peak torque over the four is reported, in N m and relative to the
+standard car's.
+
+Creeping. The peak rack force over the cycle (handwheel torque through the gear, F = T d(theta_c)/d(rack), for the
+car without assist; the force the pinion and the assist together put on the rack, with it) at 0, 1, 3 and 5 km/h,
+and the plateau's shares at each speed (the tyre's: its friction moment times the turn-slip factor, the sum of the
+tyre_friction and turn_slip terms).
+
+Numbers on this path reach a checksummed figure: elementwise arithmetic, means and extrema only.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ..model.numeric.simulate import SimulationResult, simulate
+from ..model.symbolic.components import discover_effects
+from ..parameters import Parameters, load_parameters
+from ..tables import write_csv, write_json
+from ..vehicle import ASSIST_EFFECTS, ASSISTED_EFFECTS, CREEPING_EFFECTS
+from .model import OFFSET_CASES, _at, _times, plateau_mask, until_hand_stops
+
+CASE = "unladen"
+ASSISTS = ("column", "hydraulic")  # the kinds studied besides the car without assistance
+SPEEDS_KMH = (0.0, 1.0, 3.0, 5.0)
+# The assumed values the paper quotes, by assist kind (each effect's own quantities, with their sources).
+QUOTED = {
+    "column": ("gain", "dead_band", "torsion_bar_stiffness", "reduction_ratio", "efficiency", "motor_torque_limit",
+               "torque_constant"),
+    "hydraulic": ("valve_slope", "dead_band", "torsion_bar_stiffness", "piston_area", "relief_pressure"),
+}
+SPEED_KEY = "turn_slip.vehicle_speed"
+# The rolling tyre's assumed coefficients the paper quotes (MF 6.1 defaults, in the turn_slip effect's file).
+TURN_SLIP_QUOTED = ("spin_slope_coefficient", "camber_reduction")
+
+
+def _speed(speed_kmh: float) -> dict:
+    return {SPEED_KEY: speed_kmh / 3.6}
+
+
+def _effects(kind: str | None) -> str:
+    return CREEPING_EFFECTS if kind is None else ASSISTED_EFFECTS[kind]
+
+
+def assumed_values(kind: str) -> dict:
+    """The assist's quoted quantities at their defaults: {key: {value, unit, source}}."""
+    quantities = {q.name: q for q in discover_effects()[ASSIST_EFFECTS[kind]].quantities}
+    return {key: {"value": float(quantities[key].default), "unit": quantities[key].unit,
+                  "source": quantities[key].source} for key in QUOTED[kind]}
+
+
+def turn_slip_values() -> dict:
+    """The rolling tyre's quoted coefficients at their defaults: {key: {value, unit, source}}."""
+    quantities = {q.name: q for q in discover_effects()["turn_slip"].quantities}
+    return {key: {"value": float(quantities[key].default), "unit": quantities[key].unit,
+                  "source": quantities[key].source} for key in TURN_SLIP_QUOTED}
+
+
+def equivalent_gain(kind: str, params: Parameters) -> float:
+    """The boost gain G of the assist at its defaults: the gain itself (electric), A k_v / G_hr (hydraulic)."""
+    values = {k: v["value"] for k, v in assumed_values(kind).items()}
+    if kind == "hydraulic":
+        return values["piston_area"] * values["valve_slope"] / float(params["steering.handwheel_to_rack_ratio"])
+    return values["gain"]
+
+
+def assist_columns(columns: dict) -> list[str]:
+    """The contribution columns of an assist (the gear's own push), by the effects' names."""
+    return [f"contrib_{name}_Nm" for name in ASSIST_EFFECTS.values() if f"contrib_{name}_Nm" in columns]
+
+
+def shares(columns: dict, params: Parameters) -> dict:
+    """Each mechanism's term of the handwheel torque and its share of the road torque, over the plateau and just
+    before the right-lock reversal; the driver's and the assist's shares of the road torque (module docstring)."""
+    plateau = plateau_mask(columns, params)
+    t = _times(params)
+    before_right = t["right_lock"] - t["half_rounding"]
+    assists = assist_columns(columns)
+    mechanisms = [k for k in columns if k.startswith("contrib_") and k.endswith("_Nm") and k not in assists]
+    out = {}
+    for where, value in (("plateau", lambda name: float(np.mean(columns[name][plateau]))),
+                         ("near_right_lock", lambda name: _at(columns, name, before_right))):
+        terms = {k[len("contrib_"):-len("_Nm")]: value(k) for k in mechanisms}
+        road = sum(terms.values())
+        assist = -sum(value(k) for k in assists)
+        driver = value("handwheel_torque_Nm")
+        out[where] = {
+            "road_torque_Nm": road,
+            "driver_torque_Nm": driver,
+            "assist_torque_Nm": assist,
+            "driver_share": driver / road,
+            "assist_share": assist / road,
+            "mechanisms_Nm": terms,
+            "mechanism_shares": {name: term / road for name, term in terms.items()},
+        }
+    return out
+
+
+def peak_rack_force_N(result: SimulationResult) -> float:
+    """The peak force on the rack over the cycle: with an assist the simulation's rack_force_N (pinion and assist
+    together), without one the handwheel torque through the gear."""
+    c = result.columns
+    if "rack_force_N" in c:
+        force = c["rack_force_N"]
+    else:
+        per_rack = result.model.evaluate_outputs(c["time_s"], result.states, result.parameter_vector)[
+            "column_angle_per_rack_rad_per_m"]
+        force = c["handwheel_torque_Nm"] * per_rack
+    return float(np.max(np.abs(force)))
+
+
+def _plateau_by_speed(plateaus: list[dict]) -> dict:
+    """The plateau's road and driver torque and the mechanisms' shares at each speed; the tyre's share is its
+    friction moment with the turn-slip factor applied (turn_slip's own term is the moment the rolling removes)."""
+    out = {"plateau_road_torque_Nm": [p["road_torque_Nm"] for p in plateaus],
+           "plateau_driver_torque_Nm": [p["driver_torque_Nm"] for p in plateaus]}
+    share = {name: [] for name in ("tyre", "rack_friction", "lifting")}
+    for p in plateaus:
+        m = p["mechanism_shares"]
+        share["tyre"].append(m["tyre_friction"] + m.get("turn_slip", 0.0))
+        share["rack_friction"].append(m["rack_friction"])
+        share["lifting"].append(m["lifting"])
+    out["plateau_shares"] = share
+    return out
+
+
+def _spread(values: dict) -> float:
+    return max(values.values()) - min(values.values())
+
+
+def assist_study(params: Parameters, run=simulate, progress=None) -> dict:
+    """Every run of the study and the numbers the paper quotes (module docstring). `run` is the simulation
+    (simulate's signature); `progress`, if given, is called with a line per run."""
+    discover_effects()  # the assists' own quantities, with their assumed defaults
+    kinds = (None, *ASSISTS)
+    label = lambda kind: kind or "none"  # noqa: E731
+    results: dict = {}
+    for kind in kinds:
+        for case in OFFSET_CASES:
+            if progress:
+                progress(f"assist {label(kind)}, {case}, 0 km/h")
+            results[(kind, case, 0.0)] = run(case, effects=_effects(kind), overrides=_speed(0.0), params=params)
+        for speed in SPEEDS_KMH[1:]:
+            if progress:
+                progress(f"assist {label(kind)}, {CASE}, {speed:g} km/h")
+            results[(kind, CASE, speed)] = run(CASE, effects=_effects(kind), overrides=_speed(speed), params=params)
+
+    numbers: dict = {"case": CASE, "surface": "ground", "speeds_kmh": list(SPEEDS_KMH), "offset_cases": list(OFFSET_CASES),
+                     "turn_slip": turn_slip_values(), "assists": {}, "runs": {}}
+    for kind in ASSISTS:
+        gain = equivalent_gain(kind, params)
+        numbers["assists"][kind] = {"effect": ASSIST_EFFECTS[kind], "assumed": assumed_values(kind),
+                                    "gain": gain, "driver_share_limit": 1.0 / (1.0 + gain)}
+    for kind in kinds:
+        standstill = results[(kind, CASE, 0.0)].columns
+        plateau = {case: float(np.mean(results[(kind, case, 0.0)].columns["handwheel_torque_Nm"][
+            plateau_mask(results[(kind, case, 0.0)].columns, params)])) for case in OFFSET_CASES}
+        peak = {case: float(np.max(np.abs(results[(kind, case, 0.0)].columns["handwheel_torque_Nm"])))
+                for case in OFFSET_CASES}
+        numbers["runs"][label(kind)] = {
+            "peak_torque_Nm": peak[CASE],
+            "shares": shares(standstill, params),
+            "offsets": {"plateau_torque_Nm": plateau, "peak_torque_Nm": peak,
+                        "plateau_spread_Nm": _spread(plateau), "peak_spread_Nm": _spread(peak),
+                        "plateau_spread_relative": _spread(plateau) / plateau[CASE],
+                        "peak_spread_relative": _spread(peak) / peak[CASE]},
+            "speeds": {
+                "peak_rack_force_N": [peak_rack_force_N(results[(kind, CASE, s)]) for s in SPEEDS_KMH],
+                "peak_handwheel_torque_Nm": [float(np.max(np.abs(results[(kind, CASE, s)].columns[
+                    "handwheel_torque_Nm"]))) for s in SPEEDS_KMH],
+                **_plateau_by_speed([shares(results[(kind, CASE, s)].columns, params)["plateau"]
+                                     for s in SPEEDS_KMH]),
+            },
+        }
+    force = numbers["runs"]["none"]["speeds"]["peak_rack_force_N"]
+    numbers["rack_force_fall_at_5_kmh"] = 1.0 - force[-1] / force[0]
+    numbers["_results"] = results
+    return numbers
+
+
+def study_table(numbers: dict) -> dict[str, list]:
+    """One row per run: assist, case, speed, peak and plateau torque, peak rack force."""
+    rows: dict[str, list] = {"assist": [], "case": [], "speed_kmh": [], "plateau_torque_Nm": [],
+                             "peak_torque_Nm": [], "peak_rack_force_N": []}
+    for kind, run in numbers["runs"].items():
+        for case in numbers["offset_cases"]:
+            rows["assist"].append(kind)
+            rows["case"].append(case)
+            rows["speed_kmh"].append(0.0)
+            rows["plateau_torque_Nm"].append(run["offsets"]["plateau_torque_Nm"][case])
+            rows["peak_torque_Nm"].append(run["offsets"]["peak_torque_Nm"][case])
+            rows["peak_rack_force_N"].append(run["speeds"]["peak_rack_force_N"][0] if case == numbers["case"]
+                                             else float("nan"))
+        for i, speed in enumerate(numbers["speeds_kmh"][1:], start=1):
+            rows["assist"].append(kind)
+            rows["case"].append(numbers["case"])
+            rows["speed_kmh"].append(speed)
+            rows["plateau_torque_Nm"].append(float("nan"))
+            rows["peak_torque_Nm"].append(run["speeds"]["peak_handwheel_torque_Nm"][i])
+            rows["peak_rack_force_N"].append(run["speeds"]["peak_rack_force_N"][i])
+    return rows
+
+
+def plot_study(numbers: dict, params: Parameters):
+    from ..plotting import COLOURS, new_figure  # matplotlib only where a figure is drawn
+
+    fig, (left, right) = new_figure(9.0, 3.8, ncols=2)
+    names = {"none": "without assist", "column": "column electric assist", "hydraulic": "hydraulic assist"}
+    styles = {"none": ("-", "o"), "column": ("--", "s"), "hydraulic": (":", "^")}  # the assisted curves nearly meet
+    for colour, kind in zip(COLOURS, (None, *ASSISTS)):
+        c = numbers["_results"][(kind, CASE, 0.0)].columns
+        keep = until_hand_stops(c, params)
+        left.plot(1000 * c["rack_m"][keep], c["handwheel_torque_Nm"][keep], color=colour, linewidth=1.0,
+                  linestyle=styles[kind or "none"][0], label=names[kind or "none"])
+    left.axhline(0.0, color="0.5", linewidth=0.6)
+    left.axvline(0.0, color="0.5", linewidth=0.6)
+    left.set_xlabel("rack displacement (mm), positive steering right")
+    left.set_ylabel("handwheel torque (N m)")
+    left.set_title("(a) unladen, on the ground, at standstill", fontsize=9)
+    left.legend(loc="upper left", fontsize=7)
+    for colour, kind in zip(COLOURS, ("none", *ASSISTS)):
+        right.plot(numbers["speeds_kmh"], np.asarray(numbers["runs"][kind]["speeds"]["peak_rack_force_N"]) / 1000.0,
+                   marker=styles[kind][1], markerfacecolor="none", linestyle=styles[kind][0], color=colour,
+                   linewidth=1.0, label=names[kind])
+    right.set_xlabel("vehicle speed (km/h)")
+    right.set_ylabel("peak rack force over the cycle (kN)")
+    right.set_ylim(bottom=0.0)
+    right.set_title("(b) rolling while steering (turn slip); the three nearly coincide", fontsize=9)
+    right.legend(loc="lower left", fontsize=7)
+    fig.tight_layout()
+    return fig
+
+
+def make_assist_study(parameters_path: str | Path, svg_path: str | Path, csv_path: str | Path,
+                      json_path: str | Path, progress=None) -> dict:
+    """Write the study's figure (SVG), its table (CSV) and the numbers the paper quotes (JSON)."""
+    from ..plotting import save_svg
+
+    params = load_parameters(parameters_path)
+    numbers = assist_study(params, progress=progress)
+    header = {"table": "the paper's car over the lock-to-lock cycle without and with each assist at its assumed "
+                       "defaults: the four wheel offsets at standstill, the unladen car at creeping speeds",
+              "peak_rack_force_N": "pinion and assist together on the rack; given for the unladen car"}
+    write_csv(csv_path, study_table(numbers), header)
+    save_svg(plot_study(numbers, params), svg_path)
+    quoted = {k: v for k, v in numbers.items() if k != "_results"}
+    write_json(json_path, quoted)
+    return quoted

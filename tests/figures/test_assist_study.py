@@ -1,0 +1,71 @@
+"""Today's steering on the paper's car (parksteer.figures.assist_study): the assisted driver's torque, the rack
+force of a creeping car and the mechanisms' shares, each checked against the physics it stands for."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from parksteer.figures.assist_study import ASSISTS, CASE, assist_study
+from parksteer.figures.model import plateau_mask, until_hand_stops
+from parksteer.model.numeric.simulate import simulate
+
+
+@pytest.fixture(scope="module")
+def study(params):
+    return assist_study(params)
+
+
+@pytest.mark.parametrize("kind", ASSISTS)
+def test_the_assist_leaves_the_driver_less_torque_outside_the_dead_band(study, params, kind):
+    """A boost curve adds torque in the driver's direction whenever the torsion bar carries more than the dead
+    band D, so wherever the unassisted car needs more than 2 D the assisted driver needs less, over the whole
+    cycle while the hand moves (the same prescribed handwheel angle in both runs). The margin: at a reversal the
+    torque sweeps through the band in a few hundredths of a second and the motor, not pushing while the torsion
+    bar is within it, lets the assisted torque lag the manual one by up to D there."""
+    manual = study["_results"][(None, CASE, 0.0)].columns
+    assisted = study["_results"][(kind, CASE, 0.0)].columns
+    band = study["assists"][kind]["assumed"]["dead_band"]["value"]
+    keep = until_hand_stops(manual, params) & (np.abs(manual["handwheel_torque_Nm"]) > 2.0 * band)
+    assert keep.sum() > 0.8 * len(keep)
+    assert np.all(np.abs(assisted["handwheel_torque_Nm"][keep]) < np.abs(manual["handwheel_torque_Nm"][keep]))
+
+
+def test_the_peak_rack_force_falls_as_the_car_creeps(study, params):
+    """The turn-slip moment of a rolling tyre (MF 6.x) falls as the distance rolled per steer angle grows, so the
+    peak rack force over the cycle falls with speed at every step 0, 1, 3, 5 km/h, with and without assistance;
+    and at 0 km/h the rolling-tyre model is the paper's own (the limit of no rolling)."""
+    for run in study["runs"].values():
+        force = run["speeds"]["peak_rack_force_N"]
+        assert all(a > b for a, b in zip(force, force[1:]))
+    paper = simulate(CASE, params=params).columns["handwheel_torque_Nm"]
+    assert study["runs"]["none"]["peak_torque_Nm"] == pytest.approx(float(np.max(np.abs(paper))), rel=1e-6)
+
+
+@pytest.mark.parametrize("where", ["plateau", "near_right_lock"])
+def test_the_shares_add_up_to_the_road_torque(study, where):
+    """The contributions are the generalized forces on the rack referred to the handwheel, so the mechanisms'
+    terms add up to the road torque (shares summing to one) and the driver and the assist split it between them;
+    who supplies the torque does not change what the tyres and the rack resist (each mechanism's term within 1 %
+    of the unassisted car's)."""
+    manual = study["runs"]["none"]["shares"][where]
+    assert manual["driver_share"] == pytest.approx(1.0, abs=1e-12)
+    for kind in ("none", *ASSISTS):
+        s = study["runs"][kind]["shares"][where]
+        assert sum(s["mechanism_shares"].values()) == pytest.approx(1.0, abs=1e-9)
+        assert s["driver_share"] + s["assist_share"] == pytest.approx(1.0, abs=1e-6)
+        for name, term in s["mechanisms_Nm"].items():
+            if abs(manual["mechanisms_Nm"][name]) > 0.05:
+                assert term == pytest.approx(manual["mechanisms_Nm"][name], rel=0.01), name
+
+
+@pytest.mark.parametrize("kind", ASSISTS)
+def test_the_driver_keeps_the_boost_curves_share(study, params, kind):
+    """Quasi-statically, beyond the dead band D of a boost curve of gain G below its limit, the driver carries
+    (T_road + G D) / (1 + G) of the road torque (electric_assist.py); on the plateau the simulated driver's torque
+    is that within 5 % (the motor's or the seals' friction and the torsion bar's twist rate make the rest)."""
+    s = study["runs"][kind]["shares"]["plateau"]
+    gain = study["assists"][kind]["gain"]
+    band = study["assists"][kind]["assumed"]["dead_band"]["value"]
+    assert s["driver_torque_Nm"] == pytest.approx((s["road_torque_Nm"] + gain * band) / (1.0 + gain), rel=0.05)
+    assert study["assists"][kind]["driver_share_limit"] == pytest.approx(1.0 / (1.0 + gain))
