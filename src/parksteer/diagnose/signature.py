@@ -162,7 +162,9 @@ class Signature:
             "rho": self.rho,
             "n_eff": self.n_eff,
             "axes": [{"axis": a.axis, "columns": a.columns, "share": a.share, "excess_share": a.excess_share,
-                      "statistic": a.statistic, "p_value": a.p_value, "significant": a.significant}
+                      # the p-value goes through the C library's exp and log (scipy's chi-square), whose last
+                      # digits may differ between machines: three significant digits are what it says
+                      "statistic": a.statistic, "p_value": float(f"{a.p_value:.3g}"), "significant": a.significant}
                      for a in self.axes],
             "models": [{"family": m.family, "label": m.label, "columns": m.columns, "delta_bic": m.delta_bic}
                        for m in self.models],
