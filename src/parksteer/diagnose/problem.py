@@ -62,7 +62,7 @@ from ..measure.smoothing import SmoothedRack, smooth_rack
 from ..model.numeric.prescribed import column_twist
 from ..model.symbolic.components import Effect
 from ..parameters import Parameters
-from ..synthetic.logger import add_noise, quantise
+from ..synthetic.logger import add_noise, quantisation_step, quantise
 from .parallel import fork_map, forks, worker_pool
 from .settings import DEFAULT_SETTINGS
 from .replay import Replay
@@ -164,13 +164,15 @@ class FileData:
         return prediction[self.n :] if self.uses_angle else None
 
 
-def prepare_file(measurement: Measurement, case: str | None = None, label: str | None = None) -> FileData:
-    """Smooth the rack, find the phases and the noise floor of one measurement."""
+def prepare_file(measurement: Measurement, case: str | None = None, label: str | None = None,
+                 rest_resolution_m: float = 0.0) -> FileData:
+    """Smooth the rack, find the phases and the noise floor of one measurement (`rest_resolution_m`: the rounding
+    step of an angle-derived rack, :func:`parksteer.measure.smoothing.smooth_rack`)."""
     case = case or measurement.case
     if TORQUE not in measurement.columns:
         raise UsageError(f"{measurement.path}: no column {TORQUE!r}")
     label = label or (measurement.path.name if measurement.path is not None else "measurement")
-    rack = smooth_rack(measurement.time_s, measurement.rack_m)
+    rack = smooth_rack(measurement.time_s, measurement.rack_m, rest_resolution_m=rest_resolution_m)
     phases = find_phases(measurement.time_s, measurement.rack_m, measurement.handwheel_torque_Nm,
                          surface=measurement.surface)
     floor = noise_floor(measurement.handwheel_torque_Nm, measurement.quantisation_step(TORQUE))
@@ -203,10 +205,13 @@ def load_files(paths: list[str | Path], params: Parameters, case: str | None = N
                 f"{path}: extra_offset_m = {stated:g} m but case {chosen} has "
                 f"{params.case(chosen)['extra_offset']:g} m; name the matching case (--case)"
             )
+        resolution = 0.0
         if "rack_derived" in measurement.metadata:
             measurement = rack_from_angle(measurement, params)
+            logger = rack_logger(measurement, params)
+            resolution = 0.0 if logger is None else quantisation_step(logger[0], logger[1])
         with naming(path):
-            files.append(prepare_file(measurement, chosen))
+            files.append(prepare_file(measurement, chosen, rest_resolution_m=resolution))
     return files
 
 
