@@ -149,8 +149,10 @@ def rack_from_handwheel(handwheel_angle_rad, handwheel_torque_Nm, params: Parame
     """The column law: rack displacement (m) from the handwheel angle and torque.
 
     The column twists by T / column_torsional_stiffness (its damping is left out: at parking speeds the twist
-    rate is a few hundredths of a rad/s, so the damping torque moves the rack by about 0.01 mm), the Hooke joint
-    turns the column angle into the pinion angle, and rack = theta_p / handwheel_to_rack_ratio.
+    rate is at most about 0.024 rad/s, at a reversal, where with c / k = 0.2 s the damper moves the rack by up to
+    26 um), the Hooke joint turns the column angle into the pinion angle, and rack = theta_p /
+    handwheel_to_rack_ratio. A diagnosis re-derives the rack with the damper
+    (:func:`parksteer.diagnose.problem.rack_from_angle`): at a reversal those 26 um decide the friction's flip.
     """
     s = params.sections["steering"]
     column = np.asarray(handwheel_angle_rad, dtype=float) - (

@@ -27,6 +27,11 @@ delta_i^2)``; residuals are weighted by it (``(measured - model) / sigma_i``), s
 listens to the samples the replay can predict, and a perfect model has weighted residuals
 of unit variance.
 
+A file with no rack channel (a car's own bus: handwheel angle and torque) is replayed from a rack derived from
+the angle through the model's column, its damper included (:func:`rack_from_angle`, which
+:func:`load_files` applies to every record whose importer derived its rack); its replay uncertainty comes from
+the angle channel's logger carried through the ratio (:func:`rack_logger`).
+
 A file with a handwheel angle beside a measured rack may be fitted on both signals
 (:attr:`FileData.uses_angle`, in the copies the diagnosis makes when its settings ask): each prediction is
 then the torque followed by the replayed handwheel angle (column angle plus the twist that
@@ -48,14 +53,16 @@ from scipy.ndimage import maximum_filter1d
 
 from .. import portable as pm
 from ..errors import UsageError, naming
+from ..geometry import pinion_angle_from_column
 from ..measure.importers import load_record
 from ..measure.io import Measurement
 from ..measure.metrics import NoiseFloor, noise_floor
 from ..measure.phases import CyclePhases, find_phases
 from ..measure.smoothing import SmoothedRack, smooth_rack
+from ..model.numeric.prescribed import column_twist
 from ..model.symbolic.components import Effect
 from ..parameters import Parameters
-from ..synthetic.logger import add_noise, quantise
+from ..synthetic.logger import add_noise, quantisation_step, quantise
 from .parallel import fork_map, forks, worker_pool
 from .settings import DEFAULT_SETTINGS
 from .replay import Replay
@@ -157,13 +164,15 @@ class FileData:
         return prediction[self.n :] if self.uses_angle else None
 
 
-def prepare_file(measurement: Measurement, case: str | None = None, label: str | None = None) -> FileData:
-    """Smooth the rack, find the phases and the noise floor of one measurement."""
+def prepare_file(measurement: Measurement, case: str | None = None, label: str | None = None,
+                 rest_resolution_m: float = 0.0) -> FileData:
+    """Smooth the rack, find the phases and the noise floor of one measurement (`rest_resolution_m`: the rounding
+    step of an angle-derived rack, :func:`parksteer.measure.smoothing.smooth_rack`)."""
     case = case or measurement.case
     if TORQUE not in measurement.columns:
         raise UsageError(f"{measurement.path}: no column {TORQUE!r}")
     label = label or (measurement.path.name if measurement.path is not None else "measurement")
-    rack = smooth_rack(measurement.time_s, measurement.rack_m)
+    rack = smooth_rack(measurement.time_s, measurement.rack_m, rest_resolution_m=rest_resolution_m)
     phases = find_phases(measurement.time_s, measurement.rack_m, measurement.handwheel_torque_Nm,
                          surface=measurement.surface)
     floor = noise_floor(measurement.handwheel_torque_Nm, measurement.quantisation_step(TORQUE))
@@ -196,9 +205,46 @@ def load_files(paths: list[str | Path], params: Parameters, case: str | None = N
                 f"{path}: extra_offset_m = {stated:g} m but case {chosen} has "
                 f"{params.case(chosen)['extra_offset']:g} m; name the matching case (--case)"
             )
+        resolution = 0.0
+        if "rack_derived" in measurement.metadata:
+            measurement = rack_from_angle(measurement, params)
+            logger = rack_logger(measurement, params)
+            resolution = 0.0 if logger is None else quantisation_step(logger[0], logger[1])
         with naming(path):
-            files.append(prepare_file(measurement, chosen))
+            files.append(prepare_file(measurement, chosen, rest_resolution_m=resolution))
     return files
+
+
+def rack_from_angle(measurement: Measurement, params: Parameters) -> Measurement:
+    """A copy of an angle-only record (its rack derived by the importer) with the rack derived through the model's
+    column: the column angle is the handwheel angle less the twist that passes the measured torque through the
+    column's spring and damper, ``c dtwist/dt + k twist = T`` (:func:`parksteer.model.numeric.prescribed.column_twist`,
+    exact for a torque linear between samples, from the static twist T(0) / k at the first sample), the Hooke joint
+    turns it into the pinion angle (:func:`parksteer.geometry.pinion_angle_from_column`) and
+    rack = theta_p / handwheel_to_rack_ratio. This is the inverse of the replay's own handwheel angle
+    (:func:`parksteer.model.numeric.prescribed.solve`: column angle plus that twist).
+
+    The importer's static column law (:func:`parksteer.geometry.rack_from_handwheel`, twist T / k) leaves out the
+    damper: the twist lags the torque by c / k (0.2 s on the paper's car), and where the torque swings at a reversal
+    the static twist is off by (c / k) dtwist/dt, up to 4.8e-3 rad at the handwheel, a 26 um rack error, five times
+    the angle-derived rack's own noise (a 14-bit angle on +-16 rad: 1.05e-5 m steps). That error sits at the
+    reversals, where the rack friction flips, and made a null record unexplained. The torque's noise reaches the
+    rack through the twist only, divided by k and the ratio (0.1 N m: 5e-7 m) and low-passed by the damper.
+    """
+    s = params.sections["steering"]
+    columns = measurement.columns
+    twist, _ = column_twist(columns["time_s"], columns[TORQUE], s["column_torsional_stiffness"],
+                            s["column_torsional_damping"])
+    pinion = pinion_angle_from_column(columns[ANGLE] - twist, s["hooke_joint_angle"], s["hooke_joint_phase"])
+    metadata = dict(measurement.metadata)
+    metadata["rack_derived"] = (
+        f"from {ANGLE} and {TORQUE} through the model's column (parksteer.diagnose.problem.rack_from_angle): twist "
+        f"from c dtwist/dt + k twist = T with k {s['column_torsional_stiffness']:g} N m/rad and c "
+        f"{s['column_torsional_damping']:g} N m s/rad, Hooke joint angle {s['hooke_joint_angle']:g} rad and phase "
+        f"{s['hooke_joint_phase']:g} rad, ratio {s['handwheel_to_rack_ratio']:g} rad/m"
+    )
+    return replace(measurement, columns={**columns, "rack_m": pinion / s["handwheel_to_rack_ratio"]},
+                   metadata=metadata)
 
 
 def effect_key(effects: list[Effect]) -> tuple[str, ...]:
@@ -356,7 +402,7 @@ class Problem:
         for i, f in enumerate(self.files):
             base = self.replay(effects, i)
             base.parameter_vector(overrides)  # any run the overrides need is prepared once, here
-            logger = rack_logger(f.measurement)
+            logger = rack_logger(f.measurement, self.params)
             # An end held at rest may be a hand still slowing there, and a pause's edges are not sharp
             # (smoothing.RACK_REST_TEST_CHI2, RACK_REST_MIN_S): every other draw smooths with the ends and the
             # pauses free, so the samples there carry that doubt.
@@ -415,12 +461,29 @@ def relogged_rack(rack: SmoothedRack, time_s: np.ndarray, full_scale: float, bit
                            hold_rest)
 
 
-def rack_logger(measurement: Measurement) -> tuple[float, int, float] | None:
+def rack_logger(measurement: Measurement, params: Parameters | None = None) -> tuple[float, int, float] | None:
     """(full scale, bits, analog noise RMS) of the rack channel, if the file states its logger; else None.
 
     The analog part is the rack's noise (from its second differences) less the rounding's
     step / sqrt(12), root sum of squares, as :func:`parksteer.measure.metrics.noise_floor` splits it.
+
+    A rack derived from the handwheel angle (:func:`rack_from_angle`) has no logger of its own: its noise and
+    rounding are the angle channel's, carried through the column to the rack. So its logger is the angle's
+    (``full_scale_``/``bits_`` of the angle, the angle's analog noise from its own second differences), each
+    divided by handwheel_to_rack_ratio (`params`): the rack's levels are then the angle's steps over the ratio.
+    The Hooke joint scales that step by its local speed ratio, between cos(alpha) and 1 / cos(alpha) (0.90 to
+    1.11 at 0.45 rad), which the mean ratio leaves out; the torque's share through the twist (module docstring
+    of :func:`rack_from_angle`) is twenty times smaller and left out too. Without a stated angle logger, None.
     """
+    if "rack_derived" in measurement.metadata:
+        if params is None or ANGLE not in measurement.columns:
+            return None
+        full_scale, bits = measurement.full_scale(ANGLE), measurement.bits(ANGLE)
+        if full_scale is None or bits is None:
+            return None
+        ratio = params.sections["steering"]["handwheel_to_rack_ratio"]
+        floor = noise_floor(measurement.columns[ANGLE], measurement.quantisation_step(ANGLE))
+        return full_scale / ratio, bits, floor.analog_rms / ratio
     full_scale, bits = measurement.full_scale("rack_m"), measurement.bits("rack_m")
     if full_scale is None or bits is None:
         return None

@@ -389,12 +389,19 @@ def knot_spacings(time_s: np.ndarray) -> list[float]:
     return [low * RACK_KNOT_SPACING_STEP**i for i in range(max(count, 1))]
 
 
-def smooth_rack(time_s, rack_m, knot_spacing_s: float | None = None, hold_rest: bool = True) -> SmoothedRack:
+def smooth_rack(time_s, rack_m, knot_spacing_s: float | None = None, hold_rest: bool = True,
+                rest_resolution_m: float = 0.0) -> SmoothedRack:
     """The measured rack as a least-squares cubic spline; the knot spacing from the data unless given.
 
     With `hold_rest` (the default) each end is held at rest unless the data contradict it (:func:`_lsq_fit`) and
     the spline is constant over every pause of the hand (:func:`rest_intervals`); without, the ends and the
     pauses are free (the alternative the replay's uncertainty also replays).
+
+    `rest_resolution_m`: for a rack whose rounding is coarser than its noise and not dithered by it (a rack derived
+    from a quantised handwheel angle), the step of that rounding. At rest such a rack can drift by up to a step
+    that second differences do not see as noise (the column's twist relaxing under one level of the angle), so
+    the pause test (:func:`rest_intervals`) takes the rack's noise as at least that step. 0 (the default): the
+    noise from the data alone.
 
     Chosen spacing: the largest tried (:func:`knot_spacings`) whose fit RMS per degree of
     freedom is within ``RACK_DISCREPANCY_FACTOR`` of the rack's noise RMS; if none is, the finest.
@@ -407,7 +414,7 @@ def smooth_rack(time_s, rack_m, knot_spacing_s: float | None = None, hold_rest: 
         raise UsageError("rack smoothing: time must be strictly increasing")
     noise = estimate_noise_rms(x)
     turns = turning_times(t, x)
-    rests = rest_intervals(t, x, noise) if hold_rest else ()
+    rests = rest_intervals(t, x, max(noise, rest_resolution_m)) if hold_rest else ()
 
     def build(fit, spacing):
         knots, coefficients, inverse, rms, at_rest = fit
