@@ -447,3 +447,14 @@ def test_platform_differences_name_each_fact_and_ignore_a_kernel_update():
     assert differences(PLATFORM, running) == ["libc glibc 2.36 -> glibc 2.39"]
     assert differences(PLATFORM, dict(PLATFORM, os="Darwin 23.1.0")) == ["os Linux 6.1 -> Darwin 23.1.0"]
     assert "no record" in differences(None, PLATFORM)[0]
+
+
+def test_a_text_cell_with_a_comma_is_refused_and_nothing_is_written(tmp_path):
+    """The figures' CSV has no quoting: a label holding a comma would add a cell to its row (the damage check
+    then takes the table for a cut one). Writing it is refused with the column and row named, and no file is left."""
+    from parksteer.tables import write_csv
+
+    path = tmp_path / "labels.csv"
+    with pytest.raises(ValueError, match=r"column method, row 2: .*comma"):
+        write_csv(path, {"method": ["plain", "own, as another's"], "count": [1, 2]})
+    assert not path.exists()

@@ -139,6 +139,12 @@ def write_csv(
     lengths = {len(c) for c in data}
     if len(lengths) > 1:
         raise ValueError(f"{path}: columns have different lengths {sorted(lengths)}")
+    for name, column in zip(names, data):  # the format has no quoting: a text cell holds no separator
+        if column.dtype.kind in "US":
+            for i, cell in enumerate(column):
+                if any(c in str(cell) for c in ',\n"'):
+                    raise ValueError(f"{path}: column {name}, row {i + 1}: {str(cell)!r} holds a comma, a quote or a "
+                                     "line break, which this CSV cannot carry")
     rows = (",".join(str(v) if isinstance(v, (str, np.str_)) else format_number(v, digits) for v in row)
             for row in zip(*data))
     write_csv_rows(path, names, rows, lengths.pop() if lengths else 0, header)

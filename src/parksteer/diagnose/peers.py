@@ -65,7 +65,7 @@ FROLS_ERR_TOLERANCES = (0.0, 0.001, 0.003, 0.01, 0.02, 0.05, 0.1, 0.2, 0.3)
 FROLS_SETTINGS = tuple((c, t) for c in FROLS_CRITERIA for t in FROLS_ERR_TOLERANCES)
 FROLS_MAX_TERMS = 15  # SysIdentPy's n_info_values default: the criterion is evaluated for 1..15 terms
 METHODS = ("diagnose", "stlsq", "frols")
-METHOD_LABELS = {"diagnose": "parksteer diagnose", "stlsq": "PySINDy STLSQ", "frols": "FROLS (own, as SysIdentPy's)"}
+METHOD_LABELS = {"diagnose": "parksteer diagnose", "stlsq": "PySINDy STLSQ", "frols": "FROLS (own code after SysIdentPy)"}
 
 
 @dataclass(frozen=True)
