@@ -80,7 +80,7 @@ def test_the_figure_table_and_numbers_are_written_without_machine_times(tmp_path
     assert by_record["null_1"] == ("", "yes") and by_record["null_0"] == ("", "no")
     assert not [c for c in columns if "time" in c or c.endswith("_s")]  # machine times stay out of the table
     numbers = json.loads(out.read_text(encoding="utf-8"))
-    assert numbers["timings_s"]["case_s"] == pytest.approx(4.0)
+    assert "timings_s" not in numbers  # nor out of the key numbers, which are the same on any machine
     assert svg.read_text(encoding="utf-8").startswith("<?xml")
 
 

@@ -69,7 +69,7 @@ def _ranking_entry(diagnosis: Diagnosis, candidate: Candidate, before: dict) -> 
 # Machine times in a diagnosis or a benchmark summary: they differ from run to run and machine to machine, so the
 # pipeline's key-number files (results/<target>.json), which a rebuild must reproduce byte for byte, leave them out.
 MACHINE_TIME_KEYS = frozenset({"timings_s", "wall_s", "generation_s", "wall_s_median", "diagnosis_wall_s_median",
-                               "diagnosis_wall_s_total"})
+                               "diagnosis_wall_s_total", "time_s_median", "time_with_upstream_s_median"})
 
 
 def without_machine_times(value):

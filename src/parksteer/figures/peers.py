@@ -2,7 +2,8 @@
 
 The numbers are :func:`parksteer.diagnose.peers.compare`'s: each method on the variation and out-of-class
 benchmarks' records, the peers at the setting tuned on records of another seed. Machine times stay out of the
-checksummed SVG and CSV; the key numbers (JSON) keep them, as the paper's table quotes them.
+SVG, the CSV and the key numbers (JSON), which are the same on any machine; the paper quotes model replays, and
+benchmarks/bench_peers.py prints the times.
 """
 
 from __future__ import annotations
@@ -51,6 +52,7 @@ def peers_figure(comparison: dict, svg: str | Path) -> None:
 def make_peers_figure(peer_paths, svg: str | Path, csv: str | Path, json_path: str | Path) -> dict:
     """figures/diag_peers.svg and .csv (one row per method) and results/diag_peers.json (the comparison)."""
     from ..diagnose.peers import compare, read_cases
+    from ..diagnose.report import without_machine_times
     from ..tables import write_csv, write_json
 
     comparison = compare(read_cases(peer_paths))
@@ -73,5 +75,5 @@ def make_peers_figure(peer_paths, svg: str | Path, csv: str | Path, json_path: s
                              "null_adequate": "records with nothing hidden called adequate",
                              "confident_wrong": "out-of-class rivals answered with an unrelated candidate "
                                                 "(the diagnosis: with a BIC margin beyond its band)"})
-    write_json(json_path, comparison)
+    write_json(json_path, without_machine_times(comparison))  # the times: benchmarks/bench_peers.py
     return comparison

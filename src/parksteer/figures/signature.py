@@ -262,6 +262,7 @@ def make_signature_figure(row_paths, svg: str | Path, csv: str | Path, json_path
                           design: SignatureDesign | None = None) -> dict:
     """figures/diag_signature.svg and .csv, results/diag_signature.json from the rows the jobs wrote (in any
     order; sorted by record name)."""
+    from ..diagnose.report import without_machine_times
     from ..tables import write_csv, write_json
 
     rows = []
@@ -289,5 +290,5 @@ def make_signature_figure(row_paths, svg: str | Path, csv: str | Path, json_path
     summary["sentences"] = {r["name"]: r["sentence"] for r in rows}
     summary["timings_s"] = {k: float(np.median([t[k] for t in times])) for k in (*TIME_KEYS, "case_s")
                             if times and all(k in t for t in times)}
-    write_json(json_path, summary)
+    write_json(json_path, without_machine_times(summary))  # the times: benchmarks/bench_signature.py
     return summary
