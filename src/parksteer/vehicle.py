@@ -70,6 +70,11 @@ CREEPING_EFFECTS = "+turn_slip"
 ASSISTED_EFFECTS = {kind: f"{CREEPING_EFFECTS},+{name}" for kind, name in ASSIST_EFFECTS.items()}
 
 
+def creeping_overrides(speed_kmh: float) -> dict:
+    """The overrides of a run of CREEPING_EFFECTS at `speed_kmh`: turn_slip's vehicle speed, in m/s."""
+    return {"turn_slip.vehicle_speed": speed_kmh / 3.6}
+
+
 def assist_of(params: Parameters) -> str | None:
     """The assist effect a vehicle's parameters carry (from ``[assist]``), or None."""
     found = [name for name in ASSIST_EFFECTS.values() if name in params.sections]

@@ -42,7 +42,7 @@ from ..model.numeric.simulate import SimulationResult, simulate
 from ..model.symbolic.components import discover_effects
 from ..parameters import Parameters, load_parameters
 from ..tables import write_csv, write_json
-from ..vehicle import ASSIST_EFFECTS, ASSISTED_EFFECTS, CREEPING_EFFECTS
+from ..vehicle import ASSIST_EFFECTS, ASSISTED_EFFECTS, CREEPING_EFFECTS, creeping_overrides
 from .model import OFFSET_CASES, _at, _times, plateau_mask, until_hand_stops
 
 CASE = "unladen"
@@ -54,13 +54,8 @@ QUOTED = {
                "torque_constant"),
     "hydraulic": ("valve_slope", "dead_band", "torsion_bar_stiffness", "piston_area", "relief_pressure"),
 }
-SPEED_KEY = "turn_slip.vehicle_speed"
 # The rolling tyre's assumed coefficients the paper quotes (MF 6.1 defaults, in the turn_slip effect's file).
 TURN_SLIP_QUOTED = ("spin_slope_coefficient", "camber_reduction")
-
-
-def _speed(speed_kmh: float) -> dict:
-    return {SPEED_KEY: speed_kmh / 3.6}
 
 
 def _effects(kind: str | None) -> str:
@@ -164,11 +159,11 @@ def assist_study(params: Parameters, run=simulate, progress=None) -> dict:
         for case in OFFSET_CASES:
             if progress:
                 progress(f"assist {label(kind)}, {case}, 0 km/h")
-            results[(kind, case, 0.0)] = run(case, effects=_effects(kind), overrides=_speed(0.0), params=params)
+            results[(kind, case, 0.0)] = run(case, effects=_effects(kind), overrides=creeping_overrides(0.0), params=params)
         for speed in SPEEDS_KMH[1:]:
             if progress:
                 progress(f"assist {label(kind)}, {CASE}, {speed:g} km/h")
-            results[(kind, CASE, speed)] = run(CASE, effects=_effects(kind), overrides=_speed(speed), params=params)
+            results[(kind, CASE, speed)] = run(CASE, effects=_effects(kind), overrides=creeping_overrides(speed), params=params)
 
     numbers: dict = {"case": CASE, "surface": "ground", "speeds_kmh": list(SPEEDS_KMH), "offset_cases": list(OFFSET_CASES),
                      "turn_slip": turn_slip_values(), "assists": {}, "runs": {}}

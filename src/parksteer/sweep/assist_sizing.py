@@ -28,7 +28,7 @@ from ..model.numeric.assist import check_assist
 from ..model.numeric.simulate import SimulationResult, simulate
 from ..model.symbolic.components import discover_effects
 from ..parameters import Parameters
-from ..vehicle import ASSIST_EFFECTS, ASSISTED_EFFECTS, CREEPING_EFFECTS
+from ..vehicle import ASSIST_EFFECTS, ASSISTED_EFFECTS, CREEPING_EFFECTS, creeping_overrides
 
 SPEEDS_KMH = (0.0, 1.0, 3.0, 5.0)
 MARGIN = 1.1  # the sized motor limit or relief pressure over the quasi-static demand
@@ -64,10 +64,6 @@ def _peak(values: np.ndarray) -> float:
     return float(np.max(np.abs(values)))
 
 
-def _speed(speed_kmh: float) -> dict:
-    return {"turn_slip.vehicle_speed": speed_kmh / 3.6}
-
-
 def demand_at_action(name: str, params: Parameters, torque_Nm: np.ndarray, per_rack: np.ndarray,
                      target_Nm: float) -> np.ndarray:
     """The assist at its point of action that leaves the driver `target_Nm` (module docstring), per sample."""
@@ -94,7 +90,7 @@ def size_assist(params: Parameters, case: str, target_torque_Nm: float, speeds_k
     ratio = float(params["steering.handwheel_to_rack_ratio"])
     rows, manual0, assisted0 = [], None, None
     for speed in speeds_kmh:
-        manual = simulate(case, effects=CREEPING_EFFECTS, overrides=_speed(speed), params=params)
+        manual = simulate(case, effects=CREEPING_EFFECTS, overrides=creeping_overrides(speed), params=params)
         c = manual.columns
         per_rack = manual.model.evaluate_outputs(c["time_s"], manual.states, manual.parameter_vector)[
             "column_angle_per_rack_rad_per_m"]
@@ -114,7 +110,7 @@ def size_assist(params: Parameters, case: str, target_torque_Nm: float, speeds_k
             current = motor / v("torque_constant")
             sized = {f"{name}.gain": gain, f"{name}.motor_torque_limit": MARGIN * motor}
         kind = next(k for k, e in ASSIST_EFFECTS.items() if e == name)
-        assisted = simulate(case, effects=ASSISTED_EFFECTS[kind], overrides={**_speed(speed), **sized}, params=params)
+        assisted = simulate(case, effects=ASSISTED_EFFECTS[kind], overrides={**creeping_overrides(speed), **sized}, params=params)
         rows.append(SizingRow(speed, _peak(torque * per_rack), peak_manual, demand, motor, current, pressure, gain,
                               _peak(assisted.columns["handwheel_torque_Nm"])))
         if manual0 is None:
