@@ -62,18 +62,21 @@ def _effects(kind: str | None) -> str:
     return CREEPING_EFFECTS if kind is None else ASSISTED_EFFECTS[kind]
 
 
+def _defaults(effect: str, keys: tuple[str, ...]) -> dict:
+    """The effect's quantities `keys` at their defaults: {key: {value, unit, source}}."""
+    quantities = {q.name: q for q in discover_effects()[effect].quantities}
+    return {key: {"value": float(quantities[key].default), "unit": quantities[key].unit,
+                  "source": quantities[key].source} for key in keys}
+
+
 def assumed_values(kind: str) -> dict:
     """The assist's quoted quantities at their defaults: {key: {value, unit, source}}."""
-    quantities = {q.name: q for q in discover_effects()[ASSIST_EFFECTS[kind]].quantities}
-    return {key: {"value": float(quantities[key].default), "unit": quantities[key].unit,
-                  "source": quantities[key].source} for key in QUOTED[kind]}
+    return _defaults(ASSIST_EFFECTS[kind], QUOTED[kind])
 
 
 def turn_slip_values() -> dict:
     """The rolling tyre's quoted coefficients at their defaults: {key: {value, unit, source}}."""
-    quantities = {q.name: q for q in discover_effects()["turn_slip"].quantities}
-    return {key: {"value": float(quantities[key].default), "unit": quantities[key].unit,
-                  "source": quantities[key].source} for key in TURN_SLIP_QUOTED}
+    return _defaults("turn_slip", TURN_SLIP_QUOTED)
 
 
 def equivalent_gain(kind: str, params: Parameters) -> float:
