@@ -126,8 +126,7 @@ def peak_rack_force_N(result: SimulationResult) -> float:
     if "rack_force_N" in c:
         force = c["rack_force_N"]
     else:
-        per_rack = result.model.evaluate_outputs(c["time_s"], result.states, result.parameter_vector)[
-            "column_angle_per_rack_rad_per_m"]
+        per_rack = result.outputs()["column_angle_per_rack_rad_per_m"]
         force = c["handwheel_torque_Nm"] * per_rack
     return float(np.max(np.abs(force)))
 

@@ -91,10 +91,8 @@ def size_assist(params: Parameters, case: str, target_torque_Nm: float, speeds_k
     rows, manual0, assisted0 = [], None, None
     for speed in speeds_kmh:
         manual = simulate(case, effects=CREEPING_EFFECTS, overrides=creeping_overrides(speed), params=params)
-        c = manual.columns
-        per_rack = manual.model.evaluate_outputs(c["time_s"], manual.states, manual.parameter_vector)[
-            "column_angle_per_rack_rad_per_m"]
-        torque = c["handwheel_torque_Nm"]
+        per_rack = manual.outputs()["column_angle_per_rack_rad_per_m"]
+        torque = manual.columns["handwheel_torque_Nm"]
         peak_manual = _peak(torque)
         demand = float(np.max(demand_at_action(name, params, torque, per_rack, target_torque_Nm)))
         # the boost gain that meets the target at the peak: T = (T_peak + G D) / (1 + G)

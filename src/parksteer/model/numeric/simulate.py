@@ -52,6 +52,10 @@ class SimulationResult:
     def contribution_names(self) -> list[str]:
         return [k for k in self.columns if k.startswith("contrib_")]
 
+    def outputs(self) -> dict[str, np.ndarray]:
+        """The model's named outputs (``column_angle_per_rack_rad_per_m``, ...) at every sample, from the states."""
+        return self.model.evaluate_outputs(self.columns["time_s"], self.states, self.parameter_vector)
+
 
 @dataclass
 class PreparedRun:
