@@ -9,9 +9,8 @@ from pathlib import Path
 
 from ..errors import UsageError
 from ..parameters import DEFAULT_PATH
+from ..vehicle import ASSIST_EFFECTS
 from .vehicle import parameters_of
-
-ASSIST_KINDS = ("column", "pinion", "rack", "hydraulic")
 
 
 def register(sub) -> None:
@@ -24,7 +23,7 @@ def register(sub) -> None:
     s.add_argument("--target-torque", type=float, required=True, metavar="NM",
                    help="the most handwheel torque the driver should need over the cycle (N m), e.g. 3")
     s.add_argument("--speeds-kmh", default="0,1,3,5", help="vehicle speeds, km/h, comma-separated (default 0,1,3,5)")
-    s.add_argument("--assist", choices=ASSIST_KINDS, default=None,
+    s.add_argument("--assist", choices=tuple(ASSIST_EFFECTS), default=None,
                    help="the assist to size (default: the vehicle file's [assist], else a column assist at its "
                         "assumed defaults)")
     s.add_argument("--out-dir", required=True, help="folder for sizing.csv and the two figures")
@@ -45,7 +44,7 @@ def _speeds(text: str) -> tuple[float, ...]:
 def _size(args) -> int:
     from ..figures.assist import write_sizing
     from ..sweep.assist_sizing import size_assist
-    from ..vehicle import ASSIST_EFFECTS, vehicle_name
+    from ..vehicle import vehicle_name
 
     params = parameters_of(args)
     case = args.case or params.case_names[0]

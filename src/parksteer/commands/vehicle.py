@@ -10,6 +10,7 @@ from .. import model  # noqa: F401  (its effects declare their quantities, which
 from .. import portable as pm
 from ..errors import UsageError
 from ..parameters import DEFAULT_PATH, load_parameters
+from ..vehicle import ASSIST_EFFECTS
 
 BAR_PA = 1.0e5
 INCH_M = 0.0254
@@ -43,7 +44,7 @@ def register(sub) -> None:
     n.add_argument("--tyre-pressure-bar", type=float, required=True, help="front tyre pressure, gauge (bar)")
     n.add_argument("--steering-ratio", type=float, required=True, help="overall steering ratio (handwheel/road wheel)")
     n.add_argument("--lock-turns", type=float, required=True, help="handwheel turns lock to lock")
-    n.add_argument("--assist", choices=("column", "pinion", "rack", "hydraulic"), default=None,
+    n.add_argument("--assist", choices=tuple(ASSIST_EFFECTS), default=None,
                    help="power assistance: electric at the column, pinion or rack, or hydraulic; writes [assist] "
                         "with the values given below and the rest assumed (typical, with ranges and sources)")
     n.add_argument("--assist-reduction", type=float, default=None,
