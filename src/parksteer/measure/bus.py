@@ -20,7 +20,7 @@ import numpy as np
 from ..errors import UsageError
 from .importers import Channel, channel_map_from_options, from_si, parse_channel_map
 from .io import Measurement
-from .readers.can_log import CHECKSUMS, BusMap, BusSpec, _role, dbc_bus, load_bus, load_dbc
+from .readers.can_log import BusMap, BusSpec, checksum_signal, counter_signal, dbc_bus, load_bus, load_dbc
 
 WRITERS = {"candump": ".log", "asc": ".asc", "blf": ".blf", "trc": ".trc", "mf4": ".mf4"}
 
@@ -87,9 +87,9 @@ def encode_frames(record: Measurement, channels: BusMap, t0: float = 1_700_000_0
             column = record.columns.get(ch.target)
             values = np.zeros(len(t)) if column is None else np.interp(t, time_s, column)
             raw.update(_signal_values(ch, values, message, ch.source.partition(".")[2]))
-        counter = _role(message, r"COUNTER|\w+_BZ")
-        checksum = _role(message, r"CHECKSUM|\w+_CRC")
-        algorithm = CHECKSUMS.get(bus.checksum) if bus.checksum else None
+        counter = counter_signal(message)
+        checksum = checksum_signal(message)
+        algorithm = bus.checksum_algorithm
         for k, tk in enumerate(t):
             signals = {s: int(v[k]) for s, v in raw.items()}
             if counter is not None:

@@ -119,6 +119,11 @@ class BusSpec:
     data_ids: dict[int, tuple[int, ...]] = field(default_factory=dict)
     source: str = ""
 
+    @property
+    def checksum_algorithm(self):
+        """The function computing a frame's checksum (a value of CHECKSUMS), or None when none is named."""
+        return CHECKSUMS.get(self.checksum) if self.checksum else None
+
 
 def known_buses() -> list[str]:
     return sorted(p.stem for p in BUSES_DIR.glob("*.toml"))
@@ -292,11 +297,21 @@ def _split_signal(text: str, where: Path, dbc, dbc_path: Path, what: str) -> tup
 
 
 def _role(msg, pattern: str):
-    """The counter or checksum signal of a message (COUNTER / ..._BZ, CHECKSUM / ..._CRC), or None."""
+    """The signal of a message whose name matches `pattern`, or None."""
     for s in msg.signals:
         if re.fullmatch(pattern, s.name):
             return s
     return None
+
+
+def counter_signal(msg):
+    """The message counter of a message (COUNTER, or VW's ..._BZ), or None."""
+    return _role(msg, r"COUNTER|\w+_BZ")
+
+
+def checksum_signal(msg):
+    """The checksum of a message (CHECKSUM, or VW's ..._CRC), or None."""
+    return _role(msg, r"CHECKSUM|\w+_CRC")
 
 
 def _quality_bit(msg, signal: str):
@@ -377,8 +392,8 @@ def read_bus_log(raw: bytes, where: Path, channels) -> Record:
             raise UsageError(f"{where}: two frames of {name} with different data share the time stamp "
                              f"{t[keep][k]:.6f} s: the log's time stamps cannot be trusted there")
         # checksum
-        crc = _role(msg, r"CHECKSUM|\w+_CRC")
-        algorithm = CHECKSUMS.get(bus.checksum) if bus.checksum else None
+        crc = checksum_signal(msg)
+        algorithm = bus.checksum_algorithm
         if crc is not None and algorithm is not None and msg.frame_id in bus.data_ids and crc.start == 0 \
                 and crc.length == 8:
             bad = np.array([len(f) < 2 or algorithm(f, bus.data_ids[msg.frame_id]) != f[0] for f in frames])
@@ -416,7 +431,7 @@ def read_bus_log(raw: bytes, where: Path, channels) -> Record:
         t = t[keep]
         columns = {s: np.asarray(v, dtype=float) for s, v in values.items()}
         # counter
-        counter = _role(msg, r"COUNTER|\w+_BZ")
+        counter = counter_signal(msg)
         if counter is not None and len(t) > 1:
             modulus = 2 ** counter.length
             step = np.mod(np.diff(columns[counter.name]), modulus)
