@@ -318,7 +318,7 @@ def _quality_bit(msg, signal: str):
     """The quality bit of `signal` in its message: a QBit signal whose name holds the signal's stem."""
     stem = signal.split("_", 1)[1] if "_" in signal else signal
     for s in msg.signals:
-        if "qbit" in s.name.lower() and stem.lower() in s.name.lower() and s.length == 1:
+        if QBIT in s.name.lower() and stem.lower() in s.name.lower() and s.length == 1:
             return s
     return None
 
