@@ -1,6 +1,6 @@
 """A car's own CAN bus: the channel map of ``--bus NAME`` / ``--dbc CAR.dbc``, and the way back from a record to
 the frames a car would send (:func:`encode_frames`, :func:`write_log`), with which the decoding is shown to lose
-nothing but the bus's own resolution (tests/measure/test_bus_roundtrip.py, benchmarks/bench_bus_roundtrip.py).
+nothing but the bus's own resolution (tests/measure/test_bus.py, benchmarks/bench_bus_roundtrip.py).
 
 Encoding is the reader's map run backwards: each mapped native column, in SI, negated where the map negates it,
 split into magnitude and sign flag where the map names a sign signal, converted to the signal's unit, divided by
