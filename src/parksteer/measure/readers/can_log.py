@@ -47,7 +47,7 @@ from typing import ClassVar
 import numpy as np
 
 from ...errors import UsageError
-from .base import Record, Source
+from .base import SNIFF_BYTES, Record, Source
 
 # A gap in a used message longer than this is refused: the method resolves the phases of a cycle over windows of
 # 0.1 s (parksteer.measure.importers.METHOD_RATE_HZ), so a longer hole takes a part of a phase with it.
@@ -95,7 +95,7 @@ class CanLogReader:
         return bus_format(head) is not None
 
     def read(self, raw: bytes, where: Path) -> Record:
-        fmt = FORMAT_NAMES[bus_format(raw[:4096]) or "candump"]
+        fmt = FORMAT_NAMES[bus_format(raw[:SNIFF_BYTES]) or "candump"]
         raise UsageError(f"{where}: a raw CAN log ({fmt}); decoding it needs the car's DBC: give --bus NAME "
                          f"(known: {', '.join(known_buses())}) or --dbc CAR.dbc with --map "
                          "'MESSAGE.SIGNAL[unit]=column'")
@@ -327,7 +327,7 @@ def read_bus_log(raw: bytes, where: Path, channels) -> Record:
     """The mapped signals of the bus log `raw` (file `where`), decoded with the DBC that `channels` (a
     :class:`BusMap`) carries, each with the time stamps of its message's frames, checked as the module says."""
     bus: BusSpec = channels.bus
-    fmt = bus_format(raw[:4096])
+    fmt = bus_format(raw[:SNIFF_BYTES])
     if fmt is None:
         if raw[:8] in (b"MDF     ", b"UnFinMF "):
             fmt = "mf4"
