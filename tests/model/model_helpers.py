@@ -41,3 +41,34 @@ def with_effect(name: str, strength_key: str, case: str = "unladen", strength: f
 
     chosen = {} if strength is None else {f"{name}.{strength_key}": strength}
     return simulate(case, effects=f"+{name}", overrides={**(overrides or {}), **chosen}, **kwargs)
+
+
+def rack_effect_text(class_name: str, name: str, description: str, quantity: str, unit: str, upper: str,
+                     force: str, docstring: str = "") -> str:
+    """The text of a user-effect file: one quantity `name.quantity` (unit, 0 to `upper`, default 0) and a force
+    `force` (an expression in `model` and `k`, the kinematics) along the rack, reacted on the rack housing.
+    `force` may start with statements on lines of their own; its last line is the force."""
+    *lines, last = force.split("\n")
+    body = "".join(f"        {line}\n" for line in lines)
+    head = f'"""{docstring}"""\n' if docstring else ""
+    return f'''
+{head}from parksteer.model.symbolic.components import Effect
+from parksteer.model.symbolic.system import action_reaction
+from parksteer.parameters import Quantity
+
+
+class {class_name}(Effect):
+    name = "{name}"
+    description = "{description}"
+    in_default_set = False
+    quantities = (Quantity("{name}.{quantity}", "{unit}", 0.0, {upper}, lower_inclusive=True, default=0.0,
+                           source="test"),)
+    uses = ("{name}.{quantity}",)
+
+    def loads(self, model):
+        k = model.kinematics
+{body}        return action_reaction(k.rack_point, {last}, k.rack_housing_point)
+
+
+EFFECT = {class_name}()
+'''

@@ -13,6 +13,8 @@ from parksteer.model.symbolic.derive import build_space
 from parksteer.model.numeric.simulate import simulate
 from parksteer.model.numeric.values import parse_overrides
 
+from model_helpers import rack_effect_text
+
 PAPER_EFFECTS = ["carcass_compliance", "hooke_joint", "lifting", "rack_friction", "tyre_friction"]
 
 
@@ -115,29 +117,10 @@ def test_building_two_models_leaves_no_state_on_the_effects():
     assert [c.name for c in plain.coordinates] == ["rack", "bounce", "roll", "twist_left", "twist_right"]
 
 
-NEW_EFFECT = '''
-"""Viscous damping of the rack (an effect added as one file)."""
-from parksteer.model.symbolic.components import Effect
-from parksteer.model.symbolic.system import action_reaction
-from parksteer.parameters import Quantity
-
-
-class RackViscous(Effect):
-    name = "rack_viscous_test"
-    description = "viscous force on the rack, -c * rack speed"
-    in_default_set = False
-    quantities = (Quantity("rack_viscous_test.damping", "N s/m", 0.0, 1e6, lower_inclusive=True, default=0.0,
-                           source="test"),)
-    uses = ("rack_viscous_test.damping",)
-
-    def loads(self, model):
-        k = model.kinematics
-        force = model.p("rack_viscous_test.damping") * model.rack_u
-        return action_reaction(k.rack_point, -force * k.B.y, k.rack_housing_point)
-
-
-EFFECT = RackViscous()
-'''
+NEW_EFFECT = rack_effect_text(
+    "RackViscous", "rack_viscous_test", "viscous force on the rack, -c * rack speed", "damping", "N s/m", "1e6",
+    'force = model.p("rack_viscous_test.damping") * model.rack_u\n-force * k.B.y',
+    docstring="Viscous damping of the rack (an effect added as one file).")
 
 
 def test_a_new_effect_is_one_file(tmp_path, params, nominal):

@@ -6,27 +6,10 @@ from __future__ import annotations
 from parksteer.model.codegen.cache import model_key
 from parksteer.model.symbolic.components import load_effect_module
 
-TEXT = '''
-from parksteer.model.symbolic.components import Effect
-from parksteer.model.symbolic.system import action_reaction
-from parksteer.parameters import Quantity
+from model_helpers import rack_effect_text
 
-
-class Push(Effect):
-    name = "file_key_push"
-    description = "a constant push on the rack"
-    in_default_set = False
-    quantities = (Quantity("file_key_push.force", "N", 0.0, 100.0, lower_inclusive=True, default=0.0,
-                           source="test"),)
-    uses = ("file_key_push.force",)
-
-    def loads(self, model):
-        k = model.kinematics
-        return action_reaction(k.rack_point, -SCALE * model.p("file_key_push.force") * k.B.y, k.rack_housing_point)
-
-
-EFFECT = Push()
-'''
+TEXT = rack_effect_text("Push", "file_key_push", "a constant push on the rack", "force", "N", "100.0",
+                        '-SCALE * model.p("file_key_push.force") * k.B.y')
 
 
 def test_two_files_of_one_name_and_class_but_different_text_have_different_model_keys(tmp_path):

@@ -10,6 +10,7 @@ from pathlib import Path
 from ..names import SURFACES
 from ..errors import UsageError
 from ..parameters import DEFAULT_PATH
+from ..progress import note
 from . import add_quiet_option
 from .vehicle import add_vehicle_option, parameters_of
 
@@ -193,9 +194,8 @@ def _diagnose(args) -> int:
             why = "its rack is derived from the angle" if ANGLE in f.measurement.columns else f"no column {ANGLE!r}"
             raise UsageError(f"{f.measurement.path or f.label}: --angle needs a handwheel angle beside a measured rack "
                              f"({why})")
-        if not args.quiet:
-            print(f"handwheel angle fitted beside the torque in {len(with_angle)} of {len(files)} file(s): "
-                  + ", ".join(with_angle), file=sys.stderr)
+        note(f"handwheel angle fitted beside the torque in {len(with_angle)} of {len(files)} file(s): "
+             + ", ".join(with_angle))
     diagnosis = diagnose(files, params, effects, workers=workers, quiet=args.quiet, settings=settings)
     result = _with_suggestion(args, diagnosis_dict(diagnosis), diagnosis, settings)
     if args.plot:
@@ -222,18 +222,16 @@ def _with_suggestion(args, result: dict, diagnosis, settings) -> dict:
         return result
     signature = diagnosis.outputs.get("signature")
     if diagnosis.verdict != "unexplained" or signature is None or signature.effect_class is None:
-        if not args.quiet:
-            print(f"no effect suggested (verdict {diagnosis.verdict}"
-                  + (", no structure in the residual" if signature is not None and signature.effect_class is None
-                     else "") + ")", file=sys.stderr)
+        note(f"no effect suggested (verdict {diagnosis.verdict}"
+             + (", no structure in the residual" if signature is not None and signature.effect_class is None
+                else "") + ")")
         return result
     from ..diagnose.report import with_suggestion
     from ..diagnose.suggest import suggest
 
     suggestion = suggest(diagnosis.problem, diagnosis.calibration, signature, args.suggest_effect, settings)
-    if not args.quiet:
-        print(f"suggested effect {suggestion.effect_name} written to {args.suggest_effect}: weighted RMS "
-              f"{suggestion.before_over_floor:.2f} -> {suggestion.after_over_floor:.2f} noise floors", file=sys.stderr)
+    note(f"suggested effect {suggestion.effect_name} written to {args.suggest_effect}: weighted RMS "
+         f"{suggestion.before_over_floor:.2f} -> {suggestion.after_over_floor:.2f} noise floors")
     return with_suggestion(result, suggestion)
 
 

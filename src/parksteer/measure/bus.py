@@ -1,6 +1,6 @@
 """A car's own CAN bus: the channel map of ``--bus NAME`` / ``--dbc CAR.dbc``, and the way back from a record to
 the frames a car would send (:func:`encode_frames`, :func:`write_log`), with which the decoding is shown to lose
-nothing but the bus's own resolution (tests/measure/test_bus_roundtrip.py, benchmarks/bench_bus_roundtrip.py).
+nothing but the bus's own resolution (tests/measure/test_bus.py, benchmarks/bench_bus_roundtrip.py).
 
 Encoding is the reader's map run backwards: each mapped native column, in SI, negated where the map negates it,
 split into magnitude and sign flag where the map names a sign signal, converted to the signal's unit, divided by
@@ -20,7 +20,7 @@ import numpy as np
 from ..errors import UsageError
 from .importers import Channel, channel_map_from_options, from_si, parse_channel_map
 from .io import Measurement
-from .readers.can_log import CHECKSUMS, BusMap, BusSpec, _role, dbc_bus, load_bus, load_dbc
+from .readers.can_log import BusMap, BusSpec, checksum_signal, counter_signal, dbc_bus, load_bus, load_dbc
 
 WRITERS = {"candump": ".log", "asc": ".asc", "blf": ".blf", "trc": ".trc", "mf4": ".mf4"}
 
@@ -87,9 +87,9 @@ def encode_frames(record: Measurement, channels: BusMap, t0: float = 1_700_000_0
             column = record.columns.get(ch.target)
             values = np.zeros(len(t)) if column is None else np.interp(t, time_s, column)
             raw.update(_signal_values(ch, values, message, ch.source.partition(".")[2]))
-        counter = _role(message, r"COUNTER|\w+_BZ")
-        checksum = _role(message, r"CHECKSUM|\w+_CRC")
-        algorithm = CHECKSUMS.get(bus.checksum) if bus.checksum else None
+        counter = counter_signal(message)
+        checksum = checksum_signal(message)
+        algorithm = bus.checksum_algorithm
         for k, tk in enumerate(t):
             signals = {s: int(v[k]) for s, v in raw.items()}
             if counter is not None:

@@ -10,7 +10,7 @@ entry in the table.
 
 from __future__ import annotations
 
-from .base import Reader, Record, Source
+from .base import SNIFF_BYTES, Reader, Record, Source
 from .can_log import CanLogReader
 from .logger_csv import LoggerCsvReader
 from .mdf import MdfReader
@@ -23,8 +23,6 @@ READERS: dict[str, type[Reader]] = {
     "native_csv": NativeCsvReader,
     "logger_csv": LoggerCsvReader,
 }
-# How many leading bytes a reader's sniff sees.
-SNIFF_BYTES = 4096
 
 
 def reader_for(raw: bytes) -> Reader:

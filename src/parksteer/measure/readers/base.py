@@ -22,6 +22,8 @@ from ...errors import UsageError
 
 # Channel names loggers use for time, compared by :func:`normal_name` (master channels of MDF files go by these).
 TIME_ALIASES = ("time", "t", "zeit", "timestamp", "timestamps")
+# How many leading bytes a reader's sniff sees.
+SNIFF_BYTES = 4096
 
 
 @dataclass

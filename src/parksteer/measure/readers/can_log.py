@@ -47,7 +47,7 @@ from typing import ClassVar
 import numpy as np
 
 from ...errors import UsageError
-from .base import Record, Source
+from .base import SNIFF_BYTES, Record, Source
 
 # A gap in a used message longer than this is refused: the method resolves the phases of a cycle over windows of
 # 0.1 s (parksteer.measure.importers.METHOD_RATE_HZ), so a longer hole takes a part of a phase with it.
@@ -95,7 +95,7 @@ class CanLogReader:
         return bus_format(head) is not None
 
     def read(self, raw: bytes, where: Path) -> Record:
-        fmt = FORMAT_NAMES[bus_format(raw[:4096]) or "candump"]
+        fmt = FORMAT_NAMES[bus_format(raw[:SNIFF_BYTES]) or "candump"]
         raise UsageError(f"{where}: a raw CAN log ({fmt}); decoding it needs the car's DBC: give --bus NAME "
                          f"(known: {', '.join(known_buses())}) or --dbc CAR.dbc with --map "
                          "'MESSAGE.SIGNAL[unit]=column'")
@@ -118,6 +118,11 @@ class BusSpec:
     checksum: str | None = None
     data_ids: dict[int, tuple[int, ...]] = field(default_factory=dict)
     source: str = ""
+
+    @property
+    def checksum_algorithm(self):
+        """The function computing a frame's checksum (a value of CHECKSUMS), or None when none is named."""
+        return CHECKSUMS.get(self.checksum) if self.checksum else None
 
 
 def known_buses() -> list[str]:
@@ -292,18 +297,28 @@ def _split_signal(text: str, where: Path, dbc, dbc_path: Path, what: str) -> tup
 
 
 def _role(msg, pattern: str):
-    """The counter or checksum signal of a message (COUNTER / ..._BZ, CHECKSUM / ..._CRC), or None."""
+    """The signal of a message whose name matches `pattern`, or None."""
     for s in msg.signals:
         if re.fullmatch(pattern, s.name):
             return s
     return None
 
 
+def counter_signal(msg):
+    """The message counter of a message (COUNTER, or VW's ..._BZ), or None."""
+    return _role(msg, r"COUNTER|\w+_BZ")
+
+
+def checksum_signal(msg):
+    """The checksum of a message (CHECKSUM, or VW's ..._CRC), or None."""
+    return _role(msg, r"CHECKSUM|\w+_CRC")
+
+
 def _quality_bit(msg, signal: str):
     """The quality bit of `signal` in its message: a QBit signal whose name holds the signal's stem."""
     stem = signal.split("_", 1)[1] if "_" in signal else signal
     for s in msg.signals:
-        if "qbit" in s.name.lower() and stem.lower() in s.name.lower() and s.length == 1:
+        if QBIT in s.name.lower() and stem.lower() in s.name.lower() and s.length == 1:
             return s
     return None
 
@@ -312,7 +327,7 @@ def read_bus_log(raw: bytes, where: Path, channels) -> Record:
     """The mapped signals of the bus log `raw` (file `where`), decoded with the DBC that `channels` (a
     :class:`BusMap`) carries, each with the time stamps of its message's frames, checked as the module says."""
     bus: BusSpec = channels.bus
-    fmt = bus_format(raw[:4096])
+    fmt = bus_format(raw[:SNIFF_BYTES])
     if fmt is None:
         if raw[:8] in (b"MDF     ", b"UnFinMF "):
             fmt = "mf4"
@@ -377,8 +392,8 @@ def read_bus_log(raw: bytes, where: Path, channels) -> Record:
             raise UsageError(f"{where}: two frames of {name} with different data share the time stamp "
                              f"{t[keep][k]:.6f} s: the log's time stamps cannot be trusted there")
         # checksum
-        crc = _role(msg, r"CHECKSUM|\w+_CRC")
-        algorithm = CHECKSUMS.get(bus.checksum) if bus.checksum else None
+        crc = checksum_signal(msg)
+        algorithm = bus.checksum_algorithm
         if crc is not None and algorithm is not None and msg.frame_id in bus.data_ids and crc.start == 0 \
                 and crc.length == 8:
             bad = np.array([len(f) < 2 or algorithm(f, bus.data_ids[msg.frame_id]) != f[0] for f in frames])
@@ -416,7 +431,7 @@ def read_bus_log(raw: bytes, where: Path, channels) -> Record:
         t = t[keep]
         columns = {s: np.asarray(v, dtype=float) for s, v in values.items()}
         # counter
-        counter = _role(msg, r"COUNTER|\w+_BZ")
+        counter = counter_signal(msg)
         if counter is not None and len(t) > 1:
             modulus = 2 ** counter.length
             step = np.mod(np.diff(columns[counter.name]), modulus)
