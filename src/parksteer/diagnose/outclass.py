@@ -6,7 +6,7 @@ a rival effect that is not a diagnosis candidate (gear efficiency, a tyre breaka
 branch, top-mount wind-up, a nonlinear linkage, rolling resistance), integrated handwheel-driven at a tighter
 tolerance than the diagnosis's rack replay, and logged through a whole logger chain (anti-alias filter, channel
 lag, 8-bit torque, quantised rack). The honest answers are the physically closest candidate (or one sharing its
-physics, :data:`parksteer.synthetic.datasets.OUTCLASS_RIVALS`) or ``unexplained``. Each case is scored against
+physics, :func:`parksteer.synthetic.datasets.outclass_rivals`) or ``unexplained``. Each case is scored against
 two targets: never ``adequate`` when the hidden effect is at least ADEQUATE_LIMIT_STEPS converter steps RMS,
 and never a physically unrelated candidate named with a BIC margin over the runner-up beyond the
 indistinguishable band (the diagnosis's own ``bic_indistinguishable``).
@@ -20,7 +20,7 @@ import numpy as np
 
 from ..errors import UsageError
 from ..parameters import load_parameters
-from ..synthetic.datasets import OUTCLASS_RIVALS, OutclassDesign, make_outclass_dataset, outclass_specs
+from ..synthetic.datasets import OutclassDesign, make_outclass_dataset, outclass_rivals, outclass_specs
 from .benchmark import diagnose_written, paired_results
 from .rows import OutclassRow
 
@@ -131,7 +131,7 @@ def aggregate(truth_paths, diagnosis_paths, design: OutclassDesign | None = None
                                      "nearest_after_over_floor", "target_met")} for r in rows],
         "confusion": confusion,
         "closest_table": {k: {"closest": v["closest"] or "none", "related": list(v["related"]),
-                              "reason": v["reason"]} for k, v in OUTCLASS_RIVALS.items()},
+                              "reason": v["reason"]} for k, v in outclass_rivals().items()},
         "targets": {"adequate_limit_steps": ADEQUATE_LIMIT_STEPS, "bic_band": "the diagnosis's bic_indistinguishable"},
         "settings": None if design is None else {
             "rivals": list(design.rivals), "steps": list(design.steps), "nulls": design.nulls,

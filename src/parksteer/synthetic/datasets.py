@@ -454,12 +454,6 @@ def outclass_rivals(registry=None) -> dict[str, dict]:
             for name, e in rival_effects(registry).items()}
 
 
-def __getattr__(name: str):
-    if name == "OUTCLASS_RIVALS":  # the table above under its former name, derived each time from the effects
-        return outclass_rivals()
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-
-
 @dataclass(frozen=True)
 class ChainLogger:
     """The whole logger chain of the out-of-class records, in the order a signal passes it.
