@@ -109,6 +109,9 @@ def write_log(frames, path: str | Path, fmt: str | None = None, dbc: Path | None
 
     path = Path(path)
     fmt = fmt or next((k for k, suffix in WRITERS.items() if path.suffix == suffix), None)
+    if fmt not in WRITERS:
+        raise UsageError(f"{path}: no bus log format {fmt!r} (name one of {', '.join(WRITERS)}, or a file ending "
+                         f"{', '.join(WRITERS.values())})")
     if fmt == "mf4":
         from can.io import mf4
 
