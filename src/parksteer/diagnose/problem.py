@@ -554,6 +554,8 @@ def effective_samples(n: int, rho: float) -> float:
     return max(n * (1.0 - rho) / (1.0 + rho), 2.0)
 
 
-def information_criterion(weighted_rss: float, n: int, n_eff: float, parameters: int) -> float:
-    """BIC over the effective sample size: n_eff ln(RSS / n) + k ln(n_eff)."""
-    return n_eff * pm.log(max(weighted_rss, 1e-300) / n) + parameters * pm.log(n_eff)
+def bic_gain(rss_without: float, rss_with: float, n_eff: float, parameters: int) -> float:
+    """The fall of the BIC over the effective sample size, ``BIC = n_eff ln(RSS / n) + k ln(n_eff)``, when
+    `parameters` more columns take the weighted residual sum of squares from `rss_without` to `rss_with`:
+    ``n_eff ln(rss_without / rss_with) - k ln(n_eff)`` (positive: the richer model is the better)."""
+    return n_eff * pm.log(rss_without / max(rss_with, 1e-300)) - parameters * pm.log(n_eff)

@@ -55,7 +55,7 @@ from .. import portable as pm
 from ..errors import UsageError
 from ..measure.phases import PHASES
 from ..parameters import Parameters
-from .problem import effective_samples
+from .problem import bic_gain, effective_samples
 from .settings import DEFAULT_SETTINGS, DiagnosisSettings
 
 CLASSES = ("dissipative", "elastic", "direction", "speed", "column")
@@ -305,7 +305,7 @@ def signature_from_axes(axes: Axes, settings: DiagnosisSettings = DEFAULT_SETTIN
     scores = []
     for b, (_, rss) in zip(models, fits):
         k = b.columns.shape[1]
-        gain = n_eff * pm.log(rss0 / max(rss, 1e-300)) - k * pm.log(n_eff)
+        gain = bic_gain(rss0, rss, n_eff, k)
         scores.append(ModelScore(b.family, b.label, k, float(rss), float(gain)))
     shares = []
     excess = rss0 - n

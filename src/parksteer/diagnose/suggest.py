@@ -31,11 +31,10 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import portable as pm
 from ..errors import UsageError
 from ..model.symbolic.components import load_effect_module
 from .calibrate import Fit, FitParameter, calibration_parameters, least_squares
-from .problem import Problem, effective_samples, fit_statistics, lag1_autocorrelation
+from .problem import Problem, bic_gain, effective_samples, fit_statistics, lag1_autocorrelation
 from .settings import DEFAULT_SETTINGS, DiagnosisSettings
 from .signature import Signature
 
@@ -221,7 +220,7 @@ def suggest(problem: Problem, calibration: Fit, signature: Signature, path: str 
         after = fit_statistics(problem, fit.predictions)
         rho = lag1_autocorrelation(problem, fit.weighted)
         n_eff = effective_samples(problem.n, rho)
-        gain = n_eff * pm.log(calibration.rss / fit.rss) - len(keys) * pm.log(n_eff)
+        gain = bic_gain(calibration.rss, fit.rss, n_eff, len(keys))
         values = fit.values if isinstance(fit.values, dict) else {}
         strengths = {k: float(values.get(k, fit.theta[len(calibration.theta) + i])) for i, k in enumerate(keys)}
         before_ratio = before["weighted_rms_Nm"] / floor
