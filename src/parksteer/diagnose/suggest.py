@@ -207,7 +207,8 @@ def suggest(problem: Problem, calibration: Fit, signature: Signature, path: str 
         target.write_text(source, encoding="utf-8")
         effect = load_effect_module(str(target))
         model = sorted([*calibration.effects, effect], key=lambda e: e.name)
-        floor = fit_statistics(problem, calibration.predictions)["noise_floor_Nm"]
+        before = fit_statistics(problem, calibration.predictions)
+        floor = before["noise_floor_Nm"]
         ratio = problem.params.sections["steering"]["handwheel_to_rack_ratio"]
         column = signature.effect_class == "column"
         bound = TORQUE_BOUND_NM if column else FORCE_BOUND_N
@@ -216,7 +217,6 @@ def suggest(problem: Problem, calibration: Fit, signature: Signature, path: str 
         parameters += [FitParameter(key, "linear", 1.0, -bound, bound, step) for key in keys]
         theta0 = np.concatenate([calibration.theta, np.zeros(len(keys))])
         fit = least_squares(problem, model, parameters, theta0, calibration.fixed, settings=settings)
-        before = fit_statistics(problem, calibration.predictions)
         after = fit_statistics(problem, fit.predictions)
         rho = lag1_autocorrelation(problem, fit.weighted)
         n_eff = effective_samples(problem.n, rho)
