@@ -534,18 +534,20 @@ def fit_statistics(problem: Problem, predictions: list[np.ndarray]) -> dict:
     return out
 
 
+def pooled_lag1(segments) -> float:
+    """Lag-1 autocorrelation pooled over `segments` (arrays; pairs within a segment, each about its own mean)."""
+    num = den = 0.0
+    for r in segments:
+        r = r - r.mean()
+        num += float(np.sum(r[1:] * r[:-1]))
+        den += float(np.sum(r * r))
+    return num / den if den > 0 else 0.0
+
+
 def lag1_autocorrelation(problem: Problem, weighted: np.ndarray) -> float:
     """Lag-1 autocorrelation of the weighted residuals, pooled over files (pairs within a file and signal)."""
-    num = den = 0.0
-    start = 0
-    for f in problem.files:
-        for _ in range(f.signals):  # pairs within one signal of one file
-            r = weighted[start : start + f.n]
-            r = r - r.mean()
-            num += float(np.sum(r[1:] * r[:-1]))
-            den += float(np.sum(r * r))
-            start += f.n
-    return num / den if den > 0 else 0.0
+    bounds = np.cumsum([0] + [f.n for f in problem.files for _ in range(f.signals)])
+    return pooled_lag1(weighted[a:b] for a, b in zip(bounds[:-1], bounds[1:]))
 
 
 def effective_samples(n: int, rho: float) -> float:
