@@ -6,7 +6,7 @@ benchmarks produced (weighted RMS in noise floors, BIC gains, the fraction of th
 
 from __future__ import annotations
 
-from parksteer.diagnose.select import choose_verdict, trimmed_rms
+from parksteer.diagnose.stages.verdict import choose_verdict, trimmed_rms
 from parksteer.diagnose.settings import DEFAULT_SETTINGS as S
 
 

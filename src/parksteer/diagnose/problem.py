@@ -534,18 +534,20 @@ def fit_statistics(problem: Problem, predictions: list[np.ndarray]) -> dict:
     return out
 
 
+def pooled_lag1(segments) -> float:
+    """Lag-1 autocorrelation pooled over `segments` (arrays; pairs within a segment, each about its own mean)."""
+    num = den = 0.0
+    for r in segments:
+        r = r - r.mean()
+        num += float(np.sum(r[1:] * r[:-1]))
+        den += float(np.sum(r * r))
+    return num / den if den > 0 else 0.0
+
+
 def lag1_autocorrelation(problem: Problem, weighted: np.ndarray) -> float:
     """Lag-1 autocorrelation of the weighted residuals, pooled over files (pairs within a file and signal)."""
-    num = den = 0.0
-    start = 0
-    for f in problem.files:
-        for _ in range(f.signals):  # pairs within one signal of one file
-            r = weighted[start : start + f.n]
-            r = r - r.mean()
-            num += float(np.sum(r[1:] * r[:-1]))
-            den += float(np.sum(r * r))
-            start += f.n
-    return num / den if den > 0 else 0.0
+    bounds = np.cumsum([0] + [f.n for f in problem.files for _ in range(f.signals)])
+    return pooled_lag1(weighted[a:b] for a, b in zip(bounds[:-1], bounds[1:]))
 
 
 def effective_samples(n: int, rho: float) -> float:
@@ -554,6 +556,8 @@ def effective_samples(n: int, rho: float) -> float:
     return max(n * (1.0 - rho) / (1.0 + rho), 2.0)
 
 
-def information_criterion(weighted_rss: float, n: int, n_eff: float, parameters: int) -> float:
-    """BIC over the effective sample size: n_eff ln(RSS / n) + k ln(n_eff)."""
-    return n_eff * pm.log(max(weighted_rss, 1e-300) / n) + parameters * pm.log(n_eff)
+def bic_gain(rss_without: float, rss_with: float, n_eff: float, parameters: int) -> float:
+    """The fall of the BIC over the effective sample size, ``BIC = n_eff ln(RSS / n) + k ln(n_eff)``, when
+    `parameters` more columns take the weighted residual sum of squares from `rss_without` to `rss_with`:
+    ``n_eff ln(rss_without / rss_with) - k ln(n_eff)`` (positive: the richer model is the better)."""
+    return n_eff * pm.log(rss_without / max(rss_with, 1e-300)) - parameters * pm.log(n_eff)

@@ -44,7 +44,7 @@ The steps (:func:`diagnose`, each a stage of :data:`parksteer.diagnose.stages.ST
    named as the measurement that would separate them;
 8. a candidate ``confounded`` with the calibrated parameters (these data cannot tell it from a
    change of them) gets the same: the measurement where it would show although the calibrated
-   parameters take it up here (:func:`confound_tests`).
+   parameters take it up here (:func:`parksteer.diagnose.stages.confound.confound_tests`).
 
 With ``torque_lag_fitted``, each file's torque lag behind its rack is searched after the calibration and again
 with the named effect (:mod:`parksteer.diagnose.stages.torque_lag`).
@@ -60,17 +60,9 @@ from .parallel import Progress
 from .problem import FileData, Problem
 from .settings import DEFAULT_SETTINGS, DiagnosisSettings
 from .stages import STAGES, run_table
-from .stages.confound import confound_tests
-from .stages.identify import identification
-from .stages.refit import refit
-from .stages.separate import conditions_not_covered, differences_by_condition, separation
-from .stages.torque_lag import estimate_torque_lags
-from .stages.verdict import choose_verdict, trimmed_rms
-from .state import VERDICTS, Candidate, Diagnosis, DiagnosisState, Separation, confounded_candidates, frozen_mapping
+from .state import Diagnosis, DiagnosisState, frozen_mapping
 
-__all__ = ["VERDICTS", "Candidate", "Diagnosis", "Separation", "choose_verdict", "conditions_not_covered",
-           "confound_tests", "confounded_candidates", "diagnose", "differences_by_condition", "estimate_torque_lags",
-           "identification", "refit", "separation", "trimmed_rms"]
+__all__ = ["Diagnosis", "diagnose"]
 
 
 def diagnose(files: list[FileData], params: Parameters, effects=None, registry: dict[str, Effect] | None = None,

@@ -55,7 +55,7 @@ from .. import portable as pm
 from ..errors import UsageError
 from ..measure.phases import PHASES
 from ..parameters import Parameters
-from .problem import effective_samples
+from .problem import bic_gain, effective_samples, pooled_lag1
 from .settings import DEFAULT_SETTINGS, DiagnosisSettings
 
 CLASSES = ("dissipative", "elastic", "direction", "speed", "column")
@@ -240,16 +240,6 @@ def _fit(columns: np.ndarray, weighted: np.ndarray, sigma: np.ndarray, nuisance:
     return coefficients[:k], pm.dot(left, left)
 
 
-def _lag1(values: np.ndarray, record: np.ndarray) -> float:
-    num = den = 0.0
-    for r in np.unique(record):
-        v = values[record == r]
-        v = v - v.mean()
-        num += float(np.sum(v[1:] * v[:-1]))
-        den += float(np.sum(v * v))
-    return num / den if den > 0 else 0.0
-
-
 def _axis_groups(axes: Axes, models: list[Basis]) -> list[tuple[str, np.ndarray]]:
     """The axes reported with their shares: each family's richest basis, the column orders one by one, the cycle
     phase (each phase's mean and its mean times the sign of the speed) and, where the records differ in load
@@ -298,14 +288,14 @@ def signature_from_axes(axes: Axes, settings: DiagnosisSettings = DEFAULT_SETTIN
     if nuisance is not None:
         design = np.column_stack([design, nuisance])
     left = weighted - pm.matmul(design, pm.lstsq(design, weighted))
-    rho = _lag1(left, axes.record)
+    rho = pooled_lag1(left[axes.record == r] for r in np.unique(axes.record))
     n_eff = effective_samples(n, rho)
 
     fits = [_fit(b.columns, weighted, sigma, nuisance) for b in models]
     scores = []
     for b, (_, rss) in zip(models, fits):
         k = b.columns.shape[1]
-        gain = n_eff * pm.log(rss0 / max(rss, 1e-300)) - k * pm.log(n_eff)
+        gain = bic_gain(rss0, rss, n_eff, k)
         scores.append(ModelScore(b.family, b.label, k, float(rss), float(gain)))
     shares = []
     excess = rss0 - n

@@ -31,11 +31,10 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import portable as pm
 from ..errors import UsageError
 from ..model.symbolic.components import load_effect_module
 from .calibrate import Fit, FitParameter, calibration_parameters, least_squares
-from .problem import Problem, effective_samples, fit_statistics, lag1_autocorrelation
+from .problem import Problem, bic_gain, effective_samples, fit_statistics, lag1_autocorrelation
 from .settings import DEFAULT_SETTINGS, DiagnosisSettings
 from .signature import Signature
 
@@ -208,7 +207,8 @@ def suggest(problem: Problem, calibration: Fit, signature: Signature, path: str 
         target.write_text(source, encoding="utf-8")
         effect = load_effect_module(str(target))
         model = sorted([*calibration.effects, effect], key=lambda e: e.name)
-        floor = fit_statistics(problem, calibration.predictions)["noise_floor_Nm"]
+        before = fit_statistics(problem, calibration.predictions)
+        floor = before["noise_floor_Nm"]
         ratio = problem.params.sections["steering"]["handwheel_to_rack_ratio"]
         column = signature.effect_class == "column"
         bound = TORQUE_BOUND_NM if column else FORCE_BOUND_N
@@ -217,11 +217,10 @@ def suggest(problem: Problem, calibration: Fit, signature: Signature, path: str 
         parameters += [FitParameter(key, "linear", 1.0, -bound, bound, step) for key in keys]
         theta0 = np.concatenate([calibration.theta, np.zeros(len(keys))])
         fit = least_squares(problem, model, parameters, theta0, calibration.fixed, settings=settings)
-        before = fit_statistics(problem, calibration.predictions)
         after = fit_statistics(problem, fit.predictions)
         rho = lag1_autocorrelation(problem, fit.weighted)
         n_eff = effective_samples(problem.n, rho)
-        gain = n_eff * pm.log(calibration.rss / fit.rss) - len(keys) * pm.log(n_eff)
+        gain = bic_gain(calibration.rss, fit.rss, n_eff, len(keys))
         values = fit.values if isinstance(fit.values, dict) else {}
         strengths = {k: float(values.get(k, fit.theta[len(calibration.theta) + i])) for i, k in enumerate(keys)}
         before_ratio = before["weighted_rms_Nm"] / floor

@@ -8,9 +8,8 @@ from dataclasses import replace
 
 import numpy as np
 
-from ... import portable as pm
 from ..calibrate import Fit
-from ..problem import Problem, effective_samples, lag1_autocorrelation
+from ..problem import Problem, bic_gain, effective_samples, lag1_autocorrelation
 from ..state import Candidate, DiagnosisState
 from .base import Stage
 from .replay_uncertainty import with_replay_uncertainty
@@ -23,7 +22,7 @@ def compare_refits(problem: Problem, calibration: Fit, refitted: list[Candidate]
     best_fit = min((c.refit for c in refitted), key=lambda f: f.rss, default=calibration)
     rho = lag1_autocorrelation(problem, best_fit.weighted)
     n_eff = effective_samples(problem.n, rho)
-    refitted = [replace(c, delta_bic=n_eff * pm.log(calibration.rss / c.refit.rss) - pm.log(n_eff))
+    refitted = [replace(c, delta_bic=bic_gain(calibration.rss, c.refit.rss, n_eff, 1))
                 for c in refitted]
     return max(refitted, key=lambda c: c.delta_bic, default=None), n_eff, rho, refitted
 
