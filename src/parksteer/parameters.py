@@ -267,6 +267,7 @@ RENAMED: dict[str, str] = {
     "column_friction.smoothing": "steering.friction_smoothing",
     "kingpin_friction.smoothing": "steering.friction_smoothing",
     "rack_stiction.smoothing": "steering.friction_smoothing",
+    "turn_slip.vehicle_speed": "run.vehicle_speed",
 }
 
 
