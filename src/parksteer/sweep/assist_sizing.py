@@ -10,9 +10,12 @@ T_target, the assist must carry the excess E = max(|T| - T_target, 0) of the col
 
 and its motor, through the reduction N of efficiency eta and against its own friction T_f, must give
 T_m = (A / N + T_f) / eta with A the peak of that demand; the current is T_m / k_t. A hydraulic gear needs the
-pressure E d(theta_c)/d(rack) / A_piston. This is the quasi-static demand; the check runs the cycle again with the
-assist sized so (a boost gain that meets the target at the peak beyond the file's dead band, the motor limit or
-relief pressure 10 % above the demand) and gives the driver's peak torque that results.
+pressure (A + F_s) / A_piston, against its seals' friction F_s too. This is the quasi-static demand; the check
+runs the cycle again with the assist sized so and gives the driver's peak torque that results: the motor limit or
+relief pressure 10 % above the demand, and the boost gain that meets the target at the peak beyond the file's dead band D,
+G = (T_peak + T_f,col - T_target) / (T_target - D), where T_f,col is the assist's own friction as a column
+torque, which the gear must overcome as well (the motor's bearings N T_f at the column, N T_f G_hr / c' at the
+pinion, N T_f / c' at the rack; the piston's seals F_s / c'; c' = d(theta_c)/d(rack) at the peak).
 
 A speed-dependent boost curve (an electric assist with ``speed_dependence`` > 0, from the vehicle file or
 ``parksteer assist size --gain-half-speed-kmh``) is one assist for every speed, as on the car: its parking gain G is
@@ -83,6 +86,19 @@ def demand_at_action(name: str, params: Parameters, torque_Nm: np.ndarray, per_r
     return excess * per_rack  # a force on the rack: rack motor or piston
 
 
+def friction_at_column_Nm(name: str, params: Parameters, per_rack: float) -> float:
+    """The assist's own Coulomb friction as a torque at the column, `per_rack` = d(theta_c)/d(rack) (module
+    docstring): the motor's bearings through the reduction, or the piston's seals."""
+    if name == ASSIST_EFFECTS["hydraulic"]:
+        return float(params[f"{name}.seal_friction_force"]) / per_rack
+    at_action = float(params[f"{name}.reduction_ratio"]) * float(params[f"{name}.motor_friction_torque"])
+    if name == ASSIST_EFFECTS["column"]:
+        return at_action
+    if name == ASSIST_EFFECTS["pinion"]:
+        return at_action * float(params["steering.handwheel_to_rack_ratio"]) / per_rack
+    return at_action / per_rack  # a force on the rack
+
+
 def size_assist(params: Parameters, case: str, target_torque_Nm: float, speeds_kmh=SPEEDS_KMH,
                 assist: str | None = None) -> SizingStudy:
     """The sizing study of the car of `params` in load case `case` (module docstring)."""
@@ -111,8 +127,10 @@ def size_assist(params: Parameters, case: str, target_torque_Nm: float, speeds_k
         demand = float(np.max(demand_at_action(name, params, torque, per_rack, target_torque_Nm)))
         manual_runs.append((manual, torque, per_rack))
         demands.append(demand)
-        # the boost gain that meets the target at the peak: T = (T_peak + G D) / (1 + G)
-        gains.append(max(_peak(torque) - target_torque_Nm, 0.0) / (target_torque_Nm - band))
+        # the boost gain that meets the target at the peak: T = (T_peak + T_f,col + G D) / (1 + G)
+        peak = int(np.argmax(np.abs(torque)))
+        road = _peak(torque) + friction_at_column_Nm(name, params, float(np.abs(per_rack[peak])))
+        gains.append(max(road - target_torque_Nm, 0.0) / (target_torque_Nm - band))
         if not hydraulic:
             motors.append((demand / v("reduction_ratio") + v("motor_friction_torque")) / v("efficiency"))
     if falloff:  # one assist: the parking gain met at the lowest speed, the motor for the largest demand
@@ -126,7 +144,7 @@ def size_assist(params: Parameters, case: str, target_torque_Nm: float, speeds_k
         demand, gain = demands[i], gains[i]
         if hydraulic:
             motor = current = float("nan")
-            pressure = demand / v("piston_area")
+            pressure = (demand + v("seal_friction_force")) / v("piston_area")
             sized = {f"{name}.valve_slope": gain * ratio / v("piston_area"),
                      f"{name}.relief_pressure": max(MARGIN * pressure, 1.0e5)}
         else:
