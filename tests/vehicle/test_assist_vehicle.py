@@ -152,3 +152,16 @@ def test_hydraulic_golf_iv_sizing(tmp_path):
     assert pressure < 0.5 * params["hydraulic_assist.relief_pressure"]
     for row in study.rows:
         assert row.peak_handwheel_assisted_Nm < 1.03 * 3.0
+
+
+def test_new_with_a_speed_dependent_boost_curve(tmp_path):
+    """A specification's speed at which the gain halves (km/h) lands in [assist] in m/s with the speed dependence
+    on; a hydraulic gear's valve has no such curve, so the option is refused for it in one line."""
+    out = tmp_path / "golf.toml"
+    assert main(["vehicle", "new", "--out", str(out), *GOLF, "--assist", "column",
+                 "--assist-gain-half-speed-kmh", "36"]) == 0
+    params = load_vehicle(out)
+    assert params["electric_assist_column.speed_dependence"] == 1.0
+    assert params["electric_assist_column.gain_half_speed"] == pytest.approx(10.0)
+    assert main(["vehicle", "new", "--out", str(tmp_path / "hps.toml"), *GOLF, "--assist", "hydraulic",
+                 "--assist-gain-half-speed-kmh", "36"]) == 2
