@@ -33,9 +33,8 @@ from .parameters import (
     Parameters,
     check_entry,
     check_statics,
-    Quantity,
+    VEHICLE_SPEED,
     check_table,
-    declare,
     load_parameters,
     quantity,
 )
@@ -66,17 +65,7 @@ ASSIST_SECTION = "assist"
 ASSIST_EFFECTS = {"column": "electric_assist_column", "pinion": "electric_assist_pinion",
                   "rack": "electric_assist_rack", "hydraulic": "hydraulic_assist"}
 
-# The car's speed while it steers: one quantity of the run that every effect depending on it reads (the rolling
-# tyre's turn slip, the electric assist's speed-dependent boost curve), set once per run (`parksteer simulate
-# --speed-kmh`, the sizing study: creeping_overrides). It describes the run, not the car, so neither the parameter
-# file nor a vehicle file gives it (and no run without such an effect carries it in its parameter vector or
-# header); it is declared here, in the lowest layer the model, the sweeps and the measurements (whose speed
-# channel is vehicle_speed_mps) all reach, at 0: standstill, the paper's test.
-VEHICLE_SPEED = declare(Quantity(
-    "run.vehicle_speed", "m/s", 0.0, 3.0, lower_inclusive=True, default=0.0,
-    description="the car's speed while it steers (constant over the run)",
-    source="input of the run: 0 = standstill (the paper), up to 3 m/s (10.8 km/h) of creeping"))
-MAX_CREEPING_SPEED_KMH = 10.8  # VEHICLE_SPEED's upper bound, 3 m/s, in km/h
+MAX_CREEPING_SPEED_KMH = 10.8  # the upper bound of the run's vehicle speed (parameters.VEHICLE_SPEED), 3 m/s, in km/h
 
 # The effects specs of an assist sizing study (parksteer.sweep.assist_sizing, rule vehicle_assist_size): the car
 # rolling at the study's speeds (turn_slip), without and with its assist.

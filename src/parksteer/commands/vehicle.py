@@ -153,7 +153,8 @@ def _new(args) -> int:
 
 def assist_section(args, base) -> str:
     """The ``[assist]`` section of `args` (empty without --assist): given values from the options, the rest assumed."""
-    electric_only = (("--assist-reduction", args.assist_reduction), ("--assist-motor-torque-Nm", args.assist_motor_torque_Nm),
+    electric_only = (("--assist-reduction", args.assist_reduction),
+                     ("--assist-motor-torque-Nm", args.assist_motor_torque_Nm),
                      ("--assist-gain-half-speed-kmh", args.assist_gain_half_speed_kmh))
     if args.assist is None:
         given = [o for o, v in (*electric_only, ("--assist-relief-pressure-bar", args.assist_relief_pressure_bar),

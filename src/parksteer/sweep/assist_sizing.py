@@ -11,11 +11,15 @@ T_target, the assist must carry the excess E = max(|T| - T_target, 0) of the col
 and its motor, through the reduction N of efficiency eta and against its own friction T_f, must give
 T_m = (A / N + T_f) / eta with A the peak of that demand; the current is T_m / k_t. A hydraulic gear needs the
 pressure (A + F_s) / A_piston, against its seals' friction F_s too. This is the quasi-static demand; the check
-runs the cycle again with the assist sized so and gives the driver's peak torque that results: the motor limit or
-relief pressure 10 % above the demand, and the boost gain that meets the target at the peak beyond the file's dead band D,
-G = (T_peak + T_f,col - T_target) / (T_target - D), where T_f,col is the assist's own friction as a column
-torque, which the gear must overcome as well (the motor's bearings N T_f at the column, N T_f G_hr / c' at the
-pinion, N T_f / c' at the rack; the piston's seals F_s / c'; c' = d(theta_c)/d(rack) at the peak).
+runs the cycle again with the assist sized so and gives the driver's peak torque that results: the motor limit
+or relief pressure 10 % above the demand, and the boost gain that meets the target at the peak beyond the file's
+dead band D,
+
+    G = (T_peak + T_f,col - T_target) / (T_target - D),
+
+where T_f,col is the assist's own friction as a column torque, which the gear must overcome as well (the motor's
+bearings N T_f at the column, N T_f G_hr / c' at the pinion, N T_f / c' at the rack; the piston's seals F_s / c';
+c' = d(theta_c)/d(rack) at the peak).
 
 A speed-dependent boost curve (an electric assist with ``speed_dependence`` > 0, from the vehicle file or
 ``parksteer assist size --gain-half-speed-kmh``) is one assist for every speed, as on the car: its parking gain G is

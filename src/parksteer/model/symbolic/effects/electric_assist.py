@@ -57,8 +57,7 @@ from typing import ClassVar
 import sympy as sp
 import sympy.physics.mechanics as me
 
-from ....parameters import Quantity
-from ....vehicle import VEHICLE_SPEED
+from ....parameters import VEHICLE_SPEED, Quantity
 from ..components import Effect
 from ..system import torque_between
 from .assist_common import LOCATIONS, clamp, deadband, point_of_action, series_deflection, torsion_bar_torque
@@ -189,7 +188,8 @@ class ElectricAssist(Effect):
 
     def gain(self, model):
         """G(v) = G / (1 + s (v / v_half)^2): exactly G at v = 0 or s = 0 (module docstring)."""
-        falloff = self.q(model, "speed_dependence") * (model.p(VEHICLE_SPEED.key) / self.q(model, "gain_half_speed")) ** 2
+        speed = model.p(VEHICLE_SPEED.key)
+        falloff = self.q(model, "speed_dependence") * (speed / self.q(model, "gain_half_speed")) ** 2
         return self.q(model, "gain") / (1 + falloff)
 
     def motor_torque(self, model):

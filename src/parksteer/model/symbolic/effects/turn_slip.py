@@ -22,7 +22,7 @@ distance rolled per radian of steer (V / |psi'|) measured in units of q_Dz8 R0^2
 grows: at 1 km/h and 0.3 rad/s of steer rate the wheel rolls 0.9 m per radian of steer, several contact
 lengths, and the moment is a fraction of the standstill's.
 
-The vehicle speed V is the run's (``run.vehicle_speed``, :data:`parksteer.vehicle.VEHICLE_SPEED`: a constant of
+The vehicle speed V is the run's (``run.vehicle_speed``, :data:`parksteer.parameters.VEHICLE_SPEED`: a constant of
 the run, ``parksteer simulate --speed-kmh``), the one quantity the electric assist's speed-dependent boost curve
 reads too. The coefficients are MF 6.1's published defaults (MFeval's default tyre property file): they
 stand for a typical passenger-car tyre until a fitted .tir file is at hand.
@@ -34,8 +34,7 @@ import sympy as sp
 import sympy.physics.mechanics as me
 
 from ....names import SIDES
-from ....parameters import Quantity
-from ....vehicle import VEHICLE_SPEED
+from ....parameters import VEHICLE_SPEED, Quantity
 from ..components import Effect
 
 MF_SOURCE = ("MF 6.1 default tyre property file (MFeval readTIR defaults; Pacejka, Tire and Vehicle Dynamics, 3rd ed., "
@@ -62,8 +61,8 @@ class TurnSlip(Effect):
                  description="|psi'| is smoothed as sqrt(psi'^2 + w^2)",
                  source="numerical: a thousandth of the cycle's steer rates"),
     )
-    uses = (VEHICLE_SPEED.key, *(q.key for q in quantities), "tyre.friction_coefficient", "tyre.tyre_pressure", "tyre.reference_pressure",
-            "tyre.pressure_index", "steering.friction_smoothing")
+    uses = (VEHICLE_SPEED.key, *(q.key for q in quantities), "tyre.friction_coefficient", "tyre.tyre_pressure",
+            "tyre.reference_pressure", "tyre.pressure_index", "steering.friction_smoothing")
 
     def rolling_factor(self, model, load_N, yaw_rate):
         """f = 1 / sqrt(1 + y^2) (module docstring); 1 exactly at zero speed."""
