@@ -67,11 +67,12 @@ def _size(args) -> int:
           f"({elapsed:.1f} s)")
     print("speed km/h  peak rack force N  manual peak N m  " + ("pressure bar" if hydraulic else
                                                                   "motor torque N m  motor current A")
-          + "  gain  assisted peak N m")
+          + "  gain  assisted peak N m  " + ("check pressure bar" if hydraulic else "check motor N m"))
     for r in study.rows:
         middle = (f"{r.pressure_Pa / 1e5:12.1f}" if hydraulic else f"{r.motor_torque_Nm:16.2f}  {r.motor_current_A:15.1f}")
         print(f"{r.speed_kmh:10.1f}  {r.peak_rack_force_N:17.0f}  {r.peak_handwheel_manual_Nm:15.2f}  {middle}  "
-              f"{r.gain:4.2f}  {r.peak_handwheel_assisted_Nm:17.2f}")
+              f"{r.gain:4.2f}  {r.peak_handwheel_assisted_Nm:17.2f}  "
+              + (f"{r.check_pressure_Pa / 1e5:18.1f}" if hydraulic else f"{r.check_motor_torque_Nm:15.2f}"))
     for path in written:
         print(f"wrote {path}")
     return 0

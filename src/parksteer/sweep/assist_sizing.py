@@ -60,6 +60,8 @@ class SizingRow:
     pressure_Pa: float  # hydraulic; NaN for electric
     gain: float  # the boost gain G(v) (electric) or the valve's equivalent gain A k_v / G_hr (hydraulic) of the check
     peak_handwheel_assisted_Nm: float
+    check_motor_torque_Nm: float  # electric: the peak motor torque of the check run; NaN for hydraulic
+    check_pressure_Pa: float  # hydraulic: the peak pressure of the check run; NaN for electric
 
 
 @dataclasses.dataclass
@@ -158,8 +160,11 @@ def size_assist(params: Parameters, case: str, target_torque_Nm: float, speeds_k
             sized = one_assist if falloff else {f"{name}.gain": gain, f"{name}.motor_torque_limit": MARGIN * motor}
         assisted = simulate(case, effects=ASSISTED_EFFECTS[kind], overrides={**creeping_overrides(speed), **sized},
                             params=params)
+        c = assisted.columns
         rows.append(SizingRow(speed, _peak(torque * per_rack), _peak(torque), demand, motor, current, pressure, gain,
-                              _peak(assisted.columns["handwheel_torque_Nm"])))
+                              _peak(c["handwheel_torque_Nm"]),
+                              float("nan") if hydraulic else _peak(c["motor_torque_Nm"]),
+                              _peak(c["pressure_Pa"]) if hydraulic else float("nan")))
         if manual0 is None:
             manual0, assisted0 = manual, assisted
     return SizingStudy(name, case, target_torque_Nm, rows, manual0, assisted0)
