@@ -119,9 +119,9 @@ def assist_quantities(name: str, location: str) -> tuple[Quantity, ...]:
         Quantity(f"{name}.speed_dependence", "1", 0.0, 1.0, lower_inclusive=True, default=0.0,
                  description="1: the gain falls with the vehicle speed as G / (1 + (v / v_half)^2); 0: a "
                              "speed-independent boost curve (between: the same fall with v_half / sqrt(s))",
-                 source="choice: off by default, the boost curve of the paper's parking test; current EPS "
-                        "control units scale the assist by vehicle speed (Servotronic: BMW and MINI EPS "
-                        "functional descriptions)"),
+                 source="off by default: a speed-independent boost curve, as for the paper's standstill test; "
+                        "current EPS control units scale the assist by vehicle speed (Servotronic: BMW and MINI "
+                        "EPS functional descriptions)"),
         Quantity(f"{name}.gain_half_speed", "m/s", 0.0, 100.0, default=13.9,
                  description="v_half: the vehicle speed at which the speed-dependent gain is half the parking gain",
                  source="assumed: 50 km/h, range 40-80 km/h: a speed-proportional gear gives the least effort (full "
