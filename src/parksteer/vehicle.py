@@ -29,11 +29,11 @@ from .parameters import (
     CASE_SCHEMA,
     DEFAULT_PATH,
     SCHEMA,
+    VEHICLE_SPEED,
     ParameterError,
     Parameters,
     check_entry,
     check_statics,
-    VEHICLE_SPEED,
     check_table,
     load_parameters,
     quantity,
@@ -65,7 +65,7 @@ ASSIST_SECTION = "assist"
 ASSIST_EFFECTS = {"column": "electric_assist_column", "pinion": "electric_assist_pinion",
                   "rack": "electric_assist_rack", "hydraulic": "hydraulic_assist"}
 
-MAX_CREEPING_SPEED_KMH = 10.8  # the upper bound of the run's vehicle speed (parameters.VEHICLE_SPEED), 3 m/s, in km/h
+MAX_CREEPING_SPEED_KMH = VEHICLE_SPEED.upper * 3.6  # the run's vehicle speed's upper bound, 3 m/s: 10.8 km/h
 
 # The effects specs of an assist sizing study (parksteer.sweep.assist_sizing, rule vehicle_assist_size): the car
 # rolling at the study's speeds (turn_slip), without and with its assist.

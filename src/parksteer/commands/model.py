@@ -108,7 +108,8 @@ def with_speed(effects: str | None, overrides: dict, speed_kmh: float) -> tuple[
     from ..vehicle import MAX_CREEPING_SPEED_KMH, creeping_overrides
 
     if not 0.0 <= speed_kmh <= MAX_CREEPING_SPEED_KMH:
-        raise UsageError(f"--speed-kmh {speed_kmh:g}: outside 0-{MAX_CREEPING_SPEED_KMH:g} km/h (parking and creeping)")
+        raise UsageError(f"--speed-kmh {speed_kmh:g}: outside 0-{MAX_CREEPING_SPEED_KMH:g} km/h "
+                         "(parking and creeping)")
     if not (effects and "turn_slip" in effects):
         signed = not effects or all(s.strip()[:1] in "+-" for s in effects.split(",") if s.strip())
         effects = (f"{effects}," if effects else "") + ("+turn_slip" if signed else "turn_slip")
