@@ -3,7 +3,8 @@
 Every quantity has one key (``section.name``), one SI unit and one pair of physical bounds. The car's quantities
 are listed here (:data:`SCHEMA`) and the file gives each its value and source as ``{value, unit, source}``; an
 effect's own quantities (``<effect>.<name>``) are declared on the effect, with default and source, and join the
-registry (:func:`registry`) when the effect is loaded (:func:`declare`). Overrides (``--set``,
+registry (:func:`registry`) when the effect is loaded (:func:`declare`); the run's vehicle speed
+(``run.vehicle_speed``, :data:`VEHICLE_SPEED`), which several effects read, is declared here. Overrides (``--set``,
 sweeps, diagnosis, the workflow's config) use the same keys, plus ``case.<name>`` for the active Table B1
 case (:meth:`Parameters.with_overrides`). Any unknown key, missing key, wrong unit, non-physical value or
 wheel loads that contradict the chassis statics are refused with a :class:`ParameterError` whose message is
@@ -267,6 +268,7 @@ RENAMED: dict[str, str] = {
     "column_friction.smoothing": "steering.friction_smoothing",
     "kingpin_friction.smoothing": "steering.friction_smoothing",
     "rack_stiction.smoothing": "steering.friction_smoothing",
+    "turn_slip.vehicle_speed": "run.vehicle_speed",
 }
 
 
@@ -309,6 +311,18 @@ def declare(q: Quantity) -> Quantity:
     q.check(q.default)
     _DECLARED[q.key] = q
     return q
+
+# The car's speed while it steers: one quantity of the run that every effect depending on it reads (the rolling
+# tyre's turn slip, the electric assist's speed-dependent boost curve), set once per run (`parksteer simulate
+# --speed-kmh`, the sizing study: parksteer.vehicle.creeping_overrides). It describes the run, not the car, so
+# neither the parameter file nor a vehicle file gives it, and a run without such an effect has it neither in its
+# parameter vector nor in its header; it is declared here, with its default 0 (standstill, the paper's test), in
+# the lowest layer, which the model, the sweeps and the measurements (whose speed channel is vehicle_speed_mps)
+# all reach.
+VEHICLE_SPEED = declare(Quantity(
+    "run.vehicle_speed", "m/s", 0.0, 3.0, lower_inclusive=True, default=0.0,
+    description="the car's speed while it steers (constant over the run)",
+    source="input of the run: 0 = standstill (the paper), up to 3 m/s (10.8 km/h) of creeping"))
 
 ENTRY_KEYS = {"value", "unit", "source"}
 

@@ -29,6 +29,7 @@ from .parameters import (
     CASE_SCHEMA,
     DEFAULT_PATH,
     SCHEMA,
+    VEHICLE_SPEED,
     ParameterError,
     Parameters,
     check_entry,
@@ -64,6 +65,8 @@ ASSIST_SECTION = "assist"
 ASSIST_EFFECTS = {"column": "electric_assist_column", "pinion": "electric_assist_pinion",
                   "rack": "electric_assist_rack", "hydraulic": "hydraulic_assist"}
 
+MAX_CREEPING_SPEED_KMH = VEHICLE_SPEED.upper * 3.6  # the run's vehicle speed's upper bound, 3 m/s: 10.8 km/h
+
 # The effects specs of an assist sizing study (parksteer.sweep.assist_sizing, rule vehicle_assist_size): the car
 # rolling at the study's speeds (turn_slip), without and with its assist.
 CREEPING_EFFECTS = "+turn_slip"
@@ -71,8 +74,8 @@ ASSISTED_EFFECTS = {kind: f"{CREEPING_EFFECTS},+{name}" for kind, name in ASSIST
 
 
 def creeping_overrides(speed_kmh: float) -> dict:
-    """The overrides of a run of CREEPING_EFFECTS at `speed_kmh`: turn_slip's vehicle speed, in m/s."""
-    return {"turn_slip.vehicle_speed": speed_kmh / 3.6}
+    """The overrides of a run at `speed_kmh`: the run's vehicle speed (VEHICLE_SPEED), in m/s."""
+    return {VEHICLE_SPEED.key: speed_kmh / 3.6}
 
 
 def assist_of(params: Parameters) -> str | None:

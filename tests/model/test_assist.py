@@ -11,6 +11,7 @@ from model_helpers import DISSIPATION_OFF, first_ramp
 from parksteer.errors import UsageError
 from parksteer.model.numeric.simulate import simulate
 from parksteer.model.symbolic.components import discover_effects, resolve_effects
+from parksteer.vehicle import creeping_overrides
 
 discover_effects()  # declares the assists' own quantities (their defaults are read below)
 
@@ -200,3 +201,40 @@ def test_energy_balance_with_the_pump_as_a_source(params):
     pump = cumulative_trapezoid(c["assist_force_N"] * c["rack_speed_m_s"], c["time_s"], initial=0.0)
     assert pump[-1] > 0.5 * driver[-1] > 0
     assert np.max(np.abs(driver + pump - (energy - energy[0]))) < 1e-4 * (driver[-1] + pump[-1])
+
+
+COLUMN = "electric_assist_column"
+
+
+def test_speed_dependent_gain_at_standstill_is_todays_boost_exactly(params):
+    """A speed-sensitive boost curve gives its full (parking) gain at standstill: at v = 0 the curve with the
+    speed dependence on is today's speed-independent one, and with it off the speed changes nothing, sample for
+    sample and bit for bit (the falloff term is 0 exactly, 1 + 0 = 1)."""
+    base = {f"{COLUMN}.gain_half_speed": 0.5}  # a steep fall, so a slip of the speed would show at once
+    today = simulate("unladen", effects=f"+{COLUMN}", overrides=base, params=params)
+    at_rest = simulate("unladen", effects=f"+{COLUMN}",
+                       overrides={**base, f"{COLUMN}.speed_dependence": 1.0, **creeping_overrides(0.0)}, params=params)
+    moving_off = simulate("unladen", effects=f"+{COLUMN}", overrides={**base, **creeping_overrides(5.0)}, params=params)
+    for column in ("handwheel_torque_Nm", "motor_torque_Nm", "rack_m"):
+        assert np.array_equal(at_rest.columns[column], today.columns[column])
+        assert np.array_equal(moving_off.columns[column], today.columns[column])
+
+
+def test_gain_at_the_half_speed_halves_the_assist_ratio(params):
+    """At v = v_half the boost curve's gain is half the parking gain: below the motor's limit and without a dead
+    band the motor gives G/2 times the torsion-bar torque, and quasi-statically the driver's torque is the road
+    torque over 1 + G/2 (the manual car with the same column), against 1 + G at standstill. The model holds no
+    rolling tyre here (no turn_slip), so the road torque is the same at both speeds and only the gain moves."""
+    gain, half_speed = 6.0, 1.5  # m/s
+    ideal = {**motor_off(COLUMN), f"{COLUMN}.gain": gain, f"{COLUMN}.motor_torque_limit": 30.0,
+             f"{COLUMN}.speed_dependence": 1.0, f"{COLUMN}.gain_half_speed": half_speed}
+    manual = simulate("unladen", effects="-hooke_joint", overrides=series_column(params, COLUMN), params=params)
+    ramp = first_ramp(manual)
+    for speed, expected_gain in ((0.0, gain), (half_speed, gain / 2)):
+        assisted = simulate("unladen", effects=f"-hooke_joint,+{COLUMN}",
+                            overrides={**ideal, "run.vehicle_speed": speed}, params=params)
+        c, at = assisted.columns, first_ramp(assisted)
+        ratio = c["assist_torque_Nm"][at] / c["torsion_bar_torque_Nm"][at]
+        assert np.max(np.abs(ratio / expected_gain - 1)) < 1e-3
+        road = np.interp(c["rack_m"][at], manual.columns["rack_m"][ramp], manual.columns["handwheel_torque_Nm"][ramp])
+        assert np.max(np.abs(c["handwheel_torque_Nm"][at] * (1 + expected_gain) / road - 1)) < 0.01

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from parksteer.model.numeric.simulate import simulate
+from parksteer.vehicle import creeping_overrides
 
 
 @pytest.mark.parametrize("case, pressure_Pa", [("unladen", None), ("part_laden", None), ("unladen", 180000.0)])
@@ -17,7 +18,7 @@ def test_standstill_is_todays_torque_exactly(params, case, pressure_Pa):
     the two compiled models differ only in how the same sums are ordered (rounding, grown by the integration)."""
     overrides = {} if pressure_Pa is None else {"tyre.tyre_pressure": pressure_Pa}
     today = simulate(case, overrides=overrides, params=params)
-    creeping = simulate(case, effects="+turn_slip", overrides={**overrides, "turn_slip.vehicle_speed": 0.0},
+    creeping = simulate(case, effects="+turn_slip", overrides={**overrides, **creeping_overrides(0.0)},
                         params=params)
     reference = today.columns["handwheel_torque_Nm"]
     assert np.max(np.abs(creeping.columns["handwheel_torque_Nm"] - reference)) < 1e-7 * np.max(np.abs(reference))  # far below the integrator tolerance
@@ -30,7 +31,7 @@ def test_torque_falls_monotonically_with_speed(params):
     lifting), which the air-bearing run gives."""
     peaks = []
     for speed_kmh in (0.0, 0.5, 1.0, 3.0, 5.0, 10.0):
-        result = simulate("unladen", effects="+turn_slip", overrides={"turn_slip.vehicle_speed": speed_kmh / 3.6},
+        result = simulate("unladen", effects="+turn_slip", overrides=creeping_overrides(speed_kmh),
                           params=params)
         peaks.append(np.max(np.abs(result.columns["handwheel_torque_Nm"])))
     assert np.all(np.diff(peaks) < 0)

@@ -9,7 +9,7 @@ from pathlib import Path
 
 from ..errors import UsageError
 from ..parameters import DEFAULT_PATH
-from ..vehicle import ASSIST_EFFECTS
+from ..vehicle import ASSIST_EFFECTS, MAX_CREEPING_SPEED_KMH
 from .vehicle import parameters_of
 
 
@@ -26,6 +26,10 @@ def register(sub) -> None:
     s.add_argument("--assist", choices=tuple(ASSIST_EFFECTS), default=None,
                    help="the assist to size (default: the vehicle file's [assist], else a column assist at its "
                         "assumed defaults)")
+    s.add_argument("--gain-half-speed-kmh", type=float, default=None, metavar="KMH",
+                   help="electric: a speed-dependent boost curve, the gain falling as G / (1 + (v / v_half)^2) with "
+                        "this v_half (km/h); one assist sized at the lowest speed then runs at every speed (default: "
+                        "the vehicle file's speed_dependence and gain_half_speed, off unless it sets them)")
     s.add_argument("--out-dir", required=True, help="folder for sizing.csv and the two figures")
     s.add_argument("--parameters", default=str(DEFAULT_PATH), help="the base parameter file")
     s.set_defaults(func=_size)
@@ -36,8 +40,8 @@ def _speeds(text: str) -> tuple[float, ...]:
         speeds = tuple(float(x) for x in text.split(",") if x.strip())
     except ValueError:
         raise UsageError(f"--speeds-kmh {text}: expected numbers separated by commas") from None
-    if not speeds or any(not (0.0 <= s <= 10.8) or not math.isfinite(s) for s in speeds):
-        raise UsageError(f"--speeds-kmh {text}: speeds within 0-10.8 km/h")
+    if not speeds or any(not (0.0 <= s <= MAX_CREEPING_SPEED_KMH) or not math.isfinite(s) for s in speeds):
+        raise UsageError(f"--speeds-kmh {text}: speeds within 0-{MAX_CREEPING_SPEED_KMH:g} km/h")
     return speeds
 
 
@@ -50,21 +54,44 @@ def _size(args) -> int:
     case = args.case or params.case_names[0]
     if case not in params.case_names:
         raise UsageError(f"--case {case}: not a case of {args.vehicle} ({', '.join(params.case_names)})")
+    params = with_gain_half_speed(params, args)
     start = time.perf_counter()
     study = size_assist(params, case, args.target_torque, _speeds(args.speeds_kmh),
                         ASSIST_EFFECTS[args.assist] if args.assist else None)
     written = write_sizing(study, Path(args.out_dir), vehicle_name(args.vehicle))
     elapsed = time.perf_counter() - start
     hydraulic = study.assist == ASSIST_EFFECTS["hydraulic"]
-    print(f"{vehicle_name(args.vehicle)}, case {case}, {study.assist}, target {args.target_torque:g} N m "
+    falloff = "" if hydraulic or not params[f"{study.assist}.speed_dependence"] else (
+        f", gain falling with speed (v_half {params[f'{study.assist}.gain_half_speed'] * 3.6:g} km/h)")
+    print(f"{vehicle_name(args.vehicle)}, case {case}, {study.assist}{falloff}, target {args.target_torque:g} N m "
           f"({elapsed:.1f} s)")
     print("speed km/h  peak rack force N  manual peak N m  " + ("pressure bar" if hydraulic else
                                                                   "motor torque N m  motor current A")
-          + "  assisted peak N m")
+          + "  gain  assisted peak N m  " + ("check pressure bar" if hydraulic else "check motor N m"))
     for r in study.rows:
         middle = (f"{r.pressure_Pa / 1e5:12.1f}" if hydraulic else f"{r.motor_torque_Nm:16.2f}  {r.motor_current_A:15.1f}")
         print(f"{r.speed_kmh:10.1f}  {r.peak_rack_force_N:17.0f}  {r.peak_handwheel_manual_Nm:15.2f}  {middle}  "
-              f"{r.peak_handwheel_assisted_Nm:17.2f}")
+              f"{r.gain:4.2f}  {r.peak_handwheel_assisted_Nm:17.2f}  "
+              + (f"{r.check_pressure_Pa / 1e5:18.1f}" if hydraulic else f"{r.check_motor_torque_Nm:15.2f}"))
     for path in written:
         print(f"wrote {path}")
     return 0
+
+
+def with_gain_half_speed(params, args):
+    """`params` with the assist's gain falling with speed at --gain-half-speed-kmh (unchanged without it)."""
+    if args.gain_half_speed_kmh is None:
+        return params
+    from ..model.numeric.assist import check_assist
+
+    name = ASSIST_EFFECTS[args.assist] if args.assist else (check_assist(params) or ASSIST_EFFECTS["column"])
+    if name == ASSIST_EFFECTS["hydraulic"]:
+        raise UsageError("--gain-half-speed-kmh: the hydraulic assist's valve does not depend on speed")
+    option = f"--gain-half-speed-kmh {args.gain_half_speed_kmh:g}"
+    if not (math.isfinite(args.gain_half_speed_kmh) and args.gain_half_speed_kmh > 0.0):
+        raise UsageError(f"{option}: must be a positive speed (km/h)")
+    try:
+        return params.with_overrides({f"{name}.speed_dependence": 1.0,
+                                      f"{name}.gain_half_speed": args.gain_half_speed_kmh / 3.6})
+    except UsageError as exc:
+        raise UsageError(f"{option}: {exc}") from None

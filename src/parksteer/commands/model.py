@@ -104,13 +104,16 @@ def _simulate(args) -> int:
 
 
 def with_speed(effects: str | None, overrides: dict, speed_kmh: float) -> tuple[str, dict]:
-    """The effects spec with turn_slip and the overrides with its vehicle speed (m/s) of `speed_kmh`."""
-    if not 0.0 <= speed_kmh <= 10.8:
-        raise UsageError(f"--speed-kmh {speed_kmh:g}: outside 0-10.8 km/h (parking and creeping)")
+    """The effects spec with turn_slip and the overrides with the run's vehicle speed (m/s) of `speed_kmh`."""
+    from ..vehicle import MAX_CREEPING_SPEED_KMH, creeping_overrides
+
+    if not 0.0 <= speed_kmh <= MAX_CREEPING_SPEED_KMH:
+        raise UsageError(f"--speed-kmh {speed_kmh:g}: outside 0-{MAX_CREEPING_SPEED_KMH:g} km/h "
+                         "(parking and creeping)")
     if not (effects and "turn_slip" in effects):
         signed = not effects or all(s.strip()[:1] in "+-" for s in effects.split(",") if s.strip())
         effects = (f"{effects}," if effects else "") + ("+turn_slip" if signed else "turn_slip")
-    return effects, {**overrides, "turn_slip.vehicle_speed": speed_kmh / 3.6}
+    return effects, {**overrides, **creeping_overrides(speed_kmh)}
 
 
 def _measured_rack(path: str, params, raw: bool, channel_map=None, case=None, surface=None):

@@ -55,6 +55,9 @@ def register(sub) -> None:
     n.add_argument("--assist-boost", default=None, metavar="T:A,T:A",
                    help="boost-curve points, torsion-bar torque (N m) : assist (electric: N m at the pinion; "
                         "hydraulic: pressure in bar); the least-squares line gives the gain and dead band")
+    n.add_argument("--assist-gain-half-speed-kmh", type=float, default=None, metavar="KMH",
+                   help="electric: a speed-dependent boost curve, the gain falling as G / (1 + (v / v_half)^2) with "
+                        "this v_half (km/h); without it the gain does not depend on speed")
     n.add_argument("--case", default="kerb", help="name of the load case (default kerb)")
     n.add_argument("--force", action="store_true", help="overwrite an existing file")
     n.add_argument("--parameters", default=str(DEFAULT_PATH),
@@ -150,7 +153,9 @@ def _new(args) -> int:
 
 def assist_section(args, base) -> str:
     """The ``[assist]`` section of `args` (empty without --assist): given values from the options, the rest assumed."""
-    electric_only = (("--assist-reduction", args.assist_reduction), ("--assist-motor-torque-Nm", args.assist_motor_torque_Nm))
+    electric_only = (("--assist-reduction", args.assist_reduction),
+                     ("--assist-motor-torque-Nm", args.assist_motor_torque_Nm),
+                     ("--assist-gain-half-speed-kmh", args.assist_gain_half_speed_kmh))
     if args.assist is None:
         given = [o for o, v in (*electric_only, ("--assist-relief-pressure-bar", args.assist_relief_pressure_bar),
                                 ("--assist-boost", args.assist_boost)) if v is not None]
@@ -169,6 +174,10 @@ def assist_section(args, base) -> str:
         given["reduction_ratio"] = (args.assist_reduction, "specification")
     if args.assist_motor_torque_Nm is not None:
         given["motor_torque_limit"] = (args.assist_motor_torque_Nm, "specification")
+    if args.assist_gain_half_speed_kmh is not None:
+        source = f"specification: the gain halves at {args.assist_gain_half_speed_kmh:g} km/h (km/h / 3.6)"
+        given["speed_dependence"] = (1.0, "specification: a speed-dependent boost curve")
+        given["gain_half_speed"] = (args.assist_gain_half_speed_kmh / 3.6, source)
     if args.assist_relief_pressure_bar is not None:
         given["relief_pressure"] = (args.assist_relief_pressure_bar * BAR_PA, "specification (bar x 1e5)")
     if args.assist_boost is not None:

@@ -10,9 +10,24 @@ T_target, the assist must carry the excess E = max(|T| - T_target, 0) of the col
 
 and its motor, through the reduction N of efficiency eta and against its own friction T_f, must give
 T_m = (A / N + T_f) / eta with A the peak of that demand; the current is T_m / k_t. A hydraulic gear needs the
-pressure E d(theta_c)/d(rack) / A_piston. This is the quasi-static demand; the check runs the cycle again with the
-assist sized so (a boost gain that meets the target at the peak beyond the file's dead band, the motor limit or
-relief pressure 10 % above the demand) and gives the driver's peak torque that results.
+pressure (A + F_s) / A_piston, against its seals' friction F_s too. This is the quasi-static demand; the check
+runs the cycle again with the assist sized so and gives the driver's peak torque that results: the motor limit
+or relief pressure 10 % above the demand, and the boost gain that meets the target at the peak beyond the file's
+dead band D,
+
+    G = (T_peak + T_f,col - T_target) / (T_target - D),
+
+where T_f,col is the assist's own friction as a column torque, which the gear must overcome as well (the motor's
+bearings N T_f at the column, N T_f G_hr / c' at the pinion, N T_f / c' at the rack; the piston's seals F_s / c';
+c' = d(theta_c)/d(rack) at the peak).
+
+A speed-dependent boost curve (an electric assist with ``speed_dependence`` > 0, from the vehicle file or
+``parksteer assist size --gain-half-speed-kmh``) is one assist for every speed, as on the car: its parking gain G is
+sized at the study's lowest speed v_0 to meet the target there (G = G(v_0) (1 + s (v_0 / v_half)^2)), its motor
+limit 10 % above the largest motor demand over the speeds, and each check runs the cycle with the gain that curve
+gives at the row's speed, G(v) = G / (1 + s (v / v_half)^2) (the row's ``gain``): the driver's peak torque at
+1, 3, 5 km/h is then what the falling gain leaves, quasi-statically (T_road + G(v) D) / (1 + G(v)) beyond the
+dead band D. Without it each speed's check sizes its own gain, the assist a speed-independent curve would need there.
 
 The assist's values are the vehicle file's ``[assist]``, else the assumed defaults of a column assist.
 """
@@ -43,8 +58,10 @@ class SizingRow:
     motor_torque_Nm: float  # electric; NaN for hydraulic
     motor_current_A: float  # electric; NaN for hydraulic
     pressure_Pa: float  # hydraulic; NaN for electric
-    gain: float  # the boost gain (electric) or the valve's equivalent gain A k_v / G_hr (hydraulic) of the check
+    gain: float  # the boost gain G(v) (electric) or the valve's equivalent gain A k_v / G_hr (hydraulic) of the check
     peak_handwheel_assisted_Nm: float
+    check_motor_torque_Nm: float  # electric: the peak motor torque of the check run; NaN for hydraulic
+    check_pressure_Pa: float  # hydraulic: the peak pressure of the check run; NaN for electric
 
 
 @dataclasses.dataclass
@@ -75,6 +92,19 @@ def demand_at_action(name: str, params: Parameters, torque_Nm: np.ndarray, per_r
     return excess * per_rack  # a force on the rack: rack motor or piston
 
 
+def friction_at_column_Nm(name: str, params: Parameters, per_rack: float) -> float:
+    """The assist's own Coulomb friction as a torque at the column, `per_rack` = d(theta_c)/d(rack) (module
+    docstring): the motor's bearings through the reduction, or the piston's seals."""
+    if name == ASSIST_EFFECTS["hydraulic"]:
+        return float(params[f"{name}.seal_friction_force"]) / per_rack
+    at_action = float(params[f"{name}.reduction_ratio"]) * float(params[f"{name}.motor_friction_torque"])
+    if name == ASSIST_EFFECTS["column"]:
+        return at_action
+    if name == ASSIST_EFFECTS["pinion"]:
+        return at_action * float(params["steering.handwheel_to_rack_ratio"]) / per_rack
+    return at_action / per_rack  # a force on the rack
+
+
 def size_assist(params: Parameters, case: str, target_torque_Nm: float, speeds_kmh=SPEEDS_KMH,
                 assist: str | None = None) -> SizingStudy:
     """The sizing study of the car of `params` in load case `case` (module docstring)."""
@@ -88,29 +118,53 @@ def size_assist(params: Parameters, case: str, target_torque_Nm: float, speeds_k
     if not target_torque_Nm > band:
         raise UsageError(f"--target-torque {target_torque_Nm:g}: must exceed the assist's dead band {band:g} N m")
     ratio = float(params["steering.handwheel_to_rack_ratio"])
-    rows, manual0, assisted0 = [], None, None
+    kind = next(k for k, e in ASSIST_EFFECTS.items() if e == name)
+    falloff = 0.0 if hydraulic else v("speed_dependence")
+
+    def gain_factor(speed_kmh: float) -> float:
+        """G(v) / G of the boost curve (1 exactly without speed dependence)."""
+        return 1.0 / (1.0 + falloff * (speed_kmh / 3.6 / v("gain_half_speed")) ** 2) if falloff else 1.0
+
+    manual_runs, demands, gains, motors = [], [], [], []
     for speed in speeds_kmh:
         manual = simulate(case, effects=CREEPING_EFFECTS, overrides=creeping_overrides(speed), params=params)
         per_rack = manual.outputs()["column_angle_per_rack_rad_per_m"]
         torque = manual.columns["handwheel_torque_Nm"]
-        peak_manual = _peak(torque)
         demand = float(np.max(demand_at_action(name, params, torque, per_rack, target_torque_Nm)))
-        # the boost gain that meets the target at the peak: T = (T_peak + G D) / (1 + G)
-        gain = max(peak_manual - target_torque_Nm, 0.0) / (target_torque_Nm - band)
+        manual_runs.append((manual, torque, per_rack))
+        demands.append(demand)
+        # the boost gain that meets the target at the peak: T = (T_peak + T_f,col + G D) / (1 + G)
+        peak = int(np.argmax(np.abs(torque)))
+        road = _peak(torque) + friction_at_column_Nm(name, params, float(np.abs(per_rack[peak])))
+        gains.append(max(road - target_torque_Nm, 0.0) / (target_torque_Nm - band))
+        if not hydraulic:
+            motors.append((demand / v("reduction_ratio") + v("motor_friction_torque")) / v("efficiency"))
+    if falloff:  # one assist: the parking gain met at the lowest speed, the motor for the largest demand
+        low = int(np.argmin(speeds_kmh))
+        parking_gain = gains[low] / gain_factor(speeds_kmh[low])
+        gains = [parking_gain * gain_factor(speed) for speed in speeds_kmh]
+        one_assist = {f"{name}.gain": parking_gain, f"{name}.motor_torque_limit": MARGIN * max(motors)}
+    rows, manual0, assisted0 = [], None, None
+    for i, speed in enumerate(speeds_kmh):
+        manual, torque, per_rack = manual_runs[i]
+        demand, gain = demands[i], gains[i]
         if hydraulic:
             motor = current = float("nan")
-            pressure = demand / v("piston_area")
+            pressure = (demand + v("seal_friction_force")) / v("piston_area")
             sized = {f"{name}.valve_slope": gain * ratio / v("piston_area"),
                      f"{name}.relief_pressure": max(MARGIN * pressure, 1.0e5)}
         else:
             pressure = float("nan")
-            motor = (demand / v("reduction_ratio") + v("motor_friction_torque")) / v("efficiency")
+            motor = motors[i]
             current = motor / v("torque_constant")
-            sized = {f"{name}.gain": gain, f"{name}.motor_torque_limit": MARGIN * motor}
-        kind = next(k for k, e in ASSIST_EFFECTS.items() if e == name)
-        assisted = simulate(case, effects=ASSISTED_EFFECTS[kind], overrides={**creeping_overrides(speed), **sized}, params=params)
-        rows.append(SizingRow(speed, _peak(torque * per_rack), peak_manual, demand, motor, current, pressure, gain,
-                              _peak(assisted.columns["handwheel_torque_Nm"])))
+            sized = one_assist if falloff else {f"{name}.gain": gain, f"{name}.motor_torque_limit": MARGIN * motor}
+        assisted = simulate(case, effects=ASSISTED_EFFECTS[kind], overrides={**creeping_overrides(speed), **sized},
+                            params=params)
+        c = assisted.columns
+        rows.append(SizingRow(speed, _peak(torque * per_rack), _peak(torque), demand, motor, current, pressure, gain,
+                              _peak(c["handwheel_torque_Nm"]),
+                              float("nan") if hydraulic else _peak(c["motor_torque_Nm"]),
+                              _peak(c["pressure_Pa"]) if hydraulic else float("nan")))
         if manual0 is None:
             manual0, assisted0 = manual, assisted
     return SizingStudy(name, case, target_torque_Nm, rows, manual0, assisted0)

@@ -9,12 +9,26 @@ module), ``electric_assist_pinion``, ``electric_assist_rack``; each fills the co
 torsion bar (see :mod:`.assist_common`), so two assists in one set, or an assist with the rack lash (which
 fills the same slot), are refused in one line.
 
-Boost curve (quasi-static, speed-independent: parking). The demand at the point of action is
+Boost curve (quasi-static). The demand at the point of action is
 
-    A_cmd = G deadband(T_s, D) c,     c = 1 (torque at column or pinion), c = G_hr (force at the rack)
+    A_cmd = G(v) deadband(T_s, D) c,     c = 1 (torque at column or pinion), c = G_hr (force at the rack)
 
-with the gain G (assist per driver torque beyond the dead band D), c turning a pinion torque into a rack force
-(G_hr = handwheel_to_rack_ratio, rad/m). The motor torque is the demand through the reduction, limited:
+with the gain G(v) (assist per driver torque beyond the dead band D), c turning a pinion torque into a rack force
+(G_hr = handwheel_to_rack_ratio, rad/m). The gain may fall with the vehicle speed v (the run's
+``run.vehicle_speed``, the quantity the rolling tyre's turn_slip reads), as the speed-sensitive boost curves of
+current cars do (full assist for parking, less as the car gathers speed):
+
+    G(v) = G / (1 + s (v / v_half)^2),     s = speed_dependence (0: off, 1: on),
+
+flat at standstill (dG/dv = 0 at v = 0), the parking gain G halved at v = v_half (s = 1), falling as 1/v^2 well
+beyond. At v = 0 or s = 0 the denominator is 1 + 0 = 1 exactly in IEEE arithmetic, so G(v) is G bit for bit:
+today's speed-independent curve. The rational form and v_half are assumed (a smooth stand-in for the speed
+tables of the control unit, the rational fall of EPS assist maps, k0 / (1 + k_v v) (MathWorks Cody problem
+61311, "EPS assist map with respect to the vehicle speed"), squared here so that the gain is flat at parking
+speed; the quantities' sources give the typical v_half). Quasi-statically the driver's torque is
+T_road / (1 + G(v)) (the tests).
+
+The motor torque is the demand through the reduction, limited:
 
     T_m = clamp(A_cmd / (eta N), T_max),     i = T_m / k_t (the motor current, torque constant k_t),
 
@@ -25,7 +39,7 @@ energy J_m (N dx/dt)^2 / 2, N^2 J_m reflected to x), its bearings' Coulomb frict
 (v the rack speed it corresponds to, beta the project's friction smoothing).
 
 Quasi-static consequences (the tests): with no dead band and the motor below its limit, the column carries
-T_s + G T_s = T_road, so the driver's torque is T_road / (1 + G); at the limit, T_s = T_road - eta N T_max
+T_s + G(v) T_s = T_road, so the driver's torque is T_road / (1 + G(v)); at the limit, T_s = T_road - eta N T_max
 (column) rises with the road torque at the manual steering's slope; a zero gain adds no torque at all.
 
 Outputs: torsion_bar_torque_Nm (T_s), assist_torque_Nm or assist_force_N (eta N T_m at x), motor_torque_Nm,
@@ -43,7 +57,7 @@ from typing import ClassVar
 import sympy as sp
 import sympy.physics.mechanics as me
 
-from ....parameters import Quantity
+from ....parameters import VEHICLE_SPEED, Quantity
 from ..components import Effect
 from ..system import torque_between
 from .assist_common import LOCATIONS, clamp, deadband, point_of_action, series_deflection, torsion_bar_torque
@@ -102,6 +116,19 @@ def assist_quantities(name: str, location: str) -> tuple[Quantity, ...]:
         Quantity(f"{name}.motor_friction_torque", "N m", 0.0, 1.0, lower_inclusive=True, default=0.02,
                  description="Coulomb friction of the rotor's bearings and seals, at the motor",
                  source="assumed: 0.01-0.05 N m for EPS motors (Harrer & Pfeffer, ch. 8.6)"),
+        Quantity(f"{name}.speed_dependence", "1", 0.0, 1.0, lower_inclusive=True, default=0.0,
+                 description="1: the gain falls with the vehicle speed as G / (1 + (v / v_half)^2); 0: a "
+                             "speed-independent boost curve (between: the same fall with v_half / sqrt(s))",
+                 source="off by default: a speed-independent boost curve, as for the paper's standstill test; "
+                        "current EPS control units scale the assist by vehicle speed (Servotronic: BMW and MINI "
+                        "EPS functional descriptions)"),
+        Quantity(f"{name}.gain_half_speed", "m/s", 0.0, 100.0, default=13.9,
+                 description="v_half: the vehicle speed at which the speed-dependent gain is half the parking gain",
+                 source="assumed: 50 km/h, range 40-80 km/h: a speed-proportional gear gives the least effort (full "
+                        "assist) from 0 to about 32 km/h and the most (the least assist) from about 100 km/h "
+                        "(Chrysler 1999 Concorde service manual, speed proportional steering gear); with v_half "
+                        "40-80 km/h, G / (1 + (v / v_half)^2) keeps 61-86 % of the parking gain at 32 km/h and "
+                        "14-39 % at 100 km/h"),
     )
 
 
@@ -131,7 +158,7 @@ class ElectricAssist(Effect):
                 "(gain beyond a dead band, motor torque limit) through a reduction with its efficiency, rotor "
                 "inertia and friction; off by default"),
             "quantities": quantities,
-            "uses": (*(q.key for q in quantities), "steering.column_torsional_stiffness",
+            "uses": (*(q.key for q in quantities), VEHICLE_SPEED.key, "steering.column_torsional_stiffness",
                      "steering.handwheel_to_rack_ratio", "steering.friction_smoothing"),
             "__module__": cls.__module__,
         })
@@ -159,9 +186,15 @@ class ElectricAssist(Effect):
     def sensor_torque(self, model):
         return torsion_bar_torque(model, self.location)
 
+    def gain(self, model):
+        """G(v) = G / (1 + s (v / v_half)^2): exactly G at v = 0 or s = 0 (module docstring)."""
+        speed = model.p(VEHICLE_SPEED.key)
+        falloff = self.q(model, "speed_dependence") * (speed / self.q(model, "gain_half_speed")) ** 2
+        return self.q(model, "gain") / (1 + falloff)
+
     def motor_torque(self, model):
         scale = model.p("steering.handwheel_to_rack_ratio") if self.location == "rack" else 1
-        demand = self.q(model, "gain") * deadband(self.sensor_torque(model), self.q(model, "dead_band"),
+        demand = self.gain(model) * deadband(self.sensor_torque(model), self.q(model, "dead_band"),
                                                   self.q(model, "dead_band_smoothing")) * scale
         at_motor = demand / (self.q(model, "efficiency") * self.q(model, "reduction_ratio"))
         return clamp(at_motor, self.q(model, "motor_torque_limit"), self.q(model, "limit_smoothing"))

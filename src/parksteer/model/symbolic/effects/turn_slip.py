@@ -22,8 +22,9 @@ distance rolled per radian of steer (V / |psi'|) measured in units of q_Dz8 R0^2
 grows: at 1 km/h and 0.3 rad/s of steer rate the wheel rolls 0.9 m per radian of steer, several contact
 lengths, and the moment is a fraction of the standstill's.
 
-The vehicle speed is a quantity (``turn_slip.vehicle_speed``, a constant of the run; ``parksteer simulate
---speed-kmh``). The coefficients are MF 6.1's published defaults (MFeval's default tyre property file): they
+The vehicle speed V is the run's (``run.vehicle_speed``, :data:`parksteer.parameters.VEHICLE_SPEED`: a constant of
+the run, ``parksteer simulate --speed-kmh``), the one quantity the electric assist's speed-dependent boost curve
+reads too. The coefficients are MF 6.1's published defaults (MFeval's default tyre property file): they
 stand for a typical passenger-car tyre until a fitted .tir file is at hand.
 """
 
@@ -32,9 +33,9 @@ from __future__ import annotations
 import sympy as sp
 import sympy.physics.mechanics as me
 
-from ....parameters import Quantity
-from ..components import Effect
 from ....names import SIDES
+from ....parameters import VEHICLE_SPEED, Quantity
+from ..components import Effect
 
 MF_SOURCE = ("MF 6.1 default tyre property file (MFeval readTIR defaults; Pacejka, Tire and Vehicle Dynamics, 3rd ed., "
              "2012, sec. 4.3.3)")
@@ -50,9 +51,6 @@ class TurnSlip(Effect):
     diagnosis_candidate = False
     requires = ("tyre_friction",)
     quantities = (
-        Quantity("turn_slip.vehicle_speed", "m/s", 0.0, 3.0, lower_inclusive=True, default=0.0,
-                 description="the car's speed while it steers (constant over the run)",
-                 source="input of the run: 0 = standstill (the paper), up to 3 m/s (10.8 km/h) of creeping"),
         Quantity("turn_slip.spin_slope_coefficient", "1", 0.0, 1.0, default=0.05,
                  description="q_Dz8: the spin moment's initial slope K = F_z R0 q_Dz8 per unit R0 phi",
                  source=f"|QDZ8| = 0.05, {MF_SOURCE}"),
@@ -63,8 +61,8 @@ class TurnSlip(Effect):
                  description="|psi'| is smoothed as sqrt(psi'^2 + w^2)",
                  source="numerical: a thousandth of the cycle's steer rates"),
     )
-    uses = (*(q.key for q in quantities), "tyre.friction_coefficient", "tyre.tyre_pressure", "tyre.reference_pressure",
-            "tyre.pressure_index", "steering.friction_smoothing")
+    uses = (VEHICLE_SPEED.key, *(q.key for q in quantities), "tyre.friction_coefficient", "tyre.tyre_pressure",
+            "tyre.reference_pressure", "tyre.pressure_index", "steering.friction_smoothing")
 
     def rolling_factor(self, model, load_N, yaw_rate):
         """f = 1 / sqrt(1 + y^2) (module docstring); 1 exactly at zero speed."""
@@ -74,7 +72,7 @@ class TurnSlip(Effect):
         root_load = sp.Piecewise((sp.sqrt(load_N), load_N > 0), (0, True))
         radius = model.d("wheel_radius")
         rate = sp.sqrt(yaw_rate**2 + model.p("turn_slip.yaw_rate_smoothing") ** 2)
-        y = (model.p("turn_slip.vehicle_speed") * (1 - model.p("turn_slip.camber_reduction")) * per_sqrt_load
+        y = (model.p(VEHICLE_SPEED.key) * (1 - model.p("turn_slip.camber_reduction")) * per_sqrt_load
              * root_load / (model.p("turn_slip.spin_slope_coefficient") * radius**2 * rate))
         return 1 / sp.sqrt(1 + y**2)
 
