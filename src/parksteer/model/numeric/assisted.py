@@ -46,6 +46,8 @@ from .prescribed import PRESCRIBED_ATOL_FACTOR, PRESCRIBED_RTOL, PrescribedSolut
 # The bisection stops when the bracket is this narrow (N m of torsion-bar torque), far below a sensor's resolution.
 INVERSION_TOLERANCE_NM = 1e-12
 HYDRAULIC = "hydraulic_assist"
+OFFSET_KEY = "torsion_bar_offset.strength"
+GAIN_ERROR_KEY = "boost_gain_error.strength"
 
 
 def assist_effect(run):
@@ -92,6 +94,7 @@ class BoostLaw:
     efficiency: float = 1.0
     torque_constant: float = 1.0
     area: float = 0.0
+    offset: float = 0.0  # the torsion-bar sensor's zero offset (N m), read by the law and the logger alike
 
     @property
     def hydraulic(self) -> bool:
@@ -119,14 +122,15 @@ class BoostLaw:
         scale = self.ratio if self.location == "rack" else 1.0
         return self.efficiency * self.reduction * (self.limit + self.limit_width) / scale
 
-    def torsion_bar(self, y) -> np.ndarray:
-        """The torsion-bar torque T_s with T_s + A(T_s) = y, elementwise (bisection; A is increasing)."""
+    def torsion_bar(self, y, factor=1.0) -> np.ndarray:
+        """The torsion-bar torque T_s with T_s + factor A(T_s) = y, elementwise (bisection; A is increasing, and
+        so is the sum for any factor >= 0: a motor whose delivered torque departs from the law by `factor`)."""
         y = np.asarray(y, dtype=float)
-        width = self.bound() + 1.0
+        width = self.bound() * float(np.max(factor)) + 1.0
         low, high = y - width, y + width
         for _ in range(200):
             mid = 0.5 * (low + high)
-            above = mid + self.assist(mid) > y
+            above = mid + factor * self.assist(mid) > y
             high = np.where(above, mid, high)
             low = np.where(above, low, mid)
             if np.all(high - low <= INVERSION_TOLERANCE_NM):
@@ -142,12 +146,16 @@ def boost_law(run, p: np.ndarray) -> BoostLaw | None:
     name = effect.name
     v = lambda key: float(p[run.parameter_index(f"{name}.{key}")])  # noqa: E731
     ratio = float(p[run.parameter_index("steering.handwheel_to_rack_ratio")])
+    names = run.model.info["parameters"]
+    # the law-side candidates of an assisted car's diagnosis (effects torsion_bar_offset, boost_gain_error)
+    offset = float(p[names.index(OFFSET_KEY)]) if OFFSET_KEY in names else 0.0
+    gain_factor = 1.0 + float(p[names.index(GAIN_ERROR_KEY)]) if GAIN_ERROR_KEY in names else 1.0
     if name == HYDRAULIC:
         return BoostLaw(name, "rack", v("valve_slope"), v("dead_band"), v("dead_band_smoothing"),
                         v("relief_pressure"), v("pressure_smoothing"), ratio, area=v("piston_area"))
-    return BoostLaw(name, effect.location, v("gain"), v("dead_band"), v("dead_band_smoothing"),
+    return BoostLaw(name, effect.location, v("gain") * gain_factor, v("dead_band"), v("dead_band_smoothing"),
                     v("motor_torque_limit"), v("limit_smoothing"), ratio, v("reduction_ratio"), v("efficiency"),
-                    v("torque_constant"))
+                    v("torque_constant"), offset=offset)
 
 
 @dataclass
@@ -163,21 +171,28 @@ class AssistedSolution(PrescribedSolution):
 
 
 def solve_assisted(run, p: np.ndarray, rack: RackMotion, t_out, rtol: float = PRESCRIBED_RTOL,
-                   atol_factor: float = PRESCRIBED_ATOL_FACTOR) -> AssistedSolution:
+                   atol_factor: float = PRESCRIBED_ATOL_FACTOR, law: BoostLaw | None = None,
+                   delivered=None) -> AssistedSolution:
     """The torsion-bar torque and the motor's torque and current of `run`'s assisted car with its rack following
-    `rack`, at the output times `t_out` (module docstring: the boost-free solve, then the law inverted)."""
-    law = boost_law(run, p)
+    `rack`, at the output times `t_out` (module docstring: the boost-free solve, then the law inverted). The
+    law-side candidates of a diagnosis act here: a sensor offset o (the reading S solves S + A(S) = y + o, the log
+    and the law take S) and a gain error (the law's gain G (1 + e)). `law` replaces the run's own law (a record
+    made with another curve than the file's); `delivered` (a function of the solve's states -> a factor per sample)
+    scales what the motor delivers against what the law commands (a torque ripple), the current unchanged."""
+    law = law if law is not None else boost_law(run, p)
     if law is None:
         raise UsageError("an assisted replay needs an assist effect in the model (electric_assist_* or "
                          "hydraulic_assist)")
     p_off = np.array(p, dtype=float)
     p_off[run.parameter_index(boost_key(law.name))] = 0.0
-    road = solve(run, p_off, rack, t_out, rtol=rtol, atol_factor=atol_factor, outputs=law.location != "column",
-                 assist_off=True)
+    road = solve(run, p_off, rack, t_out, rtol=rtol, atol_factor=atol_factor,
+                 outputs=law.location != "column" or delivered is not None, assist_off=True)
     y = road.torque_Nm
     if law.location != "column":
         y = y * road.outputs["column_angle_per_rack_rad_per_m"] / law.ratio
-    torsion_bar = law.torsion_bar(y)
+    # A sensor reading S = T_s + o, taken by the law: S - o + A(S) = y (effect torsion_bar_offset).
+    factor = 1.0 if delivered is None else delivered(run, road)
+    torsion_bar = law.torsion_bar(y + law.offset, factor)
     motor = law.motor(torsion_bar)
     current = None if law.hydraulic else motor / law.torque_constant
     return AssistedSolution(road.time_s, torsion_bar, road.states, road.accelerations, None, None, road.torque_Nm,
