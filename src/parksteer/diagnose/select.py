@@ -57,6 +57,7 @@ from dataclasses import replace
 from ..errors import UsageError
 from ..model.symbolic.components import Effect, discover_effects, resolve_effects
 from ..parameters import Parameters
+from .compare import check_torque_sensors
 from .parallel import Progress
 from .problem import FileData, Problem
 from .settings import DEFAULT_SETTINGS, DiagnosisSettings
@@ -89,6 +90,7 @@ def diagnose(files: list[FileData], params: Parameters, effects=None, registry: 
     # An assisted car's record: its motor channel fitted beside the torsion-bar torque (settings.use_motor_channel);
     # its handwheel angle is not replayed (parksteer.diagnose.replay).
     assisted = any(getattr(e, "power_assist", False) for e in base)
+    check_torque_sensors(files, assisted)
     if assisted and settings.use_handwheel_angle and any(f.angle_rad is not None for f in files):
         raise UsageError("--angle: the handwheel angle of an assisted car is not replayed; diagnose its torsion-bar "
                          "torque with the motor channel instead")
