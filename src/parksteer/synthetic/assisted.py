@@ -49,11 +49,10 @@ OUT_OF_CLASS = {
 }
 
 
-def _motor_ripple(amplitude: float, reduction: float):
-    """A factor 1 + a sin(motor angle) on the delivered torque, the motor angle N times the column angle."""
-    def factor(run, road) -> np.ndarray:
-        return 1.0 + amplitude * pm.sin(reduction * road.outputs["column_angle_rad"])
-    return factor
+def _motor_ripple(amplitude: float, reduction: float, pinion_angle: np.ndarray) -> np.ndarray:
+    """A factor 1 + a sin(motor angle) on the delivered torque, the motor angle N times the pinion angle (the column's
+    but for the intermediate joint's ripple, which only moves the ripple's phase)."""
+    return 1.0 + amplitude * pm.sin(reduction * pinion_angle)
 
 
 def assisted_clean(params: Parameters, hand: HandVariant, effects: str, case: str, surface: str = "ground",
@@ -70,10 +69,11 @@ def assisted_clean(params: Parameters, hand: HandVariant, effects: str, case: st
     overrides = dict(overrides or {})
     run = prepare(case, effects, overrides, surface, params)
     law, delivered = boost_law(run, run.p), None
+    rack_m = rack_position(rack, t)
     if out_of_class is not None:
         kind, size = out_of_class
         if kind == "motor_ripple":
-            delivered = _motor_ripple(size, law.reduction)
+            delivered = _motor_ripple(size, law.reduction, law.ratio * rack_m)
         elif kind == "dead_band_change":
             law = replace(law, dead_band=law.dead_band + size)
         elif kind == "torsion_bar_stiffness":
@@ -83,7 +83,7 @@ def assisted_clean(params: Parameters, hand: HandVariant, effects: str, case: st
         else:
             raise ValueError(f"unknown out-of-class change {kind!r} (known: {', '.join(OUT_OF_CLASS)})")
     solution = solve_assisted(run, run.p, rack, t, law=law, delivered=delivered)
-    return {"time_s": t, "rack_m": rack_position(rack, t), "handwheel_torque_Nm": solution.torque_Nm,
+    return {"time_s": t, "rack_m": rack_m, "handwheel_torque_Nm": solution.torque_Nm,
             "motor_current_A": solution.motor_current_A}
 
 
@@ -110,6 +110,8 @@ def assisted_record(clean: dict[str, np.ndarray], logger: AssistedLogger, case: 
     metadata = {"case": case, "surface": surface, "source": "synthetic: parksteer.synthetic.assisted",
                 "synthetic": True, "torque_sensor": "torsion_bar", "bits": logger.torque_bits,
                 "full_scale_handwheel_torque_Nm": logger.torque_full_scale_Nm,
+                # a bus states every signal's resolution: the rack's too (its replay ensemble relogs the rack)
+                "bits_rack_m": logger.rack_bits, "full_scale_rack_m": logger.rack_full_scale_m,
                 "sample_rate_hz": float(logger.sample_rate_hz), "noise_seed": logger.seed}
     if logger.log_current:
         columns["motor_current_A"] = quantise(add_noise(sampled["motor_current_A"], logger.current_noise_A, rng),

@@ -177,21 +177,21 @@ def solve_assisted(run, p: np.ndarray, rack: RackMotion, t_out, rtol: float = PR
     `rack`, at the output times `t_out` (module docstring: the boost-free solve, then the law inverted). The
     law-side candidates of a diagnosis act here: a sensor offset o (the reading S solves S + A(S) = y + o, the log
     and the law take S) and a gain error (the law's gain G (1 + e)). `law` replaces the run's own law (a record
-    made with another curve than the file's); `delivered` (a function of the solve's states -> a factor per sample)
-    scales what the motor delivers against what the law commands (a torque ripple), the current unchanged."""
+    made with another curve than the file's); `delivered` (a factor per output time, >= 0) scales what the motor
+    delivers against what the law commands (a torque ripple), the current unchanged."""
     law = law if law is not None else boost_law(run, p)
     if law is None:
         raise UsageError("an assisted replay needs an assist effect in the model (electric_assist_* or "
                          "hydraulic_assist)")
     p_off = np.array(p, dtype=float)
     p_off[run.parameter_index(boost_key(law.name))] = 0.0
-    road = solve(run, p_off, rack, t_out, rtol=rtol, atol_factor=atol_factor,
-                 outputs=law.location != "column" or delivered is not None, assist_off=True)
+    road = solve(run, p_off, rack, t_out, rtol=rtol, atol_factor=atol_factor, outputs=law.location != "column",
+                 assist_off=True)
     y = road.torque_Nm
     if law.location != "column":
         y = y * road.outputs["column_angle_per_rack_rad_per_m"] / law.ratio
     # A sensor reading S = T_s + o, taken by the law: S - o + A(S) = y (effect torsion_bar_offset).
-    factor = 1.0 if delivered is None else delivered(run, road)
+    factor = 1.0 if delivered is None else np.asarray(delivered, dtype=float)
     torsion_bar = law.torsion_bar(y + law.offset, factor)
     motor = law.motor(torsion_bar)
     current = None if law.hydraulic else motor / law.torque_constant
