@@ -10,6 +10,7 @@ from scipy.interpolate import BPoly, PPoly
 from parksteer.measure.smoothing import RackSpline
 from parksteer.model.numeric.assisted import solve_assisted
 from parksteer.model.numeric.simulate import prepare, simulate
+from parksteer.model.symbolic.components import discover_effects
 
 CASES = [
     ("electric_assist_column", {}),
@@ -75,3 +76,49 @@ def test_boost_law_inverse_is_exact_where_the_closed_form_holds(params):
     # the clamp's smoothing leaves a relative error of about (w / 2L)^2 far inside the limit; the dead band's
     # smoothing at D = 0 adds w^2 / (8 |T|) -> a tolerance of 1e-3 N m over these torques
     assert np.max(np.abs(law.torsion_bar(y) - y / (1 + gain))) < 1e-3
+
+
+def _sweep(params, effects: str, overrides: dict):
+    """The assisted replay of a smooth steer to the right and back (no free run needed: the candidates act in the
+    replay), at rtol 1e-8."""
+    from parksteer.measure.smoothing import interpolate_rack
+
+    t = np.linspace(0.0, 6.0, 601)
+    rack = interpolate_rack(t, 0.03 * np.sin(np.pi * t / 6.0))
+    run = prepare("unladen", effects, overrides, params=params)
+    return solve_assisted(run, run.p, rack, t[::5], rtol=1e-8, atol_factor=1.0)
+
+
+def test_motor_friction_at_a_column_assist_is_a_column_friction_of_n_times_it(params):
+    """Independent effects, one load: extra friction T_e on the rotor of a column assist turning at N times the
+    column is a torque N T_e on the column above the intermediate shaft, smoothed over the same rack-equivalent
+    speed as the column friction effect's; so +assist_motor_friction at T_e and +column_friction at N T_e give the
+    same torsion-bar torque (within 1e-6 N m), and strength 0 gives the assist alone exactly."""
+    name = "electric_assist_column"
+    n = next(q.default for q in discover_effects()[name].quantities if q.key == f"{name}.reduction_ratio")
+    motor = _sweep(params, f"+{name},+assist_motor_friction", {"assist_motor_friction.friction_torque": 0.05})
+    column = _sweep(params, f"+{name},+column_friction", {"column_friction.friction_torque": n * 0.05})
+    plain = _sweep(params, f"+{name}", {})
+    absent = _sweep(params, f"+{name},+assist_motor_friction", {"assist_motor_friction.friction_torque": 0.0})
+    assert np.max(np.abs(motor.torque_Nm - plain.torque_Nm)) > 0.05  # a real change
+    assert np.max(np.abs(motor.torque_Nm - column.torque_Nm)) < 1e-6
+    assert np.max(np.abs(absent.torque_Nm - plain.torque_Nm)) < 1e-9
+
+
+def test_sensor_offset_and_gain_error_follow_the_linear_law(params):
+    """Closed forms in the boost's linear range (no dead band, motor far from its limit): T_s (1 + G) = y. A sensor
+    offset o read by the law and the log moves the reading to (y + o) / (1 + G); a gain G (1 + e) gives
+    y / (1 + G (1 + e)); the current is G S / (eta N k_t) of the reading S in both. Checked on the replay against
+    the boost-free road torque (within 1e-9 N m)."""
+    name = "electric_assist_column"
+    ideal = {f"{name}.dead_band": 0.0, f"{name}.motor_torque_limit": 30.0}
+    base = _sweep(params, f"+{name}", ideal)
+    gain = 6.0  # the assist's default (Polo and paper's car alike)
+    y = base.road_torque_Nm
+    offset = _sweep(params, f"+{name},+torsion_bar_offset", {**ideal, "torsion_bar_offset.strength": 0.3})
+    error = _sweep(params, f"+{name},+boost_gain_error", {**ideal, "boost_gain_error.strength": 0.25})
+    # the smoothing of the dead band's corners at D = 0 is exact (ramp(x) - ramp(-x) = x); the clamp's leaves a
+    # relative error of (w / 2 L)^2 ~ 3e-6 far inside the limit
+    assert np.max(np.abs(offset.torque_Nm - (y + 0.3) / (1 + gain))) < 1e-4
+    assert np.max(np.abs(error.torque_Nm - y / (1 + gain * 1.25))) < 1e-4
+    assert np.max(np.abs(offset.road_torque_Nm - y)) < 1e-9  # law-side: the mechanics do not move

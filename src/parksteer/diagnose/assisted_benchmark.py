@@ -3,9 +3,9 @@
 The car is a vehicle file's with its assist (the Polo file's column assist by default). Each record's rack follows a
 hand of the variation benchmark (:data:`parksteer.synthetic.variations.VARIATIONS`: its rate wander, pauses, uneven
 strokes, a lock overshoot, a record cut mid-stroke), its torsion-bar torque and motor current are the assisted
-replay (:mod:`parksteer.synthetic.assisted`), and a logger of the car's bus logs them (100 Hz or the variation's
-faster rate, a 16-bit rack from the motor's position, a 10-bit torsion-bar torque on +-10 N m and a 12-bit current
-on +-100 A: BUS_RATE_HZ, BUS_RACK_BITS). The base parameters
+replay (:mod:`parksteer.synthetic.assisted`), and the variation's logger logs them (its rate, its rack converter
+and noise) with the assisted car's channels: a 10-bit torsion-bar torque on +-10 N m and a 12-bit current on +-100
+A, each with the variation benchmark's noise relative to its range (TORQUE_NOISE_NM, CURRENT_NOISE_A). The base parameters
 are moved off the file's values as the in-class benchmark moves them (its ``perturbation``). Three kinds of case:
 
 - nulls (nothing hidden): ``adequate`` is right;
@@ -57,12 +57,13 @@ HIDDEN = {
 }
 UPPER = {"assist_motor_friction": 0.5, "torsion_bar_offset": 2.0, "boost_gain_error": 2.0, "rack_friction": 2000.0,
          "motor_ripple": 0.5, "dead_band_change": 5.0}
-# The car's bus: EPS messages are cyclic at 10 ms (100 Hz; a faster variation keeps its rate), and the rack comes from
-# the motor's rotor position (a 12-bit resolver through N = 18 and G_hr = 125.5 rad/m steps the rack by 7e-7 m,
-# finer than 16 bits on +-0.1 m). With the variations' own 50 Hz and 8- to 12-bit racks the rack's smoothing places
-# the reversals less sharply than a 10-bit torsion-bar channel resolves, and 3 of 20 nulls came out unexplained.
-BUS_RATE_HZ = 100.0
-BUS_RACK_BITS = 16
+# The channels' noise, relative to their parking range as the variation benchmark's (0.1 N m on a 12 N m peak: 0.8 %):
+# 0.03 N m on a torsion bar's 3.5 N m, 0.25 A on a current's 27 A. With channels twice as clean (0.02 N m, 0.1 A)
+# the rack's smoothing places the lock reversals less well than the replay ensemble says (a bias, not a spread, of
+# 0.1-0.3 N m over some 50 ms where the rack turns by less than its resolution), and 2 to 8 of 20 nulls came out
+# unexplained (8 with the rack's own noise cut to 2e-6 m: the ensemble then shrinks, the bias stays).
+TORQUE_NOISE_NM = 0.03
+CURRENT_NOISE_A = 0.25
 SEARCH = SizeSearch(iterations=4, tolerance=0.05, max_lag_s=0.0)
 PERTURBATION = {"tyre.friction_coefficient": 0.10, RACK_FRICTION: 0.15, "tyre.carcass_torsional_stiffness": 0.20}
 
@@ -115,10 +116,11 @@ def cases(design: AssistedDesign) -> list[AssistedCase]:
 
 
 def _logger(variation, seed: int) -> AssistedLogger:
-    """The car's bus logger (BUS_RATE_HZ or the variation's rate if faster, a BUS_RACK_BITS rack, torque and current
-    its own), seeded as the variation's."""
-    return AssistedLogger(sample_rate_hz=max(BUS_RATE_HZ, variation.logger.sample_rate_hz), rack_bits=BUS_RACK_BITS,
-                          seed=seed)
+    """The variation's logger (its rate, rack converter and noise) with the assisted car's torque and current
+    channels (TORQUE_NOISE_NM, CURRENT_NOISE_A), seeded as the variation's."""
+    base = variation.logger
+    return AssistedLogger(sample_rate_hz=base.sample_rate_hz, rack_bits=base.rack_bits, rack_noise_m=base.rack_noise_m,
+                          torque_noise_Nm=TORQUE_NOISE_NM, current_noise_A=CURRENT_NOISE_A, seed=seed)
 
 
 def case_truth_and_record(params: Parameters, design: AssistedDesign, case: AssistedCase, assist: str):
