@@ -143,6 +143,11 @@ def effects_of(args, params) -> list:
     return resolve_effects(effects_with_assist(args.effects, params))
 
 
+def assist_of_effects(effects) -> str | None:
+    """The name of the power assist among `effects`, if any."""
+    return next((e.name for e in effects if getattr(e, "power_assist", False)), None)
+
+
 def _compare(args) -> int:
     from ..diagnose.compare import compare_files
     from ..diagnose.problem import load_files
@@ -152,7 +157,7 @@ def _compare(args) -> int:
     overrides = parse_overrides(args.overrides)
     params = parameters_of(args)
     effects = effects_of(args, params)
-    files = load_files(args.files, params, args.case, args.surface, channel_map_of(args))
+    files = load_files(args.files, params, args.case, args.surface, channel_map_of(args), assist_of_effects(effects))
     result = compare_files(files, params, effects, overrides)
     summary = result.as_dict()
     if args.plot:
@@ -188,7 +193,7 @@ def _diagnose(args) -> int:
                          "--suggest-effect OUT.py")
     params = parameters_of(args)
     effects = effects_of(args, params)
-    files = load_files(args.files, params, args.case, args.surface, channel_map_of(args))
+    files = load_files(args.files, params, args.case, args.surface, channel_map_of(args), assist_of_effects(effects))
     for f in files:
         if len(f.phases.reversal_times_s) == 0:
             raise UsageError(f"{f.measurement.path}: column 'rack_m': the rack never reverses, so the record holds "

@@ -217,9 +217,10 @@ def prepare_file(measurement: Measurement, case: str | None = None, label: str |
 
 
 def load_files(paths: list[str | Path], params: Parameters, case: str | None = None, surface: str | None = None,
-               channel_map=None) -> list[FileData]:
+               channel_map=None, assist: str | None = None) -> list[FileData]:
     """Read (through :func:`parksteer.measure.importers.load_record`), validate and prepare measurement files;
-    `case` replaces the case every file names, `surface` fills the surface a file does not state."""
+    `case` replaces the case every file names, `surface` fills the surface a file does not state; `assist` (an
+    assisted car's effect) derives an angle-only record's rack through its torsion bar (:func:`rack_from_angle`)."""
     if not paths:
         raise UsageError("no measurement file given")
     if case is not None:
@@ -239,7 +240,7 @@ def load_files(paths: list[str | Path], params: Parameters, case: str | None = N
             )
         resolution = 0.0
         if "rack_derived" in measurement.metadata:
-            measurement = rack_from_angle(measurement, params)
+            measurement = rack_from_angle(measurement, params, assist)
             logger = rack_logger(measurement, params)
             resolution = 0.0 if logger is None else quantisation_step(logger[0], logger[1])
         with naming(path):
@@ -247,7 +248,7 @@ def load_files(paths: list[str | Path], params: Parameters, case: str | None = N
     return files
 
 
-def rack_from_angle(measurement: Measurement, params: Parameters) -> Measurement:
+def rack_from_angle(measurement: Measurement, params: Parameters, assist: str | None = None) -> Measurement:
     """A copy of an angle-only record (its rack derived by the importer) with the rack derived through the model's
     column: the column angle is the handwheel angle less the twist that passes the measured torque through the
     column's spring and damper, ``c dtwist/dt + k twist = T`` (:func:`parksteer.model.numeric.prescribed.column_twist`,
@@ -262,18 +263,38 @@ def rack_from_angle(measurement: Measurement, params: Parameters) -> Measurement
     the angle-derived rack's own noise (a 14-bit angle on +-16 rad: 1.05e-5 m steps). That error sits at the
     reversals, where the rack friction flips, and made a null record unexplained. The torque's noise reaches the
     rack through the twist only, divided by k and the ratio (0.1 N m: 5e-7 m) and low-passed by the damper.
+
+    Of an assisted car (`assist`, the effect's name), the torque is the torsion bar's and the bar is in series with
+    the column shaft: the twist is through their series stiffness k k_t / (k + k_t), with the damping that keeps
+    the column's time constant (as the assist's deflection law); a bar on the pinion (pinion, rack and hydraulic
+    gears) reads the column torque through the joint, T_s = T dtheta_c/dtheta_p.
     """
     s = params.sections["steering"]
     columns = measurement.columns
-    twist, _ = column_twist(columns["time_s"], columns[TORQUE], s["column_torsional_stiffness"],
-                            s["column_torsional_damping"])
-    pinion = pinion_angle_from_column(columns[ANGLE] - twist, s["hooke_joint_angle"], s["hooke_joint_phase"])
+    stiffness, damping = s["column_torsional_stiffness"], s["column_torsional_damping"]
+    torque = columns[TORQUE]
+    if assist is not None:  # the torsion bar in series with the column shaft (assist_common.series_deflection)
+        bar = params[f"{assist}.torsion_bar_stiffness"]
+        series = stiffness * bar / (stiffness + bar)
+        stiffness, damping = series, damping * series / stiffness
+    twist, _ = column_twist(columns["time_s"], torque, stiffness, damping)
+    joint = (s["hooke_joint_angle"], s["hooke_joint_phase"])
+    pinion = pinion_angle_from_column(columns[ANGLE] - twist, *joint)
+    if assist is not None and not assist.endswith("_column"):
+        # the bar on the pinion reads T_s = T dtheta_c/dtheta_p: the column carries T_s dtheta_p/dtheta_c, the
+        # joint's speed ratio taken at the column angle of the first pass (it varies by 1e-4 over the twist)
+        column = columns[ANGLE] - twist
+        h = 1e-6
+        ratio = (pinion_angle_from_column(column + h, *joint) - pinion_angle_from_column(column - h, *joint)) / (2 * h)
+        twist, _ = column_twist(columns["time_s"], torque * ratio, stiffness, damping)
+        pinion = pinion_angle_from_column(columns[ANGLE] - twist, *joint)
     metadata = dict(measurement.metadata)
     metadata["rack_derived"] = (
         f"from {ANGLE} and {TORQUE} through the model's column (parksteer.diagnose.problem.rack_from_angle): twist "
-        f"from c dtwist/dt + k twist = T with k {s['column_torsional_stiffness']:g} N m/rad and c "
-        f"{s['column_torsional_damping']:g} N m s/rad, Hooke joint angle {s['hooke_joint_angle']:g} rad and phase "
+        f"from c dtwist/dt + k twist = T with k {stiffness:g} N m/rad and c "
+        f"{damping:g} N m s/rad, Hooke joint angle {s['hooke_joint_angle']:g} rad and phase "
         f"{s['hooke_joint_phase']:g} rad, ratio {s['handwheel_to_rack_ratio']:g} rad/m"
+        + (f"; the torsion bar of {assist} in series" if assist is not None else "")
     )
     return replace(measurement, columns={**columns, "rack_m": pinion / s["handwheel_to_rack_ratio"]},
                    metadata=metadata)
