@@ -52,11 +52,13 @@ def candidate_effects(model_effects: list[Effect], registry: dict[str, Effect] |
     """(testable candidates, names of registered effects outside the model that have no strength)."""
     registry = registry if registry is not None else discover_effects()
     in_model = {e.name for e in model_effects}
-    # An assisted car's own candidates (motor friction, torsion-bar offset, gain error) join only its diagnosis.
+    # An electrically assisted car's own candidates (motor friction, torsion-bar offset, gain error) join only its
+    # diagnosis; a candidate whose slot an assist fills (the rack lash) cannot join an assisted car's model.
     assisted = any(getattr(e, "power_assist", False) for e in model_effects)
+    electric = any(e.name.startswith("electric_assist_") for e in model_effects)
     testable, untestable = [], []
     for name in sorted(registry):
-        wanted = registry[name].diagnosis_candidate or (assisted and getattr(registry[name], "assist_candidate", False))
+        wanted = registry[name].diagnosis_candidate or (electric and getattr(registry[name], "assist_candidate", False))
         if name in in_model or not wanted:
             continue
         slot = registry[name].replaces
