@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import tempfile
 import time
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -255,4 +255,4 @@ def run(params: Parameters, design: AssistedDesign = AssistedDesign(), only=None
     return rows, summarise(rows)
 
 
-__all__ = ["AssistedDesign", "cases", "outcome", "run", "summarise", "replace"]
+__all__ = ["AssistedDesign", "cases", "outcome", "run", "summarise"]
