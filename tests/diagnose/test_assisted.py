@@ -10,7 +10,6 @@ physics the diagnosis must recover.
 
 from __future__ import annotations
 
-import dataclasses
 import json
 
 import jsonschema
