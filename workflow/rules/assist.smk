@@ -54,3 +54,28 @@ rule assist_study:
         "../envs/parksteer.yaml"
     script:
         "../scripts/assist_study.py"
+
+
+# The assisted benchmark (parksteer.diagnose.assisted_benchmark, parksteer.figures.assisted): records of the Polo
+# file's car with its column assist, hands of the variation benchmark and its logger with the car's torsion-bar and
+# current channels, with nothing, a candidate of an assisted car or an out-of-class change hidden, each diagnosed
+# from its written file; scored against the variation benchmark's targets. One job (about 60 records, a few
+# minutes); the candidate models are derived in it (the model cache locks each build). Part of `all` (FIGURES).
+rule diag_assisted:
+    input:
+        parameters=PARAMETERS,
+        vehicle="data/vehicles/polo_vi.toml",
+        models=[ASSIST_MODELS["column"]],
+        code=script_sources("diag_assisted"),
+    output:
+        svg=figure_report("figures/diag_assisted.svg", "diagnose"),
+        csv=figure_report("figures/diag_assisted.csv", "diagnose"),
+        json="results/diag_assisted.json",
+    log:
+        "logs/diag_assisted.log",
+    benchmark:
+        benchmark_file("diag_assisted")
+    conda:
+        "../envs/parksteer.yaml"
+    script:
+        "../scripts/diag_assisted.py"

@@ -30,6 +30,7 @@ FIGURES = {
     "bands": ["figures/bands.svg", "figures/bands.csv"],
     "rivals": ["figures/rivals.svg", "figures/rivals.csv"],
     "assist_study": ["figures/assist_study.svg", "figures/assist_study.csv"],
+    "diag_assisted": ["figures/diag_assisted.svg", "figures/diag_assisted.csv"],
 }
 
 

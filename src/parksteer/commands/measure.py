@@ -28,6 +28,9 @@ def _common(p) -> None:
                         "(a leading - needs no =; default: the paper's five)")
     p.add_argument("--parameters", default=str(DEFAULT_PATH), help="parameter file (default: the packaged parksteer/data/parameters.toml)")
     add_vehicle_option(p)
+    p.add_argument("--with-assist", action="store_true",
+                   help="with --vehicle: the car with its [assist]: the record's torque is the torsion bar's, replayed "
+                        "through the boost law, and a motor current or torque channel is fitted beside it")
     p.add_argument("--json", action="store_true", help="print the result as JSON on stdout")
     p.add_argument("--plot", default=None, metavar="OUT.svg", help="write a figure")
 
@@ -125,17 +128,36 @@ def _print_json(result: dict) -> None:
     sys.stdout.write("\n")
 
 
+def effects_of(args, params) -> list:
+    """The model's effects: --effects, with the vehicle file's [assist] added under --with-assist."""
+    from ..model.symbolic.components import resolve_effects
+
+    if not getattr(args, "with_assist", False):
+        return resolve_effects(args.effects)
+    if args.vehicle is None:
+        raise UsageError("--with-assist needs --vehicle FILE (the assist is the vehicle file's [assist])")
+    from ..model.numeric.assist import check_assist, effects_with_assist
+
+    if check_assist(params) is None:
+        raise UsageError(f"--with-assist: {args.vehicle} has no [assist] section")
+    return resolve_effects(effects_with_assist(args.effects, params))
+
+
+def assist_of_effects(effects) -> str | None:
+    """The name of the power assist among `effects`, if any."""
+    return next((e.name for e in effects if getattr(e, "power_assist", False)), None)
+
+
 def _compare(args) -> int:
     from ..diagnose.compare import compare_files
     from ..diagnose.problem import load_files
-    from ..model.symbolic.components import resolve_effects
     from ..model.numeric.values import parse_overrides
 
     _check_outputs(args)
     overrides = parse_overrides(args.overrides)
     params = parameters_of(args)
-    effects = resolve_effects(args.effects)
-    files = load_files(args.files, params, args.case, args.surface, channel_map_of(args))
+    effects = effects_of(args, params)
+    files = load_files(args.files, params, args.case, args.surface, channel_map_of(args), assist_of_effects(effects))
     result = compare_files(files, params, effects, overrides)
     summary = result.as_dict()
     if args.plot:
@@ -151,6 +173,10 @@ def _compare(args) -> int:
                   f"noise floor {f['noise_floor']['total_rms']:.3f} N m")
             for phase, stats in f["by_phase"].items():
                 print(f"  {phase:<13} RMS {stats['rms']:.3f} N m over {stats['samples']} samples")
+            if "motor" in f:
+                unit = "A" if f["motor"]["column"] == "motor_current_A" else "N m"
+                print(f"  motor channel {f['motor']['column']}: RMS {f['motor']['rms']:.3f} {unit}, noise floor "
+                      f"{f['motor']['noise_floor']['total_rms']:.3f} {unit}")
     return 0
 
 
@@ -160,15 +186,14 @@ def _diagnose(args) -> int:
     from ..diagnose.problem import ANGLE
     from ..diagnose.select import diagnose
     from ..diagnose.settings import DEFAULT_SETTINGS
-    from ..model.symbolic.components import resolve_effects
 
     _check_outputs(args)
     if not (args.json or args.report or args.plot or args.html or args.suggest_effect):
         raise UsageError("say where the result goes: --json, --report OUT.md, --html OUT.html, --plot OUT.svg and/or "
                          "--suggest-effect OUT.py")
     params = parameters_of(args)
-    effects = resolve_effects(args.effects)
-    files = load_files(args.files, params, args.case, args.surface, channel_map_of(args))
+    effects = effects_of(args, params)
+    files = load_files(args.files, params, args.case, args.surface, channel_map_of(args), assist_of_effects(effects))
     for f in files:
         if len(f.phases.reversal_times_s) == 0:
             raise UsageError(f"{f.measurement.path}: column 'rack_m': the rack never reverses, so the record holds "

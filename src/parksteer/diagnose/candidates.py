@@ -52,9 +52,18 @@ def candidate_effects(model_effects: list[Effect], registry: dict[str, Effect] |
     """(testable candidates, names of registered effects outside the model that have no strength)."""
     registry = registry if registry is not None else discover_effects()
     in_model = {e.name for e in model_effects}
+    # An electrically assisted car's own candidates (motor friction, torsion-bar offset, gain error) join only its
+    # diagnosis; a candidate whose slot an assist fills (the rack lash) cannot join an assisted car's model.
+    assisted = any(getattr(e, "power_assist", False) for e in model_effects)
+    electric = any(e.name.startswith("electric_assist_") for e in model_effects)
     testable, untestable = [], []
     for name in sorted(registry):
-        if name in in_model or not registry[name].diagnosis_candidate:
+        wanted = registry[name].diagnosis_candidate or (electric and getattr(registry[name], "assist_candidate", False))
+        if name in in_model or not wanted:
+            continue
+        slot = registry[name].replaces
+        if assisted and slot is not None and any(e.replaces == slot for e in model_effects):
+            untestable.append(name)  # its slot is the assist's (a rack lash shapes the column as the torsion bar)
             continue
         (testable if strength_parameter(registry[name]) is not None else untestable).append(name)
     return [registry[n] for n in testable], untestable

@@ -16,6 +16,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from ..errors import UsageError
 from ..measure.metrics import Comparison, compare
 from ..model.symbolic.components import Effect, resolve_effects
 from ..parameters import Parameters
@@ -38,7 +39,7 @@ class CompareResult:
         for f, c, m in zip(self.files, self.comparisons, self.predictions):
             summary = c.summary()
             delta = f.replay_uncertainty_Nm
-            weighted = (f.torque_Nm - m) / f.sigma_Nm * f.noise.total_rms
+            weighted = (f.torque_Nm - f.torque_part(m)) / f.sigma_Nm * f.noise.total_rms
             files.append({
                 "file": f.label,
                 "case": f.case,
@@ -53,6 +54,13 @@ class CompareResult:
                 "weighted_rms_Nm": float(np.sqrt(np.mean(weighted**2))),
                 "over_floor": float(np.sqrt(np.mean(weighted**2)) / f.noise.total_rms),
             })
+            if f.uses_motor:  # an assisted car's motor channel: its residual beside its own noise floor
+                residual = f.motor - f.motor_part(m)
+                weighted_motor = residual / f.sigma_motor * f.motor_noise.total_rms
+                files[-1]["motor"] = {"column": f.motor_column, "rms": float(np.sqrt(np.mean(residual**2))),
+                                      "peak": float(np.max(np.abs(residual))),
+                                      "weighted_rms": float(np.sqrt(np.mean(weighted_motor**2))),
+                                      "noise_floor": f.motor_noise.as_dict()}
         return {
             "effects": [e.name for e in self.effects],
             "overrides": dict(sorted(self.overrides.items())),
@@ -61,18 +69,33 @@ class CompareResult:
         }
 
 
+def check_torque_sensors(files: list[FileData], assisted: bool) -> None:
+    """A record of a torsion bar (an assisted car's) replayed without an assist, or a handwheel's with one, is
+    refused in one line: the model would be judged on another torque than the one measured."""
+    for f in files:
+        sensor = f.measurement.torque_sensor
+        if sensor == "torsion_bar" and not assisted:
+            raise UsageError(f"{f.measurement.path or f.label}: its torque is an assisted car's torsion-bar torque; "
+                             "replay it with the car's assist (--vehicle FILE --with-assist, or --effects "
+                             "+electric_assist_column|_pinion|_rack|+hydraulic_assist)")
+
+
 def compare_files(files: list[FileData], params: Parameters, effects=None,
                   overrides: dict[str, float] | None = None) -> CompareResult:
     """Replay every file through the model of `effects` (a spec or list) with `overrides`."""
     chosen = effects if isinstance(effects, list) and all(isinstance(e, Effect) for e in effects) \
         else resolve_effects(effects)
     overrides = dict(overrides or {})
-    problem = Problem([replace(f, uses_angle=False) for f in files], params)  # a comparison is of the torque alone
+    # A comparison is of the torque, and of an assisted car's motor channel beside it (its own residual and floor).
+    assisted = any(getattr(e, "power_assist", False) for e in chosen)
+    check_torque_sensors(files, assisted)
+    problem = Problem([replace(f, uses_angle=False, uses_motor=assisted and f.motor is not None) for f in files],
+                      params)
     predictions = problem.predict(chosen, overrides)
     problem = problem.with_replay_uncertainty(chosen, overrides)
     files = list(problem.files)
     comparisons = [
-        compare(f.time_s, f.torque_Nm, m, phases=f.phases,
+        compare(f.time_s, f.torque_Nm, f.torque_part(m), phases=f.phases,
                 quantisation_step=f.measurement.quantisation_step("handwheel_torque_Nm"))
         for f, m in zip(files, predictions)
     ]

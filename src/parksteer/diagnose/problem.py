@@ -69,6 +69,8 @@ from .replay import Replay
 
 TORQUE = "handwheel_torque_Nm"
 ANGLE = "handwheel_angle_rad"
+# An assisted car's motor channel (the second measured signal of its diagnosis), the current preferred.
+MOTOR_COLUMNS = ("motor_current_A", "motor_torque_Nm")
 
 
 @dataclass(frozen=True, eq=False)
@@ -94,6 +96,14 @@ class FileData:
     replay_draws_rad: np.ndarray | None = None
     # how far the torque channel runs behind the rack's (s), estimated by the diagnosis (stages/torque_lag.py)
     torque_lag_s: float = 0.0
+    # an assisted car's motor channel (MOTOR_COLUMNS: its name, values and noise floor), and whether the diagnosis
+    # fits it as a second signal (in the copies parksteer.diagnose.select makes for an assisted model)
+    motor_column: str | None = None
+    motor: np.ndarray | None = None
+    motor_noise: NoiseFloor | None = None
+    uses_motor: bool = False
+    replay_uncertainty_motor: np.ndarray | None = None
+    replay_draws_motor: np.ndarray | None = None
 
     @property
     def time_s(self) -> np.ndarray:
@@ -130,9 +140,15 @@ class FileData:
         return np.sqrt(self.angle_noise.total_rms**2 + delta**2)
 
     @property
+    def sigma_motor(self) -> np.ndarray:
+        """Attainable error of the motor channel at each sample: its noise floor combined with the replay's."""
+        delta = self.replay_uncertainty_motor if self.replay_uncertainty_motor is not None else np.zeros(self.n)
+        return np.sqrt(self.motor_noise.total_rms**2 + delta**2)
+
+    @property
     def signals(self) -> int:
-        """Measured signals fitted: 1 (the torque) or 2 (torque, then the handwheel angle)."""
-        return 2 if self.uses_angle else 1
+        """Measured signals fitted: the torque, then the handwheel angle and the motor channel where fitted."""
+        return 1 + int(self.uses_angle) + int(self.uses_motor)
 
     @property
     def m(self) -> int:
@@ -141,27 +157,38 @@ class FileData:
 
     @property
     def measured(self) -> np.ndarray:
-        """The fitted signals, stacked: the torque (N m), then with an angle the handwheel angle (rad)."""
-        return np.concatenate([self.torque_Nm, self.angle_rad]) if self.uses_angle else self.torque_Nm
+        """The fitted signals, stacked: the torque (N m), then with an angle the handwheel angle (rad), then with a
+        motor channel the motor's current (A) or torque (N m)."""
+        if not (self.uses_angle or self.uses_motor):
+            return self.torque_Nm
+        return np.concatenate([self.torque_Nm] + ([self.angle_rad] if self.uses_angle else [])
+                              + ([self.motor] if self.uses_motor else []))
 
     @property
     def sigma(self) -> np.ndarray:
         """The attainable error of each fitted signal's samples, stacked as :attr:`measured`."""
-        return np.concatenate([self.sigma_Nm, self.sigma_rad]) if self.uses_angle else self.sigma_Nm
+        if not (self.uses_angle or self.uses_motor):
+            return self.sigma_Nm
+        return np.concatenate([self.sigma_Nm] + ([self.sigma_rad] if self.uses_angle else [])
+                              + ([self.sigma_motor] if self.uses_motor else []))
 
     @property
     def replay_draws(self) -> np.ndarray | None:
         """Each draw's replayed signals less the draws' mean, stacked as :attr:`measured`."""
-        if not self.uses_angle or self.replay_draws_Nm is None:
+        if not (self.uses_angle or self.uses_motor) or self.replay_draws_Nm is None:
             return self.replay_draws_Nm
-        return None if self.replay_draws_rad is None else np.concatenate([self.replay_draws_Nm,
-                                                                          self.replay_draws_rad], axis=1)
+        parts = [self.replay_draws_Nm] + ([self.replay_draws_rad] if self.uses_angle else []) \
+            + ([self.replay_draws_motor] if self.uses_motor else [])
+        return None if any(p is None for p in parts) else np.concatenate(parts, axis=1)
 
     def torque_part(self, prediction: np.ndarray) -> np.ndarray:
         return prediction[: self.n]
 
     def angle_part(self, prediction: np.ndarray) -> np.ndarray | None:
-        return prediction[self.n :] if self.uses_angle else None
+        return prediction[self.n : 2 * self.n] if self.uses_angle else None
+
+    def motor_part(self, prediction: np.ndarray) -> np.ndarray | None:
+        return prediction[self.m - self.n :] if self.uses_motor else None
 
 
 def prepare_file(measurement: Measurement, case: str | None = None, label: str | None = None,
@@ -180,14 +207,20 @@ def prepare_file(measurement: Measurement, case: str | None = None, label: str |
     if ANGLE in measurement.columns and "rack_derived" not in measurement.metadata:
         angle = measurement.columns[ANGLE]
         angle_floor = noise_floor(angle, measurement.quantisation_step(ANGLE))
+    motor_column = next((c for c in MOTOR_COLUMNS if c in measurement.columns), None)
+    motor = motor_floor = None
+    if motor_column is not None:  # its noise floor estimated as the torque's (metrics.noise_floor)
+        motor = measurement.columns[motor_column]
+        motor_floor = noise_floor(motor, measurement.quantisation_step(motor_column))
     return FileData(label, measurement, case, measurement.surface, rack, phases, floor, angle_rad=angle,
-                    angle_noise=angle_floor)
+                    angle_noise=angle_floor, motor_column=motor_column, motor=motor, motor_noise=motor_floor)
 
 
 def load_files(paths: list[str | Path], params: Parameters, case: str | None = None, surface: str | None = None,
-               channel_map=None) -> list[FileData]:
+               channel_map=None, assist: str | None = None) -> list[FileData]:
     """Read (through :func:`parksteer.measure.importers.load_record`), validate and prepare measurement files;
-    `case` replaces the case every file names, `surface` fills the surface a file does not state."""
+    `case` replaces the case every file names, `surface` fills the surface a file does not state; `assist` (an
+    assisted car's effect) derives an angle-only record's rack through its torsion bar (:func:`rack_from_angle`)."""
     if not paths:
         raise UsageError("no measurement file given")
     if case is not None:
@@ -207,7 +240,7 @@ def load_files(paths: list[str | Path], params: Parameters, case: str | None = N
             )
         resolution = 0.0
         if "rack_derived" in measurement.metadata:
-            measurement = rack_from_angle(measurement, params)
+            measurement = rack_from_angle(measurement, params, assist)
             logger = rack_logger(measurement, params)
             resolution = 0.0 if logger is None else quantisation_step(logger[0], logger[1])
         with naming(path):
@@ -215,7 +248,7 @@ def load_files(paths: list[str | Path], params: Parameters, case: str | None = N
     return files
 
 
-def rack_from_angle(measurement: Measurement, params: Parameters) -> Measurement:
+def rack_from_angle(measurement: Measurement, params: Parameters, assist: str | None = None) -> Measurement:
     """A copy of an angle-only record (its rack derived by the importer) with the rack derived through the model's
     column: the column angle is the handwheel angle less the twist that passes the measured torque through the
     column's spring and damper, ``c dtwist/dt + k twist = T`` (:func:`parksteer.model.numeric.prescribed.column_twist`,
@@ -230,18 +263,38 @@ def rack_from_angle(measurement: Measurement, params: Parameters) -> Measurement
     the angle-derived rack's own noise (a 14-bit angle on +-16 rad: 1.05e-5 m steps). That error sits at the
     reversals, where the rack friction flips, and made a null record unexplained. The torque's noise reaches the
     rack through the twist only, divided by k and the ratio (0.1 N m: 5e-7 m) and low-passed by the damper.
+
+    Of an assisted car (`assist`, the effect's name), the torque is the torsion bar's and the bar is in series with
+    the column shaft: the twist is through their series stiffness k k_t / (k + k_t), with the damping that keeps
+    the column's time constant (as the assist's deflection law); a bar on the pinion (pinion, rack and hydraulic
+    gears) reads the column torque through the joint, T_s = T dtheta_c/dtheta_p.
     """
     s = params.sections["steering"]
     columns = measurement.columns
-    twist, _ = column_twist(columns["time_s"], columns[TORQUE], s["column_torsional_stiffness"],
-                            s["column_torsional_damping"])
-    pinion = pinion_angle_from_column(columns[ANGLE] - twist, s["hooke_joint_angle"], s["hooke_joint_phase"])
+    stiffness, damping = s["column_torsional_stiffness"], s["column_torsional_damping"]
+    torque = columns[TORQUE]
+    if assist is not None:  # the torsion bar in series with the column shaft (assist_common.series_deflection)
+        bar = params[f"{assist}.torsion_bar_stiffness"]
+        series = stiffness * bar / (stiffness + bar)
+        stiffness, damping = series, damping * series / stiffness
+    twist, _ = column_twist(columns["time_s"], torque, stiffness, damping)
+    joint = (s["hooke_joint_angle"], s["hooke_joint_phase"])
+    pinion = pinion_angle_from_column(columns[ANGLE] - twist, *joint)
+    if assist is not None and not assist.endswith("_column"):
+        # the bar on the pinion reads T_s = T dtheta_c/dtheta_p: the column carries T_s dtheta_p/dtheta_c, the
+        # joint's speed ratio taken at the column angle of the first pass (it varies by 1e-4 over the twist)
+        column = columns[ANGLE] - twist
+        h = 1e-6
+        ratio = (pinion_angle_from_column(column + h, *joint) - pinion_angle_from_column(column - h, *joint)) / (2 * h)
+        twist, _ = column_twist(columns["time_s"], torque * ratio, stiffness, damping)
+        pinion = pinion_angle_from_column(columns[ANGLE] - twist, *joint)
     metadata = dict(measurement.metadata)
     metadata["rack_derived"] = (
         f"from {ANGLE} and {TORQUE} through the model's column (parksteer.diagnose.problem.rack_from_angle): twist "
-        f"from c dtwist/dt + k twist = T with k {s['column_torsional_stiffness']:g} N m/rad and c "
-        f"{s['column_torsional_damping']:g} N m s/rad, Hooke joint angle {s['hooke_joint_angle']:g} rad and phase "
+        f"from c dtwist/dt + k twist = T with k {stiffness:g} N m/rad and c "
+        f"{damping:g} N m s/rad, Hooke joint angle {s['hooke_joint_angle']:g} rad and phase "
         f"{s['hooke_joint_phase']:g} rad, ratio {s['handwheel_to_rack_ratio']:g} rad/m"
+        + (f"; the torsion bar of {assist} in series" if assist is not None else "")
     )
     return replace(measurement, columns={**columns, "rack_m": pinion / s["handwheel_to_rack_ratio"]},
                    metadata=metadata)
@@ -348,6 +401,10 @@ class Problem:
         angle is shifted by the mean of the measured minus replayed angle (a constant fitted in closed form)."""
         f = self.files[index]
         replay = replay if replay is not None else self.replay(effects, index)
+        if f.uses_motor:  # an assisted car's torsion-bar torque and its motor's current or torque
+            solution = replay.solve(overrides)
+            motor = solution.motor_current_A if f.motor_column == "motor_current_A" else solution.motor_torque_Nm
+            return np.concatenate([solution.torque_Nm, motor])
         if not f.uses_angle:
             return replay.torque(overrides)
         solution = replay.solve(overrides, outputs=True)
@@ -381,9 +438,7 @@ class Problem:
     def in_torque_floors(self, values: list[np.ndarray]) -> np.ndarray:
         """Model differences with each angle sample rescaled by the torque's over the angle's noise floor: a change
         of one angle floor counts as one torque floor (N m), so that torque and angle changes add up."""
-        return np.concatenate([v if not f.uses_angle else
-                               np.concatenate([v[: f.n], v[f.n :] * (f.noise.total_rms / f.angle_noise.total_rms)])
-                               for f, v in zip(self.files, values)])
+        return np.concatenate([_in_torque_floors(f, v) for f, v in zip(self.files, values)])
 
     def with_replay_uncertainty(self, effects: list[Effect], overrides: dict[str, float] | None = None,
                                 draws: int = DEFAULT_SETTINGS.replay_ensemble_draws,
@@ -426,7 +481,7 @@ class Problem:
             f = replace(f, replay_draws_Nm=torque_runs - torque_runs.mean(axis=0),
                         replay_uncertainty_Nm=_spread(torque_runs, f.replay_uncertainty_Nm if keep_larger else None))
             if f.uses_angle:  # each draw's angle carries its own fitted zero (Problem.signals)
-                angle_runs = runs[:, f.n :]
+                angle_runs = runs[:, f.n : 2 * f.n]
                 # The replayed torque is itself off by about its attainable error, and the twist that passes it by
                 # as much through the column's compliance (in a dead band: the band, where |T| is that small).
                 through_torque = self.replay(effects, i).twist_spread(f.sigma_Nm, overrides)
@@ -434,8 +489,25 @@ class Problem:
                 before = f.replay_uncertainty_rad if keep_larger else None
                 f = replace(f, replay_draws_rad=angle_runs - angle_runs.mean(axis=0),
                             replay_uncertainty_rad=spread if before is None else np.maximum(spread, before))
+            if f.uses_motor:
+                motor_runs = runs[:, f.m - f.n :]
+                before = f.replay_uncertainty_motor if keep_larger else None
+                f = replace(f, replay_draws_motor=motor_runs - motor_runs.mean(axis=0),
+                            replay_uncertainty_motor=_spread(motor_runs, before))
             files.append(f)
         return self.with_files(files)
+
+
+def _in_torque_floors(f: FileData, v: np.ndarray) -> np.ndarray:
+    """`v` (a file's stacked signals) with the angle's and the motor's samples in torque floors per own floor."""
+    if not (f.uses_angle or f.uses_motor):
+        return v
+    parts = [v[: f.n]]
+    if f.uses_angle:
+        parts.append(f.angle_part(v) * (f.noise.total_rms / f.angle_noise.total_rms))
+    if f.uses_motor:
+        parts.append(f.motor_part(v) * (f.noise.total_rms / f.motor_noise.total_rms))
+    return np.concatenate(parts)
 
 
 def _spread(runs: np.ndarray, before: np.ndarray | None) -> np.ndarray:
@@ -530,6 +602,20 @@ def fit_statistics(problem: Problem, predictions: list[np.ndarray]) -> dict:
             "attainable_floor_rad": float(np.sqrt(np.mean(angle_attainable**2))),
             "weighted_rss": float(np.sum(angle_weighted**2)),
             "samples": int(angle.size),
+        }
+    with_motor = [(f, m) for f, m in zip(files, predictions) if f.uses_motor]
+    if with_motor:  # an assisted car's motor channel beside the torque (in its own unit, A or N m)
+        motor = np.concatenate([f.motor - f.motor_part(m) for f, m in with_motor])
+        motor_floors = np.concatenate([np.full(f.n, f.motor_noise.total_rms) for f, _ in with_motor])
+        motor_weighted = np.concatenate([(f.motor - f.motor_part(m)) / f.sigma_motor for f, m in with_motor])
+        out["motor"] = {
+            "column": with_motor[0][0].motor_column,
+            "rms": float(np.sqrt(np.mean(motor**2))),
+            "peak": float(np.max(np.abs(motor))),
+            "weighted_rms": float(np.sqrt(np.mean((motor_weighted * motor_floors) ** 2))),
+            "noise_floor": float(np.sqrt(np.mean(motor_floors**2))),
+            "weighted_rss": float(np.sum(motor_weighted**2)),
+            "samples": int(motor.size),
         }
     return out
 

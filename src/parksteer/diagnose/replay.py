@@ -15,6 +15,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..measure.smoothing import SmoothedRack
+from ..errors import UsageError
+from ..model.numeric.assisted import assist_effect, solve_assisted
 from ..model.numeric.prescribed import PrescribedSolution, solve, twist_spread
 from ..model.numeric.simulate import PreparedRun, prepare
 from ..model.symbolic.components import Effect
@@ -116,10 +118,23 @@ class Replay:
         run, p = self.parameter_vector()
         return float(p[run.parameter_index(key)])
 
+    @property
+    def assisted(self) -> bool:
+        """Whether the model has a power assist: then the replay is the assisted one
+        (:func:`parksteer.model.numeric.assisted.solve_assisted`), its torque the torsion bar's."""
+        return assist_effect(self._base) is not None
+
     def solve(self, overrides: dict[str, float] | None = None, outputs: bool = False) -> PrescribedSolution:
-        """The prescribed-rack solve at `time_s` (with `outputs`, also the states and the model's outputs)."""
+        """The prescribed-rack solve at `time_s` (with `outputs`, also the states and the model's outputs); of an
+        assisted car, the assisted solve (torsion-bar torque, motor torque and current; no outputs)."""
         run, p = self.parameter_vector(overrides)
         self.evaluations += 1
+        if self.assisted:
+            if outputs:
+                raise UsageError("the handwheel angle of an assisted car is not replayed (its twist passes the "
+                                 "torsion-bar torque through the torsion bar in series); fit the torque and the motor "
+                                 "channel instead of --angle")
+            return solve_assisted(run, p, self.rack, self.time_s)
         return solve(run, p, self.rack, self.time_s, outputs=outputs)
 
     def twist_spread(self, torque_error: np.ndarray, overrides: dict[str, float] | None = None) -> np.ndarray:

@@ -54,8 +54,10 @@ from __future__ import annotations
 
 from dataclasses import replace
 
+from ..errors import UsageError
 from ..model.symbolic.components import Effect, discover_effects, resolve_effects
 from ..parameters import Parameters
+from .compare import check_torque_sensors
 from .parallel import Progress
 from .problem import FileData, Problem
 from .settings import DEFAULT_SETTINGS, DiagnosisSettings
@@ -83,11 +85,20 @@ def diagnose(files: list[FileData], params: Parameters, effects=None, registry: 
     Nothing passed in is changed: the files are copied (whether each fits its angle: where it has one beside a
     measured rack, if the settings ask), and what the stages derive for them goes into further copies.
     """
-    copies = [replace(f, uses_angle=settings.use_handwheel_angle and f.angle_rad is not None,
-                      replay_uncertainty_rad=None, replay_draws_rad=None) for f in files]
-    problem = Problem(copies, params, workers=workers, angle_offset_fitted=settings.angle_offset_fitted)
     base = effects if isinstance(effects, list) and all(isinstance(e, Effect) for e in effects) \
         else resolve_effects(effects)
+    # An assisted car's record: its motor channel fitted beside the torsion-bar torque (settings.use_motor_channel);
+    # its handwheel angle is not replayed (parksteer.diagnose.replay).
+    assisted = any(getattr(e, "power_assist", False) for e in base)
+    check_torque_sensors(files, assisted)
+    if assisted and settings.use_handwheel_angle and any(f.angle_rad is not None for f in files):
+        raise UsageError("--angle: the handwheel angle of an assisted car is not replayed; diagnose its torsion-bar "
+                         "torque with the motor channel instead")
+    copies = [replace(f, uses_angle=settings.use_handwheel_angle and f.angle_rad is not None,
+                      replay_uncertainty_rad=None, replay_draws_rad=None,
+                      uses_motor=assisted and settings.use_motor_channel and f.motor is not None,
+                      replay_uncertainty_motor=None, replay_draws_motor=None) for f in files]
+    problem = Problem(copies, params, workers=workers, angle_offset_fitted=settings.angle_offset_fitted)
     progress = Progress(quiet)
     state = DiagnosisState(settings, problem, tuple(base),
                            frozen_mapping(registry if registry is not None else discover_effects()),

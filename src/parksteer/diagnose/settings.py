@@ -65,6 +65,12 @@ class DiagnosisSettings:
     # The angle sensor's zero is its own (mounted on the column at some spline position, zeroed by hand): a
     # constant per file, fitted in closed form (the mean of measured minus replayed angle) at every replay.
     angle_offset_fitted: bool = True
+    # An assisted car's record with the motor's current (or torque) beside the torsion-bar torque: the motor channel
+    # fitted as a second signal (parksteer.diagnose.problem; the replay's motor current from the boost law). It is
+    # the torsion-bar torque amplified by the boost curve's slope (about 8 A per N m on the Polo's assumed curve), so
+    # a current channel of 0.1 A resolution reads the torsion bar to about 0.01 N m, and it fixes the law itself (its
+    # gain, the sensor's zero). Off, or without an assist or such a channel, a diagnosis is the torque's alone.
+    use_motor_channel: bool = True
 
     # --- the torque channel's lag (parksteer.diagnose.stages.torque_lag) ---------------------------------------
     # A logger's torque channel may run behind its rack channel (a sensor's or an amplifier's filter delay,

@@ -46,13 +46,19 @@ from .readers.base import TIME_ALIASES, name_and_unit, normal_name
 from .readers.can_log import read_bus_log
 
 RACK, TORQUE, ANGLE, TIME = "rack_m", "handwheel_torque_Nm", "handwheel_angle_rad", "time_s"
+# An assisted car's torque sensor: a map target of its own, read into the torque column with the metadata
+# torque_sensor = torsion_bar (the torque role with a flag: everything downstream of the import reads one torque).
+TORSION_BAR = "torsion_bar_torque_Nm"
+CURRENT, MOTOR_TORQUE, SPEED = "motor_current_A", "motor_torque_Nm", "vehicle_speed_mps"
+MAP_TARGETS = ALLOWED_COLUMNS + (TORSION_BAR,)
 RACK_DRIVE_COLUMNS = (TIME, RACK)
 
 # The pint unit each native column is converted to.
 SI_UNITS = {TIME: "s", RACK: "m", TORQUE: "N*m", ANGLE: "rad", "load_left_N": "N", "load_right_N": "N",
-            "vehicle_speed_mps": "m/s"}
+            SPEED: "m/s", TORSION_BAR: "N*m", CURRENT: "A", MOTOR_TORQUE: "N*m"}
 UNIT_DIMENSIONS = {TIME: "time", RACK: "length", TORQUE: "torque", ANGLE: "angle", "load_left_N": "force",
-                   "load_right_N": "force", "vehicle_speed_mps": "speed"}
+                   "load_right_N": "force", SPEED: "speed", TORSION_BAR: "torque", CURRENT: "current",
+                   MOTOR_TORQUE: "torque"}
 
 # Logger spellings pint reads as something else: "Nm" is pint's number-metre, never a torque on a logger.
 UNIT_SPELLINGS = {"Nm": "N*m", "rev": "revolution", "Nmm": "N*mm", "kNm": "kN*m", "deg.": "deg", "sec": "s", "kph": "km/h"}
@@ -68,6 +74,10 @@ ALIASES = {
             "lenkradwinkel"),
     "load_left_N": ("loadleft", "wheelloadleft", "fzfl"),
     "load_right_N": ("loadright", "wheelloadright", "fzfr"),
+    SPEED: ("vehiclespeed", "vehspeed", "speed", "fahrzeuggeschwindigkeit", "geschwindigkeit"),
+    TORSION_BAR: ("torsionbartorque", "torsionbar", "tbt", "torsionstabmoment", "drehstabmoment"),
+    CURRENT: ("motorcurrent", "epscurrent", "imotor", "motorstrom"),
+    MOTOR_TORQUE: ("motortorque", "epsmotortorque", "motormoment"),
 }
 
 # Plausibility against the car (the parameter file's lock and ratio). Refused, not warned: each of these makes a
@@ -141,8 +151,8 @@ def parse_channel_map(text: str, origin: str = "--map") -> list[Channel]:
         source, unit = name_and_unit(source_text)
         if not eq or not source:
             raise UsageError(f"{origin}: entry {entry!r} must read 'Source[unit]=target', e.g. 'RackPos[mm]=rack_m'")
-        if target not in ALLOWED_COLUMNS:
-            raise UsageError(f"{origin}: entry {entry!r}: unknown target {target!r} (known: {', '.join(ALLOWED_COLUMNS)})")
+        if target not in MAP_TARGETS:
+            raise UsageError(f"{origin}: entry {entry!r}: unknown target {target!r} (known: {', '.join(MAP_TARGETS)})")
         for other in channels:
             if other.target == target:
                 raise UsageError(f"{origin}: entries {other.spec()!r} and {entry!r} both map to {target!r}")
@@ -291,7 +301,7 @@ def _map_sources(where: Path, sources: list[Source], channel_map: list[Channel] 
     for s in sources:
         if s.name in used:
             continue
-        if s.name in ALLOWED_COLUMNS:
+        if s.name in MAP_TARGETS:
             target = s.name
         elif channel_map is None or normal_name(s.name) in ALIASES[TIME]:
             target = next((t for t, names in ALIASES.items() if normal_name(s.name) in names), None)
@@ -493,7 +503,7 @@ def load_record(path: str | Path, channel_map: str | list[Channel] | None = None
     ignored = [s.name for s in sources if all(s is not src for src, _ in chosen.values())]
     if ignored:
         notes.append(f"{path}: note: ignored channel{'s' if len(ignored) > 1 else ''} {', '.join(ignored)} "
-                     f"(not mapped to {', '.join(ALLOWED_COLUMNS)})")
+                     f"(not mapped to {', '.join(MAP_TARGETS)})")
     _on_one_time_base(path, record, chosen, listing)
 
     columns: dict[str, np.ndarray] = {}
@@ -520,6 +530,11 @@ def load_record(path: str | Path, channel_map: str | list[Channel] | None = None
                if (src.name != ch.target or ch.negate) and ch.origin != "master"]
     if renamed:
         metadata["channel_map"] = ", ".join(renamed)
+    _torsion_bar_as_torque(path, columns, chosen, metadata)
+    if CURRENT in columns and MOTOR_TORQUE in columns:
+        raise UsageError(f"{path}: channels {chosen[CURRENT][0].name!r} ({CURRENT}) and {chosen[MOTOR_TORQUE][0].name!r} "
+                         f"({MOTOR_TORQUE}) are both the motor's; map one (the current, if the car's torque constant "
+                         "is the file's)")
 
     _check_against_lock(path, columns, chosen, params, line_numbers)
     derived = False
@@ -556,6 +571,25 @@ def load_record(path: str | Path, channel_map: str | list[Channel] | None = None
     for note in notes:
         sys.stderr.write(note + "\n")
     return Measurement(path=path, columns=ordered, metadata=metadata)
+
+
+def _torsion_bar_as_torque(path: Path, columns: dict, chosen: dict, metadata: dict[str, str]) -> None:
+    """An assisted car's torsion-bar channel read as the torque column, the metadata saying which sensor it is
+    (an assisted car has no other torque sensor; see :mod:`parksteer.measure.io`)."""
+    if TORSION_BAR not in columns:
+        return
+    if TORQUE in columns:
+        raise UsageError(f"{path}: channels {chosen[TORQUE][0].name!r} ({TORQUE}) and {chosen[TORSION_BAR][0].name!r} "
+                         f"({TORSION_BAR}) are both a steering torque; map the one the model is to be judged on")
+    if metadata.get("torque_sensor", "torsion_bar") != "torsion_bar":
+        raise UsageError(f"{path}: metadata torque_sensor = {metadata['torque_sensor']!r}, but channel "
+                         f"{chosen[TORSION_BAR][0].name!r} is mapped to {TORSION_BAR}")
+    columns[TORQUE] = columns.pop(TORSION_BAR)
+    chosen[TORQUE] = chosen.pop(TORSION_BAR)
+    for key in (f"full_scale_{TORSION_BAR}", f"bits_{TORSION_BAR}"):
+        if key in metadata:
+            metadata[key.replace(TORSION_BAR, TORQUE)] = metadata.pop(key)
+    metadata["torque_sensor"] = "torsion_bar"
 
 
 def _unmapped(ignored: list[str]) -> str:

@@ -14,7 +14,13 @@ Columns (SI units; the unit is part of the name):
 
 - required: ``time_s`` (strictly increasing), ``rack_m`` (positive to the right),
   ``handwheel_torque_Nm``;
-- optional: ``handwheel_angle_rad``, ``load_left_N``, ``load_right_N``, ``vehicle_speed_mps``.
+- optional: ``handwheel_angle_rad``, ``load_left_N``, ``load_right_N``, ``vehicle_speed_mps``, and of an
+  assisted car ``motor_current_A`` or ``motor_torque_Nm`` (the assist motor's, as its control unit reports it).
+
+An assisted car's torque sensor is its torsion bar: its record's ``handwheel_torque_Nm`` is the torsion-bar torque
+and the metadata say so (``torque_sensor: torsion_bar``; the default is ``handwheel``). For a column assist the two
+are one torque (the column is massless: the bar carries the driver's torque); at the pinion they differ by the
+intermediate shaft's joint, and the assisted replay predicts the torsion bar's.
 
 Metadata: ``case`` (a case of the parameter file) and ``surface`` (``ground`` or
 ``air_bearing``) are required, because a comparison with the model needs both;
@@ -49,7 +55,8 @@ REQUIRED_COLUMNS = ("time_s", "rack_m", "handwheel_torque_Nm")
 OPTIONAL_COLUMNS = ("handwheel_angle_rad", "load_left_N", "load_right_N")
 # The car's speed (a CAN log's speed signal; 0 in a standstill parking test): a column of measured records only,
 # kept out of OPTIONAL_COLUMNS, which the synthetic records take as the model's recorded channels.
-MEASURED_ONLY_COLUMNS = ("vehicle_speed_mps",)
+# The assist motor's current or torque: a second measured signal of an assisted car (its control unit's).
+MEASURED_ONLY_COLUMNS = ("vehicle_speed_mps", "motor_current_A", "motor_torque_Nm")
 ALLOWED_COLUMNS = REQUIRED_COLUMNS + OPTIONAL_COLUMNS + MEASURED_ONLY_COLUMNS
 UNITS = {
     "time_s": "s",
@@ -59,7 +66,11 @@ UNITS = {
     "load_left_N": "N",
     "load_right_N": "N",
     "vehicle_speed_mps": "m/s",
+    "motor_current_A": "A",
+    "motor_torque_Nm": "N m",
 }
+# What sensor the torque column holds (metadata torque_sensor): the handwheel's, or an assisted car's torsion bar.
+TORQUE_SENSORS = ("handwheel", "torsion_bar")
 REQUIRED_METADATA = ("case", "surface")
 
 # A lock-to-lock cycle has up to nine phase segments (initial rise; wind-up and sliding on
@@ -78,6 +89,10 @@ TORQUE_LIMIT_NM = 200.0
 ANGLE_LIMIT_RAD = 30.0
 LOAD_LIMIT_N = 20000.0
 LOAD_KILONEWTON_SUSPICION_N = 20.0
+# An EPS motor draws up to about 100 A (peak torques 3-6 N m at 0.03-0.07 N m/A); beyond 500 A the channel is in
+# mA or scaled. Motor torques are a few N m; beyond 50 N m the channel is the assist at the column or rack.
+MOTOR_CURRENT_LIMIT_A = 500.0
+MOTOR_TORQUE_LIMIT_NM = 50.0
 EXTRA_OFFSET_LIMIT_M = 0.2
 # A steering cycle moves the rack to a lock (tens of millimetres); a rack that spans less than half a millimetre,
 # the size of the rack lash, holds no cycle to compare, smooth or replay.
@@ -105,6 +120,11 @@ class Measurement:
     @property
     def handwheel_torque_Nm(self) -> np.ndarray:
         return self.columns["handwheel_torque_Nm"]
+
+    @property
+    def torque_sensor(self) -> str:
+        """``handwheel``, or ``torsion_bar`` for an assisted car's record (metadata torque_sensor)."""
+        return self.metadata.get("torque_sensor", "handwheel")
 
     @property
     def case(self) -> str:
@@ -183,6 +203,9 @@ def _validate_metadata(where: Path | str, metadata: Mapping[str, str], params: P
         raise UsageError(f"{where}: unknown case {metadata['case']!r} (known: {known})")
     if metadata["surface"] not in SURFACES:
         raise UsageError(f"{where}: unknown surface {metadata['surface']!r} (known: {', '.join(SURFACES)})")
+    if metadata.get("torque_sensor", "handwheel") not in TORQUE_SENSORS:
+        raise UsageError(f"{where}: metadata torque_sensor = {metadata['torque_sensor']!r} (known: "
+                         f"{', '.join(TORQUE_SENSORS)})")
     if "extra_offset_m" in metadata:
         offset = _parse_number(metadata["extra_offset_m"], f"{where}: metadata extra_offset_m")
         if offset > EXTRA_OFFSET_LIMIT_M:
@@ -272,6 +295,10 @@ def _validate_columns(where: Path | str, columns: Mapping[str, np.ndarray], line
         "implausible handwheel torque (parking torques are tens of N m); check the column's unit and scale",
     )
     check_limit("handwheel_angle_rad", ANGLE_LIMIT_RAD, "looks like degrees; convert to radians")
+    check_limit("motor_current_A", MOTOR_CURRENT_LIMIT_A,
+                "implausible motor current (EPS motors draw up to about 100 A); check the unit (mA?) and scale")
+    check_limit("motor_torque_Nm", MOTOR_TORQUE_LIMIT_NM,
+                "implausible motor torque (EPS motors give a few N m); is it the assist at the column or rack?")
     for name in ("load_left_N", "load_right_N"):
         check_limit(name, LOAD_LIMIT_N, "implausible wheel load (a front wheel carries about 3000 N)")
         if name in columns and np.abs(columns[name]).max() < LOAD_KILONEWTON_SUSPICION_N:

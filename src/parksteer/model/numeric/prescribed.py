@@ -138,15 +138,18 @@ class PrescribedSolution:
 
 
 def solve(run, p: np.ndarray, rack: RackMotion, t_out, rtol: float = PRESCRIBED_RTOL,
-          atol_factor: float = PRESCRIBED_ATOL_FACTOR, outputs: bool = False) -> PrescribedSolution:
+          atol_factor: float = PRESCRIBED_ATOL_FACTOR, outputs: bool = False,
+          assist_off: bool = False) -> PrescribedSolution:
     """Solve the model of `run` (a PreparedRun) with parameter vector `p`, the rack following `rack`.
 
     The run starts from static equilibrium with the rack at its position at ``t_out[0]``;
     `t_out` (s, strictly increasing) are the output times. Tolerances: relative `rtol`, absolute
-    `atol_factor` times the model's own (:mod:`parksteer.model.numeric.tolerances`).
+    `atol_factor` times the model's own (:mod:`parksteer.model.numeric.tolerances`). `assist_off`: the caller has
+    switched an assist's boost off in `p` (its gain 0), so that no force depends on the column torque and the
+    drive, written at zero handwheel input, is exact (:mod:`.assisted` solves an assisted car so).
     """
     model = run.model
-    if not model.info.get("rack_drive", True):
+    if not model.info.get("rack_drive", True) and not assist_off:
         raise UsageError(f"a prescribed rack cannot drive the effects {', '.join(model.effects)}: an assist feeds the "
                          "torsion-bar torque back into the load, so drive it by the handwheel angle")
     lib = model.lib

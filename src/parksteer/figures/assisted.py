@@ -1,0 +1,88 @@
+"""figures/diag_assisted: the assisted benchmark (:mod:`parksteer.diagnose.assisted_benchmark`) scored and drawn."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ..plotting import COLOURS, new_figure, save_svg
+from .diagnose import VARIATION_SHADES, _cell
+
+LABELS = {"assist_motor_friction": "motor friction", "torsion_bar_offset": "torsion-bar offset",
+          "boost_gain_error": "boost gain error", "rack_friction": "rack friction (calibrated)"}
+
+
+def assisted_figure(rows: list[dict], summary: dict, path: str | Path) -> None:
+    """Left: per hidden candidate the records named (of those of at least the named-rate's size), the nulls called
+    adequate and the out-of-class records without a confident wrong answer, each shaded by whether its target holds.
+    Right: each record's calibrated weighted error in noise floors (nulls, hidden, out of class) against the
+    diagnosis's adequate_rms_factor."""
+    from ..diagnose.settings import DEFAULT_SETTINGS
+    from ..diagnose.variations import NAMED_TARGET, NULL_ADEQUATE_TARGET
+
+    cells = [(LABELS.get(h, h), k, n, NAMED_TARGET) for h, (k, n) in summary["named_by_hidden"].items()]
+    targets = summary["targets"]
+    cells.append(("nothing hidden: adequate", *targets["null_adequate"]["count"], NULL_ADEQUATE_TARGET))
+    outclass = [r for r in rows if r["kind"] == "outclass"]
+    right = sum(not r["confident_wrong"] for r in outclass)
+    cells.append(("out of class: no confident wrong", right, len(outclass), 1.0))
+    fig, axes = new_figure(7.4, 0.34 * len(cells) + 1.4, ncols=2, gridspec_kw={"width_ratios": [0.8, 1.8]})
+    ax = axes[0]
+    for i, (_label, k, n, target) in enumerate(cells):
+        ax.add_patch(_cell(0, i, VARIATION_SHADES[None if n == 0 else k / n >= target]))
+        ax.text(0, i, f"{k}/{n}" if n else "-", ha="center", va="center", fontsize=7)
+    ax.set_xlim(-0.5, 0.5)
+    ax.set_ylim(len(cells) - 0.5, -0.5)
+    ax.set_xticks([0], ["records"], fontsize=7)
+    ax.xaxis.tick_top()
+    ax.set_yticks(np.arange(len(cells)), [c[0] for c in cells], fontsize=7)
+    ax.grid(False)
+    ax = axes[1]
+    kinds = (("null", "o", "nothing hidden"), ("hidden", "^", "candidate hidden"), ("outclass", "s", "out of class"))
+    for j, (kind, marker, label) in enumerate(kinds):
+        values = [r["calibrated_over_floor"] for r in rows if r["kind"] == kind]
+        ax.plot(values, [j] * len(values), marker, color=COLOURS[j], markersize=5, alpha=0.7, linestyle="none",
+                label=label)
+    adequate = DEFAULT_SETTINGS.adequate_rms_factor
+    ax.axvline(adequate, color="black", linestyle="--", linewidth=1.0, label=f"adequate_rms_factor {adequate:g}")
+    ax.set_yticks(range(len(kinds)), [k[2] for k in kinds], fontsize=7)
+    ax.set_ylim(len(kinds) - 0.5, -0.5)
+    ax.set_xscale("log")
+    ax.set_xlabel("calibrated model's weighted RMS error / noise floor (torsion bar and current)")
+    ax.legend(fontsize=6.5, loc="lower right")
+    save_svg(fig, path)
+
+
+def make_assisted_figure(parameters: str | Path, vehicle: str | Path, svg: str | Path, csv: str | Path,
+                         json_path: str | Path, progress=None) -> dict:
+    """Run the assisted benchmark on `vehicle` (its [assist]) over `parameters`, write figures/diag_assisted.svg, its
+    CSV (one row per record) and results/diag_assisted.json (the targets and the misses), without machine times."""
+    from ..diagnose.assisted_benchmark import AssistedDesign, run
+    from ..diagnose.report import MACHINE_TIME_KEYS, without_machine_times
+    from ..model.symbolic.components import discover_effects
+    from ..parameters import load_parameters
+    from ..tables import write_csv, write_json
+    from ..vehicle import load_vehicle
+
+    discover_effects()
+    params = load_vehicle(vehicle, load_parameters(parameters))
+    rows, summary = run(params, AssistedDesign(vehicle=str(vehicle)), progress=progress)
+    assisted_figure(rows, summary, svg)
+    names = ["name", "kind", "variation", "hidden", "steps_requested", "steps", "strength", "verdict", "effect",
+             "indistinguishable", "named", "covered", "relation", "bic_margin", "confident_wrong",
+             "calibrated_over_floor"]
+    def cell(value):
+        if value is None:
+            return ""
+        return ("yes" if value else "no") if isinstance(value, bool) else value
+
+    columns = {n: [cell(r.get(n)) for r in rows] for n in names if n not in MACHINE_TIME_KEYS}
+    write_csv(csv, columns, {"figure": "diag_assisted: one row per record of the assisted benchmark",
+                             "vehicle": Path(vehicle).name,
+                             "steps": "hidden size reached, converter steps of torsion-bar torque RMS",
+                             "named": "hidden candidate named (or in the reported group); rack friction: adequate",
+                             "covered": "rack friction: the calibrated interval holds the true value",
+                             "confident_wrong": "out of class: an unrelated candidate named beyond the BIC band"})
+    write_json(json_path, without_machine_times(summary))
+    return summary

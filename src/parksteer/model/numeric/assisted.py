@@ -1,0 +1,199 @@
+"""The prescribed-rack solve of an assisted car: the torsion-bar torque and the motor's output from a rack motion.
+
+Why the plain solve does not do it. The prescribed-rack solve (:mod:`.prescribed`) takes the column torque T as
+its unknown: ``M a = F + b T`` with the rack's acceleration given. An assist's force depends on the torsion-bar
+torque, i.e. on T itself, so F would hold the unknown (the generated drive refuses it: ``rack_drive`` false).
+
+Derivation. The model's column is massless and every assist acts on the steering's one kinematic chain: the
+column angle, the pinion angle (G_hr x, G_hr the handwheel-to-rack ratio) and the rack x are functions of x
+alone, so a torque on any of them has the generalized-force direction of the rack's, scaled by its lever
+dtheta/dx: ``c_col = dtheta_col/dx`` (the output ``column_angle_per_rack``, the Hooke joint's ratio in it),
+``G_hr`` at the pinion, 1 at the rack. With the rack prescribed, the rest of the model (wheels, tyres, the
+rotor's inertia N^2 J_m and friction, both fixed by the rack's motion) feels only the sum of the column torque and
+the assist, reduced to the rack:
+
+    R = T c_col + A_x lever_x,    lever_x = c_col (column), G_hr (pinion), 1 (rack; A_x a force),
+
+where A_x is the assist the reduction delivers at its point of action, eta N T_m. So solving the model once with
+the boost switched off (gain 0, or a valve of zero slope: the motor's inertia and friction, which depend on the
+kinematics alone, stay in) gives T_road(t), the column torque that alone would carry R: ``R = T_road c_col``.
+The torsion bar's torque is T_s = T (column assist) or T c_col / G_hr (pinion, rack, hydraulic: the bar on the
+pinion, the column torque through the joint). Dividing R by c_col (column) or G_hr (the others):
+
+    y = T_s + A(T_s),   y = T_road (column), T_road c_col / G_hr (pinion, rack, hydraulic),
+    A(T_s) = eta N clamp(G deadband(T_s) s / (eta N), T_max) / s,   s = 1 (column, pinion), G_hr (rack),
+    A(T_s) = a_p clamp(k_v deadband(T_s), p_relief) / G_hr          (hydraulic),
+
+the boost laws of :mod:`parksteer.model.symbolic.effects.electric_assist` and ``hydraulic_assist`` with the same
+smoothed corners (:mod:`parksteer.model.symbolic.effects.assist_common`). A is increasing (deadband and clamp are,
+strictly for a smoothed clamp: its slope is -(f(a) + f(b))/2 > 0 with f(z) = z / sqrt(z^2 + w^2), a + b = -2 L),
+so y(T_s) rises with slope >= 1 and has one root, found pointwise by bisection in ``[y - B, y + B]`` (B bounds
+|A|). The motor torque T_m and current T_m / k_t (or the pressure) then follow from the law. Nothing in this depends
+on the acceleration: the rotor's inertia is in T_road. The tests (tests/model/test_assisted_replay.py) replay a
+free assisted simulation's rack and recover its torsion-bar torque and motor current to the integrator's
+tolerance at the column, the pinion and the rack, and in saturation.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ...errors import UsageError
+from .prescribed import PRESCRIBED_ATOL_FACTOR, PRESCRIBED_RTOL, PrescribedSolution, RackMotion, solve
+
+# The bisection stops when the bracket is this narrow (N m of torsion-bar torque), far below a sensor's resolution.
+INVERSION_TOLERANCE_NM = 1e-12
+HYDRAULIC = "hydraulic_assist"
+OFFSET_KEY = "torsion_bar_offset.strength"
+GAIN_ERROR_KEY = "boost_gain_error.strength"
+
+
+def assist_effect(run):
+    """The power-assist effect of `run` (a PreparedRun), or None."""
+    found = [e for e in run.effects if getattr(e, "power_assist", False)]
+    return found[0] if found else None
+
+
+def boost_key(name: str) -> str:
+    """The quantity that switches the boost off at 0: the gain (electric) or the valve's slope (hydraulic)."""
+    return f"{name}.valve_slope" if name == HYDRAULIC else f"{name}.gain"
+
+
+def _ramp(z, width):
+    return 0.5 * (z + np.sqrt(z * z + width * width))
+
+
+def _deadband(x, band, width):
+    return _ramp(x - band, width) - _ramp(-x - band, width)
+
+
+def _clamp(y, limit, width):
+    return y - _ramp(y - limit, width) + _ramp(-y - limit, width)
+
+
+@dataclass(frozen=True)
+class BoostLaw:
+    """The boost law of one assist with its values: torsion-bar torque -> assist, in torsion-bar torque units.
+
+    ``location`` is the point of action (column, pinion, rack; a hydraulic gear acts at the rack through a valve on
+    the pinion). ``ratio`` is the handwheel-to-rack ratio G_hr (rad/m). Electric: gain, dead band, reduction N,
+    efficiency eta, motor limit, torque constant; hydraulic: valve slope (in ``gain``), relief pressure (in
+    ``limit``), piston area (in ``area``)."""
+
+    name: str
+    location: str
+    gain: float
+    dead_band: float
+    band_width: float
+    limit: float
+    limit_width: float
+    ratio: float
+    reduction: float = 1.0
+    efficiency: float = 1.0
+    torque_constant: float = 1.0
+    area: float = 0.0
+    offset: float = 0.0  # the torsion-bar sensor's zero offset (N m), read by the law and the logger alike
+
+    @property
+    def hydraulic(self) -> bool:
+        return self.name == HYDRAULIC
+
+    def motor(self, torsion_bar_Nm):
+        """The motor torque (N m; hydraulic: the pressure, Pa) at the torsion-bar torque (module docstring)."""
+        opening = _deadband(np.asarray(torsion_bar_Nm, dtype=float), self.dead_band, self.band_width)
+        if self.hydraulic:
+            return _clamp(self.gain * opening, self.limit, self.limit_width)
+        scale = self.ratio if self.location == "rack" else 1.0
+        return _clamp(self.gain * opening * scale / (self.efficiency * self.reduction), self.limit, self.limit_width)
+
+    def assist(self, torsion_bar_Nm):
+        """A(T_s): the assist in torsion-bar torque units (what it adds to the torsion bar's torque in y)."""
+        if self.hydraulic:
+            return self.area * self.motor(torsion_bar_Nm) / self.ratio
+        scale = self.ratio if self.location == "rack" else 1.0
+        return self.efficiency * self.reduction * self.motor(torsion_bar_Nm) / scale
+
+    def bound(self) -> float:
+        """An upper bound of |A| (the clamp's magnitude is below limit + width)."""
+        if self.hydraulic:
+            return self.area * (self.limit + self.limit_width) / self.ratio
+        scale = self.ratio if self.location == "rack" else 1.0
+        return self.efficiency * self.reduction * (self.limit + self.limit_width) / scale
+
+    def torsion_bar(self, y, factor=1.0) -> np.ndarray:
+        """The torsion-bar torque T_s with T_s + factor A(T_s) = y, elementwise (bisection; A is increasing, and
+        so is the sum for any factor >= 0: a motor whose delivered torque departs from the law by `factor`)."""
+        y = np.asarray(y, dtype=float)
+        width = self.bound() * float(np.max(factor)) + 1.0
+        low, high = y - width, y + width
+        for _ in range(200):
+            mid = 0.5 * (low + high)
+            above = mid + factor * self.assist(mid) > y
+            high = np.where(above, mid, high)
+            low = np.where(above, low, mid)
+            if np.all(high - low <= INVERSION_TOLERANCE_NM):
+                break
+        return 0.5 * (low + high)
+
+
+def boost_law(run, p: np.ndarray) -> BoostLaw | None:
+    """The boost law of `run`'s assist with the values of the parameter vector `p` (None without an assist)."""
+    effect = assist_effect(run)
+    if effect is None:
+        return None
+    name = effect.name
+    v = lambda key: float(p[run.parameter_index(f"{name}.{key}")])  # noqa: E731
+    ratio = float(p[run.parameter_index("steering.handwheel_to_rack_ratio")])
+    names = run.model.info["parameters"]
+    # the law-side candidates of an assisted car's diagnosis (effects torsion_bar_offset, boost_gain_error)
+    offset = float(p[names.index(OFFSET_KEY)]) if OFFSET_KEY in names else 0.0
+    gain_factor = 1.0 + float(p[names.index(GAIN_ERROR_KEY)]) if GAIN_ERROR_KEY in names else 1.0
+    if name == HYDRAULIC:
+        return BoostLaw(name, "rack", v("valve_slope"), v("dead_band"), v("dead_band_smoothing"),
+                        v("relief_pressure"), v("pressure_smoothing"), ratio, area=v("piston_area"))
+    return BoostLaw(name, effect.location, v("gain") * gain_factor, v("dead_band"), v("dead_band_smoothing"),
+                    v("motor_torque_limit"), v("limit_smoothing"), ratio, v("reduction_ratio"), v("efficiency"),
+                    v("torque_constant"), offset=offset)
+
+
+@dataclass
+class AssistedSolution(PrescribedSolution):
+    """The prescribed-rack solve of an assisted car. ``torque_Nm`` is the torsion-bar torque (what the car's torque
+    sensor measures), ``road_torque_Nm`` the column torque the boost-free model needs (T_road), ``motor_torque_Nm``
+    and ``motor_current_A`` the motor's (hydraulic: ``motor_torque_Nm`` holds the pressure in Pa, the current is
+    None)."""
+
+    road_torque_Nm: np.ndarray | None = None
+    motor_torque_Nm: np.ndarray | None = None
+    motor_current_A: np.ndarray | None = None
+
+
+def solve_assisted(run, p: np.ndarray, rack: RackMotion, t_out, rtol: float = PRESCRIBED_RTOL,
+                   atol_factor: float = PRESCRIBED_ATOL_FACTOR, law: BoostLaw | None = None,
+                   delivered=None) -> AssistedSolution:
+    """The torsion-bar torque and the motor's torque and current of `run`'s assisted car with its rack following
+    `rack`, at the output times `t_out` (module docstring: the boost-free solve, then the law inverted). The
+    law-side candidates of a diagnosis act here: a sensor offset o (the reading S solves S + A(S) = y + o, the log
+    and the law take S) and a gain error (the law's gain G (1 + e)). `law` replaces the run's own law (a record
+    made with another curve than the file's); `delivered` (a factor per output time, >= 0) scales what the motor
+    delivers against what the law commands (a torque ripple), the current unchanged."""
+    law = law if law is not None else boost_law(run, p)
+    if law is None:
+        raise UsageError("an assisted replay needs an assist effect in the model (electric_assist_* or "
+                         "hydraulic_assist)")
+    p_off = np.array(p, dtype=float)
+    p_off[run.parameter_index(boost_key(law.name))] = 0.0
+    road = solve(run, p_off, rack, t_out, rtol=rtol, atol_factor=atol_factor, outputs=law.location != "column",
+                 assist_off=True)
+    y = road.torque_Nm
+    if law.location != "column":
+        y = y * road.outputs["column_angle_per_rack_rad_per_m"] / law.ratio
+    # A sensor reading S = T_s + o, taken by the law: S - o + A(S) = y (effect torsion_bar_offset).
+    factor = 1.0 if delivered is None else np.asarray(delivered, dtype=float)
+    torsion_bar = law.torsion_bar(y + law.offset, factor)
+    motor = law.motor(torsion_bar)
+    current = None if law.hydraulic else motor / law.torque_constant
+    return AssistedSolution(road.time_s, torsion_bar, road.states, road.accelerations, None, None, road.torque_Nm,
+                            motor, current)
