@@ -18,6 +18,9 @@ CASES = [
     ("electric_assist_rack", {}),
     ("electric_assist_column", {"electric_assist_column.motor_torque_limit": 0.5}),  # saturated over the plateau
     ("hydraulic_assist", {}),
+    # creeping at the half-gain speed of a speed-dependent boost curve: the replay's law must use G(v) = G / 2
+    ("electric_assist_column", {"electric_assist_column.speed_dependence": 1.0,
+                                "electric_assist_column.gain_half_speed": 1.0, "run.vehicle_speed": 1.0}),
 ]
 
 
@@ -33,7 +36,7 @@ def exact_rack(result) -> RackSpline:
     return RackSpline.from_ppoly(PPoly.from_bernstein_basis(bernstein))
 
 
-@pytest.mark.parametrize(("name", "overrides"), CASES, ids=["column", "pinion", "rack", "saturated", "hydraulic"])
+@pytest.mark.parametrize(("name", "overrides"), CASES, ids=["column", "pinion", "rack", "saturated", "hydraulic", "speed_gain"])
 def test_replayed_rack_gives_back_the_torsion_bar_torque_and_motor_current(params, name, overrides):
     """Independent paths: the free (handwheel-driven) integration of the assisted model, whose boost feeds the
     torsion-bar torque back into the load, and the boost-free solve of the same rack followed by the boost law
@@ -58,7 +61,7 @@ def test_replayed_rack_gives_back_the_torsion_bar_torque_and_motor_current(param
     current = np.interp(t, c["time_s"], c["motor_current_A"])
     assert np.max(np.abs(current)) > 5.0
     assert np.max(np.abs(solution.motor_current_A - current)) < 1e-3
-    if overrides:  # saturated: the motor sits at its limit while the driver's torque rises past 10 N m
+    if "electric_assist_column.motor_torque_limit" in overrides:  # saturated: the motor sits at its limit while the driver's torque rises past 10 N m
         assert np.max(np.abs(solution.motor_torque_Nm)) > 0.49 and np.max(np.abs(expected)) > 10.0
 
 

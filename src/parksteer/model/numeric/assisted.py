@@ -41,6 +41,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...errors import UsageError
+from ...parameters import VEHICLE_SPEED
+from ..symbolic.effects.assist_common import speed_gain
 from .prescribed import PRESCRIBED_ATOL_FACTOR, PRESCRIBED_RTOL, PrescribedSolution, RackMotion, solve
 
 # The bisection stops when the bracket is this narrow (N m of torsion-bar torque), far below a sensor's resolution.
@@ -153,7 +155,9 @@ def boost_law(run, p: np.ndarray) -> BoostLaw | None:
     if name == HYDRAULIC:
         return BoostLaw(name, "rack", v("valve_slope"), v("dead_band"), v("dead_band_smoothing"),
                         v("relief_pressure"), v("pressure_smoothing"), ratio, area=v("piston_area"))
-    return BoostLaw(name, effect.location, v("gain") * gain_factor, v("dead_band"), v("dead_band_smoothing"),
+    gain = speed_gain(v("gain"), v("speed_dependence"), float(p[run.parameter_index(VEHICLE_SPEED.key)]),
+                      v("gain_half_speed"))
+    return BoostLaw(name, effect.location, gain * gain_factor, v("dead_band"), v("dead_band_smoothing"),
                     v("motor_torque_limit"), v("limit_smoothing"), ratio, v("reduction_ratio"), v("efficiency"),
                     v("torque_constant"), offset=offset)
 

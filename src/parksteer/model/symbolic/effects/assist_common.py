@@ -43,6 +43,12 @@ def clamp(y, limit, width):
     return y - ramp(y - limit, width) + ramp(-y - limit, width)
 
 
+def speed_gain(gain, dependence, speed, half_speed):
+    """The boost curve's gain at the vehicle speed, G / (1 + s (v / v_half)^2) (:mod:`.electric_assist`): exactly G
+    at v = 0 or s = 0. Plain arithmetic, so the symbolic model and the assisted replay's law share it."""
+    return gain / (1 + dependence * (speed / half_speed) ** 2)
+
+
 def series_deflection(model, twist, torsion_bar_key: str):
     """The column spring's deflection law with the torsion bar in series (module docstring)."""
     k_c = model.p("steering.column_torsional_stiffness")

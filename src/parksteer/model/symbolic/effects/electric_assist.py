@@ -60,7 +60,8 @@ import sympy.physics.mechanics as me
 from ....parameters import VEHICLE_SPEED, Quantity
 from ..components import Effect
 from ..system import torque_between
-from .assist_common import LOCATIONS, clamp, deadband, point_of_action, series_deflection, torsion_bar_torque
+from .assist_common import (LOCATIONS, clamp, deadband, point_of_action, series_deflection, speed_gain,
+                            torsion_bar_torque)
 
 # Typical values by point of action: (reduction N, its unit, bounds, efficiency, motor torque limit N m,
 # motor inertia kg m^2, source of the reduction). Column and pinion: a worm gear; rack: a ball nut driven through
@@ -188,9 +189,8 @@ class ElectricAssist(Effect):
 
     def gain(self, model):
         """G(v) = G / (1 + s (v / v_half)^2): exactly G at v = 0 or s = 0 (module docstring)."""
-        speed = model.p(VEHICLE_SPEED.key)
-        falloff = self.q(model, "speed_dependence") * (speed / self.q(model, "gain_half_speed")) ** 2
-        return self.q(model, "gain") / (1 + falloff)
+        return speed_gain(self.q(model, "gain"), self.q(model, "speed_dependence"), model.p(VEHICLE_SPEED.key),
+                          self.q(model, "gain_half_speed"))
 
     def motor_torque(self, model):
         scale = model.p("steering.handwheel_to_rack_ratio") if self.location == "rack" else 1
