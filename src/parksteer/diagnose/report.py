@@ -212,10 +212,19 @@ def _nearest(result: dict) -> str:
         return ""
     floor = result["noise_floor_Nm"]
     after = top["weighted_rms_after_Nm"] / floor if floor > 0 else float("nan")
-    return (f" The nearest candidate, {top['effect']}, is strongly evidenced (BIC gain {_n(top['delta_bic'])}) but "
-            f"leaves the weighted error at {_n(after)} noise floors, above the {_n(thresholds['missing_rms_ceiling'])} "
-            "that records with nothing hidden reach: it may be the closest form the library has to what is at work, "
-            "not the effect itself.")
+    lead = f" The nearest candidate, {top['effect']}, is strongly evidenced (BIC gain {_n(top['delta_bic'])}) but "
+    if after > thresholds["missing_rms_ceiling"]:
+        return (lead + f"leaves the weighted error at {_n(after)} noise floors, above the "
+                f"{_n(thresholds['missing_rms_ceiling'])} that records with nothing hidden reach: it may be the closest "
+                "form the library has to what is at work, not the effect itself.")
+    # below the ceiling, a name also needs the error within the adequate factor or most of the excess removed
+    explained = result["selection"]["explained_fraction"]
+    removed = f"removes {_n(100 * explained)} % of the error above the floor" if explained is not None else (
+        "removes too little of the error above the floor")
+    return (lead + f"leaves the weighted error at {_n(after)} noise floors (a name needs "
+            f"{_n(thresholds['adequate_rms_factor'])}) and {removed} (a name needs "
+            f"{_n(100 * thresholds['explained_fraction_missing'])} %): it may be part of what is at work, most of it "
+            "taken up by the calibrated parameters it is confounded with (below).")
 
 
 def _angle_change(result: dict) -> str:

@@ -41,14 +41,24 @@ def shown_files(files, limit: int = 2) -> list[int]:
 def compare_figure(result, path: str | Path, shown: list[int] | None = None) -> None:
     """Torque against rack (measured and model), residual against rack, RMS error by phase (for the files `shown`)."""
     shown = shown if shown is not None else list(range(min(len(result.files), 4)))
-    fig, axes = new_figure(7.0, 8.0, nrows=3)
+    # an assisted car's motor channel, where fitted, gets a panel of its own below the three
+    motor = any(result.files[i].uses_motor for i in shown)
+    fig, axes = new_figure(7.0, 10.5 if motor else 8.0, nrows=4 if motor else 3)
     for k, i in enumerate(shown):
-        f, m = result.files[i], result.predictions[i]
+        f, prediction = result.files[i], result.predictions[i]
+        m = f.torque_part(prediction)
         colour = COLOURS[k % len(COLOURS)]
         label = f"{f.label} ({f.case}, {f.surface.replace('_', ' ')})"
         axes[0].plot(f.rack_m * 1000, f.torque_Nm, ".", color=colour, markersize=1.5, alpha=0.35)
         axes[0].plot(f.rack_m * 1000, m, color=colour, linewidth=1.0, label=label)
         axes[1].plot(f.rack_m * 1000, f.torque_Nm - m, ".", color=colour, markersize=1.5)
+        if f.uses_motor:
+            axes[3].plot(f.rack_m * 1000, f.motor, ".", color=colour, markersize=1.5, alpha=0.35)
+            axes[3].plot(f.rack_m * 1000, f.motor_part(prediction), color=colour, linewidth=1.0)
+    if motor:
+        axes[3].set_ylabel("motor channel (A or N m)")
+        axes[3].set_xlabel("rack displacement (mm)")
+        axes[3].set_title("assisted car's motor: measured (dots) and model (lines)", fontsize=9)
     axes[0].set_ylabel("handwheel torque (N m)")
     axes[0].set_title("measured (dots) and model (lines)", fontsize=9)
     axes[0].legend(fontsize=7)

@@ -119,3 +119,44 @@ def assisted_record(clean: dict[str, np.ndarray], logger: AssistedLogger, case: 
         metadata["bits_motor_current_A"] = logger.current_bits
         metadata["full_scale_motor_current_A"] = logger.current_full_scale_A
     return Measurement(path=None, columns=columns, metadata={k: metadata_text(v) for k, v in metadata.items()})
+
+
+# The example record of an assisted car (data/measurements/example_polo_assisted.csv): the Polo file's column assist
+# on the kerb-weight case, a hand of the variation benchmark, and a motor whose bearings drag more than the file says.
+EXAMPLE_HAND = ("rest_after_stop", 7)
+EXAMPLE_HIDDEN = {"assist_motor_friction.friction_torque": 0.03}  # N m at the motor, on top of the file's 0.02
+EXAMPLE_CASE = "kerb"
+
+
+def assisted_example(params: Parameters, assist: str) -> Measurement:
+    """The example record of an assisted car: :data:`EXAMPLE_HAND` on the car of `params` with its assist effect
+    `assist` and :data:`EXAMPLE_HIDDEN`, logged as the assisted benchmark logs (rack, torsion-bar torque, current)."""
+    from .variations import variation_by_name
+
+    name, seed = EXAMPLE_HAND
+    hand, _ = variation_by_name(name).settings(seed)
+    base = variation_by_name(name).logger
+    logger = AssistedLogger(sample_rate_hz=base.sample_rate_hz, rack_bits=base.rack_bits,
+                            rack_noise_m=base.rack_noise_m, torque_noise_Nm=0.03, current_noise_A=0.25, seed=seed)
+    clean = assisted_clean(params, hand, f"+{assist},+assist_motor_friction", EXAMPLE_CASE,
+                           overrides=dict(EXAMPLE_HIDDEN))
+    record = assisted_record(clean, logger, EXAMPLE_CASE)
+    hidden = ", ".join(f"{k} = {v:g}" for k, v in EXAMPLE_HIDDEN.items())
+    record.metadata["source"] = metadata_text(f"synthetic: parksteer.synthetic.assisted.assisted_example "
+                                              f"(hand {name} seed {seed}; hidden: {hidden})")
+    return record
+
+
+def write_assisted_example(path, vehicle_path) -> None:
+    """Write the example record of the assisted car of the vehicle file `vehicle_path` (its ``[assist]``)."""
+    from ..measure.io import write_measurement
+    from ..model.numeric.assist import check_assist
+    from ..model.symbolic.components import discover_effects
+    from ..vehicle import load_vehicle
+
+    discover_effects()  # the vehicle file's assist entries are the assist effect's quantities
+    params = load_vehicle(vehicle_path)
+    assist = check_assist(params)
+    if assist is None:
+        raise ValueError(f"{vehicle_path}: no [assist] section: the example is of an assisted car")
+    write_measurement(path, assisted_example(params, assist), params)
