@@ -84,6 +84,8 @@ rule case_study:
         parameters=PARAMETERS,
         files=DIAG_CAR_FILES,
         truth="results/diagnose/car_truth.json",
+        assisted_record="data/measurements/example_polo_assisted.csv",
+        assisted_vehicle="data/vehicles/polo_vi.toml",
         code=sorted(set(script_sources("diag_case_study") + file_sources("workflow/notebooks/case_study.py"))),
     output:
         notebook="results/case_study.ipynb",

@@ -11,4 +11,6 @@ with rule_log(snakemake):
         "PARKSTEER_CASE_OUT": snakemake.output.json,
         "PARKSTEER_CASE_RESIDUALS": snakemake.output.residuals,
         "PARKSTEER_PARAMETERS": snakemake.input.parameters,
+        "PARKSTEER_ASSISTED_RECORD": snakemake.input.assisted_record,
+        "PARKSTEER_ASSISTED_VEHICLE": snakemake.input.assisted_vehicle,
     })
