@@ -60,6 +60,53 @@ def candidate_effects(model_effects: list[Effect], registry: dict[str, Effect] |
     return [registry[n] for n in testable], untestable
 
 
+def shares_diagnosis_model(effect: Effect, base_effects: list[Effect], params=None) -> bool:
+    """Whether candidate `effect` can be replayed in the diagnosis model (:func:`diagnosis_model`) instead of a model
+    of its own: it fills no slot of the core (a slot filler replaces a law of the base model, the same only to
+    rounding at strength 0), adds no coordinate or body (:meth:`Effect.configure`, :meth:`Effect.bodies`: a state
+    changes the integrator's error norm and so its steps, a body the mass matrix), needs only effects of the base
+    model, and its strength is 0 in `params` (by default the shipped file's), so that it is absent there. Its
+    loads are then a product with its strength (the effect files' promise that 0 means absent), exactly zero at
+    strength 0, and the others' loads at strength 0 leave a candidate's replays the base model's to rounding."""
+    spec = strength_parameter(effect, params)
+    kind = type(effect)
+    return (spec is not None and effect.replaces is None and kind.configure is Effect.configure
+            and kind.bodies is Effect.bodies and set(effect.requires) <= {e.name for e in base_effects}
+            and (params is None or float(params[spec.key]) == 0.0))
+
+
+def diagnosis_model(base_effects: list[Effect], candidates: list[Effect], params=None) -> list[Effect]:
+    """The one model that replays every candidate sharing it (:func:`shares_diagnosis_model`): the base effects and
+    those candidates, by name. A candidate's replays run in it with the others' strengths at 0 (their value in
+    `params`), so its signature and refit cost no model of its own; the base model's replays stay on the base
+    model."""
+    shared = [c for c in candidates if shares_diagnosis_model(c, base_effects, params)]
+    return sorted([*base_effects, *shared], key=lambda e: e.name)
+
+
+def replay_models(base_effects: list[Effect], candidates: list[Effect], params=None
+                  ) -> dict[tuple[str, ...], list[Effect]]:
+    """{names of the base effects with one candidate: the effects of the compiled model that replays them}, for the
+    candidates that share the diagnosis model (:func:`diagnosis_model`); a candidate not listed has its own."""
+    host = diagnosis_model(base_effects, candidates, params)
+    hosted = {e.name for e in host} - {e.name for e in base_effects}
+    return {tuple(sorted([*(e.name for e in base_effects), name])): host for name in sorted(hosted)} \
+        if len(hosted) > 1 else {}
+
+
+def models_to_build(base_effects: list[Effect], candidates: list[Effect], params=None) -> list[list[Effect]]:
+    """The compiled models a diagnosis of `base_effects` against `candidates` replays: the base model, the
+    diagnosis model, and the base model with each candidate that has a model of its own."""
+    hosts = replay_models(base_effects, candidates, params)
+    out = [list(base_effects)]
+    for candidate in candidates:
+        names = tuple(sorted([*(e.name for e in base_effects), candidate.name]))
+        model = hosts.get(names, sorted([*base_effects, candidate], key=lambda e: e.name))
+        if all([e.name for e in model] != [e.name for e in m] for m in out):
+            out.append(model)
+    return out
+
+
 @dataclass(frozen=True)
 class Signature:
     """A candidate's sensitivity at the calibrated base model."""

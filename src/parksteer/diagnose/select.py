@@ -54,10 +54,13 @@ from __future__ import annotations
 
 from dataclasses import replace
 
+from ..model.codegen.cache import ensure_entries
 from ..model.symbolic.components import Effect, discover_effects, resolve_effects
 from ..parameters import Parameters
+from .candidates import candidate_effects, models_to_build, replay_models
 from .parallel import Progress
 from .problem import FileData, Problem
+from .replay import replayed_in
 from .settings import DEFAULT_SETTINGS, DiagnosisSettings
 from .stages import STAGES, run_table
 from .state import Diagnosis, DiagnosisState, frozen_mapping
@@ -89,12 +92,15 @@ def diagnose(files: list[FileData], params: Parameters, effects=None, registry: 
     base = effects if isinstance(effects, list) and all(isinstance(e, Effect) for e in effects) \
         else resolve_effects(effects)
     progress = Progress(quiet)
-    state = DiagnosisState(settings, problem, tuple(base),
-                           frozen_mapping(registry if registry is not None else discover_effects()),
+    registry = registry if registry is not None else discover_effects()
+    state = DiagnosisState(settings, problem, tuple(base), frozen_mapping(registry),
                            None if strengths is None else frozen_mapping(strengths),
                            None if start is None else frozen_mapping(start), progress, tuple(stages))
+    testable, _ = candidate_effects(base, registry)
+    ensure_entries(models_to_build(base, testable, params), workers)
     try:
-        state = run_table(state)
+        with replayed_in(replay_models(base, testable, params)):
+            state = run_table(state)
     finally:
         problem.close()
     progress(f"verdict: {state.verdict}" + (f" {state.best}" if state.verdict == "missing" else "")

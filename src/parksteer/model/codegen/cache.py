@@ -298,6 +298,35 @@ def ensure_entry(effects: list[Effect]) -> Path:
     return final
 
 
+_TO_BUILD: list[list[Effect]] = []  # the effect sets ensure_entries hands its forked builders, by index
+
+
+def _build_one(index: int) -> str:
+    return str(ensure_entry(_TO_BUILD[index]))
+
+
+def ensure_entries(effect_sets: list[list[Effect]], jobs: int = 1) -> list[Path]:
+    """The cache entries of `effect_sets` (:func:`ensure_entry` of each), the missing ones built side by side on
+    up to `jobs` processes forked from this one (each build is one process: sympy, code generation and `cc` run
+    in line), the largest set first. The build lock of each entry still holds: a set another process is building
+    is waited for, not built twice. Where the platform cannot fork, or one is missing, they are built in line."""
+    import multiprocessing
+
+    missing = [i for i, effects in enumerate(effect_sets) if not entry_is_sound(entry_path(effects))]
+    workers = min(max(int(jobs), 1), len(missing))
+    if workers > 1 and "fork" in multiprocessing.get_all_start_methods():
+        from concurrent.futures import ProcessPoolExecutor
+
+        _TO_BUILD[:] = effect_sets
+        order = sorted(missing, key=lambda i: -len(effect_sets[i]))
+        try:
+            with ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("fork")) as pool:
+                list(pool.map(_build_one, order))
+        finally:
+            _TO_BUILD.clear()
+    return [ensure_entry(effects) for effects in effect_sets]
+
+
 def ensure(effects: list[Effect], note_cached: bool = False) -> dict:
     """Build (or find) the compiled model of `effects` and return its manifest.
 
