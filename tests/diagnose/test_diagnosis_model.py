@@ -11,7 +11,9 @@ hundredth of the absolute tolerances) each is within about 1e-8 N m of the exact
 the tolerance), so they must agree to BOUND_NM: forty times that for the two step sequences, and still a thousand
 times below the smallest change a probe makes (a few noise floors, at least 0.002 N m). A load that did not vanish
 at strength 0, or a candidate that changed the base model's equations (a slot's law, a coordinate), would show far
-above it.
+above it. The handwheel angle, where a lash shows (the torque on a given rack does not see it), likewise to
+BOUND_RAD: a thousand times below the smallest angle change a probe makes (a few floors of a 0.1 degree sensor
+step, 0.0017 rad).
 """
 
 from __future__ import annotations
@@ -27,6 +29,7 @@ from parksteer.model.symbolic.components import resolve_effects
 from parksteer.parameters import load_parameters
 
 BOUND_NM = 1e-6
+BOUND_RAD = 1e-6
 TIGHT = {"rtol": 1e-10, "atol_factor": 0.01}
 
 
@@ -40,11 +43,17 @@ def measured(repo_root):
     return params, record, base, testable, diagnosis_model(base, testable, params)
 
 
-def _torque(measured, effects, overrides=None) -> np.ndarray:
+def _signals(measured, effects, overrides=None) -> np.ndarray:
+    """The replayed handwheel torque (N m) and angle (rad) of the record, one after the other."""
     params, record, *_ = measured
     replay = Replay(list(effects), record.case, record.surface, params, record.rack, record.replay_time_s)
     run, p = replay.parameter_vector(overrides or {})
-    return solve(run, p, record.rack, record.replay_time_s, **TIGHT).torque_Nm
+    solution = solve(run, p, record.rack, record.replay_time_s, outputs=True, **TIGHT)
+    return solution.torque_Nm, solution.handwheel[:, 0]
+
+
+def _differences(a, b) -> tuple[float, float]:
+    return float(np.max(np.abs(a[0] - b[0]))), float(np.max(np.abs(a[1] - b[1])))
 
 
 def test_the_diagnosis_model_holds_more_than_one_candidate(measured):
@@ -55,22 +64,22 @@ def test_the_diagnosis_model_holds_more_than_one_candidate(measured):
 
 def test_every_candidate_at_strength_zero_is_the_base_model(measured):
     _, _, base, _, host = measured
-    difference = np.max(np.abs(_torque(measured, host) - _torque(measured, base)))
-    assert difference < BOUND_NM, f"{difference:.3g} N m"
+    torque, angle = _differences(_signals(measured, host), _signals(measured, base))
+    assert torque < BOUND_NM and angle < BOUND_RAD, f"{torque:.3g} N m, {angle:.3g} rad"
 
 
 def test_one_candidate_at_its_probe_strength_is_its_own_model(measured):
     """Each hosted candidate at a tenth of its range (a probe's order), the others at 0, against the base model
-    with that candidate alone: the same torque, and a change from the base model well above the bound (so the
-    strength reaches the equations)."""
+    with that candidate alone: the same torque and angle, and a change from the base model well above the bounds
+    in one of them (so the strength reaches the equations)."""
     _, _, base, testable, host = measured
     names = {e.name for e in host}
-    base_torque = _torque(measured, base)
+    base_signals = _signals(measured, base)
     for candidate in (c for c in testable if c.name in names):
         spec = strength_parameter(candidate)
         overrides = {spec.key: 0.1 * spec.upper}
-        own = _torque(measured, sorted([*base, candidate], key=lambda e: e.name), overrides)
-        shared = _torque(measured, host, overrides)
-        difference = np.max(np.abs(shared - own))
-        assert difference < BOUND_NM, f"{candidate.name}: {difference:.3g} N m"
-        assert np.max(np.abs(own - base_torque)) > 1e3 * BOUND_NM, candidate.name
+        own = _signals(measured, sorted([*base, candidate], key=lambda e: e.name), overrides)
+        torque, angle = _differences(_signals(measured, host, overrides), own)
+        assert torque < BOUND_NM and angle < BOUND_RAD, f"{candidate.name}: {torque:.3g} N m, {angle:.3g} rad"
+        torque, angle = _differences(own, base_signals)
+        assert torque > 1e3 * BOUND_NM or angle > 1e3 * BOUND_RAD, candidate.name

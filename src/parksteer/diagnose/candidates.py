@@ -60,27 +60,40 @@ def candidate_effects(model_effects: list[Effect], registry: dict[str, Effect] |
     return [registry[n] for n in testable], untestable
 
 
+# Whether a candidate that fills a slot of the core (ackermann: the steer function, rack_lash: the column's
+# deflection law) joins the diagnosis model (shares_diagnosis_model).
+SLOT_FILLERS_SHARE = True
+
+
 def shares_diagnosis_model(effect: Effect, base_effects: list[Effect], params=None) -> bool:
     """Whether candidate `effect` can be replayed in the diagnosis model (:func:`diagnosis_model`) instead of a model
-    of its own: it fills no slot of the core (a slot filler replaces a law of the base model, the same only to
-    rounding at strength 0), adds no coordinate or body (:meth:`Effect.configure`, :meth:`Effect.bodies`: a state
-    changes the integrator's error norm and so its steps, a body the mass matrix), needs only effects of the base
-    model, and its strength is 0 in `params` (by default the shipped file's), so that it is absent there. Its
-    loads are then a product with its strength (the effect files' promise that 0 means absent), exactly zero at
-    strength 0, and the others' loads at strength 0 leave a candidate's replays the base model's to rounding."""
+    of its own: it adds no coordinate or body (:meth:`Effect.configure`, :meth:`Effect.bodies`: a state changes the
+    integrator's error norm and so its steps at any strength, a body the mass matrix), needs only effects of the
+    base model, fills no slot the base model fills, and its strength is 0 in `params` (by default the shipped
+    file's), so that it is absent there. Its loads are then a product with its strength (the effect files' promise
+    that 0 means absent), exactly zero at strength 0; a slot filler's law at strength 0 is the slot's own law to
+    rounding (ackermann's atan2(sin r, cos r) is r, rack_lash's dead band of width 0 the identity), so the others at
+    strength 0 leave a candidate's replays its own model's to rounding (tests/diagnose/test_diagnosis_model.py)."""
     spec = strength_parameter(effect, params)
     kind = type(effect)
-    return (spec is not None and effect.replaces is None and kind.configure is Effect.configure
+    filled = {e.replaces for e in base_effects} - {None}
+    slot_ok = effect.replaces is None or (SLOT_FILLERS_SHARE and effect.replaces not in filled)
+    return (spec is not None and slot_ok and kind.configure is Effect.configure
             and kind.bodies is Effect.bodies and set(effect.requires) <= {e.name for e in base_effects}
             and (params is None or float(params[spec.key]) == 0.0))
 
 
 def diagnosis_model(base_effects: list[Effect], candidates: list[Effect], params=None) -> list[Effect]:
     """The one model that replays every candidate sharing it (:func:`shares_diagnosis_model`): the base effects and
-    those candidates, by name. A candidate's replays run in it with the others' strengths at 0 (their value in
-    `params`), so its signature and refit cost no model of its own; the base model's replays stay on the base
-    model."""
-    shared = [c for c in candidates if shares_diagnosis_model(c, base_effects, params)]
+    those candidates, by name, one filler per slot (the first by name; another keeps a model of its own). A
+    candidate's replays run in it with the others' strengths at 0 (their value in `params`), so its signature and
+    refit cost no model of its own; the base model's replays stay on the base model."""
+    shared, slots = [], set()
+    for candidate in sorted(candidates, key=lambda e: e.name):
+        if shares_diagnosis_model(candidate, base_effects, params) and candidate.replaces not in slots:
+            shared.append(candidate)
+            slots.add(candidate.replaces)
+            slots.discard(None)
     return sorted([*base_effects, *shared], key=lambda e: e.name)
 
 

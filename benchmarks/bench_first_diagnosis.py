@@ -1,0 +1,121 @@
+"""Benchmark (not a test): the first diagnosis of a new car, as a whole process, cold and warm.
+
+    python benchmarks/bench_first_diagnosis.py [--reference [NAME=]SRC ...] [--repeats 3] [--record FILE.csv]
+                                               [--jobs N]
+
+The car is data/vehicles/polo_vi.toml; its DAQ file is made once (unless --record names one) by the synthetic
+logger of the variation benchmark (rate_8pc_50Hz, seed 5: an 8 % hand-rate variation logged at 50 Hz with 8-bit
+converters) on the car's kerb case, nothing hidden: what a new user's first record of a sound car looks like. Each
+repeat runs, for each ``--reference`` tree's ``src`` (e.g. a ``git archive main`` unpacked; repeatable, named
+NAME or ``reference``) and this tree in turn:
+
+    PARKSTEER_MODEL_CACHE=<new empty folder> parksteer diagnose RECORD --vehicle data/vehicles/polo_vi.toml \\
+        --json --quiet [--jobs N]          # cold: every model derived, generated and compiled
+    (the same command again on the cache the cold run filled)   # warm
+
+and times the process (wall). It prints every time, the medians, and whether each tree gave the same verdict and
+ranking in every run; the cold runs' model builds (derive, codegen, compile: their model.json timings) are summed
+per tree, to show where the cold time goes.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+VEHICLE = ROOT / "data" / "vehicles" / "polo_vi.toml"
+
+
+def make_record(path: Path) -> None:
+    from parksteer.measure.io import write_measurement
+    from parksteer.parameters import load_parameters
+    from parksteer.synthetic.variations import variation_by_name, variation_record
+    from parksteer.vehicle import load_vehicle
+
+    params = load_vehicle(VEHICLE, load_parameters())
+    hand, logger = variation_by_name("rate_8pc_50Hz").settings(5)
+    write_measurement(path, variation_record(params, hand, logger, case="kerb"), params)
+
+
+def run(src: Path, record: Path, cache: Path, jobs: int | None) -> tuple[float, dict]:
+    env = {**os.environ, "PYTHONPATH": str(src), "PARKSTEER_MODEL_CACHE": str(cache)}
+    command = [sys.executable, "-m", "parksteer.cli", "diagnose", str(record), "--vehicle", str(VEHICLE), "--json",
+               "--quiet", *(["--jobs", str(jobs)] if jobs else [])]
+    start = time.perf_counter()
+    done = subprocess.run(command, env=env, capture_output=True, text=True, cwd=ROOT)
+    elapsed = time.perf_counter() - start
+    if done.returncode != 0:
+        raise SystemExit(f"{src}: diagnose failed:\n{done.stderr}")
+    return elapsed, json.loads(done.stdout)
+
+
+def build_times(cache: Path) -> dict[str, float]:
+    """Seconds of derive, codegen and compile summed over the models a cold run built into `cache`."""
+    total = {"models": 0, "derive": 0.0, "codegen": 0.0, "compile": 0.0}
+    for info in cache.glob("*/model.json"):
+        timings = json.loads(info.read_text(encoding="utf-8"))["timings_s"]
+        total["models"] += 1
+        for stage in ("derive", "codegen", "compile"):
+            total[stage] += timings[stage]
+    return total
+
+
+def answer(result: dict) -> tuple:
+    return result["verdict"], result.get("effect"), tuple(r["effect"] for r in result["ranking"])
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--reference", action="append", default=[], metavar="[NAME=]SRC",
+                        help="another tree's src (e.g. /tmp/ref-main/src); repeatable")
+    parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument("--record", type=Path, default=None, help="the DAQ file (default: made once, see above)")
+    parser.add_argument("--jobs", type=int, default=None, help="parksteer diagnose --jobs (default: its own)")
+    args = parser.parse_args()
+    trees = {}
+    for item in args.reference:
+        name, _, src = item.rpartition("=")
+        trees[name or "reference"] = Path(src).resolve()
+    trees["this"] = ROOT / "src"
+    with tempfile.TemporaryDirectory(prefix="first-diagnosis-") as scratch:
+        scratch = Path(scratch)
+        record = args.record or scratch / "polo_kerb.csv"
+        if args.record is None:
+            make_record(record)
+        times = {name: {"cold": [], "warm": []} for name in trees}
+        builds = {name: [] for name in trees}
+        answers = {name: set() for name in trees}
+        for repeat in range(args.repeats):
+            for name, src in trees.items():
+                cache = scratch / f"cache-{name}-{repeat}"
+                cache.mkdir()
+                for kind in ("cold", "warm"):
+                    elapsed, result = run(src, record, cache, args.jobs)
+                    times[name][kind].append(elapsed)
+                    answers[name].add(answer(result))
+                    print(f"{name} {kind} {elapsed:.2f} s  ({result['verdict']}, {result['cost']['replays']} replays)",
+                          flush=True)
+                builds[name].append(build_times(cache))
+    print(f"\nparksteer diagnose, one record of {VEHICLE.name}, whole process, {args.repeats} repeats "
+          f"(median s; cold = empty model cache)")
+    for name in trees:
+        b = builds[name][0]
+        print(f"  {name:9s} cold {statistics.median(times[name]['cold']):6.2f}  "
+              f"warm {statistics.median(times[name]['warm']):5.2f}   models built {b['models']}, summed over them: "
+              f"derive {b['derive']:.1f} s, codegen {b['codegen']:.1f} s, compile {b['compile']:.1f} s   "
+              f"same answer in every run: {len(answers[name]) == 1}")
+    if len(trees) > 1:
+        same = all(answers[name] == answers["this"] for name in trees)
+        print(f"  verdict, named effect and ranking order the same in every tree: {same}")
+
+
+if __name__ == "__main__":
+    main()
