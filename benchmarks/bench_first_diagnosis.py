@@ -13,7 +13,9 @@ NAME or ``reference``) and this tree in turn:
         --json --quiet [--jobs N]          # cold: every model derived, generated and compiled
     (the same command again on the cache the cold run filled)   # warm
 
-and times the process (wall). It prints every time, the medians, and whether each tree gave the same verdict and
+and times the process: wall, and the CPU (user + system) of it and every process it waited for (its workers and
+background builds), which on a machine other work shares is the steadier number (wall >= CPU / cores). It prints
+every time, the medians, and whether each tree gave the same verdict and
 ranking in every run; the cold runs' model builds (derive, codegen, compile: their model.json timings) are summed
 per tree, to show where the cold time goes.
 """
@@ -23,6 +25,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import resource
 import statistics
 import subprocess
 import sys
@@ -36,25 +39,32 @@ VEHICLE = ROOT / "data" / "vehicles" / "polo_vi.toml"
 
 def make_record(path: Path) -> None:
     from parksteer.measure.io import write_measurement
+    from parksteer.model.symbolic.components import discover_effects
     from parksteer.parameters import load_parameters
     from parksteer.synthetic.variations import variation_by_name, variation_record
     from parksteer.vehicle import load_vehicle
 
+    discover_effects()  # the effects' own quantities join the registry (the car file sets ackermann's)
     params = load_vehicle(VEHICLE, load_parameters())
     hand, logger = variation_by_name("rate_8pc_50Hz").settings(5)
     write_measurement(path, variation_record(params, hand, logger, case="kerb"), params)
 
 
-def run(src: Path, record: Path, cache: Path, jobs: int | None) -> tuple[float, dict]:
+def _children_cpu() -> float:
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return usage.ru_utime + usage.ru_stime
+
+
+def run(src: Path, record: Path, cache: Path, jobs: int | None) -> tuple[float, float, dict]:
     env = {**os.environ, "PYTHONPATH": str(src), "PARKSTEER_MODEL_CACHE": str(cache)}
     command = [sys.executable, "-m", "parksteer.cli", "diagnose", str(record), "--vehicle", str(VEHICLE), "--json",
                "--quiet", *(["--jobs", str(jobs)] if jobs else [])]
-    start = time.perf_counter()
+    start, cpu = time.perf_counter(), _children_cpu()
     done = subprocess.run(command, env=env, capture_output=True, text=True, cwd=ROOT)
-    elapsed = time.perf_counter() - start
+    elapsed, cpu = time.perf_counter() - start, _children_cpu() - cpu
     if done.returncode != 0:
         raise SystemExit(f"{src}: diagnose failed:\n{done.stderr}")
-    return elapsed, json.loads(done.stdout)
+    return elapsed, cpu, json.loads(done.stdout)
 
 
 def build_times(cache: Path) -> dict[str, float]:
@@ -91,6 +101,7 @@ def main() -> None:
         if args.record is None:
             make_record(record)
         times = {name: {"cold": [], "warm": []} for name in trees}
+        cpus = {name: {"cold": [], "warm": []} for name in trees}
         builds = {name: [] for name in trees}
         answers = {name: set() for name in trees}
         for repeat in range(args.repeats):
@@ -98,18 +109,20 @@ def main() -> None:
                 cache = scratch / f"cache-{name}-{repeat}"
                 cache.mkdir()
                 for kind in ("cold", "warm"):
-                    elapsed, result = run(src, record, cache, args.jobs)
+                    elapsed, cpu, result = run(src, record, cache, args.jobs)
                     times[name][kind].append(elapsed)
+                    cpus[name][kind].append(cpu)
                     answers[name].add(answer(result))
-                    print(f"{name} {kind} {elapsed:.2f} s  ({result['verdict']}, {result['cost']['replays']} replays)",
-                          flush=True)
+                    print(f"{name} {kind} {elapsed:.2f} s wall, {cpu:.2f} s CPU  ({result['verdict']}, "
+                          f"{result['cost']['replays']} replays; load {os.getloadavg()[0]:.1f})", flush=True)
                 builds[name].append(build_times(cache))
     print(f"\nparksteer diagnose, one record of {VEHICLE.name}, whole process, {args.repeats} repeats "
-          f"(median s; cold = empty model cache)")
+          f"(median s, wall / CPU; cold = empty model cache)")
     for name in trees:
         b = builds[name][0]
-        print(f"  {name:9s} cold {statistics.median(times[name]['cold']):6.2f}  "
-              f"warm {statistics.median(times[name]['warm']):5.2f}   models built {b['models']}, summed over them: "
+        print(f"  {name:9s} cold {statistics.median(times[name]['cold']):6.2f} / {statistics.median(cpus[name]['cold']):6.2f}"
+              f"  warm {statistics.median(times[name]['warm']):5.2f} / {statistics.median(cpus[name]['warm']):5.2f}"
+              f"   models built {b['models']}, summed over them: "
               f"derive {b['derive']:.1f} s, codegen {b['codegen']:.1f} s, compile {b['compile']:.1f} s   "
               f"same answer in every run: {len(answers[name]) == 1}")
     if len(trees) > 1:

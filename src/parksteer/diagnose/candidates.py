@@ -216,10 +216,14 @@ def score(signature: Signature, calibration: Fit) -> Score:
 
 
 def candidate_models(effects: str | None = None, extra: tuple[str, ...] = ()) -> dict[str, str | None]:
-    """Every effect set a diagnosis of the model `effects` replays, by name, as effects specs: ``base`` and
-    ``with_<candidate>`` for each testable candidate.
+    """Every effect set a diagnosis of the model `effects` replays, or a truth generator hides a candidate in, by
+    name, as effects specs: ``base``, ``diagnosis`` (the diagnosis model of the registry's candidates,
+    :func:`diagnosis_model`, with the shipped parameters) and ``with_<candidate>`` for each testable candidate (the
+    model a diagnosis replays a candidate in when it does not share the diagnosis model, and the one the
+    benchmarks' records are made with).
 
-    `extra` names effect modules outside the registry (files or dotted names) to include as candidates. The
+    `extra` names effect modules outside the registry (files or dotted names) to include as candidates (a
+    ``with_<candidate>`` set each; a diagnosis whose registry holds them has a diagnosis model of its own). The
     pipeline derives each set once (:func:`parksteer.model.codegen.cache.ensure`, one job per set) before any
     diagnosis runs, which spares the parallel diagnoses from deriving the same model side by side.
     """
@@ -227,6 +231,8 @@ def candidate_models(effects: str | None = None, extra: tuple[str, ...] = ()) ->
 
     base = resolve_effects(effects)
     registry = discover_effects()
+    shared = sorted({e.name for e in diagnosis_model(base, candidate_effects(base, registry)[0])}
+                    - {e.name for e in base})
     refs = {name: name for name in registry}
     for ref in extra:
         effect = load_effect_module(ref)
@@ -234,6 +240,8 @@ def candidate_models(effects: str | None = None, extra: tuple[str, ...] = ()) ->
         refs[effect.name] = str(ref)
     testable, _ = candidate_effects(base, registry)
     sets: dict[str, str | None] = {"base": effects}
+    if len(shared) > 1:
+        sets["diagnosis"] = ",".join(filter(None, [effects, *(f"+{refs[name]}" for name in shared)]))
     for candidate in testable:
         sets[f"with_{candidate.name}"] = ",".join(filter(None, [effects, f"+{refs[candidate.name]}"]))
     return sets

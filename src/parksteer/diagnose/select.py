@@ -54,7 +54,7 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-from ..model.codegen.cache import ensure_entries
+from ..model.codegen.cache import finish_builds, start_builds
 from ..model.symbolic.components import Effect, discover_effects, resolve_effects
 from ..parameters import Parameters
 from .candidates import candidate_effects, models_to_build, replay_models
@@ -97,12 +97,15 @@ def diagnose(files: list[FileData], params: Parameters, effects=None, registry: 
                            None if strengths is None else frozen_mapping(strengths),
                            None if start is None else frozen_mapping(start), progress, tuple(stages))
     testable, _ = candidate_effects(base, registry)
-    ensure_entries(models_to_build(base, testable, params), workers)
+    # The models the candidates replay in are built in the background while the base model's stages run (the base
+    # model itself is built, if missing, when first replayed).
+    builders = start_builds(models_to_build(base, testable, params)[1:], workers)
     try:
         with replayed_in(replay_models(base, testable, params)):
             state = run_table(state)
     finally:
         problem.close()
+        finish_builds(builders)
     progress(f"verdict: {state.verdict}" + (f" {state.best}" if state.verdict == "missing" else "")
              + f" ({state.problem.evaluations} replays)")
     return state.result()
