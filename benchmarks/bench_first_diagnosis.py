@@ -17,7 +17,11 @@ and times the process: wall, and the CPU (user + system) of it and every process
 background builds), which on a machine other work shares is the steadier number (wall >= CPU / cores). It prints
 every time, the medians, and whether each tree gave the same verdict and
 ranking in every run; the cold runs' model builds (derive, codegen, compile: their model.json timings) are summed
-per tree, to show where the cold time goes.
+per tree, to show where the cold time goes (their wall times, so only as steady as the machine is quiet). Against
+main, unpacked beside this tree:
+
+    mkdir /tmp/ref-main && git archive main | tar -x -C /tmp/ref-main
+    python benchmarks/bench_first_diagnosis.py --reference main=/tmp/ref-main/src --repeats 3
 """
 
 from __future__ import annotations
