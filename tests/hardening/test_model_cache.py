@@ -106,3 +106,18 @@ def test_processes_that_need_the_same_model_at_once_build_it_once(cache_dir):
     derivations = sum(err.count("deriving the model") for _, err in outputs)
     assert derivations == 1, [err for _, err in outputs]
     assert [p for p in cache_dir.iterdir() if p.name.startswith(".")] == []
+
+
+def test_a_model_building_in_the_background_is_waited_for_not_built_again(cache_dir, capfd):
+    """A diagnosis starts its candidates' models in the background (start_builds) and may need one before it is
+    done: the load waits for the builder's lock (or builds it first, and the builder finds it built), so the model
+    is derived once; the builder exits cleanly and leaves no lock file or scratch directory."""
+    effects = resolve_effects(SMALL)
+    builders = cache.start_builds([effects], jobs=2)
+    assert len(builders) == 1
+    path = cache.ensure_entry(effects)
+    cache.finish_builds(builders)
+    assert builders[0].exitcode == 0
+    assert cache.entry_is_sound(path)
+    assert capfd.readouterr().err.count("deriving the model") == 1
+    assert [p for p in cache_dir.iterdir() if p.name.startswith(".")] == []

@@ -69,6 +69,66 @@ def candidate_effects(model_effects: list[Effect], registry: dict[str, Effect] |
     return [registry[n] for n in testable], untestable
 
 
+# Whether a candidate that fills a slot of the core (ackermann: the steer function, rack_lash: the column's
+# deflection law) joins the diagnosis model (shares_diagnosis_model).
+SLOT_FILLERS_SHARE = True
+
+
+def shares_diagnosis_model(effect: Effect, base_effects: list[Effect], params=None) -> bool:
+    """Whether candidate `effect` can be replayed in the diagnosis model (:func:`diagnosis_model`) instead of a model
+    of its own: it adds no coordinate or body (:meth:`Effect.configure`, :meth:`Effect.bodies`: a state changes the
+    integrator's error norm and so its steps at any strength, a body the mass matrix), needs only effects of the
+    base model, fills no slot the base model fills, and its strength is 0 in `params` (by default the shipped
+    file's), so that it is absent there. Its loads are then a product with its strength (the effect files' promise
+    that 0 means absent), exactly zero at strength 0; a slot filler's law at strength 0 is the slot's own law to
+    rounding (ackermann's atan2(sin r, cos r) is r, rack_lash's dead band of width 0 the identity), so the others at
+    strength 0 leave a candidate's replays its own model's to rounding (tests/diagnose/test_diagnosis_model.py)."""
+    spec = strength_parameter(effect, params)
+    kind = type(effect)
+    filled = {e.replaces for e in base_effects} - {None}
+    slot_ok = effect.replaces is None or (SLOT_FILLERS_SHARE and effect.replaces not in filled)
+    return (spec is not None and slot_ok and kind.configure is Effect.configure
+            and kind.bodies is Effect.bodies and set(effect.requires) <= {e.name for e in base_effects}
+            and (params is None or float(params[spec.key]) == 0.0))
+
+
+def diagnosis_model(base_effects: list[Effect], candidates: list[Effect], params=None) -> list[Effect]:
+    """The one model that replays every candidate sharing it (:func:`shares_diagnosis_model`): the base effects and
+    those candidates, by name, one filler per slot (the first by name; another keeps a model of its own). A
+    candidate's replays run in it with the others' strengths at 0 (their value in `params`), so its signature and
+    refit cost no model of its own; the base model's replays stay on the base model."""
+    shared, slots = [], set()
+    for candidate in sorted(candidates, key=lambda e: e.name):
+        if shares_diagnosis_model(candidate, base_effects, params) and candidate.replaces not in slots:
+            shared.append(candidate)
+            slots.add(candidate.replaces)
+            slots.discard(None)
+    return sorted([*base_effects, *shared], key=lambda e: e.name)
+
+
+def replay_models(base_effects: list[Effect], candidates: list[Effect], params=None
+                  ) -> dict[tuple[str, ...], list[Effect]]:
+    """{names of the base effects with one candidate: the effects of the compiled model that replays them}, for the
+    candidates that share the diagnosis model (:func:`diagnosis_model`); a candidate not listed has its own."""
+    host = diagnosis_model(base_effects, candidates, params)
+    hosted = {e.name for e in host} - {e.name for e in base_effects}
+    return {tuple(sorted([*(e.name for e in base_effects), name])): host for name in sorted(hosted)} \
+        if len(hosted) > 1 else {}
+
+
+def models_to_build(base_effects: list[Effect], candidates: list[Effect], params=None) -> list[list[Effect]]:
+    """The compiled models a diagnosis of `base_effects` against `candidates` replays: the base model, the
+    diagnosis model, and the base model with each candidate that has a model of its own."""
+    hosts = replay_models(base_effects, candidates, params)
+    out = [list(base_effects)]
+    for candidate in candidates:
+        names = tuple(sorted([*(e.name for e in base_effects), candidate.name]))
+        model = hosts.get(names, sorted([*base_effects, candidate], key=lambda e: e.name))
+        if all([e.name for e in model] != [e.name for e in m] for m in out):
+            out.append(model)
+    return out
+
+
 @dataclass(frozen=True)
 class Signature:
     """A candidate's sensitivity at the calibrated base model."""
@@ -165,10 +225,14 @@ def score(signature: Signature, calibration: Fit) -> Score:
 
 
 def candidate_models(effects: str | None = None, extra: tuple[str, ...] = ()) -> dict[str, str | None]:
-    """Every effect set a diagnosis of the model `effects` replays, by name, as effects specs: ``base`` and
-    ``with_<candidate>`` for each testable candidate.
+    """Every effect set a diagnosis of the model `effects` replays, or a truth generator hides a candidate in, by
+    name, as effects specs: ``base``, ``diagnosis`` (the diagnosis model of the registry's candidates,
+    :func:`diagnosis_model`, with the shipped parameters) and ``with_<candidate>`` for each testable candidate (the
+    model a diagnosis replays a candidate in when it does not share the diagnosis model, and the one the
+    benchmarks' records are made with).
 
-    `extra` names effect modules outside the registry (files or dotted names) to include as candidates. The
+    `extra` names effect modules outside the registry (files or dotted names) to include as candidates (a
+    ``with_<candidate>`` set each; a diagnosis whose registry holds them has a diagnosis model of its own). The
     pipeline derives each set once (:func:`parksteer.model.codegen.cache.ensure`, one job per set) before any
     diagnosis runs, which spares the parallel diagnoses from deriving the same model side by side.
     """
@@ -176,6 +240,8 @@ def candidate_models(effects: str | None = None, extra: tuple[str, ...] = ()) ->
 
     base = resolve_effects(effects)
     registry = discover_effects()
+    shared = sorted({e.name for e in diagnosis_model(base, candidate_effects(base, registry)[0])}
+                    - {e.name for e in base})
     refs = {name: name for name in registry}
     for ref in extra:
         effect = load_effect_module(ref)
@@ -183,6 +249,8 @@ def candidate_models(effects: str | None = None, extra: tuple[str, ...] = ()) ->
         refs[effect.name] = str(ref)
     testable, _ = candidate_effects(base, registry)
     sets: dict[str, str | None] = {"base": effects}
+    if len(shared) > 1:
+        sets["diagnosis"] = ",".join(filter(None, [effects, *(f"+{refs[name]}" for name in shared)]))
     for candidate in testable:
         sets[f"with_{candidate.name}"] = ",".join(filter(None, [effects, f"+{refs[candidate.name]}"]))
     return sets

@@ -55,11 +55,14 @@ from __future__ import annotations
 from dataclasses import replace
 
 from ..errors import UsageError
+from ..model.codegen.cache import finish_builds, start_builds
 from ..model.symbolic.components import Effect, discover_effects, resolve_effects
 from ..parameters import Parameters
+from .candidates import candidate_effects, models_to_build, replay_models
 from .compare import check_torque_sensors
 from .parallel import Progress
 from .problem import FileData, Problem
+from .replay import replayed_in
 from .settings import DEFAULT_SETTINGS, DiagnosisSettings
 from .stages import STAGES, run_table
 from .state import Diagnosis, DiagnosisState, frozen_mapping
@@ -100,14 +103,20 @@ def diagnose(files: list[FileData], params: Parameters, effects=None, registry: 
                       replay_uncertainty_motor=None, replay_draws_motor=None) for f in files]
     problem = Problem(copies, params, workers=workers, angle_offset_fitted=settings.angle_offset_fitted)
     progress = Progress(quiet)
-    state = DiagnosisState(settings, problem, tuple(base),
-                           frozen_mapping(registry if registry is not None else discover_effects()),
+    registry = registry if registry is not None else discover_effects()
+    state = DiagnosisState(settings, problem, tuple(base), frozen_mapping(registry),
                            None if strengths is None else frozen_mapping(strengths),
                            None if start is None else frozen_mapping(start), progress, tuple(stages))
+    testable, _ = candidate_effects(base, registry)
+    # The models the candidates replay in are built in the background while the base model's stages run (the base
+    # model itself is built, if missing, when first replayed).
+    builders = start_builds(models_to_build(base, testable, params)[1:], workers)
     try:
-        state = run_table(state)
+        with replayed_in(replay_models(base, testable, params)):
+            state = run_table(state)
     finally:
         problem.close()
+        finish_builds(builders)
     progress(f"verdict: {state.verdict}" + (f" {state.best}" if state.verdict == "missing" else "")
              + f" ({state.problem.evaluations} replays)")
     return state.result()

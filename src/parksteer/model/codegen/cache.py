@@ -298,6 +298,41 @@ def ensure_entry(effects: list[Effect]) -> Path:
     return final
 
 
+def _build_in_child(effect_sets: list[list[Effect]]) -> None:
+    for effects in effect_sets:
+        ensure_entry(effects)
+
+
+def start_builds(effect_sets: list[list[Effect]], jobs: int = 1) -> list:
+    """Start building the missing cache entries of `effect_sets` in the background: on up to `jobs` processes forked
+    from this one (sympy, code generation and `cc` run in each in line), the largest sets first, dealt in turn.
+    Return the processes (:func:`finish_builds` waits for them). Nothing starts where the platform cannot fork or
+    `jobs` is 1: each entry is then built when first loaded.
+
+    Whoever needs an entry meanwhile loads it as usual (:func:`ensure_entry`): the entry's build lock makes it wait
+    for the process building it, or build it itself if it gets there first (the builder then finds it built), so
+    no entry is built twice and a failed build is met again, with its one-line error, where the entry is loaded."""
+    import multiprocessing
+
+    if int(jobs) <= 1 or "fork" not in multiprocessing.get_all_start_methods():
+        return []
+    missing = sorted((effects for effects in effect_sets if not entry_is_sound(entry_path(effects))),
+                     key=lambda effects: -len(effects))
+    shares = [missing[i :: int(jobs)] for i in range(min(int(jobs), len(missing)))]
+    context = multiprocessing.get_context("fork")
+    processes = [context.Process(target=_build_in_child, args=(share,), daemon=True) for share in shares]
+    for process in processes:
+        process.start()
+    return processes
+
+
+def finish_builds(processes: list) -> None:
+    """Wait for the background builds :func:`start_builds` started (each has finished or failed by the time its
+    entry was loaded; a failed one is reported there)."""
+    for process in processes:
+        process.join()
+
+
 def ensure(effects: list[Effect], note_cached: bool = False) -> dict:
     """Build (or find) the compiled model of `effects` and return its manifest.
 
