@@ -55,13 +55,29 @@ class Derivation:
         return mapping
 
 
+def partial_velocity(velocity: me.Vector, speed, frame: me.ReferenceFrame) -> me.Vector:
+    """velocity.diff(speed, frame), the same vector, without differentiating a direction cosine matrix that does
+    not hold `speed`.
+
+    Vector.diff differentiates, for each component expressed in another frame, that frame's direction cosine
+    matrix relative to `frame` and, if the result is zero, differentiates the component's measure numbers where
+    they are (what var_in_dcm=False does throughout). An orientation depends on coordinates, not speeds, so that
+    matrix never holds a speed; when it holds none the result is the same, and the test (`has`) costs a walk
+    over nine entries instead of nine derivatives.
+    """
+    for _, component_frame in velocity.args:
+        if component_frame != frame and frame.dcm(component_frame).has(speed):
+            return velocity.diff(speed, frame)
+    return velocity.diff(speed, frame, var_in_dcm=False)
+
+
 def generalized_forces(loads, speeds, frame) -> sp.Matrix:
     """Q_r = sum over loads of (partial velocity or partial angular velocity wrt u_r) . (force or torque)."""
     out = sp.zeros(len(speeds), 1)
     for where, vector in loads:
         velocity = where.ang_vel_in(frame) if isinstance(where, me.ReferenceFrame) else where.vel(frame)
         for r, speed in enumerate(speeds):
-            partial = velocity.diff(speed, frame)
+            partial = partial_velocity(velocity, speed, frame)
             if partial != 0:
                 out[r] += partial.dot(vector)
     return out
