@@ -69,14 +69,14 @@ def test_the_short_derivative_route_gives_sympys_derivative_exactly():
     `(x, 0)`), it returns the very expression sympy's Derivative does, and sympy's own route is back afterwards."""
     from sympy.core.expr import Expr
 
-    from parksteer.model.codegen.generate import _memoised_diff
+    from parksteer.model.symbolic.derive import memoised_diff
 
     x, y = sp.symbols("x y", real=True)
     exprs = [x * y ** 2 * sp.sin(x), sp.sqrt(x ** 2 + y ** 2), sp.Abs(x) * sp.tanh(3 * x / y), sp.atan2(y, x),
              sp.Piecewise((x ** 2, x > y), (sp.exp(-x), True)), 1 / (x * sp.cos(y) + 2), sp.Integer(3) * y]
     expected = [[e.diff(s) for s in (x, y)] + [e.diff((x, 1)), e.diff((y, 0))] for e in exprs]
     original = Expr.diff
-    with _memoised_diff():
+    with memoised_diff():
         assert Expr.diff is not original
         found = [[e.diff(s) for s in (x, y)] + [e.diff((x, 1)), e.diff((y, 0))] for e in exprs]
         again = [sp.diff(e, x) for e in exprs]  # a second time: from the memo

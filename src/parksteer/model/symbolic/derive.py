@@ -13,6 +13,7 @@ d(theta_c)/d(rack), is that effect's share of the handwheel torque.
 
 from __future__ import annotations
 
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -53,6 +54,66 @@ class Derivation:
             mapping[c.q] = sp.Symbol(f"q[{i}]", real=True)
             mapping[c.u] = sp.Symbol(f"u[{i}]", real=True)
         return mapping
+
+
+@contextmanager
+def memoised_diff():
+    """Within it, Expr.diff by one symbol (as sympy.diff and every _eval_derivative call it: `x`, `(x, 1)` or
+    `(x, 0)`) returns what sympy's Derivative(expr, x, evaluate=True) returns, the same expression, without its
+    general front end (argument tuples, sympification, the variable-count bookkeeping, paid again at every node of
+    the expression it recurses through) and once per (expression, symbol): the chain rule differentiates the same
+    subexpressions (a sine of a coordinate, a parameter product) inside many others.
+
+    The short route follows Derivative.__new__ for a symbol and count 1 step by step: zero when the symbol is not
+    free in the expression, else the expression's _eval_derivative_n_times, returned at once when zero, otherwise
+    with every Derivative in it made canonical. Anything else (another kind of variable, a count above 1, an
+    expression without _eval_derivative or one that leaves the derivative unevaluated) takes sympy's own route.
+    """
+    from sympy.core.expr import Expr
+
+    original = Expr.diff
+    memo: dict[tuple, sp.Expr] = {}
+    derivative_type = sp.Derivative
+
+    def canonical(obj):
+        return obj.replace(lambda x: isinstance(x, derivative_type), lambda x: x.canonical)
+
+    def diff(self, *symbols, **assumptions):
+        if assumptions or len(symbols) != 1:
+            return original(self, *symbols, **assumptions)
+        s = symbols[0]
+        if isinstance(s, tuple):
+            if len(s) != 2 or not isinstance(s[0], sp.Symbol) or s[1] not in (0, 1) or isinstance(s[1], bool):
+                return original(self, *symbols)
+            s, count = s
+            if count == 0:
+                return self
+        elif not isinstance(s, sp.Symbol):
+            return original(self, *symbols)
+        key = (self, s)
+        found = memo.get(key)
+        if found is not None:
+            return found
+        if isinstance(self, derivative_type) or not hasattr(self, "_eval_derivative"):
+            result = original(self, s)
+        elif s not in self.free_symbols:
+            result = sp.S.Zero
+        else:
+            obj = self._eval_derivative_n_times(s, 1)
+            if obj is None:
+                result = original(self, s)
+            elif obj.is_zero:
+                result = obj
+            else:
+                result = canonical(obj)
+        memo[key] = result
+        return result
+
+    Expr.diff = diff
+    try:
+        yield
+    finally:
+        Expr.diff = original
 
 
 def partial_velocity(velocity: me.Vector, speed, frame: me.ReferenceFrame) -> me.Vector:
@@ -100,6 +161,11 @@ def build_space(effects: list[Effect], speeds_as_qdot: bool = False) -> ModelSpa
 
 def derive(effects: list[Effect]) -> Derivation:
     """Kane's equations and the per-effect generalized forces for the given effects."""
+    with memoised_diff():  # Kane's method and the partial velocities differentiate the same terms many times
+        return _derive(effects)
+
+
+def _derive(effects: list[Effect]) -> Derivation:
     import time
 
     timings = {}
