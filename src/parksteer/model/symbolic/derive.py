@@ -13,6 +13,7 @@ d(theta_c)/d(rack), is that effect's share of the handwheel torque.
 
 from __future__ import annotations
 
+import threading
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from typing import Any
@@ -71,49 +72,60 @@ def memoised_diff():
     """
     from sympy.core.expr import Expr
 
-    original = Expr.diff
-    memo: dict[tuple, sp.Expr] = {}
-    derivative_type = sp.Derivative
-
-    def canonical(obj):
-        return obj.replace(lambda x: isinstance(x, derivative_type), lambda x: x.canonical)
-
-    def diff(self, *symbols, **assumptions):
-        if assumptions or len(symbols) != 1:
-            return original(self, *symbols, **assumptions)
-        s = symbols[0]
-        if isinstance(s, tuple):
-            if len(s) != 2 or not isinstance(s[0], sp.Symbol) or s[1] not in (0, 1) or isinstance(s[1], bool):
-                return original(self, *symbols)
-            s, count = s
-            if count == 0:
-                return self
-        elif not isinstance(s, sp.Symbol):
-            return original(self, *symbols)
-        key = (self, s)
-        found = memo.get(key)
-        if found is not None:
-            return found
-        if isinstance(self, derivative_type) or not hasattr(self, "_eval_derivative"):
-            result = original(self, s)
-        elif s not in self.free_symbols:
-            result = sp.S.Zero
-        else:
-            obj = self._eval_derivative_n_times(s, 1)
-            if obj is None:
-                result = original(self, s)
-            elif obj.is_zero:
-                result = obj
-            else:
-                result = canonical(obj)
-        memo[key] = result
-        return result
-
-    Expr.diff = diff
+    with _DIFF_LOCK:
+        if _DIFF_STATE["depth"] == 0:
+            _DIFF_STATE["original"], _DIFF_STATE["memo"] = Expr.diff, {}
+            Expr.diff = _short_diff
+        _DIFF_STATE["depth"] += 1
     try:
         yield
     finally:
-        Expr.diff = original
+        with _DIFF_LOCK:
+            _DIFF_STATE["depth"] -= 1
+            if _DIFF_STATE["depth"] == 0:
+                Expr.diff, _DIFF_STATE["memo"] = _DIFF_STATE["original"], None
+
+
+# memoised_diff's state, one for the process: nested or concurrent uses (threads) share one installation and one
+# memo, and the last to leave restores sympy's own Expr.diff.
+_DIFF_LOCK = threading.Lock()
+_DIFF_STATE: dict[str, Any] = {"depth": 0, "original": None, "memo": None}
+
+
+def _short_diff(self, *symbols, **assumptions):
+    """Expr.diff within memoised_diff."""
+    original, memo = _DIFF_STATE["original"], _DIFF_STATE["memo"]
+    derivative_type = sp.Derivative
+
+    if assumptions or len(symbols) != 1:
+        return original(self, *symbols, **assumptions)
+    s = symbols[0]
+    if isinstance(s, tuple):
+        if len(s) != 2 or not isinstance(s[0], sp.Symbol) or s[1] not in (0, 1) or isinstance(s[1], bool):
+            return original(self, *symbols)
+        s, count = s
+        if count == 0:
+            return self
+    elif not isinstance(s, sp.Symbol):
+        return original(self, *symbols)
+    key = (self, s)
+    found = memo.get(key)
+    if found is not None:
+        return found
+    if isinstance(self, derivative_type) or not hasattr(self, "_eval_derivative"):
+        result = original(self, s)
+    elif s not in self.free_symbols:
+        result = sp.S.Zero
+    else:
+        obj = self._eval_derivative_n_times(s, 1)
+        if obj is None:
+            result = original(self, s)
+        elif obj.is_zero:
+            result = obj
+        else:  # as Derivative.__new__ ends: every Derivative in the result made canonical
+            result = obj.replace(lambda x: isinstance(x, derivative_type), lambda x: x.canonical)
+    memo[key] = result
+    return result
 
 
 def partial_velocity(velocity: me.Vector, speed, frame: me.ReferenceFrame) -> me.Vector:
