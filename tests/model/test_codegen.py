@@ -66,7 +66,8 @@ def test_the_short_derivative_route_gives_sympys_derivative_exactly():
     """The chain-rule Jacobian differentiates through a memoised short route to Expr.diff (the generated C, and so
     every model figure's last bits, must not change): for the functions the models use (products, powers, square
     roots, |x| and its sign, atan2, tanh, a piecewise law), in either form sympy calls it (`x`, `(x, 1)`,
-    `(x, 0)`), it returns the very expression sympy's Derivative does, and sympy's own route is back afterwards."""
+    `(x, 0)`), it returns the very expression sympy's Derivative does, and sympy's own route is back afterwards
+    (after the outermost of nested uses)."""
     from sympy.core.expr import Expr
 
     from parksteer.model.symbolic.derive import memoised_diff
@@ -80,6 +81,9 @@ def test_the_short_derivative_route_gives_sympys_derivative_exactly():
         assert Expr.diff is not original
         found = [[e.diff(s) for s in (x, y)] + [e.diff((x, 1)), e.diff((y, 0))] for e in exprs]
         again = [sp.diff(e, x) for e in exprs]  # a second time: from the memo
+        with memoised_diff():  # nested: the outer one's route stays until the outer one ends
+            patched = Expr.diff
+        assert Expr.diff is patched is not original
     assert Expr.diff is original
     for want, got in zip(expected, found):
         assert [sp.srepr(w) for w in want] == [sp.srepr(g) for g in got]
