@@ -217,6 +217,28 @@ def test_batches_partition_the_points_and_a_new_point_reruns_only_its_batch(tmp_
     assert sum(sizes) == 2000 and max(sizes) <= 75 and 15 <= 2000 / len(sizes) <= 40
 
 
+def test_a_large_sweep_is_cut_into_a_bounded_number_of_batches_and_a_small_one_as_before(monkeypatch):
+    """The scheduler's cost grows with the number of batch jobs, so beyond MAX_BATCHES x the batch size points the
+    batch size doubles until the points fit in about MAX_BATCHES batches; a sweep up to that size is cut exactly as
+    at the plain batch size (same batches, same ids: its results stay valid), and the grown size is a power-of-two
+    multiple of the asked one (its natural boundaries a subset of the plain size's)."""
+    from parksteer.sweep import declaration
+    from parksteer.sweep.declaration import batch_points, effective_batch_size
+
+    ids = [hashlib.sha256(str(k).encode()).hexdigest()[:10] for k in range(2000)]  # uniform, as point ids are
+    plain = batch_points(ids, 25)  # 2,000 points <= 4,096 x 25: the plain size
+    assert effective_batch_size(2000, 25) == 25 and effective_batch_size(4096 * 50, 50) == 50
+    assert effective_batch_size(4096 * 50 + 1, 50) == 100 and effective_batch_size(10**6, 50) == 400
+    monkeypatch.setattr(declaration, "MAX_BATCHES", 80)  # 2,000 points = 80 x 25: still the plain size
+    assert batch_points(ids, 25) == plain
+    monkeypatch.setattr(declaration, "MAX_BATCHES", 20)  # 2,000 > 20 x 25 x 2: cut at 100 points a batch
+    grown = batch_points(ids, 25)
+    monkeypatch.setattr(declaration, "MAX_BATCHES", 10**6)
+    assert grown == batch_points(ids, 100)
+    assert sorted(p for points in grown.values() for p in points) == sorted(ids)
+    assert 10 <= len(grown) <= 1.25 * 20 and len(plain) > 60  # about n / size: fewer only where a batch is capped
+
+
 def test_a_batch_writes_the_records_its_points_give_alone(tmp_path, params):
     """The batch job's records are, point for point, the records of the single-point job (same simulation, same
     rounding): batching changes where the work runs, not its result."""

@@ -211,6 +211,11 @@ def _clean(obj: Any, digits: int) -> Any:
 
 
 def write_json(path: str | Path, obj: Any, digits: int = SIGNIFICANT_DIGITS) -> None:
-    """Write JSON with sorted keys and rounded floats (non-finite numbers become null)."""
-    with atomic_path(path) as tmp:
-        tmp.write_text(json.dumps(_clean(obj, digits), indent=2, sort_keys=True) + "\n", encoding="utf-8")
+    """Write JSON with sorted keys and rounded floats (non-finite numbers become null).
+
+    The text goes to the file as it is encoded (json.dump: the bytes json.dumps gives), never whole in memory: a
+    sweep's summary of a million points lists some 450,000 points above its assistance threshold, and the text and
+    its pieces took about 0.9 GB besides."""
+    with atomic_path(path) as tmp, open(tmp, "w", encoding="utf-8") as out:
+        json.dump(_clean(obj, digits), out, indent=2, sort_keys=True)
+        out.write("\n")

@@ -60,3 +60,48 @@ def test_analytic_jacobian_equals_finite_differences(params, effects):
             numeric[:, j] = (model.rhs(t, up, p) - model.rhs(t, down, p)) / (2 * h)
         scale = np.max(np.abs(numeric), axis=1, keepdims=True) + 1e-12
         assert np.max(np.abs(jac - numeric) / scale) < 1e-5
+
+
+def test_the_short_derivative_route_gives_sympys_derivative_exactly():
+    """The chain-rule Jacobian differentiates through a memoised short route to Expr.diff (the generated C, and so
+    every model figure's last bits, must not change): for the functions the models use (products, powers, square
+    roots, |x| and its sign, atan2, tanh, a piecewise law), in either form sympy calls it (`x`, `(x, 1)`,
+    `(x, 0)`), it returns the very expression sympy's Derivative does, and sympy's own route is back afterwards
+    (after the outermost of nested uses)."""
+    from sympy.core.expr import Expr
+
+    from parksteer.model.symbolic.derive import memoised_diff
+
+    x, y = sp.symbols("x y", real=True)
+    exprs = [x * y ** 2 * sp.sin(x), sp.sqrt(x ** 2 + y ** 2), sp.Abs(x) * sp.tanh(3 * x / y), sp.atan2(y, x),
+             sp.Piecewise((x ** 2, x > y), (sp.exp(-x), True)), 1 / (x * sp.cos(y) + 2), sp.Integer(3) * y]
+    expected = [[e.diff(s) for s in (x, y)] + [e.diff((x, 1)), e.diff((y, 0))] for e in exprs]
+    original = Expr.diff
+    with memoised_diff():
+        assert Expr.diff is not original
+        found = [[e.diff(s) for s in (x, y)] + [e.diff((x, 1)), e.diff((y, 0))] for e in exprs]
+        again = [sp.diff(e, x) for e in exprs]  # a second time: from the memo
+        with memoised_diff():  # nested: the outer one's route stays until the outer one ends
+            patched = Expr.diff
+        assert Expr.diff is patched is not original
+    assert Expr.diff is original
+    for want, got in zip(expected, found):
+        assert [sp.srepr(w) for w in want] == [sp.srepr(g) for g in got]
+    assert [sp.srepr(g[0]) for g in found] == [sp.srepr(a) for a in again]
+
+
+def test_partial_velocities_are_sympys():
+    """A generalized force takes each load point's partial velocity with respect to every speed; the short route
+    (no direction cosine matrix differentiated when it holds no speed: an orientation depends on the
+    coordinates only) gives Vector.diff's very vector for every load of the default model."""
+    from parksteer.model.symbolic.derive import build_space, partial_velocity
+    import sympy.physics.mechanics as me
+
+    space = build_space(resolve_effects(None))
+    loads = space.core_loads() + space.column_loads()
+    assert loads
+    for where, _ in loads:
+        velocity = where.ang_vel_in(space.N) if isinstance(where, me.ReferenceFrame) else where.vel(space.N)
+        for speed in space.u:
+            short, full = partial_velocity(velocity, speed, space.N), velocity.diff(speed, space.N)
+            assert [(sp.srepr(m), f) for m, f in short.args] == [(sp.srepr(m), f) for m, f in full.args]

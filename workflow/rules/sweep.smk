@@ -1,7 +1,8 @@
 # Design exploration: the sweep declared in config["sweep"] (default config/sweeps/design.yaml; its large
 # version with config["sweep_full"]), expanded into points and the points into batches of about
-# config["sweep_batch_size"] (parksteer.sweep.declaration.batch_points), one sweep_batch job per batch, so that a
-# point costs its physics rather than a process start, and the batches run in parallel with --cores N and
+# config["sweep_batch_size"] (parksteer.sweep.declaration.batch_points; doubled until a sweep makes at most about
+# 4,096 batches, so that a million points make some 2,600 jobs rather than 21,000), one sweep_batch job per batch,
+# so that a point costs its physics rather than a process start, and the batches run in parallel with --cores N and
 # unchanged on a cluster (workflow/profiles/slurm). Each batch job reads the compiled model of its effect sets
 # ("free", and "braked" when the sweep simulates braked wheels) from the cache, where rule derive puts it, and
 # never derives; sweep_<name> gathers the table, the key numbers and the torque maps.

@@ -29,10 +29,12 @@ Every problem is one line naming the file and the key (:class:`SweepError`).
 
 from __future__ import annotations
 
+import gc
 import hashlib
 import itertools
 import json
 import math
+import operator
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -72,6 +74,11 @@ DEFAULT_BATCH_SIZE = 50
 DEFAULT_SWEEP_FILE = "config/sweeps/design.yaml"
 # A batch is closed at the latest when it holds this many times the batch size.
 BATCH_CAP_FACTOR = 3
+# At most about this many batch jobs per sweep: beyond MAX_BATCHES x the batch size points the batch size doubles
+# (see effective_batch_size). The scheduler's cost per job (about 1.5 ms of Snakemake's own work while the DAG is
+# built, a submission on a cluster) then stays bounded, and a million points still make over 1,024 jobs for a
+# cluster to run at once.
+MAX_BATCHES = 4096
 
 
 @dataclass(frozen=True)
@@ -376,18 +383,17 @@ def point_ids(case: str, effects: str | None, surface: str, values_list) -> list
     (a million points: about 2 s instead of 15)."""
     head = json.dumps({"case": case, "effects": effects, "surface": surface}, sort_keys=True)[:-1] + ', "values": {'
     fragments: dict[str, dict[float, str]] = {}
-    orders: dict[tuple[str, ...], list[str]] = {}
+    orders: dict[tuple[str, ...], list[tuple[str, dict[float, str]]]] = {}
     sha256 = hashlib.sha256
     out = []
     for values in values_list:
         keys = tuple(values)
         order = orders.get(keys)
-        if order is None:
-            order = orders[keys] = sorted(keys)  # json.dumps(sort_keys=True) sorts the same way
+        if order is None:  # json.dumps(sort_keys=True) sorts the same way
+            order = orders[keys] = [(key, fragments.setdefault(key, {})) for key in sorted(keys)]
         parts = []
-        for key in order:
+        for key, known in order:
             value = values[key]
-            known = fragments.setdefault(key, {})
             text = known.get(value) if value != 0.0 else None  # 0.0 and -0.0 are one dict key but print apart
             if text is None:
                 text = f'{json.dumps(key)}: {json.dumps(format(value, f".{GRID_DIGITS}g"))}'
@@ -398,8 +404,25 @@ def point_ids(case: str, effects: str | None, surface: str, values_list) -> list
     return out
 
 
+def effective_batch_size(n_points: int, batch_size: int) -> int:
+    """The batch size a sweep of `n_points` points is cut at: `batch_size` x 2^k, the smallest k >= 0 with
+    n_points <= MAX_BATCHES x batch_size x 2^k.
+
+    Every sweep of at most MAX_BATCHES x `batch_size` points (204,800 at the default 50) is cut at `batch_size`
+    itself, into the batches and batch ids it always had; a larger one into about MAX_BATCHES / 2 to MAX_BATCHES
+    batches. The size doubles, so that a batch boundary at the larger size (an id that is a multiple of it) is one
+    at the smaller size too: a sweep that grows past a threshold merges neighbouring batches rather than cutting
+    new ones anywhere.
+    """
+    size = batch_size
+    while n_points > MAX_BATCHES * size:
+        size *= 2
+    return size
+
+
 def batch_points(ids, batch_size: int) -> dict[str, tuple[str, ...]]:
-    """Group point ids into batches of about `batch_size`, batch id -> its point ids (sorted).
+    """Group point ids into batches of about `batch_size` (grown with the sweep beyond MAX_BATCHES x `batch_size`
+    points: :func:`effective_batch_size`), batch id -> its point ids (sorted).
 
     The ids are taken in sorted order and a batch ends after every id whose value is a multiple of
     `batch_size` (content-defined boundaries, as in rsync), or once it holds BATCH_CAP_FACTOR x `batch_size`
@@ -411,6 +434,8 @@ def batch_points(ids, batch_size: int) -> dict[str, tuple[str, ...]]:
     """
     if isinstance(batch_size, bool) or not isinstance(batch_size, int) or batch_size < 1:
         raise SweepError(f"sweep_batch_size: {batch_size!r} is not a positive integer")
+    ids = sorted(ids)
+    batch_size = effective_batch_size(len(ids), batch_size)
     batches: dict[str, tuple[str, ...]] = {}
     current: list[str] = []
 
@@ -419,7 +444,7 @@ def batch_points(ids, batch_size: int) -> dict[str, tuple[str, ...]]:
         batches[batch_id(members)] = members
         current.clear()
 
-    for point in sorted(ids):
+    for point in ids:
         current.append(point)
         if int(point, 16) % batch_size == 0 or len(current) >= BATCH_CAP_FACTOR * batch_size:
             close()
@@ -461,8 +486,9 @@ def write_batch_index(sweep: Sweep, batch_size: int, index_dir: str | Path) -> P
         return target
     target.parent.mkdir(parents=True, exist_ok=True)
     with atomic_path(target) as scratch, open(scratch, "w", encoding="utf-8") as out:
+        by_id = sweep._by_id
         for batch, members in sorted(sweep.batches(batch_size).items()):
-            out.write(f"{batch} {' '.join(str(sweep.point(m).index) for m in members)}\n")
+            out.write(f"{batch} {' '.join([str(by_id[m].index) for m in members])}\n")
     return target
 
 
@@ -645,7 +671,7 @@ def _check_effects(path: Path, effects: str | None) -> None:
 def _check_model_consistency(path: Path, params: Parameters, case: str, effects: str | None,
                              values_list: list[dict[str, float]], what: str = "point") -> None:
     """Effect parameters belong to an effect of the sweep's model; derived case values are physical."""
-    owners = {k.partition(".")[0] for v in values_list for k in v}
+    owners = {k.partition(".")[0] for k in set().union(*values_list)}
     effect_owners = owners - set(MODEL_SECTIONS) - {"case", "design"}
     if effect_owners:
         from ..model.symbolic.components import resolve_effects
@@ -660,18 +686,20 @@ def _check_model_consistency(path: Path, params: Parameters, case: str, effects:
     # those share one check, so that a million-point grid checks each combination of its design axes once. Which
     # keys it reads depends only on which keys a point has (its branches test presence), so one traced call per
     # key set tells them.
-    relevant_keys: dict[tuple[str, ...], tuple[str, ...]] = {}
+    relevant_values: dict[tuple[str, ...], Any] = {}  # key set -> the function giving a point's relevant values
     checked: set[tuple] = set()
     for i, values in enumerate(values_list):
         keys = tuple(values)
-        if keys not in relevant_keys:
+        relevant = relevant_values.get(keys)
+        if relevant is None:
             traced = _KeysRead(values)
             try:
                 point_overrides(params, case, traced)
             except SweepError:
                 pass  # reported below with the point's number
-            relevant_keys[keys] = tuple(k for k in keys if k.startswith("design.") or k in traced.read)
-        signature = (keys, tuple(values[k] for k in relevant_keys[keys]))
+            read = [k for k in keys if k.startswith("design.") or k in traced.read]
+            relevant = relevant_values[keys] = operator.itemgetter(*read) if read else (lambda _: ())
+        signature = (keys, relevant(values))
         if signature in checked:
             continue
         try:
@@ -739,8 +767,22 @@ def load_sweep(path: str | Path, params: Parameters, full: bool = False) -> Swee
     """Read, validate and expand a sweep declaration against the parameter file `params`.
 
     full: use `full_axes` (the large version of the study) instead of `axes`.
+
+    Python's cyclic garbage collector is paused meanwhile: the expansion allocates a few objects per point, none
+    of them in a cycle, and each collection it triggers walks every object made so far (a million points: about
+    2 s of 7).
     """
-    path = Path(path)
+    enabled = gc.isenabled()
+    gc.disable()
+    try:
+        return _load_sweep(Path(path), params, full)
+    finally:
+        if enabled:
+            gc.enable()
+
+
+def _load_sweep(path: Path, params: Parameters, full: bool) -> Sweep:
+    """load_sweep with the garbage collector paused."""
     doc = _read(path)
     unknown = sorted(set(doc) - TOP_LEVEL_KEYS)
     if unknown:

@@ -21,7 +21,7 @@ from pathlib import Path
 import sympy as sp
 from sympy.printing.c import C99CodePrinter
 
-from ..symbolic.derive import Derivation
+from ..symbolic.derive import Derivation, memoised_diff
 
 # The handwheel input is a piecewise-quadratic table in p: count, then (t0, angle0, rate0, accel) per piece.
 MAX_INPUT_PIECES = 24
@@ -105,33 +105,35 @@ def _derivative_block(expressions: list[sp.Expr], variables: list[sp.Symbol], ta
     names = sp.numbered_symbols("dx", real=True)
 
     def gradient(expr: sp.Expr) -> dict[sp.Symbol, sp.Expr]:
-        total: dict[sp.Symbol, sp.Expr] = {}
+        # The terms of each derivative are summed at once: a sum is canonical (its terms sorted and collected),
+        # the same expression in whatever order they come (the free symbols' order changes from run to run).
+        terms: dict[sp.Symbol, list[sp.Expr]] = {}
         if isinstance(expr, sp.logic.boolalg.Boolean):  # a condition (x > 0) shared by cse: piecewise constant
-            return total
+            return {}
         for arg in expr.free_symbols:
             if arg in wanted:
-                terms = {arg: sp.diff(expr, arg)}
+                terms.setdefault(arg, []).append(sp.diff(expr, arg))
             elif arg in derivative:
                 outer = sp.diff(expr, arg)
-                terms = {v: outer * d for v, d in derivative[arg].items()}
-            else:
-                continue
-            for v, term in terms.items():
-                total[v] = total.get(v, sp.S.Zero) + term
+                for v, d in derivative[arg].items():
+                    terms.setdefault(v, []).append(outer * d)
+        total = {v: sp.Add(*parts) for v, parts in terms.items()}
         return {v: d for v, d in total.items() if d != 0}
 
-    for sym, val in replacements:
-        grads = gradient(val)
-        if grads:
-            derivative[sym] = {}
-            for v in variables:  # in the variables' order, so the file is the same on every run
-                if v in grads:
-                    name = next(names)
-                    derivative[sym][v] = name
-                    lines.append(f"    const double {name} = {printer.doprint(grads[v])};")
-    for row, expr in zip(targets, reduced):
-        grads = gradient(expr)
-        lines += [f"    {target} = {printer.doprint(grads.get(v, sp.S.Zero))};" for target, v in zip(row, variables)]
+    with memoised_diff():
+        for sym, val in replacements:
+            grads = gradient(val)
+            if grads:
+                derivative[sym] = {}
+                for v in variables:  # in the variables' order, so the file is the same on every run
+                    if v in grads:
+                        name = next(names)
+                        derivative[sym][v] = name
+                        lines.append(f"    const double {name} = {printer.doprint(grads[v])};")
+        for row, expr in zip(targets, reduced):
+            grads = gradient(expr)
+            lines += [f"    {target} = {printer.doprint(grads.get(v, sp.S.Zero))};"
+                      for target, v in zip(row, variables)]
     return lines
 
 

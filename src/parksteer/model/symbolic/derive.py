@@ -13,6 +13,8 @@ d(theta_c)/d(rack), is that effect's share of the handwheel torque.
 
 from __future__ import annotations
 
+import threading
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -55,13 +57,100 @@ class Derivation:
         return mapping
 
 
+@contextmanager
+def memoised_diff():
+    """Within it, Expr.diff by one symbol (as sympy.diff and every _eval_derivative call it: `x`, `(x, 1)` or
+    `(x, 0)`) returns what sympy's Derivative(expr, x, evaluate=True) returns, the same expression, without its
+    general front end (argument tuples, sympification, the variable-count bookkeeping, paid again at every node of
+    the expression it recurses through) and once per (expression, symbol): the chain rule differentiates the same
+    subexpressions (a sine of a coordinate, a parameter product) inside many others.
+
+    The short route follows Derivative.__new__ for a symbol and count 1 step by step: zero when the symbol is not
+    free in the expression, else the expression's _eval_derivative_n_times, returned at once when zero, otherwise
+    with every Derivative in it made canonical. Anything else (another kind of variable, a count above 1, an
+    expression without _eval_derivative or one that leaves the derivative unevaluated) takes sympy's own route.
+    """
+    from sympy.core.expr import Expr
+
+    with _DIFF_LOCK:
+        if _DIFF_STATE["depth"] == 0:
+            _DIFF_STATE["original"], _DIFF_STATE["memo"] = Expr.diff, {}
+            Expr.diff = _short_diff
+        _DIFF_STATE["depth"] += 1
+    try:
+        yield
+    finally:
+        with _DIFF_LOCK:
+            _DIFF_STATE["depth"] -= 1
+            if _DIFF_STATE["depth"] == 0:
+                Expr.diff, _DIFF_STATE["memo"] = _DIFF_STATE["original"], None
+
+
+# memoised_diff's state, one for the process: nested or concurrent uses (threads) share one installation and one
+# memo, and the last to leave restores sympy's own Expr.diff.
+_DIFF_LOCK = threading.Lock()
+_DIFF_STATE: dict[str, Any] = {"depth": 0, "original": None, "memo": None}
+
+
+def _short_diff(self, *symbols, **assumptions):
+    """Expr.diff within memoised_diff."""
+    original, memo = _DIFF_STATE["original"], _DIFF_STATE["memo"]
+    derivative_type = sp.Derivative
+
+    if assumptions or len(symbols) != 1:
+        return original(self, *symbols, **assumptions)
+    s = symbols[0]
+    if isinstance(s, tuple):
+        if len(s) != 2 or not isinstance(s[0], sp.Symbol) or s[1] not in (0, 1) or isinstance(s[1], bool):
+            return original(self, *symbols)
+        s, count = s
+        if count == 0:
+            return self
+    elif not isinstance(s, sp.Symbol):
+        return original(self, *symbols)
+    key = (self, s)
+    found = memo.get(key)
+    if found is not None:
+        return found
+    if isinstance(self, derivative_type) or not hasattr(self, "_eval_derivative"):
+        result = original(self, s)
+    elif s not in self.free_symbols:
+        result = sp.S.Zero
+    else:
+        obj = self._eval_derivative_n_times(s, 1)
+        if obj is None:
+            result = original(self, s)
+        elif obj.is_zero:
+            result = obj
+        else:  # as Derivative.__new__ ends: every Derivative in the result made canonical
+            result = obj.replace(lambda x: isinstance(x, derivative_type), lambda x: x.canonical)
+    memo[key] = result
+    return result
+
+
+def partial_velocity(velocity: me.Vector, speed, frame: me.ReferenceFrame) -> me.Vector:
+    """velocity.diff(speed, frame), the same vector, without differentiating a direction cosine matrix that does
+    not hold `speed`.
+
+    Vector.diff differentiates, for each component expressed in another frame, that frame's direction cosine
+    matrix relative to `frame` and, if the result is zero, differentiates the component's measure numbers where
+    they are (what var_in_dcm=False does throughout). An orientation depends on coordinates, not speeds, so that
+    matrix never holds a speed; when it holds none the result is the same, and the test (`has`) costs a walk
+    over nine entries instead of nine derivatives.
+    """
+    for _, component_frame in velocity.args:
+        if component_frame != frame and frame.dcm(component_frame).has(speed):
+            return velocity.diff(speed, frame)
+    return velocity.diff(speed, frame, var_in_dcm=False)
+
+
 def generalized_forces(loads, speeds, frame) -> sp.Matrix:
     """Q_r = sum over loads of (partial velocity or partial angular velocity wrt u_r) . (force or torque)."""
     out = sp.zeros(len(speeds), 1)
     for where, vector in loads:
         velocity = where.ang_vel_in(frame) if isinstance(where, me.ReferenceFrame) else where.vel(frame)
         for r, speed in enumerate(speeds):
-            partial = velocity.diff(speed, frame)
+            partial = partial_velocity(velocity, speed, frame)
             if partial != 0:
                 out[r] += partial.dot(vector)
     return out
@@ -84,6 +173,11 @@ def build_space(effects: list[Effect], speeds_as_qdot: bool = False) -> ModelSpa
 
 def derive(effects: list[Effect]) -> Derivation:
     """Kane's equations and the per-effect generalized forces for the given effects."""
+    with memoised_diff():  # Kane's method and the partial velocities differentiate the same terms many times
+        return _derive(effects)
+
+
+def _derive(effects: list[Effect]) -> Derivation:
     import time
 
     timings = {}
