@@ -69,11 +69,6 @@ def candidate_effects(model_effects: list[Effect], registry: dict[str, Effect] |
     return [registry[n] for n in testable], untestable
 
 
-# Whether a candidate that fills a slot of the core (ackermann: the steer function, rack_lash: the column's
-# deflection law) joins the diagnosis model (shares_diagnosis_model).
-SLOT_FILLERS_SHARE = True
-
-
 def shares_diagnosis_model(effect: Effect, base_effects: list[Effect], params=None) -> bool:
     """Whether candidate `effect` can be replayed in the diagnosis model (:func:`diagnosis_model`) instead of a model
     of its own: it adds no coordinate or body (:meth:`Effect.configure`, :meth:`Effect.bodies`: a state changes the
@@ -86,7 +81,7 @@ def shares_diagnosis_model(effect: Effect, base_effects: list[Effect], params=No
     spec = strength_parameter(effect, params)
     kind = type(effect)
     filled = {e.replaces for e in base_effects} - {None}
-    slot_ok = effect.replaces is None or (SLOT_FILLERS_SHARE and effect.replaces not in filled)
+    slot_ok = effect.replaces is None or effect.replaces not in filled
     return (spec is not None and slot_ok and kind.configure is Effect.configure
             and kind.bodies is Effect.bodies and set(effect.requires) <= {e.name for e in base_effects}
             and (params is None or float(params[spec.key]) == 0.0))
