@@ -143,6 +143,59 @@ def effects_of(args, params) -> list:
     return resolve_effects(effects_with_assist(args.effects, params))
 
 
+# A record's speed channel gives the run's one constant speed (the model has no time-varying speed): its middle 90 %
+# must lie within this band (km/h), every file's median within it of the others', and a median below the standstill
+# limit is standstill (the model as it was, bit for bit).
+SPEED_BAND_KMH = 1.0
+STANDSTILL_KMH = 0.1
+
+
+def with_record_speed(params, effects, files):
+    """(params, effects) of a run at the records' vehicle speed, from their speed channel (``vehicle_speed_mps``):
+    unchanged at standstill or without the channel, else the rolling tyre's turn slip added at the median speed
+    (as ``simulate --speed-kmh``); a speed that varies, or differs between files, is refused in one line."""
+    import numpy as np
+
+    from ..measure.importers import SPEED
+    from ..model.symbolic.components import discover_effects
+    from ..vehicle import MAX_CREEPING_SPEED_KMH, creeping_overrides
+
+    logged = [f for f in files if SPEED in f.measurement.columns]
+    if not logged:
+        return params, effects
+    if len(logged) != len(files):
+        missing = next(f for f in files if SPEED not in f.measurement.columns)
+        raise UsageError(f"{missing.measurement.path or missing.label}: no column {SPEED!r} while "
+                         f"{logged[0].measurement.path or logged[0].label} has one; a run has one speed, give it in "
+                         "every file or in none")
+    medians = []
+    for f in logged:
+        kmh = np.abs(np.asarray(f.measurement.columns[SPEED], dtype=float)) * 3.6
+        low, middle, high = np.percentile(kmh, [5.0, 50.0, 95.0])
+        where = f"{f.measurement.path or f.label}: column {SPEED!r}"
+        if high - low > SPEED_BAND_KMH:
+            raise UsageError(f"{where}: the speed varies from {low:.2f} to {high:.2f} km/h (middle 90 %); the model "
+                             f"takes one constant speed a run (within {SPEED_BAND_KMH:g} km/h): cut the record where "
+                             "the car creeps steadily")
+        if middle > MAX_CREEPING_SPEED_KMH:
+            raise UsageError(f"{where}: {middle:.1f} km/h is beyond parking and creeping (0-"
+                             f"{MAX_CREEPING_SPEED_KMH:g} km/h)")
+        medians.append((middle, f))
+    (slow, f_slow), (fast, f_fast) = min(medians, key=lambda m: m[0]), max(medians, key=lambda m: m[0])
+    if fast - slow > SPEED_BAND_KMH:
+        raise UsageError(f"{f_fast.measurement.path or f_fast.label}: column {SPEED!r}: {fast:.2f} km/h against "
+                         f"{slow:.2f} km/h in {f_slow.measurement.path or f_slow.label}; diagnose files of one speed "
+                         "together")
+    speed_kmh = float(np.median([m for m, _ in medians]))
+    if speed_kmh < STANDSTILL_KMH:
+        return params, effects
+    if all(e.name != "turn_slip" for e in effects):
+        effects = sorted([*effects, discover_effects()["turn_slip"]], key=lambda e: e.name)
+    note(f"vehicle speed from the records' {SPEED}: {speed_kmh:.2f} km/h, constant over the run (the rolling tyre's "
+         "turn slip added)")
+    return params.with_overrides(creeping_overrides(speed_kmh)), effects
+
+
 def assist_of_effects(effects) -> str | None:
     """The name of the power assist among `effects`, if any."""
     return next((e.name for e in effects if getattr(e, "power_assist", False)), None)
@@ -158,6 +211,7 @@ def _compare(args) -> int:
     params = parameters_of(args)
     effects = effects_of(args, params)
     files = load_files(args.files, params, args.case, args.surface, channel_map_of(args), assist_of_effects(effects))
+    params, effects = with_record_speed(params, effects, files)
     result = compare_files(files, params, effects, overrides)
     summary = result.as_dict()
     if args.plot:
@@ -194,6 +248,7 @@ def _diagnose(args) -> int:
     params = parameters_of(args)
     effects = effects_of(args, params)
     files = load_files(args.files, params, args.case, args.surface, channel_map_of(args), assist_of_effects(effects))
+    params, effects = with_record_speed(params, effects, files)
     for f in files:
         if len(f.phases.reversal_times_s) == 0:
             raise UsageError(f"{f.measurement.path}: column 'rack_m': the rack never reverses, so the record holds "
