@@ -49,8 +49,12 @@ def assisted_figure(rows: list[dict], summary: dict, path: str | Path) -> None:
     ax.set_yticks(range(len(kinds)), [k[2] for k in kinds], fontsize=7)
     ax.set_ylim(len(kinds) - 0.5, -0.5)
     ax.set_xscale("log")
-    ax.set_xlabel("calibrated model's weighted RMS error / noise floor (torsion bar and current)")
-    ax.legend(fontsize=6.5, loc="lower right")
+    ticks = [t for t in (1.0, 1.5, 2.0, 3.0, 4.0, 6.0, 8.0) if t <= max(r["calibrated_over_floor"] for r in rows) * 1.2]
+    ax.set_xticks(ticks, [f"{t:g}" for t in ticks])
+    ax.set_xticks([], minor=True)
+    ax.set_xlabel("calibrated weighted RMS error / noise floor\n(torsion-bar torque and current)", fontsize=8)
+    ax.legend(fontsize=6.5, loc="upper right")  # the nulls sit near 1: the upper right is free
+    fig.tight_layout()
     save_svg(fig, path)
 
 
