@@ -87,13 +87,17 @@ def answer(result: dict) -> tuple:
 
 
 def main() -> None:
+    global VEHICLE  # --vehicle replaces the default car for every tree
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--reference", action="append", default=[], metavar="[NAME=]SRC",
                         help="another tree's src (e.g. /tmp/ref-main/src); repeatable")
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--record", type=Path, default=None, help="the DAQ file (default: made once, see above)")
     parser.add_argument("--jobs", type=int, default=None, help="parksteer diagnose --jobs (default: its own)")
+    parser.add_argument("--vehicle", type=Path, default=VEHICLE,
+                        help="the car's file (default: the Polo's; an older tree may need its own version of it)")
     args = parser.parse_args()
+    VEHICLE = args.vehicle.resolve()
     trees = {}
     for item in args.reference:
         name, _, src = item.rpartition("=")
