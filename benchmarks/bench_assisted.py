@@ -32,7 +32,7 @@ def main(argv: list[str] | None = None) -> int:
 
     discover_effects()
     params = load_vehicle(args.vehicle)
-    design = AssistedDesign(vehicle=args.vehicle)
+    design = AssistedDesign()
 
     def line(row: dict) -> None:
         said = row["verdict"] + (f" {row['effect']}" if row["effect"] else "")

@@ -70,9 +70,9 @@ PERTURBATION = {"tyre.friction_coefficient": 0.10, RACK_FRICTION: 0.15, "tyre.ca
 
 @dataclass(frozen=True)
 class AssistedDesign:
-    """Which hands (variations), what is hidden at which sizes (converter steps RMS), how many nulls, the seed."""
+    """Which hands (variations), what is hidden at which sizes (converter steps RMS), how many nulls, the seed (the
+    car is the `params` given to :func:`run`)."""
 
-    vehicle: str = "data/vehicles/polo_vi.toml"
     case: str = "kerb"
     null_replicates: int = 2  # each null hand twice, with other seeds (20 nulls: a 95 % rate is one miss)
     null_variations: tuple[str, ...] = ("rest_after_stop", "mid_stroke_end", "pauses", "rate_8pc_50Hz",

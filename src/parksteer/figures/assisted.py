@@ -71,7 +71,7 @@ def make_assisted_figure(parameters: str | Path, vehicle: str | Path, svg: str |
 
     discover_effects()
     params = load_vehicle(vehicle, load_parameters(parameters))
-    rows, summary = run(params, AssistedDesign(vehicle=str(vehicle)), progress=progress)
+    rows, summary = run(params, AssistedDesign(), progress=progress)
     assisted_figure(rows, summary, svg)
     names = ["name", "kind", "variation", "hidden", "steps_requested", "steps", "strength", "verdict", "effect",
              "indistinguishable", "named", "covered", "relation", "bic_margin", "confident_wrong",
