@@ -198,7 +198,10 @@ def with_record_speed(params, effects, files):
 
 def assist_of_effects(effects) -> str | None:
     """The name of the power assist among `effects`, if any."""
-    return next((e.name for e in effects if getattr(e, "power_assist", False)), None)
+    from ..model.symbolic.components import power_assist_of
+
+    assist = power_assist_of(effects)
+    return None if assist is None else assist.name
 
 
 def _compare(args) -> int:

@@ -42,7 +42,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import portable as pm
-from ..model.symbolic.components import Effect, discover_effects, strength_parameter
+from ..model.symbolic.components import Effect, discover_effects, power_assist_of, strength_parameter
 from .settings import DEFAULT_SETTINGS, DiagnosisSettings
 from .calibrate import Fit
 from .problem import Problem
@@ -54,7 +54,7 @@ def candidate_effects(model_effects: list[Effect], registry: dict[str, Effect] |
     in_model = {e.name for e in model_effects}
     # An electrically assisted car's own candidates (motor friction, torsion-bar offset, gain error) join only its
     # diagnosis; a candidate whose slot an assist fills (the rack lash) cannot join an assisted car's model.
-    assisted = any(getattr(e, "power_assist", False) for e in model_effects)
+    assisted = power_assist_of(model_effects) is not None
     electric = any(e.name.startswith("electric_assist_") for e in model_effects)
     testable, untestable = [], []
     for name in sorted(registry):

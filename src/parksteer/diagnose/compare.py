@@ -18,7 +18,7 @@ import numpy as np
 
 from ..errors import UsageError
 from ..measure.metrics import Comparison, compare
-from ..model.symbolic.components import Effect, resolve_effects
+from ..model.symbolic.components import Effect, power_assist_of, resolve_effects
 from ..parameters import Parameters
 from .problem import FileData, Problem, fit_statistics
 
@@ -87,7 +87,7 @@ def compare_files(files: list[FileData], params: Parameters, effects=None,
         else resolve_effects(effects)
     overrides = dict(overrides or {})
     # A comparison is of the torque, and of an assisted car's motor channel beside it (its own residual and floor).
-    assisted = any(getattr(e, "power_assist", False) for e in chosen)
+    assisted = power_assist_of(chosen) is not None
     check_torque_sensors(files, assisted)
     problem = Problem([replace(f, uses_angle=False, uses_motor=assisted and f.motor is not None) for f in files],
                       params)

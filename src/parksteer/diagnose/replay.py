@@ -22,10 +22,10 @@ import numpy as np
 
 from ..measure.smoothing import SmoothedRack
 from ..errors import UsageError
-from ..model.numeric.assisted import assist_effect, solve_assisted
+from ..model.numeric.assisted import solve_assisted
 from ..model.numeric.prescribed import PrescribedSolution, solve, twist_spread
 from ..model.numeric.simulate import PreparedRun, prepare
-from ..model.symbolic.components import Effect
+from ..model.symbolic.components import Effect, power_assist_of
 from ..parameters import Parameters, quantity
 
 # Prepared runs kept per replay: the base run and the latest others.
@@ -149,7 +149,7 @@ class Replay:
     def assisted(self) -> bool:
         """Whether the model has a power assist: then the replay is the assisted one
         (:func:`parksteer.model.numeric.assisted.solve_assisted`), its torque the torsion bar's."""
-        return assist_effect(self._base) is not None
+        return power_assist_of(self._base.effects) is not None
 
     def solve(self, overrides: dict[str, float] | None = None, outputs: bool = False) -> PrescribedSolution:
         """The prescribed-rack solve at `time_s` (with `outputs`, also the states and the model's outputs); of an

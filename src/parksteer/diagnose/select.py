@@ -56,7 +56,7 @@ from dataclasses import replace
 
 from ..errors import UsageError
 from ..model.codegen.cache import finish_builds, start_builds
-from ..model.symbolic.components import Effect, discover_effects, resolve_effects
+from ..model.symbolic.components import Effect, discover_effects, power_assist_of, resolve_effects
 from ..parameters import Parameters
 from .candidates import candidate_effects, models_to_build, replay_models
 from .compare import check_torque_sensors
@@ -92,7 +92,7 @@ def diagnose(files: list[FileData], params: Parameters, effects=None, registry: 
         else resolve_effects(effects)
     # An assisted car's record: its motor channel fitted beside the torsion-bar torque (settings.use_motor_channel);
     # its handwheel angle is not replayed (parksteer.diagnose.replay).
-    assisted = any(getattr(e, "power_assist", False) for e in base)
+    assisted = power_assist_of(base) is not None
     check_torque_sensors(files, assisted)
     if assisted and settings.use_handwheel_angle and any(f.angle_rad is not None for f in files):
         raise UsageError("--angle: the handwheel angle of an assisted car is not replayed; diagnose its torsion-bar "

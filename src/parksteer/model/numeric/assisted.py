@@ -42,7 +42,8 @@ import numpy as np
 
 from ...errors import UsageError
 from ...parameters import VEHICLE_SPEED
-from ..symbolic.effects.assist_common import speed_gain
+from ..symbolic.components import power_assist_of
+from ..symbolic.effects.assist_common import clamp, deadband, speed_gain
 from .prescribed import PRESCRIBED_ATOL_FACTOR, PRESCRIBED_RTOL, PrescribedSolution, RackMotion, solve
 
 # The bisection stops when the bracket is this narrow (N m of torsion-bar torque), far below a sensor's resolution.
@@ -52,27 +53,9 @@ OFFSET_KEY = "torsion_bar_offset.strength"
 GAIN_ERROR_KEY = "boost_gain_error.strength"
 
 
-def assist_effect(run):
-    """The power-assist effect of `run` (a PreparedRun), or None."""
-    found = [e for e in run.effects if getattr(e, "power_assist", False)]
-    return found[0] if found else None
-
-
 def boost_key(name: str) -> str:
     """The quantity that switches the boost off at 0: the gain (electric) or the valve's slope (hydraulic)."""
     return f"{name}.valve_slope" if name == HYDRAULIC else f"{name}.gain"
-
-
-def _ramp(z, width):
-    return 0.5 * (z + np.sqrt(z * z + width * width))
-
-
-def _deadband(x, band, width):
-    return _ramp(x - band, width) - _ramp(-x - band, width)
-
-
-def _clamp(y, limit, width):
-    return y - _ramp(y - limit, width) + _ramp(-y - limit, width)
 
 
 @dataclass(frozen=True)
@@ -104,11 +87,11 @@ class BoostLaw:
 
     def motor(self, torsion_bar_Nm):
         """The motor torque (N m; hydraulic: the pressure, Pa) at the torsion-bar torque (module docstring)."""
-        opening = _deadband(np.asarray(torsion_bar_Nm, dtype=float), self.dead_band, self.band_width)
+        opening = deadband(np.asarray(torsion_bar_Nm, dtype=float), self.dead_band, self.band_width)
         if self.hydraulic:
-            return _clamp(self.gain * opening, self.limit, self.limit_width)
+            return clamp(self.gain * opening, self.limit, self.limit_width)
         scale = self.ratio if self.location == "rack" else 1.0
-        return _clamp(self.gain * opening * scale / (self.efficiency * self.reduction), self.limit, self.limit_width)
+        return clamp(self.gain * opening * scale / (self.efficiency * self.reduction), self.limit, self.limit_width)
 
     def assist(self, torsion_bar_Nm):
         """A(T_s): the assist in torsion-bar torque units (what it adds to the torsion bar's torque in y)."""
@@ -142,7 +125,7 @@ class BoostLaw:
 
 def boost_law(run, p: np.ndarray) -> BoostLaw | None:
     """The boost law of `run`'s assist with the values of the parameter vector `p` (None without an assist)."""
-    effect = assist_effect(run)
+    effect = power_assist_of(run.effects)
     if effect is None:
         return None
     name = effect.name

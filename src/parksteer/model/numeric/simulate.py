@@ -157,7 +157,7 @@ def _columns(run: PreparedRun, t: np.ndarray, states: np.ndarray, outputs: dict,
     if extra:
         # The force the pinion and the assist together put on the rack: every load on the rack but theirs, i.e.
         # the handwheel-torque contributions of all but the assist, through d(column angle)/d(rack).
-        assists = [f"contrib_{e.name}_Nm" for e in run.effects if getattr(e, "power_assist", False)]
+        assists = [f"contrib_{e.name}_Nm" for e in run.effects if e.power_assist]
         road = cols["handwheel_torque_Nm"] - sum((cols[name] for name in assists), np.zeros(len(t)))
         cols["rack_force_N"] = road * outputs["column_angle_per_rack_rad_per_m"]
         for name in extra:

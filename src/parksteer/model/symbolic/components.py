@@ -88,6 +88,9 @@ class Effect:
     # False keeps an effect out of the diagnosis' candidates; a rival (``rival`` set) is never one
     diagnosis_candidate: ClassVar[bool] = True
     rival: ClassVar[Rival | None] = None
+    # True for a power assist (electric or hydraulic): its push is the gear's own, left out of the rack force, and
+    # a record of the car is replayed through its boost law (parksteer.model.numeric.assisted)
+    power_assist: ClassVar[bool] = False
 
     def __init_subclass__(cls, **kwargs: Any) -> None:
         super().__init_subclass__(**kwargs)
@@ -140,6 +143,11 @@ class Effect:
                 for key in self.uses
             ],
         }
+
+
+def power_assist_of(effects) -> Effect | None:
+    """The power assist among `effects` (a model has at most one), or None."""
+    return next((e for e in effects if e.power_assist), None)
 
 
 def _register_quantities(effect: Effect, where: str) -> Effect:

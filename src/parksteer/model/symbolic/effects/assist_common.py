@@ -18,19 +18,26 @@ ramp(z, w) = (z + sqrt(z^2 + w^2)) / 2 (a smooth max(z, 0), as the rack lash's d
     clamp(y, L) = y - ramp(y - L) + ramp(-y - L)      (= 0 exactly at y = 0; -> y well inside +-L)
 
 so the Jacobian stays continuous, a zero gain gives exactly no assist, and only sqrt (exact in IEEE
-arithmetic) enters the generated C.
+arithmetic) enters the generated C. The same three functions evaluate the law on numbers (the assisted replay,
+:mod:`parksteer.model.numeric.assisted`): on sympy expressions they build the model's terms, on floats and numpy
+arrays they compute them, with products for squares (no ``pow``) so the numbers are the same on every machine.
 """
 
 from __future__ import annotations
 
+import numpy as np
 import sympy as sp
 
 LOCATIONS = ("column", "pinion", "rack")
 
 
+def _sqrt(x):
+    return sp.sqrt(x) if isinstance(x, sp.Basic) else np.sqrt(x)
+
+
 def ramp(z, width):
     """A smooth max(z, 0): the hyperbola through the two asymptotes, within `width` of the corner."""
-    return (z + sp.sqrt(z**2 + width**2)) / 2
+    return (z + _sqrt(z * z + width * width)) / 2
 
 
 def deadband(x, band, width):

@@ -27,7 +27,6 @@ class BoostGainError(Effect):
     in_default_set = False
     diagnosis_candidate = False
     assist_candidate = True
-    law_side = True
     quantities = (
         Quantity(KEY, "1", -0.9, 2.0, lower_inclusive=True, default=0.0,
                  source="candidate: parking gains of EPS boost curves span 4-10 (Harrer & Pfeffer, Steering "

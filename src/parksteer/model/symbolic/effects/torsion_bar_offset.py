@@ -28,7 +28,6 @@ class TorsionBarOffset(Effect):
     in_default_set = False
     diagnosis_candidate = False
     assist_candidate = True
-    law_side = True  # acts in the assisted replay's boost law (parksteer.model.numeric.assisted)
     quantities = (
         Quantity(KEY, "N m", -2.0, 2.0, lower_inclusive=True, default=0.0,
                  source="candidate: a torque sensor's zero drifts by up to a few tenths of a N m before the "
