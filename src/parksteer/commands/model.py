@@ -57,6 +57,10 @@ def register(sub) -> None:
     p = sub.add_parser("derive", help="derive, generate and compile the model for an effect set (cached)")
     p.add_argument("--effects", default=None, help="effects spec (default: all five)")
     p.add_argument("--out", default=None, help="also write a JSON manifest of the cache entry here")
+    p.add_argument("--prebuilt", action="store_true",
+                   help="instead: derive the models of a diagnosis with the default effects and keep their C in the "
+                        "package (src/parksteer/model/prebuilt), where a cold cache compiles it without deriving; "
+                        "run after any change to the symbolic half (the tests say when)")
     add_quiet_option(p)
     p.set_defaults(func=_derive)
 
@@ -159,6 +163,15 @@ def _derive(args) -> int:
     from ..model.symbolic.components import resolve_effects
 
     start = time.perf_counter()
+    if args.prebuilt:
+        from ..diagnose.candidates import default_diagnosis_models
+        from ..model.codegen.cache import write_prebuilt
+
+        if args.effects is not None or args.out is not None:
+            raise UsageError("--prebuilt derives the default diagnosis' models: give it no --effects or --out")
+        written = write_prebuilt(default_diagnosis_models())
+        print(f"pre-derived {len(written) // 2} models -> {written[0].parent} ({time.perf_counter() - start:.1f} s)")
+        return 0
     manifest = ensure(resolve_effects(args.effects), note_cached=True)
     if args.out:
         write_json(args.out, manifest)

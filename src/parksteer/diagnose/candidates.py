@@ -42,7 +42,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import portable as pm
-from ..model.symbolic.components import Effect, discover_effects, power_assist_of, strength_parameter
+from ..model.symbolic.components import (Effect, discover_effects, power_assist_of, resolve_effects,
+                                         strength_parameter)
 from .settings import DEFAULT_SETTINGS, DiagnosisSettings
 from .calibrate import Fit
 from .problem import Problem
@@ -122,6 +123,14 @@ def models_to_build(base_effects: list[Effect], candidates: list[Effect], params
         if all([e.name for e in model] != [e.name for e in m] for m in out):
             out.append(model)
     return out
+
+
+def default_diagnosis_models(params=None) -> list[list[Effect]]:
+    """The compiled models a diagnosis of a car with the default effects builds (:func:`models_to_build`): the ones
+    the package ships pre-derived (``parksteer derive --prebuilt``). The same for every vehicle file that leaves the
+    candidates absent, the package's three and the parameter file's car alike."""
+    base = resolve_effects(None)
+    return models_to_build(base, candidate_effects(base)[0], params)
 
 
 @dataclass(frozen=True)

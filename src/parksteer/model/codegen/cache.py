@@ -51,6 +51,10 @@ KEYLESS_SOURCE = Path(__file__).resolve()
 COMPILE_FLAGS = ("-O1", "-ffp-contract=off", "-shared", "-fPIC")
 # Built files whose SHA-256 model.json records: an entry is used only if both exist and match.
 BUILT_FILES = ("model.c", "model.so")
+# The package's pre-derived models: the generated C (gzip) and description of the effect sets a first diagnosis of
+# a car with the default effects builds, named by their cache keys (`parksteer derive --prebuilt` writes them; the
+# tests derive each again and compare the bytes). Outside the symbolic half, so they are not part of any key.
+PREBUILT_DIR = MODEL_DIR / "prebuilt"
 # A scratch directory (".<key>.<host>.<pid>.<random>") whose builder is gone is removed by the next build; one
 # from another host (a shared cache on a cluster) only once it is older than any build could take.
 STALE_SCRATCH_S = 6 * 3600.0
@@ -127,10 +131,8 @@ def find_compiler() -> str:
     raise UsageError("no C compiler found (tried $CC, cc, gcc, clang): install one, e.g. apt-get install gcc")
 
 
-def build_entry(effects: list[Effect], directory: Path) -> dict:
-    """Derive, generate and compile the model for `effects` into `directory`; return its description."""
-    import sympy
-
+def derive_source(effects: list[Effect]) -> tuple[str, dict, dict]:
+    """Derive and generate the model of `effects`: its C source, its description and the derivation's timings."""
     from ..symbolic.derive import derive
     from .generate import generate
 
@@ -145,6 +147,61 @@ def build_entry(effects: list[Effect], directory: Path) -> dict:
     source, info = generate(derivation)
     t_codegen = time.perf_counter() - start - t_derive
     note(f"generated C: {source.count(chr(10))} lines, {len(source) / 1024:.0f} KiB, {t_codegen:.1f} s")
+    return source, info, {"derive": t_derive, "codegen": t_codegen, **derivation.timings_s}
+
+
+def _prebuilt_paths(key: str) -> tuple[Path, Path]:
+    return PREBUILT_DIR / f"{key}.c.gz", PREBUILT_DIR / f"{key}.json"
+
+
+def prebuilt_source(key: str) -> tuple[str, dict] | None:
+    """The package's pre-derived C and description under `key`, or None (:data:`PREBUILT_DIR`)."""
+    import gzip
+
+    c_path, json_path = _prebuilt_paths(key)
+    try:
+        source = gzip.decompress(c_path.read_bytes()).decode("utf-8")
+        info = json.loads(json_path.read_text(encoding="utf-8"))
+    except (OSError, ValueError, EOFError):
+        return None
+    return source, info
+
+
+def write_prebuilt(effect_sets: list[list[Effect]]) -> list[Path]:
+    """Derive `effect_sets` and keep their C and descriptions as the package's pre-derived models, replacing all
+    others; return the files written. The gzip stream carries no time stamp, so the same C gives the same file."""
+    import gzip
+
+    PREBUILT_DIR.mkdir(parents=True, exist_ok=True)
+    written = []
+    for effects in effect_sets:
+        source, info, _ = derive_source(effects)
+        info.pop("codegen_timings_s", None)
+        c_path, json_path = _prebuilt_paths(model_key(effects))
+        c_path.write_bytes(gzip.compress(source.encode("utf-8"), compresslevel=9, mtime=0))
+        json_path.write_text(json.dumps(info, indent=1, sort_keys=True) + "\n", encoding="utf-8")
+        written += [c_path, json_path]
+    for path in PREBUILT_DIR.iterdir():
+        if path.name.endswith((".c.gz", ".json")) and path not in written:
+            path.unlink()
+    return written
+
+
+def build_entry(effects: list[Effect], directory: Path, key: str | None = None) -> dict:
+    """Derive, generate and compile the model for `effects` into `directory` (with the cache `key`, the package's
+    pre-derived C of that key is compiled instead of deriving it, :data:`PREBUILT_DIR`); return its description."""
+    import sympy
+
+    names = ",".join(e.name for e in effects) or "none"
+    start = time.perf_counter()
+    prebuilt = prebuilt_source(key) if key is not None else None
+    if prebuilt is not None:
+        source, info = prebuilt
+        timings = {"derive": 0.0, "codegen": time.perf_counter() - start}
+        note(f"the model of {names}: the package's pre-derived C ({source.count(chr(10))} lines), compiling it")
+    else:
+        source, info, timings = derive_source(effects)
+    t_derive, t_codegen = timings["derive"], timings["codegen"]
     directory.mkdir(parents=True, exist_ok=True)
     (directory / "model.c").write_text(source, encoding="utf-8")
     compiler = find_compiler()
@@ -158,8 +215,8 @@ def build_entry(effects: list[Effect], directory: Path) -> dict:
     info.update({
         "sha256": {name: _sha256(directory / name) for name in BUILT_FILES},
         "sympy_version": sympy.__version__,
-        "timings_s": {"derive": t_derive, "codegen": t_codegen, "compile": t_compile,
-                      "total": time.perf_counter() - start, **derivation.timings_s},
+        "prebuilt": prebuilt is not None,
+        "timings_s": {**timings, "compile": t_compile, "total": time.perf_counter() - start},
     })
     (directory / "model.json").write_text(json.dumps(info, indent=1, sort_keys=True) + "\n", encoding="utf-8")
     return info
@@ -282,7 +339,7 @@ def ensure_entry(effects: list[Effect]) -> Path:
         host = socket.gethostname().replace(".", "-")
         scratch = Path(tempfile.mkdtemp(prefix=f".{final.name}.{host}.{os.getpid()}.", dir=final.parent))
         try:
-            build_entry(effects, scratch)
+            build_entry(effects, scratch, final.name)
             if final.exists() and not entry_is_sound(final):  # damaged or incomplete: replaced by the new build
                 broken = Path(tempfile.mkdtemp(prefix=f".{final.name}.{host}.{os.getpid()}.", dir=final.parent))
                 os.rename(final, broken / "old")
