@@ -17,8 +17,14 @@ and times the process: wall, and the CPU (user + system) of it and every process
 background builds), which on a machine other work shares is the steadier number (wall >= CPU / cores). It prints
 every time, the medians, and whether each tree gave the same verdict and
 ranking in every run; the cold runs' model builds (derive, codegen, compile: their model.json timings) are summed
-per tree, to show where the cold time goes (their wall times, so only as steady as the machine is quiet). Against
-main, unpacked beside this tree:
+per tree, to show where the cold time goes (their wall times, so only as steady as the machine is quiet). The package's
+pre-derived models (src/parksteer/model/prebuilt) make a cold run compile without deriving; to time the cold run
+that derives them (an edited effect, a set not shipped), give a copy of this tree's src without them:
+
+    cp -r src /tmp/derived-src && rm -r /tmp/derived-src/parksteer/model/prebuilt
+    python benchmarks/bench_first_diagnosis.py --reference derived=/tmp/derived-src --repeats 3
+
+Against main, unpacked beside this tree:
 
     mkdir /tmp/ref-main && git archive main | tar -x -C /tmp/ref-main
     python benchmarks/bench_first_diagnosis.py --reference main=/tmp/ref-main/src --repeats 3
