@@ -12,8 +12,9 @@ offset x steering ratio around the unladen test car) it measures, once each, on 
   index, wall time each;
 * gather: the gathering (parksteer.figures.sweep.make_sweep_figure: table, key numbers, maps) over synthetic batch
   files, one per batch, with records shaped as run_batch writes them (trimmed of the fields the gathering does not
-  read); no point is simulated. Wall time and the peak resident memory of the gathering process (ru_maxrss),
-  and that after load_sweep alone in the same process (the expansion's share of it).
+  read); no point is simulated. Wall and CPU time and the peak resident memory of the gathering process
+  (ru_maxrss; base_rss_mb: that of the process with its imports, before the gathering), then, after it in the same
+  process, the peak with the sweep's expansion (load_sweep) made as well, for comparison.
 
 It prints, per stage, each size's time and its cost per point (linear growth: the cost per point roughly
 constant), writes all numbers to the JSON file given, and, with --point-cost, measures a sweep point's cost
@@ -176,17 +177,21 @@ from pathlib import Path
 from parksteer.parameters import load_parameters
 from parksteer.sweep import load_sweep
 from parksteer.figures.sweep import make_sweep_figure
+def cpu():
+    usage = resource.getrusage(resource.RUSAGE_SELF)
+    return usage.ru_utime + usage.ru_stime
 params = load_parameters(sys.argv[2])
 paths = Path(sys.argv[3], "paths.txt").read_text(encoding="utf-8").split()
-start = time.perf_counter()
-sweep = load_sweep(sys.argv[1], params)
-expansion_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
-del sweep
-loaded = time.perf_counter()
 out = Path(sys.argv[4])
+base_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+start, start_cpu = time.perf_counter(), cpu()
 make_sweep_figure(sys.argv[1], params, paths, out / "s.svg", out / "s.csv", out / "s.json")
-print(json.dumps({"gather_s": time.perf_counter() - loaded, "expansion_peak_mb": expansion_mb,
-                  "peak_rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024}))
+result = {"gather_s": time.perf_counter() - start, "gather_cpu_s": cpu() - start_cpu, "base_rss_mb": base_mb,
+          "peak_rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
+          "summary_bytes": (out / "s.json").stat().st_size, "table_bytes": (out / "s.csv").stat().st_size}
+sweep = load_sweep(sys.argv[1], params)  # after the gathering, so that its peak is the gathering's own
+result["expansion_peak_mb"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+print(json.dumps(result))
 """
 
 

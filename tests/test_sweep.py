@@ -296,15 +296,23 @@ def test_a_batch_job_reads_from_the_batch_index_the_spec_the_sweep_gives(tmp_pat
         batch_spec_from_index(path, params.path, False, 4, "0123456789", sweep.shared_spec, index_dir)
 
 
-def test_the_streamed_table_is_the_table_of_all_records(tmp_path, params):
-    """gather_points, reading batch files in any order and spilling rows, writes the table sweep_table and
-    write_csv give from every record in memory, byte for byte, and keeps every record the summary and the maps
-    select (a line through the design point on each axis, the map's held slice)."""
-    from parksteer.sweep.aggregate import gather_points, matching, read_points, sweep_table
-    from parksteer.tables import write_csv
+def test_the_streamed_gathering_writes_what_all_records_in_memory_give(tmp_path, params):
+    """gather_points, reading batch files in any order with the sweep unexpanded (each record's index found from
+    its values, checked against its id), writes the table sweep_table and write_csv give from every record in
+    memory, and the summary (points above the threshold streamed from a scratch file) that summarise gives from
+    every record, byte for byte; a missing point is named, a record of another sweep or one gathered twice
+    refused."""
+    from parksteer.sweep.aggregate import gather_points, read_points, summarise, sweep_table
+    from parksteer.tables import write_csv, write_json
 
-    path = _write(tmp_path, GRID + "map: {x: tyre.tyre_pressure, y: design.front_axle_load, quantity: peak_torque_Nm}\n")
+    text = GRID + ("map: {x: tyre.tyre_pressure, y: design.front_axle_load, panels: steering.rack_friction_force,\n"
+                   "      quantity: peak_torque_Nm}\n"
+                   "assistance:\n  rim_force: {value: 150, unit: N, source: test}\n"
+                   "  rim_radius: {value: 0.2, unit: m, source: test}\n")
+    path = _write(tmp_path, text)
     sweep = load_sweep(path, params)
+    streamed = load_sweep(path, params, expand=False)
+    assert not streamed.points and streamed.n_points == len(sweep.points) == 12
     files = []
     for k, (batch, members) in enumerate(sorted(sweep.batches(3).items())):
         records = []
@@ -322,16 +330,56 @@ def test_the_streamed_table_is_the_table_of_all_records(tmp_path, params):
         files[-1].write_text(json.dumps({"batch": batch, "records": records}), encoding="utf-8")
     files.reverse()
     header = {"sweep": "streamed"}
-    kept, totals = gather_points(files, sweep, params, tmp_path / "streamed.csv", lambda totals: header, 30.0)
+    with gather_points(files, streamed, params, tmp_path / "streamed.csv", lambda totals: header, 30.0) as kept:
+        write_json(tmp_path / "streamed.json", summarise(streamed, params, kept.records, kept.totals, kept.map_slice))
     everything = read_points(files, sweep)
     write_csv(tmp_path / "memory.csv", sweep_table(sweep, everything, 30.0), header)
+    write_json(tmp_path / "memory.json", summarise(sweep, params, everything))
     assert (tmp_path / "streamed.csv").read_bytes() == (tmp_path / "memory.csv").read_bytes()
-    assert totals.n_points == len(everything) == 12 and totals.peak_range_Nm == (20.0, 31.0)
-    assert len(totals.points_above) == sum(r["merits"]["peak_torque_Nm"] > 30.0 for r in everything)
-    held = {"steering.rack_friction_force": 730.0}
-    assert [r["point"] for r in matching(kept, held)] == [r["point"] for r in matching(everything, held)]
+    assert (tmp_path / "streamed.json").read_bytes() == (tmp_path / "memory.json").read_bytes()
+    summary = json.loads((tmp_path / "memory.json").read_text())
+    assert summary["assistance"]["n_above"] == len(summary["assistance"]["points_above"]) == 1  # 20 + 11 > 30
+    assert kept.totals.n_points == 12 and kept.totals.peak_range_Nm == (20.0, 31.0)
+    assert len(kept.records) < 12  # only the lines through the design point are kept whole
+    with pytest.raises(SweepError, match=f"first difference: {min(sweep.batches(3)[json.loads(files[0].read_text())['batch']])}"):
+        with gather_points(files[1:], streamed, params, tmp_path / "short.csv", lambda totals: header, 30.0):
+            pass
+    with pytest.raises(SweepError, match="gathered from another file"):
+        with gather_points(files + files[:1], streamed, params, tmp_path / "twice.csv", lambda totals: header, 30.0):
+            pass
+    other = load_sweep(_write(tmp_path, text.replace("base_case: unladen", "base_case: part_laden"), "o.yaml"), params,
+                       expand=False)  # the same values simulate another case: other ids
     with pytest.raises(SweepError, match="point files do not match"):
-        gather_points(files[1:], sweep, params, tmp_path / "short.csv", lambda totals: header, 30.0)
+        with gather_points(files, other, params, tmp_path / "other.csv", lambda totals: header, 30.0):
+            pass
+
+
+def test_an_unexpanded_grid_is_checked_and_indexed_as_the_expansion(tmp_path, params):
+    """Loaded without its expansion, a grid decodes each point's values and id from its index and finds each
+    index from the values, as the expansion lists them; a point whose design values are unphysical is refused
+    with the same line, naming the same (first) point."""
+    path = _write(tmp_path, GRID)
+    sweep, lazy = load_sweep(path, params), load_sweep(path, params, expand=False)
+    for point in sweep.points:
+        assert lazy.values_at(point.index) == point.values and lazy.id_at(point.index) == point.id
+        assert lazy.locate(point.id, point.values) == point.index
+    assert lazy.locate(sweep.points[1].id, sweep.points[0].values) == -1
+    with pytest.raises(SweepError, match="expanded"):
+        lazy.point_ids
+    # 1,500 N on the front axle is below the unsprung weight once the unsprung mass is 200 kg (1,962 N): the
+    # first such point is pressure 0, load 1, mass 1: point 3 (the check itself tries a point per load and mass,
+    # that one its second), and the same in the unselected full sweep of one pressure
+    axes = "  tyre.tyre_pressure: [150000, 200000]\n  design.front_axle_load: [5576, 1500]\n" \
+           "  vehicle.unsprung_mass: [50, 200]\n"
+    for text, where in ((f"name: bad\nbase_case: unladen\naxes:\n{axes}", ": point 3:"),
+                        (f"name: bad\nbase_case: unladen\naxes: {{tyre.tyre_pressure: [2.0e+5]}}\n"
+                         f"full_axes:\n{axes.replace('150000, ', '')}", ": full_axes point 3:")):
+        bad = _write(tmp_path, text, "bad.yaml")
+        with pytest.raises(SweepError) as expanded:
+            load_sweep(bad, params)
+        with pytest.raises(SweepError) as unexpanded:
+            load_sweep(bad, params, expand=False)
+        assert str(unexpanded.value) == str(expanded.value) and where in str(expanded.value)
 
 
 # ---------------------------------------------------------------------------- design variables

@@ -68,6 +68,13 @@ def diagnosis(config: dict, parameters_path: str, user_effect: str) -> dict:
     }
 
 
+def assisted_cases() -> list[str]:
+    """The case names of the assisted benchmark (parksteer.diagnose.assisted_benchmark), in its order."""
+    from .diagnose.assisted_benchmark import case_names
+
+    return case_names()
+
+
 def sweep(path: str, parameters_path: str, full: bool, batch_size: int, index_dir: str) -> dict:
     """The sweep declared in `path`, read, checked and expanded (parksteer.sweep.load_sweep; its braked-wheel
     check resolves effects): its name, effect sets by variant, what every point spec shares, and its batch ids;

@@ -196,11 +196,24 @@ def read_csv(path: str | Path) -> tuple[dict[str, np.ndarray], dict[str, str]]:
     return cols, header
 
 
-def _clean(obj: Any, digits: int) -> Any:
+class StreamedList:
+    """A list of a JSON document that write_json encodes item by item as `items` yields them (read once), so that
+    it need never be whole in memory: the bytes are those of the same document holding the list itself."""
+
+    def __init__(self, items: Iterable[Any]):
+        self.items = items
+
+
+def _clean(obj: Any, digits: int, streamed: list | None = None) -> Any:
+    if isinstance(obj, StreamedList):
+        if streamed is None:
+            raise TypeError("a StreamedList only at the top of write_json's document")
+        streamed.append(obj)
+        return f"\0streamed list {len(streamed) - 1}\0"
     if isinstance(obj, Mapping):
-        return {str(k): _clean(v, digits) for k, v in obj.items()}
+        return {str(k): _clean(v, digits, streamed) for k, v in obj.items()}
     if isinstance(obj, (list, tuple, np.ndarray)):
-        return [_clean(v, digits) for v in obj]
+        return [_clean(v, digits, streamed) for v in obj]
     if isinstance(obj, (bool, np.bool_)):
         return bool(obj)
     if isinstance(obj, (int, np.integer)):
@@ -213,9 +226,34 @@ def _clean(obj: Any, digits: int) -> Any:
 def write_json(path: str | Path, obj: Any, digits: int = SIGNIFICANT_DIGITS) -> None:
     """Write JSON with sorted keys and rounded floats (non-finite numbers become null).
 
-    The text goes to the file as it is encoded (json.dump: the bytes json.dumps gives), never whole in memory: a
-    sweep's summary of a million points lists some 450,000 points above its assistance threshold, and the text and
-    its pieces took about 0.9 GB besides."""
+    The text goes to the file as it is encoded (json.dump: the bytes json.dumps gives), never whole in memory. A
+    list given as a :class:`StreamedList` is encoded one item at a time where it stands (a sweep's summary of a
+    million points lists some 450,000 points above its assistance threshold): the rest of the document is
+    encoded with a placeholder string there, and the items go in its place, each encoded alone and indented
+    as json.dump indents a list's items at that depth (the placeholder's line's indent plus one step)."""
+    streamed: list[StreamedList] = []
+    cleaned = _clean(obj, digits, streamed)
     with atomic_path(path) as tmp, open(tmp, "w", encoding="utf-8") as out:
-        json.dump(_clean(obj, digits), out, indent=2, sort_keys=True)
+        if not streamed:
+            json.dump(cleaned, out, indent=2, sort_keys=True)
+        else:
+            text = json.dumps(cleaned, indent=2, sort_keys=True)
+            places = sorted((text.index(json.dumps(f"\0streamed list {number}\0")), number)
+                            for number in range(len(streamed)))  # in the text's order (keys are sorted)
+            start = 0
+            for at, number in places:
+                listed, placeholder = streamed[number], json.dumps(f"\0streamed list {number}\0")
+                line = text[text.rfind("\n", 0, at) + 1:at]
+                indent = " " * (len(line) - len(line.lstrip(" ")))
+                inner = "\n" + indent + "  "
+                out.write(text[start:at])
+                out.write("[")
+                empty = True
+                for item in listed.items:
+                    out.write(("" if empty else ",") + inner)
+                    out.write(json.dumps(_clean(item, digits), indent=2, sort_keys=True).replace("\n", inner))
+                    empty = False
+                out.write("]" if empty else "\n" + indent + "]")
+                start = at + len(placeholder)
+            out.write(text[start:])
         out.write("\n")

@@ -132,3 +132,30 @@ def test_an_angle_only_record_gives_the_rack_through_the_torsion_bar(params, nam
     through_shaft = rack_from_angle(measurement, params).rack_m
     error, naive = (float(np.max(np.abs(r - run["rack_m"]))) for r in (through_bar, through_shaft))
     assert error < 1e-6 and naive > 100 * error
+
+
+def test_the_assisted_benchmark_rows_come_back_in_the_design_order(tmp_path):
+    """Bookkeeping, not physics: the rows the benchmark's jobs write (one file per case, in any job's folder) are
+    read back in the order of the design's cases, whatever job ran each, so that the summary and the figure do not
+    depend on how the cases were dealt; a case without a row, or with a row in two folders, is refused in one line
+    naming it."""
+    from parksteer.diagnose.assisted_benchmark import ROW_SUFFIX, case_names, read_rows
+    from parksteer.errors import UsageError
+
+    names = case_names()
+    assert len(names) == len(set(names)) == 62  # 20 nulls, 4 candidates x 2 sizes x 4 hands, 10 out of class
+    folders = [tmp_path / "a", tmp_path / "b"]
+    for folder in folders:
+        folder.mkdir()
+    for i, name in enumerate(reversed(names)):
+        (folders[i % 2] / f"{name}{ROW_SUFFIX}").write_text(json.dumps({"name": name, "value": 0.1 * i}))
+    assert [row["name"] for row in read_rows(folders, names)] == names
+    for folder in folders:
+        (folder / f"{names[0]}{ROW_SUFFIX}").unlink(missing_ok=True)
+    with pytest.raises(UsageError, match=f"no row of case {names[0]}"):
+        read_rows(folders, names)
+    for folder in folders:  # names[1] in both folders
+        (folder / f"{names[1]}{ROW_SUFFIX}").write_text("{}")
+    (folders[0] / f"{names[0]}{ROW_SUFFIX}").write_text("{}")
+    with pytest.raises(UsageError, match=f"case {names[1]} has a row"):
+        read_rows(folders, names)

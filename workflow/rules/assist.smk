@@ -59,18 +59,49 @@ rule assist_study:
 # The assisted benchmark (parksteer.diagnose.assisted_benchmark, parksteer.figures.assisted): records of the Polo
 # file's car with its column assist, hands of the variation benchmark and its logger with the car's torsion-bar and
 # current channels, with nothing, a candidate of an assisted car or an out-of-class change hidden, each diagnosed
-# from its written file; scored against the variation benchmark's targets. One job (about 60 records, a few
-# minutes); the candidate models are derived in it (the model cache locks each build). Part of `all` (FIGURES).
-rule diag_assisted:
+# from its written file; scored against the variation benchmark's targets. Its 62 cases are each made from their
+# own seed: diag_assisted_batch runs them in jobs of config["assisted_cases_per_job"] (dealt in turn, as the other
+# diagnosis benchmarks' cases, so that the jobs run in parallel and each mixes costly and cheap cases), each job
+# writing one row per case, and diag_assisted scores and draws the rows. The candidate models are derived in the
+# jobs (the model cache locks each build: jobs that need one at once build it once). Part of `all` (FIGURES).
+DIAG_ASSISTED_CASES = planned("assisted_cases")
+DIAG_ASSISTED_BATCHES = case_batches("assisted_", DIAG_ASSISTED_CASES,
+                                     int(config.get("assisted_cases_per_job", 16)))
+
+
+rule diag_assisted_batch:
     input:
         parameters=PARAMETERS,
         vehicle="data/vehicles/polo_vi.toml",
         models=[ASSIST_MODELS["column"]],
+        code=script_sources("diag_assisted_batch"),
+    output:
+        directory("results/diagnose/assisted/{batch}"),
+    params:
+        cases=lambda wildcards: DIAG_ASSISTED_BATCHES[wildcards.batch],
+    wildcard_constraints:
+        batch="|".join(DIAG_ASSISTED_BATCHES) if DIAG_ASSISTED_BATCHES else "none",
+    log:
+        "logs/diag_assisted_batch/{batch}.log",
+    benchmark:
+        benchmark_file("diag_assisted_batch", "batch")
+    conda:
+        "../envs/parksteer.yaml"
+    script:
+        "../scripts/diag_assisted_batch.py"
+
+
+rule diag_assisted:
+    input:
+        batches=expand("results/diagnose/assisted/{batch}", batch=DIAG_ASSISTED_BATCHES),
+        vehicle="data/vehicles/polo_vi.toml",
         code=script_sources("diag_assisted"),
     output:
         svg=figure_report("figures/diag_assisted.svg", "diagnose"),
         csv=figure_report("figures/diag_assisted.csv", "diagnose"),
         json="results/diag_assisted.json",
+    params:
+        cases=DIAG_ASSISTED_CASES,
     log:
         "logs/diag_assisted.log",
     benchmark:

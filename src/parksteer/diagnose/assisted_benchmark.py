@@ -26,6 +26,7 @@ steps, nulls adequate at least NULL_ADEQUATE_TARGET, and no confident wrong answ
 
 from __future__ import annotations
 
+import json
 import tempfile
 import time
 from dataclasses import dataclass
@@ -33,6 +34,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..errors import UsageError
 from ..measure.io import write_measurement
 from ..model.symbolic.components import discover_effects, resolve_effects
 from ..parameters import Parameters
@@ -113,6 +115,11 @@ def cases(design: AssistedDesign) -> list[AssistedCase]:
             out.append(AssistedCase(f"{v}__{kind}_{size:g}", "outclass", v, kind, size,
                                     design.seed + 10 * design.null_variations.index(v)))
     return out
+
+
+def case_names(design: AssistedDesign = AssistedDesign()) -> list[str]:
+    """The names of the cases of `design`, in the order run() runs them (and the outputs list them)."""
+    return [case.name for case in cases(design)]
 
 
 def _logger(variation, seed: int) -> AssistedLogger:
@@ -255,4 +262,42 @@ def run(params: Parameters, design: AssistedDesign = AssistedDesign(), only=None
     return rows, summarise(rows)
 
 
-__all__ = ["AssistedDesign", "cases", "outcome", "run", "summarise"]
+ROW_SUFFIX = ".row.json"
+
+
+def run_batch(params: Parameters, names: list[str], folder: str | Path, design: AssistedDesign = AssistedDesign()
+              ) -> None:
+    """Run the cases `names` of `design` (one job of the pipeline's rule diag_assisted_batch) and write each one's
+    outcome row to <folder>/<name>.row.json. Each case is made from its own seed and diagnosed from its own file,
+    so it gives the same row whichever job runs it and with whichever others."""
+    from ..tables import atomic_path
+
+    known = set(case_names(design))
+    unknown = [name for name in names if name not in known]
+    if unknown:
+        raise UsageError(f"assisted benchmark: no case {unknown[0]!r}")
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    rows, _ = run(params, design, only=set(names))
+    for row in rows:  # floats as repr: read back, the same numbers
+        with atomic_path(folder / f"{row['name']}{ROW_SUFFIX}") as scratch:
+            scratch.write_text(json.dumps(row), encoding="utf-8")
+
+
+def read_rows(folders, names: list[str]) -> list[dict]:
+    """The rows run_batch wrote into `folders` of the cases `names`, in that order; a case with no row, or with
+    rows in two folders, is refused in one line."""
+    found: dict[str, Path] = {}
+    for folder in map(Path, folders):
+        for path in sorted(folder.glob(f"*{ROW_SUFFIX}")):
+            name = path.name[:-len(ROW_SUFFIX)]
+            if name in found:
+                raise UsageError(f"{path}: case {name} has a row in {found[name].parent} as well")
+            found[name] = path
+    missing = [name for name in names if name not in found]
+    if missing:
+        raise UsageError(f"assisted benchmark: no row of case {missing[0]} in {', '.join(map(str, folders))}")
+    return [json.loads(found[name].read_text(encoding="utf-8")) for name in names]
+
+
+__all__ = ["AssistedDesign", "case_names", "cases", "outcome", "read_rows", "run", "run_batch", "summarise"]

@@ -58,30 +58,60 @@ def assisted_figure(rows: list[dict], summary: dict, path: str | Path) -> None:
     save_svg(fig, path)
 
 
-def make_assisted_figure(parameters: str | Path, vehicle: str | Path, svg: str | Path, csv: str | Path,
-                         json_path: str | Path, progress=None) -> dict:
-    """Run the assisted benchmark on `vehicle` (its [assist]) over `parameters`, write figures/diag_assisted.svg, its
-    CSV (one row per record) and results/diag_assisted.json (the targets and the misses), without machine times."""
-    from ..diagnose.assisted_benchmark import AssistedDesign, run
-    from ..diagnose.report import MACHINE_TIME_KEYS, without_machine_times
+def _assisted_params(parameters: str | Path, vehicle: str | Path):
     from ..model.symbolic.components import discover_effects
     from ..parameters import load_parameters
-    from ..tables import write_csv, write_json
     from ..vehicle import load_vehicle
 
     discover_effects()
-    params = load_vehicle(vehicle, load_parameters(parameters))
-    rows, summary = run(params, AssistedDesign(), progress=progress)
+    return load_vehicle(vehicle, load_parameters(parameters))
+
+
+def run_assisted_batch(parameters: str | Path, vehicle: str | Path, names: list[str], folder: str | Path) -> None:
+    """Run the assisted benchmark's cases `names` on `vehicle` (its [assist]) over `parameters`, each one's row
+    into `folder` (parksteer.diagnose.assisted_benchmark.run_batch): one job of rule diag_assisted_batch."""
+    from ..diagnose.assisted_benchmark import run_batch
+
+    run_batch(_assisted_params(parameters, vehicle), names, folder)
+
+
+def make_assisted_figure(parameters: str | Path, vehicle: str | Path, svg: str | Path, csv: str | Path,
+                         json_path: str | Path, progress=None) -> dict:
+    """Run the assisted benchmark on `vehicle` (its [assist]) over `parameters` in this process, write
+    figures/diag_assisted.svg, its CSV (one row per record) and results/diag_assisted.json (the targets and the
+    misses), without machine times."""
+    from ..diagnose.assisted_benchmark import AssistedDesign, run
+
+    rows, summary = run(_assisted_params(parameters, vehicle), AssistedDesign(), progress=progress)
+    return _write_outputs(rows, summary, vehicle, svg, csv, json_path)
+
+
+def gather_assisted_figure(batches, names: list[str], vehicle: str | Path, svg: str | Path, csv: str | Path,
+                           json_path: str | Path) -> dict:
+    """make_assisted_figure's files from the rows the jobs of rule diag_assisted_batch wrote into the folders
+    `batches` (run_assisted_batch), the cases `names` in the design's order: the same bytes."""
+    from ..diagnose.assisted_benchmark import read_rows, summarise
+
+    rows = read_rows(batches, list(names))
+    return _write_outputs(rows, summarise(rows), vehicle, svg, csv, json_path)
+
+
+def _write_outputs(rows: list[dict], summary: dict, vehicle: str | Path, svg: str | Path, csv: str | Path,
+                   json_path: str | Path) -> dict:
+    from ..diagnose.report import MACHINE_TIME_KEYS, without_machine_times
+    from ..tables import write_csv, write_json
+
     assisted_figure(rows, summary, svg)
-    names = ["name", "kind", "variation", "hidden", "steps_requested", "steps", "strength", "verdict", "effect",
-             "indistinguishable", "named", "covered", "relation", "bic_margin", "confident_wrong",
-             "calibrated_over_floor"]
+    fields = ["name", "kind", "variation", "hidden", "steps_requested", "steps", "strength", "verdict", "effect",
+              "indistinguishable", "named", "covered", "relation", "bic_margin", "confident_wrong",
+              "calibrated_over_floor"]
+
     def cell(value):
         if value is None:
             return ""
         return ("yes" if value else "no") if isinstance(value, bool) else value
 
-    columns = {n: [cell(r.get(n)) for r in rows] for n in names if n not in MACHINE_TIME_KEYS}
+    columns = {n: [cell(r.get(n)) for r in rows] for n in fields if n not in MACHINE_TIME_KEYS}
     write_csv(csv, columns, {"figure": "diag_assisted: one row per record of the assisted benchmark",
                              "vehicle": Path(vehicle).name,
                              "steps": "hidden size reached, converter steps of torsion-bar torque RMS",

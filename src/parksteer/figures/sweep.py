@@ -17,10 +17,12 @@ import numpy as np
 from ..parameters import Parameters, load_parameters
 from ..plotting import COLOURS, new_figure, save_svg
 from ..sweep.aggregate import (
+    MapSlice,
     Totals,
     axis_values,
     design_values,
     gather_points,
+    map_held,
     matching,
     point_quantity,
     summarise,
@@ -57,17 +59,17 @@ def _format_value(key: str, value: float) -> str:
     return f"{value * factor:.4g}{' ' + unit if unit else ''}"
 
 
-def _draw_map(ax, sweep: Sweep, records: list[dict], fixed: dict, levels, threshold, mark_design, design):
+def _draw_map(ax, sweep: Sweep, map_slice: MapSlice, panel, levels, threshold, mark_design, design):
     spec = sweep.map
     fx, xlabel = display(spec.x)
     fy, ylabel = display(spec.y)
-    sel = matching(records, fixed)
-    xs = np.array([r["values"][spec.x] for r in sel]) * fx
-    ys = np.array([r["values"][spec.y] for r in sel]) * fy
-    qs = np.array([point_quantity(r, spec.quantity) for r in sel])
+    sel = map_slice.panel == panel if spec.panels else np.ones(len(map_slice.x), dtype=bool)
+    xs = map_slice.x[sel] * fx
+    ys = map_slice.y[sel] * fy
+    qs = map_slice.quantities[spec.quantity][sel]
     ux, uy = np.unique(xs), np.unique(ys)
     filled = None
-    if len(ux) >= 2 and len(uy) >= 2 and len(sel) == len(ux) * len(uy):
+    if len(ux) >= 2 and len(uy) >= 2 and len(qs) == len(ux) * len(uy):
         grid = np.full((len(uy), len(ux)), np.nan)
         for x, y, q in zip(xs, ys, qs):
             grid[np.searchsorted(uy, y), np.searchsorted(ux, x)] = q
@@ -75,7 +77,7 @@ def _draw_map(ax, sweep: Sweep, records: list[dict], fixed: dict, levels, thresh
         if threshold is not None and np.nanmin(grid) < threshold < np.nanmax(grid):
             line = ax.contour(ux, uy, grid, levels=[threshold], colors="white", linewidths=1.8, linestyles="--")
             ax.clabel(line, fmt=lambda v: f"{v:.1f} N m", fontsize=7)
-    elif len(sel) >= 3:
+    elif len(qs) >= 3:
         filled = ax.tricontourf(xs, ys, qs, levels=levels, cmap="viridis", extend="both")
     ax.scatter(xs, ys, s=6, color="black", zorder=3, label="sweep points", clip_on=False)
     shown_x, shown_y = list(xs), list(ys)
@@ -112,9 +114,9 @@ def _draw_sensitivity(ax, sweep: Sweep, records: list[dict], key: str, design: d
 
 
 def plot_sweep(sweep: Sweep, params: Parameters, records: list[dict], out_svg: str | Path,
-               totals: Totals | None = None) -> None:
-    """Draw the maps and sensitivity lines from the sweep's records (all, or those gather_points keeps with its
-    totals)."""
+               totals: Totals | None = None, map_slice: MapSlice | None = None) -> None:
+    """Draw the maps and sensitivity lines from the sweep's records in the sweep's order (all, or those
+    gather_points keeps with its totals and the map's slice)."""
     design = design_values(sweep, params)
     keys = sweep.keys
     spec = sweep.map
@@ -133,17 +135,18 @@ def plot_sweep(sweep: Sweep, params: Parameters, records: list[dict], out_svg: s
         low = CONTOUR_STEP_NM * math.floor(lowest / CONTOUR_STEP_NM)
         high = CONTOUR_STEP_NM * math.ceil(highest / CONTOUR_STEP_NM)
         levels = np.arange(low, high + CONTOUR_STEP_NM / 2, CONTOUR_STEP_NM)
-        held = {k: spec.hold.get(k, d["nearest"]) for k, d in design.items() if k not in (spec.x, spec.y, spec.panels)}
+        held = map_held(sweep, design)
+        if map_slice is None:
+            map_slice = MapSlice.of(sweep, records, held, [spec.quantity])
         design_panel = design[spec.panels]["nearest"] if spec.panels else None
         filled = None
         top_axes = []
         for i, panel in enumerate(panels):
             ax = fig.add_subplot(grid[0, i * n_bottom:(i + 1) * n_bottom])
             top_axes.append(ax)
-            fixed = dict(held, **({spec.panels: panel} if spec.panels else {}))
             on_design = all(design[k]["nearest"] == v for k, v in held.items())
-            drawn = _draw_map(ax, sweep, records, fixed, levels, threshold,
-                              on_design and panel == design_panel, design)
+            drawn = _draw_map(ax, sweep, map_slice, panel, levels, threshold, on_design and panel == design_panel,
+                              design)
             filled = drawn or filled
             if spec.panels:
                 ax.set_title(f"{display(spec.panels)[1].split(' (')[0]} {_format_value(spec.panels, panel)}",
@@ -171,9 +174,13 @@ def plot_sweep(sweep: Sweep, params: Parameters, records: list[dict], out_svg: s
 
 def make_sweep_figure(sweep_path: str | Path, parameters: Parameters | str | Path, point_paths, out_svg: str | Path,
                       out_csv: str | Path, out_json: str | Path, full: bool = False) -> dict:
-    """Write the sweep's table (CSV), its key numbers (JSON) and its torque maps (SVG); return the numbers."""
+    """Write the sweep's table (CSV), its key numbers (JSON) and its torque maps (SVG); return the numbers but the
+    list of the points above the assistance threshold (in the JSON file only: it can hold most of the points).
+
+    The sweep is read without its expansion and the point files one at a time (gather_points); memory per point:
+    an 8-byte offset, and a few numbers per point of the map's slice."""
     params = parameters if isinstance(parameters, Parameters) else load_parameters(parameters)
-    sweep = load_sweep(sweep_path, params, full=full)
+    sweep = load_sweep(sweep_path, params, full=full, expand=False)
     threshold = sweep.assistance.torque_Nm if sweep.assistance else None
 
     def header(totals: Totals) -> dict[str, str]:
@@ -190,9 +197,12 @@ def make_sweep_figure(sweep_path: str | Path, parameters: Parameters | str | Pat
                                              f"{sweep.assistance.rim_radius_m:g} m; needs_assistance = peak above it")
         return lines
 
-    # the table is written as the point files are read; only what the summary and the maps select is kept
-    records, totals = gather_points(point_paths, sweep, params, out_csv, header, threshold)
-    summary = summarise(sweep, params, records, totals)
-    write_json(out_json, summary)
-    plot_sweep(sweep, params, records, out_svg, totals)
+    # the table is written as the point files are read; only what the summary and the maps select is kept, and
+    # the list of the points above the threshold is written from a scratch file as the summary is encoded
+    with gather_points(point_paths, sweep, params, out_csv, header, threshold) as gathered:
+        summary = summarise(sweep, params, gathered.records, gathered.totals, gathered.map_slice)
+        write_json(out_json, summary)
+    if "assistance" in summary:
+        del summary["assistance"]["points_above"]
+    plot_sweep(sweep, params, gathered.records, out_svg, gathered.totals, gathered.map_slice)
     return summary

@@ -14,6 +14,9 @@ from __future__ import annotations
 import json
 import math
 import tempfile
+from array import array
+from collections.abc import Iterable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -21,7 +24,7 @@ from typing import Any
 import numpy as np
 
 from ..parameters import Parameters
-from ..tables import format_number, write_csv_rows
+from ..tables import StreamedList, format_number, write_csv_rows
 from .declaration import Sweep, SweepError, parameter_bounds
 from .design import base_value
 
@@ -146,23 +149,79 @@ def sensitivities(sweep: Sweep, records: list[dict], design: dict) -> dict[str, 
     return out
 
 
-def threshold_crossings(sweep: Sweep, records: list[dict], design: dict, quantity: str, threshold: float
-                        ) -> list[dict[str, Any]]:
-    """Along the map's y axis, where `quantity` reaches `threshold` (linear interpolation), per panel and x value."""
+def map_held(sweep: Sweep, design: dict) -> dict[str, float]:
+    """The values the map holds the keys other than its x, y and panels at (its own, or the design point's)."""
+    spec = sweep.map
+    return {k: spec.hold.get(k, d["nearest"]) for k, d in design.items() if k not in (spec.x, spec.y, spec.panels)}
+
+
+@dataclass
+class MapSlice:
+    """The map's held slice of a sweep (the points whose keys other than the map's x, y and panels are at the held
+    values), in the sweep's order: each point's panel value, x, y (nan where a point has no such key) and the
+    figures of merit `quantities` names; a few numbers a point instead of its record."""
+
+    panel: np.ndarray
+    x: np.ndarray
+    y: np.ndarray
+    quantities: dict[str, np.ndarray]
+
+    @classmethod
+    def of(cls, sweep: Sweep, records: Iterable[dict], held: dict[str, float], quantities) -> MapSlice:
+        """The slice of `records`, all of them or the points gathered, each with its index, in any order."""
+        collector = _SliceCollector(sweep, held, quantities)
+        for position, record in enumerate(records):
+            collector.add(record, record.get("index", position))
+        return collector.finish()
+
+
+class _SliceCollector:
+    """MapSlice.of one record at a time: the held points' numbers in flat arrays, sorted by index at the end."""
+
+    def __init__(self, sweep: Sweep, held: dict[str, float], quantities):
+        self.spec, self.held, self.names = sweep.map, list(held.items()), list(dict.fromkeys(quantities))
+        self.index = array("q")
+        self.columns = {name: array("d") for name in ("panel", "x", "y", *self.names)}
+
+    def add(self, record: dict, index: int) -> None:
+        values = record["values"]
+        if not all(values.get(k) == v for k, v in self.held):
+            return
+        spec, columns = self.spec, self.columns
+        self.index.append(index)
+        columns["panel"].append(_nan(values.get(spec.panels)) if spec.panels else math.nan)
+        columns["x"].append(_nan(values.get(spec.x)))
+        columns["y"].append(_nan(values.get(spec.y)))
+        for name in self.names:
+            columns[name].append(point_quantity(record, name))
+
+    def finish(self) -> MapSlice:
+        order = np.argsort(np.asarray(self.index, dtype=np.int64), kind="stable")
+        column = {name: np.asarray(values, dtype=float)[order] for name, values in self.columns.items()}
+        return MapSlice(column["panel"], column["x"], column["y"], {name: column[name] for name in self.names})
+
+
+def threshold_crossings(sweep: Sweep, records: list[dict], design: dict, quantity: str, threshold: float,
+                        map_slice: MapSlice | None = None) -> list[dict[str, Any]]:
+    """Along the map's y axis, where `quantity` reaches `threshold` (linear interpolation), per panel and x value;
+    from the map's slice of `records` (in the sweep's order), or `map_slice` where given (with `quantity`)."""
     spec = sweep.map
     if spec is None:
         return []
-    held = {k: spec.hold.get(k, d["nearest"]) for k, d in design.items() if k not in (spec.x, spec.y, spec.panels)}
+    if map_slice is None:
+        map_slice = MapSlice.of(sweep, records, map_held(sweep, design), [quantity])
     panels = axis_values(sweep, spec.panels) if spec.panels else [None]
-    lines: dict[tuple, list[dict]] = {}  # (panel, x) -> its records, in the order of `records`: one pass over them
-    for r in matching(records, held):
-        lines.setdefault((r["values"].get(spec.panels) if spec.panels else None, r["values"].get(spec.x)), []).append(r)
+    lines: dict[tuple, list[int]] = {}  # (panel, x) -> its points' places in the slice, in the sweep's order
+    panel_of = map_slice.panel.tolist() if spec.panels else [None] * len(map_slice.x)
+    for place, key in enumerate(zip(panel_of, map_slice.x.tolist())):
+        lines.setdefault(key, []).append(place)
+    ys_all, qs_all = map_slice.y, map_slice.quantities[quantity]
     out = []
     for panel in panels:
         for x in axis_values(sweep, spec.x):
-            line = sorted(lines.get((panel, x), []), key=lambda r: r["values"][spec.y])
-            ys = np.array([r["values"][spec.y] for r in line])
-            qs = np.array([point_quantity(r, quantity) for r in line])
+            line = sorted(lines.get((panel, x), []), key=lambda place: ys_all[place])
+            ys = ys_all[np.asarray(line, dtype=np.int64)]
+            qs = qs_all[np.asarray(line, dtype=np.int64)]
             crossing = math.nan
             above = np.flatnonzero(qs > threshold)
             if len(above) and above[0] > 0:
@@ -174,10 +233,12 @@ def threshold_crossings(sweep: Sweep, records: list[dict], design: dict, quantit
     return out
 
 
-def summarise(sweep: Sweep, params: Parameters, records: list[dict], totals: Totals | None = None
-              ) -> dict[str, Any]:
+def summarise(sweep: Sweep, params: Parameters, records: list[dict], totals: Totals | None = None,
+              map_slice: MapSlice | None = None) -> dict[str, Any]:
     """The key numbers of a sweep (results/sweep_<name>.json), from its records in the sweep's order: all of them,
-    or those gather_points keeps with the totals it counts over all."""
+    or those gather_points keeps (the lines through the design point) with the totals it counts over all and the
+    map's slice. The list of the points above the assistance threshold is then a StreamedList, to be written
+    (tables.write_json) while gather_points' context is open."""
     if totals is None:
         totals = Totals.of(records, sweep.assistance.torque_Nm if sweep.assistance else None)
     design = design_values(sweep, params)
@@ -213,10 +274,10 @@ def summarise(sweep: Sweep, params: Parameters, records: list[dict], totals: Tot
             "rim_force_source": sweep.assistance.rim_force_source,
             "rim_radius_source": sweep.assistance.rim_radius_source,
             "quantity": "peak_torque_Nm",
-            "n_above": len(totals.points_above),
+            "n_above": totals.n_above,
             "n_above_braked": totals.n_above_braked,
-            "points_above": [entry for _, entry in sorted(totals.points_above, key=lambda item: item[0])],
-            "crossings": threshold_crossings(sweep, records, design, "peak_torque_Nm", threshold),
+            "points_above": totals.points_above_in_order(),
+            "crossings": threshold_crossings(sweep, records, design, "peak_torque_Nm", threshold, map_slice),
         }
         if sweep.map is not None:
             summary["assistance"]["crossing_axis"] = sweep.map.y
@@ -244,7 +305,10 @@ class Totals:
     braked_method: str = ""
     peak_range_Nm: tuple = ()
     map_range: dict = field(default_factory=dict)  # map quantity -> (nanmin, nanmax) over every record
+    keep_above: bool = True  # False: the points above the threshold are counted only (gather_points spills them)
     points_above: list = field(default_factory=list)  # (index, entry) of each point above the threshold
+    above: Iterable | None = None  # or their entries in the sweep's order, read once (from gather_points' spill)
+    n_above: int = 0
     n_above_braked: int = 0
 
     def add(self, record: dict) -> None:
@@ -261,10 +325,17 @@ class Totals:
                 self.map_range[quantity] = (min(low, value), max(high, value))
         if self.threshold_Nm is not None:
             if peak > self.threshold_Nm:
-                self.points_above.append((record["index"], {"point": record["point"], "values": record["values"],
-                                                            "peak_torque_Nm": peak}))
+                self.n_above += 1
+                if self.keep_above:
+                    self.points_above.append((record["index"], above_entry(record, peak)))
             if point_quantity(record, "peak_torque_braked_Nm") > self.threshold_Nm:
                 self.n_above_braked += 1
+
+    def points_above_in_order(self) -> list | StreamedList:
+        """The summary's entries of the points above the threshold, in the sweep's order."""
+        if self.above is not None:
+            return StreamedList(self.above)
+        return [entry for _, entry in sorted(self.points_above, key=lambda item: item[0])]
 
     @classmethod
     def of(cls, records: list[dict], threshold_Nm: float | None, map_quantity: str | None = None) -> Totals:
@@ -272,6 +343,11 @@ class Totals:
         for record in records:
             totals.add(record)
         return totals
+
+
+def above_entry(record: dict, peak_Nm: float) -> dict[str, Any]:
+    """A point's entry in the summary's list of the points above the assistance threshold."""
+    return {"point": record["point"], "values": record["values"], "peak_torque_Nm": peak_Nm}
 
 
 def _row(keys: list[str], record: dict, threshold_Nm: float | None) -> tuple[str, dict[str, str], str]:
@@ -290,47 +366,71 @@ def _row(keys: list[str], record: dict, threshold_Nm: float | None) -> tuple[str
     return ",".join(head), shares, ",".join(tail)
 
 
+@dataclass
+class Gathered:
+    """What gather_points keeps of a sweep's records: those on a line through the design point along one key
+    (the design point, the sensitivities; full records, in the sweep's order), the map's slice and the totals."""
+
+    records: list[dict[str, Any]]
+    map_slice: MapSlice | None
+    totals: Totals
+
+
+@contextmanager
 def gather_points(paths, sweep: Sweep, params: Parameters, out_csv: str | Path, header, threshold_Nm: float | None
-                  ) -> tuple[list[dict[str, Any]], Totals]:
+                  ) -> Iterator[Gathered]:
     """Read the point or batch files `paths` one at a time and write the sweep's table (the file sweep_table and
     write_csv give) to `out_csv`: each record's row goes to a scratch file as it is read, the rows are then
-    copied in the sweep's order under the lines header(totals) gives. Keep only the records the summary and the maps select (those on a line through
-    the design point, and on the map's held values) and the totals over all; return both.
+    copied in the sweep's order under the lines header(totals) gives. Yield what the summary and the maps read
+    (:class:`Gathered`); the totals' list of the points above the threshold comes from a second scratch file,
+    written in the sweep's order as the rows are copied, and can be read (written: tables.write_json) only
+    within this context.
 
-    Memory: those records, the totals (one entry per point above the assistance threshold) and two numbers per
-    point, whatever the number of points; the sweep's own expansion aside."""
+    A record's index in the sweep is found from its values and checked against its id (Sweep.locate), so the
+    sweep may be loaded without its expansion (load_sweep(expand=False)): no point is regenerated unless one is
+    missing (to name it). Memory: an 8-byte offset per point, the lines' records (a few per axis value), the map
+    slice (7 numbers a point of it) and the batch file being read, whatever the number of points."""
     design = design_values(sweep, params)
     keys = sweep.keys
     design_fixed = {k: d["nearest"] for k, d in design.items()}
     spec = sweep.map
-    map_held = {k: spec.hold.get(k, d["nearest"]) for k, d in design.items()
-                if k not in (spec.x, spec.y, spec.panels)} if spec else None
-    totals = Totals(threshold_Nm, map_range={spec.quantity: (math.inf, -math.inf)} if spec else {})
-    n = len(sweep.points)
+    collector = _SliceCollector(sweep, map_held(sweep, design), [spec.quantity, "peak_torque_Nm"]) if spec else None
+    totals = Totals(threshold_Nm, map_range={spec.quantity: (math.inf, -math.inf)} if spec else {}, keep_above=False)
+    n = sweep.n_points
     offsets = np.full(n, -1, dtype=np.int64)
     first_share: dict[str, tuple[int, int]] = {}  # merit name -> (index, position) where it first shows
     kept, unknown = [], []
-    with tempfile.TemporaryFile("w+", encoding="utf-8", dir=Path(out_csv).parent or None) as spill:
+    folder = Path(out_csv).parent or None
+    end = 0  # of the spill, in bytes (a binary file: no text-mode tell() per record)
+    with tempfile.TemporaryFile("w+b", dir=folder) as spill, \
+            tempfile.TemporaryFile("w+", encoding="utf-8", dir=folder) as above:
         for path in paths:
             for record in _batch_records(path):
-                point = sweep.find(record["point"])
-                if point is None:
+                index = sweep.locate(record["point"], record["values"])
+                if index < 0:
                     unknown.append(record["point"])
                     continue
-                record["index"] = point.index
+                if offsets[index] >= 0:
+                    raise SweepError(f"{path}: point {record['point']} was gathered from another file already")
+                record["index"] = index
                 head, shares, tail = _row(keys, record, threshold_Nm)
                 for position, name in enumerate(shares):
-                    if name not in first_share or first_share[name] > (point.index, position):
-                        first_share[name] = (point.index, position)
-                offsets[point.index] = spill.tell()
-                spill.write(json.dumps([head, shares, tail]) + "\n")
+                    if name not in first_share or first_share[name] > (index, position):
+                        first_share[name] = (index, position)
+                # the row's parts, and after a tab (never in JSON text) the point's entry if above the threshold
+                peak = point_quantity(record, "peak_torque_Nm")
+                entry = "\t" + json.dumps(above_entry(record, peak)) \
+                    if threshold_Nm is not None and peak > threshold_Nm else ""
+                offsets[index] = end
+                end += spill.write((json.dumps([head, shares, tail]) + entry + "\n").encode())
                 totals.add(record)
-                if sum(record["values"].get(k) != v for k, v in design_fixed.items()) <= 1 or (
-                        map_held is not None and all(record["values"].get(k) == v for k, v in map_held.items())):
+                if sum(record["values"].get(k) != v for k, v in design_fixed.items()) <= 1:
                     kept.append(record)
+                if collector is not None:
+                    collector.add(record, index)
         missing = np.flatnonzero(offsets < 0)
         if len(missing) or unknown:
-            first = sorted(sweep.points[i].id for i in missing) or sorted(unknown)
+            first = sorted(sweep.id_at(int(i)) for i in missing) or sorted(unknown)
             raise SweepError(f"{sweep.path}: point files do not match the sweep (first difference: {first[0]})")
         shares = sorted(first_share, key=first_share.get)
         names = ["point", "index", *(column_name(k) for k in keys), *SUMMARY_MERITS,
@@ -343,8 +443,13 @@ def gather_points(paths, sweep: Sweep, params: Parameters, out_csv: str | Path, 
         def rows():
             for offset in offsets:
                 spill.seek(int(offset))
-                head, cells, tail = json.loads(spill.readline())
+                row, _, entry = spill.readline().decode().rstrip("\n").partition("\t")
+                if entry:
+                    above.write(entry + "\n")
+                head, cells, tail = json.loads(row)
                 yield ",".join([head, *(cells.get(name, nan) for name in shares), tail])
 
         write_csv_rows(out_csv, names, rows(), n, header(totals))
-    return sorted(kept, key=lambda r: r["index"]), totals
+        above.seek(0)
+        totals.above = (json.loads(line) for line in above)
+        yield Gathered(sorted(kept, key=lambda r: r["index"]), collector.finish() if collector else None, totals)

@@ -180,11 +180,68 @@ class Sweep:
     full: bool
     braked: str = BRAKED_NONE
     braked_effects: tuple[str, ...] | None = None  # the effect set of the braked run (an effect method only)
+    # False: a grid read without its expansion (load_sweep(expand=False)); `points` is empty, a point's values
+    # are decoded from its index (values_at) and a record's index from its values (locate)
+    expanded: bool = True
     _by_id: dict[str, SweepPoint] = field(default_factory=dict, repr=False, compare=False)
     _batches: dict[int, dict[str, tuple[str, ...]]] = field(default_factory=dict, repr=False, compare=False)
+    _grid: dict[str, Any] = field(default_factory=dict, repr=False, compare=False)
 
     def __post_init__(self):
         self._by_id.update({p.id: p for p in self.points})
+
+    @property
+    def n_points(self) -> int:
+        return len(self.points) if self.expanded else math.prod(len(v) for v in self.axes.values())
+
+    def _unexpanded(self, what: str):
+        if not self.expanded:
+            raise SweepError(f"{self.path}: {what} needs the sweep expanded (load_sweep with expand=True)")
+
+    def values_at(self, index: int) -> dict[str, float]:
+        """The values of point `index` (of the expansion's order; a grid's first axis slowest)."""
+        if self.expanded:
+            return dict(self.points[index].values)
+        return _Grid(self.axes)[index]
+
+    def id_at(self, index: int) -> str:
+        """The id of point `index`."""
+        if self.expanded:
+            return self.points[index].id
+        return self._id_maker()(self.values_at(index))
+
+    def _id_maker(self):
+        if "id" not in self._grid:
+            self._grid["id"] = point_id_maker(self.base_case, self.effects, self.surface)
+        return self._grid["id"]
+
+    def locate(self, point_id: str, values: dict[str, float]) -> int:
+        """The index of the sweep's point of id `point_id`, whose values are `values`, or -1 if it has none.
+
+        An expanded sweep looks the id up. A grid without its expansion finds the index from the values (each
+        value's position on its axis, the digits of the index, the first axis slowest) and checks that the point
+        there has that id (the id hashes what the point simulates, so a record of another case, effect set or
+        surface is no point of this sweep): no point is held, about 2 us a record."""
+        if self.expanded:
+            point = self._by_id.get(point_id)
+            return point.index if point is not None else -1
+        if "positions" not in self._grid:
+            stride, strides = 1, {}
+            for key in reversed(list(self.axes)):
+                strides[key] = stride
+                stride *= len(self.axes[key])
+            self._grid["positions"] = [(key, {v: i * strides[key] for i, v in enumerate(self.axes[key])})
+                                       for key in self.axes]
+        positions = self._grid["positions"]
+        if len(values) != len(positions):
+            return -1
+        index = 0
+        for key, offsets in positions:
+            offset = offsets.get(values.get(key))
+            if offset is None:
+                return -1
+            index += offset
+        return index if self._id_maker()(values) == point_id else -1
 
     @property
     def model_sets(self) -> dict[str, Any]:
@@ -196,6 +253,7 @@ class Sweep:
 
     @property
     def point_ids(self) -> list[str]:
+        self._unexpanded("point_ids")
         return [p.id for p in self.points]
 
     @property
@@ -236,9 +294,11 @@ class Sweep:
 
     def find(self, point_id: str) -> SweepPoint | None:
         """The point of id `point_id`, or None if the sweep has none."""
+        self._unexpanded("find")
         return self._by_id.get(point_id)
 
     def point(self, point_id: str) -> SweepPoint:
+        self._unexpanded("point")
         try:
             return self._by_id[point_id]
         except KeyError:
@@ -378,15 +438,22 @@ def point_id(case: str, effects: str | None, surface: str, values: dict[str, flo
 
 
 def point_ids(case: str, effects: str | None, surface: str, values_list) -> list[str]:
-    """point_id of every values dict of `values_list`, the same strings, in linear time with a small constant:
-    the canonical text is assembled from pieces kept per key and value instead of being encoded again per point
-    (a million points: about 2 s instead of 15)."""
+    """point_id of every values dict of `values_list`, the same strings, in linear time with a small constant
+    (:func:`point_id_maker`)."""
+    make = point_id_maker(case, effects, surface)
+    return [make(values) for values in values_list]
+
+
+def point_id_maker(case: str, effects: str | None, surface: str):
+    """A function giving point_id(case, effects, surface, values) of a values dict, the same string: the canonical
+    text is assembled from pieces kept per key and value instead of being encoded again per point (a million
+    points: about 2 s instead of 15)."""
     head = json.dumps({"case": case, "effects": effects, "surface": surface}, sort_keys=True)[:-1] + ', "values": {'
     fragments: dict[str, dict[float, str]] = {}
     orders: dict[tuple[str, ...], list[tuple[str, dict[float, str]]]] = {}
     sha256 = hashlib.sha256
-    out = []
-    for values in values_list:
+
+    def make(values: dict[str, float]) -> str:
         keys = tuple(values)
         order = orders.get(keys)
         if order is None:  # json.dumps(sort_keys=True) sorts the same way
@@ -400,8 +467,9 @@ def point_ids(case: str, effects: str | None, surface: str, values_list) -> list
                 if value != 0.0:
                     known[value] = text
             parts.append(text)
-        out.append(sha256(f'{head}{", ".join(parts)}}}}}'.encode()).hexdigest()[:ID_HEX_DIGITS])
-    return out
+        return sha256(f'{head}{", ".join(parts)}}}}}'.encode()).hexdigest()[:ID_HEX_DIGITS]
+
+    return make
 
 
 def effective_batch_size(n_points: int, batch_size: int) -> int:
@@ -501,17 +569,22 @@ def _declared_values(path: Path, full: bool):
     if field_name not in doc:
         raise SweepError(f"{path}: {field_name}: not declared")
     axes = _axes(path, field_name, doc[field_name])
-    keys, sizes = list(axes), [len(v) for v in axes.values()]
+    return _Grid(axes)
 
-    class Grid:
-        def __getitem__(self, index: int) -> dict[str, float]:
-            digits = []
-            for size in reversed(sizes):  # the first axis slowest, as itertools.product
-                index, digit = divmod(index, size)
-                digits.append(digit)
-            return {k: axes[k][d] for k, d in zip(keys, reversed(digits))}
 
-    return Grid()
+class _Grid:
+    """The points of a full factorial without its expansion: point i's values are the mixed-radix digits of i."""
+
+    def __init__(self, axes: dict[str, tuple[float, ...]]):
+        self.axes = axes
+        self.keys, self.sizes = list(axes), [len(v) for v in axes.values()]
+
+    def __getitem__(self, index: int) -> dict[str, float]:
+        digits = []
+        for size in reversed(self.sizes):  # the first axis slowest, as itertools.product
+            index, digit = divmod(index, size)
+            digits.append(digit)
+        return {k: self.axes[k][d] for k, d in zip(self.keys, reversed(digits))}
 
 
 def batch_spec_from_index(path: str | Path, parameters_path: str | Path, full: bool, batch_size: int, batch: str,
@@ -669,8 +742,10 @@ def _check_effects(path: Path, effects: str | None) -> None:
 
 
 def _check_model_consistency(path: Path, params: Parameters, case: str, effects: str | None,
-                             values_list: list[dict[str, float]], what: str = "point") -> None:
-    """Effect parameters belong to an effect of the sweep's model; derived case values are physical."""
+                             values_list: list[dict[str, float]], numbers: list[int] | None = None,
+                             what: str = "point") -> None:
+    """Effect parameters belong to an effect of the sweep's model; derived case values are physical. A problem
+    names the point by its position in `values_list`, or by `numbers` at that position (:func:`_grid_check`)."""
     owners = {k.partition(".")[0] for k in set().union(*values_list)}
     effect_owners = owners - set(MODEL_SECTIONS) - {"case", "design"}
     if effect_owners:
@@ -705,15 +780,40 @@ def _check_model_consistency(path: Path, params: Parameters, case: str, effects:
         try:
             derived = point_overrides(params, case, values)
         except SweepError as exc:
-            raise SweepError(f"{path}: {what} {i}: {exc}") from None
+            raise SweepError(f"{path}: {what} {i if numbers is None else numbers[i]}: {exc}") from None
         for key, value in derived.items():
             if key in values:
                 continue  # checked with its axis
             q = quantity(key)
             if not q.within(value):
-                raise SweepError(f"{path}: {what} {i}: derived {key} = {value:g} {q.unit} is out of bounds "
+                raise SweepError(f"{path}: {what} {i if numbers is None else numbers[i]}: derived {key} = "
+                                 f"{value:g} {q.unit} is out of bounds "
                                  f"{q.bounds_text()}")
         checked.add(signature)
+
+
+def _grid_check(params: Parameters, case: str, axes: dict[str, tuple[float, ...]]
+                ) -> tuple[list[dict[str, float]], list[int]]:
+    """The points of the grid `axes` that _check_model_consistency tells apart, and their indices: one per
+    combination of the values of the keys the check reads (those point_overrides reads of the first point, and
+    the design axes), the other keys at their first value; in the grid's order, so the first that fails is the
+    grid's first point that fails (of the points sharing a combination, the one with the other digits 0: the
+    smallest index), and the check of the whole grid costs those combinations, not its points."""
+    keys = list(axes)
+    first = {key: values[0] for key, values in axes.items()}
+    traced = _KeysRead(first)
+    try:
+        point_overrides(params, case, traced)
+    except SweepError:
+        pass  # reported by the check with the point's number
+    read = [k for k in keys if k.startswith("design.") or k in traced.read]
+    grid = _Grid(axes)
+    strides = {k: math.prod(grid.sizes[j + 1:]) for j, k in enumerate(keys)}
+    values_list, numbers = [], []
+    for digits in itertools.product(*(range(len(axes[k])) for k in read)):
+        values_list.append({**first, **{k: axes[k][d] for k, d in zip(read, digits)}})
+        numbers.append(sum(strides[k] * d for k, d in zip(read, digits)))
+    return values_list, numbers
 
 
 class _KeysRead(dict):
@@ -763,10 +863,14 @@ def _braked(path: Path, raw: Any, effects: str | None, surface: str) -> tuple[st
     return raw, tuple(sorted(chosen + [raw]))
 
 
-def load_sweep(path: str | Path, params: Parameters, full: bool = False) -> Sweep:
+def load_sweep(path: str | Path, params: Parameters, full: bool = False, expand: bool = True) -> Sweep:
     """Read, validate and expand a sweep declaration against the parameter file `params`.
 
     full: use `full_axes` (the large version of the study) instead of `axes`.
+    expand: False leaves a grid's points unexpanded (Sweep.expanded; the gathering of a million points needs
+    their number, each one's index from its values and the id there, not the 0.45 kB a point the expansion
+    holds). Every point is checked as with the expansion, each combination of the values the check reads once
+    (:func:`_grid_check`). A declared list of points is expanded either way (the file holds it).
 
     Python's cyclic garbage collector is paused meanwhile: the expansion allocates a few objects per point, none
     of them in a cycle, and each collection it triggers walks every object made so far (a million points: about
@@ -775,13 +879,13 @@ def load_sweep(path: str | Path, params: Parameters, full: bool = False) -> Swee
     enabled = gc.isenabled()
     gc.disable()
     try:
-        return _load_sweep(Path(path), params, full)
+        return _load_sweep(Path(path), params, full, expand)
     finally:
         if enabled:
             gc.enable()
 
 
-def _load_sweep(path: Path, params: Parameters, full: bool) -> Sweep:
+def _load_sweep(path: Path, params: Parameters, full: bool, expand: bool = True) -> Sweep:
     """load_sweep with the garbage collector paused."""
     doc = _read(path)
     unknown = sorted(set(doc) - TOP_LEVEL_KEYS)
@@ -817,17 +921,26 @@ def _load_sweep(path: Path, params: Parameters, full: bool) -> Sweep:
         if full and "full_axes" not in doc:
             raise SweepError(f"{path}: full_axes: the full sweep was asked for but is not declared")
         axes = _axes(path, field_name, doc[field_name])
-        values_list = _expand(axes)
+        values_list = _expand(axes) if expand else None
     if "full_axes" in doc and not full:  # validate the other half of the file as well, every point of it
-        _check_model_consistency(path, params, base_case, effects, _expand(_axes(path, "full_axes", doc["full_axes"])),
-                                 "full_axes point")
+        other = _axes(path, "full_axes", doc["full_axes"])
+        if expand:
+            _check_model_consistency(path, params, base_case, effects, _expand(other),
+                                     what="full_axes point")
+        else:
+            _check_model_consistency(path, params, base_case, effects, *_grid_check(params, base_case, other),
+                                     what="full_axes point")
 
-    _check_model_consistency(path, params, base_case, effects, values_list)
-    ids = point_ids(base_case, effects, surface, values_list)
-    points = tuple(SweepPoint(i, pid, v) for i, (pid, v) in enumerate(zip(ids, values_list)))
+    if values_list is None:
+        _check_model_consistency(path, params, base_case, effects, *_grid_check(params, base_case, axes))
+        points: tuple[SweepPoint, ...] = ()
+    else:
+        _check_model_consistency(path, params, base_case, effects, values_list)
+        ids = point_ids(base_case, effects, surface, values_list)
+        points = tuple(SweepPoint(i, pid, v) for i, (pid, v) in enumerate(zip(ids, values_list)))
     keys = list(axes) if axes else list(dict.fromkeys(k for v in values_list for k in v))
     spec_map = _map(path, doc["map"], keys, axes, values_list) if doc.get("map") is not None else None
     threshold = _threshold(path, doc["assistance"]) if doc.get("assistance") is not None else None
     braked, braked_effects = _braked(path, doc.get("braked", BRAKED_NONE), effects, surface)
     return Sweep(path, name, description.strip(), base_case, effects, surface, axes, points, spec_map, threshold,
-                 full, braked, braked_effects)
+                 full, braked, braked_effects, expanded=values_list is not None)
