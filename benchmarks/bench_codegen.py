@@ -45,7 +45,8 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parents[1]
 # Effect sets the workflow derives (rule derive; config/config.yaml variants, the rivals, the diagnosis
 # candidates), by the name of their manifest, and the spec that gives each. with_brush_patch is the largest
-# (nine coordinates).
+# (nine coordinates); diagnosis is the one model of a diagnosis, every candidate effect in one derivation (the
+# largest C).
 MODELS = {
     "default": None,
     "no_friction": "-rack_friction,-tyre_friction",
@@ -54,6 +55,7 @@ MODELS = {
     "with_carcass_hysteresis": "+carcass_hysteresis",
     "assist_hydraulic": "+hydraulic_assist",
     "with_brush_patch": "+brush_patch",
+    "diagnosis": "+ackermann,+braked_wheels,+column_friction,+kingpin_friction,+rack_damping,+rack_lash,+rack_stiction",
 }
 STAGES = ("import", "kane", "forces", "expressions", "cse", "chain_rule", "print", "rest", "cc")
 # besides: python_cpu, the CPU time of the build's Python process (all but cc): near the sum of the Python stages

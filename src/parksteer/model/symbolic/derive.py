@@ -20,6 +20,7 @@ from typing import Any
 
 import sympy as sp
 import sympy.physics.mechanics as me
+from sympy.matrices.matrixbase import MatrixBase
 
 from .components import Effect
 from .system import INPUT_NAMES, ModelSpace
@@ -128,6 +129,49 @@ def _short_diff(self, *symbols, **assumptions):
     return result
 
 
+class Replacer:
+    """expr.xreplace(rule) for many expressions that share subtrees, each shared subtree replaced once.
+
+    sympy's xreplace rebuilds every node above a replaced one (node.func(*new_args)) and keeps no memo, neither
+    within one expression nor across the entries of a matrix or across expressions: a model's mass matrix,
+    forcing, drive and outputs hold the same kinematic terms many times over. Called on an expression (or a
+    matrix, entry by entry as Matrix.xreplace does), a Replacer gives what xreplace(rule) gives, node by node the
+    same rebuild (a node in the rule is replaced, a node whose arguments changed is rebuilt from them, any other
+    node is kept), with each node's result kept for the next time the same node comes. One Replacer per rule.
+    """
+
+    def __init__(self, rule: dict):
+        self.rule = rule
+        self._memo: dict = {}
+
+    def __call__(self, expr):
+        if isinstance(expr, MatrixBase):
+            return expr.applyfunc(self)
+        return self._replaced(sp.sympify(expr))[0]
+
+    def _replaced(self, node) -> tuple[Any, bool]:
+        found = self._memo.get(node)
+        if found is not None:
+            return found
+        rule = self.rule
+        if node in rule:
+            result = (rule[node], True)
+        elif rule:
+            args, changed = [], False
+            for arg in node.args:
+                if getattr(arg, "_xreplace", None) is not None:
+                    value, arg_changed = self._replaced(arg)
+                    args.append(value)
+                    changed |= arg_changed
+                else:
+                    args.append(arg)
+            result = (node.func(*args), True) if changed else (node, False)
+        else:
+            result = (node, False)
+        self._memo[node] = result
+        return result
+
+
 def partial_velocity(velocity: me.Vector, speed, frame: me.ReferenceFrame) -> me.Vector:
     """velocity.diff(speed, frame), the same vector, without differentiating a direction cosine matrix that does
     not hold `speed`.
@@ -216,4 +260,4 @@ def _derive(effects: list[Effect]) -> Derivation:
     )
 
 
-__all__ = ["Derivation", "derive", "build_space", "generalized_forces", "INPUT_NAMES"]
+__all__ = ["Derivation", "Replacer", "derive", "build_space", "generalized_forces", "INPUT_NAMES"]
