@@ -20,6 +20,7 @@ from typing import Any
 
 import sympy as sp
 import sympy.physics.mechanics as me
+from sympy.core.function import AppliedUndef
 from sympy.matrices.matrixbase import MatrixBase
 
 from .components import Effect
@@ -68,8 +69,11 @@ def memoised_diff():
 
     The short route follows Derivative.__new__ for a symbol and count 1 step by step: zero when the symbol is not
     free in the expression, else the expression's _eval_derivative_n_times, returned at once when zero, otherwise
-    with every Derivative in it made canonical. Anything else (another kind of variable, a count above 1, an
-    expression without _eval_derivative or one that leaves the derivative unevaluated) takes sympy's own route.
+    with every Derivative in it made canonical. A derivative by a dynamic symbol (a coordinate or speed, q(t) or
+    u(t)) takes sympy's own route, once per (expression, symbol): the partial velocities of the generalized forces
+    differentiate the velocities of the same points load after load. Anything else (another kind of variable, a
+    count above 1, an expression without _eval_derivative or one that leaves the derivative unevaluated) takes
+    sympy's own route every time.
     """
     from sympy.core.expr import Expr
 
@@ -107,6 +111,12 @@ def _short_diff(self, *symbols, **assumptions):
         s, count = s
         if count == 0:
             return self
+    elif isinstance(s, AppliedUndef):  # a coordinate or speed q(t), u(t): sympy's own route, memoised
+        key = (self, s)
+        found = memo.get(key)
+        if found is None:
+            found = memo[key] = original(self, s)
+        return found
     elif not isinstance(s, sp.Symbol):
         return original(self, *symbols)
     key = (self, s)
@@ -180,12 +190,50 @@ def partial_velocity(velocity: me.Vector, speed, frame: me.ReferenceFrame) -> me
     matrix relative to `frame` and, if the result is zero, differentiates the component's measure numbers where
     they are (what var_in_dcm=False does throughout). An orientation depends on coordinates, not speeds, so that
     matrix never holds a speed; when it holds none the result is the same, and the test (`has`) costs a walk
-    over nine entries instead of nine derivatives.
+    over nine entries instead of nine derivatives. The measure numbers are then differentiated entry by entry, so
+    that within memoised_diff an entry shared by the velocities of several loads is differentiated once.
     """
     for _, component_frame in velocity.args:
         if component_frame != frame and frame.dcm(component_frame).has(speed):
             return velocity.diff(speed, frame)
-    return velocity.diff(speed, frame, var_in_dcm=False)
+    # velocity.diff(speed, frame, var_in_dcm=False), each measure number differentiated entry by entry (the same
+    # entries; a 3-vector's own diff goes through ArrayDerivative and differentiates each entry anew)
+    return me.Vector([(measure.applyfunc(lambda entry: entry.diff(speed)), component_frame)
+                      for measure, component_frame in velocity.args])
+
+
+_INFINITIES = (sp.S.Infinity, sp.S.NegativeInfinity, sp.S.ComplexInfinity, sp.S.NaN)
+
+
+def dot(a: me.Vector, b: me.Vector):
+    """a.dot(b) for two vectors, the same expression, without multiplying any expression by zero.
+
+    Vector.dot sums, over the pairs of components (measure numbers m_a in frame A, m_b in frame B), the matrix
+    product (m_b^T C_BA) m_a, C_BA the direction cosine matrix; sympy's matrix product multiplies every nonzero
+    entry by 0 first to see whether it is infinite (0 * oo is nan), an assumptions query over the whole of a
+    large expression. Here the same products and sums are formed in the same order (a row entry is the sum over
+    k of m_b[k] C[k, j] for the nonzero pairs, the result the sum over k of row[k] m_a[k], the pairs summed one
+    after another from zero) and the check skipped; vectors that hold an infinity or nan take Vector.dot.
+    """
+    entries = [e for measure, _ in a.args for e in measure] + [e for measure, _ in b.args for e in measure]
+    if any(e.has(*_INFINITIES) for e in entries):
+        return a.dot(b)
+    out = sp.S.Zero
+    for m1, f1 in a.args:
+        for m2, f2 in b.args:
+            dcm = f2.dcm(f1)
+            if any(e.has(*_INFINITIES) for e in dcm):
+                return a.dot(b)
+            row = {}
+            for j in range(3):
+                terms = [m2[k] * dcm[k, j] for k in range(3) if m2[k] != 0 and dcm[k, j] != 0]
+                if terms:
+                    total = sp.Add(*terms)
+                    if total:
+                        row[j] = total
+            terms = [row[k] * m1[k] for k in range(3) if k in row and m1[k] != 0]
+            out += sp.Add(*terms) if terms else sp.S.Zero
+    return out
 
 
 def generalized_forces(loads, speeds, frame) -> sp.Matrix:
@@ -196,7 +244,7 @@ def generalized_forces(loads, speeds, frame) -> sp.Matrix:
         for r, speed in enumerate(speeds):
             partial = partial_velocity(velocity, speed, frame)
             if partial != 0:
-                out[r] += partial.dot(vector)
+                out[r] += dot(partial, vector)
     return out
 
 
