@@ -65,6 +65,7 @@ STAGES = ("import", "kane", "forces", "expressions", "cse", "chain_rule", "print
 def child(spec: str | None, out_dir: Path) -> dict:
     """One cold build of the model of `spec` in this process, its stages timed."""
     start = time.perf_counter()
+    import parksteer  # noqa: F401  (first, as in every parksteer process: it sizes sympy's cache)
     import sympy
 
     from parksteer.model.codegen import cache, generate as gen
