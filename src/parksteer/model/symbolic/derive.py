@@ -68,8 +68,9 @@ def memoised_diff():
     subexpressions (a sine of a coordinate, a parameter product) inside many others.
 
     The short route follows Derivative.__new__ for a symbol and count 1 step by step: zero when the symbol is not
-    free in the expression, else the expression's _eval_derivative_n_times, returned at once when zero, otherwise
-    with every Derivative in it made canonical. A derivative by a dynamic symbol (a coordinate or speed, q(t) or
+    free in the expression (each node's free symbols found once), else the expression's _eval_derivative_n_times,
+    returned at once when zero, otherwise with every Derivative in it made canonical (the same expression when it
+    holds none: the zero test is then skipped). A derivative by a dynamic symbol (a coordinate or speed, q(t) or
     u(t)) takes sympy's own route, once per (expression, symbol): the partial velocities of the generalized forces
     differentiate the velocities of the same points load after load. Anything else (another kind of variable, a
     count above 1, an expression without _eval_derivative or one that leaves the derivative unevaluated) takes
@@ -80,6 +81,7 @@ def memoised_diff():
     with _DIFF_LOCK:
         if _DIFF_STATE["depth"] == 0:
             _DIFF_STATE["original"], _DIFF_STATE["memo"] = Expr.diff, {}
+            _DIFF_STATE["free"], _DIFF_STATE["holds"] = {}, {}
             Expr.diff = _short_diff
         _DIFF_STATE["depth"] += 1
     try:
@@ -89,12 +91,36 @@ def memoised_diff():
             _DIFF_STATE["depth"] -= 1
             if _DIFF_STATE["depth"] == 0:
                 Expr.diff, _DIFF_STATE["memo"] = _DIFF_STATE["original"], None
+                _DIFF_STATE["free"], _DIFF_STATE["holds"] = None, None
 
 
 # memoised_diff's state, one for the process: nested or concurrent uses (threads) share one installation and one
 # memo, and the last to leave restores sympy's own Expr.diff.
 _DIFF_LOCK = threading.Lock()
-_DIFF_STATE: dict[str, Any] = {"depth": 0, "original": None, "memo": None}
+_DIFF_STATE: dict[str, Any] = {"depth": 0, "original": None, "memo": None, "free": None, "holds": None}
+_BASIC_FREE_SYMBOLS = sp.Basic.free_symbols  # the property, as a class without a free_symbols of its own has it
+
+
+def _free_symbols(node, memo: dict):
+    """node.free_symbols (not to be changed), each node's once: Basic's free_symbols is the union of its
+    arguments', walked again at every node sympy asks; a class with a free_symbols of its own answers itself."""
+    found = memo.get(node)
+    if found is None:
+        if type(node).free_symbols is _BASIC_FREE_SYMBOLS:
+            found = set().union(*(_free_symbols(arg, memo) for arg in node.args))
+        else:
+            found = node.free_symbols
+        memo[node] = found
+    return found
+
+
+def _holds_derivative(node, memo: dict) -> bool:
+    """Whether an unevaluated Derivative is in node (node itself or below), each node's answer once."""
+    found = memo.get(node)
+    if found is None:
+        found = isinstance(node, sp.Derivative) or any(_holds_derivative(arg, memo) for arg in node.args)
+        memo[node] = found
+    return found
 
 
 def _short_diff(self, *symbols, **assumptions):
@@ -125,12 +151,16 @@ def _short_diff(self, *symbols, **assumptions):
         return found
     if isinstance(self, derivative_type) or not hasattr(self, "_eval_derivative"):
         result = original(self, s)
-    elif s not in self.free_symbols:
+    elif s not in _free_symbols(self, _DIFF_STATE["free"]):
         result = sp.S.Zero
     else:
         obj = self._eval_derivative_n_times(s, 1)
         if obj is None:
             result = original(self, s)
+        elif not _holds_derivative(obj, _DIFF_STATE["holds"]):
+            # zero or not, the expression Derivative.__new__ returns is obj itself (replace changes nothing in an
+            # expression without a Derivative): the zero test, an assumptions query over all of obj, is not made
+            result = obj
         elif obj.is_zero:
             result = obj
         else:  # as Derivative.__new__ ends: every Derivative in the result made canonical
