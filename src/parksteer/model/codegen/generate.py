@@ -21,7 +21,7 @@ from pathlib import Path
 import sympy as sp
 from sympy.printing.c import C99CodePrinter
 
-from ..symbolic.derive import Derivation, Replacer, memoised_diff
+from ..symbolic.derive import Derivation, Replacer, free_symbols, memoised_diff
 
 # The handwheel input is a piecewise-quadratic table in p: count, then (t0, angle0, rate0, accel) per piece.
 MAX_INPUT_PIECES = 24
@@ -171,9 +171,10 @@ def generate(derivation: Derivation) -> tuple[str, dict]:
     # hold it; an effect that feeds the column torque back (a power assist's torsion bar) is driven by the
     # handwheel only, and its drive is written at zero handwheel input (prescribed.solve refuses it).
     hand = {plain[space.handwheel_angle], plain[space.handwheel_rate]}
-    drive_hand = any(F_nocol[i].free_symbols & hand for i in range(n))
+    seen: dict = {}  # free symbols of each node, found once across the rows (they share their terms)
+    drive_hand = any(free_symbols(F_nocol[i], seen) & hand for i in range(n))
     if drive_hand:
-        F_nocol = F_nocol.xreplace({h: 0 for h in hand})
+        F_nocol = Replacer({h: 0 for h in hand})(F_nocol)
     drive += [(f"F[{i}]", F_nocol[i]) for i in range(n)] + [(f"b[{i}]", bcol[i]) for i in range(n)]
     timings["expressions_s"] = time.perf_counter() - start
 

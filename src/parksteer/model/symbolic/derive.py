@@ -101,13 +101,13 @@ _DIFF_STATE: dict[str, Any] = {"depth": 0, "original": None, "memo": None, "free
 _BASIC_FREE_SYMBOLS = sp.Basic.free_symbols  # the property, as a class without a free_symbols of its own has it
 
 
-def _free_symbols(node, memo: dict):
+def free_symbols(node, memo: dict):
     """node.free_symbols (not to be changed), each node's once: Basic's free_symbols is the union of its
     arguments', walked again at every node sympy asks; a class with a free_symbols of its own answers itself."""
     found = memo.get(node)
     if found is None:
         if type(node).free_symbols is _BASIC_FREE_SYMBOLS:
-            found = set().union(*(_free_symbols(arg, memo) for arg in node.args))
+            found = set().union(*(free_symbols(arg, memo) for arg in node.args))
         else:
             found = node.free_symbols
         memo[node] = found
@@ -151,7 +151,7 @@ def _short_diff(self, *symbols, **assumptions):
         return found
     if isinstance(self, derivative_type) or not hasattr(self, "_eval_derivative"):
         result = original(self, s)
-    elif s not in _free_symbols(self, _DIFF_STATE["free"]):
+    elif s not in free_symbols(self, _DIFF_STATE["free"]):
         result = sp.S.Zero
     else:
         obj = self._eval_derivative_n_times(s, 1)
@@ -338,4 +338,4 @@ def _derive(effects: list[Effect]) -> Derivation:
     )
 
 
-__all__ = ["Derivation", "Replacer", "derive", "build_space", "generalized_forces", "INPUT_NAMES"]
+__all__ = ["Derivation", "Replacer", "derive", "free_symbols", "build_space", "generalized_forces", "INPUT_NAMES"]
