@@ -191,8 +191,8 @@ def main() -> int:
                                    "c_lines": runs[0]["c_lines"], "median_s": median,
                                    "median_cpu_s": median_cpu, "runs_s": [r["stages_s"] for r in runs],
                                    "runs_cpu_s": [r["cpu_s"] for r in runs]}
-        print(f"{name:26s} wall " + " ".join(f"{s} {median[s]:.2f}" for s in (*STAGES, "total", "process", "python_cpu")),
-              flush=True)
+        shown = (*STAGES, "total", "process", "python_cpu")
+        print(f"{name:26s} wall " + " ".join(f"{s} {median[s]:.2f}" for s in shown), flush=True)
         print(f"{name:26s} cpu  " + " ".join(f"{s} {median_cpu[s]:.2f}" for s in (*CPU_STAGES, "total")), flush=True)
     if args.reference:
         reference = json.loads(args.reference.read_text())["models"]
