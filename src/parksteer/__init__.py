@@ -1,3 +1,13 @@
 """parksteer: car steering torque at parking speed, after Sharp & Granger."""
 
+import os as _os
+
 __version__ = "0.1.0"
+
+# sympy's cache of constructed expressions (SYMPY_CACHE_SIZE, read once when sympy is first imported; 1000 entries
+# unless set): a model build rebuilds the same sums and products many times over (Kane's method substitutes into
+# every expression, code generation rewrites them in C symbols), and the largest, the diagnosis model, holds
+# 23,600 distinct ones; with 1000 most are evicted before they are met again and built anew, their assumptions
+# asked anew. 100,000 keeps a whole build's. The cache changes no expression, only how often one is built; a
+# value the user sets wins, and a process that imported sympy before parksteer keeps its own.
+_os.environ.setdefault("SYMPY_CACHE_SIZE", "100000")

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import contextlib
+
 import numpy as np
 import pytest
 import sympy as sp
@@ -72,36 +74,79 @@ def test_the_short_derivative_route_gives_sympys_derivative_exactly():
 
     from parksteer.model.symbolic.derive import memoised_diff
 
+    import sympy.physics.mechanics as me
+
     x, y = sp.symbols("x y", real=True)
+    q, u = me.dynamicsymbols("q u", real=True)
+    g = sp.Function("g")
     exprs = [x * y ** 2 * sp.sin(x), sp.sqrt(x ** 2 + y ** 2), sp.Abs(x) * sp.tanh(3 * x / y), sp.atan2(y, x),
-             sp.Piecewise((x ** 2, x > y), (sp.exp(-x), True)), 1 / (x * sp.cos(y) + 2), sp.Integer(3) * y]
+             sp.Piecewise((x ** 2, x > y), (sp.exp(-x), True)), 1 / (x * sp.cos(y) + 2), sp.Integer(3) * y,
+             x * g(x, y) ** 2]  # the last one's derivative holds an unevaluated Derivative of g
+    dynamic = [u * sp.cos(q) * x + q ** 2 * y, sp.sqrt(1 + u ** 2) * sp.sin(q), y]  # by a coordinate, a speed
     expected = [[e.diff(s) for s in (x, y)] + [e.diff((x, 1)), e.diff((y, 0))] for e in exprs]
+    expected_dynamic = [[e.diff(s) for s in (q, u)] for e in dynamic]
     original = Expr.diff
     with memoised_diff():
         assert Expr.diff is not original
         found = [[e.diff(s) for s in (x, y)] + [e.diff((x, 1)), e.diff((y, 0))] for e in exprs]
+        found_dynamic = [[e.diff(s) for s in (q, u)] for e in dynamic]
         again = [sp.diff(e, x) for e in exprs]  # a second time: from the memo
+        assert [[sp.srepr(e.diff(s)) for s in (q, u)] for e in dynamic] == [[sp.srepr(d) for d in row]
+                                                                            for row in found_dynamic]
         with memoised_diff():  # nested: the outer one's route stays until the outer one ends
             patched = Expr.diff
         assert Expr.diff is patched is not original
     assert Expr.diff is original
-    for want, got in zip(expected, found):
+    for want, got in zip(expected + expected_dynamic, found + found_dynamic):
         assert [sp.srepr(w) for w in want] == [sp.srepr(g) for g in got]
     assert [sp.srepr(g[0]) for g in found] == [sp.srepr(a) for a in again]
 
 
-def test_partial_velocities_are_sympys():
-    """A generalized force takes each load point's partial velocity with respect to every speed; the short route
-    (no direction cosine matrix differentiated when it holds no speed: an orientation depends on the
-    coordinates only) gives Vector.diff's very vector for every load of the default model."""
-    from parksteer.model.symbolic.derive import build_space, partial_velocity
+def test_partial_velocities_and_their_dot_products_are_sympys():
+    """A generalized force is the sum over loads of each load point's partial velocity with respect to a speed,
+    dotted with the load; the short routes (no direction cosine matrix differentiated when it holds no speed: an
+    orientation depends on the coordinates only; measure numbers differentiated entry by entry, memoised; the dot
+    product without sympy's multiplications by zero) give Vector.diff's very vector and Vector.dot's very
+    expression for every load of a model with friction, lash and braked wheels, within memoised_diff (as the
+    derivation runs them) and outside it; a vector holding an infinity takes Vector.dot (0 * oo is nan)."""
+    from parksteer.model.symbolic.derive import build_space, dot, memoised_diff, partial_velocity
     import sympy.physics.mechanics as me
 
-    space = build_space(resolve_effects(None))
-    loads = space.core_loads() + space.column_loads()
-    assert loads
-    for where, _ in loads:
-        velocity = where.ang_vel_in(space.N) if isinstance(where, me.ReferenceFrame) else where.vel(space.N)
-        for speed in space.u:
-            short, full = partial_velocity(velocity, speed, space.N), velocity.diff(speed, space.N)
-            assert [(sp.srepr(m), f) for m, f in short.args] == [(sp.srepr(m), f) for m, f in full.args]
+    effects = resolve_effects("+braked_wheels,+kingpin_friction,+rack_lash")
+    space = build_space(effects)
+    loads = space.core_loads() + space.column_loads() + [load for e in effects for load in e.loads(space)]
+    assert len(loads) > 10
+    for memoised in (False, True):
+        with memoised_diff() if memoised else contextlib.nullcontext():
+            for where, load in loads:
+                velocity = where.ang_vel_in(space.N) if isinstance(where, me.ReferenceFrame) else where.vel(space.N)
+                for speed in space.u:
+                    short, full = partial_velocity(velocity, speed, space.N), velocity.diff(speed, space.N)
+                    assert [(sp.srepr(m), f) for m, f in short.args] == [(sp.srepr(m), f) for m, f in full.args]
+                    assert sp.srepr(dot(short, load)) == sp.srepr(full.dot(load))
+    x = sp.Symbol("x", real=True)
+    A = space.N.orientnew("A", "Axis", (x, space.N.z))
+    infinite, finite = sp.oo * space.N.x + x * space.N.y, x * A.y
+    assert sp.srepr(dot(infinite, finite)) == sp.srepr(infinite.dot(finite))
+    assert sp.srepr(dot(finite, x * A.x + space.N.z)) == sp.srepr(finite.dot(x * A.x + space.N.z))
+
+
+def test_the_memoised_replacement_is_xreplaces():
+    """Code generation writes every expression in C symbols through one memoised Replacer (the matrices and outputs
+    share their kinematic terms): it gives xreplace's very expressions for the mass matrix, the forcing and the
+    energies of the default model, and for a rule that sets symbols to 0 (the drive at zero handwheel input)."""
+    from parksteer.model.symbolic.derive import Replacer
+
+    derivation = derive(resolve_effects(None))
+    plain = derivation.plain_symbols()
+    for i, name in enumerate(derivation.parameter_names):
+        plain[derivation.space.parameter_symbols[name]] = sp.Symbol(f"p[{i}]", real=True)
+    replace = Replacer(plain)
+    exprs = [derivation.mass_matrix, derivation.forcing, derivation.forcing_inertia, derivation.potential_energy,
+             derivation.space.kinetic_energy()]
+    for expr in exprs:
+        assert sp.srepr(replace(expr)) == sp.srepr(expr.xreplace(plain))
+    column = derivation.space.kinematics.column_torque
+    zero_hand = {derivation.space.handwheel_angle: 0, derivation.space.handwheel_rate: 0}
+    assert sp.srepr(Replacer(zero_hand)(column)) == sp.srepr(column.xreplace(zero_hand))
+    assert Replacer(zero_hand)(column) != column

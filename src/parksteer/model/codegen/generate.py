@@ -21,7 +21,7 @@ from pathlib import Path
 import sympy as sp
 from sympy.printing.c import C99CodePrinter
 
-from ..symbolic.derive import Derivation, memoised_diff
+from ..symbolic.derive import Derivation, Replacer, free_symbols, memoised_diff
 
 # The handwheel input is a piecewise-quadratic table in p: count, then (t0, angle0, rate0, accel) per piece.
 MAX_INPUT_PIECES = 24
@@ -149,17 +149,16 @@ def generate(derivation: Derivation) -> tuple[str, dict]:
         plain[space.parameter_symbols[name]] = sp.Symbol(f"p[{i}]", real=True)
     plain[space.handwheel_angle] = sp.Symbol("th", real=True)
     plain[space.handwheel_rate] = sp.Symbol("thd", real=True)
-
-    def c(expr):
-        return sp.sympify(expr).xreplace(plain)
+    # every expression in C symbols through one Replacer: the matrices and outputs share their kinematic terms
+    c = Replacer(plain)
 
     q = [plain[x] for x in space.q]
     u = [plain[x] for x in space.u]
     a = [sp.Symbol(f"a[{i}]", real=True) for i in range(n)]
-    M = derivation.mass_matrix.xreplace(plain)
-    F = derivation.forcing.xreplace(plain)
-    F_nocol = (derivation.forcing_inertia + sum(derivation.generalized_forces.values(), sp.zeros(n, 1))).xreplace(plain)
-    bcol = derivation.column_direction.xreplace(plain)
+    M = c(derivation.mass_matrix)
+    F = c(derivation.forcing)
+    F_nocol = c(derivation.forcing_inertia + sum(derivation.generalized_forces.values(), sp.zeros(n, 1)))
+    bcol = c(derivation.column_direction)
 
     mf = [(f"M[{i * n + j}]", M[i, j]) for i in range(n) for j in range(i, n)]
     mf += [(f"F[{i}]", F[i]) for i in range(n)]
@@ -172,9 +171,10 @@ def generate(derivation: Derivation) -> tuple[str, dict]:
     # hold it; an effect that feeds the column torque back (a power assist's torsion bar) is driven by the
     # handwheel only, and its drive is written at zero handwheel input (prescribed.solve refuses it).
     hand = {plain[space.handwheel_angle], plain[space.handwheel_rate]}
-    drive_hand = any(F_nocol[i].free_symbols & hand for i in range(n))
+    seen: dict = {}  # free symbols of each node, found once across the rows (they share their terms)
+    drive_hand = any(free_symbols(F_nocol[i], seen) & hand for i in range(n))
     if drive_hand:
-        F_nocol = F_nocol.xreplace({h: 0 for h in hand})
+        F_nocol = Replacer({h: 0 for h in hand})(F_nocol)
     drive += [(f"F[{i}]", F_nocol[i]) for i in range(n)] + [(f"b[{i}]", bcol[i]) for i in range(n)]
     timings["expressions_s"] = time.perf_counter() - start
 
@@ -192,12 +192,11 @@ def generate(derivation: Derivation) -> tuple[str, dict]:
         ("ring_yaw_rate_right_rad_s", c(space.kinematics.ring_frame["right"].ang_vel_in(space.N).dot(space.N.z))),
     ]
     for name in derivation.effects:
-        outputs.append((f"contrib_{name}_Nm", -derivation.generalized_forces[name][rack].xreplace(plain) / dcol))
+        outputs.append((f"contrib_{name}_Nm", -c(derivation.generalized_forces[name][rack]) / dcol))
     inertia_row = sum(M[rack, j] * a[j] for j in range(n))
     outputs.append((
         "contrib_inertia_Nm",
-        (inertia_row - derivation.forcing_inertia[rack].xreplace(plain)
-         - derivation.generalized_forces["core"][rack].xreplace(plain)) / dcol,
+        (inertia_row - c(derivation.forcing_inertia[rack]) - c(derivation.generalized_forces["core"][rack])) / dcol,
     ))
     outputs += [
         ("kinetic_energy_J", c(space.kinetic_energy())),

@@ -20,6 +20,8 @@ from typing import Any
 
 import sympy as sp
 import sympy.physics.mechanics as me
+from sympy.core.function import AppliedUndef
+from sympy.matrices.matrixbase import MatrixBase
 
 from .components import Effect
 from .system import INPUT_NAMES, ModelSpace
@@ -66,15 +68,20 @@ def memoised_diff():
     subexpressions (a sine of a coordinate, a parameter product) inside many others.
 
     The short route follows Derivative.__new__ for a symbol and count 1 step by step: zero when the symbol is not
-    free in the expression, else the expression's _eval_derivative_n_times, returned at once when zero, otherwise
-    with every Derivative in it made canonical. Anything else (another kind of variable, a count above 1, an
-    expression without _eval_derivative or one that leaves the derivative unevaluated) takes sympy's own route.
+    free in the expression (each node's free symbols found once), else the expression's _eval_derivative_n_times,
+    returned at once when zero, otherwise with every Derivative in it made canonical (the same expression when it
+    holds none: the zero test is then skipped). A derivative by a dynamic symbol (a coordinate or speed, q(t) or
+    u(t)) takes sympy's own route, once per (expression, symbol): the partial velocities of the generalized forces
+    differentiate the velocities of the same points load after load. Anything else (another kind of variable, a
+    count above 1, an expression without _eval_derivative or one that leaves the derivative unevaluated) takes
+    sympy's own route every time.
     """
     from sympy.core.expr import Expr
 
     with _DIFF_LOCK:
         if _DIFF_STATE["depth"] == 0:
             _DIFF_STATE["original"], _DIFF_STATE["memo"] = Expr.diff, {}
+            _DIFF_STATE["free"], _DIFF_STATE["holds"] = {}, {}
             Expr.diff = _short_diff
         _DIFF_STATE["depth"] += 1
     try:
@@ -84,12 +91,36 @@ def memoised_diff():
             _DIFF_STATE["depth"] -= 1
             if _DIFF_STATE["depth"] == 0:
                 Expr.diff, _DIFF_STATE["memo"] = _DIFF_STATE["original"], None
+                _DIFF_STATE["free"], _DIFF_STATE["holds"] = None, None
 
 
 # memoised_diff's state, one for the process: nested or concurrent uses (threads) share one installation and one
 # memo, and the last to leave restores sympy's own Expr.diff.
 _DIFF_LOCK = threading.Lock()
-_DIFF_STATE: dict[str, Any] = {"depth": 0, "original": None, "memo": None}
+_DIFF_STATE: dict[str, Any] = {"depth": 0, "original": None, "memo": None, "free": None, "holds": None}
+_BASIC_FREE_SYMBOLS = sp.Basic.free_symbols  # the property, as a class without a free_symbols of its own has it
+
+
+def free_symbols(node, memo: dict):
+    """node.free_symbols (not to be changed), each node's once: Basic's free_symbols is the union of its
+    arguments', walked again at every node sympy asks; a class with a free_symbols of its own answers itself."""
+    found = memo.get(node)
+    if found is None:
+        if type(node).free_symbols is _BASIC_FREE_SYMBOLS:
+            found = set().union(*(free_symbols(arg, memo) for arg in node.args))
+        else:
+            found = node.free_symbols
+        memo[node] = found
+    return found
+
+
+def _holds_derivative(node, memo: dict) -> bool:
+    """Whether an unevaluated Derivative is in node (node itself or below), each node's answer once."""
+    found = memo.get(node)
+    if found is None:
+        found = isinstance(node, sp.Derivative) or any(_holds_derivative(arg, memo) for arg in node.args)
+        memo[node] = found
+    return found
 
 
 def _short_diff(self, *symbols, **assumptions):
@@ -106,6 +137,12 @@ def _short_diff(self, *symbols, **assumptions):
         s, count = s
         if count == 0:
             return self
+    elif isinstance(s, AppliedUndef):  # a coordinate or speed q(t), u(t): sympy's own route, memoised
+        key = (self, s)
+        found = memo.get(key)
+        if found is None:
+            found = memo[key] = original(self, s)
+        return found
     elif not isinstance(s, sp.Symbol):
         return original(self, *symbols)
     key = (self, s)
@@ -114,18 +151,65 @@ def _short_diff(self, *symbols, **assumptions):
         return found
     if isinstance(self, derivative_type) or not hasattr(self, "_eval_derivative"):
         result = original(self, s)
-    elif s not in self.free_symbols:
+    elif s not in free_symbols(self, _DIFF_STATE["free"]):
         result = sp.S.Zero
     else:
         obj = self._eval_derivative_n_times(s, 1)
         if obj is None:
             result = original(self, s)
+        elif not _holds_derivative(obj, _DIFF_STATE["holds"]):
+            # zero or not, the expression Derivative.__new__ returns is obj itself (replace changes nothing in an
+            # expression without a Derivative): the zero test, an assumptions query over all of obj, is not made
+            result = obj
         elif obj.is_zero:
             result = obj
         else:  # as Derivative.__new__ ends: every Derivative in the result made canonical
             result = obj.replace(lambda x: isinstance(x, derivative_type), lambda x: x.canonical)
     memo[key] = result
     return result
+
+
+class Replacer:
+    """expr.xreplace(rule) for many expressions that share subtrees, each shared subtree replaced once.
+
+    sympy's xreplace rebuilds every node above a replaced one (node.func(*new_args)) and keeps no memo, neither
+    within one expression nor across the entries of a matrix or across expressions: a model's mass matrix,
+    forcing, drive and outputs hold the same kinematic terms many times over. Called on an expression (or a
+    matrix, entry by entry as Matrix.xreplace does), a Replacer gives what xreplace(rule) gives, node by node the
+    same rebuild (a node in the rule is replaced, a node whose arguments changed is rebuilt from them, any other
+    node is kept), with each node's result kept for the next time the same node comes. One Replacer per rule.
+    """
+
+    def __init__(self, rule: dict):
+        self.rule = rule
+        self._memo: dict = {}
+
+    def __call__(self, expr):
+        if isinstance(expr, MatrixBase):
+            return expr.applyfunc(self)
+        return self._replaced(sp.sympify(expr))[0]
+
+    def _replaced(self, node) -> tuple[Any, bool]:
+        found = self._memo.get(node)
+        if found is not None:
+            return found
+        rule = self.rule
+        if node in rule:
+            result = (rule[node], True)
+        elif rule:
+            args, changed = [], False
+            for arg in node.args:
+                if getattr(arg, "_xreplace", None) is not None:
+                    value, arg_changed = self._replaced(arg)
+                    args.append(value)
+                    changed |= arg_changed
+                else:
+                    args.append(arg)
+            result = (node.func(*args), True) if changed else (node, False)
+        else:
+            result = (node, False)
+        self._memo[node] = result
+        return result
 
 
 def partial_velocity(velocity: me.Vector, speed, frame: me.ReferenceFrame) -> me.Vector:
@@ -136,12 +220,50 @@ def partial_velocity(velocity: me.Vector, speed, frame: me.ReferenceFrame) -> me
     matrix relative to `frame` and, if the result is zero, differentiates the component's measure numbers where
     they are (what var_in_dcm=False does throughout). An orientation depends on coordinates, not speeds, so that
     matrix never holds a speed; when it holds none the result is the same, and the test (`has`) costs a walk
-    over nine entries instead of nine derivatives.
+    over nine entries instead of nine derivatives. The measure numbers are then differentiated entry by entry, so
+    that within memoised_diff an entry shared by the velocities of several loads is differentiated once.
     """
     for _, component_frame in velocity.args:
         if component_frame != frame and frame.dcm(component_frame).has(speed):
             return velocity.diff(speed, frame)
-    return velocity.diff(speed, frame, var_in_dcm=False)
+    # velocity.diff(speed, frame, var_in_dcm=False), each measure number differentiated entry by entry (the same
+    # entries; a 3-vector's own diff goes through ArrayDerivative and differentiates each entry anew)
+    return me.Vector([(measure.applyfunc(lambda entry: entry.diff(speed)), component_frame)
+                      for measure, component_frame in velocity.args])
+
+
+_INFINITIES = (sp.S.Infinity, sp.S.NegativeInfinity, sp.S.ComplexInfinity, sp.S.NaN)
+
+
+def dot(a: me.Vector, b: me.Vector):
+    """a.dot(b) for two vectors, the same expression, without multiplying any expression by zero.
+
+    Vector.dot sums, over the pairs of components (measure numbers m_a in frame A, m_b in frame B), the matrix
+    product (m_b^T C_BA) m_a, C_BA the direction cosine matrix; sympy's matrix product multiplies every nonzero
+    entry by 0 first to see whether it is infinite (0 * oo is nan), an assumptions query over the whole of a
+    large expression. Here the same products and sums are formed in the same order (a row entry is the sum over
+    k of m_b[k] C[k, j] for the nonzero pairs, the result the sum over k of row[k] m_a[k], the pairs summed one
+    after another from zero) and the check skipped; vectors that hold an infinity or nan take Vector.dot.
+    """
+    entries = [e for measure, _ in a.args for e in measure] + [e for measure, _ in b.args for e in measure]
+    if any(e.has(*_INFINITIES) for e in entries):
+        return a.dot(b)
+    out = sp.S.Zero
+    for m1, f1 in a.args:
+        for m2, f2 in b.args:
+            dcm = f2.dcm(f1)
+            if any(e.has(*_INFINITIES) for e in dcm):
+                return a.dot(b)
+            row = {}
+            for j in range(3):
+                terms = [m2[k] * dcm[k, j] for k in range(3) if m2[k] != 0 and dcm[k, j] != 0]
+                if terms:
+                    total = sp.Add(*terms)
+                    if total:
+                        row[j] = total
+            terms = [row[k] * m1[k] for k in range(3) if k in row and m1[k] != 0]
+            out += sp.Add(*terms) if terms else sp.S.Zero
+    return out
 
 
 def generalized_forces(loads, speeds, frame) -> sp.Matrix:
@@ -152,7 +274,7 @@ def generalized_forces(loads, speeds, frame) -> sp.Matrix:
         for r, speed in enumerate(speeds):
             partial = partial_velocity(velocity, speed, frame)
             if partial != 0:
-                out[r] += partial.dot(vector)
+                out[r] += dot(partial, vector)
     return out
 
 
@@ -216,4 +338,4 @@ def _derive(effects: list[Effect]) -> Derivation:
     )
 
 
-__all__ = ["Derivation", "derive", "build_space", "generalized_forces", "INPUT_NAMES"]
+__all__ = ["Derivation", "Replacer", "derive", "free_symbols", "build_space", "generalized_forces", "INPUT_NAMES"]
