@@ -68,7 +68,7 @@ def test_a_diagnosis_leaves_the_files_and_arguments_it_is_given_as_they_were(lag
     """After a diagnosis that moved the torque lag twice and diagnosed again with the lags held, every field of
     the caller's files (the lag, the replay uncertainty, the angle flag, the measured arrays) and the registry,
     start values and strengths passed in are exactly as before; the lag found is in the result's own files (the
-    channel's 10 ms within 3 ms, as tests/diagnose/test_torque_lag.py finds it)."""
+    channel's 10 ms within 3.5 ms, as tests/diagnose/test_torque_lag.py finds it)."""
     files = load_files([lagged_stiction], PARAMS)
     registry = dict(discover_effects())
     start = {"steering.rack_friction_force": PARAMS["steering.rack_friction_force"]}  # the parameter file's
@@ -79,7 +79,7 @@ def test_a_diagnosis_leaves_the_files_and_arguments_it_is_given_as_they_were(lag
     assert registry == before[1] and list(registry) == list(before[1]) and start == before[2]
     assert [f.torque_lag_s for f in files] == [0.0] and files[0].replay_uncertainty_Nm is None
     (lag,) = [f.torque_lag_s for f in result.problem.files]
-    assert lag == pytest.approx(0.010, abs=0.003)
+    assert lag == pytest.approx(0.010, abs=0.0035)
     with pytest.raises(dataclasses.FrozenInstanceError):
         result.verdict = "adequate"
 

@@ -61,9 +61,9 @@ UPPER = {"assist_motor_friction": 0.5, "torsion_bar_offset": 2.0, "boost_gain_er
          "motor_ripple": 0.5, "dead_band_change": 5.0}
 # The channels' noise, relative to their parking range as the variation benchmark's (0.1 N m on a 12 N m peak: 0.8 %):
 # 0.03 N m on a torsion bar's 3.5 N m, 0.25 A on a current's 27 A. With channels twice as clean (0.02 N m, 0.1 A)
-# the rack's smoothing places the lock reversals less well than the replay ensemble says (a bias, not a spread, of
-# 0.1-0.3 N m over some 50 ms where the rack turns by less than its resolution), and 2 to 8 of 20 nulls came out
-# unexplained (8 with the rack's own noise cut to 2e-6 m: the ensemble then shrinks, the bias stays).
+# the nulls are adequate too (20 of 20), now that the replay ensemble smooths at every knot spacing the rack data
+# allow (parksteer.diagnose.problem.ensemble_sources): about one spline it missed the smoothing's bias at the lock
+# reversals, where the rack turns by less than its resolution, and 6 of 20 came out unexplained or missing.
 TORQUE_NOISE_NM = 0.03
 CURRENT_NOISE_A = 0.25
 SEARCH = SizeSearch(iterations=4, tolerance=0.05, max_lag_s=0.0)

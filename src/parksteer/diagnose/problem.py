@@ -15,7 +15,9 @@ the converter's levels) and smoothed again, a few times
 (:func:`relogged_rack`, a parametric bootstrap of the
 whole logging and smoothing); otherwise splines are drawn from the least-squares
 distribution of the coefficients, as if the rack noise were white
-(:meth:`parksteer.measure.smoothing.SmoothedRack.perturbed`). Replaying them and taking the
+(:meth:`parksteer.measure.smoothing.SmoothedRack.perturbed`). The draws start from the rack smoothed at each
+knot spacing the data allow (:func:`ensemble_sources`), not from the chosen spline alone: at a reversal the
+spacing, not the data, sets how the spline eases through zero speed. Replaying them and taking the
 spread of the torque at each sample gives how far the replay alone can be off there (where the
 smoothing held an end of the record or a pause of the hand at rest, every other draw leaves
 them free: a record cut while the hand is still slowing passes the smoothing's rest test, the
@@ -461,10 +463,10 @@ class Problem:
             # An end held at rest may be a hand still slowing there, and a pause's edges are not sharp
             # (smoothing.RACK_REST_TEST_CHI2, RACK_REST_MIN_S): every other draw smooths with the ends and the
             # pauses free, so the samples there carry that doubt.
-            released = (smooth_rack(f.time_s, f.rack_m, f.rack.knot_spacing_s, hold_rest=False)
-                        if any(f.rack.held_at_rest) or f.rack.rest_intervals_s else None)
+            released = any(f.rack.held_at_rest) or bool(f.rack.rest_intervals_s)
+            sources = ensemble_sources(f, draws, released, logger)
             for k in range(draws):
-                source, hold = (released, False) if released is not None and k % 2 else (f.rack, True)
+                source, hold = sources[k]
                 if logger is not None:
                     rack = relogged_rack(source, f.time_s, *logger, rng, hold_rest=hold)
                 else:
@@ -522,6 +524,48 @@ _POOLED: Problem | None = None  # the problem a worker pool was forked from (Pro
 def _pooled_torque(task) -> np.ndarray:
     effects, index, overrides = task
     return _POOLED.signals(effects, index, overrides)
+
+
+def ensemble_sources(f: FileData, draws: int, released: bool, logger: tuple[float, int, float] | None
+                     ) -> list[tuple[SmoothedRack, bool]]:
+    """The smoothed rack each draw of the replay ensemble is logged again from, and whether it holds rests.
+
+    The knot spacing is not fixed by the data: every spacing tried whose fit passes the discrepancy test
+    (:attr:`parksteer.measure.smoothing.SmoothedRack.passing_spacings_s`) fits the rack to within its noise, and
+    the smoothing keeps the coarsest only because the noise estimate cannot choose between them. Away from a
+    reversal they agree; at a reversal they do not, since there the rack stays within a converter step or its
+    noise for a tenth of a second or more, and how the spline eases into and out of the turn (which sets when
+    the speed passes the millimetre per second over which the rack friction turns over) is set by its knots, not
+    by the data. Redrawing the noise about one spline (the chosen one) measures that spline's variance but not
+    this choice: on a sound car's record at 50 Hz (the Polo, rate_8pc_50Hz) the chosen spline's replay was
+    1.3 N m off at the reversals where the draws spread by 0.08 N m, while replays of the other passing
+    spacings bracket the truth. So the draws are spread over the passing spacings, the chosen one first and the
+    finest last (evenly by index); with `released`, the draws come in pairs, the first of each pair held at rest
+    as the chosen spline is, the second with the ends and pauses free. A record whose chosen spacing is the
+    only one to pass draws as before.
+    """
+    spacings = f.rack.passing_spacings_s or (f.rack.knot_spacing_s,)
+    pair = 2 if released else 1
+    slots = max(draws // pair, 1)
+    resolution = (quantisation_step(logger[0], logger[1])
+                  if logger is not None and "rack_derived" in f.measurement.metadata else 0.0)
+    smoothed = {}
+
+    def at(spacing: float, hold: bool) -> SmoothedRack:
+        if hold and spacing == f.rack.knot_spacing_s:
+            return f.rack
+        if (spacing, hold) not in smoothed:
+            smoothed[spacing, hold] = smooth_rack(f.time_s, f.rack_m, spacing, hold_rest=hold,
+                                                  rest_resolution_m=resolution)
+        return smoothed[spacing, hold]
+
+    out = []
+    for k in range(draws):
+        slot = (k // pair) % slots
+        index = int(slot * (len(spacings) - 1) / (slots - 1) + 0.5) if slots > 1 else 0
+        hold = not (released and k % 2)
+        out.append((at(spacings[index], hold), hold))
+    return out
 
 
 def relogged_rack(rack: SmoothedRack, time_s: np.ndarray, full_scale: float, bits: int, analog_rms: float,

@@ -18,7 +18,11 @@ friction force, F tanh(beta v), turns over within about 1 mm/s of it (a few hund
 second). The rack data fix the turning time only to a few hundredths of a second, so a replay is
 least certain there. :meth:`SmoothedRack.perturbed` and :meth:`SmoothedRack.resmoothed` give
 other racks the data allow as well; :mod:`parksteer.diagnose.problem` replays them to measure
-that uncertainty at every sample.
+that uncertainty at every sample. Nor do the data fix how the rack eases into and out of a turn: within a tenth
+of a second of it the rack moves by less than a converter step or its noise, so there the spline's speed follows
+its knots, and every spacing that passes the discrepancy test (``SmoothedRack.passing_spacings_s``) is as
+consistent with the data as the one kept; the replay's uncertainty smooths at each of them
+(:func:`parksteer.diagnose.problem.ensemble_sources`).
 
 Every rack here is a :class:`RackSpline` (a piecewise polynomial: ``breaks``, ``coefficients``, ``start_s`` and
 ``end_s``), the rack motion :func:`parksteer.model.numeric.prescribed.solve` takes.
@@ -181,16 +185,20 @@ class SmoothedRack(RackSpline):
     held_at_rest: tuple[bool, bool] = (False, False)  # (start, end) of the record
     turning_times_s: tuple[float, ...] = ()  # where the rack reverses (each has a knot)
     rest_intervals_s: tuple[tuple[float, float], ...] = ()  # pauses of the hand, where the spline is constant
+    # every spacing tried that passed the discrepancy test, coarsest (the chosen one) first; only the chosen one
+    # when the spacing was given (smooth_rack)
+    passing_spacings_s: tuple[float, ...] = ()
 
     @classmethod
     def from_bspline(cls, knots, bspline, covariance, knot_spacing_s, fit_rms_m, noise_rms_m,
-                     held_at_rest=(False, False), turning_times_s=(), rest_intervals_s=()) -> SmoothedRack:
+                     held_at_rest=(False, False), turning_times_s=(), rest_intervals_s=(),
+                     passing_spacings_s=()) -> SmoothedRack:
         from scipy.interpolate import BSpline, PPoly
 
         piecewise = RackSpline.from_ppoly(PPoly.from_spline(BSpline(knots, bspline, 3, extrapolate=False)))
         return cls(piecewise.breaks, piecewise.coefficients, knots, bspline, covariance, float(knot_spacing_s),
                    float(fit_rms_m), float(noise_rms_m), tuple(held_at_rest), tuple(turning_times_s),
-                   tuple(rest_intervals_s))
+                   tuple(rest_intervals_s), tuple(float(x) for x in passing_spacings_s) or (float(knot_spacing_s),))
 
     def perturbed(self, rng: np.random.Generator) -> SmoothedRack:
         """A rack the data allow as well: coefficients drawn from their least-squares distribution."""
@@ -198,7 +206,7 @@ class SmoothedRack(RackSpline):
         draw = self.bspline + pm.matmul(factor, rng.standard_normal(factor.shape[1]))
         return SmoothedRack.from_bspline(self.knots, draw, self.coefficient_covariance, self.knot_spacing_s,
                                          self.fit_rms_m, self.noise_rms_m, self.held_at_rest, self.turning_times_s,
-                                         self.rest_intervals_s)
+                                         self.rest_intervals_s, self.passing_spacings_s)
 
     def resmoothed(self, time_s: np.ndarray, log: Callable[[np.ndarray], np.ndarray],
                    hold_rest: bool = True) -> SmoothedRack:
@@ -416,10 +424,10 @@ def smooth_rack(time_s, rack_m, knot_spacing_s: float | None = None, hold_rest: 
     turns = turning_times(t, x)
     rests = rest_intervals(t, x, max(noise, rest_resolution_m)) if hold_rest else ()
 
-    def build(fit, spacing):
+    def build(fit, spacing, passing=()):
         knots, coefficients, inverse, rms, at_rest = fit
         return SmoothedRack.from_bspline(knots, coefficients, noise**2 * inverse, spacing, rms, noise, at_rest, turns,
-                                         rests)
+                                         rests, passing)
 
     if knot_spacing_s is not None:
         if not knot_spacing_s > 0:
@@ -428,15 +436,18 @@ def smooth_rack(time_s, rack_m, knot_spacing_s: float | None = None, hold_rest: 
         if fit is None:
             raise UsageError(f"rack smoothing: knot spacing {knot_spacing_s:g} s leaves intervals without samples")
         return build(fit, knot_spacing_s)
-    best = None
+    best, passing = None, []
     for spacing in knot_spacings(t):
         fit = _lsq_fit(t, x, spacing, turns, rests, hold_rest)
         if fit is None:
             continue
         # the residual of a least-squares fit with p coefficients has n - p degrees of freedom
         unbiased = fit[3] * math.sqrt(len(t) / max(len(t) - len(fit[1]), 1))
+        if unbiased <= RACK_DISCREPANCY_FACTOR * noise:
+            passing.append(spacing)
         if best is None or unbiased <= RACK_DISCREPANCY_FACTOR * noise:
             best = (fit, spacing)
     if best is None:
         raise UsageError("rack smoothing: no knot spacing gives a well-posed spline (samples too uneven)")
-    return build(*best)
+    passing = sorted({*passing, best[1]}, reverse=True)
+    return build(*best, passing=[s for s in passing if s <= best[1]])
