@@ -544,7 +544,7 @@ def ensemble_sources(f: FileData, draws: int, released: bool, logger: tuple[floa
     as the chosen spline is, the second with the ends and pauses free. A record whose chosen spacing is the
     only one to pass draws as before.
     """
-    spacings = f.rack.passing_spacings_s or (f.rack.knot_spacing_s,)
+    spacings = f.rack.passing_spacings_s
     pair = 2 if released else 1
     slots = max(draws // pair, 1)
     resolution = (quantisation_step(logger[0], logger[1])

@@ -449,5 +449,5 @@ def smooth_rack(time_s, rack_m, knot_spacing_s: float | None = None, hold_rest: 
             best = (fit, spacing)
     if best is None:
         raise UsageError("rack smoothing: no knot spacing gives a well-posed spline (samples too uneven)")
-    passing = sorted({*passing, best[1]}, reverse=True)
-    return build(*best, passing=[s for s in passing if s <= best[1]])
+    # the spacings run from fine to coarse, so the kept one is the coarsest that passed (or, none passing, the finest)
+    return build(*best, passing=sorted(passing, reverse=True))

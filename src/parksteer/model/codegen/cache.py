@@ -154,15 +154,25 @@ def _prebuilt_paths(key: str) -> tuple[Path, Path]:
     return PREBUILT_DIR / f"{key}.c.gz", PREBUILT_DIR / f"{key}.json"
 
 
+def prebuilt_info(info: dict) -> dict:
+    """A generated model's description as the package keeps it: without its code-generation timings (which
+    depend on the machine), so that the same model gives the same file."""
+    return {k: v for k, v in info.items() if k != "codegen_timings_s"}
+
+
 def prebuilt_source(key: str) -> tuple[str, dict] | None:
-    """The package's pre-derived C and description under `key`, or None (:data:`PREBUILT_DIR`)."""
+    """The package's pre-derived C and description under `key`, or None (:data:`PREBUILT_DIR`). A damaged pair
+    (truncated, or a placeholder in its place) is said on stderr and the model derived instead."""
     import gzip
 
     c_path, json_path = _prebuilt_paths(key)
+    if not (c_path.is_file() and json_path.is_file()):
+        return None
     try:
         source = gzip.decompress(c_path.read_bytes()).decode("utf-8")
         info = json.loads(json_path.read_text(encoding="utf-8"))
-    except (OSError, ValueError, EOFError):
+    except (OSError, ValueError, EOFError) as error:
+        note(f"the package's pre-derived model {c_path.name} is damaged ({error}): deriving it instead")
         return None
     return source, info
 
@@ -172,14 +182,21 @@ def write_prebuilt(effect_sets: list[list[Effect]]) -> list[Path]:
     others; return the files written. The gzip stream carries no time stamp, so the same C gives the same file."""
     import gzip
 
+    from ...tables import atomic_path
+
+    if _checkout_root() is None:
+        raise UsageError("--prebuilt writes into the package's source: run it in a checkout of the repository "
+                         "(an editable install), not an installed package")
     PREBUILT_DIR.mkdir(parents=True, exist_ok=True)
     written = []
     for effects in effect_sets:
         source, info, _ = derive_source(effects)
-        info.pop("codegen_timings_s", None)
         c_path, json_path = _prebuilt_paths(model_key(effects))
-        c_path.write_bytes(gzip.compress(source.encode("utf-8"), compresslevel=9, mtime=0))
-        json_path.write_text(json.dumps(info, indent=1, sort_keys=True) + "\n", encoding="utf-8")
+        # each file renamed into place whole: a cold build reading meanwhile finds the old file or the new one
+        with atomic_path(c_path) as tmp:
+            tmp.write_bytes(gzip.compress(source.encode("utf-8"), compresslevel=9, mtime=0))
+        with atomic_path(json_path) as tmp:
+            tmp.write_text(json.dumps(prebuilt_info(info), indent=1, sort_keys=True) + "\n", encoding="utf-8")
         written += [c_path, json_path]
     for path in PREBUILT_DIR.iterdir():
         if path.name.endswith((".c.gz", ".json")) and path not in written:
@@ -197,7 +214,7 @@ def build_entry(effects: list[Effect], directory: Path, key: str | None = None) 
     prebuilt = prebuilt_source(key) if key is not None else None
     if prebuilt is not None:
         source, info = prebuilt
-        timings = {"derive": 0.0, "codegen": time.perf_counter() - start}
+        timings = {"derive": 0.0, "codegen": 0.0, "read_prebuilt": time.perf_counter() - start}
         note(f"the model of {names}: the package's pre-derived C ({source.count(chr(10))} lines), compiling it")
     else:
         source, info, timings = derive_source(effects)
