@@ -464,7 +464,7 @@ class Problem:
             # (smoothing.RACK_REST_TEST_CHI2, RACK_REST_MIN_S): every other draw smooths with the ends and the
             # pauses free, so the samples there carry that doubt.
             released = any(f.rack.held_at_rest) or bool(f.rack.rest_intervals_s)
-            sources = ensemble_sources(f, draws, released, logger)
+            sources = ensemble_sources(f, draws, released)
             for k in range(draws):
                 source, hold = sources[k]
                 if logger is not None:
@@ -526,8 +526,7 @@ def _pooled_torque(task) -> np.ndarray:
     return _POOLED.signals(effects, index, overrides)
 
 
-def ensemble_sources(f: FileData, draws: int, released: bool, logger: tuple[float, int, float] | None
-                     ) -> list[tuple[SmoothedRack, bool]]:
+def ensemble_sources(f: FileData, draws: int, released: bool) -> list[tuple[SmoothedRack, bool]]:
     """The smoothed rack each draw of the replay ensemble is logged again from, and whether it holds rests.
 
     The knot spacing is not fixed by the data: every spacing tried whose fit passes the discrepancy test
@@ -547,8 +546,6 @@ def ensemble_sources(f: FileData, draws: int, released: bool, logger: tuple[floa
     spacings = f.rack.passing_spacings_s
     pair = 2 if released else 1
     slots = max(draws // pair, 1)
-    resolution = (quantisation_step(logger[0], logger[1])
-                  if logger is not None and "rack_derived" in f.measurement.metadata else 0.0)
     smoothed = {}
 
     def at(spacing: float, hold: bool) -> SmoothedRack:
@@ -556,7 +553,7 @@ def ensemble_sources(f: FileData, draws: int, released: bool, logger: tuple[floa
             return f.rack
         if (spacing, hold) not in smoothed:
             smoothed[spacing, hold] = smooth_rack(f.time_s, f.rack_m, spacing, hold_rest=hold,
-                                                  rest_resolution_m=resolution)
+                                                  rest_resolution_m=f.rack.rest_resolution_m)
         return smoothed[spacing, hold]
 
     out = []

@@ -188,17 +188,19 @@ class SmoothedRack(RackSpline):
     # every spacing tried that passed the discrepancy test, coarsest (the chosen one) first; only the chosen one
     # when the spacing was given (smooth_rack)
     passing_spacings_s: tuple[float, ...] = ()
+    rest_resolution_m: float = 0.0  # the rounding the rests were tested with (smooth_rack's rest_resolution_m)
 
     @classmethod
     def from_bspline(cls, knots, bspline, covariance, knot_spacing_s, fit_rms_m, noise_rms_m,
                      held_at_rest=(False, False), turning_times_s=(), rest_intervals_s=(),
-                     passing_spacings_s=()) -> SmoothedRack:
+                     passing_spacings_s=(), rest_resolution_m=0.0) -> SmoothedRack:
         from scipy.interpolate import BSpline, PPoly
 
         piecewise = RackSpline.from_ppoly(PPoly.from_spline(BSpline(knots, bspline, 3, extrapolate=False)))
         return cls(piecewise.breaks, piecewise.coefficients, knots, bspline, covariance, float(knot_spacing_s),
                    float(fit_rms_m), float(noise_rms_m), tuple(held_at_rest), tuple(turning_times_s),
-                   tuple(rest_intervals_s), tuple(float(x) for x in passing_spacings_s) or (float(knot_spacing_s),))
+                   tuple(rest_intervals_s), tuple(float(x) for x in passing_spacings_s) or (float(knot_spacing_s),),
+                   float(rest_resolution_m))
 
     def perturbed(self, rng: np.random.Generator) -> SmoothedRack:
         """A rack the data allow as well: coefficients drawn from their least-squares distribution."""
@@ -206,7 +208,7 @@ class SmoothedRack(RackSpline):
         draw = self.bspline + pm.matmul(factor, rng.standard_normal(factor.shape[1]))
         return SmoothedRack.from_bspline(self.knots, draw, self.coefficient_covariance, self.knot_spacing_s,
                                          self.fit_rms_m, self.noise_rms_m, self.held_at_rest, self.turning_times_s,
-                                         self.rest_intervals_s, self.passing_spacings_s)
+                                         self.rest_intervals_s, self.passing_spacings_s, self.rest_resolution_m)
 
     def resmoothed(self, time_s: np.ndarray, log: Callable[[np.ndarray], np.ndarray],
                    hold_rest: bool = True) -> SmoothedRack:
@@ -427,7 +429,7 @@ def smooth_rack(time_s, rack_m, knot_spacing_s: float | None = None, hold_rest: 
     def build(fit, spacing, passing=()):
         knots, coefficients, inverse, rms, at_rest = fit
         return SmoothedRack.from_bspline(knots, coefficients, noise**2 * inverse, spacing, rms, noise, at_rest, turns,
-                                         rests, passing)
+                                         rests, passing, rest_resolution_m)
 
     if knot_spacing_s is not None:
         if not knot_spacing_s > 0:
