@@ -80,9 +80,9 @@ def _job_name(snakemake: Any) -> str:
 @contextmanager
 def rule_log(snakemake: Any) -> Iterator[None]:
     """Send stderr to the rule's log, with the job's progress; a UsageError ends the job with one line in that
-    log, no traceback."""
+    log, no traceback. A job that fails also says why in one line on the terminal's stderr."""
     log = open(snakemake.log[0], "w", encoding="utf-8")
-    sys.stderr = log
+    terminal, sys.stderr = sys.stderr, log
     job = _job_name(snakemake)
     inputs = list(snakemake.input)
     note(f"{job}: started, {len(inputs)} input files")
@@ -94,7 +94,15 @@ def rule_log(snakemake: Any) -> Iterator[None]:
     except UsageError as exc:
         print(f"{snakemake.rule}: error: {exc}", file=log)
         log.flush()
+        print(f"parksteer: {job}: error: {exc}", file=terminal)
         sys.exit(1)
+    except BaseException as exc:
+        # The cause on the terminal too, beside Snakemake's own report: one line, the traceback in the log.
+        if not isinstance(exc, (SystemExit, KeyboardInterrupt)):
+            cause = str(exc).splitlines()[0] if str(exc) else ""
+            print(f"parksteer: {job}: {type(exc).__name__}: {cause} (traceback in {snakemake.log[0]})",
+                  file=terminal)
+        raise
     finally:
         note(f"{job}: {outcome} after {time.perf_counter() - start:.2f} s")
         for line in describe_outputs(snakemake.output):

@@ -64,6 +64,25 @@ def test_rule_log_ends_a_usage_error_with_one_line(tmp_path, monkeypatch):
     assert "finished" not in text and "Traceback" not in text
 
 
+def test_a_failing_job_names_its_cause_on_the_terminal(tmp_path, monkeypatch, capsys):
+    """Snakemake reports a failed job by its log file's path only: the cause (a user error, or the exception that
+    ended the job, such as a module that is not installed) is also one line on the terminal's stderr, naming the
+    job; the traceback stays in the log."""
+    terminal = sys.stderr
+    monkeypatch.setattr(sys, "stderr", terminal)
+    job = _job(tmp_path, ["out.json"], batch="peers_00")
+    with pytest.raises(ModuleNotFoundError):
+        with rule_log(job):
+            raise ModuleNotFoundError("No module named 'pysindy'")
+    assert capsys.readouterr().err.strip().splitlines() == [f"parksteer: figX batch=peers_00: ModuleNotFoundError: No module named 'pysindy' "
+                        f"(traceback in {tmp_path / 'job.log'})"]
+    monkeypatch.setattr(sys, "stderr", terminal)
+    with pytest.raises(SystemExit):
+        with rule_log(_job(tmp_path, ["out.json"])):
+            raise UsageError("data/x.toml: key tyre.radius_m: must be positive")
+    assert capsys.readouterr().err.strip() == "parksteer: figX: error: data/x.toml: key tyre.radius_m: must be positive"
+
+
 def test_every_rule_script_logs_through_rule_log(repo_root):
     """Each rule script under workflow/scripts runs its work inside rule_log, so no rule's log stays empty."""
     scripts = sorted((repo_root / "workflow" / "scripts").glob("*.py"))
