@@ -12,17 +12,21 @@ from parksteer.diagnose.candidates import default_diagnosis_models
 from parksteer.model.codegen import cache
 from parksteer.model.symbolic.components import resolve_effects
 
-REFRESH = "run `parksteer derive --prebuilt` and commit src/parksteer/model/prebuilt"
+REFRESH = "run `parksteer derive --prebuilt results/model/*.json` and commit src/parksteer/model/prebuilt"
 
 
-def test_prebuilt_models_are_the_default_diagnosis_models():
-    """The shipped keys are the keys of the base, diagnosis and brush_patch models of today's source: no stale
-    entry (a key nothing asks for any more) and none missing."""
-    wanted = {cache.model_key(effects) for effects in default_diagnosis_models()}
+def test_prebuilt_models_are_current_and_cover_the_default_diagnosis():
+    """Every shipped model is the model of its spec in today's source (its key is the key of what the spec
+    resolves to: no stale entry that nothing asks for any more), C and description in pairs, and the base,
+    diagnosis and brush_patch models of a diagnosis with the default effects are among them. That they cover every
+    set the pipeline derives is checked where the pipeline runs cold (.ci/run: every manifest says `prebuilt`)."""
     shipped = {p.name.removesuffix(".c.gz") for p in cache.PREBUILT_DIR.glob("*.c.gz")}
-    described = {p.stem for p in cache.PREBUILT_DIR.glob("*.json")}
-    assert len(wanted) == 3
-    assert shipped == wanted == described, f"pre-derived models out of date: {REFRESH}"
+    specs = cache.prebuilt_specs()
+    assert shipped == set(specs), f"pre-derived C and descriptions do not pair up: {REFRESH}"
+    stale = sorted(key for key, spec in specs.items() if cache.model_key(resolve_effects(spec)) != key)
+    assert not stale, f"pre-derived models out of date ({len(stale)} of {len(specs)}): {REFRESH}"
+    wanted = {cache.model_key(effects) for effects in default_diagnosis_models()}
+    assert len(wanted) == 3 and wanted <= shipped, f"the default diagnosis's models are not all shipped: {REFRESH}"
 
 
 def test_the_package_cars_first_diagnosis_needs_only_shipped_models(repo_root):
@@ -77,7 +81,23 @@ def test_cold_cache_compiles_the_prebuilt_model(tmp_path, monkeypatch):
     entry = json.loads((tmp_path / manifest["key"] / "model.json").read_text())
     assert entry["prebuilt"] is True
     assert (tmp_path / manifest["key"] / "model.c").read_text() == cache.prebuilt_source(manifest["key"])[0]
-    other = resolve_effects("-rack_friction")
+    other = resolve_effects("-carcass_compliance,-hooke_joint,-lifting,-tyre_friction")  # rack friction alone
+    assert cache.model_key(other) not in cache.prebuilt_specs()
     manifest = cache.ensure(other)
     assert manifest["timings_s"]["derive"] > 0.0
     assert json.loads((tmp_path / manifest["key"] / "model.json").read_text())["prebuilt"] is False
+
+
+def test_prebuilt_refuses_a_file_that_is_not_a_pipeline_manifest(tmp_path, capsys):
+    """`parksteer derive --prebuilt results/model/*.json` reads the effects spec the derive rule keeps in each
+    manifest: a file without one (an old manifest, another JSON) is refused in one line naming it, before
+    anything is derived or written."""
+    from parksteer.cli import main
+
+    before = sorted(p.name for p in cache.PREBUILT_DIR.iterdir())
+    manifest = tmp_path / "full.json"
+    manifest.write_text(json.dumps({"effects": ["rack_friction"], "key": "0" * 20}), encoding="utf-8")
+    assert main(["derive", "--prebuilt", str(manifest)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and str(manifest) in err[0] and "no 'spec'" in err[0]
+    assert sorted(p.name for p in cache.PREBUILT_DIR.iterdir()) == before

@@ -58,11 +58,28 @@ def register(sub) -> None:
     p.add_argument("--effects", default=None, help="effects spec (default: all five)")
     p.add_argument("--out", default=None, help="also write a JSON manifest of the cache entry here")
     p.add_argument("--prebuilt", action="store_true",
-                   help="instead: derive the models of a diagnosis with the default effects and keep their C in the "
-                        "package (src/parksteer/model/prebuilt), where a cold cache compiles it without deriving; "
-                        "run after any change to the symbolic half (the tests say when)")
+                   help="instead: derive the models of a diagnosis with the default effects, and those of the "
+                        "pipeline's model manifests given, and keep their C in the package "
+                        "(src/parksteer/model/prebuilt), where a cold cache compiles it without deriving; run after "
+                        "any change to the symbolic half (the tests say when) as "
+                        "`parksteer derive --prebuilt results/model/*.json`")
+    p.add_argument("manifests", nargs="*", metavar="MANIFEST",
+                   help="with --prebuilt: model manifests the pipeline wrote (results/model/<name>.json); their "
+                        "effect sets are pre-derived too")
     add_quiet_option(p)
     p.set_defaults(func=_derive)
+
+
+def _manifest_spec(path: str):
+    """The effects spec of a model manifest the pipeline's derive rule wrote (its `spec`), refused in one line."""
+    try:
+        manifest = json.loads(Path(path).read_text(encoding="utf-8"))
+    except (OSError, ValueError) as error:
+        raise UsageError(f"{path}: not a model manifest ({error})") from None
+    if not isinstance(manifest, dict) or "spec" not in manifest:
+        raise UsageError(f"{path}: not a model manifest of the pipeline (no 'spec'; `snakemake --cores 2 {path}` "
+                         "writes one)")
+    return manifest["spec"]
 
 
 def _simulate(args) -> int:
@@ -168,10 +185,17 @@ def _derive(args) -> int:
         from ..model.codegen.cache import write_prebuilt
 
         if args.effects is not None or args.out is not None:
-            raise UsageError("--prebuilt derives the default diagnosis' models: give it no --effects or --out")
-        written = write_prebuilt(default_diagnosis_models())
+            raise UsageError("--prebuilt derives the default diagnosis' models and the manifests' sets: give it no "
+                             "--effects or --out")
+        sets = [([e.name for e in effects], effects) for effects in default_diagnosis_models()]
+        for path in args.manifests:
+            spec = _manifest_spec(path)
+            sets.append((spec, resolve_effects(spec)))
+        written = write_prebuilt(sets)
         print(f"pre-derived {len(written) // 2} models -> {written[0].parent} ({time.perf_counter() - start:.1f} s)")
         return 0
+    if args.manifests:
+        raise UsageError(f"{args.manifests[0]}: manifests are read only with --prebuilt")
     manifest = ensure(resolve_effects(args.effects), note_cached=True)
     if args.out:
         write_json(args.out, manifest)

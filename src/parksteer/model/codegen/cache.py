@@ -174,12 +174,26 @@ def prebuilt_source(key: str) -> tuple[str, dict] | None:
     except (OSError, ValueError, EOFError) as error:
         note(f"the package's pre-derived model {c_path.name} is damaged ({error}): deriving it instead")
         return None
+    info.pop("spec", None)
     return source, info
 
 
-def write_prebuilt(effect_sets: list[list[Effect]]) -> list[Path]:
-    """Derive `effect_sets` and keep their C and descriptions as the package's pre-derived models, replacing all
-    others; return the files written. The gzip stream carries no time stamp, so the same C gives the same file."""
+def prebuilt_specs() -> dict[str, str | list | None]:
+    """The effects spec (:func:`~parksteer.model.symbolic.components.resolve_effects`) of each pre-derived model,
+    by its key: what `parksteer derive --prebuilt` was asked for, so that a stale key can be told."""
+    specs = {}
+    for json_path in sorted(PREBUILT_DIR.glob("*.json")):
+        try:
+            specs[json_path.stem] = json.loads(json_path.read_text(encoding="utf-8")).get("spec")
+        except (OSError, ValueError):
+            specs[json_path.stem] = None
+    return specs
+
+
+def write_prebuilt(effect_sets: list[tuple[str | list | None, list[Effect]]]) -> list[Path]:
+    """Derive each (spec, effects) of `effect_sets` and keep its C and description, with its spec, as the package's
+    pre-derived models, replacing all others; return the files written. The gzip stream carries no time stamp, so
+    the same C gives the same file."""
     import gzip
 
     from ...tables import atomic_path
@@ -189,14 +203,18 @@ def write_prebuilt(effect_sets: list[list[Effect]]) -> list[Path]:
                          "(an editable install), not an installed package")
     PREBUILT_DIR.mkdir(parents=True, exist_ok=True)
     written = []
-    for effects in effect_sets:
-        source, info, _ = derive_source(effects)
+    for number, (spec, effects) in enumerate(effect_sets, 1):
         c_path, json_path = _prebuilt_paths(model_key(effects))
+        if c_path in written:
+            continue
+        note(f"pre-deriving model {number} of {len(effect_sets)}: {','.join(e.name for e in effects) or 'none'}")
+        source, info, _ = derive_source(effects)
         # each file renamed into place whole: a cold build reading meanwhile finds the old file or the new one
         with atomic_path(c_path) as tmp:
             tmp.write_bytes(gzip.compress(source.encode("utf-8"), compresslevel=9, mtime=0))
         with atomic_path(json_path) as tmp:
-            tmp.write_text(json.dumps(prebuilt_info(info), indent=1, sort_keys=True) + "\n", encoding="utf-8")
+            tmp.write_text(json.dumps({**prebuilt_info(info), "spec": spec}, indent=1, sort_keys=True) + "\n",
+                           encoding="utf-8")
         written += [c_path, json_path]
     for path in PREBUILT_DIR.iterdir():
         if path.name.endswith((".c.gz", ".json")) and path not in written:
@@ -430,4 +448,6 @@ def ensure(effects: list[Effect], note_cached: bool = False) -> dict:
         "n_parameters": len(info["parameters"]),
         "timings_s": info["timings_s"],
         "built_now": not existed,
+        # compiled from the package's pre-derived C rather than derived (the build that made the entry)
+        "prebuilt": bool(info.get("prebuilt")),
     }
