@@ -6,7 +6,9 @@ its model cache is the copy's results/model). Then `snakemake --cores N TARGET..
 rule's benchmark file (results/benchmarks/<rule>/*.tsv: wall seconds `s` and `cpu_time` of each job) is read.
 It reports the run's wall time, and per rule the number of jobs and the sum of their wall and CPU seconds; the
 top five rules by summed wall time are printed. The sum over jobs exceeds the run's wall time when jobs ran in
-parallel.
+parallel. It also reports the critical path: the chain of jobs through the DAG (`snakemake --dag`) whose wall
+times add up to the most, which no number of cores shortens, and the lower bound of the run's wall time on N
+cores, the larger of that path and the jobs' summed wall time over N.
 
     python benchmarks/bench_pipeline.py results/bench_pipeline.json [--cores 2] [--keep DIR] [TARGET ...]
 
@@ -78,6 +80,39 @@ def run(work: Path, cores: int, targets: list[str]) -> tuple[float, list[str]]:
     return wall, ran
 
 
+def critical_path(work: Path, targets: list[str], env: dict) -> tuple[float, list[str]]:
+    """(seconds, jobs) of the longest chain of the DAG, each job weighted by its benchmark file's wall time."""
+    import re
+
+    dot = subprocess.run([str(SNAKEMAKE), *targets, "--dag", "--quiet", "all"], cwd=work, env=env,
+                         capture_output=True, text=True, check=True).stdout
+    labels = {m.group(1): m.group(2).split("\\n") for m in re.finditer(r'^\s*(\d+)\[label = "([^"]*)"', dot, re.M)}
+    edges = [(a, b) for a, b in re.findall(r"^\s*(\d+) -> (\d+)", dot, re.M)]
+
+    def seconds(node: str) -> float:
+        rule, *wildcards = labels[node]
+        stem = "__".join(w.split(": ", 1)[1] for w in wildcards) or rule
+        path = work / "results" / "benchmarks" / rule / f"{stem}.tsv"
+        if not path.is_file():
+            return 0.0
+        with path.open(encoding="utf-8") as f:
+            return max((float(row["s"]) for row in csv.DictReader(f, delimiter="\t")), default=0.0)
+
+    before: dict[str, list[str]] = {node: [] for node in labels}
+    for a, b in edges:  # a is an input of b
+        before[b].append(a)
+    best: dict[str, tuple[float, list[str]]] = {}
+
+    def longest(node: str) -> tuple[float, list[str]]:
+        if node not in best:
+            prior = max((longest(a) for a in before[node]), default=(0.0, []))
+            best[node] = (prior[0] + seconds(node), prior[1] + [" ".join(labels[node])])
+        return best[node]
+
+    sys.setrecursionlimit(max(10_000, sys.getrecursionlimit()))
+    return max((longest(node) for node in labels), default=(0.0, []))
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("out", help="JSON file for the results")
@@ -92,12 +127,16 @@ def main(argv=None) -> int:
         scratch_copy(work)
         wall, ran = run(work, args.cores, args.targets)
         rules = read_benchmarks(work)
+        env = dict(os.environ, PYTHONPATH=str(work / "src"), PARKSTEER_MODEL_CACHE=str(work / "results" / "model"))
+        path_s, path_jobs = critical_path(work, args.targets, env)
     top = sorted(rules.items(), key=lambda item: -item[1]["wall_s"])[:TOP]
     result = {
         "targets": args.targets or ["(default)"], "cores": args.cores, "wall_s": wall,
         "jobs_wall_s": sum(r["wall_s"] for r in rules.values()), "jobs_cpu_s": sum(r["cpu_s"] for r in rules.values()),
         "rules": rules, "top": [name for name, _ in top],
         "rules_without_benchmark": sorted(set(ran) - set(rules)),
+        "critical_path_s": path_s, "critical_path": path_jobs,
+        "wall_lower_bound_s": max(path_s, sum(r["wall_s"] for r in rules.values()) / args.cores),
         "machine": platform.platform(), "cpu_count": os.cpu_count(), "python": platform.python_version(),
         "load_average_at_start": load_start, "load_average_at_end": os.getloadavg(),
     }
@@ -106,6 +145,8 @@ def main(argv=None) -> int:
     print(f"{'rule':<20} {'jobs':>5} {'wall s':>9} {'CPU s':>9} {'max s':>8}")
     for name, r in top:
         print(f"{name:<20} {r['jobs']:>5} {r['wall_s']:>9.1f} {r['cpu_s']:>9.1f} {r['max_wall_s']:>8.1f}")
+    print(f"critical path {path_s:.1f} s ({' -> '.join(path_jobs)}); lower bound of the wall time on {args.cores} "
+          f"cores {result['wall_lower_bound_s']:.1f} s")
     if result["rules_without_benchmark"]:
         print(f"rules without a benchmark file: {', '.join(result['rules_without_benchmark'])}")
     Path(args.out).parent.mkdir(parents=True, exist_ok=True)
