@@ -11,7 +11,7 @@ from parksteer.measure.smoothing import smooth_rack
 from parksteer.model.numeric.prescribed import solve
 from parksteer.model.numeric.simulate import prepare
 from parksteer.model.symbolic.components import resolve_effects
-from parksteer.synthetic.logger import add_noise, quantise, quantisation_step
+from parksteer.measure.converter import add_noise, quantise, quantisation_step
 
 FULL_SCALE_M = 0.1
 

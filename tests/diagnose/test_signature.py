@@ -15,8 +15,8 @@ import pytest
 
 from parksteer import portable as pm
 from parksteer.cli import main
-from parksteer.diagnose.benchmark import BENCHMARK_SETTINGS
-from parksteer.diagnose.outoflibrary import SignatureCase, SignatureDesign, make_record, summarise
+from parksteer.experiments.benchmark import BENCHMARK_SETTINGS
+from parksteer.experiments.outoflibrary import SignatureCase, SignatureDesign, make_record, summarise
 from parksteer.diagnose.problem import load_files
 from parksteer.diagnose.report import diagnosis_dict, markdown_report, with_suggestion
 from parksteer.diagnose.select import diagnose

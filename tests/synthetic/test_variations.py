@@ -90,7 +90,7 @@ def test_an_angle_channel_leaves_the_other_channels_alone_and_shows_a_lash_the_t
     ratio): the twist that passes the same torque is widened by the band on either flank."""
     from dataclasses import replace
 
-    from parksteer.synthetic.logger import quantisation_step
+    from parksteer.measure.converter import quantisation_step
     from parksteer.synthetic.variations import variation_by_name
 
     variation = variation_by_name("angle_channel")

@@ -64,7 +64,7 @@ from ..measure.smoothing import SmoothedRack, smooth_rack
 from ..model.numeric.prescribed import column_twist
 from ..model.symbolic.components import Effect
 from ..parameters import Parameters
-from ..synthetic.logger import add_noise, quantisation_step, quantise
+from ..measure.converter import add_noise, quantisation_step, quantise
 from .parallel import fork_map, forks, worker_pool
 from .settings import DEFAULT_SETTINGS
 from .replay import Replay

@@ -47,6 +47,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import UsageError
+from .converter import quantisation_step
 from ..names import SURFACES
 from ..parameters import Parameters, load_parameters
 from ..tables import atomic_path, format_number
@@ -172,7 +173,7 @@ class Measurement:
         full_scale, bits = self.full_scale(column), self.bits(column)
         if full_scale is None or bits is None:
             return 0.0
-        return 2.0 * full_scale / (2**bits - 1)
+        return quantisation_step(full_scale, bits)
 
 
 def _where(path: Path | str, column: str, row: int, line_numbers: list[int] | None) -> str:

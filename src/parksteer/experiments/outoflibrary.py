@@ -31,14 +31,14 @@ from ..measure.io import write_measurement
 from ..model.symbolic.components import resolve_effects
 from ..parameters import Parameters
 from ..synthetic.datasets import perturbed_base, rms_difference
-from ..synthetic.logger import quantisation_step
+from ..measure.converter import quantisation_step
 from ..synthetic.outoflibrary import FORMS, form_by_name
 from ..synthetic.variations import VARIATIONS, variation_rack, variation_record
 from .benchmark import BENCHMARK_SETTINGS
-from .problem import load_files
-from .select import diagnose
-from .signature import signature_of
-from .suggest import suggest
+from ..diagnose.problem import load_files
+from ..diagnose.select import diagnose
+from ..diagnose.signature import signature_of
+from ..diagnose.suggest import suggest
 
 CLASS_TARGET = 0.80
 SUGGESTION_TARGET = 0.70

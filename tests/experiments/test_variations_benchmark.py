@@ -9,9 +9,9 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from parksteer.diagnose.rows import VariationRow
+from parksteer.experiments.rows import VariationRow
 from parksteer.diagnose.settings import DEFAULT_SETTINGS
-from parksteer.diagnose.variations import (COVERAGE_TARGET, NAMED_MIN_STEPS, NAMED_TARGET, NULL_ADEQUATE_TARGET,
+from parksteer.experiments.variations import (COVERAGE_TARGET, NAMED_MIN_STEPS, NAMED_TARGET, NULL_ADEQUATE_TARGET,
                                            VariationDesign, outcome, run_case, summarise, variation_cases)
 from parksteer.errors import UsageError
 from parksteer.measure.io import read_measurement
@@ -191,9 +191,9 @@ def test_what_a_calibration_can_absorb_of_a_hidden_effect(effect, confounded):
     the calibrated directions, the same verdict the diagnosis reaches on its own from the replayed signature. A
     rack stiction (a breakaway peak at each rack reversal, which no constant force, friction coefficient or carcass
     stiffness makes) keeps most of its change. The size is set on the whole change (2 steps +-2 %)."""
-    from parksteer.diagnose.variations import _case_files, hidden_strength
+    from parksteer.experiments.variations import _case_files, hidden_strength
     from parksteer.synthetic.datasets import perturbed_base
-    from parksteer.synthetic.logger import quantisation_step
+    from parksteer.measure.converter import quantisation_step
 
     design = _design(("pauses",), hidden=(effect,), steps=(2.0,))
     case = next(c for c in variation_cases(design) if c.hidden)

@@ -40,13 +40,13 @@ from ..model.symbolic.components import discover_effects, resolve_effects
 from ..parameters import Parameters
 from ..synthetic.assisted import OUT_OF_CLASS, AssistedLogger, assisted_clean, assisted_record
 from ..synthetic.datasets import SizeSearch, perturbed_base, rms_difference, strength_for_rms
-from ..synthetic.logger import quantisation_step
+from ..measure.converter import quantisation_step
 from ..synthetic.variations import variation_by_name
 from .benchmark import BENCHMARK_SETTINGS
 from .outclass import bic_margin
-from .problem import load_files
-from .report import diagnosis_dict
-from .select import diagnose
+from ..diagnose.problem import load_files
+from ..diagnose.report import diagnosis_dict
+from ..diagnose.select import diagnose
 from .variations import NAMED_MIN_STEPS, NAMED_TARGET, NULL_ADEQUATE_TARGET
 
 RACK_FRICTION = "steering.rack_friction_force"

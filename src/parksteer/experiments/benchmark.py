@@ -32,11 +32,11 @@ from ..measure.io import write_measurement
 from ..parameters import Parameters, load_parameters
 from ..synthetic.datasets import BenchmarkDesign, benchmark_specs, file_name, make_dataset
 from ..tables import write_json
-from .problem import load_files
-from .report import diagnosis_dict
+from ..diagnose.problem import load_files
+from ..diagnose.report import diagnosis_dict
 from .rows import BenchmarkRow
-from .select import diagnose
-from .settings import DEFAULT_SETTINGS, DiagnosisSettings
+from ..diagnose.select import diagnose
+from ..diagnose.settings import DEFAULT_SETTINGS, DiagnosisSettings
 
 # The benchmarks' diagnoses: a user's, without the confound tests (where a confounded candidate would show), which
 # change no verdict, name or interval the benchmarks score. bench_variations.py --confound-tests turns them on.
