@@ -56,10 +56,10 @@ def candidate_effects(model_effects: list[Effect], registry: dict[str, Effect] |
     # An electrically assisted car's own candidates (motor friction, torsion-bar offset, gain error) join only its
     # diagnosis; a candidate whose slot an assist fills (the rack lash) cannot join an assisted car's model.
     assisted = power_assist_of(model_effects) is not None
-    electric = any(e.name.startswith("electric_assist_") for e in model_effects)
+    electric = any(e.power_assist == "electric" for e in model_effects)
     testable, untestable = [], []
     for name in sorted(registry):
-        wanted = registry[name].diagnosis_candidate or (electric and getattr(registry[name], "assist_candidate", False))
+        wanted = registry[name].diagnosis_candidate or (electric and registry[name].assist_candidate)
         if name in in_model or not wanted:
             continue
         slot = registry[name].replaces
