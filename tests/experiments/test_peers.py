@@ -179,8 +179,8 @@ def test_the_library_of_a_real_diagnosis_holds_its_residual_and_its_candidates_s
     # the replays are counted as they run: never fewer after a stage than before it, all of them by the end, and
     # the peers' share (up to the signatures) short of the whole, since the refits replay the candidates again
     counts = list(diagnosis.replays_by_stage.values())
-    assert counts == sorted(counts) and counts[-1] == diagnosis.problem.evaluations
-    assert 0 < diagnosis.replays_by_stage["signatures_and_scores"] < diagnosis.problem.evaluations
+    assert counts == sorted(counts) and counts[-1] == diagnosis.replays
+    assert 0 < diagnosis.replays_by_stage["signatures_and_scores"] < diagnosis.replays
 
 
 def test_the_comparison_tunes_on_the_tuning_split_and_scores_on_the_evaluation_records():

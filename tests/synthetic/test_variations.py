@@ -12,6 +12,8 @@ measured racks adds no error of its own that its uncertainty estimate does not c
 import numpy as np
 import pytest
 
+from parksteer.diagnose.engine import ReplayEngine
+from parksteer.diagnose.ensemble import with_replay_uncertainty
 from parksteer.diagnose.problem import Problem, fit_statistics, prepare_file
 from parksteer.measure.smoothing import rest_intervals, smooth_rack
 from parksteer.model.symbolic.components import resolve_effects
@@ -74,8 +76,9 @@ def test_independent_null_sits_at_the_noise_floor(name):
     record = variation_record(PARAMS, hand, logger)
     problem = Problem([prepare_file(record, "unladen", name)], PARAMS)
     effects = resolve_effects(None)
-    prediction = problem.predict(effects)
-    problem = problem.with_replay_uncertainty(effects)
+    engine = ReplayEngine()
+    prediction = engine.predict(problem, effects)
+    problem = with_replay_uncertainty(engine, problem, effects)
     stats = fit_statistics(problem, prediction)
     ratio = stats["weighted_rms_Nm"] / stats["noise_floor_Nm"]
     assert 0.9 < ratio < 1.12, ratio

@@ -165,7 +165,7 @@ def diagnosis_dict(diagnosis: Diagnosis) -> dict:
                 "confounded_fraction": diagnosis.settings.confounded_fraction,
             },
         },
-        "cost": {"replays": problem.evaluations, "replays_by_stage": dict(diagnosis.replays_by_stage),
+        "cost": {"replays": diagnosis.replays, "replays_by_stage": dict(diagnosis.replays_by_stage),
                  "timings_s": diagnosis.timings_s},
     }
     if problem.uses_angle:  # the handwheel angle fitted as a second signal: which files, and its floor

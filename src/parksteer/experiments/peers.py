@@ -314,7 +314,7 @@ def case_result(truth: dict, diagnosis: Diagnosis, result: dict, wall_s: float, 
         "time_s": {"diagnose": wall_s, "upstream": upstream, "stlsq": answers["time_s"]["stlsq"],
                    "frols": answers["time_s"]["frols"]},
         # model replays (the same on any machine): the whole diagnosis's, and those up to its signatures
-        "replays": {"diagnose": diagnosis.problem.evaluations,
+        "replays": {"diagnose": diagnosis.replays,
                     "upstream": diagnosis.replays_by_stage["signatures_and_scores"]},
     }
 
