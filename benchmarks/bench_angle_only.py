@@ -5,7 +5,7 @@ the handwheel angle (a 14- or 16-bit encoder on +-16 rad, 2e-4 rad of noise), wi
 effect hidden at 3.5 torque converter steps RMS (:func:`parksteer.experiments.variations.hidden_strength`). Each is
 written twice, with its rack channel and with that column removed, and diagnosed from the file as a user would
 (``parksteer diagnose FILE --json``); the angle-only file's rack is then derived from the angle and torque
-(:func:`parksteer.diagnose.problem.rack_from_angle`). Printed: per record, both verdicts and named effects and the
+(:func:`parksteer.measure.column.rack_from_angle`). Printed: per record, both verdicts and named effects and the
 calibrated RMS error over the noise floor; then the rates (nulls adequate, hidden effects named) of each.
 Run:
 

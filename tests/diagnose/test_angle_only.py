@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 
 from parksteer.cli import main
-from parksteer.diagnose.problem import rack_from_angle
+from parksteer.measure.column import rack_from_angle
 from parksteer.experiments.variations import hidden_strength
 from parksteer.geometry import rack_from_handwheel
 from parksteer.measure.io import Measurement, format_measurement

@@ -120,7 +120,7 @@ def test_an_angle_only_record_gives_the_rack_through_the_torsion_bar(params, nam
     1 um over a 0.07 m stroke (2e-7 m found, column and pinion assist); taken through the shaft alone (the car
     without its assist's bar, k_c = 1000 N m/rad against the series 103 N m/rad) the rack is off by 1.5e-4 m, the
     bar's twist T / k_t through the ratio."""
-    from parksteer.diagnose.problem import rack_from_angle
+    from parksteer.measure.column import rack_from_angle
     from parksteer.measure.io import Measurement
     from parksteer.model.numeric.simulate import simulate
 

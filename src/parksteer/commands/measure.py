@@ -240,7 +240,7 @@ def _compare(args) -> int:
 def _diagnose(args) -> int:
     from ..diagnose.problem import load_files
     from ..diagnose.report import diagnosis_dict, markdown_report, write_markdown
-    from ..diagnose.problem import ANGLE
+    from ..measure.importers import ANGLE
     from ..diagnose.select import diagnose
     from ..diagnose.settings import DEFAULT_SETTINGS
 

@@ -36,7 +36,8 @@ from ..model.symbolic.system import CORE_PARAMETERS
 from ..parameters import quantity
 from .settings import DEFAULT_SETTINGS, DiagnosisSettings
 from .engine import ReplayEngine
-from .problem import Problem, lag1_autocorrelation
+from .problem import Problem
+from .statistics import lag1_autocorrelation
 
 Z95 = 1.959964  # two-sided 95 % quantile of the standard normal
 

@@ -22,7 +22,8 @@ from ..model.symbolic.components import Effect, power_assist_of, resolve_effects
 from ..parameters import Parameters
 from .engine import ReplayEngine
 from .ensemble import with_replay_uncertainty
-from .problem import FileData, Problem, fit_statistics
+from .problem import FileData, Problem
+from .statistics import fit_statistics
 
 
 @dataclass

@@ -34,7 +34,8 @@ from ..measure.converter import add_noise, quantise
 from ..measure.smoothing import SmoothedRack, smooth_rack
 from ..model.symbolic.components import Effect
 from .engine import ReplayEngine
-from .problem import FileData, Problem, rack_logger
+from ..measure.column import rack_logger
+from .problem import FileData, Problem
 from .settings import DEFAULT_SETTINGS
 
 

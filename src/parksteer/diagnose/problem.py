@@ -13,9 +13,7 @@ The replay uncertainty (:mod:`parksteer.diagnose.ensemble`) is found by propagat
 racks the data allow equally well.
 
 A file with no rack channel (a car's own bus: handwheel angle and torque) is replayed from a rack derived from
-the angle through the model's column, its damper included (:func:`rack_from_angle`, which
-:func:`load_files` applies to every record whose importer derived its rack); its replay uncertainty comes from
-the angle channel's logger carried through the ratio (:func:`rack_logger`).
+the angle through the model's column (:mod:`parksteer.measure.column`, which :func:`load_files` reads through).
 
 A file with a handwheel angle beside a measured rack may be fitted on both signals
 (:attr:`FileData.uses_angle`, in the copies the diagnosis makes when its settings ask): each prediction is
@@ -29,27 +27,20 @@ on a linear column, a lash's whole band where the torque is that close to zero).
 
 from __future__ import annotations
 
-import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from .. import portable as pm
 from ..errors import UsageError, naming
-from ..geometry import pinion_angle_from_column
-from ..measure.importers import load_record
+from ..measure.column import load_measurements
+from ..measure.importers import ANGLE, TORQUE
 from ..measure.io import Measurement
 from ..measure.metrics import NoiseFloor, noise_floor
 from ..measure.phases import CyclePhases, find_phases
 from ..measure.smoothing import SmoothedRack, smooth_rack
-from ..model.numeric.prescribed import column_twist
 from ..parameters import Parameters
-from ..measure.converter import quantisation_step
 from .settings import DEFAULT_SETTINGS
-
-TORQUE = "handwheel_torque_Nm"
-ANGLE = "handwheel_angle_rad"
 # An assisted car's motor channel (the second measured signal of its diagnosis), the current preferred.
 MOTOR_COLUMNS = ("motor_current_A", "motor_torque_Nm")
 
@@ -199,86 +190,14 @@ def prepare_file(measurement: Measurement, case: str | None = None, label: str |
 
 def load_files(paths: list[str | Path], params: Parameters, case: str | None = None, surface: str | None = None,
                channel_map=None, assist: str | None = None) -> list[FileData]:
-    """Read (through :func:`parksteer.measure.importers.load_record`), validate and prepare measurement files;
-    `case` replaces the case every file names, `surface` fills the surface a file does not state; `assist` (an
-    assisted car's effect) derives an angle-only record's rack through its torsion bar (:func:`rack_from_angle`)."""
-    if not paths:
-        raise UsageError("no measurement file given")
-    if case is not None:
-        params.case(case)  # one-line error for an unknown case
+    """Read and validate measurement files (:func:`parksteer.measure.column.load_measurements`, which says what
+    `case`, `surface`, `channel_map` and `assist` do) and prepare each (:func:`prepare_file`)."""
     files = []
-    for path in paths:
-        measurement = load_record(path, channel_map, case=case, surface=surface, params=params)
-        if surface is not None and measurement.surface != surface:
-            raise UsageError(f"{path}: the file says surface {measurement.surface!r} but --surface is {surface!r}; "
-                             "remove one")
-        chosen = case or measurement.case
-        stated = measurement.extra_offset_m
-        if stated is not None and abs(stated - params.case(chosen)["extra_offset"]) > 5e-4:
-            raise UsageError(
-                f"{path}: extra_offset_m = {stated:g} m but case {chosen} has "
-                f"{params.case(chosen)['extra_offset']:g} m; name the matching case (--case)"
-            )
-        resolution = 0.0
-        if "rack_derived" in measurement.metadata:
-            measurement = rack_from_angle(measurement, params, assist)
-            logger = rack_logger(measurement, params)
-            resolution = 0.0 if logger is None else quantisation_step(logger[0], logger[1])
+    for path, measurement, chosen, resolution in load_measurements(paths, params, case, surface, channel_map,
+                                                                   assist):
         with naming(path):
             files.append(prepare_file(measurement, chosen, rest_resolution_m=resolution))
     return files
-
-
-def rack_from_angle(measurement: Measurement, params: Parameters, assist: str | None = None) -> Measurement:
-    """A copy of an angle-only record (its rack derived by the importer) with the rack derived through the model's
-    column: the column angle is the handwheel angle less the twist that passes the measured torque through the
-    column's spring and damper, ``c dtwist/dt + k twist = T`` (:func:`parksteer.model.numeric.prescribed.column_twist`,
-    exact for a torque linear between samples, from the static twist T(0) / k at the first sample), the Hooke joint
-    turns it into the pinion angle (:func:`parksteer.geometry.pinion_angle_from_column`) and
-    rack = theta_p / handwheel_to_rack_ratio. This is the inverse of the replay's own handwheel angle
-    (:func:`parksteer.model.numeric.prescribed.solve`: column angle plus that twist).
-
-    The importer's static column law (:func:`parksteer.geometry.rack_from_handwheel`, twist T / k) leaves out the
-    damper: the twist lags the torque by c / k (0.2 s on the paper's car), and where the torque swings at a reversal
-    the static twist is off by (c / k) dtwist/dt, up to 4.8e-3 rad at the handwheel, a 26 um rack error, five times
-    the angle-derived rack's own noise (a 14-bit angle on +-16 rad: 1.05e-5 m steps). That error sits at the
-    reversals, where the rack friction flips, and made a null record unexplained. The torque's noise reaches the
-    rack through the twist only, divided by k and the ratio (0.1 N m: 5e-7 m) and low-passed by the damper.
-
-    Of an assisted car (`assist`, the effect's name), the torque is the torsion bar's and the bar is in series with
-    the column shaft: the twist is through their series stiffness k k_t / (k + k_t), with the damping that keeps
-    the column's time constant (as the assist's deflection law); a bar on the pinion (pinion, rack and hydraulic
-    gears) reads the column torque through the joint, T_s = T dtheta_c/dtheta_p.
-    """
-    s = params.sections["steering"]
-    columns = measurement.columns
-    stiffness, damping = s["column_torsional_stiffness"], s["column_torsional_damping"]
-    torque = columns[TORQUE]
-    if assist is not None:  # the torsion bar in series with the column shaft (assist_common.series_deflection)
-        bar = params[f"{assist}.torsion_bar_stiffness"]
-        series = stiffness * bar / (stiffness + bar)
-        stiffness, damping = series, damping * series / stiffness
-    twist, _ = column_twist(columns["time_s"], torque, stiffness, damping)
-    joint = (s["hooke_joint_angle"], s["hooke_joint_phase"])
-    pinion = pinion_angle_from_column(columns[ANGLE] - twist, *joint)
-    if assist is not None and not assist.endswith("_column"):
-        # the bar on the pinion reads T_s = T dtheta_c/dtheta_p: the column carries T_s dtheta_p/dtheta_c, the
-        # joint's speed ratio taken at the column angle of the first pass (it varies by 1e-4 over the twist)
-        column = columns[ANGLE] - twist
-        h = 1e-6
-        ratio = (pinion_angle_from_column(column + h, *joint) - pinion_angle_from_column(column - h, *joint)) / (2 * h)
-        twist, _ = column_twist(columns["time_s"], torque * ratio, stiffness, damping)
-        pinion = pinion_angle_from_column(columns[ANGLE] - twist, *joint)
-    metadata = dict(measurement.metadata)
-    metadata["rack_derived"] = (
-        f"from {ANGLE} and {TORQUE} through the model's column (parksteer.diagnose.problem.rack_from_angle): twist "
-        f"from c dtwist/dt + k twist = T with k {stiffness:g} N m/rad and c "
-        f"{damping:g} N m s/rad, Hooke joint angle {s['hooke_joint_angle']:g} rad and phase "
-        f"{s['hooke_joint_phase']:g} rad, ratio {s['handwheel_to_rack_ratio']:g} rad/m"
-        + (f"; the torsion bar of {assist} in series" if assist is not None else "")
-    )
-    return replace(measurement, columns={**columns, "rack_m": pinion / s["handwheel_to_rack_ratio"]},
-                   metadata=metadata)
 
 
 class Problem:
@@ -343,117 +262,3 @@ def _in_torque_floors(f: FileData, v: np.ndarray) -> np.ndarray:
     return np.concatenate(parts)
 
 
-def rack_logger(measurement: Measurement, params: Parameters | None = None) -> tuple[float, int, float] | None:
-    """(full scale, bits, analog noise RMS) of the rack channel, if the file states its logger; else None.
-
-    The analog part is the rack's noise (from its second differences) less the rounding's
-    step / sqrt(12), root sum of squares, as :func:`parksteer.measure.metrics.noise_floor` splits it.
-
-    A rack derived from the handwheel angle (:func:`rack_from_angle`) has no logger of its own: its noise and
-    rounding are the angle channel's, carried through the column to the rack. So its logger is the angle's
-    (``full_scale_``/``bits_`` of the angle, the angle's analog noise from its own second differences), each
-    divided by handwheel_to_rack_ratio (`params`): the rack's levels are then the angle's steps over the ratio.
-    The Hooke joint scales that step by its local speed ratio, between cos(alpha) and 1 / cos(alpha) (0.90 to
-    1.11 at 0.45 rad), which the mean ratio leaves out; the torque's share through the twist (module docstring
-    of :func:`rack_from_angle`) is twenty times smaller and left out too. Without a stated angle logger, None.
-    """
-    if "rack_derived" in measurement.metadata:
-        if params is None or ANGLE not in measurement.columns:
-            return None
-        full_scale, bits = measurement.full_scale(ANGLE), measurement.bits(ANGLE)
-        if full_scale is None or bits is None:
-            return None
-        ratio = params.sections["steering"]["handwheel_to_rack_ratio"]
-        floor = noise_floor(measurement.columns[ANGLE], measurement.quantisation_step(ANGLE))
-        return full_scale / ratio, bits, floor.analog_rms / ratio
-    full_scale, bits = measurement.full_scale("rack_m"), measurement.bits("rack_m")
-    if full_scale is None or bits is None:
-        return None
-    floor = noise_floor(measurement.rack_m, measurement.quantisation_step("rack_m"))
-    return full_scale, bits, floor.analog_rms
-
-
-def fit_statistics(problem: Problem, predictions: list[np.ndarray]) -> dict:
-    """Plain and weighted RMS, the noise floor and the attainable floor over all files.
-
-    ``weighted_rms_Nm`` is sqrt(mean(r_i^2 floor_f^2)) with r_i the weighted residual and
-    floor_f the file's noise floor: it equals the noise floor for a perfect model, and
-    sqrt(floor^2 + e^2) for a model off by e where the replay is certain.
-    """
-    files = problem.files
-    residual = np.concatenate([f.torque_Nm - f.torque_part(m) for f, m in zip(files, predictions)])
-    weighted = problem.weighted(predictions)
-    is_torque = np.concatenate([np.arange(f.m) < f.n for f in files])
-    floors = np.concatenate([np.full(f.n, f.noise.total_rms) for f in files])
-    attainable = np.concatenate([f.sigma_Nm for f in files])
-    floor = float(np.sqrt(np.mean(floors**2)))
-    out = {
-        "rms_Nm": float(np.sqrt(np.mean(residual**2))),
-        "peak_Nm": float(np.max(np.abs(residual))),
-        "weighted_rms_Nm": float(np.sqrt(np.mean((weighted[is_torque] * floors) ** 2))),
-        "noise_floor_Nm": floor,
-        "attainable_floor_Nm": float(np.sqrt(np.mean(attainable**2))),
-        "weighted_rss": float(np.sum(weighted**2)),
-        "samples": int(weighted.size),
-    }
-    with_angle = [(f, m) for f, m in zip(files, predictions) if f.uses_angle]
-    if with_angle:  # the angle's residual beside the torque's (the same definitions, in rad and degrees)
-        angle = np.concatenate([f.angle_rad - f.angle_part(m) for f, m in with_angle])
-        angle_floors = np.concatenate([np.full(f.n, f.angle_noise.total_rms) for f, _ in with_angle])
-        angle_weighted = np.concatenate([(f.angle_rad - f.angle_part(m)) / f.sigma_rad for f, m in with_angle])
-        angle_attainable = np.concatenate([f.sigma_rad for f, _ in with_angle])
-        rms = float(np.sqrt(np.mean(angle**2)))
-        out["angle"] = {
-            "rms_rad": rms,
-            "rms_deg": math.degrees(rms),
-            "peak_rad": float(np.max(np.abs(angle))),
-            "weighted_rms_rad": float(np.sqrt(np.mean((angle_weighted * angle_floors) ** 2))),
-            "noise_floor_rad": float(np.sqrt(np.mean(angle_floors**2))),
-            "attainable_floor_rad": float(np.sqrt(np.mean(angle_attainable**2))),
-            "weighted_rss": float(np.sum(angle_weighted**2)),
-            "samples": int(angle.size),
-        }
-    with_motor = [(f, m) for f, m in zip(files, predictions) if f.uses_motor]
-    if with_motor:  # an assisted car's motor channel beside the torque (in its own unit, A or N m)
-        motor = np.concatenate([f.motor - f.motor_part(m) for f, m in with_motor])
-        motor_floors = np.concatenate([np.full(f.n, f.motor_noise.total_rms) for f, _ in with_motor])
-        motor_weighted = np.concatenate([(f.motor - f.motor_part(m)) / f.sigma_motor for f, m in with_motor])
-        out["motor"] = {
-            "column": with_motor[0][0].motor_column,
-            "rms": float(np.sqrt(np.mean(motor**2))),
-            "peak": float(np.max(np.abs(motor))),
-            "weighted_rms": float(np.sqrt(np.mean((motor_weighted * motor_floors) ** 2))),
-            "noise_floor": float(np.sqrt(np.mean(motor_floors**2))),
-            "weighted_rss": float(np.sum(motor_weighted**2)),
-            "samples": int(motor.size),
-        }
-    return out
-
-
-def pooled_lag1(segments) -> float:
-    """Lag-1 autocorrelation pooled over `segments` (arrays; pairs within a segment, each about its own mean)."""
-    num = den = 0.0
-    for r in segments:
-        r = r - r.mean()
-        num += float(np.sum(r[1:] * r[:-1]))
-        den += float(np.sum(r * r))
-    return num / den if den > 0 else 0.0
-
-
-def lag1_autocorrelation(problem: Problem, weighted: np.ndarray) -> float:
-    """Lag-1 autocorrelation of the weighted residuals, pooled over files (pairs within a file and signal)."""
-    bounds = np.cumsum([0] + [f.n for f in problem.files for _ in range(f.signals)])
-    return pooled_lag1(weighted[a:b] for a, b in zip(bounds[:-1], bounds[1:]))
-
-
-def effective_samples(n: int, rho: float) -> float:
-    """n (1 - rho) / (1 + rho) for AR(1)-like residuals, rho clipped to [0, 0.95]."""
-    rho = min(max(rho, 0.0), 0.95)
-    return max(n * (1.0 - rho) / (1.0 + rho), 2.0)
-
-
-def bic_gain(rss_without: float, rss_with: float, n_eff: float, parameters: int) -> float:
-    """The fall of the BIC over the effective sample size, ``BIC = n_eff ln(RSS / n) + k ln(n_eff)``, when
-    `parameters` more columns take the weighted residual sum of squares from `rss_without` to `rss_with`:
-    ``n_eff ln(rss_without / rss_with) - k ln(n_eff)`` (positive: the richer model is the better)."""
-    return n_eff * pm.log(rss_without / max(rss_with, 1e-300)) - parameters * pm.log(n_eff)

@@ -55,7 +55,7 @@ from .. import portable as pm
 from ..errors import UsageError
 from ..measure.phases import PHASES
 from ..parameters import Parameters
-from .problem import bic_gain, effective_samples, pooled_lag1
+from .statistics import bic_gain, effective_samples, pooled_lag1
 from .settings import DEFAULT_SETTINGS, DiagnosisSettings
 
 CLASSES = ("dissipative", "elastic", "direction", "speed", "column")

@@ -17,7 +17,8 @@ import numpy as np
 from ..model.symbolic.components import Effect
 from .calibrate import Fit
 from .candidates import Score, Signature
-from .problem import Problem, fit_statistics
+from .problem import Problem
+from .statistics import fit_statistics
 from .settings import DEFAULT_SETTINGS, DiagnosisSettings
 
 VERDICTS = ("missing", "adequate", "unexplained")

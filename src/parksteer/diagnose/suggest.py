@@ -35,7 +35,8 @@ from ..errors import UsageError
 from ..model.symbolic.components import load_effect_module
 from .calibrate import Fit, FitParameter, calibration_parameters, least_squares
 from .engine import ReplayEngine
-from .problem import Problem, bic_gain, effective_samples, fit_statistics, lag1_autocorrelation
+from .problem import Problem
+from .statistics import bic_gain, effective_samples, fit_statistics, lag1_autocorrelation
 from .settings import DEFAULT_SETTINGS, DiagnosisSettings
 from .signature import Signature
 

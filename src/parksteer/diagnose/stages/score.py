@@ -6,7 +6,7 @@ from __future__ import annotations
 from dataclasses import replace
 
 from ..candidates import Signature, candidate_effects, probe_signature, score
-from ..problem import fit_statistics
+from ..statistics import fit_statistics
 from ..state import Candidate, DiagnosisState
 from ..engine import ReplayEngine
 from .base import Stage

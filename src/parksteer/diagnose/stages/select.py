@@ -9,7 +9,8 @@ from dataclasses import replace
 import numpy as np
 
 from ..calibrate import Fit
-from ..problem import Problem, bic_gain, effective_samples, lag1_autocorrelation
+from ..problem import Problem
+from ..statistics import bic_gain, effective_samples, lag1_autocorrelation
 from ..engine import ReplayEngine
 from ..state import Candidate, DiagnosisState
 from .base import Stage
