@@ -103,7 +103,7 @@ def steer_axis(params: Parameters, case: str, side: str) -> SteerAxis:
     return SteerAxis(side, top, frame, centre, g["ground_z"] - g["wheel_centre_z"])
 
 
-def overall_steering_ratio(params: Parameters) -> float:
+def steering_ratio(params: Parameters) -> float:
     """G: handwheel angle per road-wheel steer angle (186.47 / 8.3682 = 22.28)."""
     s = params.sections["steering"]
     return s["handwheel_to_rack_ratio"] / s["roadwheel_to_rack_ratio"]
@@ -122,12 +122,12 @@ def lifting_torque_a1(params: Parameters, case: str, steer_rad: float | np.ndarr
     wl, wr = c["load_left"], c["load_right"]
     delta = np.asarray(steer_rad, dtype=float)
     tau = d * ((wr - wl) * pm.sin(eps) * pm.cos(delta) + (wr + wl) * pm.cos(eps) * pm.sin(chi) * pm.sin(delta))
-    return tau / overall_steering_ratio(params)
+    return tau / steering_ratio(params)
 
 
 def lock_steer_angle(params: Parameters) -> float:
     """Road-wheel steer angle at full lock (rad)."""
-    return params["input.handwheel_lock_angle"] / overall_steering_ratio(params)
+    return params["input.handwheel_lock_angle"] / steering_ratio(params)
 
 
 def pinion_angle_from_column(column_angle_rad, joint_angle_rad: float, phase_rad: float) -> np.ndarray:

@@ -46,7 +46,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import UsageError
+from ..errors import UsageError, cannot_read
 from .converter import quantisation_step
 from ..names import SURFACES
 from ..parameters import Parameters, load_parameters
@@ -488,7 +488,7 @@ def read_measurement(path: str | Path, params: Parameters | None = None) -> Meas
     try:
         raw = path.read_bytes()
     except OSError as exc:
-        raise UsageError(f"{path}: cannot read ({exc.strerror})") from None
+        raise UsageError(cannot_read(path, exc)) from None
     try:
         text = raw.decode("utf-8")
     except UnicodeDecodeError as exc:
