@@ -6,6 +6,7 @@ are counted. :func:`parksteer.diagnose.select.diagnose` makes one :class:`Replay
 stage (``stage.run(state, engine)``). It is openly mutable and keeps its counts on itself, as scipy's
 ``OdeSolver`` keeps ``nfev`` on the solver that spends them. It owns:
 
+- `models`: the compiled models loaded (:class:`parksteer.model.numeric.compiled.CompiledModels`);
 - `hosts`: which compiled model each effect set is replayed on (:func:`parksteer.diagnose.candidates.replay_models`:
   most candidates share the diagnosis model);
 - `direct`: which quantities only enter a compiled model's equations (found once per model and key,
@@ -23,6 +24,7 @@ from collections.abc import Callable
 
 import numpy as np
 
+from ..model.numeric.compiled import CompiledModels
 from ..model.symbolic.components import Effect
 from .parallel import fork_map, forks, pool, pool_map
 from .problem import Problem
@@ -42,6 +44,7 @@ class ReplayEngine:
 
     def __init__(self, workers: int = 1, hosts: dict[tuple[str, ...], list[Effect]] | None = None):
         self.workers = max(int(workers), 1)
+        self.models = CompiledModels()
         self.hosts: dict[tuple[str, ...], list[Effect]] = dict(hosts or {})
         self.direct: dict[tuple[str, str], bool] = {}
         self.replays: dict[tuple, Replay] = {}
@@ -61,7 +64,8 @@ class ReplayEngine:
         """A replay of `effects` on its host's compiled model, sharing what the engine knows of that model; not kept
         (its solves are not counted)."""
         return Replay(list(effects), case, surface, params, rack, time_s,
-                      model_effects=self.hosts.get(effect_key(effects), list(effects)), direct=self.direct)
+                      model_effects=self.hosts.get(effect_key(effects), list(effects)), direct=self.direct,
+                      models=self.models)
 
     def replay(self, problem: Problem, effects: list[Effect], index: int) -> Replay:
         """The kept replay of `effects` on file `index` of `problem`, at the file's instants (made when first asked

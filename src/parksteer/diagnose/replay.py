@@ -22,6 +22,7 @@ import numpy as np
 from ..measure.smoothing import SmoothedRack
 from ..errors import UsageError
 from ..model.numeric.assisted import solve_assisted
+from ..model.numeric.compiled import CompiledModels
 from ..model.numeric.prescribed import PrescribedSolution, solve, twist_spread
 from ..model.numeric.simulate import PreparedRun, prepare
 from ..model.symbolic.components import Effect, power_assist_of
@@ -59,6 +60,9 @@ class Replay:
     # (compiled model, quantity key) -> whether the quantity only enters the equations (_is_direct), shared by the
     # replays of one engine (ReplayEngine.direct); by default this replay's own
     direct: dict[tuple[str, str], bool] | None = field(default=None, repr=False, compare=False)
+    # the compiled models it loads through, shared by the replays of one engine (ReplayEngine.models); by default
+    # this replay's own
+    models: CompiledModels | None = field(default=None, repr=False, compare=False)
 
     def __post_init__(self):
         self.time_s = np.asarray(self.time_s, dtype=float)
@@ -68,6 +72,8 @@ class Replay:
             self.model_effects = self.effects
         if self.direct is None:
             self.direct = {}
+        if self.models is None:
+            self.models = CompiledModels()
         self._base = self._prepared(self.base_overrides)
 
     def on_rack(self, rack: SmoothedRack) -> Replay:
@@ -82,14 +88,16 @@ class Replay:
 
     def _sharing(self, rack: SmoothedRack, time_s: np.ndarray) -> Replay:
         return Replay(self.effects, self.case, self.surface, self.params, rack, time_s, dict(self.base_overrides),
-                      runs=self._runs, model_effects=self.model_effects, direct=self.direct)
+                      runs=self._runs, model_effects=self.model_effects, direct=self.direct,
+                      models=self.models)
 
     def _prepared(self, overrides: dict[str, float]) -> PreparedRun:
         key = tuple(sorted(overrides.items()))
         if key not in self._runs:
             if len(self._runs) >= KEPT_RUNS:  # a fit moving a prepared quantity makes a new run at every step
                 del self._runs[next(k for k in self._runs if self._runs[k] is not self._base)]
-            self._runs[key] = prepare(self.case, self.model_effects, overrides, self.surface, self.params)
+            self._runs[key] = prepare(self.case, self.model_effects, overrides, self.surface, self.params,
+                                     models=self.models)
         return self._runs[key]
 
     def _is_direct(self, key: str, value: float) -> bool:
@@ -109,7 +117,8 @@ class Replay:
         if value == base.p[i]:
             return True  # no change to test with, and none to make
         # Preparing with the new value also checks its bounds, once.
-        moved = prepare(self.case, self.model_effects, {**self.base_overrides, key: value}, self.surface, self.params).p
+        moved = prepare(self.case, self.model_effects, {**self.base_overrides, key: value}, self.surface, self.params,
+                        models=self.models).p
         self.direct[known] = set(np.flatnonzero(moved != base.p).tolist()) <= {i}
         return self.direct[known]
 
