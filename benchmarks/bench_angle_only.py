@@ -2,10 +2,10 @@
 
 Each record is a variation of :mod:`parksteer.synthetic.variations` (its own hand and logger) whose logger also logs
 the handwheel angle (a 14- or 16-bit encoder on +-16 rad, 2e-4 rad of noise), with nothing hidden or with a library
-effect hidden at 3.5 torque converter steps RMS (:func:`parksteer.diagnose.variations.hidden_strength`). Each is
+effect hidden at 3.5 torque converter steps RMS (:func:`parksteer.experiments.variations.hidden_strength`). Each is
 written twice, with its rack channel and with that column removed, and diagnosed from the file as a user would
 (``parksteer diagnose FILE --json``); the angle-only file's rack is then derived from the angle and torque
-(:func:`parksteer.diagnose.problem.rack_from_angle`). Printed: per record, both verdicts and named effects and the
+(:func:`parksteer.measure.column.rack_from_angle`). Printed: per record, both verdicts and named effects and the
 calibrated RMS error over the noise floor; then the rates (nulls adequate, hidden effects named) of each.
 Run:
 
@@ -30,10 +30,10 @@ import tempfile
 from pathlib import Path
 
 from parksteer.cli import main
-from parksteer.diagnose.variations import hidden_strength
+from parksteer.experiments.variations import hidden_strength
 from parksteer.measure.io import Measurement, format_measurement
 from parksteer.parameters import load_parameters
-from parksteer.synthetic.logger import quantisation_step
+from parksteer.measure.converter import quantisation_step
 from parksteer.synthetic.variations import variation_by_name, variation_record
 
 # (variation, angle converter bits): hands and loggers of the variation benchmark, each logging an angle too

@@ -2,7 +2,7 @@
 
     python benchmarks/bench_assisted.py OUT.json [--vehicle data/vehicles/polo_vi.toml] [--only NAME,NAME]
 
-The logic is :mod:`parksteer.diagnose.assisted_benchmark` (the design, the scoring and the targets are there).
+The logic is :mod:`parksteer.experiments.assisted_benchmark` (the design, the scoring and the targets are there).
 Prints one line per case as it is diagnosed (what was hidden, its size in torsion-bar converter steps, the verdict,
 the effect named and its group), then the targets: named rate, nulls called adequate, confident wrong answers out
 of class; writes the summary and every case's outcome as JSON, with the wall time.
@@ -25,7 +25,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--only", default="", help="comma-separated case names (default: all)")
     args = parser.parse_args(argv)
 
-    from parksteer.diagnose.assisted_benchmark import AssistedDesign, run
+    from parksteer.experiments.assisted_benchmark import AssistedDesign, run
     from parksteer.model.symbolic.components import discover_effects
     from parksteer.tables import write_json
     from parksteer.vehicle import load_vehicle

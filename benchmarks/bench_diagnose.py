@@ -49,6 +49,7 @@ def _measure(repeats: int, workers: int, car: Path | None, eight_repeats: int) -
 
     from parksteer.diagnose.candidates import candidate_models
     from parksteer.diagnose.compare import compare_files
+    from parksteer.diagnose.engine import ReplayEngine
     from parksteer.diagnose.problem import Problem, load_files, prepare_file
     from parksteer.diagnose.select import diagnose
     from parksteer.model.codegen.cache import ensure
@@ -66,7 +67,7 @@ def _measure(repeats: int, workers: int, car: Path | None, eight_repeats: int) -
     bench_measurements = make_dataset(params, case).measurements
 
     one = [prepare_file(bench_measurements[0], label="unladen")]
-    replay = Problem(one, params).replay(resolve_effects(None), 0)
+    replay = ReplayEngine().replay(Problem(one, params), resolve_effects(None), 0)
     replay.torque()
     times = []
     for _ in range(20):
@@ -87,7 +88,7 @@ def _measure(repeats: int, workers: int, car: Path | None, eight_repeats: int) -
             t0 = time.perf_counter()
             d = diagnose(files, params, **kwargs)
             walls.append(time.perf_counter() - t0)
-            replays.append(d.problem.evaluations)
+            replays.append(d.replays)
             outcomes.append({"verdict": d.verdict, "effect": d.effect,
                              "best": d.best.name if d.best is not None else None,
                              "calibrated": d.calibration.values,

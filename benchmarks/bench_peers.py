@@ -2,7 +2,7 @@
 
     python benchmarks/bench_peers.py OUT_FOLDER [--records results/diagnose] [--jobs 2] [--table-only]
 
-The logic is :mod:`parksteer.diagnose.peers`. The evaluation records are those the variation and out-of-class
+The logic is :mod:`parksteer.experiments.peers`. The evaluation records are those the variation and out-of-class
 benchmarks wrote under ``--records``
 (``variations/*/`` and ``outclass/*/``, each case's truth beside its folder of files: run the DAG's
 ``diag_variations`` and ``diag_outclass`` first); the tuning split is made here, the variation grid of
@@ -25,7 +25,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def _jobs(records: Path, design) -> list[tuple[str, str]]:
-    from parksteer.diagnose.variations import case_names
+    from parksteer.experiments.variations import case_names
 
     jobs = [("tuning", f"tuning:{name}") for name in case_names(design)]
     for kind in ("variations", "outclass"):
@@ -38,8 +38,8 @@ def _run(item) -> str:
     out, job, tuning_seed = item
     import yaml
 
-    from parksteer.diagnose.peers import run_peer_batch, tuning_design
-    from parksteer.diagnose.variations import VariationDesign
+    from parksteer.experiments.peers import run_peer_batch, tuning_design
+    from parksteer.experiments.variations import VariationDesign
     from parksteer.parameters import DEFAULT_PATH
 
     config = yaml.safe_load((ROOT / "config" / "config.yaml").read_text(encoding="utf-8"))
@@ -85,8 +85,8 @@ def main(argv: list[str] | None = None) -> int:
     sys.path.insert(0, str(ROOT / "src"))
     import yaml
 
-    from parksteer.diagnose.peers import compare, peers_file_name, read_cases
-    from parksteer.diagnose.variations import VariationDesign
+    from parksteer.experiments.peers import compare, peers_file_name, read_cases
+    from parksteer.experiments.variations import VariationDesign
 
     config = yaml.safe_load((ROOT / "config" / "config.yaml").read_text(encoding="utf-8"))
     design = VariationDesign.from_config(config["variations"], config["benchmark"])

@@ -3,7 +3,7 @@ effect scored per signature class, and the time the signature and the suggestion
 
     python benchmarks/bench_signature.py [--steps 5] [--nulls 4] [--seed 2411] [--first-variation 0] [--json OUT.json]
 
-The grid (parksteer.diagnose.outoflibrary.SignatureDesign): the ten truth forms of
+The grid (parksteer.experiments.outoflibrary.SignatureDesign): the ten truth forms of
 parksteer.synthetic.outoflibrary at each size, on the first six variations of the variation benchmark in
 turn, and the nulls: 14 records by default, a few minutes on one core (each suggestion compiles its own model).
 """
@@ -16,7 +16,7 @@ import sys
 import tempfile
 import time
 
-from parksteer.diagnose.outoflibrary import AFTER_LIMIT, SignatureDesign, run_case, summarise
+from parksteer.experiments.outoflibrary import AFTER_LIMIT, SignatureDesign, run_case, summarise
 from parksteer.parameters import load_parameters
 
 

@@ -3,7 +3,7 @@
     python benchmarks/bench_variations.py OUT.json [--full] [--only pauses,lock_overshoot] [--hidden kingpin_friction]
         [--confound-tests] [--sizes]
 
-The logic is :mod:`parksteer.diagnose.variations` (rules ``diag_variation_batch`` and ``diag_variations`` run
+The logic is :mod:`parksteer.experiments.variations` (rules ``diag_variation_batch`` and ``diag_variations`` run
 the same cases in the DAG); the grid is config/config.yaml's ``variations`` section (``--full``: its full grid).
 Prints one line per case as it is diagnosed, then per variation the named rate, the nulls called adequate, the
 coverage of the 95 % intervals, the nulls' calibrated error in noise floors and the median diagnosis time; writes
@@ -41,10 +41,10 @@ def main(argv: list[str] | None = None) -> int:
 
     import yaml
 
-    from parksteer.diagnose.benchmark import BENCHMARK_SETTINGS
+    from parksteer.experiments.benchmark import BENCHMARK_SETTINGS
     from parksteer.diagnose.settings import DEFAULT_SETTINGS
-    from parksteer.diagnose.rows import as_dict
-    from parksteer.diagnose.variations import VariationDesign, case_names, outcome, run_case, summarise
+    from parksteer.experiments.rows import as_dict
+    from parksteer.experiments.variations import VariationDesign, case_names, outcome, run_case, summarise
     from parksteer.parameters import DEFAULT_PATH
     from parksteer.tables import write_json
 
@@ -92,7 +92,7 @@ def main(argv: list[str] | None = None) -> int:
 
 def _sizes(design, out: str) -> int:
     """Each hidden case's whole and observable change (case_truth), and per hidden effect the observable share."""
-    from parksteer.diagnose.variations import case_truth, spread, variation_cases
+    from parksteer.experiments.variations import case_truth, spread, variation_cases
     from parksteer.parameters import load_parameters
     from parksteer.tables import write_json
 

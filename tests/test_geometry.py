@@ -17,7 +17,7 @@ from parksteer.geometry import (
     SIDES,
     lifting_torque_a1,
     lock_steer_angle,
-    overall_steering_ratio,
+    steering_ratio,
     steer_axis,
 )
 
@@ -216,7 +216,7 @@ def _virtual_work_torque_Nm(params, case: str, steer: np.ndarray, step_rad: floa
     def work_J(s):
         return c["load_left"] * left.wheel_drop_m(s) + c["load_right"] * right.wheel_drop_m(s)
 
-    return (work_J(steer + step_rad) - work_J(steer - step_rad)) / (2 * step_rad) / overall_steering_ratio(params)
+    return (work_J(steer + step_rad) - work_J(steer - step_rad)) / (2 * step_rad) / steering_ratio(params)
 
 
 @pytest.mark.parametrize("case", TABLE_B1_CASES)
@@ -236,7 +236,7 @@ def test_a1_is_the_virtual_work_of_the_wheel_loads(params, exact_params, case):
         (c["load_left"] + c["load_right"])
         * _trail_rounding_m(params)
         * (math.sin(g["castor_angle"]) + math.sin(g["kingpin_inclination"]))
-        / overall_steering_ratio(params)
+        / steering_ratio(params)
     )
     np.testing.assert_allclose(
         _virtual_work_torque_Nm(params, case, steer), lifting_torque_a1(params, case, steer), rtol=0, atol=bound_Nm
@@ -308,7 +308,7 @@ def test_lifting_is_proportional_to_d(params):
         assert c["load_left"] + c["load_right"] == pytest.approx(standard["load_left"] + standard["load_right"])
         d_m = steer_axis(params, case, "left").offset_d_m
         load_difference_change_N = (c["load_right"] - c["load_left"]) - (standard["load_right"] - standard["load_left"])
-        bound = abs(load_difference_change_N) * math.sin(eps) / overall_steering_ratio(params) + 1e-12
+        bound = abs(load_difference_change_N) * math.sin(eps) / steering_ratio(params) + 1e-12
         assert np.max(np.abs(lifting_torque_a1(params, case, steer) / d_m - per_d_standard)) <= bound
     assert steer_axis(params, "offset_68_5mm", "left").offset_d_m > 2 * d_standard_m
 

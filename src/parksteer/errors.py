@@ -22,6 +22,17 @@ class SolverError(UsageError):
         self.t_failed_s = t_failed_s
 
 
+def cannot_read(path: str | PathLike, exc: OSError) -> str:
+    """The one-line message of a file that cannot be read: its path and the system's reason."""
+    return f"{path}: cannot read ({exc.strerror})"
+
+
+def cannot_read_as(path: str | PathLike, what: str, problem: str) -> str:
+    """The one-line message of a file a reader cannot read as its format `what`: its path and the reader's
+    `problem`."""
+    return f"{path}: cannot read as {what} ({problem})"
+
+
 @contextmanager
 def naming(where: str | PathLike) -> Iterator[None]:
     """Prefix a :class:`UsageError` raised inside with `where` (a file), unless the message names it already."""

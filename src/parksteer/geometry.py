@@ -103,7 +103,7 @@ def steer_axis(params: Parameters, case: str, side: str) -> SteerAxis:
     return SteerAxis(side, top, frame, centre, g["ground_z"] - g["wheel_centre_z"])
 
 
-def overall_steering_ratio(params: Parameters) -> float:
+def steering_ratio(params: Parameters) -> float:
     """G: handwheel angle per road-wheel steer angle (186.47 / 8.3682 = 22.28)."""
     s = params.sections["steering"]
     return s["handwheel_to_rack_ratio"] / s["roadwheel_to_rack_ratio"]
@@ -122,12 +122,12 @@ def lifting_torque_a1(params: Parameters, case: str, steer_rad: float | np.ndarr
     wl, wr = c["load_left"], c["load_right"]
     delta = np.asarray(steer_rad, dtype=float)
     tau = d * ((wr - wl) * pm.sin(eps) * pm.cos(delta) + (wr + wl) * pm.cos(eps) * pm.sin(chi) * pm.sin(delta))
-    return tau / overall_steering_ratio(params)
+    return tau / steering_ratio(params)
 
 
 def lock_steer_angle(params: Parameters) -> float:
     """Road-wheel steer angle at full lock (rad)."""
-    return params["input.handwheel_lock_angle"] / overall_steering_ratio(params)
+    return params["input.handwheel_lock_angle"] / steering_ratio(params)
 
 
 def pinion_angle_from_column(column_angle_rad, joint_angle_rad: float, phase_rad: float) -> np.ndarray:
@@ -152,10 +152,32 @@ def rack_from_handwheel(handwheel_angle_rad, handwheel_torque_Nm, params: Parame
     rate is at most about 0.024 rad/s, at a reversal, where with c / k = 0.2 s the damper moves the rack by up to
     26 um), the Hooke joint turns the column angle into the pinion angle, and rack = theta_p /
     handwheel_to_rack_ratio. A diagnosis re-derives the rack with the damper
-    (:func:`parksteer.diagnose.problem.rack_from_angle`): at a reversal those 26 um decide the friction's flip.
+    (:func:`parksteer.measure.column.rack_from_angle`): at a reversal those 26 um decide the friction's flip.
     """
     s = params.sections["steering"]
     column = np.asarray(handwheel_angle_rad, dtype=float) - (
         np.asarray(handwheel_torque_Nm, dtype=float) / s["column_torsional_stiffness"])
     pinion = pinion_angle_from_column(column, s["hooke_joint_angle"], s["hooke_joint_phase"])
     return pinion / s["handwheel_to_rack_ratio"]
+
+
+def column_twist(t: np.ndarray, torque: np.ndarray, stiffness: float, damping: float
+                 ) -> tuple[np.ndarray, np.ndarray]:
+    """Twist (rad) and twist rate (rad/s) of the column from ``c dtwist/dt + k twist = T``, from rest at T(t[0]) / k.
+
+    Exact for a torque linear between the samples `t`. Without damping the twist is T / k.
+    """
+    if damping <= 0.0:
+        twist = torque / stiffness
+        return twist, np.gradient(twist, t)
+    tau = damping / stiffness
+    h = np.diff(t)
+    decay = pm.exp(-h / tau)
+    slope = np.diff(torque) / h
+    # x(t0 + h) = T1/k - tau s/k + (x0 - T0/k + tau s/k) e^(-h/tau), s the torque's slope over the interval
+    twist = np.empty(len(t))
+    twist[0] = torque[0] / stiffness
+    for k in range(len(h)):
+        lag = tau * slope[k] / stiffness
+        twist[k + 1] = torque[k + 1] / stiffness - lag + (twist[k] - torque[k] / stiffness + lag) * decay[k]
+    return twist, (torque - stiffness * twist) / damping

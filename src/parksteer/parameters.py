@@ -23,7 +23,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from .errors import UsageError
+from .errors import UsageError, cannot_read
 from .resources import data_file
 
 DEFAULT_PATH = data_file("parameters.toml")
@@ -499,7 +499,7 @@ def load_parameters(path: str | Path = DEFAULT_PATH) -> Parameters:
     try:
         raw = path.read_bytes()
     except OSError as exc:
-        raise ParameterError(f"{path}: cannot read ({exc.strerror})") from None
+        raise ParameterError(cannot_read(path, exc)) from None
     try:
         text = raw.decode("utf-8")
     except UnicodeDecodeError as exc:

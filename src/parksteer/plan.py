@@ -34,8 +34,8 @@ def rival_names(selection: list | None = None) -> list[str]:
 
 def case_file(folder: str, name: str, part: str) -> str:
     """The truth or diagnosis file of benchmark case `name` in its job's `folder`
-    (parksteer.diagnose.benchmark.case_files)."""
-    from .diagnose.benchmark import case_files
+    (parksteer.experiments.benchmark.case_files)."""
+    from .experiments.benchmark import case_files
 
     return str(case_files(folder, name)[{"truth": 1, "diagnosis": 2}[part]])
 
@@ -44,10 +44,10 @@ def diagnosis(config: dict, parameters_path: str, user_effect: str) -> dict:
     """What the diagnosis rules need of the configuration's car data set and its three benchmarks:
     candidate model specs by name, the car data set's files, and the case names (and rivals) of the hidden-effect,
     out-of-class, variation and signature benchmarks."""
-    from .diagnose.benchmark import case_names as bench_case_names
+    from .experiments.benchmark import case_names as bench_case_names
     from .diagnose.candidates import candidate_models
-    from .diagnose.outclass import case_names as outclass_case_names
-    from .diagnose.variations import VariationDesign, case_names as variation_case_names
+    from .experiments.outclass import case_names as outclass_case_names
+    from .experiments.variations import VariationDesign, case_names as variation_case_names
     from .figures.signature import case_names as signature_case_names, design_from_config as signature_design
     from .parameters import load_parameters
     from .synthetic.datasets import BenchmarkDesign, CarDesign, OutclassDesign, file_name
@@ -69,8 +69,8 @@ def diagnosis(config: dict, parameters_path: str, user_effect: str) -> dict:
 
 
 def assisted_cases() -> list[str]:
-    """The case names of the assisted benchmark (parksteer.diagnose.assisted_benchmark), in its order."""
-    from .diagnose.assisted_benchmark import case_names
+    """The case names of the assisted benchmark (parksteer.experiments.assisted_benchmark), in its order."""
+    from .experiments.assisted_benchmark import case_names
 
     return case_names()
 

@@ -38,7 +38,7 @@ import numpy as np
 from scipy.special import ellipe, ellipk
 
 from . import portable as pm
-from .errors import UsageError
+from .errors import UsageError, cannot_read
 from .parameters import Parameters
 
 # Below this R/e the far-field series is used: the elliptic form loses about
@@ -211,7 +211,7 @@ def read_printed_table1(path: str | Path) -> tuple[list[dict[str, str]], dict[st
     try:
         lines = path.read_text(encoding="utf-8").splitlines()
     except OSError as exc:
-        raise UsageError(f"{path}: cannot read ({exc.strerror})") from None
+        raise UsageError(cannot_read(path, exc)) from None
     header: dict[str, str] = {}
     body = []
     for line in lines:

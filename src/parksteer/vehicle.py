@@ -23,7 +23,7 @@ from pathlib import Path
 from typing import Any
 
 from . import portable as pm
-from .errors import UsageError
+from .errors import UsageError, cannot_read
 from .geometry import lock_steer_angle, steer_axis
 from .parameters import (
     CASE_SCHEMA,
@@ -121,7 +121,7 @@ def load_vehicle(path: str | Path, base: str | Path | Parameters = DEFAULT_PATH)
     try:
         text = path.read_text(encoding="utf-8")
     except OSError as exc:
-        raise ParameterError(f"{path}: cannot read ({exc.strerror})") from None
+        raise ParameterError(cannot_read(path, exc)) from None
     return vehicle_from_text(text, path, base)
 
 

@@ -19,13 +19,13 @@ import numpy as np
 import pytest
 
 from parksteer.cli import main
-from parksteer.diagnose.problem import rack_from_angle
-from parksteer.diagnose.variations import hidden_strength
+from parksteer.measure.column import rack_from_angle
+from parksteer.experiments.variations import hidden_strength
 from parksteer.geometry import rack_from_handwheel
 from parksteer.measure.io import Measurement, format_measurement
 from parksteer.model.numeric.simulate import simulate
 from parksteer.parameters import load_parameters
-from parksteer.synthetic.logger import quantisation_step
+from parksteer.measure.converter import quantisation_step
 from parksteer.synthetic.variations import variation_by_name, variation_rack, variation_record
 
 SEED = 1

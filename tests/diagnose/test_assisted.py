@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 from parksteer.cli import main
-from parksteer.diagnose.benchmark import BENCHMARK_SETTINGS
+from parksteer.experiments.benchmark import BENCHMARK_SETTINGS
 from parksteer.diagnose.problem import prepare_file
 from parksteer.diagnose.report import SCHEMA_PATH, diagnosis_dict
 from parksteer.diagnose.select import diagnose
@@ -120,7 +120,7 @@ def test_an_angle_only_record_gives_the_rack_through_the_torsion_bar(params, nam
     1 um over a 0.07 m stroke (2e-7 m found, column and pinion assist); taken through the shaft alone (the car
     without its assist's bar, k_c = 1000 N m/rad against the series 103 N m/rad) the rack is off by 1.5e-4 m, the
     bar's twist T / k_t through the ratio."""
-    from parksteer.diagnose.problem import rack_from_angle
+    from parksteer.measure.column import rack_from_angle
     from parksteer.measure.io import Measurement
     from parksteer.model.numeric.simulate import simulate
 
@@ -139,7 +139,7 @@ def test_the_assisted_benchmark_rows_come_back_in_the_design_order(tmp_path):
     read back in the order of the design's cases, whatever job ran each, so that the summary and the figure do not
     depend on how the cases were dealt; a case without a row, or with a row in two folders, is refused in one line
     naming it."""
-    from parksteer.diagnose.assisted_benchmark import ROW_SUFFIX, case_names, read_rows
+    from parksteer.experiments.assisted_benchmark import ROW_SUFFIX, case_names, read_rows
     from parksteer.errors import UsageError
 
     names = case_names()

@@ -5,13 +5,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from parksteer.diagnose.problem import relogged_rack
-from parksteer.diagnose.replay import _DIRECT, Replay
+from parksteer.diagnose.ensemble import relogged_rack
+from parksteer.diagnose.replay import Replay
 from parksteer.measure.smoothing import smooth_rack
 from parksteer.model.numeric.prescribed import solve
 from parksteer.model.numeric.simulate import prepare
 from parksteer.model.symbolic.components import resolve_effects
-from parksteer.synthetic.logger import add_noise, quantise, quantisation_step
+from parksteer.measure.converter import add_noise, quantise, quantisation_step
 
 FULL_SCALE_M = 0.1
 
@@ -102,7 +102,7 @@ def test_an_override_set_in_the_vector_replays_as_a_prepared_run(params):
         expected = solve(run, run.p, rack, t).torque_Nm
         assert np.max(np.abs(replay.torque({key: value}) - expected)) < 1e-9, key
     model = replay.parameter_vector()[0].model.directory.name
-    assert _DIRECT[(model, "steering.rack_friction_force")] and not _DIRECT[(model, "case.load_left")]
+    assert replay.direct[(model, "steering.rack_friction_force")] and not replay.direct[(model, "case.load_left")]
 
 
 def test_a_rack_friction_override_changes_the_torque_by_its_physical_share(params):

@@ -13,6 +13,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from parksteer.diagnose.engine import ReplayEngine
+from parksteer.diagnose.ensemble import with_replay_uncertainty
 from parksteer.diagnose.problem import Problem, prepare_file
 from parksteer.diagnose.replay import Replay
 from parksteer.diagnose.select import diagnose
@@ -42,10 +44,11 @@ def test_the_replay_uncertainty_covers_the_rack_splines_error_at_a_reversal(polo
     effects = resolve_effects(None)
     f = prepare_file(record, "kerb")
     assert len(f.rack.passing_spacings_s) > 1 and f.rack.passing_spacings_s[0] == f.rack.knot_spacing_s
-    problem = Problem([f], params).with_replay_uncertainty(effects, {})
+    engine = ReplayEngine()
+    problem = with_replay_uncertainty(engine, Problem([f], params), effects, {})
     f = problem.files[0]
     t = f.time_s
-    chosen = problem.signals(effects, 0)
+    chosen = engine.signals(problem, effects, 0)
     truth = Replay(effects, "kerb", "ground", params, variation_rack(params, hand), t).torque({})
     near = np.zeros(len(t), dtype=bool)
     for turn in f.rack.turning_times_s:

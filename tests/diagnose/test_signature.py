@@ -15,12 +15,14 @@ import pytest
 
 from parksteer import portable as pm
 from parksteer.cli import main
-from parksteer.diagnose.benchmark import BENCHMARK_SETTINGS
-from parksteer.diagnose.outoflibrary import SignatureCase, SignatureDesign, make_record, summarise
+from parksteer.experiments.benchmark import BENCHMARK_SETTINGS
+from parksteer.experiments.outoflibrary import SignatureCase, SignatureDesign, make_record, summarise
 from parksteer.diagnose.problem import load_files
-from parksteer.diagnose.report import diagnosis_dict, markdown_report, with_suggestion
+from parksteer.diagnose.report import diagnosis_dict, with_suggestion
+from parksteer.diagnose.pages import markdown_report
 from parksteer.diagnose.select import diagnose
-from parksteer.diagnose.signature import Axes, column_angle, signature_from_axes
+from parksteer.diagnose.signature import signature_from_axes
+from parksteer.diagnose.signature_axes import Axes, column_angle
 from parksteer.diagnose.suggest import suggest
 from parksteer.errors import UsageError
 from parksteer.measure.io import write_measurement

@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 from parksteer.errors import UsageError
-from parksteer.synthetic.logger import quantisation_step, quantise, resample
+from parksteer.measure.converter import quantisation_step, quantise
+from parksteer.synthetic.logger import resample
 from parksteer.measure.metrics import (
     compare,
     compare_measurement,

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from parksteer.errors import UsageError
-from parksteer.synthetic.logger import quantise
+from parksteer.measure.converter import quantise
 from parksteer.measure.phases import find_phases, local_linear_fit
 
 SPEED_M_S = 0.015  # rack speed at 2.8 rad/s of handwheel (about 15 mm/s)

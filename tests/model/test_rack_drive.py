@@ -10,7 +10,8 @@ from parksteer.cli import main
 from parksteer.errors import UsageError
 from parksteer.measure.io import read_measurement
 from parksteer.measure.smoothing import RackSpline, interpolate_rack
-from parksteer.model.numeric.prescribed import column_twist, solve
+from parksteer.geometry import column_twist
+from parksteer.model.numeric.prescribed import solve
 from parksteer.model.numeric.simulate import prepare, simulate, static_state
 from parksteer.tables import read_csv
 

@@ -8,15 +8,8 @@ import numpy as np
 import pytest
 
 from parksteer.errors import UsageError
-from parksteer.synthetic.logger import (
-    LoggerSettings,
-    add_noise,
-    degrade,
-    quantisation_step,
-    quantise,
-    resample,
-    synthetic_measurement,
-)
+from parksteer.measure.converter import add_noise, quantisation_step, quantise
+from parksteer.synthetic.logger import LoggerSettings, degrade, resample, synthetic_measurement
 
 FULL_SCALE = 25.0
 

@@ -12,7 +12,10 @@ measured racks adds no error of its own that its uncertainty estimate does not c
 import numpy as np
 import pytest
 
-from parksteer.diagnose.problem import Problem, fit_statistics, prepare_file
+from parksteer.diagnose.engine import ReplayEngine
+from parksteer.diagnose.ensemble import with_replay_uncertainty
+from parksteer.diagnose.problem import Problem, prepare_file
+from parksteer.diagnose.statistics import fit_statistics
 from parksteer.measure.smoothing import rest_intervals, smooth_rack
 from parksteer.model.symbolic.components import resolve_effects
 from parksteer.parameters import load_parameters
@@ -74,8 +77,9 @@ def test_independent_null_sits_at_the_noise_floor(name):
     record = variation_record(PARAMS, hand, logger)
     problem = Problem([prepare_file(record, "unladen", name)], PARAMS)
     effects = resolve_effects(None)
-    prediction = problem.predict(effects)
-    problem = problem.with_replay_uncertainty(effects)
+    engine = ReplayEngine()
+    prediction = engine.predict(problem, effects)
+    problem = with_replay_uncertainty(engine, problem, effects)
     stats = fit_statistics(problem, prediction)
     ratio = stats["weighted_rms_Nm"] / stats["noise_floor_Nm"]
     assert 0.9 < ratio < 1.12, ratio
@@ -90,7 +94,7 @@ def test_an_angle_channel_leaves_the_other_channels_alone_and_shows_a_lash_the_t
     ratio): the twist that passes the same torque is widened by the band on either flank."""
     from dataclasses import replace
 
-    from parksteer.synthetic.logger import quantisation_step
+    from parksteer.measure.converter import quantisation_step
     from parksteer.synthetic.variations import variation_by_name
 
     variation = variation_by_name("angle_channel")

@@ -1,4 +1,4 @@
-# Thin rule script: the logic is parksteer.diagnose.assisted_benchmark.run_batch (via
+# Thin rule script: the logic is parksteer.experiments.assisted_benchmark.run_batch (via
 # parksteer.figures.assisted.run_assisted_batch), once for the cases of the job.
 from parksteer.figures.assisted import run_assisted_batch
 from parksteer.rules import rule_log

@@ -1,5 +1,5 @@
-# Thin rule script: the logic is parksteer.diagnose.benchmark.run_case, once per case of the job (run_batch).
-from parksteer.diagnose.benchmark import run_batch, run_case
+# Thin rule script: the logic is parksteer.experiments.benchmark.run_case, once per case of the job (run_batch).
+from parksteer.experiments.benchmark import run_batch, run_case
 from parksteer.rules import rule_log
 from parksteer.synthetic.datasets import BenchmarkDesign
 

@@ -1,6 +1,6 @@
-# Thin rule script: the logic is parksteer.diagnose.outclass.run_case, once per case of the job (run_batch).
-from parksteer.diagnose.benchmark import run_batch
-from parksteer.diagnose.outclass import run_case
+# Thin rule script: the logic is parksteer.experiments.outclass.run_case, once per case of the job (run_batch).
+from parksteer.experiments.benchmark import run_batch
+from parksteer.experiments.outclass import run_case
 from parksteer.rules import rule_log
 from parksteer.synthetic.datasets import OutclassDesign
 

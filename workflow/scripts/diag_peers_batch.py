@@ -1,6 +1,6 @@
-# Thin rule script: the logic is parksteer.diagnose.peers.run_peer_batch, once per job of cases.
-from parksteer.diagnose.peers import run_peer_batch, tuning_design
-from parksteer.diagnose.variations import VariationDesign
+# Thin rule script: the logic is parksteer.experiments.peers.run_peer_batch, once per job of cases.
+from parksteer.experiments.peers import run_peer_batch, tuning_design
+from parksteer.experiments.variations import VariationDesign
 from parksteer.rules import rule_log
 
 with rule_log(snakemake):

@@ -1,6 +1,6 @@
-# Thin rule script: the logic is parksteer.diagnose.variations.run_case, once per case of the job (run_batch).
-from parksteer.diagnose.benchmark import run_batch
-from parksteer.diagnose.variations import VariationDesign, run_case
+# Thin rule script: the logic is parksteer.experiments.variations.run_case, once per case of the job (run_batch).
+from parksteer.experiments.benchmark import run_batch
+from parksteer.experiments.variations import VariationDesign, run_case
 from parksteer.rules import rule_log
 
 with rule_log(snakemake):

@@ -1,5 +1,5 @@
 # Thin rule script: the logic is parksteer.figures.diagnose.make_variations_figure.
-from parksteer.diagnose.variations import VariationDesign
+from parksteer.experiments.variations import VariationDesign
 from parksteer.figures.diagnose import make_variations_figure
 from parksteer.rules import rule_log
 

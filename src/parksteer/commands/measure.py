@@ -239,8 +239,9 @@ def _compare(args) -> int:
 
 def _diagnose(args) -> int:
     from ..diagnose.problem import load_files
-    from ..diagnose.report import diagnosis_dict, markdown_report, write_markdown
-    from ..diagnose.problem import ANGLE
+    from ..diagnose.report import diagnosis_dict
+    from ..diagnose.pages import markdown_report, write_markdown
+    from ..measure.importers import ANGLE
     from ..diagnose.select import diagnose
     from ..diagnose.settings import DEFAULT_SETTINGS
 
@@ -319,11 +320,12 @@ def _with_suggestion(args, result: dict, diagnosis, settings) -> dict:
 
 
 def _write_html(path: str, diagnosis, result: dict, files, params, workers: int = 1) -> None:
-    """The diagnosis and its error ladder as one self-contained HTML page (parksteer.diagnose.report.html_report)."""
+    """The diagnosis and its error ladder as one self-contained HTML page (parksteer.diagnose.pages.html_report)."""
     import tempfile
 
     from ..diagnose.ladder import error_ladder
-    from ..diagnose.report import html_report, phase_residuals, write_markdown
+    from ..diagnose.report import phase_residuals
+    from ..diagnose.pages import html_report, write_markdown
     from ..figures.diagnose import diagnosis_figure, ladder_figure, phase_residual_figure
 
     phases = phase_residuals(diagnosis)

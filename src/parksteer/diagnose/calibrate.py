@@ -35,7 +35,9 @@ from ..model.symbolic.components import Effect
 from ..model.symbolic.system import CORE_PARAMETERS
 from ..parameters import quantity
 from .settings import DEFAULT_SETTINGS, DiagnosisSettings
-from .problem import Problem, lag1_autocorrelation
+from .engine import ReplayEngine
+from .problem import Problem
+from .statistics import lag1_autocorrelation
 
 Z95 = 1.959964  # two-sided 95 % quantile of the standard normal
 
@@ -174,7 +176,7 @@ def block_sandwich(jacobian: np.ndarray, weighted: np.ndarray, problem: Problem,
 
 def replay_covariance(jacobian: np.ndarray, problem: Problem) -> np.ndarray:
     """Covariance of the fitted parameters from the replay's own uncertainty: each rack of the replay ensemble
-    (:meth:`parksteer.diagnose.problem.Problem.with_replay_uncertainty`) changes the replayed torque by its
+    (:func:`parksteer.diagnose.ensemble.with_replay_uncertainty`) changes the replayed torque by its
     deviation d from the ensemble mean, which a fit absorbs as the parameter shift (J^T J)^-1 J^T (d / sigma);
     the covariance of these shifts over the draws. Zero when the ensemble was not run."""
     k = jacobian.shape[1]
@@ -186,16 +188,16 @@ def replay_covariance(jacobian: np.ndarray, problem: Problem) -> np.ndarray:
     return pm.matmul(shifts, shifts.T) / (shifts.shape[1] - 1)
 
 
-def _predict(problem: Problem, effects: list[Effect], parameters: list[FitParameter], theta: np.ndarray,
-             fixed: dict[str, float]) -> tuple[list[np.ndarray], np.ndarray]:
+def _predict(engine: ReplayEngine, problem: Problem, effects: list[Effect], parameters: list[FitParameter],
+             theta: np.ndarray, fixed: dict[str, float]) -> tuple[list[np.ndarray], np.ndarray]:
     overrides = {**fixed, **{p.key: p.value(t) for p, t in zip(parameters, theta)}}
-    predictions = problem.predict(effects, overrides)
+    predictions = engine.predict(problem, effects, overrides)
     return predictions, problem.weighted(predictions)
 
 
-def finite_difference_jacobian(problem: Problem, effects: list[Effect], parameters: list[FitParameter],
-                               theta: np.ndarray, fixed: dict[str, float], predictions: list[np.ndarray]
-                               ) -> np.ndarray:
+def finite_difference_jacobian(engine: ReplayEngine, problem: Problem, effects: list[Effect],
+                               parameters: list[FitParameter], theta: np.ndarray, fixed: dict[str, float],
+                               predictions: list[np.ndarray]) -> np.ndarray:
     """d(model / sigma)/d(theta) by forward differences (a backward step at an upper bound)."""
     base = problem.scale(predictions)
     columns = []
@@ -205,13 +207,13 @@ def finite_difference_jacobian(problem: Problem, effects: list[Effect], paramete
             step = -step
         shifted = theta.copy()
         shifted[i] += step
-        moved, _ = _predict(problem, effects, parameters, shifted, fixed)
+        moved, _ = _predict(engine, problem, effects, parameters, shifted, fixed)
         columns.append((problem.scale(moved) - base) / step)
     return np.column_stack(columns) if columns else np.zeros((base.size, 0))
 
 
-def least_squares(problem: Problem, effects: list[Effect], parameters: list[FitParameter], theta0: np.ndarray,
-                  fixed: dict[str, float] | None = None, jacobian: np.ndarray | None = None,
+def least_squares(engine: ReplayEngine, problem: Problem, effects: list[Effect], parameters: list[FitParameter],
+                  theta0: np.ndarray, fixed: dict[str, float] | None = None, jacobian: np.ndarray | None = None,
                   max_iterations: int | None = None, tolerance: float | None = None,
                   settings: DiagnosisSettings = DEFAULT_SETTINGS) -> Fit:
     """Levenberg-Marquardt with Broyden updates (see the module docstring); `jacobian` may seed it.
@@ -221,17 +223,17 @@ def least_squares(problem: Problem, effects: list[Effect], parameters: list[FitP
     max_iterations = settings.calibration_max_iterations if max_iterations is None else max_iterations
     tolerance = settings.calibration_tolerance if tolerance is None else tolerance
     fixed = dict(fixed or {})
-    start_evaluations = problem.evaluations
+    start_evaluations = engine.evaluations
     lower = np.array([p.theta_bounds()[0] for p in parameters])
     upper = np.array([p.theta_bounds()[1] for p in parameters])
     theta = np.clip(np.asarray(theta0, dtype=float), lower, upper)
-    predictions, r = _predict(problem, effects, parameters, theta, fixed)
+    predictions, r = _predict(engine, problem, effects, parameters, theta, fixed)
     rss = pm.dot(r, r)
     history = [rss]
     if not parameters:
         return Fit(effects, parameters, theta, fixed, predictions, r, np.zeros((r.size, 0)), 0, 0, history)
     J = jacobian.copy() if jacobian is not None else finite_difference_jacobian(
-        problem, effects, parameters, theta, fixed, predictions)
+        engine, problem, effects, parameters, theta, fixed, predictions)
     theta_at_jacobian = theta.copy()
     damping = 1e-3
     iterations = 0
@@ -258,7 +260,7 @@ def least_squares(problem: Problem, effects: list[Effect], parameters: list[FitP
         step = trial - theta
         if not np.any(step):
             break
-        trial_predictions, trial_r = _predict(problem, effects, parameters, trial, fixed)
+        trial_predictions, trial_r = _predict(engine, problem, effects, parameters, trial, fixed)
         trial_rss = pm.dot(trial_r, trial_r)
         predicted = rss - float(np.sum((r - pm.matmul(J, step)) ** 2))
         # Broyden: the actual change of model / sigma is r - trial_r. A step much smaller than the standard
@@ -272,27 +274,27 @@ def least_squares(problem: Problem, effects: list[Effect], parameters: list[FitP
             damping = max(damping / 3.0, 1e-7)
             failures = 0
             if poor:  # the linear model promised much more than the step gave: renew it
-                J = finite_difference_jacobian(problem, effects, parameters, theta, fixed, predictions)
+                J = finite_difference_jacobian(engine, problem, effects, parameters, theta, fixed, predictions)
                 theta_at_jacobian = theta.copy()
         else:
             damping *= 4.0
             failures += 1
             if failures == 2:  # the updated Jacobian misleads: start again from finite differences
-                J = finite_difference_jacobian(problem, effects, parameters, theta, fixed, predictions)
+                J = finite_difference_jacobian(engine, problem, effects, parameters, theta, fixed, predictions)
                 theta_at_jacobian = theta.copy()
             elif failures > 3:
                 break
     if np.max(np.abs(theta - theta_at_jacobian)) > settings.jacobian_refresh_theta:
-        J = finite_difference_jacobian(problem, effects, parameters, theta, fixed, predictions)
+        J = finite_difference_jacobian(engine, problem, effects, parameters, theta, fixed, predictions)
     return Fit(effects, parameters, theta, fixed, predictions, r, J, iterations,
-               problem.evaluations - start_evaluations, history)
+               engine.evaluations - start_evaluations, history)
 
 
-def log_parameter(problem: Problem, effects: list[Effect], key: str,
+def log_parameter(engine: ReplayEngine, problem: Problem, effects: list[Effect], key: str,
                   settings: DiagnosisSettings = DEFAULT_SETTINGS) -> FitParameter:
     """A positive parameter fitted as log(value / default), within calibration_range_factor of the default."""
     spec = quantity(key)
-    default = problem.replay(effects, 0).value(key)
+    default = engine.replay(problem, effects, 0).value(key)
     factor = settings.calibration_range_factor
     return FitParameter(key, "log", default, max(spec.lower, default / factor), min(spec.upper, default * factor),
                         settings.calibration_relative_step)
@@ -304,7 +306,7 @@ def linear_parameter(effects: list[Effect], key: str, step: float) -> FitParamet
     return FitParameter(key, "linear", 1.0, max(spec.lower, 0.0), spec.upper, step)
 
 
-def calibration_parameters(problem: Problem, effects: list[Effect],
+def calibration_parameters(engine: ReplayEngine, problem: Problem, effects: list[Effect],
                            keys: tuple[str, ...] | None = None, strengths: dict[str, float] | None = None,
                            settings: DiagnosisSettings = DEFAULT_SETTINGS) -> list[FitParameter]:
     """The calibrated parameters the model has (an effect left out of the model leaves its keys out).
@@ -318,8 +320,8 @@ def calibration_parameters(problem: Problem, effects: list[Effect],
     else:
         used = _used_keys(effects)
         logs, offsets = [key for key in keys if key in used], []
-    out = [log_parameter(problem, effects, key, settings) for key in logs]
-    out += [offset_parameter(problem, effects, key, half_range, step) for key, half_range, step in offsets]
+    out = [log_parameter(engine, problem, effects, key, settings) for key in logs]
+    out += [offset_parameter(engine, problem, effects, key, half_range, step) for key, half_range, step in offsets]
     out += [linear_parameter(effects, key, step) for key, step in (strengths or {}).items()]
     return out
 
@@ -342,16 +344,16 @@ def calibrated_keys(effects: list[Effect], uses_angle: bool, settings: Diagnosis
     return logs, offsets
 
 
-def offset_parameter(problem: Problem, effects: list[Effect], key: str, half_range: float, step: float
-                     ) -> FitParameter:
+def offset_parameter(engine: ReplayEngine, problem: Problem, effects: list[Effect], key: str, half_range: float,
+                     step: float) -> FitParameter:
     """A parameter fitted as it stands within `half_range` of the model's value (an angle such as a phase)."""
     spec = quantity(key)
-    default = problem.replay(effects, 0).value(key)
+    default = engine.replay(problem, effects, 0).value(key)
     return FitParameter(key, "offset", default, max(spec.lower, default - half_range),
                         min(spec.upper, default + half_range), step)
 
 
-def calibrate(problem: Problem, effects: list[Effect], fixed: dict[str, float] | None = None,
+def calibrate(engine: ReplayEngine, problem: Problem, effects: list[Effect], fixed: dict[str, float] | None = None,
               keys: tuple[str, ...] | None = None, strengths: dict[str, float] | None = None,
               start: dict[str, float] | None = None, settings: DiagnosisSettings = DEFAULT_SETTINGS,
               announce=None) -> Fit:
@@ -360,11 +362,11 @@ def calibrate(problem: Problem, effects: list[Effect], fixed: dict[str, float] |
     From the model's defaults, or from the values in `start` where it has them. `announce`, if given, is called
     with the keys of the calibrated parameters (the base model's, and with a fitted angle the column's).
     """
-    parameters = calibration_parameters(problem, effects, keys, strengths, settings)
+    parameters = calibration_parameters(engine, problem, effects, keys, strengths, settings)
     if announce is not None:
         announce([p.key for p in parameters if p.key not in (strengths or {})])
     start = start or {}
     theta0 = np.array([p.theta(start[p.key]) if p.key in start else
                        {"log": 0.0, "offset": p.reference}.get(p.transform, p.lower)
                        for p in parameters])
-    return least_squares(problem, effects, parameters, theta0, fixed, settings=settings)
+    return least_squares(engine, problem, effects, parameters, theta0, fixed, settings=settings)

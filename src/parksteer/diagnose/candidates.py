@@ -46,6 +46,7 @@ from ..model.symbolic.components import (Effect, discover_effects, power_assist_
                                          strength_parameter)
 from .settings import DEFAULT_SETTINGS, DiagnosisSettings
 from .calibrate import Fit
+from .engine import ReplayEngine
 from .problem import Problem
 
 def candidate_effects(model_effects: list[Effect], registry: dict[str, Effect] | None = None
@@ -56,10 +57,10 @@ def candidate_effects(model_effects: list[Effect], registry: dict[str, Effect] |
     # An electrically assisted car's own candidates (motor friction, torsion-bar offset, gain error) join only its
     # diagnosis; a candidate whose slot an assist fills (the rack lash) cannot join an assisted car's model.
     assisted = power_assist_of(model_effects) is not None
-    electric = any(e.name.startswith("electric_assist_") for e in model_effects)
+    electric = any(e.power_assist == "electric" for e in model_effects)
     testable, untestable = [], []
     for name in sorted(registry):
-        wanted = registry[name].diagnosis_candidate or (electric and getattr(registry[name], "assist_candidate", False))
+        wanted = registry[name].diagnosis_candidate or (electric and registry[name].assist_candidate)
         if name in in_model or not wanted:
             continue
         slot = registry[name].replaces
@@ -157,17 +158,18 @@ def _rms_change(problem: Problem, a: list[np.ndarray], b: list[np.ndarray]) -> f
     return float(np.sqrt(np.mean(diff**2)))
 
 
-def probe_signature(problem: Problem, base_effects: list[Effect], candidate: Effect, overrides: dict[str, float],
-                    target_Nm: float, settings: DiagnosisSettings = DEFAULT_SETTINGS) -> Signature:
+def probe_signature(engine: ReplayEngine, problem: Problem, base_effects: list[Effect], candidate: Effect,
+                    overrides: dict[str, float], target_Nm: float, settings: DiagnosisSettings = DEFAULT_SETTINGS
+                    ) -> Signature:
     """The candidate's signature at a probe strength that changes the torque by about `target_Nm` RMS."""
     spec = strength_parameter(candidate)
     key = f"{candidate.name}.{spec.name}"
     effects = sorted([*base_effects, candidate], key=lambda e: e.name)
-    zero = problem.predict(effects, {**overrides, key: 0.0})
+    zero = engine.predict(problem, effects, {**overrides, key: 0.0})
     strength = max(spec.upper * settings.probe_start_fraction, 1e-12)
     probed, change = None, 0.0
     for _ in range(settings.probe_max_tries):
-        probed = problem.predict(effects, {**overrides, key: strength})
+        probed = engine.predict(problem, effects, {**overrides, key: strength})
         change = _rms_change(problem, probed, zero)
         if change > 0.0 and 0.5 <= change / target_Nm <= 2.0:
             break

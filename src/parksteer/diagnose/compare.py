@@ -20,7 +20,10 @@ from ..errors import UsageError
 from ..measure.metrics import Comparison, compare
 from ..model.symbolic.components import Effect, power_assist_of, resolve_effects
 from ..parameters import Parameters
-from .problem import FileData, Problem, fit_statistics
+from .engine import ReplayEngine
+from .ensemble import with_replay_uncertainty
+from .problem import FileData, Problem
+from .statistics import fit_statistics
 
 
 @dataclass
@@ -91,8 +94,9 @@ def compare_files(files: list[FileData], params: Parameters, effects=None,
     check_torque_sensors(files, assisted)
     problem = Problem([replace(f, uses_angle=False, uses_motor=assisted and f.motor is not None) for f in files],
                       params)
-    predictions = problem.predict(chosen, overrides)
-    problem = problem.with_replay_uncertainty(chosen, overrides)
+    engine = ReplayEngine()
+    predictions = engine.predict(problem, chosen, overrides)
+    problem = with_replay_uncertainty(engine, problem, chosen, overrides)
     files = list(problem.files)
     comparisons = [
         compare(f.time_s, f.torque_Nm, f.torque_part(m), phases=f.phases,

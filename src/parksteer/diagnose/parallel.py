@@ -23,10 +23,6 @@ from collections.abc import Callable, Sequence
 from typing import Any
 from ..progress import note
 
-_TASK: tuple[Callable[[Any], Any], Sequence[Any]] | None = None
-_IN_WORKER = False
-
-
 def available_workers() -> int:
     """The CPUs this process may run on (its affinity where the platform tells it)."""
     try:
@@ -39,32 +35,55 @@ def can_fork() -> bool:
     return "fork" in multiprocessing.get_all_start_methods()
 
 
-def mark_worker() -> None:
-    """Called in each worker as it starts: a worker runs every further map in line."""
-    global _IN_WORKER
-    _IN_WORKER = True
+def forks(count: int, workers: int) -> bool:
+    """Whether :func:`fork_map` of `count` items on `workers` workers runs in worker processes (never in a worker)."""
+    return min(workers, count) > 1 and not WORKER.serving and can_fork()
+
+
+class WorkerProcess:
+    """What a worker process serves: `serve(argument)` for each task it is sent.
+
+    The one piece of per-process state of the parallel replays, and it is written only in worker processes:
+    :func:`pool` forks its workers with `serve` (a closure over anything in the forking process, inherited, never
+    pickled) and the pool's initializer, :meth:`start`, keeps it on the worker's :data:`WORKER`, where
+    :func:`_serve` finds it for each task (multiprocessing sends a task's function by name, so the function a
+    worker runs needs a module-level home: this object). In the diagnosing process it stays empty, which is how
+    :func:`forks` tells a worker, which never forks again, from the process that forked it.
+    """
+
+    def __init__(self) -> None:
+        self.serve: Callable[[Any], Any] | None = None
+
+    def start(self, serve: Callable[[Any], Any]) -> None:
+        self.serve = serve
+
+    @property
+    def serving(self) -> bool:
+        return self.serve is not None
+
+
+WORKER = WorkerProcess()
 
 
 def in_worker() -> bool:
-    return _IN_WORKER
+    return WORKER.serving
 
 
-def forks(count: int, workers: int) -> bool:
-    """Whether :func:`fork_map` of `count` items on `workers` workers runs in worker processes."""
-    return min(workers, count) > 1 and not _IN_WORKER and can_fork()
+def _serve(argument):
+    return WORKER.serve(argument)
 
 
-def worker_pool(workers: int):
-    """A pool of `workers` processes forked from this one (close it when done), or None where it would not fork."""
+def pool(workers: int, serve: Callable[[Any], Any]):
+    """A pool of `workers` processes forked from this one, each serving `serve` (:class:`WorkerProcess`), or None
+    where it would not fork. Map items over it with :func:`pool_map`; close it when done."""
     if not forks(workers, workers):
         return None
-    return multiprocessing.get_context("fork").Pool(workers, initializer=mark_worker)
+    return multiprocessing.get_context("fork").Pool(workers, initializer=WORKER.start, initargs=(serve,))
 
 
-def _run(index: int):
-    mark_worker()
-    function, items = _TASK
-    return function(items[index])
+def pool_map(workers_pool, items: Sequence[Any]) -> list:
+    """``[serve(item) for item in items]`` on the workers of `workers_pool` (:func:`pool`), in order."""
+    return workers_pool.map(_serve, list(items), chunksize=1)
 
 
 def fork_map(function: Callable[[Any], Any], items: Sequence[Any], workers: int) -> list:
@@ -73,17 +92,15 @@ def fork_map(function: Callable[[Any], Any], items: Sequence[Any], workers: int)
     `function` may be a closure over anything in this process (it is inherited, never pickled); its
     results must pickle.
     """
-    global _TASK
     items = list(items)
     if not forks(len(items), workers):
         return [function(item) for item in items]
-    workers = min(workers, len(items))
-    _TASK = (function, items)
+    workers_pool = pool(min(workers, len(items)), lambda index: function(items[index]))
     try:
-        with multiprocessing.get_context("fork").Pool(workers) as pool:
-            return pool.map(_run, range(len(items)), chunksize=1)
+        return pool_map(workers_pool, range(len(items)))
     finally:
-        _TASK = None
+        workers_pool.close()
+        workers_pool.join()
 
 
 class Progress:

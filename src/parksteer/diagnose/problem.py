@@ -3,36 +3,17 @@
 Each file (:class:`FileData`) carries what its residuals need: the measured torque, the
 phases of its cycle (:mod:`parksteer.measure.phases`), its noise floor
 (:mod:`parksteer.measure.metrics`: quantisation step / sqrt(12) combined with the analog
-noise estimated from the data) and, in the files :meth:`Problem.with_replay_uncertainty` makes,
+noise estimated from the data) and, in the files
+:func:`parksteer.diagnose.ensemble.with_replay_uncertainty` makes,
 the replay's own uncertainty at every sample. A file is never changed: what a diagnosis derives for
 it (its replay uncertainty, its torque lag, whether its angle is fitted) goes into a new
 :class:`FileData` (``dataclasses.replace``), and into a new :class:`Problem` that holds it.
 
-The replay uncertainty is found by propagation, not assumed: the smoothed rack is one
-spline among many the rack data allow equally well. When the file states its logger (the
-rack's full scale and bits), the smoothed rack is logged again (analog noise, rounding to
-the converter's levels) and smoothed again, a few times
-(:func:`relogged_rack`, a parametric bootstrap of the
-whole logging and smoothing); otherwise splines are drawn from the least-squares
-distribution of the coefficients, as if the rack noise were white
-(:meth:`parksteer.measure.smoothing.SmoothedRack.perturbed`). The draws start from the rack smoothed at each
-knot spacing the data allow (:func:`ensemble_sources`), not from the chosen spline alone: at a reversal the
-spacing, not the data, sets how the spline eases through zero speed. Replaying them and taking the
-spread of the torque at each sample gives how far the replay alone can be off there (where the
-smoothing held an end of the record or a pause of the hand at rest, every other draw leaves
-them free: a record cut while the hand is still slowing passes the smoothing's rest test, the
-edges of a pause are not sharp, and the rack friction there hangs on that choice). It is tiny on the
-plateaus and large at a reversal, where the rack friction flips within about a millimetre
-per second of zero speed, so the turning time the data allow decides which sample carries
-the torque drop. Each sample then has an attainable error ``sigma_i = sqrt(noise_floor^2 +
-delta_i^2)``; residuals are weighted by it (``(measured - model) / sigma_i``), so a fit
-listens to the samples the replay can predict, and a perfect model has weighted residuals
-of unit variance.
+The replay uncertainty (:mod:`parksteer.diagnose.ensemble`) is found by propagation: the spread of replays of the
+racks the data allow equally well.
 
 A file with no rack channel (a car's own bus: handwheel angle and torque) is replayed from a rack derived from
-the angle through the model's column, its damper included (:func:`rack_from_angle`, which
-:func:`load_files` applies to every record whose importer derived its rack); its replay uncertainty comes from
-the angle channel's logger carried through the ratio (:func:`rack_logger`).
+the angle through the model's column (:mod:`parksteer.measure.column`, which :func:`load_files` reads through).
 
 A file with a handwheel angle beside a measured rack may be fitted on both signals
 (:attr:`FileData.uses_angle`, in the copies the diagnosis makes when its settings ask): each prediction is
@@ -46,31 +27,20 @@ on a linear column, a lash's whole band where the torque is that close to zero).
 
 from __future__ import annotations
 
-import math
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from scipy.ndimage import maximum_filter1d
 
-from .. import portable as pm
 from ..errors import UsageError, naming
-from ..geometry import pinion_angle_from_column
-from ..measure.importers import load_record
+from ..measure.column import load_measurements
+from ..measure.importers import ANGLE, TORQUE
 from ..measure.io import Measurement
 from ..measure.metrics import NoiseFloor, noise_floor
 from ..measure.phases import CyclePhases, find_phases
 from ..measure.smoothing import SmoothedRack, smooth_rack
-from ..model.numeric.prescribed import column_twist
-from ..model.symbolic.components import Effect
 from ..parameters import Parameters
-from ..synthetic.logger import add_noise, quantisation_step, quantise
-from .parallel import fork_map, forks, worker_pool
 from .settings import DEFAULT_SETTINGS
-from .replay import Replay
-
-TORQUE = "handwheel_torque_Nm"
-ANGLE = "handwheel_angle_rad"
 # An assisted car's motor channel (the second measured signal of its diagnosis), the current preferred.
 MOTOR_COLUMNS = ("motor_current_A", "motor_torque_Nm")
 
@@ -220,171 +190,43 @@ def prepare_file(measurement: Measurement, case: str | None = None, label: str |
 
 def load_files(paths: list[str | Path], params: Parameters, case: str | None = None, surface: str | None = None,
                channel_map=None, assist: str | None = None) -> list[FileData]:
-    """Read (through :func:`parksteer.measure.importers.load_record`), validate and prepare measurement files;
-    `case` replaces the case every file names, `surface` fills the surface a file does not state; `assist` (an
-    assisted car's effect) derives an angle-only record's rack through its torsion bar (:func:`rack_from_angle`)."""
-    if not paths:
-        raise UsageError("no measurement file given")
-    if case is not None:
-        params.case(case)  # one-line error for an unknown case
+    """Read and validate measurement files (:func:`parksteer.measure.column.load_measurements`, which says what
+    `case`, `surface`, `channel_map` and `assist` do) and prepare each (:func:`prepare_file`)."""
     files = []
-    for path in paths:
-        measurement = load_record(path, channel_map, case=case, surface=surface, params=params)
-        if surface is not None and measurement.surface != surface:
-            raise UsageError(f"{path}: the file says surface {measurement.surface!r} but --surface is {surface!r}; "
-                             "remove one")
-        chosen = case or measurement.case
-        stated = measurement.extra_offset_m
-        if stated is not None and abs(stated - params.case(chosen)["extra_offset"]) > 5e-4:
-            raise UsageError(
-                f"{path}: extra_offset_m = {stated:g} m but case {chosen} has "
-                f"{params.case(chosen)['extra_offset']:g} m; name the matching case (--case)"
-            )
-        resolution = 0.0
-        if "rack_derived" in measurement.metadata:
-            measurement = rack_from_angle(measurement, params, assist)
-            logger = rack_logger(measurement, params)
-            resolution = 0.0 if logger is None else quantisation_step(logger[0], logger[1])
+    for path, measurement, chosen, resolution in load_measurements(paths, params, case, surface, channel_map,
+                                                                   assist):
         with naming(path):
             files.append(prepare_file(measurement, chosen, rest_resolution_m=resolution))
     return files
 
 
-def rack_from_angle(measurement: Measurement, params: Parameters, assist: str | None = None) -> Measurement:
-    """A copy of an angle-only record (its rack derived by the importer) with the rack derived through the model's
-    column: the column angle is the handwheel angle less the twist that passes the measured torque through the
-    column's spring and damper, ``c dtwist/dt + k twist = T`` (:func:`parksteer.model.numeric.prescribed.column_twist`,
-    exact for a torque linear between samples, from the static twist T(0) / k at the first sample), the Hooke joint
-    turns it into the pinion angle (:func:`parksteer.geometry.pinion_angle_from_column`) and
-    rack = theta_p / handwheel_to_rack_ratio. This is the inverse of the replay's own handwheel angle
-    (:func:`parksteer.model.numeric.prescribed.solve`: column angle plus that twist).
-
-    The importer's static column law (:func:`parksteer.geometry.rack_from_handwheel`, twist T / k) leaves out the
-    damper: the twist lags the torque by c / k (0.2 s on the paper's car), and where the torque swings at a reversal
-    the static twist is off by (c / k) dtwist/dt, up to 4.8e-3 rad at the handwheel, a 26 um rack error, five times
-    the angle-derived rack's own noise (a 14-bit angle on +-16 rad: 1.05e-5 m steps). That error sits at the
-    reversals, where the rack friction flips, and made a null record unexplained. The torque's noise reaches the
-    rack through the twist only, divided by k and the ratio (0.1 N m: 5e-7 m) and low-passed by the damper.
-
-    Of an assisted car (`assist`, the effect's name), the torque is the torsion bar's and the bar is in series with
-    the column shaft: the twist is through their series stiffness k k_t / (k + k_t), with the damping that keeps
-    the column's time constant (as the assist's deflection law); a bar on the pinion (pinion, rack and hydraulic
-    gears) reads the column torque through the joint, T_s = T dtheta_c/dtheta_p.
-    """
-    s = params.sections["steering"]
-    columns = measurement.columns
-    stiffness, damping = s["column_torsional_stiffness"], s["column_torsional_damping"]
-    torque = columns[TORQUE]
-    if assist is not None:  # the torsion bar in series with the column shaft (assist_common.series_deflection)
-        bar = params[f"{assist}.torsion_bar_stiffness"]
-        series = stiffness * bar / (stiffness + bar)
-        stiffness, damping = series, damping * series / stiffness
-    twist, _ = column_twist(columns["time_s"], torque, stiffness, damping)
-    joint = (s["hooke_joint_angle"], s["hooke_joint_phase"])
-    pinion = pinion_angle_from_column(columns[ANGLE] - twist, *joint)
-    if assist is not None and not assist.endswith("_column"):
-        # the bar on the pinion reads T_s = T dtheta_c/dtheta_p: the column carries T_s dtheta_p/dtheta_c, the
-        # joint's speed ratio taken at the column angle of the first pass (it varies by 1e-4 over the twist)
-        column = columns[ANGLE] - twist
-        h = 1e-6
-        ratio = (pinion_angle_from_column(column + h, *joint) - pinion_angle_from_column(column - h, *joint)) / (2 * h)
-        twist, _ = column_twist(columns["time_s"], torque * ratio, stiffness, damping)
-        pinion = pinion_angle_from_column(columns[ANGLE] - twist, *joint)
-    metadata = dict(measurement.metadata)
-    metadata["rack_derived"] = (
-        f"from {ANGLE} and {TORQUE} through the model's column (parksteer.diagnose.problem.rack_from_angle): twist "
-        f"from c dtwist/dt + k twist = T with k {stiffness:g} N m/rad and c "
-        f"{damping:g} N m s/rad, Hooke joint angle {s['hooke_joint_angle']:g} rad and phase "
-        f"{s['hooke_joint_phase']:g} rad, ratio {s['handwheel_to_rack_ratio']:g} rad/m"
-        + (f"; the torsion bar of {assist} in series" if assist is not None else "")
-    )
-    return replace(measurement, columns={**columns, "rack_m": pinion / s["handwheel_to_rack_ratio"]},
-                   metadata=metadata)
-
-
-def effect_key(effects: list[Effect]) -> tuple[str, ...]:
-    return tuple(sorted(e.name for e in effects))
-
-
-@dataclass(eq=False)
-class ReplayCache:
-    """What every :class:`Problem` derived from one another shares: the replays made (one per effect set, file and
-    generation of replay instants, :meth:`Problem.with_files`), the count of solves run in worker processes, and
-    the worker pool. Each replay is made at its file's instants when first asked for in its generation."""
-
-    workers: int = 1
-    replays: dict = field(default_factory=dict)
-    extra_evaluations: int = 0  # replays run in worker processes
-    pool: object = None
-
-    @property
-    def evaluations(self) -> int:
-        return sum(r.evaluations for r in self.replays.values()) + self.extra_evaluations
-
-
 class Problem:
-    """Files and the models to replay them with; caches one :class:`Replay` per effect set and file.
+    """The files of a comparison or a diagnosis, the parameters and the one setting the replayed signals read.
 
-    With `workers` > 1 the files of a prediction are replayed side by side, on a pool of processes
-    forked once (:mod:`parksteer.diagnose.parallel`; :meth:`close` ends it), and the draws of the
-    replay ensemble likewise: the same numbers as in line.
-
-    A problem is not changed once made: :meth:`with_files` and :meth:`with_replay_uncertainty` make a new one
-    (the files derived), sharing the replay cache. `angle_offset_fitted` is the one setting it reads
-    (:meth:`signals`); the diagnosis's settings are owned by the diagnosis.
+    A problem is not changed once made: :meth:`with_files` makes a new one (the files derived). It replays
+    nothing itself: the replays, their counts and the worker processes are the replay engine's
+    (:class:`parksteer.diagnose.engine.ReplayEngine`). `angle_offset_fitted` is the setting the replayed angle
+    reads (:meth:`parksteer.diagnose.engine.ReplayEngine.signals`); `instants` numbers the generation of the files'
+    replay instants (a new one when a torque lag moves), so that the engine's replays are made again at the new
+    instants. The diagnosis's settings are owned by the diagnosis.
     """
 
-    def __init__(self, files, params: Parameters, workers: int = 1,
-                 angle_offset_fitted: bool = DEFAULT_SETTINGS.angle_offset_fitted, cache: ReplayCache | None = None,
-                 instants: int = 0):
+    def __init__(self, files, params: Parameters,
+                 angle_offset_fitted: bool = DEFAULT_SETTINGS.angle_offset_fitted, instants: int = 0):
         self.files: tuple[FileData, ...] = tuple(files)
         self.params = params
         self.angle_offset_fitted = angle_offset_fitted
-        self.cache = cache if cache is not None else ReplayCache(workers=max(int(workers), 1))
-        self.instants = instants  # which replays of the cache are this problem's (with_files)
+        self.instants = instants
 
     def with_files(self, files, new_instants: bool = False) -> Problem:
-        """The same problem on other files (derived from these: the same records, one per index), sharing the
-        replay cache.
+        """The same problem on other files (derived from these: the same records, one per index).
 
         With `new_instants` (a file's torque lag moved), the replays made so far are not this problem's: each is
         made again at the files' instants when first asked for (the solves already run stay counted). Without,
         the replays made so far are kept, at the instants they were made for: a lag moved by less than a search
         step keeps them (parksteer.diagnose.stages.torque_lag)."""
-        return Problem(files, self.params, angle_offset_fitted=self.angle_offset_fitted, cache=self.cache,
+        return Problem(files, self.params, angle_offset_fitted=self.angle_offset_fitted,
                        instants=self.instants + 1 if new_instants else self.instants)
-
-    @property
-    def workers(self) -> int:
-        return self.cache.workers
-
-    def replay(self, effects: list[Effect], index: int) -> Replay:
-        f = self.files[index]
-        key = (effect_key(effects), index, self.instants)
-        if key not in self.cache.replays:
-            self.cache.replays[key] = Replay(list(effects), f.case, f.surface, self.params, f.rack, f.replay_time_s)
-        return self.cache.replays[key]
-
-    @property
-    def evaluations(self) -> int:
-        return self.cache.evaluations
-
-    def count_extra(self, evaluations: int) -> None:
-        """Count replays run in worker processes (they are not in this process's cache)."""
-        self.cache.extra_evaluations += evaluations
-
-    @property
-    def parallel_files(self) -> bool:
-        """Whether predictions spread their files over the workers (else the callers spread candidates)."""
-        return len(self.files) > 1 and forks(len(self.files), self.workers)
-
-    def close(self) -> None:
-        """End the worker pool, if one was started; later predictions run in line."""
-        self.cache.workers = 1
-        if self.cache.pool is not None:
-            self.cache.pool.close()
-            self.cache.pool.join()
-            self.cache.pool = None
 
     @property
     def n(self) -> int:
@@ -394,40 +236,6 @@ class Problem:
     @property
     def uses_angle(self) -> bool:
         return any(f.uses_angle for f in self.files)
-
-    def signals(self, effects: list[Effect], index: int, overrides: dict[str, float] | None = None,
-                replay: Replay | None = None) -> np.ndarray:
-        """File `index`'s fitted signals replayed: the torque, and with an angle the handwheel angle after it.
-
-        The angle channel's zero is the sensor's, not the model's: with ``angle_offset_fitted`` the replayed
-        angle is shifted by the mean of the measured minus replayed angle (a constant fitted in closed form)."""
-        f = self.files[index]
-        replay = replay if replay is not None else self.replay(effects, index)
-        if f.uses_motor:  # an assisted car's torsion-bar torque and its motor's current or torque
-            solution = replay.solve(overrides)
-            motor = solution.motor_current_A if f.motor_column == "motor_current_A" else solution.motor_torque_Nm
-            return np.concatenate([solution.torque_Nm, motor])
-        if not f.uses_angle:
-            return replay.torque(overrides)
-        solution = replay.solve(overrides, outputs=True)
-        angle = solution.handwheel[:, 0]
-        if self.angle_offset_fitted:
-            angle = angle + float(np.mean(f.angle_rad - angle))
-        return np.concatenate([solution.torque_Nm, angle])
-
-    def predict(self, effects: list[Effect], overrides: dict[str, float] | None = None) -> list[np.ndarray]:
-        """Model torque at every file's samples (one array per file)."""
-        if self.parallel_files:
-            if self.cache.pool is None:
-                global _POOLED
-                _POOLED = self
-                self.cache.pool = worker_pool(self.workers)
-            if self.cache.pool is not None:
-                tasks = [(list(effects), i, overrides) for i in range(len(self.files))]
-                out = self.cache.pool.map(_pooled_torque, tasks, chunksize=1)
-                self.count_extra(len(tasks))
-                return out
-        return [self.signals(effects, i, overrides) for i in range(len(self.files))]
 
     def weighted(self, predictions: list[np.ndarray]) -> np.ndarray:
         """Weighted residuals (measured - model) / sigma_i of all files, concatenated."""
@@ -442,64 +250,6 @@ class Problem:
         of one angle floor counts as one torque floor (N m), so that torque and angle changes add up."""
         return np.concatenate([_in_torque_floors(f, v) for f, v in zip(self.files, values)])
 
-    def with_replay_uncertainty(self, effects: list[Effect], overrides: dict[str, float] | None = None,
-                                draws: int = DEFAULT_SETTINGS.replay_ensemble_draws,
-                                seed: int = DEFAULT_SETTINGS.replay_ensemble_seed, keep_larger: bool = False
-                                ) -> Problem:
-        """This problem on files with their replay uncertainty: the spread of replays of racks the data allow
-        (module docstring).
-
-        The spread is widened by one sample either side (a running maximum), since a torque
-        drop the draws place on one sample may fall on its neighbour. With `keep_larger`, each
-        sample keeps the larger of this and the uncertainty already estimated.
-        """
-        rng = np.random.default_rng(seed)
-        # The racks are drawn in line, in order (one random stream), then replayed side by side.
-        racks = []
-        for i, f in enumerate(self.files):
-            base = self.replay(effects, i)
-            base.parameter_vector(overrides)  # any run the overrides need is prepared once, here
-            logger = rack_logger(f.measurement, self.params)
-            # An end held at rest may be a hand still slowing there, and a pause's edges are not sharp
-            # (smoothing.RACK_REST_TEST_CHI2, RACK_REST_MIN_S): every other draw smooths with the ends and the
-            # pauses free, so the samples there carry that doubt.
-            released = any(f.rack.held_at_rest) or bool(f.rack.rest_intervals_s)
-            sources = ensemble_sources(f, draws, released)
-            for k in range(draws):
-                source, hold = sources[k]
-                if logger is not None:
-                    rack = relogged_rack(source, f.time_s, *logger, rng, hold_rest=hold)
-                else:
-                    rack = source.perturbed(rng)
-                racks.append((base, rack))
-            base.evaluations += draws
-        owners = [i for i in range(len(self.files)) for _ in range(draws)]
-        replayed = fork_map(lambda job: self.signals(effects, job[0], overrides, job[1][0].on_rack(job[1][1])),
-                            list(zip(owners, racks)), self.workers)
-        files = []
-        for i, f in enumerate(self.files):
-            runs = np.array(replayed[i * draws : (i + 1) * draws])
-            torque_runs = runs[:, : f.n]
-            f = replace(f, replay_draws_Nm=torque_runs - torque_runs.mean(axis=0),
-                        replay_uncertainty_Nm=_spread(torque_runs, f.replay_uncertainty_Nm if keep_larger else None))
-            if f.uses_angle:  # each draw's angle carries its own fitted zero (Problem.signals)
-                angle_runs = runs[:, f.n : 2 * f.n]
-                # The replayed torque is itself off by about its attainable error, and the twist that passes it by
-                # as much through the column's compliance (in a dead band: the band, where |T| is that small).
-                through_torque = self.replay(effects, i).twist_spread(f.sigma_Nm, overrides)
-                spread = pm.hypot(_spread(angle_runs, None), maximum_filter1d(through_torque, size=3, mode="nearest"))
-                before = f.replay_uncertainty_rad if keep_larger else None
-                f = replace(f, replay_draws_rad=angle_runs - angle_runs.mean(axis=0),
-                            replay_uncertainty_rad=spread if before is None else np.maximum(spread, before))
-            if f.uses_motor:
-                motor_runs = runs[:, f.m - f.n :]
-                before = f.replay_uncertainty_motor if keep_larger else None
-                f = replace(f, replay_draws_motor=motor_runs - motor_runs.mean(axis=0),
-                            replay_uncertainty_motor=_spread(motor_runs, before))
-            files.append(f)
-        return self.with_files(files)
-
-
 def _in_torque_floors(f: FileData, v: np.ndarray) -> np.ndarray:
     """`v` (a file's stacked signals) with the angle's and the motor's samples in torque floors per own floor."""
     if not (f.uses_angle or f.uses_motor):
@@ -512,179 +262,3 @@ def _in_torque_floors(f: FileData, v: np.ndarray) -> np.ndarray:
     return np.concatenate(parts)
 
 
-def _spread(runs: np.ndarray, before: np.ndarray | None) -> np.ndarray:
-    """The draws' standard deviation at each sample, widened by one sample either side; at least `before`."""
-    spread = maximum_filter1d(np.std(runs, axis=0, ddof=1), size=3, mode="nearest")
-    return spread if before is None else np.maximum(spread, before)
-
-
-_POOLED: Problem | None = None  # the problem a worker pool was forked from (Problem.predict)
-
-
-def _pooled_torque(task) -> np.ndarray:
-    effects, index, overrides = task
-    return _POOLED.signals(effects, index, overrides)
-
-
-def ensemble_sources(f: FileData, draws: int, released: bool) -> list[tuple[SmoothedRack, bool]]:
-    """The smoothed rack each draw of the replay ensemble is logged again from, and whether it holds rests.
-
-    The knot spacing is not fixed by the data: every spacing tried whose fit passes the discrepancy test
-    (:attr:`parksteer.measure.smoothing.SmoothedRack.passing_spacings_s`) fits the rack to within its noise, and
-    the smoothing keeps the coarsest only because the noise estimate cannot choose between them. Away from a
-    reversal they agree; at a reversal they do not, since there the rack stays within a converter step or its
-    noise for a tenth of a second or more, and how the spline eases into and out of the turn (which sets when
-    the speed passes the millimetre per second over which the rack friction turns over) is set by its knots, not
-    by the data. Redrawing the noise about one spline (the chosen one) measures that spline's variance but not
-    this choice: on a sound car's record at 50 Hz (the Polo, rate_8pc_50Hz) the chosen spline's replay was
-    1.3 N m off at the reversals where the draws spread by 0.08 N m, while replays of the other passing
-    spacings bracket the truth. So the draws are spread over the passing spacings, the chosen one first and the
-    finest last (evenly by index); with `released`, the draws come in pairs, the first of each pair held at rest
-    as the chosen spline is, the second with the ends and pauses free. A record whose chosen spacing is the
-    only one to pass draws as before.
-    """
-    spacings = f.rack.passing_spacings_s
-    pair = 2 if released else 1
-    slots = max(draws // pair, 1)
-    smoothed = {}
-
-    def at(spacing: float, hold: bool) -> SmoothedRack:
-        if hold and spacing == f.rack.knot_spacing_s:
-            return f.rack
-        if (spacing, hold) not in smoothed:
-            smoothed[spacing, hold] = smooth_rack(f.time_s, f.rack_m, spacing, hold_rest=hold,
-                                                  rest_resolution_m=f.rack.rest_resolution_m)
-        return smoothed[spacing, hold]
-
-    out = []
-    for k in range(draws):
-        slot = (k // pair) % slots
-        index = int(slot * (len(spacings) - 1) / (slots - 1) + 0.5) if slots > 1 else 0
-        hold = not (released and k % 2)
-        out.append((at(spacings[index], hold), hold))
-    return out
-
-
-def relogged_rack(rack: SmoothedRack, time_s: np.ndarray, full_scale: float, bits: int, analog_rms: float,
-                  rng: np.random.Generator, hold_rest: bool = True) -> SmoothedRack:
-    """A rack the logger could equally have recorded: `rack` at `time_s` with analog noise of `analog_rms`,
-    rounded to the levels of a `bits` converter over +-`full_scale`, and smoothed again
-    (:meth:`parksteer.measure.smoothing.SmoothedRack.resmoothed`)."""
-    return rack.resmoothed(time_s, lambda clean: quantise(add_noise(clean, analog_rms, rng), full_scale, bits),
-                           hold_rest)
-
-
-def rack_logger(measurement: Measurement, params: Parameters | None = None) -> tuple[float, int, float] | None:
-    """(full scale, bits, analog noise RMS) of the rack channel, if the file states its logger; else None.
-
-    The analog part is the rack's noise (from its second differences) less the rounding's
-    step / sqrt(12), root sum of squares, as :func:`parksteer.measure.metrics.noise_floor` splits it.
-
-    A rack derived from the handwheel angle (:func:`rack_from_angle`) has no logger of its own: its noise and
-    rounding are the angle channel's, carried through the column to the rack. So its logger is the angle's
-    (``full_scale_``/``bits_`` of the angle, the angle's analog noise from its own second differences), each
-    divided by handwheel_to_rack_ratio (`params`): the rack's levels are then the angle's steps over the ratio.
-    The Hooke joint scales that step by its local speed ratio, between cos(alpha) and 1 / cos(alpha) (0.90 to
-    1.11 at 0.45 rad), which the mean ratio leaves out; the torque's share through the twist (module docstring
-    of :func:`rack_from_angle`) is twenty times smaller and left out too. Without a stated angle logger, None.
-    """
-    if "rack_derived" in measurement.metadata:
-        if params is None or ANGLE not in measurement.columns:
-            return None
-        full_scale, bits = measurement.full_scale(ANGLE), measurement.bits(ANGLE)
-        if full_scale is None or bits is None:
-            return None
-        ratio = params.sections["steering"]["handwheel_to_rack_ratio"]
-        floor = noise_floor(measurement.columns[ANGLE], measurement.quantisation_step(ANGLE))
-        return full_scale / ratio, bits, floor.analog_rms / ratio
-    full_scale, bits = measurement.full_scale("rack_m"), measurement.bits("rack_m")
-    if full_scale is None or bits is None:
-        return None
-    floor = noise_floor(measurement.rack_m, measurement.quantisation_step("rack_m"))
-    return full_scale, bits, floor.analog_rms
-
-
-def fit_statistics(problem: Problem, predictions: list[np.ndarray]) -> dict:
-    """Plain and weighted RMS, the noise floor and the attainable floor over all files.
-
-    ``weighted_rms_Nm`` is sqrt(mean(r_i^2 floor_f^2)) with r_i the weighted residual and
-    floor_f the file's noise floor: it equals the noise floor for a perfect model, and
-    sqrt(floor^2 + e^2) for a model off by e where the replay is certain.
-    """
-    files = problem.files
-    residual = np.concatenate([f.torque_Nm - f.torque_part(m) for f, m in zip(files, predictions)])
-    weighted = problem.weighted(predictions)
-    is_torque = np.concatenate([np.arange(f.m) < f.n for f in files])
-    floors = np.concatenate([np.full(f.n, f.noise.total_rms) for f in files])
-    attainable = np.concatenate([f.sigma_Nm for f in files])
-    floor = float(np.sqrt(np.mean(floors**2)))
-    out = {
-        "rms_Nm": float(np.sqrt(np.mean(residual**2))),
-        "peak_Nm": float(np.max(np.abs(residual))),
-        "weighted_rms_Nm": float(np.sqrt(np.mean((weighted[is_torque] * floors) ** 2))),
-        "noise_floor_Nm": floor,
-        "attainable_floor_Nm": float(np.sqrt(np.mean(attainable**2))),
-        "weighted_rss": float(np.sum(weighted**2)),
-        "samples": int(weighted.size),
-    }
-    with_angle = [(f, m) for f, m in zip(files, predictions) if f.uses_angle]
-    if with_angle:  # the angle's residual beside the torque's (the same definitions, in rad and degrees)
-        angle = np.concatenate([f.angle_rad - f.angle_part(m) for f, m in with_angle])
-        angle_floors = np.concatenate([np.full(f.n, f.angle_noise.total_rms) for f, _ in with_angle])
-        angle_weighted = np.concatenate([(f.angle_rad - f.angle_part(m)) / f.sigma_rad for f, m in with_angle])
-        angle_attainable = np.concatenate([f.sigma_rad for f, _ in with_angle])
-        rms = float(np.sqrt(np.mean(angle**2)))
-        out["angle"] = {
-            "rms_rad": rms,
-            "rms_deg": math.degrees(rms),
-            "peak_rad": float(np.max(np.abs(angle))),
-            "weighted_rms_rad": float(np.sqrt(np.mean((angle_weighted * angle_floors) ** 2))),
-            "noise_floor_rad": float(np.sqrt(np.mean(angle_floors**2))),
-            "attainable_floor_rad": float(np.sqrt(np.mean(angle_attainable**2))),
-            "weighted_rss": float(np.sum(angle_weighted**2)),
-            "samples": int(angle.size),
-        }
-    with_motor = [(f, m) for f, m in zip(files, predictions) if f.uses_motor]
-    if with_motor:  # an assisted car's motor channel beside the torque (in its own unit, A or N m)
-        motor = np.concatenate([f.motor - f.motor_part(m) for f, m in with_motor])
-        motor_floors = np.concatenate([np.full(f.n, f.motor_noise.total_rms) for f, _ in with_motor])
-        motor_weighted = np.concatenate([(f.motor - f.motor_part(m)) / f.sigma_motor for f, m in with_motor])
-        out["motor"] = {
-            "column": with_motor[0][0].motor_column,
-            "rms": float(np.sqrt(np.mean(motor**2))),
-            "peak": float(np.max(np.abs(motor))),
-            "weighted_rms": float(np.sqrt(np.mean((motor_weighted * motor_floors) ** 2))),
-            "noise_floor": float(np.sqrt(np.mean(motor_floors**2))),
-            "weighted_rss": float(np.sum(motor_weighted**2)),
-            "samples": int(motor.size),
-        }
-    return out
-
-
-def pooled_lag1(segments) -> float:
-    """Lag-1 autocorrelation pooled over `segments` (arrays; pairs within a segment, each about its own mean)."""
-    num = den = 0.0
-    for r in segments:
-        r = r - r.mean()
-        num += float(np.sum(r[1:] * r[:-1]))
-        den += float(np.sum(r * r))
-    return num / den if den > 0 else 0.0
-
-
-def lag1_autocorrelation(problem: Problem, weighted: np.ndarray) -> float:
-    """Lag-1 autocorrelation of the weighted residuals, pooled over files (pairs within a file and signal)."""
-    bounds = np.cumsum([0] + [f.n for f in problem.files for _ in range(f.signals)])
-    return pooled_lag1(weighted[a:b] for a, b in zip(bounds[:-1], bounds[1:]))
-
-
-def effective_samples(n: int, rho: float) -> float:
-    """n (1 - rho) / (1 + rho) for AR(1)-like residuals, rho clipped to [0, 0.95]."""
-    rho = min(max(rho, 0.0), 0.95)
-    return max(n * (1.0 - rho) / (1.0 + rho), 2.0)
-
-
-def bic_gain(rss_without: float, rss_with: float, n_eff: float, parameters: int) -> float:
-    """The fall of the BIC over the effective sample size, ``BIC = n_eff ln(RSS / n) + k ln(n_eff)``, when
-    `parameters` more columns take the weighted residual sum of squares from `rss_without` to `rss_with`:
-    ``n_eff ln(rss_without / rss_with) - k ln(n_eff)`` (positive: the richer model is the better)."""
-    return n_eff * pm.log(rss_without / max(rss_with, 1e-300)) - parameters * pm.log(n_eff)

@@ -8,14 +8,13 @@ per override of a quantity that shapes them (a case value, the geometry), while 
 quantity that only enters the equations is written into a copy of the vector.
 
 A diagnosis replays most candidates in one compiled model, the diagnosis model
-(:func:`parksteer.diagnose.candidates.diagnosis_model`): inside :func:`replayed_in`, a replay of an effect set it
-maps is run on the compiled model of its host set, the other candidates there at their values, strength 0.
+(:func:`parksteer.diagnose.candidates.diagnosis_model`): the replay engine
+(:class:`parksteer.diagnose.engine.ReplayEngine`) makes a replay of an effect set it maps on the compiled model of
+its host set (`model_effects`), the other candidates there at their values, strength 0.
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterator
-from contextlib import contextmanager
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -23,6 +22,7 @@ import numpy as np
 from ..measure.smoothing import SmoothedRack
 from ..errors import UsageError
 from ..model.numeric.assisted import solve_assisted
+from ..model.numeric.compiled import CompiledModels
 from ..model.numeric.prescribed import PrescribedSolution, solve, twist_spread
 from ..model.numeric.simulate import PreparedRun, prepare
 from ..model.symbolic.components import Effect, power_assist_of
@@ -30,25 +30,6 @@ from ..parameters import Parameters, quantity
 
 # Prepared runs kept per replay: the base run and the latest others.
 KEPT_RUNS = 8
-# names of an effect set -> the effects of the compiled model its replays run on (replayed_in)
-_HOSTS: dict[tuple[str, ...], list[Effect]] = {}
-# (compiled model key, quantity key) -> whether the quantity only enters the equations (Replay._is_direct).
-_DIRECT: dict[tuple[str, str], bool] = {}
-
-
-@contextmanager
-def replayed_in(hosts: dict[tuple[str, ...], list[Effect]]) -> Iterator[None]:
-    """Within this block, a :class:`Replay` made of an effect set named in `hosts` (its effects' names, sorted)
-    runs on the compiled model of the host set mapped to it; each host's effects beyond the set must be absent at
-    their values in the parameters (:func:`parksteer.diagnose.candidates.shares_diagnosis_model`). Worker
-    processes forked inside inherit it."""
-    before = dict(_HOSTS)
-    _HOSTS.update(hosts)
-    try:
-        yield
-    finally:
-        _HOSTS.clear()
-        _HOSTS.update(before)
 
 
 @dataclass
@@ -74,15 +55,25 @@ class Replay:
     evaluations: int = 0
     # prepared runs to start from (another replay's of the same model, case and surface: :meth:`on_rack`)
     runs: dict[tuple, PreparedRun] | None = field(default=None, repr=False, compare=False)
-    # the effects of the compiled model it runs on: by default the set's own, or its host's (replayed_in)
+    # the effects of the compiled model it runs on: by default the set's own (a host's: ReplayEngine.new_replay)
     model_effects: list[Effect] | None = field(default=None, repr=False, compare=False)
+    # (compiled model, quantity key) -> whether the quantity only enters the equations (_is_direct), shared by the
+    # replays of one engine (ReplayEngine.direct); by default this replay's own
+    direct: dict[tuple[str, str], bool] | None = field(default=None, repr=False, compare=False)
+    # the compiled models it loads through, shared by the replays of one engine (ReplayEngine.models); by default
+    # this replay's own
+    models: CompiledModels | None = field(default=None, repr=False, compare=False)
 
     def __post_init__(self):
         self.time_s = np.asarray(self.time_s, dtype=float)
         self._runs: dict[tuple, PreparedRun] = dict(self.runs) if self.runs is not None else {}
         self.runs = None
         if self.model_effects is None:
-            self.model_effects = _HOSTS.get(tuple(sorted(e.name for e in self.effects)), self.effects)
+            self.model_effects = self.effects
+        if self.direct is None:
+            self.direct = {}
+        if self.models is None:
+            self.models = CompiledModels()
         self._base = self._prepared(self.base_overrides)
 
     def on_rack(self, rack: SmoothedRack) -> Replay:
@@ -97,14 +88,16 @@ class Replay:
 
     def _sharing(self, rack: SmoothedRack, time_s: np.ndarray) -> Replay:
         return Replay(self.effects, self.case, self.surface, self.params, rack, time_s, dict(self.base_overrides),
-                      runs=self._runs, model_effects=self.model_effects)
+                      runs=self._runs, model_effects=self.model_effects, direct=self.direct,
+                      models=self.models)
 
     def _prepared(self, overrides: dict[str, float]) -> PreparedRun:
         key = tuple(sorted(overrides.items()))
         if key not in self._runs:
             if len(self._runs) >= KEPT_RUNS:  # a fit moving a prepared quantity makes a new run at every step
                 del self._runs[next(k for k in self._runs if self._runs[k] is not self._base)]
-            self._runs[key] = prepare(self.case, self.model_effects, overrides, self.surface, self.params)
+            self._runs[key] = prepare(self.case, self.model_effects, overrides, self.surface, self.params,
+                                     models=self.models)
         return self._runs[key]
 
     def _is_direct(self, key: str, value: float) -> bool:
@@ -114,19 +107,20 @@ class Replay:
         """
         base = self._base
         known = (base.model.directory.name, key)
-        if known in _DIRECT:
-            return _DIRECT[known]
+        if known in self.direct:
+            return self.direct[known]
         names = base.model.info["parameters"]
         if key not in names or key.startswith("derived."):
-            _DIRECT[known] = False
+            self.direct[known] = False
             return False
         i = names.index(key)
         if value == base.p[i]:
             return True  # no change to test with, and none to make
         # Preparing with the new value also checks its bounds, once.
-        moved = prepare(self.case, self.model_effects, {**self.base_overrides, key: value}, self.surface, self.params).p
-        _DIRECT[known] = set(np.flatnonzero(moved != base.p).tolist()) <= {i}
-        return _DIRECT[known]
+        moved = prepare(self.case, self.model_effects, {**self.base_overrides, key: value}, self.surface, self.params,
+                        models=self.models).p
+        self.direct[known] = set(np.flatnonzero(moved != base.p).tolist()) <= {i}
+        return self.direct[known]
 
     def parameter_vector(self, overrides: dict[str, float] | None = None) -> tuple[PreparedRun, np.ndarray]:
         """The prepared run and the parameter vector of the base overrides with `overrides` on top."""

@@ -61,8 +61,8 @@ from ..parameters import Parameters
 from .candidates import candidate_effects, models_to_build, replay_models
 from .compare import check_torque_sensors
 from .parallel import Progress
+from .engine import ReplayEngine
 from .problem import FileData, Problem
-from .replay import replayed_in
 from .settings import DEFAULT_SETTINGS, DiagnosisSettings
 from .stages import STAGES, run_table
 from .state import Diagnosis, DiagnosisState, frozen_mapping
@@ -101,7 +101,7 @@ def diagnose(files: list[FileData], params: Parameters, effects=None, registry: 
                       replay_uncertainty_rad=None, replay_draws_rad=None,
                       uses_motor=assisted and settings.use_motor_channel and f.motor is not None,
                       replay_uncertainty_motor=None, replay_draws_motor=None) for f in files]
-    problem = Problem(copies, params, workers=workers, angle_offset_fitted=settings.angle_offset_fitted)
+    problem = Problem(copies, params, angle_offset_fitted=settings.angle_offset_fitted)
     progress = Progress(quiet)
     registry = registry if registry is not None else discover_effects()
     state = DiagnosisState(settings, problem, tuple(base), frozen_mapping(registry),
@@ -111,12 +111,12 @@ def diagnose(files: list[FileData], params: Parameters, effects=None, registry: 
     # The models the candidates replay in are built in the background while the base model's stages run (the base
     # model itself is built, if missing, when first replayed).
     builders = start_builds(models_to_build(base, testable, params)[1:], workers)
+    engine = ReplayEngine(workers, hosts=replay_models(base, testable, params))
     try:
-        with replayed_in(replay_models(base, testable, params)):
-            state = run_table(state)
+        state = run_table(state, engine)
     finally:
-        problem.close()
+        engine.close()
         finish_builds(builders)
     progress(f"verdict: {state.verdict}" + (f" {state.best}" if state.verdict == "missing" else "")
-             + f" ({state.problem.evaluations} replays)")
-    return state.result()
+             + f" ({engine.evaluations} replays)")
+    return state.result(engine.evaluations)

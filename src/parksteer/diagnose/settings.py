@@ -192,13 +192,13 @@ class DiagnosisSettings:
     # model under every load case and surface the data lack, and the one where it would still show is named
     # (parksteer.diagnose.stages.confound). On one file with four confounded candidates that is nine conditions of
     # five models replayed. The diagnosis benchmarks, which score verdicts, names and intervals (none of which this
-    # changes), leave it off (parksteer.diagnose.benchmark.BENCHMARK_SETTINGS).
+    # changes), leave it off (parksteer.experiments.benchmark.BENCHMARK_SETTINGS).
     confound_tests: bool = True
 
     # --- the residual's signature (parksteer.diagnose.stages.signature) ---------------------------------------
     # What kind of effect the calibrated model lacks, read off its residual beside any verdict (about 0.2 s a
     # record). The diagnosis benchmarks, which score verdicts, names and intervals (none of which it changes),
-    # leave it off (parksteer.diagnose.benchmark.BENCHMARK_SETTINGS).
+    # leave it off (parksteer.experiments.benchmark.BENCHMARK_SETTINGS).
     residual_signature: bool = True
     signature: SignatureSettings = SignatureSettings()
 

@@ -17,7 +17,8 @@ import numpy as np
 from ..model.symbolic.components import Effect
 from .calibrate import Fit
 from .candidates import Score, Signature
-from .problem import Problem, fit_statistics
+from .problem import Problem
+from .statistics import fit_statistics
 from .settings import DEFAULT_SETTINGS, DiagnosisSettings
 
 VERDICTS = ("missing", "adequate", "unexplained")
@@ -133,17 +134,18 @@ class DiagnosisState:
     def with_timing(self, name: str, seconds: float) -> DiagnosisState:
         return replace(self, timings_s=frozen_mapping({**self.timings_s, name: seconds}))
 
-    def with_cost(self, name: str, seconds: float) -> DiagnosisState:
-        """This state with stage `name`'s time and the replays run so far when it ended (the count, unlike the
+    def with_cost(self, name: str, seconds: float, replays: int) -> DiagnosisState:
+        """This state with stage `name`'s time and the `replays` run so far when it ended (the count, unlike the
         time, is the same on any machine)."""
         return replace(self.with_timing(name, seconds),
-                       replays_by_stage=frozen_mapping({**self.replays_by_stage, name: self.problem.evaluations}))
+                       replays_by_stage=frozen_mapping({**self.replays_by_stage, name: replays}))
 
-    def result(self) -> Diagnosis:
+    def result(self, replays: int) -> Diagnosis:
+        """What the diagnosis found, with the count of `replays` it ran (the replay engine's)."""
         return Diagnosis(self.problem, self.base, self.nominal, self.calibration, self.candidates, self.untestable,
                          self.verdict, self.best_candidate, self.indistinguishable, self.n_eff, self.rho,
                          self.explained_fraction, self.timings_s, self.settings, self.identification,
-                         self.confound_tests, self.outputs, self.replays_by_stage)
+                         self.confound_tests, self.outputs, self.replays_by_stage, replays)
 
 
 @dataclass(frozen=True)
@@ -170,6 +172,7 @@ class Diagnosis:
     confound_tests: Mapping[str, dict | None] = field(default_factory=frozen_mapping)
     outputs: Mapping[str, object] = field(default_factory=frozen_mapping)  # what added stages keep, by name
     replays_by_stage: Mapping[str, int] = field(default_factory=frozen_mapping)  # replays run when each stage ended
+    replays: int = 0  # every replay the diagnosis ran
 
     @property
     def effect(self) -> str | None:

@@ -34,7 +34,9 @@ import numpy as np
 from ..errors import UsageError
 from ..model.symbolic.components import load_effect_module
 from .calibrate import Fit, FitParameter, calibration_parameters, least_squares
-from .problem import Problem, bic_gain, effective_samples, fit_statistics, lag1_autocorrelation
+from .engine import ReplayEngine
+from .problem import Problem
+from .statistics import bic_gain, effective_samples, fit_statistics, lag1_autocorrelation
 from .settings import DEFAULT_SETTINGS, DiagnosisSettings
 from .signature import Signature
 
@@ -190,7 +192,8 @@ def strength_keys(source: str) -> tuple[str, ...]:
 def suggest(problem: Problem, calibration: Fit, signature: Signature, path: str | Path | None = None,
             settings: DiagnosisSettings = DEFAULT_SETTINGS) -> Suggestion:
     """Write the effect `signature` points to, fit its strengths with the calibrated parameters on `problem`, and
-    write it again with the fitted values beside the zero defaults (to `path`, or a temporary file)."""
+    write it again with the fitted values beside the zero defaults (to `path`, or a temporary file). Its replays
+    run on a replay engine of its own, in line."""
     speed_90 = signature.numbers.get("speed_90_m_s")
     if signature.effect_class == "speed" and speed_90 is None:
         speed_90 = float(np.quantile(np.abs(np.concatenate([f.rack.evaluate(f.replay_time_s)[1]
@@ -213,10 +216,11 @@ def suggest(problem: Problem, calibration: Fit, signature: Signature, path: str 
         column = signature.effect_class == "column"
         bound = TORQUE_BOUND_NM if column else FORCE_BOUND_N
         step = floor if column else floor * ratio  # a strength moving the torque by about a noise floor
-        parameters = calibration_parameters(problem, model, settings=settings)
+        engine = ReplayEngine()
+        parameters = calibration_parameters(engine, problem, model, settings=settings)
         parameters += [FitParameter(key, "linear", 1.0, -bound, bound, step) for key in keys]
         theta0 = np.concatenate([calibration.theta, np.zeros(len(keys))])
-        fit = least_squares(problem, model, parameters, theta0, calibration.fixed, settings=settings)
+        fit = least_squares(engine, problem, model, parameters, theta0, calibration.fixed, settings=settings)
         after = fit_statistics(problem, fit.predictions)
         rho = lag1_autocorrelation(problem, fit.weighted)
         n_eff = effective_samples(problem.n, rho)

@@ -41,13 +41,13 @@ import numpy as np
 from ..model.numeric.simulate import SimulationResult, simulate
 from ..model.symbolic.components import discover_effects
 from ..parameters import Parameters, load_parameters
+from ..sweep.assist_sizing import SPEEDS_KMH
 from ..tables import write_csv, write_json
 from ..vehicle import ASSIST_EFFECTS, ASSISTED_EFFECTS, CREEPING_EFFECTS, creeping_overrides
 from .model import OFFSET_CASES, _at, _times, plateau_mask, until_hand_stops
 
 CASE = "unladen"
 ASSISTS = ("column", "hydraulic")  # the kinds studied besides the car without assistance
-SPEEDS_KMH = (0.0, 1.0, 3.0, 5.0)
 # The assumed values the paper quotes, by assist kind (each effect's own quantities, with their sources).
 QUOTED = {
     "column": ("gain", "dead_band", "torsion_bar_stiffness", "reduction_ratio", "efficiency", "motor_torque_limit",

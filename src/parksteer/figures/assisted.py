@@ -1,4 +1,4 @@
-"""figures/diag_assisted: the assisted benchmark (:mod:`parksteer.diagnose.assisted_benchmark`) scored and drawn."""
+"""figures/diag_assisted: the assisted benchmark (:mod:`parksteer.experiments.assisted_benchmark`) scored and drawn."""
 
 from __future__ import annotations
 
@@ -19,7 +19,7 @@ def assisted_figure(rows: list[dict], summary: dict, path: str | Path) -> None:
     Right: each record's calibrated weighted error in noise floors (nulls, hidden, out of class) against the
     diagnosis's adequate_rms_factor."""
     from ..diagnose.settings import DEFAULT_SETTINGS
-    from ..diagnose.variations import NAMED_TARGET, NULL_ADEQUATE_TARGET
+    from ..experiments.variations import NAMED_TARGET, NULL_ADEQUATE_TARGET
 
     cells = [(LABELS.get(h, h), k, n, NAMED_TARGET) for h, (k, n) in summary["named_by_hidden"].items()]
     targets = summary["targets"]
@@ -69,8 +69,8 @@ def _assisted_params(parameters: str | Path, vehicle: str | Path):
 
 def run_assisted_batch(parameters: str | Path, vehicle: str | Path, names: list[str], folder: str | Path) -> None:
     """Run the assisted benchmark's cases `names` on `vehicle` (its [assist]) over `parameters`, each one's row
-    into `folder` (parksteer.diagnose.assisted_benchmark.run_batch): one job of rule diag_assisted_batch."""
-    from ..diagnose.assisted_benchmark import run_batch
+    into `folder` (parksteer.experiments.assisted_benchmark.run_batch): one job of rule diag_assisted_batch."""
+    from ..experiments.assisted_benchmark import run_batch
 
     run_batch(_assisted_params(parameters, vehicle), names, folder)
 
@@ -80,7 +80,7 @@ def make_assisted_figure(parameters: str | Path, vehicle: str | Path, svg: str |
     """Run the assisted benchmark on `vehicle` (its [assist]) over `parameters` in this process, write
     figures/diag_assisted.svg, its CSV (one row per record) and results/diag_assisted.json (the targets and the
     misses), without machine times."""
-    from ..diagnose.assisted_benchmark import AssistedDesign, run
+    from ..experiments.assisted_benchmark import AssistedDesign, run
 
     rows, summary = run(_assisted_params(parameters, vehicle), AssistedDesign(), progress=progress)
     return _write_outputs(rows, summary, vehicle, svg, csv, json_path)
@@ -90,7 +90,7 @@ def gather_assisted_figure(batches, names: list[str], vehicle: str | Path, svg: 
                            json_path: str | Path) -> dict:
     """make_assisted_figure's files from the rows the jobs of rule diag_assisted_batch wrote into the folders
     `batches` (run_assisted_batch), the cases `names` in the design's order: the same bytes."""
-    from ..diagnose.assisted_benchmark import read_rows, summarise
+    from ..experiments.assisted_benchmark import read_rows, summarise
 
     rows = read_rows(batches, list(names))
     return _write_outputs(rows, summarise(rows), vehicle, svg, csv, json_path)

@@ -252,9 +252,9 @@ def benchmark_figure(rows: list, summary: dict, path: str | Path) -> None:
 def make_benchmark_figure(truth_paths, diagnosis_paths, svg: str | Path, csv: str | Path, json_path: str | Path,
                           design=None) -> dict:
     """figures/diag_benchmark.svg (confusion matrix, accuracy against strength), its CSV, results JSON."""
-    from ..diagnose.benchmark import aggregate
+    from ..experiments.benchmark import aggregate
     from ..diagnose.report import MACHINE_TIME_KEYS, without_machine_times
-    from ..diagnose.rows import csv_columns
+    from ..experiments.rows import csv_columns
     from ..tables import write_csv, write_json
 
     rows, summary = aggregate(truth_paths, diagnosis_paths, design)
@@ -347,9 +347,9 @@ def _cell(x: float, y: float, colour: str):
 def make_outclass_figure(truth_paths, diagnosis_paths, svg: str | Path, csv: str | Path, json_path: str | Path,
                          design=None) -> dict:
     """figures/diag_outclass.svg (the out-of-class confusion table), its CSV (one row per data set), results JSON."""
-    from ..diagnose.outclass import aggregate
+    from ..experiments.outclass import aggregate
     from ..diagnose.report import MACHINE_TIME_KEYS, without_machine_times
-    from ..diagnose.rows import csv_columns
+    from ..experiments.rows import csv_columns
     from ..tables import write_csv, write_json
 
     rows, summary = aggregate(truth_paths, diagnosis_paths, design)
@@ -376,7 +376,7 @@ def variations_figure(rows: list[dict], summary: dict, path: str | Path) -> None
     Right: each null record's calibrated weighted error in noise floors (circles) and each named record's error
     with the named effect (triangles), against the diagnosis's adequate_rms_factor and missing_rms_ceiling."""
     from ..diagnose.settings import DEFAULT_SETTINGS
-    from ..diagnose.variations import COVERAGE_TARGET, NAMED_TARGET, NULL_ADEQUATE_TARGET
+    from ..experiments.variations import COVERAGE_TARGET, NAMED_TARGET, NULL_ADEQUATE_TARGET
 
     table = summary["variations"]
     labels = [v["variation"].replace("_", " ") for v in table] + ["all"]
@@ -426,8 +426,8 @@ def make_variations_figure(truth_paths, diagnosis_paths, svg: str | Path, csv: s
     """figures/diag_variations.svg (targets per variation, errors against the thresholds), its CSV (one row per
     record) and results/diag_variations.json (the per-variation table and the targets)."""
     from ..diagnose.report import MACHINE_TIME_KEYS, without_machine_times
-    from ..diagnose.rows import csv_columns
-    from ..diagnose.variations import aggregate
+    from ..experiments.rows import csv_columns
+    from ..experiments.variations import aggregate
     from ..tables import write_csv, write_json
 
     rows, summary = aggregate(truth_paths, diagnosis_paths, design)

@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import portable as pm
-from ..geometry import lifting_torque_a1, lock_steer_angle, overall_steering_ratio, steer_axis
+from ..geometry import lifting_torque_a1, lock_steer_angle, steering_ratio, steer_axis
 from ..parameters import Parameters, load_parameters
 from ..plotting import COLOURS, new_figure, save_svg
 from ..tables import write_csv, write_json
@@ -39,7 +39,7 @@ def first_term_a1_Nm(params: Parameters, case: str, steer_rad: float | np.ndarra
     d_m = steer_axis(params, case, "left").offset_d_m
     castor_rad = params["geometry.castor_angle"]
     load_difference_N = c["load_right"] - c["load_left"]
-    return d_m * load_difference_N * pm.sin(castor_rad) * pm.cos(steer_rad) / overall_steering_ratio(params)
+    return d_m * load_difference_N * pm.sin(castor_rad) * pm.cos(steer_rad) / steering_ratio(params)
 
 
 def lifting_curves(params: Parameters, cases: tuple[str, ...] = FIGA3_CASES, n_points: int = N_POINTS) -> dict:
@@ -78,7 +78,7 @@ def lifting_summary(params: Parameters, cases: tuple[str, ...] = FIGA3_CASES) ->
         "lock_steer_rad": lock_rad,
         "lock_rack_m": lock_rad / params["steering.roadwheel_to_rack_ratio"],
         "lock_handwheel_rad": params["input.handwheel_lock_angle"],
-        "steering_ratio": overall_steering_ratio(params),
+        "steering_ratio": steering_ratio(params),
         "castor_angle_rad": params["geometry.castor_angle"],
         "kingpin_inclination_rad": params["geometry.kingpin_inclination"],
     }

@@ -1,6 +1,6 @@
 """The diagnosis against its peers (figures/diag_peers.svg, .csv, results/diag_peers.json).
 
-The numbers are :func:`parksteer.diagnose.peers.compare`'s: each method on the variation and out-of-class
+The numbers are :func:`parksteer.experiments.peers.compare`'s: each method on the variation and out-of-class
 benchmarks' records, the peers at the setting tuned on records of another seed. Machine times stay out of the
 SVG, the CSV and the key numbers (JSON), which are the same on any machine; the paper quotes model replays, and
 benchmarks/bench_peers.py prints the times.
@@ -51,7 +51,7 @@ def peers_figure(comparison: dict, svg: str | Path) -> None:
 
 def make_peers_figure(peer_paths, svg: str | Path, csv: str | Path, json_path: str | Path) -> dict:
     """figures/diag_peers.svg and .csv (one row per method) and results/diag_peers.json (the comparison)."""
-    from ..diagnose.peers import compare, read_cases
+    from ..experiments.peers import compare, read_cases
     from ..diagnose.report import without_machine_times
     from ..tables import write_csv, write_json
 

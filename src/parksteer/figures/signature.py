@@ -1,15 +1,15 @@
 """The signature benchmark in the pipeline: out-of-library records diagnosed, the residual's signature and the
 suggested effect scored per signature class (figures/diag_signature, results/diag_signature.json).
 
-The records and their diagnoses are :mod:`parksteer.diagnose.outoflibrary`'s (its default grid:
-:class:`~parksteer.diagnose.outoflibrary.SignatureDesign`). :func:`run_case` adapts its ``run_case`` to the
-benchmark jobs' interface (:func:`parksteer.diagnose.benchmark.run_batch`): each case's truth and its scored row go
+The records and their diagnoses are :mod:`parksteer.experiments.outoflibrary`'s (its default grid:
+:class:`~parksteer.experiments.outoflibrary.SignatureDesign`). :func:`run_case` adapts its ``run_case`` to the
+benchmark jobs' interface (:func:`parksteer.experiments.benchmark.run_batch`): each case's truth and its scored row go
 to their own files, the row's wall times under ``timings_s`` (a machine time, kept out of the figure, its table
 and the paper). :func:`aggregate` scores the rows again from their numbers alone:
 
 - the class is right when the class the signature named is the truth form's class;
 - a suggestion is *within* when the weighted error with the suggested effect, fitted with the calibrated
-  parameters, is at most :data:`~parksteer.diagnose.outoflibrary.AFTER_LIMIT` noise floors;
+  parameters, is at most :data:`~parksteer.experiments.outoflibrary.AFTER_LIMIT` noise floors;
 - a null fails when the diagnosis would write a suggestion for it (an ``unexplained`` verdict with a class).
 
 Every number written is the diagnosis's (portable arithmetic) or a count; the likelihood-ratio p-values of the
@@ -24,7 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..diagnose.outoflibrary import AFTER_LIMIT, CLASS_TARGET, SUGGESTION_TARGET, SignatureDesign
+from ..experiments.outoflibrary import AFTER_LIMIT, CLASS_TARGET, SUGGESTION_TARGET, SignatureDesign
 from ..diagnose.signature import CLASSES
 from ..errors import UsageError
 from ..plotting import COLOURS, new_figure, save_svg
@@ -54,7 +54,7 @@ def design_dict(design: SignatureDesign) -> dict:
 
 def method_dict() -> dict:
     """The signature's bases and thresholds as the benchmark's diagnoses use them (the paper quotes them)."""
-    from ..diagnose.benchmark import BENCHMARK_SETTINGS
+    from ..experiments.benchmark import BENCHMARK_SETTINGS
 
     sig = BENCHMARK_SETTINGS.signature
     return {"position_knots": list(sig.position_knots), "speed_knots": sig.speed_knots,
@@ -77,9 +77,9 @@ def case_names(design: SignatureDesign) -> list[str]:
 
 def run_case(parameters_path: str | Path, design: SignatureDesign, name: str, folder: str | Path,
              truth_path: str | Path, row_path: str | Path) -> dict:
-    """Make, write, diagnose and score case `name` (:func:`parksteer.diagnose.outoflibrary.run_case`); write its
+    """Make, write, diagnose and score case `name` (:func:`parksteer.experiments.outoflibrary.run_case`); write its
     truth and its row (the wall times under ``timings_s``)."""
-    from ..diagnose.outoflibrary import run_case as run_one
+    from ..experiments.outoflibrary import run_case as run_one
     from ..parameters import load_parameters
     from ..tables import write_json
 

@@ -37,7 +37,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import portable as pm
-from ..errors import UsageError
+from ..errors import UsageError, cannot_read
 from ..geometry import rack_from_handwheel
 from ..parameters import Parameters, load_parameters
 from .io import ALLOWED_COLUMNS, REQUIRED_COLUMNS, UNITS, Measurement, metadata_text, validate_record
@@ -190,7 +190,7 @@ def read_channel_map(path: str | Path) -> list[Channel]:
     try:
         text = path.read_bytes().decode("utf-8-sig")
     except OSError as exc:
-        raise UsageError(f"{path}: cannot read ({exc.strerror})") from None
+        raise UsageError(cannot_read(path, exc)) from None
     except UnicodeDecodeError as exc:
         raise UsageError(f"{path}: not UTF-8 text (byte {exc.start})") from None
     channels: list[Channel] = []
@@ -437,7 +437,7 @@ def read_record_bytes(path: Path) -> bytes:
         if exc.errno == errno.ELOOP:
             raise UsageError(f"{path}: a symbolic link loop (a link that leads back to itself); point it at the "
                              "record file") from None
-        raise UsageError(f"{path}: cannot read ({exc.strerror})") from None
+        raise UsageError(cannot_read(path, exc)) from None
     if len(raw) > MAX_RECORD_BYTES:
         raise UsageError(f"{path}: more than {MAX_RECORD_BYTES / 2**20:.0f} MiB, the most a record may have; cut it "
                          f"to the steering cycles or decimate it to {METHOD_RATE_HZ:g} Hz")

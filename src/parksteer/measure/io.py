@@ -46,7 +46,8 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import UsageError
+from ..errors import UsageError, cannot_read
+from .converter import quantisation_step
 from ..names import SURFACES
 from ..parameters import Parameters, load_parameters
 from ..tables import atomic_path, format_number
@@ -172,7 +173,7 @@ class Measurement:
         full_scale, bits = self.full_scale(column), self.bits(column)
         if full_scale is None or bits is None:
             return 0.0
-        return 2.0 * full_scale / (2**bits - 1)
+        return quantisation_step(full_scale, bits)
 
 
 def _where(path: Path | str, column: str, row: int, line_numbers: list[int] | None) -> str:
@@ -487,7 +488,7 @@ def read_measurement(path: str | Path, params: Parameters | None = None) -> Meas
     try:
         raw = path.read_bytes()
     except OSError as exc:
-        raise UsageError(f"{path}: cannot read ({exc.strerror})") from None
+        raise UsageError(cannot_read(path, exc)) from None
     try:
         text = raw.decode("utf-8")
     except UnicodeDecodeError as exc:

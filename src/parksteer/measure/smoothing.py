@@ -22,7 +22,7 @@ that uncertainty at every sample. Nor do the data fix how the rack eases into an
 of a second of it the rack moves by less than a converter step or its noise, so there the spline's speed follows
 its knots, and every spacing that passes the discrepancy test (``SmoothedRack.passing_spacings_s``) is as
 consistent with the data as the one kept; the replay's uncertainty smooths at each of them
-(:func:`parksteer.diagnose.problem.ensemble_sources`).
+(:func:`parksteer.diagnose.ensemble.ensemble_sources`).
 
 Every rack here is a :class:`RackSpline` (a piecewise polynomial: ``breaks``, ``coefficients``, ``start_s`` and
 ``end_s``), the rack motion :func:`parksteer.model.numeric.prescribed.solve` takes.
@@ -215,7 +215,7 @@ class SmoothedRack(RackSpline):
         """A rack the logger could equally have recorded: this spline at `time_s`, logged by `log`, smoothed again.
 
         `log` maps a clean rack (m) to a logged one (noise and rounding to the logger's levels;
-        see :func:`parksteer.diagnose.problem.relogged_rack`); the smoothing keeps this knot
+        see :func:`parksteer.diagnose.ensemble.relogged_rack`); the smoothing keeps this knot
         spacing (and the same tests for rest at the ends). Unlike :meth:`perturbed`, this keeps
         what makes an 8-bit rack hard near a turning point: there the rack stays within one
         converter step for a tenth of a second or more, its rounding errors are the same from

@@ -43,7 +43,7 @@ from typing import Any
 import numpy as np
 import yaml
 
-from ..errors import UsageError
+from ..errors import UsageError, cannot_read
 from ..names import SURFACES
 from ..parameters import Parameters, quantity, registry
 from .design import SweepError, point_overrides
@@ -625,7 +625,7 @@ def _read(path: Path) -> dict:
     try:
         text = path.read_text(encoding="utf-8")
     except OSError as exc:
-        raise SweepError(f"{path}: cannot read ({exc.strerror})") from None
+        raise SweepError(cannot_read(path, exc)) from None
     try:
         doc = yaml.safe_load(text)
     except yaml.YAMLError as exc:

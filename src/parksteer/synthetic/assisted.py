@@ -19,7 +19,8 @@ import numpy as np
 from .. import portable as pm
 from ..measure.io import Measurement, metadata_text
 from ..parameters import Parameters
-from .logger import add_noise, quantise, resample
+from ..measure.converter import add_noise, quantise
+from .logger import resample
 from .variations import CLEAN_DT_S, HandVariant, VariationLogger, variation_rack
 
 

@@ -44,7 +44,8 @@ import numpy as np
 from .. import portable as pm
 from ..errors import UsageError
 from .hand import HandProfile, irregular_hand_profile
-from .logger import quantisation_step, synthetic_measurement
+from ..measure.converter import quantisation_step
+from .logger import synthetic_measurement
 from .example import example_hand, example_logger
 from ..measure.io import OPTIONAL_COLUMNS, REQUIRED_COLUMNS, Measurement
 from ..model.symbolic.components import chosen_rivals, discover_effects, load_effect_module, rival_effects
@@ -534,7 +535,8 @@ def chain_logged(params: Parameters, columns: dict[str, np.ndarray], chain: Chai
                  seed: int, hand_profile: HandProfile) -> Measurement:
     """Pass clean columns (time_s, rack_m, handwheel_torque_Nm on a fine even grid) through the logger chain."""
     from ..measure.io import metadata_text
-    from .logger import add_noise, quantise, resample
+    from ..measure.converter import add_noise, quantise
+    from .logger import resample
 
     t = np.asarray(columns["time_s"], dtype=float)
     filtered = anti_alias_and_lag(t, columns, chain.anti_alias_hz, chain.anti_alias_order, chain.torque_lag_s)

@@ -23,7 +23,7 @@ from __future__ import annotations
 import numpy as np
 
 from .. import portable as pm
-from ..geometry import lifting_torque_a1, overall_steering_ratio
+from ..geometry import lifting_torque_a1, steering_ratio
 from ..names import SURFACES
 from ..parameters import Parameters
 from ..rig import limiting_torque_Nm
@@ -77,7 +77,7 @@ def quasi_static_cycle(
     rack_m = rack_of_hand(params, hand.angle_rad)
     rack_speed = hand.rate_rad_s * ratio / s["handwheel_to_rack_ratio"]
     steer = rack_m * s["roadwheel_to_rack_ratio"]
-    overall = overall_steering_ratio(params)
+    overall = steering_ratio(params)
 
     pinion_torque = s["rack_friction_force"] / s["handwheel_to_rack_ratio"] * pm.tanh(
         s["friction_smoothing"] * rack_speed

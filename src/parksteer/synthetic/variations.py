@@ -20,7 +20,7 @@ in every one of these, each in a way a real test could:
 :data:`VARIATIONS` names one record per way of differing (besides the above: uneven strokes, a driver who
 overshoots the lock, 8-, 12- and 16-bit racks beside 8-, 10- and 12-bit torques, 50 Hz to 1 kHz, an anti-alias
 filter and a channel lag, three files to a case): with nothing hidden, a diagnosis must say ``adequate`` on
-each; the variation benchmark (:mod:`parksteer.diagnose.variations`) hides library effects in them as well.
+each; the variation benchmark (:mod:`parksteer.experiments.variations`) hides library effects in them as well.
 """
 
 from __future__ import annotations
@@ -34,7 +34,8 @@ from ..errors import UsageError
 from ..measure.io import Measurement, metadata_text
 from ..measure.smoothing import interpolate_rack
 from ..parameters import Parameters
-from .logger import add_noise, quantise, resample
+from ..measure.converter import add_noise, quantise
+from .logger import resample
 from .standin import rack_of_hand
 
 # The hand's motion is sampled this finely before the rack is splined through it (s).
@@ -235,7 +236,7 @@ class Variation:
 
 _H = HandVariant
 _L = VariationLogger
-# Every variation of the variation benchmark (parksteer.diagnose.variations), in a fixed order: a record's seeds
+# Every variation of the variation benchmark (parksteer.experiments.variations), in a fixed order: a record's seeds
 # follow its place here, so that choosing a subset in config/config.yaml does not change any record.
 VARIATIONS: tuple[Variation, ...] = (
     Variation("rest_after_stop", "5 % smooth rate variation, 1.5 s at rest after the stop",

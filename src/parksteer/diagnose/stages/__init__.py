@@ -3,10 +3,12 @@
 Each stage is a :class:`~parksteer.diagnose.stages.base.Stage`: a `name` (its key in the diagnosis's
 ``timings_s``), an optional progress line (:meth:`~parksteer.diagnose.stages.base.Stage.message`) and
 :meth:`~parksteer.diagnose.stages.base.Stage.run`, which takes the frozen
-:class:`~parksteer.diagnose.state.DiagnosisState` and returns a new one (``dataclasses.replace``) with what it
-found. A stage reads its settings from the state, changes nothing it is given (not the files, not the fits, not
-the state), and runs its independent replays side by side through
-:func:`~parksteer.diagnose.stages.base.in_workers`. :func:`parksteer.diagnose.select.diagnose` runs the table
+:class:`~parksteer.diagnose.state.DiagnosisState` and the diagnosis's replay engine
+(:class:`~parksteer.diagnose.engine.ReplayEngine`: its replays, their counts and its workers) and returns a new
+state (``dataclasses.replace``) with what it found. A stage reads its settings from the state, changes nothing in
+the state it is given (not the files, not the fits), replays only through the engine, and runs its independent
+replays side by side through :meth:`~parksteer.diagnose.engine.ReplayEngine.in_workers`.
+:func:`parksteer.diagnose.select.diagnose` makes the engine and runs the table
 (:func:`~parksteer.diagnose.stages.base.run_table`: a loop that prints each stage's line and times it).
 
 To add a stage:
@@ -24,7 +26,7 @@ the JSON). Settings the stage needs go in :class:`parksteer.diagnose.settings.Di
 
 from __future__ import annotations
 
-from .base import Stage, in_workers, restart, run_table
+from .base import Stage, restart, run_table
 from .calibrate import Calibrate
 from .confound import Confound
 from .identify import Identify
@@ -52,4 +54,4 @@ STAGES: tuple[Stage, ...] = (
     TorqueLagWithEffect(),  # the lags searched again with the named effect; if one moved, the table again
 )
 
-__all__ = ["STAGES", "Stage", "in_workers", "restart", "run_table"]
+__all__ = ["STAGES", "Stage", "restart", "run_table"]

@@ -1,14 +1,15 @@
-"""The contract every stage of a diagnosis keeps (:class:`Stage`), the loop that runs a table of them
-(:func:`run_table`), and the helper that spreads a stage's independent replays over the workers
-(:func:`in_workers`). The table itself, and how to add a stage, is in :mod:`parksteer.diagnose.stages`."""
+"""The contract every stage of a diagnosis keeps (:class:`Stage`) and the loop that runs a table of them
+(:func:`run_table`). The table itself, and how to add a stage, is in :mod:`parksteer.diagnose.stages`; a stage's
+replays run through the replay engine it is handed (:class:`parksteer.diagnose.engine.ReplayEngine`, whose
+:meth:`~parksteer.diagnose.engine.ReplayEngine.in_workers` spreads a stage's independent replays over the
+workers)."""
 
 from __future__ import annotations
 
 import time
 from dataclasses import replace
 
-from ..parallel import fork_map, forks
-from ..problem import Problem
+from ..engine import ReplayEngine
 from ..state import DiagnosisState
 
 
@@ -17,8 +18,9 @@ class Stage:
 
     `name` is the key its time takes in ``Diagnosis.timings_s`` (the JSON's ``cost.timings_s``); :meth:`message`
     is the progress line printed before it runs (None: none); :meth:`run` returns a new state
-    (``dataclasses.replace``) and changes nothing it was given. A stage reads the settings from the state
-    (``state.settings``), never from elsewhere.
+    (``dataclasses.replace``) and changes nothing in the state it was given. Its replays run on the `engine` it is
+    handed, the one thing of a diagnosis that changes (its replays, counts and workers). A stage reads the
+    settings from the state (``state.settings``), never from elsewhere.
     """
 
     name: str = ""
@@ -26,20 +28,20 @@ class Stage:
     def message(self, state: DiagnosisState) -> str | None:
         return None
 
-    def run(self, state: DiagnosisState) -> DiagnosisState:
+    def run(self, state: DiagnosisState, engine: ReplayEngine) -> DiagnosisState:
         raise NotImplementedError
 
 
-def run_table(state: DiagnosisState) -> DiagnosisState:
-    """Run the state's table of stages in order, each on the state the one before returned, timing each and
-    counting the replays run by its end."""
+def run_table(state: DiagnosisState, engine: ReplayEngine) -> DiagnosisState:
+    """Run the state's table of stages in order on `engine`, each on the state the one before returned, timing
+    each and counting the replays run by its end."""
     for stage in state.table:
         clock = time.perf_counter()
         line = stage.message(state)
         if line is not None:
             state.progress(line)
-        state = stage.run(state)
-        state = state.with_cost(stage.name, time.perf_counter() - clock)
+        state = stage.run(state, engine)
+        state = state.with_cost(stage.name, time.perf_counter() - clock, engine.evaluations)
     return state
 
 
@@ -48,20 +50,3 @@ def restart(state: DiagnosisState, **changes) -> DiagnosisState:
     fresh = DiagnosisState(state.settings, state.problem, state.base, state.registry, state.strengths, state.start,
                            state.progress, state.table)
     return replace(fresh, **changes)
-
-
-def in_workers(problem: Problem, function, items: list, by_candidate: bool) -> list:
-    """`function` over `items` (candidates), spread over the workers if `by_candidate` or the predictions do
-    not spread the files; the replays the workers ran are counted. `function` must return what pickles: a
-    result that holds effects returns a copy without them (``dataclasses.replace``), and the caller puts them
-    back."""
-    if (problem.parallel_files and not by_candidate) or not forks(len(items), problem.workers):
-        return [function(item) for item in items]
-
-    def counted(item):
-        before = problem.evaluations
-        return function(item), problem.evaluations - before
-
-    out = fork_map(counted, items, problem.workers)
-    problem.count_extra(sum(evaluations for _, evaluations in out))
-    return [result for result, _ in out]

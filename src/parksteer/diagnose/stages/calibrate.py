@@ -6,13 +6,15 @@ from dataclasses import replace
 
 from ..calibrate import Fit, calibrate
 from ..problem import Problem
+from ..engine import ReplayEngine
 from ..state import DiagnosisState
 from .base import Stage
 
 
-def calibrated(state: DiagnosisState, problem: Problem, announce=None) -> Fit:
+def calibrated(state: DiagnosisState, engine: ReplayEngine, problem: Problem, announce=None) -> Fit:
     """The base model calibrated on `problem` with the state's strengths, start values and settings."""
-    return calibrate(problem, list(state.base), strengths=None if state.strengths is None else dict(state.strengths),
+    return calibrate(engine, problem, list(state.base),
+                     strengths=None if state.strengths is None else dict(state.strengths),
                      start=None if state.start is None else dict(state.start), settings=state.settings,
                      announce=announce)
 
@@ -20,6 +22,7 @@ def calibrated(state: DiagnosisState, problem: Problem, announce=None) -> Fit:
 class Calibrate(Stage):
     name = "calibration"
 
-    def run(self, state: DiagnosisState) -> DiagnosisState:
-        fit = calibrated(state, state.problem, announce=lambda keys: state.progress("calibrating " + ", ".join(keys)))
+    def run(self, state: DiagnosisState, engine: ReplayEngine) -> DiagnosisState:
+        fit = calibrated(state, engine, state.problem,
+                         announce=lambda keys: state.progress("calibrating " + ", ".join(keys)))
         return replace(state, calibration=fit)

@@ -8,11 +8,13 @@ from dataclasses import replace
 from ..calibrate import Fit
 from ..problem import Problem
 from ..state import Candidate, DiagnosisState, confounded_candidates, frozen_mapping
+from ..engine import ReplayEngine
 from .base import Stage
 from .separate import conditions_not_covered, differences_by_condition
 
 
-def confound_tests(problem: Problem, calibration: Fit, candidates: list[Candidate]) -> dict[str, dict | None]:
+def confound_tests(engine: ReplayEngine, problem: Problem, calibration: Fit, candidates: list[Candidate]
+                   ) -> dict[str, dict | None]:
     """Where each candidate that the calibrated parameters take up in these data would show, by name: None if
     the data cover every load case and surface.
 
@@ -41,7 +43,7 @@ def confound_tests(problem: Problem, calibration: Fit, candidates: list[Candidat
                           "left_here_over_noise_floor": left_Nm / problem.files[0].noise.total_rms,
                           "compensated": moved})
     out = {}
-    for candidate, rows, summary in zip(candidates, differences_by_condition(problem, runs), summaries):
+    for candidate, rows, summary in zip(candidates, differences_by_condition(engine, problem, runs), summaries):
         top = max(rows, key=lambda r: r["over_noise_floor"])
         out[candidate.name] = {"case": top["case"], "surface": top["surface"],
                                "predicted_difference_rms_Nm": top["predicted_difference_rms_Nm"],
@@ -61,6 +63,6 @@ class Confound(Stage):
         return ("where the confounded candidates would show: " + ", ".join(c.name for c in confounded)
                 if confounded else None)
 
-    def run(self, state: DiagnosisState) -> DiagnosisState:
-        tested = confound_tests(state.problem, state.calibration, list(_confounded(state)))
+    def run(self, state: DiagnosisState, engine: ReplayEngine) -> DiagnosisState:
+        tested = confound_tests(engine, state.problem, state.calibration, list(_confounded(state)))
         return replace(state, confound_tests=frozen_mapping(tested))

@@ -9,12 +9,13 @@ from ..calibrate import Fit
 from ..problem import Problem
 from ..settings import DEFAULT_SETTINGS, DiagnosisSettings
 from ..state import DiagnosisState
+from ..engine import ReplayEngine
 from .base import Stage
 from .separate import differences_by_condition
 
 
-def identification(problem: Problem, calibration: Fit, settings: DiagnosisSettings = DEFAULT_SETTINGS
-                   ) -> list[dict]:
+def identification(engine: ReplayEngine, problem: Problem, calibration: Fit,
+                   settings: DiagnosisSettings = DEFAULT_SETTINGS) -> list[dict]:
     """What these data fix: every parameter the method calibrates (with the angle, also what only the angle
     shows), each with a status and, where it is not fixed, the test that would fix it.
 
@@ -45,15 +46,16 @@ def identification(problem: Problem, calibration: Fit, settings: DiagnosisSettin
         row = {"parameter": key, "status": "fixed" if halfwidth <= limit else "not fixed", "value": value,
                "ci95": ci, "fixed_by": None}
         if row["status"] == "not fixed" and math.isfinite(halfwidth):
-            row["fixed_by"] = _fixing_test(problem, calibration, key, ci[0], ci[1])
+            row["fixed_by"] = _fixing_test(engine, problem, calibration, key, ci[0], ci[1])
         out.append(row)
     return out
 
 
-def _fixing_test(problem: Problem, calibration: Fit, key: str, low: float, high: float) -> dict | None:
+def _fixing_test(engine: ReplayEngine, problem: Problem, calibration: Fit, key: str, low: float, high: float
+                 ) -> dict | None:
     """The uncovered condition where the parameter's two interval ends move the replayed torque most."""
     base = calibration.overrides
-    rows = differences_by_condition(problem, [(calibration.effects, {**base, key: v}) for v in (low, high)])[0]
+    rows = differences_by_condition(engine, problem, [(calibration.effects, {**base, key: v}) for v in (low, high)])[0]
     return max(rows, key=lambda r: r["over_noise_floor"]) if rows else None
 
 
@@ -63,5 +65,6 @@ class Identify(Stage):
     def message(self, state: DiagnosisState) -> str:
         return "what these data fix: the calibrated parameters' intervals"
 
-    def run(self, state: DiagnosisState) -> DiagnosisState:
-        return replace(state, identification=tuple(identification(state.problem, state.calibration, state.settings)))
+    def run(self, state: DiagnosisState, engine: ReplayEngine) -> DiagnosisState:
+        found = identification(engine, state.problem, state.calibration, state.settings)
+        return replace(state, identification=tuple(found))

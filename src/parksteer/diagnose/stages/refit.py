@@ -12,10 +12,11 @@ from ..candidates import Signature, strength_parameter
 from ..problem import Problem
 from ..settings import DEFAULT_SETTINGS, DiagnosisSettings
 from ..state import DiagnosisState
-from .base import Stage, in_workers
+from ..engine import ReplayEngine
+from .base import Stage
 
 
-def refit(problem: Problem, calibration: Fit, signature: Signature, start_strength: float,
+def refit(engine: ReplayEngine, problem: Problem, calibration: Fit, signature: Signature, start_strength: float,
           settings: DiagnosisSettings = DEFAULT_SETTINGS) -> Fit:
     """The calibrated parameters and the candidate's strength fitted together in the full model."""
     spec = strength_parameter(signature.effect)
@@ -23,7 +24,7 @@ def refit(problem: Problem, calibration: Fit, signature: Signature, start_streng
     parameters = [*calibration.parameters, strength]
     theta0 = np.concatenate([calibration.theta, [min(max(start_strength, strength.lower), strength.upper)]])
     seed = np.column_stack([calibration.jacobian, signature.weighted])
-    fit = least_squares(problem, signature.model, parameters, theta0, calibration.fixed, jacobian=seed,
+    fit = least_squares(engine, problem, signature.model, parameters, theta0, calibration.fixed, jacobian=seed,
                         max_iterations=settings.refit_max_iterations, settings=settings)
     angle_keys = set(settings.calibrated_with_angle) | {key for key, _, _ in settings.calibrated_with_angle_offsets}
     reset = [i for i, p in enumerate(calibration.parameters) if p.key in angle_keys]
@@ -34,7 +35,7 @@ def refit(problem: Problem, calibration: Fit, signature: Signature, start_streng
         for i in reset:
             theta1[i] = calibration.parameters[i].theta(calibration.parameters[i].reference) \
                 if calibration.parameters[i].transform == "offset" else 0.0
-        other = least_squares(problem, signature.model, parameters, theta1, calibration.fixed,
+        other = least_squares(engine, problem, signature.model, parameters, theta1, calibration.fixed,
                               max_iterations=settings.refit_max_iterations, settings=settings)
         if other.rss < fit.rss:
             fit = replace(other, evaluations=other.evaluations + fit.evaluations)
@@ -54,17 +55,17 @@ class Refit(Stage):
         chosen = chosen_for_refit(state)
         return "refitting " + ", ".join(c.name for c in chosen) if chosen else None
 
-    def run(self, state: DiagnosisState) -> DiagnosisState:
+    def run(self, state: DiagnosisState, engine: ReplayEngine) -> DiagnosisState:
         problem, calibration, settings = state.problem, state.calibration, state.settings
         chosen = chosen_for_refit(state)
 
         # The few refits spread their files over the workers (or, with one file, one refit each); each fit travels
         # back without its effects (a copy), which are put back here.
         def refit_of(candidate) -> Fit:
-            fit = refit(problem, calibration, candidate.signature, candidate.score.linear_strength, settings)
+            fit = refit(engine, problem, calibration, candidate.signature, candidate.score.linear_strength, settings)
             return replace(fit, effects=None)
 
         fits = {c.name: replace(fit, effects=c.signature.model)
-                for c, fit in zip(chosen, in_workers(problem, refit_of, chosen, False))}
+                for c, fit in zip(chosen, engine.in_workers(problem, refit_of, chosen, False))}
         candidates = tuple(replace(c, refit=fits[c.name]) if c.name in fits else c for c in state.candidates)
         return replace(state, candidates=candidates)

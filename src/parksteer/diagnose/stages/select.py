@@ -9,7 +9,9 @@ from dataclasses import replace
 import numpy as np
 
 from ..calibrate import Fit
-from ..problem import Problem, bic_gain, effective_samples, lag1_autocorrelation
+from ..problem import Problem
+from ..statistics import bic_gain, effective_samples, lag1_autocorrelation
+from ..engine import ReplayEngine
 from ..state import Candidate, DiagnosisState
 from .base import Stage
 from .replay_uncertainty import with_replay_uncertainty
@@ -36,7 +38,7 @@ def reweigh(problem: Problem, fit: Fit, sigma_before: list[np.ndarray]) -> Fit:
 class Select(Stage):
     name = "selection"
 
-    def run(self, state: DiagnosisState) -> DiagnosisState:
+    def run(self, state: DiagnosisState, engine: ReplayEngine) -> DiagnosisState:
         problem, calibration, settings = state.problem, state.calibration, state.settings
         refitted = [c for c in state.candidates if c.refit is not None]
         best, n_eff, rho, refitted = compare_refits(problem, calibration, refitted)
@@ -46,7 +48,8 @@ class Select(Stage):
             # model by the larger of the two uncertainties and compare again.
             state.progress(f"{best.name} evidenced: replay uncertainty again with it")
             before = [f.sigma for f in problem.files]
-            problem = with_replay_uncertainty(state, best.signature.model, best.refit.overrides, keep_larger=True)
+            problem = with_replay_uncertainty(state, engine, best.signature.model, best.refit.overrides,
+                                              keep_larger=True)
             calibration = reweigh(problem, calibration, before)
             refitted = [replace(c, refit=reweigh(problem, c.refit, before)) for c in refitted]
             best, n_eff, rho, refitted = compare_refits(problem, calibration, refitted)

@@ -9,6 +9,7 @@ import numpy as np
 
 from ...names import SURFACES
 from ...model.symbolic.components import Effect
+from ..engine import ReplayEngine
 from ..problem import Problem
 from ..replay import Replay
 from ..state import Candidate, DiagnosisState, Separation
@@ -20,7 +21,7 @@ def conditions_not_covered(problem: Problem) -> list[tuple[str, str]]:
     return [(c, s) for c in problem.params.case_names for s in SURFACES if (c, s) not in covered]
 
 
-def differences_by_condition(problem: Problem, runs: list[tuple[list[Effect], dict[str, float]]]
+def differences_by_condition(engine: ReplayEngine, problem: Problem, runs: list[tuple[list[Effect], dict[str, float]]]
                              ) -> list[list[dict]]:
     """The first run and each other ((effects, overrides) each), replayed on the first file's rack under each
     load case and surface the data do not cover: for each other run, one row per condition with the RMS torque
@@ -33,7 +34,7 @@ def differences_by_condition(problem: Problem, runs: list[tuple[list[Effect], di
         predicted = []
         for effects, overrides in runs:
             if id(effects) not in replays:
-                replays[id(effects)] = Replay(effects, case, surface, problem.params, f.rack, f.time_s)
+                replays[id(effects)] = engine.new_replay(effects, case, surface, problem.params, f.rack, f.time_s)
             predicted.append(replays[id(effects)].torque(overrides))
         for out, other in zip(rows, predicted[1:]):
             difference = float(np.sqrt(np.mean((predicted[0] - other) ** 2)))
@@ -42,9 +43,9 @@ def differences_by_condition(problem: Problem, runs: list[tuple[list[Effect], di
     return rows
 
 
-def separation(problem: Problem, best: Candidate, other: Candidate) -> Separation:
+def separation(engine: ReplayEngine, problem: Problem, best: Candidate, other: Candidate) -> Separation:
     """Replay both fitted models on the first file's rack under each uncovered condition (module docstring)."""
-    rows = differences_by_condition(problem, [(c.signature.model, c.refit.overrides) for c in (best, other)])[0]
+    rows = differences_by_condition(engine, problem, [(c.signature.model, c.refit.overrides) for c in (best, other)])[0]
     top = max(rows, key=lambda r: r["over_noise_floor"])
     return Separation(other.name, float(other.delta_bic), top["case"], top["surface"],
                       top["predicted_difference_rms_Nm"], top["over_noise_floor"], tuple(rows))
@@ -53,10 +54,11 @@ def separation(problem: Problem, best: Candidate, other: Candidate) -> Separatio
 class Separate(Stage):
     name = "separation"
 
-    def run(self, state: DiagnosisState) -> DiagnosisState:
+    def run(self, state: DiagnosisState, engine: ReplayEngine) -> DiagnosisState:
         if state.verdict != "missing":
             return state
         best, threshold = state.best_candidate, state.settings.bic_indistinguishable
-        separations = tuple(separation(state.problem, best, c) for c in state.candidates
-                            if c.refit is not None and c.name != best.name and c.delta_bic >= best.delta_bic - threshold)
+        separations = tuple(separation(engine, state.problem, best, c) for c in state.candidates
+                            if c.refit is not None and c.name != best.name
+                            and c.delta_bic >= best.delta_bic - threshold)
         return replace(state, indistinguishable=separations)

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from ..signature import signature_of
 from ..state import DiagnosisState
+from ..engine import ReplayEngine
 from .base import Stage
 
 
@@ -14,7 +15,7 @@ class ResidualSignature(Stage):
     def message(self, state: DiagnosisState) -> str | None:
         return "the residual's signature" if state.settings.residual_signature else None
 
-    def run(self, state: DiagnosisState) -> DiagnosisState:
+    def run(self, state: DiagnosisState, engine: ReplayEngine) -> DiagnosisState:
         if not state.settings.residual_signature:
             return state
         calibration = state.calibration

@@ -24,6 +24,7 @@ import numpy as np
 from ... import portable as pm
 from ...errors import SolverError
 from ...model.symbolic.components import Effect
+from ..engine import ReplayEngine
 from ..problem import Problem
 from ..settings import DEFAULT_SETTINGS, DiagnosisSettings
 from ..state import DiagnosisState
@@ -32,7 +33,7 @@ from .calibrate import calibrated
 from .replay_uncertainty import with_replay_uncertainty
 
 
-def estimate_torque_lags(problem: Problem, effects: list[Effect], overrides: dict[str, float],
+def estimate_torque_lags(engine: ReplayEngine, problem: Problem, effects: list[Effect], overrides: dict[str, float],
                          settings: DiagnosisSettings = DEFAULT_SETTINGS) -> tuple[list[float], float]:
     """Search each file's torque channel lag behind its rack channel on the model `effects` with `overrides`
     (with settings.torque_lag_fitted: a grid search around the file's present lag and a parabola through its best
@@ -47,7 +48,7 @@ def estimate_torque_lags(problem: Problem, effects: list[Effect], overrides: dic
     for i, f in enumerate(problem.files):
         if f.uses_angle:
             continue
-        replay = problem.replay(effects, i)  # at the file's present replay instants
+        replay = engine.replay(problem, effects, i)  # at the file's present replay instants
         sigma = f.sigma_Nm
 
         def rss(lag: float) -> float:
@@ -75,13 +76,13 @@ def estimate_torque_lags(problem: Problem, effects: list[Effect], overrides: dic
     return found, largest
 
 
-def lags_searched(state: DiagnosisState, effects: list[Effect], overrides: dict[str, float], why: str
-                  ) -> tuple[Problem, bool]:
+def lags_searched(state: DiagnosisState, engine: ReplayEngine, effects: list[Effect], overrides: dict[str, float],
+                  why: str) -> tuple[Problem, bool]:
     """(the state's problem on files with the lags searched on `effects` with `overrides`, whether one moved by a
     search step or more). Where one did, the progress line says so and the new problem's files have neither
     replays nor replay uncertainty yet (they were made at the old instants)."""
     problem, settings = state.problem, state.settings
-    lags, largest = estimate_torque_lags(problem, effects, overrides, settings)
+    lags, largest = estimate_torque_lags(engine, problem, effects, overrides, settings)
     files = [replace(f, torque_lag_s=lag) for f, lag in zip(problem.files, lags)]
     if largest < settings.torque_lag_step_s:
         return problem.with_files(files), False
@@ -94,29 +95,29 @@ def lags_searched(state: DiagnosisState, effects: list[Effect], overrides: dict[
 class TorqueLag(Stage):
     name = "torque_lag"
 
-    def run(self, state: DiagnosisState) -> DiagnosisState:
+    def run(self, state: DiagnosisState, engine: ReplayEngine) -> DiagnosisState:
         base = list(state.base)
         for _ in range(state.settings.torque_lag_rounds):
-            problem, moved = lags_searched(state, base, state.calibration.overrides,
+            problem, moved = lags_searched(state, engine, base, state.calibration.overrides,
                                            " (replay uncertainty and calibration again at the lagged instants)")
             state = replace(state, problem=problem)
             if not moved:
                 break
-            state = replace(state, problem=with_replay_uncertainty(state, base, state.start_values))
-            state = replace(state, calibration=calibrated(state, state.problem))
+            state = replace(state, problem=with_replay_uncertainty(state, engine, base, state.start_values))
+            state = replace(state, calibration=calibrated(state, engine, state.problem))
         return state
 
 
 class TorqueLagWithEffect(Stage):
     name = "torque_lag_with_effect"
 
-    def run(self, state: DiagnosisState) -> DiagnosisState:
+    def run(self, state: DiagnosisState, engine: ReplayEngine) -> DiagnosisState:
         if not state.settings.torque_lag_fitted or state.verdict != "missing":
             return state
         best = state.best_candidate
-        problem, moved = lags_searched(state, best.signature.model, best.refit.overrides,
+        problem, moved = lags_searched(state, engine, best.signature.model, best.refit.overrides,
                                        f" (again, with {best.name}; diagnosing again)")
         if not moved:
             return replace(state, problem=problem)
         held = restart(state, problem=problem, settings=replace(state.settings, torque_lag_fitted=False))
-        return replace(run_table(held), settings=state.settings)
+        return replace(run_table(held, engine), settings=state.settings)

@@ -9,6 +9,7 @@ import numpy as np
 
 from ..settings import DEFAULT_SETTINGS, DiagnosisSettings
 from ..state import DiagnosisState
+from ..engine import ReplayEngine
 from .base import Stage
 
 
@@ -42,7 +43,7 @@ def choose_verdict(base_ratio: float, best_delta_bic: float | None, after_ratio:
 class Verdict(Stage):
     name = "verdict"
 
-    def run(self, state: DiagnosisState) -> DiagnosisState:
+    def run(self, state: DiagnosisState, engine: ReplayEngine) -> DiagnosisState:
         settings, n, best = state.settings, state.problem.n, state.best_candidate
         base_rss = state.calibration.rss
         base_ratio = math.sqrt(base_rss / n)

@@ -46,7 +46,7 @@ from typing import ClassVar
 
 import numpy as np
 
-from ...errors import UsageError
+from ...errors import UsageError, cannot_read_as
 from .base import SNIFF_BYTES, Record, Source
 
 # A gap in a used message longer than this is refused: the method resolves the phases of a cycle over windows of
@@ -254,8 +254,8 @@ def read_frames(raw: bytes, where: Path, fmt: str):
         quiet[0].disabled, sys.unraisablehook = False, quiet[1]
     if problem is not None:
         got = f" after {len(times)} frames" if times else ""
-        raise UsageError(f"{where}: cannot read as {FORMAT_NAMES[fmt]}{got} ({problem}); the file is damaged or "
-                         "cut short")
+        raise UsageError(cannot_read_as(where, f"{FORMAT_NAMES[fmt]}{got}", problem)
+                         + "; the file is damaged or cut short")
     if not times:
         raise UsageError(f"{where}: the {FORMAT_NAMES[fmt]} holds no CAN data frame")
     return np.asarray(times, dtype=float), np.asarray(ids, dtype=np.int64), data, np.asarray(channels), errors

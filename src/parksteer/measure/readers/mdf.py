@@ -13,7 +13,7 @@ from typing import ClassVar
 
 import numpy as np
 
-from ...errors import UsageError
+from ...errors import UsageError, cannot_read_as
 from .base import TIME_ALIASES, Record, Source, normal_name
 
 MAGIC = (b"MDF     ", b"UnFinMF ")
@@ -51,7 +51,7 @@ def _sources(raw: bytes, where: Path) -> list[Source]:
             gc.collect()
         finally:
             sys.unraisablehook = hook
-        raise UsageError(f"{where}: cannot read as ASAM MDF ({problem.splitlines()[0]})")
+        raise UsageError(cannot_read_as(where, "ASAM MDF", problem.splitlines()[0]))
     sources: list[Source] = []
     try:
         for name, places in mdf.channels_db.items():

@@ -98,41 +98,55 @@ class CompiledModel:
         return {name: out[:, i] for i, name in enumerate(self.outputs)}
 
 
-_LOADED: dict[Path, CompiledModel] = {}
+class CompiledModels:
+    """The compiled models one owner has loaded (a diagnosis's replay engine, or one call of :func:`load_model`), by
+    cache entry: each entry's library is loaded once, and an entry loaded is used again without re-checking its
+    files (the library in memory is the one checked)."""
+
+    def __init__(self) -> None:
+        self.loaded: dict[Path, CompiledModel] = {}
+
+    def entry(self, directory: Path) -> CompiledModel:
+        """The compiled model of the cache entry in `directory`."""
+        directory = Path(directory).resolve()
+        if directory in self.loaded:
+            return self.loaded[directory]
+        info = json.loads((directory / "model.json").read_text(encoding="utf-8"))
+        lib = ctypes.CDLL(str(directory / "model.so"))
+        vp, dbl, i32 = ctypes.c_void_p, ctypes.c_double, ctypes.c_int
+        for name, restype, args in (
+            ("ps_rhs", i32, [dbl, vp, vp, vp]),
+            ("ps_jac", i32, [dbl, vp, vp, vp]),
+            ("ps_forcing", None, [dbl, vp, vp, vp]),
+            ("ps_forcing_dq", None, [dbl, vp, vp, vp]),
+            ("ps_drive", None, [vp, vp, vp, vp, vp]),
+            ("ps_handwheel", None, [dbl, vp, vp, vp]),
+            ("ps_outputs", i32, [i32, vp, vp, vp, vp, vp, vp]),
+            ("ps_rack", None, [dbl, vp, vp]),
+            ("ps_prescribed_rhs", i32, [dbl, vp, vp, vp, vp]),
+            ("ps_prescribed_jac", i32, [dbl, vp, vp, vp, vp, vp]),
+            ("ps_prescribed_samples", i32, [i32, vp, vp, vp, vp, vp, vp, vp]),
+            ("ps_integrate", i32, [vp, vp, i32, vp, i32, vp, dbl, vp, ctypes.c_long, vp, vp]),
+            ("ps_integrate_prescribed", i32, [vp, vp, vp, vp, i32, vp, i32, vp, dbl, vp, ctypes.c_long, vp, vp]),
+        ):
+            function = getattr(lib, name)
+            function.restype = restype
+            function.argtypes = args
+        self.loaded[directory] = CompiledModel(directory, info, lib)
+        return self.loaded[directory]
+
+    def of(self, effects: list[Effect]) -> CompiledModel:
+        """The compiled model of `effects`, from the cache (derived and compiled once if missing)."""
+        loaded = self.loaded.get(entry_path(effects).resolve())
+        return loaded if loaded is not None else self.entry(ensure_entry(effects))
 
 
 def load_entry(directory: Path) -> CompiledModel:
-    directory = Path(directory).resolve()
-    if directory in _LOADED:
-        return _LOADED[directory]
-    info = json.loads((directory / "model.json").read_text(encoding="utf-8"))
-    lib = ctypes.CDLL(str(directory / "model.so"))
-    vp, dbl, i32 = ctypes.c_void_p, ctypes.c_double, ctypes.c_int
-    for name, restype, args in (
-        ("ps_rhs", i32, [dbl, vp, vp, vp]),
-        ("ps_jac", i32, [dbl, vp, vp, vp]),
-        ("ps_forcing", None, [dbl, vp, vp, vp]),
-        ("ps_forcing_dq", None, [dbl, vp, vp, vp]),
-        ("ps_drive", None, [vp, vp, vp, vp, vp]),
-        ("ps_handwheel", None, [dbl, vp, vp, vp]),
-        ("ps_outputs", i32, [i32, vp, vp, vp, vp, vp, vp]),
-        ("ps_rack", None, [dbl, vp, vp]),
-        ("ps_prescribed_rhs", i32, [dbl, vp, vp, vp, vp]),
-        ("ps_prescribed_jac", i32, [dbl, vp, vp, vp, vp, vp]),
-        ("ps_prescribed_samples", i32, [i32, vp, vp, vp, vp, vp, vp, vp]),
-        ("ps_integrate", i32, [vp, vp, i32, vp, i32, vp, dbl, vp, ctypes.c_long, vp, vp]),
-        ("ps_integrate_prescribed", i32, [vp, vp, vp, vp, i32, vp, i32, vp, dbl, vp, ctypes.c_long, vp, vp]),
-    ):
-        function = getattr(lib, name)
-        function.restype = restype
-        function.argtypes = args
-    model = CompiledModel(directory, info, lib)
-    _LOADED[directory] = model
-    return model
+    """The compiled model of the cache entry in `directory`, loaded afresh."""
+    return CompiledModels().entry(directory)
 
 
-def load_model(effects: list[Effect]) -> CompiledModel:
-    """The compiled model of `effects`, from the cache (derived and compiled once if missing). An entry this
-    process has loaded is used again without re-checking its files: the library in memory is the one checked."""
-    loaded = _LOADED.get(entry_path(effects).resolve())
-    return loaded if loaded is not None else load_entry(ensure_entry(effects))
+def load_model(effects: list[Effect], models: CompiledModels | None = None) -> CompiledModel:
+    """The compiled model of `effects`, from the cache (derived and compiled once if missing), through `models`
+    (the models an owner keeps loaded; by default, loaded afresh)."""
+    return (models if models is not None else CompiledModels()).of(effects)

@@ -35,8 +35,8 @@ from typing import Protocol
 
 import numpy as np
 
-from ... import portable as pm
 from ...errors import UsageError
+from ...geometry import column_twist
 from .statics import static_state
 from .tolerances import (PRESCRIBED_ATOL_FACTOR, PRESCRIBED_RTOL, absolute_tolerances, integrator_failure,
                          max_steps)
@@ -353,28 +353,6 @@ def twist_spread(run, p: np.ndarray, solution: PrescribedSolution, torque_error:
                     solution.states[0], solution.accelerations[0], column[0], rate[0])
     torque = solution.torque_Nm
     return 0.5 * (law.inverse((torque + torque_error) / stiffness) - law.inverse((torque - torque_error) / stiffness))
-
-
-def column_twist(t: np.ndarray, torque: np.ndarray, stiffness: float, damping: float
-                 ) -> tuple[np.ndarray, np.ndarray]:
-    """Twist (rad) and twist rate (rad/s) of the column from ``c dtwist/dt + k twist = T``, from rest at T(t[0]) / k.
-
-    Exact for a torque linear between the samples `t`. Without damping the twist is T / k.
-    """
-    if damping <= 0.0:
-        twist = torque / stiffness
-        return twist, np.gradient(twist, t)
-    tau = damping / stiffness
-    h = np.diff(t)
-    decay = pm.exp(-h / tau)
-    slope = np.diff(torque) / h
-    # x(t0 + h) = T1/k - tau s/k + (x0 - T0/k + tau s/k) e^(-h/tau), s the torque's slope over the interval
-    twist = np.empty(len(t))
-    twist[0] = torque[0] / stiffness
-    for k in range(len(h)):
-        lag = tau * slope[k] / stiffness
-        twist[k + 1] = torque[k + 1] / stiffness - lag + (twist[k] - torque[k] / stiffness + lag) * decay[k]
-    return twist, (torque - stiffness * twist) / damping
 
 
 def _refined(t_out: np.ndarray, max_step: float) -> tuple[np.ndarray, np.ndarray]:

@@ -21,7 +21,7 @@ import numpy as np
 from ...errors import SolverError, UsageError
 from ...parameters import Parameters, load_parameters
 from ...tables import write_csv
-from .compiled import CompiledModel, load_model
+from .compiled import CompiledModel, CompiledModels, load_model
 from ..symbolic.components import Effect, discover_effects, resolve_effects
 from .inputs import HandwheelProfile, sawtooth_profile
 from .statics import static_state
@@ -72,15 +72,18 @@ class PreparedRun:
 
 
 def prepare(case: str, effects=None, overrides: dict | None = None, surface: str = "ground",
-            params: Parameters | None = None, handwheel: HandwheelProfile | None = None) -> PreparedRun:
+            params: Parameters | None = None, handwheel: HandwheelProfile | None = None,
+            models: CompiledModels | None = None) -> PreparedRun:
     """Resolve effects and values, load (or derive) the compiled model, and balance its static state.
 
-    `handwheel` is the prescribed handwheel angle (default: the paper's saw tooth from the input section).
+    `handwheel` is the prescribed handwheel angle (default: the paper's saw tooth from the input section);
+    `models`, the compiled models the caller keeps loaded (:class:`parksteer.model.numeric.compiled.CompiledModels`;
+    by default the model is loaded afresh).
     """
     params = params if params is not None else load_parameters()
     chosen = resolve_effects(effects)
     values = resolve_values(params, case, chosen, overrides, surface, all_effects=discover_effects())
-    model = load_model(chosen)
+    model = load_model(chosen, models)
     profile = handwheel if handwheel is not None else sawtooth_profile(values.params)
     p = parameter_vector(model.info["parameters"], values, profile.table(model.info["max_input_pieces"]))
     run = PreparedRun(model, chosen, values, p, profile)

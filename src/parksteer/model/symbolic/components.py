@@ -73,9 +73,20 @@ class Effect:
     quantities (``tyre.*``, ``steering.*``, ...) are in the parameter file; an effect declares its own in
     ``quantities`` (key ``<name>.<quantity>``, with unit, bounds, default and source), the package's effects and a
     user's alike; they join the registry when the effect is loaded. ``requires`` names the effects it needs;
-    ``replaces`` names the slot it fills (see :data:`SLOTS`). A rival of the paper's mechanisms sets ``rival``
-    (:class:`Rival`), which keeps it out of the diagnosis' candidates. Per-build state lives on the model being
-    built (``model.state(self)``), never on the effect.
+    ``replaces`` names the slot it fills (see :data:`SLOTS`). Per-build state lives on the model being built
+    (``model.state(self)``), never on the effect.
+
+    The effect's roles are the class attributes below the line ``# roles``, declared here and only here (a
+    subclass sets those that differ; nothing reads a role by the effect's name or by ``getattr``):
+
+    - ``in_default_set``: in the model when no effect set is named (the paper's five);
+    - ``diagnosis_candidate``: a candidate of the diagnosis of a car without power assist;
+    - ``assist_candidate``: a candidate of the diagnosis of a car with an electric assist (its motor friction,
+      its torsion bar's offset, its gain error);
+    - ``rival``: a rival of the paper's mechanisms (:class:`Rival`), never a candidate;
+    - ``power_assist``: ``"electric"`` or ``"hydraulic"`` for a power assist, None otherwise: its push is the
+      gear's own, left out of the rack force, and a record of the car is replayed through its boost law
+      (:mod:`parksteer.model.numeric.assisted`).
     """
 
     name: ClassVar[str] = ""
@@ -84,13 +95,12 @@ class Effect:
     quantities: ClassVar[tuple[Quantity, ...]] = ()
     requires: ClassVar[tuple[str, ...]] = ()
     replaces: ClassVar[str | None] = None
-    in_default_set: ClassVar[bool] = True  # the paper's five are; candidate mechanisms are not
-    # False keeps an effect out of the diagnosis' candidates; a rival (``rival`` set) is never one
+    # roles (class docstring)
+    in_default_set: ClassVar[bool] = True
     diagnosis_candidate: ClassVar[bool] = True
+    assist_candidate: ClassVar[bool] = False
     rival: ClassVar[Rival | None] = None
-    # True for a power assist (electric or hydraulic): its push is the gear's own, left out of the rack force, and
-    # a record of the car is replayed through its boost law (parksteer.model.numeric.assisted)
-    power_assist: ClassVar[bool] = False
+    power_assist: ClassVar[str | None] = None
 
     def __init_subclass__(cls, **kwargs: Any) -> None:
         super().__init_subclass__(**kwargs)

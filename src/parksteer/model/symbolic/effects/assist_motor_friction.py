@@ -28,7 +28,7 @@ NAME = "assist_motor_friction"
 
 def electric_assist_of(model, who: str):
     """The electric assist of the set being built (refused in one line without one)."""
-    found = [e for e in model.effects if e.name.startswith("electric_assist_")]
+    found = [e for e in model.effects if e.power_assist == "electric"]
     if not found:
         raise UsageError(f"{who} requires an electric assist in the effects (+electric_assist_column, _pinion or "
                          "_rack; or a vehicle file's [assist] with --with-assist)")
@@ -41,7 +41,7 @@ class AssistMotorFriction(Effect):
                    "the point of action); 0 = absent")
     in_default_set = False
     diagnosis_candidate = False  # not a candidate of a car without assist
-    assist_candidate = True  # a candidate of an assisted car (parksteer.diagnose.candidates)
+    assist_candidate = True
     quantities = (
         Quantity(f"{NAME}.friction_torque", "N m", 0.0, 0.5, lower_inclusive=True, default=0.0,
                  source="candidate: extra breakaway torque at the motor beyond the assist's own; EPS motors and "

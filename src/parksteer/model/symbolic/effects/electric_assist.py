@@ -141,7 +141,7 @@ class ElectricAssist(Effect):
     location: ClassVar[str] = ""
     in_default_set = False
     diagnosis_candidate = False
-    power_assist = True  # the simulation's rack force leaves its contribution out (the gear's own push)
+    power_assist = "electric"  # the simulation's rack force leaves its contribution out (the gear's own push)
     replaces = "column_deflection"
 
     @classmethod

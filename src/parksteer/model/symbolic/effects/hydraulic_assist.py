@@ -44,7 +44,7 @@ class HydraulicAssist(Effect):
     )
     in_default_set = False
     diagnosis_candidate = False
-    power_assist = True  # the simulation's rack force leaves its contribution out (the gear's own push)
+    power_assist = "hydraulic"  # the simulation's rack force leaves its contribution out (the gear's own push)
     replaces = "column_deflection"
     quantities = (
         Quantity(f"{NAME}.valve_slope", "Pa/(N m)", 0.0, 1.0e8, lower_inclusive=True, default=1.5e6,

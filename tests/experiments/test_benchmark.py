@@ -6,7 +6,7 @@ import json
 
 import pytest
 
-from parksteer.diagnose.benchmark import aggregate, outcome
+from parksteer.experiments.benchmark import aggregate, outcome
 
 
 def _diagnosis(verdict, effect=None, group=(), after=None):

@@ -1,9 +1,9 @@
 """One row per benchmark case: how a diagnosis fared against the case's truth, typed.
 
 Each benchmark scores its cases into rows of its own kind (:class:`BenchmarkRow` for the hidden-effect
-benchmark, :mod:`parksteer.diagnose.benchmark`; :class:`VariationRow` for the variation benchmark,
-:mod:`parksteer.diagnose.variations`; :class:`OutclassRow` for the out-of-class one,
-:mod:`parksteer.diagnose.outclass`); the summaries and the figures (:mod:`parksteer.figures.diagnose`) read
+benchmark, :mod:`parksteer.experiments.benchmark`; :class:`VariationRow` for the variation benchmark,
+:mod:`parksteer.experiments.variations`; :class:`OutclassRow` for the out-of-class one,
+:mod:`parksteer.experiments.outclass`); the summaries and the figures (:mod:`parksteer.figures.diagnose`) read
 them by attribute. A row's fields, in order, are the columns of its benchmark's CSV (:func:`csv_columns`).
 
 The error ratios share one spelling: ``<model>_over_floor`` is that model's weighted RMS error over the noise
@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 @dataclass(frozen=True)
 class BenchmarkRow:
-    """A hidden-effect benchmark case (:func:`parksteer.diagnose.benchmark.outcome`)."""
+    """A hidden-effect benchmark case (:func:`parksteer.experiments.benchmark.outcome`)."""
 
     name: str
     kind: str  # candidate, null or outside
@@ -41,7 +41,7 @@ class BenchmarkRow:
 
 @dataclass(frozen=True)
 class VariationRow:
-    """A variation benchmark case (:func:`parksteer.diagnose.variations.outcome`)."""
+    """A variation benchmark case (:func:`parksteer.experiments.variations.outcome`)."""
 
     name: str
     variation: str
@@ -69,7 +69,7 @@ class VariationRow:
 
 @dataclass(frozen=True)
 class OutclassRow:
-    """An out-of-class benchmark case (:func:`parksteer.diagnose.outclass.outcome`)."""
+    """An out-of-class benchmark case (:func:`parksteer.experiments.outclass.outcome`)."""
 
     name: str
     kind: str  # rival or null

@@ -1,4 +1,4 @@
-"""The diagnosis's peers (parksteer.diagnose.peers): STLSQ and FROLS on constructed residuals, the mapping of
+"""The diagnosis's peers (parksteer.experiments.peers): STLSQ and FROLS on constructed residuals, the mapping of
 their selections onto the diagnosis's verdicts, the tuning, and (slow) the library of a real diagnosis."""
 
 from __future__ import annotations
@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from parksteer.diagnose.peers import (FROLS_SETTINGS, STLSQ_RIDGES, STLSQ_SETTINGS, STLSQ_THRESHOLDS, frols, frols_ranking, generic_terms,
+from parksteer.experiments.peers import (FROLS_SETTINGS, STLSQ_RIDGES, STLSQ_SETTINGS, STLSQ_THRESHOLDS, frols, frols_ranking, generic_terms,
                                       library_from, peer_answers, portable_stlsq, score_method, setting_label, stlsq, tune,
                                       verdict_of)
 
@@ -161,7 +161,7 @@ def test_an_out_of_class_rival_answered_with_an_unrelated_candidate_is_a_peers_c
 
 @pytest.mark.slow
 def test_the_library_of_a_real_diagnosis_holds_its_residual_and_its_candidates_signatures(written, params):
-    from parksteer.diagnose.peers import record_library
+    from parksteer.experiments.peers import record_library
     from parksteer.diagnose.problem import load_files
     from parksteer.diagnose.select import diagnose
 
@@ -179,12 +179,12 @@ def test_the_library_of_a_real_diagnosis_holds_its_residual_and_its_candidates_s
     # the replays are counted as they run: never fewer after a stage than before it, all of them by the end, and
     # the peers' share (up to the signatures) short of the whole, since the refits replay the candidates again
     counts = list(diagnosis.replays_by_stage.values())
-    assert counts == sorted(counts) and counts[-1] == diagnosis.problem.evaluations
-    assert 0 < diagnosis.replays_by_stage["signatures_and_scores"] < diagnosis.problem.evaluations
+    assert counts == sorted(counts) and counts[-1] == diagnosis.replays
+    assert 0 < diagnosis.replays_by_stage["signatures_and_scores"] < diagnosis.replays
 
 
 def test_the_comparison_tunes_on_the_tuning_split_and_scores_on_the_evaluation_records():
-    from parksteer.diagnose.peers import compare
+    from parksteer.experiments.peers import compare
 
     k = len(STLSQ_THRESHOLDS)
     frols_quiet = {setting_label("frols", s): {"verdict": "adequate", "effect": None} for s in FROLS_SETTINGS}

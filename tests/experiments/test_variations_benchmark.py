@@ -9,9 +9,10 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from parksteer.diagnose.rows import VariationRow
+from parksteer.experiments.benchmark import BASE_PERTURBATION
+from parksteer.experiments.rows import VariationRow
 from parksteer.diagnose.settings import DEFAULT_SETTINGS
-from parksteer.diagnose.variations import (COVERAGE_TARGET, NAMED_MIN_STEPS, NAMED_TARGET, NULL_ADEQUATE_TARGET,
+from parksteer.experiments.variations import (COVERAGE_TARGET, NAMED_MIN_STEPS, NAMED_TARGET, NULL_ADEQUATE_TARGET,
                                            VariationDesign, outcome, run_case, summarise, variation_cases)
 from parksteer.errors import UsageError
 from parksteer.measure.io import read_measurement
@@ -19,13 +20,11 @@ from parksteer.parameters import DEFAULT_PATH, load_parameters
 from parksteer.synthetic.variations import VARIATIONS, HandVariant, variation_hand
 
 PARAMS = load_parameters()
-PERTURBATION = {"tyre.friction_coefficient": 0.10, "steering.rack_friction_force": 0.15,
-                "tyre.carcass_torsional_stiffness": 0.20}
 FILES = (("unladen", "ground"), ("part_laden", "ground"), ("offset_68_5mm", "ground"))
 
 
 def _design(variations=("pauses",), replicates=1, hidden=("rack_stiction",), steps=(3.5,)):
-    return VariationDesign(tuple(variations), replicates, tuple(hidden), tuple(steps), FILES, 11, PERTURBATION)
+    return VariationDesign(tuple(variations), replicates, tuple(hidden), tuple(steps), FILES, 11, BASE_PERTURBATION)
 
 
 def _row(variation, hidden="nothing", steps=0.0, verdict="adequate", named=False, covered=3, intervals=3,
@@ -176,11 +175,11 @@ def test_an_unknown_variation_or_too_many_files_is_refused_in_one_line():
                "small": {"variations": ["no_such"], "replicates": 1, "hidden": [], "steps": [1.0]},
                "full": {"variations": ["pauses"], "replicates": 1, "hidden": [], "steps": [1.0]}}
     with pytest.raises(UsageError, match="no_such") as info:
-        VariationDesign.from_config(section, {"perturbation": PERTURBATION})
+        VariationDesign.from_config(section, {"perturbation": BASE_PERTURBATION})
     assert "\n" not in str(info.value)
     section["small"]["variations"] = ["three_files"]
     with pytest.raises(UsageError, match="three_files needs 3 files"):
-        VariationDesign.from_config(section, {"perturbation": PERTURBATION})
+        VariationDesign.from_config(section, {"perturbation": BASE_PERTURBATION})
 
 
 @pytest.mark.parametrize("effect, confounded", [("kingpin_friction", True), ("rack_stiction", False)])
@@ -191,16 +190,16 @@ def test_what_a_calibration_can_absorb_of_a_hidden_effect(effect, confounded):
     the calibrated directions, the same verdict the diagnosis reaches on its own from the replayed signature. A
     rack stiction (a breakaway peak at each rack reversal, which no constant force, friction coefficient or carcass
     stiffness makes) keeps most of its change. The size is set on the whole change (2 steps +-2 %)."""
-    from parksteer.diagnose.variations import _case_files, hidden_strength
+    from parksteer.experiments.variations import _case_files, hidden_strength
     from parksteer.synthetic.datasets import perturbed_base
-    from parksteer.synthetic.logger import quantisation_step
+    from parksteer.measure.converter import quantisation_step
 
     design = _design(("pauses",), hidden=(effect,), steps=(2.0,))
     case = next(c for c in variation_cases(design) if c.hidden)
     files = _case_files(case, design)
     logger = files[0][3]
     step = quantisation_step(logger.torque_full_scale_Nm, logger.torque_bits)
-    _key, strength, change, observable = hidden_strength(PARAMS, files, perturbed_base(PARAMS, case.seed, PERTURBATION),
+    _key, strength, change, observable = hidden_strength(PARAMS, files, perturbed_base(PARAMS, case.seed, BASE_PERTURBATION),
                                                          effect, 2.0 * step)
     assert strength > 0.0 and change == pytest.approx(2.0 * step, rel=0.021)
     kept = observable / change
@@ -237,11 +236,11 @@ def test_a_null_case_runs_end_to_end(tmp_path):
     truth = json.loads((tmp_path / "t.json").read_text(encoding="utf-8"))
     record = read_measurement(folder / "unladen__ground.csv")
     assert record.metadata["sample_rate_hz"].startswith("50")
-    assert truth["hidden"] is None and set(truth["base_overrides"]) == set(PERTURBATION)
+    assert truth["hidden"] is None and set(truth["base_overrides"]) == set(BASE_PERTURBATION)
     o = outcome(truth, result)
     assert o.verdict == "adequate" and not o.false_alarm
     assert o.calibrated_over_floor < DEFAULT_SETTINGS.adequate_rms_factor
-    assert o.intervals == len(PERTURBATION)
+    assert o.intervals == len(BASE_PERTURBATION)
 
 
 def test_a_lagged_torque_channel_is_the_unlagged_one_shifted_and_the_rack_is_untouched():

@@ -1,6 +1,6 @@
 """The variation benchmark: diagnose records made by another hand, another logger and another drive.
 
-The in-class benchmark (:mod:`parksteer.diagnose.benchmark`) makes its records with the hand, the logger and
+The in-class benchmark (:mod:`parksteer.experiments.benchmark`) makes its records with the hand, the logger and
 the handwheel-driven simulation the diagnosis was tuned on. Here each record comes from
 :mod:`parksteer.synthetic.variations` instead: one of its :data:`~parksteer.synthetic.variations.VARIATIONS`
 (another hand: a smooth rate variation, pauses, uneven strokes, a lock overshoot, a record cut mid-stroke or
@@ -36,12 +36,12 @@ from .. import portable as pm
 from ..errors import UsageError
 from ..parameters import Parameters, load_parameters
 from ..synthetic.datasets import SizeSearch, perturbed_base, rms_difference, strength_for_rms
-from ..synthetic.logger import quantisation_step
+from ..measure.converter import quantisation_step
 from ..synthetic.variations import VARIATIONS, Variation, variation_by_name, variation_rack, variation_record
 from .benchmark import BENCHMARK_SETTINGS, diagnose_written, paired_results
-from .calibrate import calibrated_keys
+from ..diagnose.calibrate import calibrated_keys
 from .rows import VariationRow
-from .settings import DEFAULT_SETTINGS, DiagnosisSettings
+from ..diagnose.settings import DEFAULT_SETTINGS, DiagnosisSettings
 
 NAMED_MIN_STEPS = 2.0  # converter steps RMS: hidden effects at least this large count towards the named rate
 NAMED_TARGET = 0.90  # of those, named first or in the reported group

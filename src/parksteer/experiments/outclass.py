@@ -1,6 +1,6 @@
 """The out-of-class benchmark: diagnose records whose hidden effect is none of the candidates' forms.
 
-The in-class benchmark (:mod:`parksteer.diagnose.benchmark`) hides candidates in records made by the model the
+The in-class benchmark (:mod:`parksteer.experiments.benchmark`) hides candidates in records made by the model the
 diagnosis fits. Here the truth comes from elsewhere (:func:`parksteer.synthetic.datasets.make_outclass_dataset`):
 a rival effect that is not a diagnosis candidate (gear efficiency, a tyre breakaway peak, a Maxwell carcass
 branch, top-mount wind-up, a nonlinear linkage, rolling resistance), integrated handwheel-driven at a tighter

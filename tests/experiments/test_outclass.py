@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from parksteer.diagnose.candidates import candidate_effects
-from parksteer.diagnose.outclass import outcome, run_case
+from parksteer.experiments.outclass import outcome, run_case
 from parksteer.errors import UsageError
 from parksteer.model.symbolic.components import discover_effects, resolve_effects
 from parksteer.parameters import DEFAULT_PATH, load_parameters

@@ -46,7 +46,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import portable as pm
-from .select import Diagnosis
+from ..diagnose.select import Diagnosis
 
 # STLSQ thresholds tried, in noise floors RMS of a term's contribution (a coefficient of the unit-RMS terms)
 STLSQ_THRESHOLDS = (0.05, 0.1, 0.2, 0.3, 0.5, 0.75, 1.0, 1.5, 2.0, 3.0)
@@ -314,7 +314,7 @@ def case_result(truth: dict, diagnosis: Diagnosis, result: dict, wall_s: float, 
         "time_s": {"diagnose": wall_s, "upstream": upstream, "stlsq": answers["time_s"]["stlsq"],
                    "frols": answers["time_s"]["frols"]},
         # model replays (the same on any machine): the whole diagnosis's, and those up to its signatures
-        "replays": {"diagnose": diagnosis.problem.evaluations,
+        "replays": {"diagnose": diagnosis.replays,
                     "upstream": diagnosis.replays_by_stage["signatures_and_scores"]},
     }
 
@@ -338,9 +338,9 @@ def diagnose_case(params, folder, truth: dict, benchmark: str, split: str) -> di
     from ..synthetic.datasets import file_name
     from ..synthetic.variations import variation_by_name
     from .benchmark import BENCHMARK_SETTINGS
-    from .problem import load_files
-    from .report import diagnosis_dict
-    from .select import diagnose
+    from ..diagnose.problem import load_files
+    from ..diagnose.report import diagnosis_dict
+    from ..diagnose.select import diagnose
 
     settings = BENCHMARK_SETTINGS
     if benchmark == "variations":  # as variations.run_case diagnoses it
@@ -375,7 +375,7 @@ def score_method(cases: list[dict], method: str, setting: str | None = None) -> 
     nulls called adequate, and on the out-of-class rivals what it said (closest or related candidate, unrelated
     candidate, unexplained, adequate). A peer's unrelated candidate is a confident wrong answer (a peer reports no
     doubt beside it); the diagnosis's is confident when its BIC margin is beyond its indistinguishable band
-    (:func:`parksteer.diagnose.outclass.outcome`)."""
+    (:func:`parksteer.experiments.outclass.outcome`)."""
     from .variations import NAMED_MIN_STEPS
 
     hidden = [c for c in cases if c["benchmark"] == "variations" and c["truth"]["hidden"] is not None

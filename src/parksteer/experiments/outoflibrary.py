@@ -31,22 +31,19 @@ from ..measure.io import write_measurement
 from ..model.symbolic.components import resolve_effects
 from ..parameters import Parameters
 from ..synthetic.datasets import perturbed_base, rms_difference
-from ..synthetic.logger import quantisation_step
+from ..measure.converter import quantisation_step
 from ..synthetic.outoflibrary import FORMS, form_by_name
 from ..synthetic.variations import VARIATIONS, variation_rack, variation_record
-from .benchmark import BENCHMARK_SETTINGS
-from .problem import load_files
-from .select import diagnose
-from .signature import signature_of
-from .suggest import suggest
+from .benchmark import BASE_PERTURBATION, BENCHMARK_SETTINGS
+from ..diagnose.problem import load_files
+from ..diagnose.select import diagnose
+from ..diagnose.signature import signature_of
+from ..diagnose.suggest import suggest
 
 CLASS_TARGET = 0.80
 SUGGESTION_TARGET = 0.70
 AFTER_LIMIT = 1.3  # noise floors
 PROBE_DT_S = 0.01
-# The in-class benchmark's base perturbation (config/config.yaml benchmark.perturbation), relative 1-sigma.
-PERTURBATION = {"tyre.friction_coefficient": 0.10, "steering.rack_friction_force": 0.15,
-                "tyre.carcass_torsional_stiffness": 0.20}
 
 
 @dataclass(frozen=True)
@@ -68,7 +65,7 @@ class SignatureDesign:
     variations: int = 6
     seed: int = 2411
     first_variation: int = 0
-    perturbation: dict = field(default_factory=lambda: dict(PERTURBATION))
+    perturbation: dict = field(default_factory=lambda: dict(BASE_PERTURBATION))
 
     def cases(self) -> list[SignatureCase]:
         out, k = [], 0

@@ -40,13 +40,13 @@ from ..model.symbolic.components import discover_effects, resolve_effects
 from ..parameters import Parameters
 from ..synthetic.assisted import OUT_OF_CLASS, AssistedLogger, assisted_clean, assisted_record
 from ..synthetic.datasets import SizeSearch, perturbed_base, rms_difference, strength_for_rms
-from ..synthetic.logger import quantisation_step
+from ..measure.converter import quantisation_step
 from ..synthetic.variations import variation_by_name
-from .benchmark import BENCHMARK_SETTINGS
+from .benchmark import BASE_PERTURBATION, BENCHMARK_SETTINGS
 from .outclass import bic_margin
-from .problem import load_files
-from .report import diagnosis_dict
-from .select import diagnose
+from ..diagnose.problem import load_files
+from ..diagnose.report import diagnosis_dict
+from ..diagnose.select import diagnose
 from .variations import NAMED_MIN_STEPS, NAMED_TARGET, NULL_ADEQUATE_TARGET
 
 RACK_FRICTION = "steering.rack_friction_force"
@@ -62,12 +62,11 @@ UPPER = {"assist_motor_friction": 0.5, "torsion_bar_offset": 2.0, "boost_gain_er
 # The channels' noise, relative to their parking range as the variation benchmark's (0.1 N m on a 12 N m peak: 0.8 %):
 # 0.03 N m on a torsion bar's 3.5 N m, 0.25 A on a current's 27 A. With channels twice as clean (0.02 N m, 0.1 A)
 # the nulls are adequate too (20 of 20), now that the replay ensemble smooths at every knot spacing the rack data
-# allow (parksteer.diagnose.problem.ensemble_sources): about one spline it missed the smoothing's bias at the lock
+# allow (parksteer.diagnose.ensemble.ensemble_sources): about one spline it missed the smoothing's bias at the lock
 # reversals, where the rack turns by less than its resolution, and 6 of 20 came out unexplained or missing.
 TORQUE_NOISE_NM = 0.03
 CURRENT_NOISE_A = 0.25
 SEARCH = SizeSearch(iterations=4, tolerance=0.05, max_lag_s=0.0)
-PERTURBATION = {"tyre.friction_coefficient": 0.10, RACK_FRICTION: 0.15, "tyre.carcass_torsional_stiffness": 0.20}
 
 
 @dataclass(frozen=True)
@@ -136,7 +135,7 @@ def case_truth_and_record(params: Parameters, design: AssistedDesign, case: Assi
     hand, _ = variation.settings(case.seed)
     logger = _logger(variation, case.seed)
     step = quantisation_step(logger.torque_full_scale_Nm, logger.torque_bits)
-    base = perturbed_base(params, case.seed, PERTURBATION)
+    base = perturbed_base(params, case.seed, BASE_PERTURBATION)
     spec, key, strength, out_of_class = assist, None, None, None
 
     def torque(effects: str, overrides: dict, change=None) -> np.ndarray:

@@ -1,0 +1,146 @@
+"""The replay engine: everything of a diagnosis that replays and changes, in one object the stages are handed.
+
+The state a stage reads and returns (:class:`parksteer.diagnose.state.DiagnosisState`) is frozen; what replays
+cannot be: models are compiled and prepared, replays are kept for reuse, worker processes are started, solves
+are counted. :func:`parksteer.diagnose.select.diagnose` makes one :class:`ReplayEngine` and hands it to every
+stage (``stage.run(state, engine)``). It is openly mutable and keeps its counts on itself, as scipy's
+``OdeSolver`` keeps ``nfev`` on the solver that spends them. It owns:
+
+- `models`: the compiled models loaded (:class:`parksteer.model.numeric.compiled.CompiledModels`);
+- `hosts`: which compiled model each effect set is replayed on (:func:`parksteer.diagnose.candidates.replay_models`:
+  most candidates share the diagnosis model);
+- `direct`: which quantities only enter a compiled model's equations (found once per model and key,
+  :meth:`parksteer.diagnose.replay.Replay._is_direct`);
+- `replays`: one :class:`parksteer.diagnose.replay.Replay` per effect set, file and generation of replay instants
+  (:attr:`parksteer.diagnose.problem.Problem.instants`), each counting its own solves;
+- `pool`, `workers`: the worker processes a prediction spreads its files over (:mod:`parksteer.diagnose.parallel`);
+- `other_replays`: the solves not counted by a kept replay (run in worker processes, or on the replay ensemble's
+  racks), so that :attr:`evaluations` counts every solve the diagnosis ran.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+from ..model.numeric.compiled import CompiledModels
+from ..model.symbolic.components import Effect
+from .parallel import fork_map, forks, pool, pool_map
+from .problem import Problem
+from .replay import Replay
+
+
+def effect_key(effects: list[Effect]) -> tuple[str, ...]:
+    """An effect set's key: its effects' names, sorted."""
+    return tuple(sorted(e.name for e in effects))
+
+
+class ReplayEngine:
+    """The replays of one diagnosis (module docstring). `workers` > 1 spreads independent replays over forked
+    processes (the same numbers as in line); `hosts` maps an effect set's key (:func:`effect_key`) to the effects
+    of the compiled model it is replayed on, each host's effects beyond the set absent at their values in the
+    parameters (:func:`parksteer.diagnose.candidates.shares_diagnosis_model`). :meth:`close` ends the pool."""
+
+    def __init__(self, workers: int = 1, hosts: dict[tuple[str, ...], list[Effect]] | None = None):
+        self.workers = max(int(workers), 1)
+        self.models = CompiledModels()
+        self.hosts: dict[tuple[str, ...], list[Effect]] = dict(hosts or {})
+        self.direct: dict[tuple[str, str], bool] = {}
+        self.replays: dict[tuple, Replay] = {}
+        self.other_replays = 0
+        self.pool = None
+
+    @property
+    def evaluations(self) -> int:
+        """Every solve run so far: those of the kept replays and :attr:`other_replays`."""
+        return sum(r.evaluations for r in self.replays.values()) + self.other_replays
+
+    def count(self, evaluations: int) -> None:
+        """Count solves no kept replay counts (run in worker processes, or on one-off racks)."""
+        self.other_replays += evaluations
+
+    def new_replay(self, effects: list[Effect], case: str, surface: str, params, rack, time_s) -> Replay:
+        """A replay of `effects` on its host's compiled model, sharing what the engine knows of that model; not kept
+        (its solves are not counted)."""
+        return Replay(list(effects), case, surface, params, rack, time_s,
+                      model_effects=self.hosts.get(effect_key(effects), list(effects)), direct=self.direct,
+                      models=self.models)
+
+    def replay(self, problem: Problem, effects: list[Effect], index: int) -> Replay:
+        """The kept replay of `effects` on file `index` of `problem`, at the file's instants (made when first asked
+        for in the problem's generation of instants)."""
+        key = (effect_key(effects), index, problem.instants)
+        if key not in self.replays:
+            f = problem.files[index]
+            self.replays[key] = self.new_replay(effects, f.case, f.surface, problem.params, f.rack, f.replay_time_s)
+        return self.replays[key]
+
+    def signals(self, problem: Problem, effects: list[Effect], index: int, overrides: dict[str, float] | None = None,
+                replay: Replay | None = None) -> np.ndarray:
+        """File `index`'s fitted signals replayed: the torque, then the handwheel angle or the motor channel where
+        fitted.
+
+        The angle channel's zero is the sensor's, not the model's: with ``angle_offset_fitted`` the replayed
+        angle is shifted by the mean of the measured minus replayed angle (a constant fitted in closed form)."""
+        f = problem.files[index]
+        replay = replay if replay is not None else self.replay(problem, effects, index)
+        if f.uses_motor:  # an assisted car's torsion-bar torque and its motor's current or torque
+            solution = replay.solve(overrides)
+            motor = solution.motor_current_A if f.motor_column == "motor_current_A" else solution.motor_torque_Nm
+            return np.concatenate([solution.torque_Nm, motor])
+        if not f.uses_angle:
+            return replay.torque(overrides)
+        solution = replay.solve(overrides, outputs=True)
+        angle = solution.handwheel[:, 0]
+        if problem.angle_offset_fitted:
+            angle = angle + float(np.mean(f.angle_rad - angle))
+        return np.concatenate([solution.torque_Nm, angle])
+
+    def parallel_files(self, problem: Problem) -> bool:
+        """Whether predictions on `problem` spread its files over the workers (else the callers spread candidates)."""
+        return len(problem.files) > 1 and forks(len(problem.files), self.workers)
+
+    def predict(self, problem: Problem, effects: list[Effect], overrides: dict[str, float] | None = None
+                ) -> list[np.ndarray]:
+        """The fitted signals replayed at every file's samples (one array per file).
+
+        With several files and workers, on a pool forked once, at the first such prediction: its workers serve
+        the problem and the replays as they were then (a worker's replays are its own copies)."""
+        if self.parallel_files(problem):
+            if self.pool is None:
+                self.pool = pool(self.workers, lambda task, problem=problem: self.signals(problem, *task))
+            if self.pool is not None:
+                tasks = [(list(effects), i, overrides) for i in range(len(problem.files))]
+                out = pool_map(self.pool, tasks)
+                self.count(len(tasks))
+                return out
+        return [self.signals(problem, effects, i, overrides) for i in range(len(problem.files))]
+
+    def map(self, function: Callable, items: list) -> list:
+        """``[function(item) for item in items]`` on the workers (:func:`parksteer.diagnose.parallel.fork_map`)."""
+        return fork_map(function, items, self.workers)
+
+    def in_workers(self, problem: Problem, function: Callable, items: list, by_candidate: bool) -> list:
+        """`function` over `items` (candidates), spread over the workers if `by_candidate` or the predictions do
+        not spread the files; the solves the workers ran are counted. `function` must return what pickles: a
+        result that holds effects returns a copy without them (``dataclasses.replace``), and the caller puts them
+        back."""
+        if (self.parallel_files(problem) and not by_candidate) or not forks(len(items), self.workers):
+            return [function(item) for item in items]
+
+        def counted(item):
+            before = self.evaluations
+            return function(item), self.evaluations - before
+
+        out = self.map(counted, items)
+        self.count(sum(evaluations for _, evaluations in out))
+        return [result for result, _ in out]
+
+    def close(self) -> None:
+        """End the worker pool, if one was started; later predictions run in line."""
+        self.workers = 1
+        if self.pool is not None:
+            self.pool.close()
+            self.pool.join()
+            self.pool = None

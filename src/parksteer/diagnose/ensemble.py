@@ -1,0 +1,152 @@
+"""The replay ensemble: how far the replay alone can be off at each sample.
+
+The replay uncertainty is found by propagation, not assumed: the smoothed rack is one
+spline among many the rack data allow equally well. When the file states its logger (the
+rack's full scale and bits), the smoothed rack is logged again (analog noise, rounding to
+the converter's levels) and smoothed again, a few times
+(:func:`relogged_rack`, a parametric bootstrap of the
+whole logging and smoothing); otherwise splines are drawn from the least-squares
+distribution of the coefficients, as if the rack noise were white
+(:meth:`parksteer.measure.smoothing.SmoothedRack.perturbed`). The draws start from the rack smoothed at each
+knot spacing the data allow (:func:`ensemble_sources`), not from the chosen spline alone: at a reversal the
+spacing, not the data, sets how the spline eases through zero speed. Replaying them and taking the
+spread of the torque at each sample gives how far the replay alone can be off there (where the
+smoothing held an end of the record or a pause of the hand at rest, every other draw leaves
+them free: a record cut while the hand is still slowing passes the smoothing's rest test, the
+edges of a pause are not sharp, and the rack friction there hangs on that choice). It is tiny on the
+plateaus and large at a reversal, where the rack friction flips within about a millimetre
+per second of zero speed, so the turning time the data allow decides which sample carries
+the torque drop. Each sample then has an attainable error ``sigma_i = sqrt(noise_floor^2 +
+delta_i^2)``; residuals are weighted by it (``(measured - model) / sigma_i``), so a fit
+listens to the samples the replay can predict, and a perfect model has weighted residuals
+of unit variance.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+from scipy.ndimage import maximum_filter1d
+
+from .. import portable as pm
+from ..measure.converter import add_noise, quantise
+from ..measure.smoothing import SmoothedRack, smooth_rack
+from ..model.symbolic.components import Effect
+from .engine import ReplayEngine
+from ..measure.column import rack_logger
+from .problem import FileData, Problem
+from .settings import DEFAULT_SETTINGS
+
+
+def with_replay_uncertainty(engine: ReplayEngine, problem: Problem, effects: list[Effect],
+                            overrides: dict[str, float] | None = None,
+                            draws: int = DEFAULT_SETTINGS.replay_ensemble_draws,
+                            seed: int = DEFAULT_SETTINGS.replay_ensemble_seed, keep_larger: bool = False) -> Problem:
+    """`problem` on files with their replay uncertainty: the spread of replays, by `engine`, of racks the data
+    allow (module docstring).
+
+    The spread is widened by one sample either side (a running maximum), since a torque
+    drop the draws place on one sample may fall on its neighbour. With `keep_larger`, each
+    sample keeps the larger of this and the uncertainty already estimated.
+    """
+    rng = np.random.default_rng(seed)
+    # The racks are drawn in line, in order (one random stream), then replayed side by side.
+    racks = []
+    for i, f in enumerate(problem.files):
+        base = engine.replay(problem, effects, i)
+        base.parameter_vector(overrides)  # any run the overrides need is prepared once, here
+        logger = rack_logger(f.measurement, problem.params)
+        # An end held at rest may be a hand still slowing there, and a pause's edges are not sharp
+        # (smoothing.RACK_REST_TEST_CHI2, RACK_REST_MIN_S): every other draw smooths with the ends and the
+        # pauses free, so the samples there carry that doubt.
+        released = any(f.rack.held_at_rest) or bool(f.rack.rest_intervals_s)
+        sources = ensemble_sources(f, draws, released)
+        for k in range(draws):
+            source, hold = sources[k]
+            if logger is not None:
+                rack = relogged_rack(source, f.time_s, *logger, rng, hold_rest=hold)
+            else:
+                rack = source.perturbed(rng)
+            racks.append((base, rack))
+        engine.count(draws)  # the draws' solves (on one-off replays)
+    owners = [i for i in range(len(problem.files)) for _ in range(draws)]
+    replayed = engine.map(
+        lambda job: engine.signals(problem, effects, job[0], overrides, job[1][0].on_rack(job[1][1])),
+        list(zip(owners, racks)))
+    files = []
+    for i, f in enumerate(problem.files):
+        runs = np.array(replayed[i * draws : (i + 1) * draws])
+        torque_runs = runs[:, : f.n]
+        f = replace(f, replay_draws_Nm=torque_runs - torque_runs.mean(axis=0),
+                    replay_uncertainty_Nm=_spread(torque_runs, f.replay_uncertainty_Nm if keep_larger else None))
+        if f.uses_angle:  # each draw's angle carries its own fitted zero (Problem.signals)
+            angle_runs = runs[:, f.n : 2 * f.n]
+            # The replayed torque is itself off by about its attainable error, and the twist that passes it by
+            # as much through the column's compliance (in a dead band: the band, where |T| is that small).
+            through_torque = engine.replay(problem, effects, i).twist_spread(f.sigma_Nm, overrides)
+            spread = pm.hypot(_spread(angle_runs, None), maximum_filter1d(through_torque, size=3, mode="nearest"))
+            before = f.replay_uncertainty_rad if keep_larger else None
+            f = replace(f, replay_draws_rad=angle_runs - angle_runs.mean(axis=0),
+                        replay_uncertainty_rad=spread if before is None else np.maximum(spread, before))
+        if f.uses_motor:
+            motor_runs = runs[:, f.m - f.n :]
+            before = f.replay_uncertainty_motor if keep_larger else None
+            f = replace(f, replay_draws_motor=motor_runs - motor_runs.mean(axis=0),
+                        replay_uncertainty_motor=_spread(motor_runs, before))
+        files.append(f)
+    return problem.with_files(files)
+
+
+def _spread(runs: np.ndarray, before: np.ndarray | None) -> np.ndarray:
+    """The draws' standard deviation at each sample, widened by one sample either side; at least `before`."""
+    spread = maximum_filter1d(np.std(runs, axis=0, ddof=1), size=3, mode="nearest")
+    return spread if before is None else np.maximum(spread, before)
+
+
+def ensemble_sources(f: FileData, draws: int, released: bool) -> list[tuple[SmoothedRack, bool]]:
+    """The smoothed rack each draw of the replay ensemble is logged again from, and whether it holds rests.
+
+    The knot spacing is not fixed by the data: every spacing tried whose fit passes the discrepancy test
+    (:attr:`parksteer.measure.smoothing.SmoothedRack.passing_spacings_s`) fits the rack to within its noise, and
+    the smoothing keeps the coarsest only because the noise estimate cannot choose between them. Away from a
+    reversal they agree; at a reversal they do not, since there the rack stays within a converter step or its
+    noise for a tenth of a second or more, and how the spline eases into and out of the turn (which sets when
+    the speed passes the millimetre per second over which the rack friction turns over) is set by its knots, not
+    by the data. Redrawing the noise about one spline (the chosen one) measures that spline's variance but not
+    this choice: on a sound car's record at 50 Hz (the Polo, rate_8pc_50Hz) the chosen spline's replay was
+    1.3 N m off at the reversals where the draws spread by 0.08 N m, while replays of the other passing
+    spacings bracket the truth. So the draws are spread over the passing spacings, the chosen one first and the
+    finest last (evenly by index); with `released`, the draws come in pairs, the first of each pair held at rest
+    as the chosen spline is, the second with the ends and pauses free. A record whose chosen spacing is the
+    only one to pass draws as before.
+    """
+    spacings = f.rack.passing_spacings_s
+    pair = 2 if released else 1
+    slots = max(draws // pair, 1)
+    smoothed = {}
+
+    def at(spacing: float, hold: bool) -> SmoothedRack:
+        if hold and spacing == f.rack.knot_spacing_s:
+            return f.rack
+        if (spacing, hold) not in smoothed:
+            smoothed[spacing, hold] = smooth_rack(f.time_s, f.rack_m, spacing, hold_rest=hold,
+                                                  rest_resolution_m=f.rack.rest_resolution_m)
+        return smoothed[spacing, hold]
+
+    out = []
+    for k in range(draws):
+        slot = (k // pair) % slots
+        index = int(slot * (len(spacings) - 1) / (slots - 1) + 0.5) if slots > 1 else 0
+        hold = not (released and k % 2)
+        out.append((at(spacings[index], hold), hold))
+    return out
+
+
+def relogged_rack(rack: SmoothedRack, time_s: np.ndarray, full_scale: float, bits: int, analog_rms: float,
+                  rng: np.random.Generator, hold_rest: bool = True) -> SmoothedRack:
+    """A rack the logger could equally have recorded: `rack` at `time_s` with analog noise of `analog_rms`,
+    rounded to the levels of a `bits` converter over +-`full_scale`, and smoothed again
+    (:meth:`parksteer.measure.smoothing.SmoothedRack.resmoothed`)."""
+    return rack.resmoothed(time_s, lambda clean: quantise(add_noise(clean, analog_rms, rng), full_scale, bits),
+                           hold_rest)
