@@ -212,3 +212,31 @@ def test_the_comparison_tunes_on_the_tuning_split_and_scores_on_the_evaluation_r
     # a peer replays nothing of its own: what it needs is the diagnosis's replays up to the signatures
     assert (ours["replays_median"], stlsq_row["replays_median"], stlsq_row["replays_with_upstream_median"]) == \
         (200, 0, 120)
+
+
+@pytest.mark.slow
+def test_the_peers_run_beside_a_benchmark_batch_are_those_of_diagnosing_its_files_again(tmp_path):
+    """The variation and out-of-class batches run the peers on the diagnosis they have just made
+    (peers_beside), instead of a peers job reading the written records back and diagnosing them again: the same
+    records and settings give the same diagnosis, so both records agree in everything but the machine's times."""
+    import json
+
+    from parksteer.experiments.benchmark import BASE_PERTURBATION, run_batch
+    from parksteer.experiments.peers import peers_beside, peers_file_name, run_peer_batch
+    from parksteer.experiments.variations import VariationDesign, run_case, variation_cases
+    from parksteer.parameters import DEFAULT_PATH
+
+    files = (("unladen", "ground"), ("part_laden", "ground"), ("offset_68_5mm", "ground"))
+    design = VariationDesign(("pauses",), 1, ("rack_stiction",), (3.5,), files, 11, BASE_PERTURBATION)
+    name = next(c.name for c in variation_cases(design) if c.hidden is None)
+    batch = tmp_path / "variations_00"
+    run_batch(run_case, DEFAULT_PATH, design, [name], batch, on_diagnosis=peers_beside("variations"))
+    beside = json.loads((batch / peers_file_name("evaluation", name)).read_text(encoding="utf-8"))
+    run_peer_batch(DEFAULT_PATH, [f"variations:{batch / (name + '.truth.json')}"], tmp_path / "peers")
+    again = json.loads((tmp_path / "peers" / peers_file_name("evaluation", name)).read_text(encoding="utf-8"))
+    for record in (beside, again):
+        record.pop("time_s")
+    assert beside == again
+    said = beside["diagnosis"]
+    assert beside["replays"]["diagnose"] > 0
+    assert said["benchmark_said"] == (said["effect"] if said["verdict"] == "missing" else said["verdict"])

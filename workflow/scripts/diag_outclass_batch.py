@@ -1,10 +1,12 @@
-# Thin rule script: the logic is parksteer.experiments.outclass.run_case, once per case of the job (run_batch).
+# Thin rule script: the logic is parksteer.experiments.outclass.run_case, once per case of the job (run_batch);
+# the peers run on each diagnosis as it is made (parksteer.experiments.peers.peers_beside).
 from parksteer.experiments.benchmark import run_batch
 from parksteer.experiments.outclass import run_case
+from parksteer.experiments.peers import peers_beside
 from parksteer.rules import rule_log
 from parksteer.synthetic.datasets import OutclassDesign
 
 with rule_log(snakemake):
     run_batch(run_case, snakemake.input.parameters,
               OutclassDesign.from_config(snakemake.params.design, snakemake.params.benchmark),
-              snakemake.params.cases, snakemake.output[0])
+              snakemake.params.cases, snakemake.output[0], on_diagnosis=peers_beside("outclass"))

@@ -58,22 +58,26 @@ def case_names(design: BenchmarkDesign, params: Parameters | None = None) -> lis
 
 def diagnose_written(params: Parameters, records, folder: str | Path, truth: dict, truth_path: str | Path,
                      diagnosis_path: str | Path, started_s: float,
-                     settings: DiagnosisSettings = BENCHMARK_SETTINGS) -> dict:
+                     settings: DiagnosisSettings = BENCHMARK_SETTINGS, on_diagnosis: Callable | None = None) -> dict:
     """Write `records` ((case, surface, measurement) each) into `folder`, diagnose them from the files (read back
     through the reader a user's file goes through) with `settings`, write the truth and the result. The result's
     cost gains the diagnosis's wall time and the generation's (from `started_s`, a perf_counter reading, to the
-    files written)."""
+    files written). `on_diagnosis(diagnosis, result, truth_path, diagnosis_path)`, when given, is handed the
+    diagnosis once both are written: another experiment on the same replays (the peers) without diagnosing again."""
     paths = []
     for case, surface, measurement in records:
         path = Path(folder) / file_name(case, surface)
         write_measurement(path, measurement, params)
         paths.append(path)
     generated = time.perf_counter()
-    result = diagnosis_dict(diagnose(load_files(paths, params), params, settings=settings))
+    diagnosis = diagnose(load_files(paths, params), params, settings=settings)
+    result = diagnosis_dict(diagnosis)
     result["cost"]["wall_s"] = time.perf_counter() - generated
     result["cost"]["generation_s"] = generated - started_s
     write_json(truth_path, truth)
     write_json(diagnosis_path, result)
+    if on_diagnosis is not None:
+        on_diagnosis(diagnosis, result, truth_path, diagnosis_path)
     return result
 
 
@@ -84,14 +88,15 @@ def case_files(folder: str | Path, name: str) -> tuple[Path, Path, Path]:
     return folder / name, folder / f"{name}.truth.json", folder / f"{name}.diagnosis.json"
 
 
-def run_batch(run_case: Callable, parameters_path: str | Path, design, names: list[str], folder: str | Path) -> None:
+def run_batch(run_case: Callable, parameters_path: str | Path, design, names: list[str], folder: str | Path,
+              **options) -> None:
     """Run the cases `names` of one benchmark job, each with `run_case` (this module's, the out-of-class or the
-    variation benchmark's: ``run_case(parameters_path, design, name, records_folder, truth_path, diagnosis_path)``)
-    into its place in `folder` (:func:`case_files`)."""
+    variation benchmark's: ``run_case(parameters_path, design, name, records_folder, truth_path, diagnosis_path,
+    **options)``) into its place in `folder` (:func:`case_files`)."""
     for name in names:
         records, truth, diagnosis = case_files(folder, name)
         records.mkdir(parents=True, exist_ok=True)
-        run_case(parameters_path, design, name, records, truth, diagnosis)
+        run_case(parameters_path, design, name, records, truth, diagnosis, **options)
 
 
 def paired_results(truth_paths, diagnosis_paths, what: str) -> Iterator[tuple[dict, dict]]:

@@ -31,8 +31,10 @@ def case_names(design: OutclassDesign, params=None) -> list[str]:
     return [s.name for s in outclass_specs(params or load_parameters(), design)]
 
 
-def run_case(parameters_path, design: OutclassDesign, name: str, folder, truth_path, diagnosis_path) -> dict:
-    """Generate out-of-class data set `name`, write its files into `folder`, diagnose them from the files."""
+def run_case(parameters_path, design: OutclassDesign, name: str, folder, truth_path, diagnosis_path,
+             on_diagnosis=None) -> dict:
+    """Generate out-of-class data set `name`, write its files into `folder`, diagnose them from the files;
+    `on_diagnosis` as :func:`~parksteer.experiments.benchmark.diagnose_written` takes it."""
     params = load_parameters(parameters_path)
     specs = {s.name: s for s in outclass_specs(params, design)}
     if name not in specs:
@@ -40,7 +42,8 @@ def run_case(parameters_path, design: OutclassDesign, name: str, folder, truth_p
     start = time.perf_counter()
     dataset = make_outclass_dataset(params, specs[name], design)
     records = [(case, surface, m) for m, (case, surface) in zip(dataset.measurements, specs[name].files)]
-    return diagnose_written(params, records, folder, dataset.truth, truth_path, diagnosis_path, start)
+    return diagnose_written(params, records, folder, dataset.truth, truth_path, diagnosis_path, start,
+                            on_diagnosis=on_diagnosis)
 
 
 def bic_margin(result: dict) -> float | None:

@@ -576,6 +576,26 @@ def run_peer_batch(parameters_path, jobs: list[str], folder, tuning=None) -> Non
         write_json(out / peers_file_name(result["split"], result["name"]), result)
 
 
+def peers_beside(benchmark: str):
+    """The `on_diagnosis` of the variation or out-of-class benchmark's batch (`benchmark`): each case's peers run on
+    the diagnosis the batch has just made, written beside its diagnosis as ``evaluation__<case>.peers.json``, the
+    record :func:`run_peer_batch` would make by diagnosing the written files again (the same records and settings,
+    so the same diagnosis): the comparison's evaluation split costs no replay of its own."""
+    import json
+    from pathlib import Path
+
+    from ..tables import write_json
+
+    def write(diagnosis: Diagnosis, result: dict, truth_path, diagnosis_path) -> None:
+        truth = json.loads(Path(truth_path).read_text(encoding="utf-8"))  # as a peers job reads it back
+        record = case_result(truth, diagnosis, result, result["cost"]["wall_s"], "evaluation", benchmark)
+        record["diagnosis"]["benchmark_said"] = result["effect"] if result["verdict"] == "missing" \
+            else result["verdict"]
+        write_json(Path(diagnosis_path).with_name(peers_file_name("evaluation", truth["name"])), record)
+
+    return write
+
+
 def peers_file_name(split: str, name: str) -> str:
     return f"{split}__{name}.peers.json"
 

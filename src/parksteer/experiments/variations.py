@@ -223,13 +223,15 @@ def case_truth(params: Parameters, design: VariationDesign, case: VariationCase)
 
 
 def run_case(parameters_path, design: VariationDesign, name: str, folder, truth_path, diagnosis_path,
-             settings: DiagnosisSettings = BENCHMARK_SETTINGS) -> dict:
+             settings: DiagnosisSettings = BENCHMARK_SETTINGS, on_diagnosis=None) -> dict:
     """Make variation case `name`'s records, write them into `folder`, diagnose them from the files with
-    `settings` (and the angle and lag settings below)."""
+    `settings` (and the angle and lag settings below); `on_diagnosis` as
+    :func:`~parksteer.experiments.benchmark.diagnose_written` takes it."""
     params = load_parameters(parameters_path)
     start = time.perf_counter()
     truth, records, settings = case_records(params, design, name, settings)
-    return diagnose_written(params, records, folder, truth, truth_path, diagnosis_path, start, settings)
+    return diagnose_written(params, records, folder, truth, truth_path, diagnosis_path, start, settings,
+                            on_diagnosis=on_diagnosis)
 
 
 def case_records(params: Parameters, design: VariationDesign, name: str,
