@@ -133,7 +133,9 @@ def effects_of(args, params) -> list:
     from ..model.symbolic.components import resolve_effects
 
     if not getattr(args, "with_assist", False):
-        return resolve_effects(args.effects)
+        effects = resolve_effects(args.effects)
+        _warn_unused_assist(args, params, effects)
+        return effects
     if args.vehicle is None:
         raise UsageError("--with-assist needs --vehicle FILE (the assist is the vehicle file's [assist])")
     from ..model.numeric.assist import check_assist, effects_with_assist
@@ -141,6 +143,20 @@ def effects_of(args, params) -> list:
     if check_assist(params) is None:
         raise UsageError(f"--with-assist: {args.vehicle} has no [assist] section")
     return resolve_effects(effects_with_assist(args.effects, params))
+
+
+def _warn_unused_assist(args, params, effects) -> None:
+    """One line on stderr when the vehicle file has an [assist] the run leaves out: the record is then fitted as
+    the car without assistance, its torque as the whole steering torque, which a record of the car with its
+    assist working (a bus log's torsion-bar torque, say) is not."""
+    if getattr(args, "vehicle", None) is None or assist_of_effects(effects) is not None:
+        return
+    from ..vehicle import assist_of
+
+    if assist_of(params) is not None:
+        print(f"parksteer {args.command}: warning: {args.vehicle} has an [assist] section, left out: the records "
+              "are fitted as the car without assistance; if they were logged with the assist working, add "
+              "--with-assist", file=sys.stderr)
 
 
 # A record's speed channel gives the run's one constant speed (the model has no time-varying speed): its middle 90 %
