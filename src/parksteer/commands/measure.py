@@ -135,14 +135,31 @@ def effects_of(args, params) -> list:
     if not getattr(args, "with_assist", False):
         effects = resolve_effects(args.effects)
         _warn_unused_assist(args, params, effects)
-        return effects
+        return _by_reference(effects)
     if args.vehicle is None:
         raise UsageError("--with-assist needs --vehicle FILE (the assist is the vehicle file's [assist])")
     from ..model.numeric.assist import check_assist, effects_with_assist
 
     if check_assist(params) is None:
         raise UsageError(f"--with-assist: {args.vehicle} has no [assist] section")
-    return resolve_effects(effects_with_assist(args.effects, params))
+    return _by_reference(resolve_effects(effects_with_assist(args.effects, params)))
+
+
+def _by_reference(effects: list) -> list:
+    """`effects`, each one's class findable by its module's name. An effect loaded from a file (--effects=+path.py)
+    is of a module kept out of sys.modules (its name carries a hash of the file's text:
+    parksteer.model.symbolic.components.load_effect_module), and the diagnosis's worker pool pickles the effects it
+    sends to its forked workers, which looks a class up by that name: the class is registered under it here, before
+    any pool forks, so the workers inherit it."""
+    import types
+
+    for effect in effects:
+        cls = type(effect)
+        if cls.__module__ not in sys.modules and "." not in cls.__qualname__:
+            module = types.ModuleType(cls.__module__)
+            setattr(module, cls.__qualname__, cls)
+            sys.modules[cls.__module__] = module
+    return effects
 
 
 def _warn_unused_assist(args, params, effects) -> None:
