@@ -12,6 +12,9 @@ What a document may say about a block, in HTML comments the rendered page does n
 - ``<!-- docs-test: skip (REASON) -->`` before a block: it is not run (the whole pipeline, a SLURM cluster, a
   benchmark of minutes); REASON is required and is listed in the test's output;
 - ``<!-- docs-test: skip-line "TEXT" (REASON) -->`` before a block: its commands containing TEXT are left out;
+- ``<!-- docs-test: heavy "TEXT" (REASON) -->`` before a block: its commands containing TEXT (a pipeline target or
+  a derivation of tens of seconds) run only with PARKSTEER_DOCS_TEST=full in the environment, so that the suite's
+  default run stays within its time; the full run is the same test with every such command in;
 - ``<!-- docs-test: exits N -->`` before a block: the block's last command must end with status N (a documented
   refusal), not 0;
 - ``<!-- docs-test: quotes VALUE from SOURCE: REGEX -->`` after a block: SOURCE (``output``, the block's stdout and
@@ -49,6 +52,8 @@ FENCE = re.compile(r"^```(\w*)\n(.*?)^```\n", re.S | re.M)
 MARKER = re.compile(r"<!--\s*docs-test:\s*(.*?)\s*-->", re.S)
 SKIP = re.compile(r"skip\s+\((.+)\)$", re.S)
 SKIP_LINE = re.compile(r'skip-line\s+"([^"]+)"\s+\((.+)\)$', re.S)
+HEAVY = re.compile(r'heavy\s+"([^"]+)"\s+\((.+)\)$', re.S)
+FULL = os.environ.get("PARKSTEER_DOCS_TEST") == "full"
 EXITS = re.compile(r"exits\s+(\d+)$")
 QUOTES = re.compile(r"quotes\s+(\S+)\s+from\s+(\S+?):\s+(.+)$", re.S)
 
@@ -94,11 +99,11 @@ def parse(document: str, text: str) -> list[Block]:
                 if last is None:
                     raise AssertionError(f"{document}:{line}: a quotes marker before any block")
                 last.quotes.append(QUOTES.match(body).groups())
-            elif SKIP.match(body) or SKIP_LINE.match(body) or EXITS.match(body):
+            elif SKIP.match(body) or SKIP_LINE.match(body) or HEAVY.match(body) or EXITS.match(body):
                 pending.append(body)
             else:
                 raise AssertionError(f"{document}:{line}: unknown docs-test marker {body!r} (skip (REASON), "
-                                     "skip-line \"TEXT\" (REASON), exits N, quotes VALUE from SOURCE: REGEX)")
+                                     "skip-line \"TEXT\" (REASON), heavy \"TEXT\" (REASON), exits N, quotes VALUE from SOURCE: REGEX)")
             continue
         language, body = item.group(1), item.group(2)
         if language != "sh":
@@ -114,6 +119,9 @@ def parse(document: str, text: str) -> list[Block]:
                 block.skip = m.group(1)
             elif (m := SKIP_LINE.match(marker)) is not None:
                 block.skip_lines.append((m.group(1), m.group(2)))
+            elif (m := HEAVY.match(marker)) is not None:
+                if not FULL:
+                    block.skip_lines.append((m.group(1), f"heavy, run with PARKSTEER_DOCS_TEST=full: {m.group(2)}"))
             else:
                 block.exits = int(EXITS.match(marker).group(1))
         pending = []
