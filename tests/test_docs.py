@@ -21,7 +21,8 @@ What a document may say about a block, in HTML comments the rendered page does n
   stderr, or a file the block wrote, relative to the copy) must match REGEX, its first group must be VALUE, and
   VALUE must appear in the document's text outside the markers: a number the prose quotes is the one printed.
 
-The marker checks (test_markers_*) are quick; running the blocks (test_document_runs) is marked slow.
+The marker checks are quick; running the blocks (TestDocuments*, in two groups that xdist runs side by side) and
+regenerating data/samples/ are marked slow.
 """
 
 from __future__ import annotations
@@ -222,9 +223,49 @@ def run_block(block: Block, work: Path, env: dict) -> tuple[int, str, float]:
     return done.returncode, done.stdout + done.stderr, time.perf_counter() - start
 
 
+# The documents in two groups of about the same run time: pytest-xdist's loadscope gives each class its own worker.
+GROUPS = {
+    "A": ["README.md", "docs/bus.md", "docs/model.md", "docs/assist.md", "docs/development.md", "docs/diagnosis.md"],
+    "B": ["docs/measurement.md", "docs/peers.md", "docs/reproducibility.md", "docs/scaling.md", "docs/signature.md",
+          "docs/sweeps.md", "docs/targets.md", "docs/vehicles.md", "docs/workflow.md"],
+}
+
+
+def test_every_document_in_one_group():
+    """A new document is run: each of README.md and docs/*.md is in exactly one group."""
+    grouped = [d for docs in GROUPS.values() for d in docs]
+    assert sorted(grouped) == sorted(DOCUMENTS)
+
+
 @pytest.mark.slow
-@pytest.mark.parametrize("document", DOCUMENTS)
-def test_document_runs(document, tmp_path, copy_repository, model_cache):
+class TestDocumentsA:
+    @pytest.mark.parametrize("document", GROUPS["A"])
+    def test_document_runs(self, document, tmp_path, copy_repository, model_cache):
+        run_document(document, tmp_path, copy_repository, model_cache)
+
+
+@pytest.mark.slow
+class TestDocumentsB:
+    @pytest.mark.parametrize("document", GROUPS["B"])
+    def test_document_runs(self, document, tmp_path, copy_repository, model_cache):
+        run_document(document, tmp_path, copy_repository, model_cache)
+
+    def test_samples_are_their_generator_s(self, tmp_path):
+        """data/samples/ holds what `python data/samples/make_samples.py` writes, byte for byte."""
+        import importlib.util
+
+        spec = importlib.util.spec_from_file_location("make_samples", REPO / "data" / "samples" / "make_samples.py")
+        module = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(module)
+        written = module.write_samples(tmp_path)
+        shipped = sorted(p.relative_to(REPO / "data" / "samples") for p in (REPO / "data" / "samples").rglob("*")
+                         if p.is_file() and p.suffix not in (".md", ".py"))
+        assert sorted(p.relative_to(tmp_path) for p in written) == shipped
+        for name in shipped:
+            assert (tmp_path / name).read_bytes() == (REPO / "data" / "samples" / name).read_bytes(), name
+
+
+def run_document(document, tmp_path, copy_repository, model_cache):
     """Each sh block of `document` runs in a scratch copy, in order, and ends with status 0 (or the status its exits
     marker states); each quote marker's value is what the block printed or wrote. Skipped blocks and lines are
     listed with their reasons on stdout."""

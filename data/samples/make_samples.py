@@ -12,7 +12,8 @@ be tried on a fresh clone before any pipeline has run.
   its column assist, kerb load on the ground, as its powertrain CAN sends it on the shipped ``vw_mqb`` bus
   (:func:`parksteer.measure.bus.encode_frames`: driver's torque at the torsion bar, steering-wheel angle, speed 0).
 
-Made again, byte for byte, by ``python -m parksteer.synthetic.samples data/samples`` (seeded; the BLF's header
+Made again, byte for byte, by ``python data/samples/make_samples.py`` (a script beside them, not part of the package:
+it drives the command line, which the package's synthetic layer may not import) (seeded; the BLF's header
 times are the frames' own; tests/test_docs.py checks the bytes).
 """
 
@@ -38,7 +39,7 @@ SEED = 3401
 
 def _simulate(*argv: str) -> tuple[dict[str, np.ndarray], dict[str, str]]:
     """The columns and metadata of one `parksteer simulate` run (its CSV read back)."""
-    from ..cli import main
+    from parksteer.cli import main
 
     with tempfile.TemporaryDirectory() as folder:
         out = Path(folder) / "run.csv"
@@ -58,10 +59,10 @@ def write_car(folder: Path) -> list[Path]:
     """Three records of the pipeline's car data set (rack stiction hidden)."""
     import yaml
 
-    from ..parameters import DEFAULT_PATH
-    from .datasets import CarDesign, write_car_dataset
+    from parksteer.parameters import DEFAULT_PATH
+    from parksteer.synthetic.datasets import CarDesign, write_car_dataset
 
-    root = Path(__file__).resolve().parents[3]
+    root = Path(__file__).resolve().parents[2]
     config = yaml.safe_load((root / "config" / "config.yaml").read_text(encoding="utf-8"))
     car = dict(config["car"], files=[list(c) for c in CAR_CONDITIONS])
     design = CarDesign.from_config(car, config["benchmark"]["perturbation"])
@@ -74,8 +75,8 @@ def write_car(folder: Path) -> list[Path]:
 
 def write_my_car(folder: Path) -> list[Path]:
     """A logger's export of the docs' own car, and its channel map."""
-    from ..cli import main
-    from .logger import add_noise, quantise
+    from parksteer.cli import main
+    from parksteer.synthetic.logger import add_noise, quantise
 
     with tempfile.TemporaryDirectory() as scratch:
         vehicle = Path(scratch) / "my_car.toml"
@@ -89,7 +90,7 @@ def write_my_car(folder: Path) -> list[Path]:
     rack_mm = quantise(add_noise(columns["rack_m"] * 1e3, 0.02, rng), 100.0, 14)
     torque = quantise(add_noise(columns["handwheel_torque_Nm"], 0.05, rng), 40.0, 12)
     angle_deg = quantise(add_noise(np.degrees(columns["handwheel_angle_rad"]), 0.05, rng), 1000.0, 16)
-    lines = ["# source: synthetic logger export (parksteer.synthetic.samples): the car of docs/vehicles.md, kerb "
+    lines = ["# source: synthetic logger export (data/samples/make_samples.py): the car of docs/vehicles.md, kerb "
              "load, on the ground, column friction 0.5 N m hidden",
              "# bits_rack_m: 14", "# bits_handwheel_torque_Nm: 12", "# bits_handwheel_angle_rad: 16",
              "Time[s],RackPos,SteerTorque,SWA"]
@@ -105,11 +106,11 @@ def write_my_car(folder: Path) -> list[Path]:
 
 def write_polo_bus(folder: Path) -> list[Path]:
     """The assisted Polo's kerb cycle as its MQB powertrain CAN sends it, candump and BLF."""
-    from ..measure.bus import bus_channel_map, encode_frames, write_log
-    from ..measure.io import Measurement
-    from .logger import add_noise
+    from parksteer.measure.bus import bus_channel_map, encode_frames, write_log
+    from parksteer.measure.io import Measurement
+    from parksteer.synthetic.logger import add_noise
 
-    root = Path(__file__).resolve().parents[3]
+    root = Path(__file__).resolve().parents[2]
     columns, _ = _simulate("--vehicle", str(root / "data" / "vehicles" / "polo_vi.toml"), "--with-assist",
                            "--case", "kerb", "--surface", "ground")
     rng = np.random.default_rng(SEED + 1)
@@ -130,5 +131,5 @@ def write_samples(folder: str | Path) -> list[Path]:
 
 
 if __name__ == "__main__":
-    for path in write_samples(sys.argv[1] if len(sys.argv) > 1 else "data/samples"):
+    for path in write_samples(sys.argv[1] if len(sys.argv) > 1 else Path(__file__).resolve().parent):
         print(path)
