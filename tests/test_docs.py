@@ -7,7 +7,7 @@ the document's order, as a reader following it would; `parksteer`, `snakemake` a
 environment's, the package is the copy's (PYTHONPATH), and the model cache is one for the session, seeded with the
 worktree's compiled models (a model a document's commands need and no earlier run built is derived there once).
 
-What a document may say about a block, in HTML comments the rendered page does not show:
+What a document may say about a block, in HTML comments the rendered page does not show, each on a line of its own:
 
 - ``<!-- docs-test: skip (REASON) -->`` before a block: it is not run (the whole pipeline, a SLURM cluster, a
   benchmark of minutes); REASON is required and is listed in the test's output;
@@ -50,7 +50,7 @@ SKIPPED_HERE = {("README.md", "quick start 1"): "installs and builds the whole p
 BLOCK_TIMEOUT_S = 600
 
 FENCE = re.compile(r"^```(\w*)\n(.*?)^```\n", re.S | re.M)
-MARKER = re.compile(r"<!--\s*docs-test:\s*(.*?)\s*-->", re.S)
+MARKER = re.compile(r"^<!--\s*docs-test:\s*(.*?)\s*-->", re.S | re.M)  # on a line of its own
 SKIP = re.compile(r"skip\s+\((.+)\)$", re.S)
 SKIP_LINE = re.compile(r'skip-line\s+"([^"]+)"\s+\((.+)\)$', re.S)
 HEAVY = re.compile(r'heavy\s+"([^"]+)"\s+\((.+)\)$', re.S)
