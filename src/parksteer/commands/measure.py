@@ -155,10 +155,14 @@ def _by_reference(effects: list) -> list:
 
     for effect in effects:
         cls = type(effect)
-        if cls.__module__ not in sys.modules and "." not in cls.__qualname__:
+        module = sys.modules.get(cls.__module__)
+        if "." in cls.__qualname__ or (module is not None and not getattr(module, "_parksteer_by_reference", False)):
+            continue
+        if module is None:  # the file loaded again in one process is a new class of the same name: the latest wins
             module = types.ModuleType(cls.__module__)
-            setattr(module, cls.__qualname__, cls)
+            module._parksteer_by_reference = True
             sys.modules[cls.__module__] = module
+        setattr(module, cls.__qualname__, cls)
     return effects
 
 
