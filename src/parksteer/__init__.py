@@ -1,6 +1,14 @@
 """parksteer: car steering torque at parking speed, after Sharp & Granger."""
 
 import os as _os
+import sys as _sys
+
+# The package needs Python 3.11 (tomllib, the typing it uses); pip refuses to install it on an older one, but a
+# checkout on the path or a venv made by another interpreter gets here: one line, not a traceback from deep inside.
+if _sys.version_info < (3, 11):
+    _sys.stderr.write(f"parksteer: error: Python 3.11 or newer is needed, this is {_sys.version.split()[0]} "
+                      f"({_sys.executable}): make the venv with a newer one, e.g. python3.11 -m venv .venv\n")
+    raise SystemExit(2)
 
 __version__ = "0.1.0"
 

@@ -2,11 +2,14 @@
 # written under its own name (results/vehicles/<vehicle>/, figures/vehicles/<vehicle>/), never into the
 # reproduction's checksummed outputs and never part of `all`:
 #   snakemake --cores 2 vehicle_study --config vehicle=polo_vi                          (synthetic measurements)
-#   snakemake --cores 2 vehicle_study --config vehicle=my_car vehicle_data=logs/my_car vehicle_map=my_car.map
+#   snakemake --cores 2 vehicle_study --config vehicle=my_car vehicle_data=logs/my_car vehicle_map=my_car.map \
+#       vehicle_case=kerb vehicle_surface=ground
 # `vehicle` names data/vehicles/<vehicle>.toml; without `vehicle_data` the study runs on synthetic measurements
 # of that car (each load case on the ground, the first also on air bearings, config["car"]'s hidden effect).
 wildcard_constraints:
     vehicle="[A-Za-z0-9_-]+",
+
+check_vehicle_data()
 
 
 rule vehicle_synthetic_data:

@@ -26,6 +26,38 @@ def vehicle_measurements(wildcards):
     return files
 
 
+def check_vehicle_data():
+    """A study of a folder of measurement files (`vehicle_data`): each file read while the DAG is built, as the
+    study's rules will read it (the vehicle's values, `vehicle_map`, `vehicle_case`, `vehicle_surface`), so that a
+    file the study cannot use (no surface stated, a channel the map lacks, a unit slip) stops Snakemake with its
+    one line and exit status 2, not a failed job with the cause in its log."""
+    folder, name = config.get("vehicle_data"), config.get("vehicle")
+    if folder is None or name is None:
+        return
+    import contextlib
+    import io
+
+    from parksteer.errors import UsageError
+    from parksteer.measure.importers import channel_map_from_options, load_record
+
+    keys = "--case, --surface and --map-file are --config vehicle_case=, vehicle_surface= and vehicle_map="
+    try:
+        if not Path(vehicle_file(name)).is_file():
+            raise UsageError(f"--config vehicle={name}: no file {vehicle_file(name)} (write it with `parksteer "
+                             "vehicle new`, docs/vehicles.md)")
+        if not Path(folder).is_dir():
+            raise UsageError(f"--config vehicle_data={folder}: no such folder")
+        params = _load_vehicle(vehicle_file(name), PARAMETERS)
+        channel_map = channel_map_from_options(None, config.get("vehicle_map"))
+        for path in vehicle_measurements(None):
+            with contextlib.redirect_stderr(io.StringIO()):  # the rules write a file's notes; here only its refusal
+                load_record(path, channel_map, config.get("vehicle_case"), config.get("vehicle_surface"), params)
+    except ValueError as error:  # UsageError is one, as is vehicle_measurements' empty folder
+        hint = f" (in vehicle_study, {keys})" if any(o in str(error) for o in ("--case", "--surface", "--map")) else ""
+        print(f"parksteer: error: {error}{hint}", file=sys.stderr)
+        sys.exit(2)
+
+
 def vehicle_options():
     """Import options for every file of the study: --map-file, --case, --surface from the configuration."""
     options = []

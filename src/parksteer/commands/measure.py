@@ -133,14 +133,51 @@ def effects_of(args, params) -> list:
     from ..model.symbolic.components import resolve_effects
 
     if not getattr(args, "with_assist", False):
-        return resolve_effects(args.effects)
+        effects = resolve_effects(args.effects)
+        _warn_unused_assist(args, params, effects)
+        return _by_reference(effects)
     if args.vehicle is None:
         raise UsageError("--with-assist needs --vehicle FILE (the assist is the vehicle file's [assist])")
     from ..model.numeric.assist import check_assist, effects_with_assist
 
     if check_assist(params) is None:
         raise UsageError(f"--with-assist: {args.vehicle} has no [assist] section")
-    return resolve_effects(effects_with_assist(args.effects, params))
+    return _by_reference(resolve_effects(effects_with_assist(args.effects, params)))
+
+
+def _by_reference(effects: list) -> list:
+    """`effects`, each one's class findable by its module's name. An effect loaded from a file (--effects=+path.py)
+    is of a module kept out of sys.modules (its name carries a hash of the file's text:
+    parksteer.model.symbolic.components.load_effect_module), and the diagnosis's worker pool pickles the effects it
+    sends to its forked workers, which looks a class up by that name: the class is registered under it here, before
+    any pool forks, so the workers inherit it."""
+    import types
+
+    for effect in effects:
+        cls = type(effect)
+        module = sys.modules.get(cls.__module__)
+        if "." in cls.__qualname__ or (module is not None and not getattr(module, "_parksteer_by_reference", False)):
+            continue
+        if module is None:  # the file loaded again in one process is a new class of the same name: the latest wins
+            module = types.ModuleType(cls.__module__)
+            module._parksteer_by_reference = True
+            sys.modules[cls.__module__] = module
+        setattr(module, cls.__qualname__, cls)
+    return effects
+
+
+def _warn_unused_assist(args, params, effects) -> None:
+    """One line on stderr when the vehicle file has an [assist] the run leaves out: the record is then fitted as
+    the car without assistance, its torque as the whole steering torque, which a record of the car with its
+    assist working (a bus log's torsion-bar torque, say) is not."""
+    if getattr(args, "vehicle", None) is None or assist_of_effects(effects) is not None:
+        return
+    from ..vehicle import assist_of
+
+    if assist_of(params) is not None:
+        print(f"parksteer {args.command}: warning: {args.vehicle} has an [assist] section, left out: the records "
+              "are fitted as the car without assistance; if they were logged with the assist working, add "
+              "--with-assist", file=sys.stderr)
 
 
 # A record's speed channel gives the run's one constant speed (the model has no time-varying speed): its middle 90 %

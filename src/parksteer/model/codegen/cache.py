@@ -11,6 +11,7 @@ user's cache directory. :func:`ensure` is the one way to get a model built and d
 
 from __future__ import annotations
 
+import errno
 import fcntl
 import hashlib
 import inspect
@@ -228,6 +229,7 @@ def build_entry(effects: list[Effect], directory: Path, key: str | None = None) 
     import sympy
 
     names = ",".join(e.name for e in effects) or "none"
+    compiler = find_compiler()  # before the derivation: without one, say so at once rather than after minutes
     start = time.perf_counter()
     prebuilt = prebuilt_source(key) if key is not None else None
     if prebuilt is not None:
@@ -239,10 +241,11 @@ def build_entry(effects: list[Effect], directory: Path, key: str | None = None) 
     t_derive, t_codegen = timings["derive"], timings["codegen"]
     directory.mkdir(parents=True, exist_ok=True)
     (directory / "model.c").write_text(source, encoding="utf-8")
-    compiler = find_compiler()
     cmd = [compiler, *COMPILE_FLAGS, "-o", str(directory / "model.so"), str(directory / "model.c"), "-lm"]
     done = subprocess.run(cmd, capture_output=True, text=True)
     if done.returncode != 0:
+        if "No space left on device" in done.stderr:  # the library could not be written: the cache's disk is full
+            raise OSError(errno.ENOSPC, "No space left on device")
         first = (done.stderr.strip().splitlines() or ["unknown error"])[0]
         raise UsageError(f"C compiler failed on the generated model: {first}")
     t_compile = time.perf_counter() - start - t_derive - t_codegen
@@ -360,12 +363,38 @@ def _build_lock(final: Path) -> Iterator[None]:
             os.close(fd)
 
 
+# What a cache folder that cannot be written raises: read-only, no permission, no space or quota, a file in the path.
+CACHE_WRITE_ERRNOS = {errno.EROFS, errno.EACCES, errno.EPERM, errno.ENOSPC, errno.EDQUOT, errno.ENOTDIR, errno.EEXIST}
+
+
+def cache_write_error(root: Path, exc: OSError) -> UsageError:
+    """The one line for a model cache that cannot be written (a read-only checkout, a full disk, a path through a
+    file): the folder, why, and where else the cache can go."""
+    if exc.errno == errno.ENOSPC:
+        why = "no space left on its disk"
+    else:
+        why = exc.strerror or type(exc).__name__
+    return UsageError(f"cannot write the model cache {root} ({why}): set {CACHE_ENV} to a folder with room that you "
+                      "can write (the cache is results/model of a checkout, else $XDG_CACHE_HOME/parksteer/model, "
+                      f"XDG_CACHE_HOME {os.environ.get('XDG_CACHE_HOME') or 'unset: ~/.cache'})")
+
+
 def ensure_entry(effects: list[Effect]) -> Path:
     """The cache entry of `effects`, built if missing or unsound (atomically: built aside, then renamed into
-    place; a scratch directory left by a killed build is removed here; one build at a time per entry)."""
+    place; a scratch directory left by a killed build is removed here; one build at a time per entry). A cache
+    that cannot be written is one line (:func:`cache_write_error`), with nothing half-written left in it."""
     final = entry_path(effects)
     if entry_is_sound(final):
         return final
+    try:
+        return _build_entry_into(effects, final)
+    except OSError as exc:
+        if exc.errno not in CACHE_WRITE_ERRNOS:
+            raise
+        raise cache_write_error(final.parent, exc) from None
+
+
+def _build_entry_into(effects: list[Effect], final: Path) -> Path:
     final.parent.mkdir(parents=True, exist_ok=True)
     with _build_lock(final):
         if entry_is_sound(final):  # built by the process this one waited for

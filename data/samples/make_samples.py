@@ -1,0 +1,135 @@
+"""The small sample inputs under data/samples/ that the README and docs/ run their commands on, so that every
+documented path (a logger's CSV with its channel map, a raw CAN log in candump and BLF, a set of car records) can
+be tried on a fresh clone before any pipeline has run.
+
+- ``car/``: three records of the paper's car with the pipeline's hidden effect (config/config.yaml ``car``: rack
+  stiction, 300 N), made as rule ``diag_car_data`` makes its set (:func:`parksteer.synthetic.datasets.
+  write_car_dataset`), on three of its six conditions.
+- ``my_car/run1.csv`` and ``my_car.map``: a logger's export (its own channel names, the rack in millimetres, the
+  angle in degrees, no case or surface stated) of the car docs/vehicles.md specifies with ``parksteer vehicle new``,
+  simulated at its kerb load on the ground with a column friction of 0.5 N m hidden, with noise and quantisation.
+- ``polo_kerb.log`` (candump) and ``polo_kerb.blf`` (Vector BLF): the VW Polo VI of data/vehicles/polo_vi.toml with
+  its column assist, kerb load on the ground, as its powertrain CAN sends it on the shipped ``vw_mqb`` bus
+  (:func:`parksteer.measure.bus.encode_frames`: driver's torque at the torsion bar, steering-wheel angle, speed 0).
+
+Made again, byte for byte, by ``python data/samples/make_samples.py`` (a script beside them, not part of the package:
+it drives the command line, which the package's synthetic layer may not import) (seeded; the BLF's header
+times are the frames' own; tests/test_docs.py checks the bytes).
+"""
+
+from __future__ import annotations
+
+import io
+import sys
+import tempfile
+from contextlib import redirect_stdout
+from pathlib import Path
+
+import numpy as np
+
+# The car of docs/vehicles.md, step 1 (the same options, in the same order).
+MY_CAR_OPTIONS = ["--front-axle-mass-kg", "780", "--left-share", "0.51", "--track-m", "1.49",
+                  "--kingpin-inclination-deg", "12.5", "--castor-deg", "4.2", "--scrub-radius-m", "0.01",
+                  "--tyre-size", "185/65R15", "--tyre-pressure-bar", "2.3", "--steering-ratio", "15.3",
+                  "--lock-turns", "2.6"]
+MY_CAR_MAP = "RackPos[mm]=rack_m\nSteerTorque[N*m]=handwheel_torque_Nm\nSWA[deg]=handwheel_angle_rad\n"
+CAR_CONDITIONS = [("unladen", "ground"), ("part_laden", "ground"), ("offset_12_7mm", "air_bearing")]
+SEED = 3401
+
+
+def _simulate(*argv: str) -> tuple[dict[str, np.ndarray], dict[str, str]]:
+    """The columns and metadata of one `parksteer simulate` run (its CSV read back)."""
+    from parksteer.cli import main
+
+    with tempfile.TemporaryDirectory() as folder:
+        out = Path(folder) / "run.csv"
+        with redirect_stdout(io.StringIO()):
+            if main(["simulate", *argv, "--output-dt", "0.01", "--quiet", "--out", str(out)]) != 0:
+                raise RuntimeError(f"parksteer simulate {' '.join(argv)} failed")
+        text = out.read_text(encoding="utf-8")
+    lines = text.splitlines()
+    metadata = dict(line[2:].split(": ", 1) for line in lines if line.startswith("# ") and ": " in line)
+    rows = [line for line in lines if line and not line.startswith("#")]
+    header = rows[0].split(",")
+    data = np.array([[float(cell) for cell in row.split(",")] for row in rows[1:]])
+    return {name: data[:, i] for i, name in enumerate(header)}, metadata
+
+
+def write_car(folder: Path) -> list[Path]:
+    """Three records of the pipeline's car data set (rack stiction hidden)."""
+    import yaml
+
+    from parksteer.parameters import DEFAULT_PATH
+    from parksteer.synthetic.datasets import CarDesign, write_car_dataset
+
+    root = Path(__file__).resolve().parents[2]
+    config = yaml.safe_load((root / "config" / "config.yaml").read_text(encoding="utf-8"))
+    car = dict(config["car"], files=[list(c) for c in CAR_CONDITIONS])
+    design = CarDesign.from_config(car, config["benchmark"]["perturbation"])
+    folder.mkdir(parents=True, exist_ok=True)
+    files = [folder / f"{case}__{surface}.csv" for case, surface in CAR_CONDITIONS]
+    with tempfile.TemporaryDirectory() as scratch:
+        write_car_dataset(str(DEFAULT_PATH), design, [str(f) for f in files], str(Path(scratch) / "truth.json"))
+    return files
+
+
+def write_my_car(folder: Path) -> list[Path]:
+    """A logger's export of the docs' own car, and its channel map."""
+    from parksteer.cli import main
+    from parksteer.synthetic.logger import add_noise, quantise
+
+    with tempfile.TemporaryDirectory() as scratch:
+        vehicle = Path(scratch) / "my_car.toml"
+        with redirect_stdout(io.StringIO()):
+            if main(["vehicle", "new", "--out", str(vehicle), *MY_CAR_OPTIONS]) != 0:
+                raise RuntimeError("parksteer vehicle new failed")
+        columns, _ = _simulate("--vehicle", str(vehicle), "--case", "kerb", "--surface", "ground",
+                               "--effects=+column_friction", "--set", "column_friction.friction_torque=0.5")
+    rng = np.random.default_rng(SEED)
+    time = columns["time_s"]
+    rack_mm = quantise(add_noise(columns["rack_m"] * 1e3, 0.02, rng), 100.0, 14)
+    torque = quantise(add_noise(columns["handwheel_torque_Nm"], 0.05, rng), 40.0, 12)
+    angle_deg = quantise(add_noise(np.degrees(columns["handwheel_angle_rad"]), 0.05, rng), 1000.0, 16)
+    lines = ["# source: synthetic logger export (data/samples/make_samples.py): the car of docs/vehicles.md, kerb "
+             "load, on the ground, column friction 0.5 N m hidden",
+             "# bits_rack_m: 14", "# bits_handwheel_torque_Nm: 12", "# bits_handwheel_angle_rad: 16",
+             "Time[s],RackPos,SteerTorque,SWA"]
+    lines += [f"{t:.2f},{r:.4f},{q:.4f},{a:.3f}" for t, r, q, a in zip(time, rack_mm, torque, angle_deg)]
+    out = folder / "my_car" / "run1.csv"
+    out.parent.mkdir(parents=True, exist_ok=True)
+    out.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    map_file = folder / "my_car.map"
+    map_file.write_text("# the channels of data/samples/my_car/*.csv: logger name [unit] = column\n" + MY_CAR_MAP,
+                        encoding="utf-8")
+    return [out, map_file]
+
+
+def write_polo_bus(folder: Path) -> list[Path]:
+    """The assisted Polo's kerb cycle as its MQB powertrain CAN sends it, candump and BLF."""
+    from parksteer.measure.bus import bus_channel_map, encode_frames, write_log
+    from parksteer.measure.io import Measurement
+    from parksteer.synthetic.logger import add_noise
+
+    root = Path(__file__).resolve().parents[2]
+    columns, _ = _simulate("--vehicle", str(root / "data" / "vehicles" / "polo_vi.toml"), "--with-assist",
+                           "--case", "kerb", "--surface", "ground")
+    rng = np.random.default_rng(SEED + 1)
+    record = Measurement(None, {
+        "time_s": columns["time_s"],
+        "handwheel_torque_Nm": add_noise(columns["handwheel_torque_Nm"], 0.03, rng),
+        "handwheel_angle_rad": add_noise(columns["handwheel_angle_rad"], 2e-4, rng),
+    }, {"case": "kerb", "surface": "ground"})
+    channels = bus_channel_map("vw_mqb", None, None, None)
+    frames = encode_frames(record, channels)
+    return [write_log(frames, folder / "polo_kerb.log", "candump"),
+            write_log(frames, folder / "polo_kerb.blf", "blf")]
+
+
+def write_samples(folder: str | Path) -> list[Path]:
+    folder = Path(folder)
+    return [*write_car(folder / "car"), *write_my_car(folder), *write_polo_bus(folder)]
+
+
+if __name__ == "__main__":
+    for path in write_samples(sys.argv[1] if len(sys.argv) > 1 else Path(__file__).resolve().parent):
+        print(path)
