@@ -150,7 +150,7 @@ def case_batches(prefix, names, per_job):
 
 def case_outputs(folder, names, batches, suffix):
     """The `suffix` file (truth or diagnosis) of each case of `names`, in its job's folder (where run_batch puts
-    it: parksteer.diagnose.benchmark.case_files), in the order of `names`."""
+    it: parksteer.experiments.benchmark.case_files), in the order of `names`."""
     job_of = {name: batch for batch, members in batches.items() for name in members}
     return [planned("case_file", f"{folder}/{job_of[name]}", name, suffix) for name in names]
 

@@ -9,7 +9,7 @@
 # (config["outclass"]): rival effects that are not candidates, hidden by a truth generator that is not the
 # diagnosis model, scored against the physically closest candidate. diag_variation_batch and diag_variations are
 # the variation benchmark (config["variations"]): records of other hands, loggers and drives, with nothing or a
-# library effect hidden, scored against the targets of parksteer.diagnose.variations. diag_signature_batch and
+# library effect hidden, scored against the targets of parksteer.experiments.variations. diag_signature_batch and
 # diag_signature are the signature benchmark (config["signature"]): out-of-library effects and nulls, the
 # residual's signature and the suggested effect scored per signature class (parksteer.figures.signature).
 DIAG_USER_EFFECT = os.path.relpath(PACKAGE_DIR / "examples" / "column_imbalance.py")
