@@ -39,7 +39,7 @@ import dataclasses
 import numpy as np
 
 from ..errors import UsageError
-from ..model.numeric.assist import check_assist
+from ..model.numeric.assist import check_assist, table_off
 from ..model.numeric.simulate import SimulationResult, simulate
 from ..model.symbolic.components import discover_effects
 from ..parameters import Parameters
@@ -143,7 +143,8 @@ def size_assist(params: Parameters, case: str, target_torque_Nm: float, speeds_k
         low = int(np.argmin(speeds_kmh))
         parking_gain = gains[low] / gain_factor(speeds_kmh[low])
         gains = [parking_gain * gain_factor(speed) for speed in speeds_kmh]
-        one_assist = {f"{name}.gain": parking_gain, f"{name}.motor_torque_limit": MARGIN * max(motors)}
+        one_assist = {f"{name}.gain": parking_gain, f"{name}.motor_torque_limit": MARGIN * max(motors),
+                      **table_off(name)}
     rows, manual0, assisted0 = [], None, None
     for i, speed in enumerate(speeds_kmh):
         manual, torque, per_rack = manual_runs[i]
@@ -157,7 +158,9 @@ def size_assist(params: Parameters, case: str, target_torque_Nm: float, speeds_k
             pressure = float("nan")
             motor = motors[i]
             current = motor / v("torque_constant")
-            sized = one_assist if falloff else {f"{name}.gain": gain, f"{name}.motor_torque_limit": MARGIN * motor}
+            # the sized assist is the straight line of the sized gain: a table of the file is switched off
+            sized = one_assist if falloff else {f"{name}.gain": gain, f"{name}.motor_torque_limit": MARGIN * motor,
+                                                **table_off(name)}
         assisted = simulate(case, effects=ASSISTED_EFFECTS[kind], overrides={**creeping_overrides(speed), **sized},
                             params=params)
         c = assisted.columns
