@@ -21,11 +21,13 @@ The torsion bar's torque is T_s = T (column assist) or T c_col / G_hr (pinion, r
 pinion, the column torque through the joint). Dividing R by c_col (column) or G_hr (the others):
 
     y = T_s + A(T_s),   y = T_road (column), T_road c_col / G_hr (pinion, rack, hydraulic),
-    A(T_s) = eta N clamp(G deadband(T_s) s / (eta N), T_max) / s,   s = 1 (column, pinion), G_hr (rack),
+    A(T_s) = e N clamp((G deadband(T_s) s + B(T_s)) / (eta N), T_max) / s,   s = 1 (column, pinion), G_hr (rack),
     A(T_s) = a_p clamp(k_v deadband(T_s), p_relief) / G_hr          (hydraulic),
 
 the boost laws of :mod:`parksteer.model.symbolic.effects.electric_assist` and ``hydraulic_assist`` with the same
-smoothed corners (:mod:`parksteer.model.symbolic.effects.assist_common`). A is increasing (deadband and clamp are,
+smoothed corners (:mod:`parksteer.model.symbolic.effects.assist_common`); B is the boost table's law (zero without
+a table) and e the gear's efficiency in the direction the power flows (eta_f driving, 1 / eta_b back-driven), read
+from the prescribed rack's speed (the point of action's rate, as the effect reads it) and the law's motor torque. A is increasing (deadband and clamp are,
 strictly for a smoothed clamp: its slope is -(f(a) + f(b))/2 > 0 with f(z) = z / sqrt(z^2 + w^2), a + b = -2 L),
 so y(T_s) rises with slope >= 1 and has one root, found pointwise by bisection in ``[y - B, y + B]`` (B bounds
 |A|). The motor torque T_m and current T_m / k_t (or the pressure) then follow from the law. Nothing in this depends
@@ -36,11 +38,11 @@ tolerance at the column, the pinion and the rack, and in saturation.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ...boost_table import off_keys, table_keys
+from ...boost_table import MAX_POINTS, off_keys, table_keys
 from ...errors import UsageError
 from ...parameters import VEHICLE_SPEED
 from ..symbolic.components import power_assist_of
@@ -107,6 +109,15 @@ class BoostLaw:
             demand = demand + self.table_scale * table_law(np.asarray(torsion_bar_Nm, dtype=float), values.__getitem__,
                                                            self.speed)
         return clamp(demand / (self.efficiency * self.reduction), self.limit, self.limit_width)
+
+    def with_wider_dead_band(self, size_Nm: float) -> BoostLaw:
+        """This law with its dead band wider by `size_Nm`: the line's band, and every point of a table but the
+        origin moved out by it (the curve beyond the band unchanged in shape)."""
+        table = list(self.table)
+        if any(table):
+            for k in range(1, MAX_POINTS):
+                table[k] += size_Nm  # boost_torque_<k>: the first MAX_POINTS scalars (table_keys)
+        return replace(self, dead_band=self.dead_band + size_Nm, table=tuple(table))
 
     def delivered(self, motor, rack_speed_mps):
         """What the gear delivers per motor torque, in the direction the power flows (eta_f driving, 1 / eta_b

@@ -28,21 +28,35 @@ tables of the control unit, the rational fall of EPS assist maps, k0 / (1 + k_v 
 speed; the quantities' sources give the typical v_half). Quasi-statically the driver's torque is
 T_road / (1 + G(v)) (the tests).
 
+Boost table. A vehicle file's ``[assist.boost]`` gives the curve as the control unit's table instead: torsion-bar
+torques and the assist at the point of action, optionally one row per vehicle speed (:mod:`parksteer.boost_table`).
+The demand is then the table's law, the monotone cubic through the points, odd, exactly zero in the dead band,
+linear in speed between rows (:func:`.assist_common.table_law`), read at the torsion-bar torque and the run's
+vehicle speed; the file's gain is 0 (the reader refuses both), and the table's default, all zeros, adds exactly
+nothing to today's law.
+
 The motor torque is the demand through the reduction, limited:
 
     T_m = clamp(A_cmd / (eta N), T_max),     i = T_m / k_t (the motor current, torque constant k_t),
 
-and the torque eta T_m acts on the motor's rotor (reacted on the body): its generalized force on the rack is
-eta N T_m dx/d(rack), the assist eta N T_m at the point of action; (1 - eta) T_m N dx/dt is lost in the gear
-(a constant efficiency, also when the gear is back-driven). The rotor's inertia J_m turns at N dx/dt (kinetic
+and the torque e T_m acts on the motor's rotor (reacted on the body): its generalized force on the rack is
+e N T_m dx/d(rack), the assist e N T_m at the point of action. The gear's efficiency depends on which way the power
+flows: e = eta_f when the motor drives (T_m and dx/dt of one sign), e = 1 / eta_b when the point of action drives
+the motor against its torque (after a reversal, the tyre's wind-up returning the rack): a back-driven worm or
+ball nut passes on eta_b of the power put in at the rack, so the motor's torque N T_m / eta_b at the point of
+action, not eta_f N T_m. Between the two, smoothly through the power's sign
+(:func:`.assist_common.directional_efficiency`, sharp over the friction smoothing's rack speed and
+limit_smoothing of motor torque), so that the gear's loss, T_m N dx/dt (1 - e), is never negative. The control
+unit commands T_m = A_cmd / (eta_f N): while the motor drives, the assist is the demand. The rotor's inertia J_m turns at N dx/dt (kinetic
 energy J_m (N dx/dt)^2 / 2, N^2 J_m reflected to x), its bearings' Coulomb friction T_f tanh(beta v) opposes it
 (v the rack speed it corresponds to, beta the project's friction smoothing).
 
 Quasi-static consequences (the tests): with no dead band and the motor below its limit, the column carries
-T_s + G(v) T_s = T_road, so the driver's torque is T_road / (1 + G(v)); at the limit, T_s = T_road - eta N T_max
-(column) rises with the road torque at the manual steering's slope; a zero gain adds no torque at all.
+T_s + G(v) T_s = T_road, so the driver's torque is T_road / (1 + G(v)) (with a table, the root of T_s + A(T_s) =
+T_road); at the limit, T_s = T_road - eta N T_max (column) rises with the road torque at the manual steering's
+slope; a zero gain adds no torque at all.
 
-Outputs: torsion_bar_torque_Nm (T_s), assist_torque_Nm or assist_force_N (eta N T_m at x), motor_torque_Nm,
+Outputs: torsion_bar_torque_Nm (T_s), assist_torque_Nm or assist_force_N (e N T_m at x), motor_torque_Nm,
 motor_current_A; the simulation adds rack_force_N (the force the pinion and the assist together put on the
 rack). The model has no tie rods (a linear linkage), so no tie-rod force.
 
