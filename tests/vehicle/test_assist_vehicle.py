@@ -205,3 +205,18 @@ def test_new_with_a_speed_dependent_boost_curve(tmp_path):
     assert params["electric_assist_column.gain_half_speed"] == pytest.approx(10.0)
     assert main(["vehicle", "new", "--out", str(tmp_path / "hps.toml"), *GOLF, "--assist", "hydraulic",
                  "--assist-gain-half-speed-kmh", "36"]) == 2
+
+
+def test_sizing_reports_the_rack_force_over_the_friction_band(tmp_path, capsys):
+    """The standstill load is mostly the tyres' bore torque, proportional to the tyre-ground friction: over the dry
+    asphalt band 0.67, 0.8, 1.0 the Polo's peak rack force and the motor torque it asks rise at every step; at 0.67
+    (the file's 0.666, nearly) the force is below the 3 kN published for small cars and the command says so."""
+    assert main(["assist", "size", "--vehicle", str(POLO), "--target-torque", "3", "--speeds-kmh", "0",
+                 "--out-dir", str(tmp_path / "sizing")]) == 0
+    out, err = capsys.readouterr()
+    rows = [line.split() for line in out.splitlines() if line.strip()[:4] in ("0.67", "0.80", "1.00")]
+    assert [r[0] for r in rows] == ["0.67", "0.80", "1.00"]
+    force = [float(r[1]) for r in rows]
+    motor = [float(r[2]) for r in rows]
+    assert force[0] < force[1] < force[2] and motor[0] < motor[1] < motor[2]
+    assert force[0] < 3000.0 and "warning: at tyre-ground friction 0.67" in err

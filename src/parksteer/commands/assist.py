@@ -94,11 +94,14 @@ def print_friction_band(study) -> None:
     for r in study.friction_band:
         print(f"{r.friction:8.2f}  {r.peak_rack_force_N:17.0f}"
               + ("" if hydraulic else f"  {r.motor_torque_Nm:16.2f}  {r.motor_current_A:15.1f}"))
-    if study.below_published():
+    below = study.below_published()
+    if below:
+        frictions = ", ".join(f"{r.friction:g}" for r in below)
         top = max(r.peak_rack_force_N for r in study.friction_band)
-        print(f"warning: the standstill rack force, {top:.0f} N at most over the friction band, is below the "
-              f"{low / 1e3:g}-{high / 1e3:g} kN published for current small and medium cars: the tyre's bore torque "
-              "(equation (2)) or the car's loads may be those of an older or lighter car", file=sys.stderr)
+        print(f"warning: at tyre-ground friction {frictions} the standstill rack force is below the "
+              f"{low / 1e3:g}-{high / 1e3:g} kN published for current small and medium cars ({top:.0f} N at the "
+              "band's top): the tyre's bore torque (equation (2)) or the car's loads may be those of an older or "
+              "lighter car; size the motor for the band's top", file=sys.stderr)
 
 
 def with_gain_half_speed(params, args):

@@ -243,7 +243,8 @@ def assist_study(params: Parameters, run=simulate, progress=None) -> dict:
     band = [peak_rack_force_N(results[("friction", f)]) for f in FRICTION_BAND]
     numbers["friction_band"] = {"friction": list(FRICTION_BAND), "peak_rack_force_N": band,
                                 "published_standstill_rack_force_N": list(PUBLISHED_STANDSTILL_RACK_FORCE_N),
-                                "below_published": max(band) < PUBLISHED_STANDSTILL_RACK_FORCE_N[0]}
+                                "below_published_at": [f for f, force in zip(FRICTION_BAND, band)
+                                                       if force < PUBLISHED_STANDSTILL_RACK_FORCE_N[0]]}
     standstill_tyre = _tyre_term(results[(None, CASE, 0.0)], params)
     numbers["spin_slope_band"] = {
         "q_dz8": list(SPIN_SLOPE_BAND),

@@ -97,11 +97,10 @@ class SizingStudy:
     standstill_assisted: SimulationResult
     friction_band: list[FrictionRow] = dataclasses.field(default_factory=list)
 
-    def below_published(self) -> bool:
-        """Whether the largest standstill rack force over the friction band is below the published forces of
-        current small and medium cars (PUBLISHED_STANDSTILL_RACK_FORCE_N)."""
-        forces = [r.peak_rack_force_N for r in self.friction_band]
-        return bool(forces) and max(forces) < PUBLISHED_STANDSTILL_RACK_FORCE_N[0]
+    def below_published(self) -> list[FrictionRow]:
+        """The rows of the friction band whose standstill rack force is below the published forces of current
+        small and medium cars (PUBLISHED_STANDSTILL_RACK_FORCE_N)."""
+        return [r for r in self.friction_band if r.peak_rack_force_N < PUBLISHED_STANDSTILL_RACK_FORCE_N[0]]
 
     def columns(self) -> dict[str, np.ndarray]:
         return {f.name: np.array([getattr(r, f.name) for r in self.rows]) for f in dataclasses.fields(SizingRow)}
