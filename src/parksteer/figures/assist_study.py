@@ -314,7 +314,7 @@ def plot_study(numbers: dict, params: Parameters):
     right.set_xlabel("vehicle speed (km/h)")
     right.set_ylabel("peak rack force over the cycle (kN)")
     right.set_ylim(bottom=0.0)
-    right.set_title("(b) rolling while steering (turn slip, q_Dz8 0.05; band: 0.05-0.5)", fontsize=9)
+    right.set_title("(b) creeping (turn slip, q_Dz8 0.05; shaded 0.05-0.5)", fontsize=9)
     right.legend(loc="lower left", fontsize=7)
     fig.tight_layout()
     return fig
