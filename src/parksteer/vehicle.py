@@ -23,6 +23,7 @@ from pathlib import Path
 from typing import Any
 
 from . import portable as pm
+from .boost_table import KMH, BoostTableError, entries
 from .errors import UsageError, cannot_read
 from .geometry import lock_steer_angle, steer_axis
 from .parameters import (
@@ -65,6 +66,10 @@ ASSIST_SECTION = "assist"
 ASSIST_EFFECTS = {"column": "electric_assist_column", "pinion": "electric_assist_pinion",
                   "rack": "electric_assist_rack", "hydraulic": "hydraulic_assist"}
 
+# ``[assist.boost]``: the boost table of an electric assist (parksteer.boost_table) and the units its entries take.
+BOOST_SECTION = "boost"
+BOOST_UNITS = {"torsion_bar_torque": ("N m",), "assist": ("N m", "N"), "vehicle_speed": ("km/h", "m/s")}
+
 MAX_CREEPING_SPEED_KMH = VEHICLE_SPEED.upper * 3.6  # the run's vehicle speed's upper bound, 3 m/s: 10.8 km/h
 
 # The effects specs of an assist sizing study (parksteer.sweep.assist_sizing, rule vehicle_assist_size): the car
@@ -96,6 +101,12 @@ def _read_assist(path: Path, table: Any, sections: dict, sources: dict) -> None:
     for key, entry in table.items():
         if key == "type":
             continue
+        if key == BOOST_SECTION:
+            values.update(_read_boost(path, kind, entry, name, sources))
+            continue
+        if key.startswith("boost_"):
+            raise ParameterError(f"{path}: assist.{key}: a boost table is written as [assist.boost] (torsion_bar_torque, "
+                                 "assist, optionally vehicle_speed)")
         if not isinstance(entry, dict) or set(entry) != {"value", "unit", "source"}:
             raise ParameterError(f"{path}: assist.{key}: expected {{ value, unit, source }}")
         value = entry["value"]
@@ -104,7 +115,53 @@ def _read_assist(path: Path, table: Any, sections: dict, sources: dict) -> None:
         values[key] = float(value)
         sources[f"{name}.{key}"] = str(entry["source"])
         sources[f"{name}.{key}.unit"] = str(entry["unit"])
+    if BOOST_SECTION in table:
+        # the table is the boost curve: the gain's straight line is not added to it
+        if values.get("gain", 0.0) != 0.0 or values.get("speed_dependence", 0.0) != 0.0:
+            raise ParameterError(f"{path}: assist: a boost table and a gain (or its speed dependence) give the "
+                                 "boost curve twice; drop gain, dead_band and speed_dependence (the table's rows "
+                                 "give the speeds)")
+        values.setdefault("gain", 0.0)
+        sources.setdefault(f"{name}.gain", "0: the boost table [assist.boost] gives the curve")
     sections[name] = values
+
+
+def _read_boost(path: Path, kind: str, table: Any, name: str, sources: dict) -> dict[str, float]:
+    """``[assist.boost]``: the boost table (:mod:`parksteer.boost_table`) as the effect's scalar entries."""
+    where = f"{path}: assist.boost"
+    if kind == "hydraulic":
+        raise ParameterError(f"{where}: a boost table is for an electric assist (the valve takes its slope)")
+    if not isinstance(table, dict) or not {"torsion_bar_torque", "assist"} <= set(table) or not set(table) <= set(
+            BOOST_UNITS):
+        raise ParameterError(f"{where}: expected torsion_bar_torque, assist and optionally vehicle_speed")
+    read: dict[str, list] = {}
+    for key, entry in table.items():
+        if not isinstance(entry, dict) or not {"value", "unit"} <= set(entry) or not set(entry) <= {
+                "value", "unit", "source"}:
+            raise ParameterError(f"{where}.{key}: expected {{ value, unit, source }}")
+        units = BOOST_UNITS[key] if key != "assist" else (("N",) if kind == "rack" else ("N m",))
+        if entry["unit"] not in units:
+            raise ParameterError(f"{where}.{key}: unit {entry['unit']!r}, expected {' or '.join(map(repr, units))}")
+        read[key] = entry["value"]
+        sources[f"{name}.boost.{key}"] = str(entry.get("source", ""))
+    speeds = read.get("vehicle_speed")
+    rows = read["assist"]
+    if speeds is None:
+        rows = [rows]
+    try:
+        torques = [float(t) for t in read["torsion_bar_torque"]]
+        rows = [[float(a) for a in row] for row in rows]
+        if speeds is not None:
+            scale = KMH if table["vehicle_speed"]["unit"] == "km/h" else 1.0
+            speeds = [float(v) * scale for v in speeds]
+        out = entries(torques, speeds, rows)
+    except (TypeError, ValueError) as exc:
+        detail = str(exc) if isinstance(exc, BoostTableError) else "lists of numbers (one row per vehicle speed)"
+        raise ParameterError(f"{where}: {detail}") from None
+    source = f"derived: [assist.boost] ({sources[f'{name}.boost.assist']})"
+    for key in out:
+        sources[f"{name}.{key}"] = source
+    return out
 
 
 def vehicle_name(path: str | Path) -> str:

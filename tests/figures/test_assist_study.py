@@ -69,3 +69,29 @@ def test_the_driver_keeps_the_boost_curves_share(study, params, kind):
     band = study["assists"][kind]["assumed"]["dead_band"]["value"]
     assert s["driver_torque_Nm"] == pytest.approx((s["road_torque_Nm"] + gain * band) / (1.0 + gain), rel=0.05)
     assert study["assists"][kind]["driver_share_limit"] == pytest.approx(1.0 / (1.0 + gain))
+
+
+def test_the_standstill_rack_force_grows_with_the_tyre_ground_friction(study):
+    """The tyre's bore torque at standstill (equation (2)) is proportional to the tyre-ground friction, and it is
+    most of the standstill load: the peak rack force rises at every step of the dry-asphalt band 0.67, 0.8, 1.0,
+    by less than the friction's ratio (rack friction and lifting do not grow with it), and the study says where
+    the band sits against the published standstill rack forces."""
+    band = study["friction_band"]
+    force = band["peak_rack_force_N"]
+    assert all(a < b for a, b in zip(force, force[1:]))
+    assert force[-1] / force[0] < band["friction"][-1] / band["friction"][0]
+    low = band["published_standstill_rack_force_N"][0]
+    assert band["below_published_at"] == [f for f, x in zip(band["friction"], force) if x < low]
+
+
+def test_a_steeper_turn_slip_slope_keeps_more_of_the_tyre_moment(study):
+    """The turn-slip factor 1 / sqrt(1 + y^2) has y proportional to 1 / q_Dz8: the larger q_Dz8, the less the
+    rolling removes, so at every creeping speed the tyre keeps more of its standstill moment, and the peak rack
+    force is larger, at 0.5 than at 0.12 than at 0.05; the 0.05 runs are the study's own creeping runs."""
+    spin = study["spin_slope_band"]
+    kept = [spin["tyre_moment_kept"][f"{q:g}"] for q in spin["q_dz8"]]
+    force = [spin["peak_rack_force_N"][f"{q:g}"] for q in spin["q_dz8"]]
+    for i in range(1, 4):
+        assert kept[0][i] < kept[1][i] < kept[2][i] <= 1.0
+        assert force[0][i] < force[1][i] < force[2][i]
+    assert force[0] == pytest.approx(study["runs"]["none"]["speeds"]["peak_rack_force_N"], rel=1e-12)

@@ -71,8 +71,10 @@ def test_boost_law_inverse_is_exact_where_the_closed_form_holds(params):
     from parksteer.model.numeric.assisted import boost_law
 
     name = "electric_assist_column"
-    run = prepare("unladen", f"+{name}", {f"{name}.dead_band": 0.0, f"{name}.motor_torque_limit": 30.0},
-                  params=params)
+    # a lossless gear (eta_f = eta_b = 1) delivers N T_m whichever way the power flows, so the law is the same at
+    # rest and in motion
+    run = prepare("unladen", f"+{name}", {f"{name}.dead_band": 0.0, f"{name}.motor_torque_limit": 30.0,
+                                          f"{name}.efficiency": 1.0, f"{name}.back_efficiency": 1.0}, params=params)
     law = boost_law(run, run.p)
     y = np.linspace(-20.0, 20.0, 41)
     gain = law.gain
@@ -114,7 +116,9 @@ def test_sensor_offset_and_gain_error_follow_the_linear_law(params):
     y / (1 + G (1 + e)); the current is G S / (eta N k_t) of the reading S in both. Checked on the replay against
     the boost-free road torque (within 1e-9 N m)."""
     name = "electric_assist_column"
-    ideal = {f"{name}.dead_band": 0.0, f"{name}.motor_torque_limit": 30.0}
+    # a lossless gear (eta_f = eta_b = 1): no change of law where the rack reverses and the gear is back-driven
+    ideal = {f"{name}.dead_band": 0.0, f"{name}.motor_torque_limit": 30.0, f"{name}.efficiency": 1.0,
+             f"{name}.back_efficiency": 1.0}
     base = _sweep(params, f"+{name}", ideal)
     gain = 6.0  # the assist's default (Polo and paper's car alike)
     y = base.road_torque_Nm

@@ -73,9 +73,35 @@ def _size(args) -> int:
         print(f"{r.speed_kmh:10.1f}  {r.peak_rack_force_N:17.0f}  {r.peak_handwheel_manual_Nm:15.2f}  {middle}  "
               f"{r.gain:4.2f}  {r.peak_handwheel_assisted_Nm:17.2f}  "
               + (f"{r.check_pressure_Pa / 1e5:18.1f}" if hydraulic else f"{r.check_motor_torque_Nm:15.2f}"))
+    print_friction_band(study)
     for path in written:
         print(f"wrote {path}")
     return 0
+
+
+def print_friction_band(study) -> None:
+    """The standstill rack force over the tyre-ground friction band, against the published forces; a warning on
+    stderr when even the band's top is below them."""
+    import sys
+
+    from ..sweep.assist_sizing import PUBLISHED_STANDSTILL_RACK_FORCE_N
+
+    low, high = PUBLISHED_STANDSTILL_RACK_FORCE_N
+    hydraulic = study.assist == ASSIST_EFFECTS["hydraulic"]
+    print(f"standstill over the tyre-ground friction of dry asphalt (published for small and medium cars: "
+          f"{low / 1e3:g}-{high / 1e3:g} kN)")
+    print("friction  peak rack force N" + ("" if hydraulic else "  motor torque N m  motor current A"))
+    for r in study.friction_band:
+        print(f"{r.friction:8.2f}  {r.peak_rack_force_N:17.0f}"
+              + ("" if hydraulic else f"  {r.motor_torque_Nm:16.2f}  {r.motor_current_A:15.1f}"))
+    below = study.below_published()
+    if below:
+        frictions = ", ".join(f"{r.friction:g}" for r in below)
+        top = max(r.peak_rack_force_N for r in study.friction_band)
+        print(f"warning: at tyre-ground friction {frictions} the standstill rack force is below the "
+              f"{low / 1e3:g}-{high / 1e3:g} kN published for current small and medium cars ({top:.0f} N at the "
+              "band's top): the tyre's bore torque (equation (2)) or the car's loads may be those of an older or "
+              "lighter car; size the motor for the band's top", file=sys.stderr)
 
 
 def with_gain_half_speed(params, args):

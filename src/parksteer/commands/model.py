@@ -169,8 +169,13 @@ def _effects(args) -> int:
         needs += [f"requires {', '.join(d['requires'])}"] if d["requires"] else []
         if needs:
             print(f"      ({'; '.join(needs)})")
+        table = [par for par in d["parameters"] if par["key"].partition(".")[2].startswith("boost_")]
         for par in d["parameters"]:
-            print(f"      {par['key']} = {par['default']:g} {par['unit']}  [{par['min']:g}, {par['max']:g}]")
+            if par not in table:
+                print(f"      {par['key']} = {par['default']:g} {par['unit']}  [{par['min']:g}, {par['max']:g}]")
+        if table:  # the boost table's scalars, filled from [assist.boost] (parksteer.boost_table): one line
+            print(f"      {d['name']}.boost_*: {len(table)} scalars of the boost table [assist.boost] (points, speeds, "
+                  "assists, slopes); default 0: no table (--json lists them)")
     print("(* in the default set)")
     return 0
 

@@ -53,8 +53,14 @@ def register(sub) -> None:
     n.add_argument("--assist-relief-pressure-bar", type=float, default=None,
                    help="hydraulic: the relief valve's pressure (bar)")
     n.add_argument("--assist-boost", default=None, metavar="T:A,T:A",
-                   help="boost-curve points, torsion-bar torque (N m) : assist (electric: N m at the pinion; "
-                        "hydraulic: pressure in bar); the least-squares line gives the gain and dead band")
+                   help="boost-curve points, torsion-bar torque (N m) : assist, rising (electric: written as the "
+                        "table [assist.boost], 0:0 added in front if missing, the assist in the unit "
+                        "--assist-boost-unit says; hydraulic: pressure "
+                        "in bar, the least-squares line gives the valve's slope and dead band)")
+    n.add_argument("--assist-boost-unit", choices=BOOST_POINT_UNITS, default=None,
+                   help="electric: what the assist of --assist-boost is: the motor's torque (N m; turned into the "
+                        "point of action's through eta N), or the torque at the column or pinion (N m), or the force "
+                        "at the rack (N); default the point of action's own")
     n.add_argument("--assist-gain-half-speed-kmh", type=float, default=None, metavar="KMH",
                    help="electric: a speed-dependent boost curve, the gain falling as G / (1 + (v / v_half)^2) with "
                         "this v_half (km/h); without it the gain does not depend on speed")
@@ -151,6 +157,50 @@ def _new(args) -> int:
     return 0
 
 
+# What the assist of --assist-boost points is: the motor's torque, or the assist at a point of action.
+BOOST_POINT_UNITS = ("motor", "column", "pinion", "rack")
+
+
+def boost_points(text: str) -> list[tuple[float, float]]:
+    """--assist-boost T:A,T:A,... as points; one-line UsageError otherwise."""
+    try:
+        points = [tuple(float(x) for x in item.split(":")) for item in text.split(",")]
+    except ValueError:
+        points = [()]
+    if any(len(pt) != 2 for pt in points):
+        raise UsageError(f"--assist-boost {text}: expected points T:A separated by commas")
+    return points  # type: ignore[return-value]
+
+
+def boost_table_text(args, efficiency: float, reduction: float) -> str:
+    """The ``[assist.boost]`` section of --assist-boost, its assist at the point of action (a motor torque through
+    eta N); checked as a boost table."""
+    from ..boost_table import BoostTableError, check_table
+
+    unit = args.assist_boost_unit or args.assist
+    if unit not in ("motor", args.assist):
+        raise UsageError(f"--assist-boost-unit {unit}: a {args.assist} assist takes its points as motor torque or "
+                         f"as the assist at the {args.assist}")
+    points = boost_points(args.assist_boost)
+    if points and points[0][0] > 0.0:
+        points = [(0.0, 0.0), *points]  # a curve given from its dead band on starts at the origin
+    torques = [t for t, _ in points]
+    scale = efficiency * reduction if unit == "motor" else 1.0
+    assist = [a * scale for _, a in points]
+    try:
+        check_table(torques, None, [assist])
+    except BoostTableError as exc:
+        raise UsageError(f"--assist-boost {args.assist_boost}: {exc}") from None
+    how = (f"motor torque x eta N = {scale:g} (the reduction and forward efficiency of [assist])" if unit == "motor"
+           else f"the assist at the {unit}")
+    assist_unit = "N" if args.assist == "rack" else "N m"
+    source = f"specification: --assist-boost {args.assist_boost} ({how})"
+    return ("\n# The boost curve as the control unit's table (parksteer.boost_table): monotone cubic between the points.\n"
+            "[assist.boost]\n"
+            f'torsion_bar_torque = {{ value = {[float(t) for t in torques]}, unit = "N m", source = "{source}" }}\n'
+            f'assist = {{ value = {[float(f"{a:.10g}") for a in assist]}, unit = "{assist_unit}", source = "{source}" }}\n')
+
+
 def assist_section(args, base) -> str:
     """The ``[assist]`` section of `args` (empty without --assist): given values from the options, the rest assumed."""
     electric_only = (("--assist-reduction", args.assist_reduction),
@@ -158,15 +208,21 @@ def assist_section(args, base) -> str:
                      ("--assist-gain-half-speed-kmh", args.assist_gain_half_speed_kmh))
     if args.assist is None:
         given = [o for o, v in (*electric_only, ("--assist-relief-pressure-bar", args.assist_relief_pressure_bar),
-                                ("--assist-boost", args.assist_boost)) if v is not None]
+                                ("--assist-boost", args.assist_boost),
+                                ("--assist-boost-unit", args.assist_boost_unit)) if v is not None]
         if given:
             raise UsageError(f"{given[0]} needs --assist")
         return ""
-    from ..model.numeric.assist import assist_template, boost_line
+    from ..model.numeric.assist import assist_template, boost_line, gear_values
 
     hydraulic = args.assist == "hydraulic"
-    wrong = [o for o, v in electric_only if v is not None] if hydraulic else (
-        ["--assist-relief-pressure-bar"] if args.assist_relief_pressure_bar is not None else [])
+    wrong = [o for o, v in (*electric_only, ("--assist-boost-unit", args.assist_boost_unit)) if v is not None
+             ] if hydraulic else (["--assist-relief-pressure-bar"] if args.assist_relief_pressure_bar is not None else [])
+    if args.assist_boost_unit is not None and args.assist_boost is None:
+        raise UsageError("--assist-boost-unit needs --assist-boost")
+    if not hydraulic and args.assist_boost is not None and args.assist_gain_half_speed_kmh is not None:
+        raise UsageError("--assist-gain-half-speed-kmh: a boost table gives the curve (one row per speed in "
+                         "[assist.boost]), not a gain falling with speed")
     if wrong:
         raise UsageError(f"{wrong[0]}: not a value of a {args.assist} assist")
     given: dict[str, tuple[float, str]] = {}
@@ -180,19 +236,16 @@ def assist_section(args, base) -> str:
         given["gain_half_speed"] = (args.assist_gain_half_speed_kmh / 3.6, source)
     if args.assist_relief_pressure_bar is not None:
         given["relief_pressure"] = (args.assist_relief_pressure_bar * BAR_PA, "specification (bar x 1e5)")
-    if args.assist_boost is not None:
-        try:
-            points = [tuple(float(x) for x in item.split(":")) for item in args.assist_boost.split(",")]
-        except ValueError:
-            points = [()]
-        if any(len(pt) != 2 for pt in points):
-            raise UsageError(f"--assist-boost {args.assist_boost}: expected points T:A separated by commas")
-        scale = BAR_PA if hydraulic else 1.0
-        slope, band = boost_line([(t, a * scale) for t, a in points], f"--assist-boost {args.assist_boost}")
+    if args.assist_boost is not None and hydraulic:
+        points = boost_points(args.assist_boost)
+        slope, band = boost_line([(t, a * BAR_PA) for t, a in points], f"--assist-boost {args.assist_boost}")
         source = f"specification: least-squares line through the boost-curve points {args.assist_boost}"
-        given["valve_slope" if hydraulic else "gain"] = (slope, source)
+        given["valve_slope"] = (slope, source)
         given["dead_band"] = (max(band, 0.0), source)
-    return assist_template(args.assist, given)
+    if args.assist_boost is None or hydraulic:
+        return assist_template(args.assist, given)
+    efficiency, reduction = gear_values(args.assist, given)
+    return assist_template(args.assist, given, table=True) + boost_table_text(args, efficiency, reduction)
 
 
 def _check(args) -> int:

@@ -39,7 +39,7 @@ import dataclasses
 import numpy as np
 
 from ..errors import UsageError
-from ..model.numeric.assist import check_assist
+from ..model.numeric.assist import check_assist, table_off
 from ..model.numeric.simulate import SimulationResult, simulate
 from ..model.symbolic.components import discover_effects
 from ..parameters import Parameters
@@ -47,6 +47,29 @@ from ..vehicle import ASSIST_EFFECTS, ASSISTED_EFFECTS, CREEPING_EFFECTS, creepi
 
 SPEEDS_KMH = (0.0, 1.0, 3.0, 5.0)
 MARGIN = 1.1  # the sized motor limit or relief pressure over the quasi-static demand
+
+# The tyre-ground friction of dry asphalt the standstill rack force is reported over (tyre.friction_coefficient,
+# which scales the bore torque of equation (2)): from the sliding friction of dry asphalt, 0.65-0.8 (Noon,
+# Engineering Analysis of Vehicular Accidents, CRC 1994: 0.65; road-engineering tables: asphalt concrete 0.70-0.80
+# dry), to the peak friction of a current car tyre on a dry road, about 1.0 (Pacejka, Tire and Vehicle Dynamics, 3rd
+# ed. 2012, ch. 4: the Magic Formula's D / F_z near 1 on dry asphalt). The paper's car takes 0.666.
+FRICTION_BAND = (0.67, 0.8, 1.0)
+# Standstill rack forces of current small and medium cars, N: 3-8 kN (Harrer & Pfeffer, Steering Handbook, Springer
+# 2017, ch. 8, as parksteer.model.numeric.assist cites it); rack-type EPS gears are built for up to 18 kN (small
+# utility vehicles: thyssenkrupp Automotive Technology, steering gears, rack EPS). No published standstill rack
+# force of a named small car was found for this project; a rack force below the lower end is reported as such.
+PUBLISHED_STANDSTILL_RACK_FORCE_N = (3.0e3, 8.0e3)
+
+
+@dataclasses.dataclass
+class FrictionRow:
+    """The standstill cycle without assistance at one tyre-ground friction: its peak rack force and the motor
+    torque and current the sized gear would need for the target there (electric)."""
+
+    friction: float
+    peak_rack_force_N: float
+    motor_torque_Nm: float  # NaN for hydraulic
+    motor_current_A: float  # NaN for hydraulic
 
 
 @dataclasses.dataclass
@@ -72,6 +95,12 @@ class SizingStudy:
     rows: list[SizingRow]
     standstill_manual: SimulationResult
     standstill_assisted: SimulationResult
+    friction_band: list[FrictionRow] = dataclasses.field(default_factory=list)
+
+    def below_published(self) -> list[FrictionRow]:
+        """The rows of the friction band whose standstill rack force is below the published forces of current
+        small and medium cars (PUBLISHED_STANDSTILL_RACK_FORCE_N)."""
+        return [r for r in self.friction_band if r.peak_rack_force_N < PUBLISHED_STANDSTILL_RACK_FORCE_N[0]]
 
     def columns(self) -> dict[str, np.ndarray]:
         return {f.name: np.array([getattr(r, f.name) for r in self.rows]) for f in dataclasses.fields(SizingRow)}
@@ -143,7 +172,8 @@ def size_assist(params: Parameters, case: str, target_torque_Nm: float, speeds_k
         low = int(np.argmin(speeds_kmh))
         parking_gain = gains[low] / gain_factor(speeds_kmh[low])
         gains = [parking_gain * gain_factor(speed) for speed in speeds_kmh]
-        one_assist = {f"{name}.gain": parking_gain, f"{name}.motor_torque_limit": MARGIN * max(motors)}
+        one_assist = {f"{name}.gain": parking_gain, f"{name}.motor_torque_limit": MARGIN * max(motors),
+                      **table_off(name)}
     rows, manual0, assisted0 = [], None, None
     for i, speed in enumerate(speeds_kmh):
         manual, torque, per_rack = manual_runs[i]
@@ -157,7 +187,9 @@ def size_assist(params: Parameters, case: str, target_torque_Nm: float, speeds_k
             pressure = float("nan")
             motor = motors[i]
             current = motor / v("torque_constant")
-            sized = one_assist if falloff else {f"{name}.gain": gain, f"{name}.motor_torque_limit": MARGIN * motor}
+            # the sized assist is the straight line of the sized gain: a table of the file is switched off
+            sized = one_assist if falloff else {f"{name}.gain": gain, f"{name}.motor_torque_limit": MARGIN * motor,
+                                                **table_off(name)}
         assisted = simulate(case, effects=ASSISTED_EFFECTS[kind], overrides={**creeping_overrides(speed), **sized},
                             params=params)
         c = assisted.columns
@@ -167,4 +199,28 @@ def size_assist(params: Parameters, case: str, target_torque_Nm: float, speeds_k
                               _peak(c["pressure_Pa"]) if hydraulic else float("nan")))
         if manual0 is None:
             manual0, assisted0 = manual, assisted
-    return SizingStudy(name, case, target_torque_Nm, rows, manual0, assisted0)
+    band_rows = friction_band(params, case, name, target_torque_Nm)
+    return SizingStudy(name, case, target_torque_Nm, rows, manual0, assisted0, band_rows)
+
+
+def friction_band(params: Parameters, case: str, name: str, target_torque_Nm: float,
+                  frictions=FRICTION_BAND) -> list[FrictionRow]:
+    """The standstill cycle without assistance at each tyre-ground friction of `frictions`: its peak rack force
+    and, for an electric assist, the motor torque and current that keep the driver at the target (module
+    docstring's quasi-static demand)."""
+    hydraulic = name == ASSIST_EFFECTS["hydraulic"]
+    out = []
+    for friction in frictions:
+        manual = simulate(case, effects=CREEPING_EFFECTS, overrides={**creeping_overrides(0.0),
+                                                                     "tyre.friction_coefficient": friction},
+                          params=params)
+        per_rack = manual.outputs()["column_angle_per_rack_rad_per_m"]
+        torque = manual.columns["handwheel_torque_Nm"]
+        motor = current = float("nan")
+        if not hydraulic:
+            demand = float(np.max(demand_at_action(name, params, torque, per_rack, target_torque_Nm)))
+            v = lambda key: float(params[f"{name}.{key}"])  # noqa: E731
+            motor = (demand / v("reduction_ratio") + v("motor_friction_torque")) / v("efficiency")
+            current = motor / v("torque_constant")
+        out.append(FrictionRow(friction, _peak(torque * per_rack), motor, current))
+    return out

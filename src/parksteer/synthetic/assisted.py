@@ -12,7 +12,7 @@ bar stiffer than the file's.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -76,7 +76,7 @@ def assisted_clean(params: Parameters, hand: HandVariant, effects: str, case: st
         if kind == "motor_ripple":
             delivered = _motor_ripple(size, law.reduction, law.ratio * rack_m)
         elif kind == "dead_band_change":
-            law = replace(law, dead_band=law.dead_band + size)
+            law = law.with_wider_dead_band(size)
         elif kind == "torsion_bar_stiffness":
             key = f"{law.name}.torsion_bar_stiffness"
             run = prepare(case, effects, {**overrides, key: run.p[run.parameter_index(key)] * (1.0 + size)}, surface,

@@ -9,6 +9,7 @@ assist. :func:`assist_template` writes the section for ``parksteer vehicle new -
 
 from __future__ import annotations
 
+from ...boost_table import off_keys, table_keys
 from ...errors import UsageError
 from ...parameters import ParameterError, Parameters
 from ...vehicle import ASSIST_EFFECTS, assist_of
@@ -37,7 +38,7 @@ def check_assist(params: Parameters) -> str | None:
     for key, value in params.sections[name].items():
         q = known.get(key)
         if q is None:
-            raise ParameterError(f"{path}: assist.{key}: unknown key for a {name} (keys: {', '.join(known)})")
+            raise ParameterError(f"{path}: assist.{key}: unknown key for a {name} (keys: {', '.join(k for k in known if k not in TABLE_KEYS)}, and the table [assist.boost])")
         unit = params.sources.get(f"{name}.{key}.unit")
         if unit is not None and unit != q.unit:
             raise ParameterError(f"{path}: assist.{key}: unit {unit!r}, expected {q.unit!r}")
@@ -90,9 +91,33 @@ def boost_line(points: list[tuple[float, float]], what: str) -> tuple[float, flo
     return slope, mean_t - mean_a / slope
 
 
-def assist_template(kind: str, given: dict[str, tuple[float, str]]) -> str:
+# The quantities a boost table replaces (the straight line's) and those it fills (its scalars, derived by the
+# vehicle reader from [assist.boost]): neither is written into a vehicle file's [assist].
+LINE_KEYS = ("gain", "dead_band", "dead_band_smoothing", "speed_dependence", "gain_half_speed")
+TABLE_KEYS = frozenset(table_keys())
+
+
+def table_off(name: str) -> dict[str, float]:
+    """Overrides that switch `name`'s boost table off (the law then is the gain's straight line alone)."""
+    return {f"{name}.{key}": 0.0 for key in off_keys()}
+
+
+def has_table(params: Parameters, name: str) -> bool:
+    """Whether the electric assist `name` of `params` carries a boost table (a nonzero table assist)."""
+    return any(params.sections.get(name, {}).get(key, 0.0) for key in off_keys())
+
+
+def gear_values(kind: str, given: dict[str, tuple[float, str]]) -> tuple[float, float]:
+    """The forward efficiency and reduction of a `kind` electric assist: given, else the assumed defaults."""
+    known = _quantities(ASSIST_EFFECTS[kind])
+    pick = lambda key: float(given[key][0]) if key in given else float(known[key].default)  # noqa: E731
+    return pick("efficiency"), pick("reduction_ratio")
+
+
+def assist_template(kind: str, given: dict[str, tuple[float, str]], table: bool = False) -> str:
     """The ``[assist]`` section of a vehicle file: `given` values ({quantity: (value, source)}) and every other
-    quantity of the assist at its assumed default, marked as assumed with its range and source."""
+    quantity of the assist at its assumed default, marked as assumed with its range and source. With `table` the
+    boost curve is a table that follows ([assist.boost]): the straight line's quantities are left out."""
     if kind not in ASSIST_EFFECTS:
         raise UsageError(f"--assist {kind}: one of {', '.join(ASSIST_EFFECTS)}")
     name = ASSIST_EFFECTS[kind]
@@ -100,6 +125,8 @@ def assist_template(kind: str, given: dict[str, tuple[float, str]]) -> str:
     lines = ["", "# Power assistance: the effect " + name + "; values marked assumed are typical of current cars.",
              "[assist]", f'type = "{kind}"']
     for key, q in known.items():
+        if key in TABLE_KEYS or (table and key in LINE_KEYS):
+            continue
         if key in given:
             value, source = given[key]
             q.check(value, where=f"assist.{key}")

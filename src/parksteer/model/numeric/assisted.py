@@ -21,11 +21,13 @@ The torsion bar's torque is T_s = T (column assist) or T c_col / G_hr (pinion, r
 pinion, the column torque through the joint). Dividing R by c_col (column) or G_hr (the others):
 
     y = T_s + A(T_s),   y = T_road (column), T_road c_col / G_hr (pinion, rack, hydraulic),
-    A(T_s) = eta N clamp(G deadband(T_s) s / (eta N), T_max) / s,   s = 1 (column, pinion), G_hr (rack),
+    A(T_s) = e N clamp((G deadband(T_s) s + B(T_s)) / (eta N), T_max) / s,   s = 1 (column, pinion), G_hr (rack),
     A(T_s) = a_p clamp(k_v deadband(T_s), p_relief) / G_hr          (hydraulic),
 
 the boost laws of :mod:`parksteer.model.symbolic.effects.electric_assist` and ``hydraulic_assist`` with the same
-smoothed corners (:mod:`parksteer.model.symbolic.effects.assist_common`). A is increasing (deadband and clamp are,
+smoothed corners (:mod:`parksteer.model.symbolic.effects.assist_common`); B is the boost table's law (zero without
+a table) and e the gear's efficiency in the direction the power flows (eta_f driving, 1 / eta_b back-driven), read
+from the prescribed rack's speed (the point of action's rate, as the effect reads it) and the law's motor torque. A is increasing (deadband and clamp are,
 strictly for a smoothed clamp: its slope is -(f(a) + f(b))/2 > 0 with f(z) = z / sqrt(z^2 + w^2), a + b = -2 L),
 so y(T_s) rises with slope >= 1 and has one root, found pointwise by bisection in ``[y - B, y + B]`` (B bounds
 |A|). The motor torque T_m and current T_m / k_t (or the pressure) then follow from the law. Nothing in this depends
@@ -36,14 +38,15 @@ tolerance at the column, the pinion and the rack, and in saturation.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
+from ...boost_table import MAX_POINTS, off_keys, table_keys
 from ...errors import UsageError
 from ...parameters import VEHICLE_SPEED
 from ..symbolic.components import power_assist_of
-from ..symbolic.effects.assist_common import clamp, deadband, speed_gain
+from ..symbolic.effects.assist_common import clamp, deadband, directional_efficiency, speed_gain, table_law
 from .prescribed import PRESCRIBED_ATOL_FACTOR, PRESCRIBED_RTOL, PrescribedSolution, RackMotion, solve
 
 # The bisection stops when the bracket is this narrow (N m of torsion-bar torque), far below a sensor's resolution.
@@ -53,9 +56,12 @@ OFFSET_KEY = "torsion_bar_offset.strength"
 GAIN_ERROR_KEY = "boost_gain_error.strength"
 
 
-def boost_key(name: str) -> str:
-    """The quantity that switches the boost off at 0: the gain (electric) or the valve's slope (hydraulic)."""
-    return f"{name}.valve_slope" if name == HYDRAULIC else f"{name}.gain"
+def boost_keys(name: str) -> list[str]:
+    """The quantities that switch the boost off at 0: the gain and the boost table's assists and slopes (electric)
+    or the valve's slope (hydraulic)."""
+    if name == HYDRAULIC:
+        return [f"{name}.valve_slope"]
+    return [f"{name}.gain", *(f"{name}.{key}" for key in off_keys())]
 
 
 @dataclass(frozen=True)
@@ -80,6 +86,12 @@ class BoostLaw:
     torque_constant: float = 1.0
     area: float = 0.0
     offset: float = 0.0  # the torsion-bar sensor's zero offset (N m), read by the law and the logger alike
+    table: tuple = ()  # the boost table's scalars (boost_table.table_keys order); () or all zero: no table
+    speed: float = 0.0  # the vehicle speed (m/s) the table is read at
+    table_scale: float = 1.0  # the boost gain error's factor on the table (1 + e)
+    back_efficiency: float = 1.0  # eta_b of the gear back-driven
+    direction_width: float = 0.0  # motor torque (N m) over which the power's sign is smoothed (limit_smoothing)
+    sharpness: float = 0.0  # s/m: the friction smoothing beta of tanh(beta rack speed)
 
     @property
     def hydraulic(self) -> bool:
@@ -91,23 +103,46 @@ class BoostLaw:
         if self.hydraulic:
             return clamp(self.gain * opening, self.limit, self.limit_width)
         scale = self.ratio if self.location == "rack" else 1.0
-        return clamp(self.gain * opening * scale / (self.efficiency * self.reduction), self.limit, self.limit_width)
+        demand = self.gain * opening * scale
+        if any(self.table):
+            values = dict(zip(table_keys(), self.table))
+            demand = demand + self.table_scale * table_law(np.asarray(torsion_bar_Nm, dtype=float), values.__getitem__,
+                                                           self.speed)
+        return clamp(demand / (self.efficiency * self.reduction), self.limit, self.limit_width)
 
-    def assist(self, torsion_bar_Nm):
-        """A(T_s): the assist in torsion-bar torque units (what it adds to the torsion bar's torque in y)."""
+    def with_wider_dead_band(self, size_Nm: float) -> BoostLaw:
+        """This law with its dead band wider by `size_Nm`: the line's band, and every point of a table but the
+        origin moved out by it (the curve beyond the band unchanged in shape)."""
+        table = list(self.table)
+        if any(table):
+            for k in range(1, MAX_POINTS):
+                table[k] += size_Nm  # boost_torque_<k>: the first MAX_POINTS scalars (table_keys)
+        return replace(self, dead_band=self.dead_band + size_Nm, table=tuple(table))
+
+    def delivered(self, motor, rack_speed_mps):
+        """What the gear delivers per motor torque, in the direction the power flows (eta_f driving, 1 / eta_b
+        back-driven; :func:`~parksteer.model.symbolic.effects.assist_common.directional_efficiency`)."""
+        return directional_efficiency(motor, np.asarray(rack_speed_mps, dtype=float), self.efficiency,
+                                      self.back_efficiency, self.direction_width, self.sharpness)
+
+    def assist(self, torsion_bar_Nm, rack_speed_mps=0.0):
+        """A(T_s): the assist in torsion-bar torque units (what it adds to the torsion bar's torque in y), with the
+        rack moving at `rack_speed_mps` (the direction of the gear's power flow)."""
+        motor = self.motor(torsion_bar_Nm)
         if self.hydraulic:
-            return self.area * self.motor(torsion_bar_Nm) / self.ratio
+            return self.area * motor / self.ratio
         scale = self.ratio if self.location == "rack" else 1.0
-        return self.efficiency * self.reduction * self.motor(torsion_bar_Nm) / scale
+        return self.delivered(motor, rack_speed_mps) * self.reduction * motor / scale
 
     def bound(self) -> float:
-        """An upper bound of |A| (the clamp's magnitude is below limit + width)."""
+        """An upper bound of |A| (the clamp's magnitude is below limit + width; a back-driven gear delivers at most
+        1 / eta_b of the motor torque)."""
         if self.hydraulic:
             return self.area * (self.limit + self.limit_width) / self.ratio
         scale = self.ratio if self.location == "rack" else 1.0
-        return self.efficiency * self.reduction * (self.limit + self.limit_width) / scale
+        return max(self.efficiency, 1.0 / self.back_efficiency) * self.reduction * (self.limit + self.limit_width) / scale
 
-    def torsion_bar(self, y, factor=1.0) -> np.ndarray:
+    def torsion_bar(self, y, factor=1.0, rack_speed_mps=0.0) -> np.ndarray:
         """The torsion-bar torque T_s with T_s + factor A(T_s) = y, elementwise (bisection; A is increasing, and
         so is the sum for any factor >= 0: a motor whose delivered torque departs from the law by `factor`)."""
         y = np.asarray(y, dtype=float)
@@ -115,7 +150,7 @@ class BoostLaw:
         low, high = y - width, y + width
         for _ in range(200):
             mid = 0.5 * (low + high)
-            above = mid + factor * self.assist(mid) > y
+            above = mid + factor * self.assist(mid, rack_speed_mps) > y
             high = np.where(above, mid, high)
             low = np.where(above, low, mid)
             if np.all(high - low <= INVERSION_TOLERANCE_NM):
@@ -142,7 +177,20 @@ def boost_law(run, p: np.ndarray) -> BoostLaw | None:
                       v("gain_half_speed"))
     return BoostLaw(name, effect.location, gain * gain_factor, v("dead_band"), v("dead_band_smoothing"),
                     v("motor_torque_limit"), v("limit_smoothing"), ratio, v("reduction_ratio"), v("efficiency"),
-                    v("torque_constant"), offset=offset)
+                    v("torque_constant"), offset=offset, table=tuple(v(key) for key in table_keys()),
+                    speed=float(p[run.parameter_index(VEHICLE_SPEED.key)]), table_scale=gain_factor,
+                    back_efficiency=v("back_efficiency"), direction_width=v("limit_smoothing"),
+                    sharpness=float(p[run.parameter_index("steering.friction_smoothing")]))
+
+
+def rack_speed_mps(rack: RackMotion, t) -> np.ndarray:
+    """The speed of `rack` at the times `t` (m/s; 0 where it is held, before its first and after its last break)."""
+    from scipy.interpolate import PPoly
+
+    breaks = np.asarray(rack.breaks, dtype=float)
+    speed = PPoly(np.asarray(rack.coefficients, dtype=float), breaks).derivative()(np.asarray(t, dtype=float))
+    inside = (np.asarray(t) >= breaks[0]) & (np.asarray(t) <= breaks[-1])
+    return np.where(inside, speed, 0.0)
 
 
 @dataclass
@@ -171,15 +219,22 @@ def solve_assisted(run, p: np.ndarray, rack: RackMotion, t_out, rtol: float = PR
         raise UsageError("an assisted replay needs an assist effect in the model (electric_assist_* or "
                          "hydraulic_assist)")
     p_off = np.array(p, dtype=float)
-    p_off[run.parameter_index(boost_key(law.name))] = 0.0
-    road = solve(run, p_off, rack, t_out, rtol=rtol, atol_factor=atol_factor, outputs=law.location != "column",
-                 assist_off=True)
+    for key in boost_keys(law.name):
+        p_off[run.parameter_index(key)] = 0.0
+    electric = not law.hydraulic
+    road = solve(run, p_off, rack, t_out, rtol=rtol, atol_factor=atol_factor,
+                 outputs=law.location != "column" or electric, assist_off=True)
     y = road.torque_Nm
     if law.location != "column":
         y = y * road.outputs["column_angle_per_rack_rad_per_m"] / law.ratio
+    # the speed the gear's direction of power flow is read from: the point of action's rate over G_hr (the column's
+    # through the joint), as the effect reads it
+    speed = rack_speed_mps(rack, road.time_s) if electric else 0.0
+    if electric and law.location == "column":
+        speed = speed * road.outputs["column_angle_per_rack_rad_per_m"] / law.ratio
     # A sensor reading S = T_s + o, taken by the law: S - o + A(S) = y (effect torsion_bar_offset).
     factor = 1.0 if delivered is None else np.asarray(delivered, dtype=float)
-    torsion_bar = law.torsion_bar(y + law.offset, factor)
+    torsion_bar = law.torsion_bar(y + law.offset, factor, speed)
     motor = law.motor(torsion_bar)
     current = None if law.hydraulic else motor / law.torque_constant
     return AssistedSolution(road.time_s, torsion_bar, road.states, road.accelerations, None, None, road.torque_Nm,

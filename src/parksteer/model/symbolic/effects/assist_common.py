@@ -18,7 +18,15 @@ ramp(z, w) = (z + sqrt(z^2 + w^2)) / 2 (a smooth max(z, 0), as the rack lash's d
     clamp(y, L) = y - ramp(y - L) + ramp(-y - L)      (= 0 exactly at y = 0; -> y well inside +-L)
 
 so the Jacobian stays continuous, a zero gain gives exactly no assist, and only sqrt (exact in IEEE
-arithmetic) enters the generated C. The same three functions evaluate the law on numbers (the assisted replay,
+arithmetic) enters the generated C.
+
+Boost table. A table (:mod:`parksteer.boost_table`: points, one row per vehicle speed, Fritsch-Carlson slopes) is
+evaluated by :func:`table_law`: each point's assist and slope interpolated linearly in the vehicle speed between
+the rows (held beyond the first and last), as a_r + lambda (a_r+1 - a_r) so that equal rows give a_r exactly; then
+the cubic Hermite segment the torque falls in, and beyond the last point the straight continuation; odd through
+A(-T) = -A(T). At a point the segment's basis is (1, 0, 0, 0), so the law gives the point's assist exactly; a
+segment between two zero points with zero slopes gives exactly 0 (the dead band). On sympy expressions the choice of
+segment and row is a Piecewise (conditional expressions in the C), on numbers the same branches chosen elementwise. The same three functions evaluate the law on numbers (the assisted replay,
 :mod:`parksteer.model.numeric.assisted`): on sympy expressions they build the model's terms, on floats and numpy
 arrays they compute them, with products for squares (no ``pow``) so the numbers are the same on every machine.
 """
@@ -27,6 +35,8 @@ from __future__ import annotations
 
 import numpy as np
 import sympy as sp
+
+from ....boost_table import MAX_POINTS, MAX_SPEEDS
 
 LOCATIONS = ("column", "pinion", "rack")
 
@@ -48,6 +58,24 @@ def deadband(x, band, width):
 def clamp(y, limit, width):
     """y limited to +-`limit`, corners smoothed over `width`; zero exactly at y = 0."""
     return y - ramp(y - limit, width) + ramp(-y - limit, width)
+
+
+def _tanh(x):
+    return sp.tanh(x) if isinstance(x, sp.Basic) else np.tanh(x)
+
+
+def directional_efficiency(motor, speed, forward, back, width, sharpness):
+    """What the gear delivers per motor torque, in the direction the power flows: eta_f when the motor drives
+    (motor torque and speed of one sign), 1 / eta_b when the point of action drives the motor. With the smooth
+    sign of the power s = tanh(sharpness speed) motor / sqrt(motor^2 + width^2) in (-1, 1),
+
+        factor = 1 + s g(s),   g(s) = (eta_f - 1) (1 + s) / 2 + (1 - 1 / eta_b) (1 - s) / 2,
+
+    eta_f at s = 1, 1 / eta_b at s = -1, 1 at rest. g < 0 everywhere, so factor < 1 when the motor drives and > 1
+    when it is driven: the power the gear loses, motor power x (1 - factor), is s g(s) times minus that power, never
+    negative (the gear dissipates, never creates)."""
+    s = _tanh(sharpness * speed) * motor / _sqrt(motor * motor + width * width)
+    return 1 + s * ((forward - 1) * (1 + s) / 2 + (1 - 1 / back) * (1 - s) / 2)
 
 
 def speed_gain(gain, dependence, speed, half_speed):
@@ -82,3 +110,51 @@ def point_of_action(model, location: str):
     if location == "pinion":
         return ratio * model.rack_q, ratio * model.rack_u
     return model.rack_q, model.rack_u
+
+
+def _select(branches, otherwise):
+    """The first branch (condition, value) whose condition holds, else `otherwise`: a Piecewise on sympy
+    expressions, elementwise on numbers (every value is finite, so all are computed and one kept)."""
+    if any(isinstance(c, sp.Basic) or isinstance(v, sp.Basic) for c, v in branches) or isinstance(otherwise, sp.Basic):
+        return sp.Piecewise(*((v, c) for c, v in branches), (otherwise, True))
+    conditions = [np.asarray(c) for c, _ in branches]
+    return np.select(conditions, [np.asarray(v, dtype=float) for _, v in branches], np.asarray(otherwise, dtype=float))
+
+
+def _hermite(x, t0, t1, a0, a1, m0, m1):
+    """The cubic Hermite segment through (t0, a0), (t1, a1) with slopes m0, m1; exactly a0 at x = t0."""
+    h = t1 - t0
+    s = (x - t0) / h
+    r = 1 - s
+    return a0 * ((1 + 2 * s) * r * r) + h * m0 * (s * r * r) + a1 * (s * s * (3 - 2 * s)) + h * m1 * (s * s * (s - 1))
+
+
+def _at_speed(speed, speeds, row_values):
+    """One point's value at the vehicle speed, linear between the rows `row_values` at `speeds`, held beyond."""
+    branches = [(speed < speeds[0], row_values[0])]
+    for r in range(len(speeds) - 1):
+        fraction = (speed - speeds[r]) / (speeds[r + 1] - speeds[r])
+        branches.append((speed < speeds[r + 1], row_values[r] + fraction * (row_values[r + 1] - row_values[r])))
+    return _select(branches, row_values[-1])
+
+
+def table_law(torque, value, speed):
+    """The boost table's assist at the torsion-bar torque `torque` and the vehicle speed `speed` (module docstring);
+    `value(key)` gives the table's scalar (``boost_torque_<k>``, ...) as a symbol or a number."""
+    knots = [value(f"boost_torque_{k}") for k in range(MAX_POINTS)]
+    speeds = [value(f"boost_speed_{r}") for r in range(MAX_SPEEDS)]
+    assist = [_at_speed(speed, speeds, [value(f"boost_assist_{r}_{k}") for r in range(MAX_SPEEDS)])
+              for k in range(MAX_POINTS)]
+    slope = [_at_speed(speed, speeds, [value(f"boost_slope_{r}_{k}") for r in range(MAX_SPEEDS)])
+             for k in range(MAX_POINTS)]
+
+    def half(x):  # x >= 0
+        branches = [(x < knots[k + 1], _hermite(x, knots[k], knots[k + 1], assist[k], assist[k + 1], slope[k],
+                                                  slope[k + 1])) for k in range(MAX_POINTS - 1)]
+        return _select(branches, assist[-1] + slope[-1] * (x - knots[-1]))
+
+    if isinstance(torque, sp.Basic):
+        return sp.Piecewise((half(torque), torque >= 0), (-half(-torque), True))
+    torque = np.asarray(torque, dtype=float)
+    magnitude = half(np.abs(torque))
+    return np.where(torque >= 0, magnitude, -magnitude)

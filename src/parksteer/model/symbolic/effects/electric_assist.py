@@ -28,21 +28,35 @@ tables of the control unit, the rational fall of EPS assist maps, k0 / (1 + k_v 
 speed; the quantities' sources give the typical v_half). Quasi-statically the driver's torque is
 T_road / (1 + G(v)) (the tests).
 
+Boost table. A vehicle file's ``[assist.boost]`` gives the curve as the control unit's table instead: torsion-bar
+torques and the assist at the point of action, optionally one row per vehicle speed (:mod:`parksteer.boost_table`).
+The demand is then the table's law, the monotone cubic through the points, odd, exactly zero in the dead band,
+linear in speed between rows (:func:`.assist_common.table_law`), read at the torsion-bar torque and the run's
+vehicle speed; the file's gain is 0 (the reader refuses both), and the table's default, all zeros, adds exactly
+nothing to today's law.
+
 The motor torque is the demand through the reduction, limited:
 
     T_m = clamp(A_cmd / (eta N), T_max),     i = T_m / k_t (the motor current, torque constant k_t),
 
-and the torque eta T_m acts on the motor's rotor (reacted on the body): its generalized force on the rack is
-eta N T_m dx/d(rack), the assist eta N T_m at the point of action; (1 - eta) T_m N dx/dt is lost in the gear
-(a constant efficiency, also when the gear is back-driven). The rotor's inertia J_m turns at N dx/dt (kinetic
+and the torque e T_m acts on the motor's rotor (reacted on the body): its generalized force on the rack is
+e N T_m dx/d(rack), the assist e N T_m at the point of action. The gear's efficiency depends on which way the power
+flows: e = eta_f when the motor drives (T_m and dx/dt of one sign), e = 1 / eta_b when the point of action drives
+the motor against its torque (after a reversal, the tyre's wind-up returning the rack): a back-driven worm or
+ball nut passes on eta_b of the power put in at the rack, so the motor's torque N T_m / eta_b at the point of
+action, not eta_f N T_m. Between the two, smoothly through the power's sign
+(:func:`.assist_common.directional_efficiency`, sharp over the friction smoothing's rack speed and
+limit_smoothing of motor torque), so that the gear's loss, T_m N dx/dt (1 - e), is never negative. The control
+unit commands T_m = A_cmd / (eta_f N): while the motor drives, the assist is the demand. The rotor's inertia J_m turns at N dx/dt (kinetic
 energy J_m (N dx/dt)^2 / 2, N^2 J_m reflected to x), its bearings' Coulomb friction T_f tanh(beta v) opposes it
 (v the rack speed it corresponds to, beta the project's friction smoothing).
 
 Quasi-static consequences (the tests): with no dead band and the motor below its limit, the column carries
-T_s + G(v) T_s = T_road, so the driver's torque is T_road / (1 + G(v)); at the limit, T_s = T_road - eta N T_max
-(column) rises with the road torque at the manual steering's slope; a zero gain adds no torque at all.
+T_s + G(v) T_s = T_road, so the driver's torque is T_road / (1 + G(v)) (with a table, the root of T_s + A(T_s) =
+T_road); at the limit, T_s = T_road - eta N T_max (column) rises with the road torque at the manual steering's
+slope; a zero gain adds no torque at all.
 
-Outputs: torsion_bar_torque_Nm (T_s), assist_torque_Nm or assist_force_N (eta N T_m at x), motor_torque_Nm,
+Outputs: torsion_bar_torque_Nm (T_s), assist_torque_Nm or assist_force_N (e N T_m at x), motor_torque_Nm,
 motor_current_A; the simulation adds rack_force_N (the force the pinion and the assist together put on the
 rack). The model has no tie rods (a linear linkage), so no tie-rod force.
 
@@ -57,11 +71,12 @@ from typing import ClassVar
 import sympy as sp
 import sympy.physics.mechanics as me
 
+from ....boost_table import MAX_POINTS, MAX_SPEEDS, PAD_STEP_MPS, PAD_STEP_NM
 from ....parameters import VEHICLE_SPEED, Quantity
 from ..components import Effect
 from ..system import torque_between
-from .assist_common import (LOCATIONS, clamp, deadband, point_of_action, series_deflection, speed_gain,
-                            torsion_bar_torque)
+from .assist_common import (LOCATIONS, clamp, deadband, directional_efficiency, point_of_action,
+                            series_deflection, speed_gain, table_law, torsion_bar_torque)
 
 # Typical values by point of action: (reduction N, its unit, bounds, efficiency, motor torque limit N m,
 # motor inertia kg m^2, source of the reduction). Column and pinion: a worm gear; rack: a ball nut driven through
@@ -78,9 +93,52 @@ _GEARS = {
              "1500-3500 rad/m (Harrer & Pfeffer, Steering Handbook, ch. 8.4)"),
 }
 
+# Back-driven efficiency by point of action (the rack drives the motor), with its source. A worm of lead angle
+# lambda and friction angle rho has eta_f = tan(lambda) / tan(lambda + rho) forward and eta_b = tan(lambda - rho) /
+# tan(lambda) backward (Shigley's Mechanical Engineering Design, ch. 13, worm gearing); an EPS worm is built to be
+# back-driven (the wheels' self-centring returns the handwheel through it). A ball nut's rolling contact gives
+# nearly the same efficiency both ways.
+_BACK_EFFICIENCY = {
+    "column": (0.80, "assumed: back-driven worm gear, 0.75-0.85: tan(lambda - rho) / tan(lambda) for the lead angle "
+                     "that gives eta_f = 0.85 (about 25 deg at rho = 3 deg) is 0.86, 0.80 at rho = 4.5 deg "
+                     "(Shigley's Mechanical Engineering Design, ch. 13); EPS worms are made back-drivable "
+                     "(Harrer & Pfeffer, ch. 8.3)"),
+    "pinion": (0.80, "assumed: back-driven worm gear, 0.75-0.85, as at the column (Shigley's Mechanical "
+                     "Engineering Design, ch. 13; Harrer & Pfeffer, ch. 8.3)"),
+    "rack": (0.85, "assumed: back-driven ball nut and belt, 0.8-0.9: ball screws back-drive at 0.8-0.9 of the "
+                   "forward 0.9-0.95 (Harrer & Pfeffer, ch. 8.4; THK and NSK ball screw catalogues, 'reverse "
+                   "efficiency')"),
+}
+
+
+
+def table_quantities(name: str, location: str) -> tuple[Quantity, ...]:
+    """The scalar quantities of a boost table (:mod:`parksteer.boost_table`), by default a table of zeros: no
+    assist from the table, the law of the gain and dead band alone."""
+    unit, slope_unit = ("N", "N/(N m)") if location == "rack" else ("N m", "1")
+    where = "at the rack" if location == "rack" else f"at the {location}"
+    table = "derived from [assist.boost] of the vehicle file; default 0: no table"
+    out = [Quantity(f"{name}.boost_torque_{k}", "N m", 0.0, 100.0, lower_inclusive=True, default=k * PAD_STEP_NM,
+                    description=f"boost table: torsion-bar torque of point {k}",
+                    source="derived from [assist.boost] of the vehicle file (padded 1 N m apart beyond its last "
+                           "point); default evenly spaced, unused without a table") for k in range(MAX_POINTS)]
+    out += [Quantity(f"{name}.boost_speed_{r}", "m/s", 0.0, 200.0, lower_inclusive=True,
+                     default=r * PAD_STEP_MPS, description=f"boost table: vehicle speed of row {r}",
+                     source="derived from [assist.boost] of the vehicle file (one row: 0); default evenly spaced, "
+                            "unused without a table") for r in range(MAX_SPEEDS)]
+    for r in range(MAX_SPEEDS):
+        out += [Quantity(f"{name}.boost_assist_{r}_{k}", unit, 0.0, 1.0e6, lower_inclusive=True, default=0.0,
+                         description=f"boost table: assist {where} at point {k}, row {r}", source=table)
+                for k in range(MAX_POINTS)]
+        out += [Quantity(f"{name}.boost_slope_{r}_{k}", slope_unit, 0.0, 1.0e6, lower_inclusive=True, default=0.0,
+                         description=f"boost table: Fritsch-Carlson slope at point {k}, row {r}", source=table)
+                for k in range(MAX_POINTS)]
+    return tuple(out)
+
 
 def assist_quantities(name: str, location: str) -> tuple[Quantity, ...]:
     ratio, ratio_unit, (lo, hi), efficiency, limit, inertia, ratio_source = _GEARS[location]
+    back, back_source = _BACK_EFFICIENCY[location]
     return (
         Quantity(f"{name}.gain", "1", 0.0, 50.0, lower_inclusive=True, default=6.0,
                  description="boost curve: assist per driver torque beyond the dead band",
@@ -102,6 +160,10 @@ def assist_quantities(name: str, location: str) -> tuple[Quantity, ...]:
         Quantity(f"{name}.efficiency", "1", 0.0, 1.0, default=efficiency,
                  description="forward efficiency of the reduction (worm gear or ball nut)",
                  source="assumed: worm gears of EPS 0.75-0.9 (Kim, Mech. Sci. 9, 201, 2018), ball nuts 0.9-0.95"),
+        Quantity(f"{name}.back_efficiency", "1", 0.0, 1.0, default=back,
+                 description="efficiency of the reduction back-driven (power from the point of action into the "
+                             "motor): the motor feels eta_b of the power the rack puts in",
+                 source=back_source),
         Quantity(f"{name}.motor_torque_limit", "N m", 0.0, 30.0, default=limit,
                  description="peak torque of the motor (the boost curve's saturation)",
                  source="assumed: EPS motors 3-6 N m peak at 60-100 A on 12 V (Harrer & Pfeffer, ch. 8.6)"),
@@ -130,6 +192,7 @@ def assist_quantities(name: str, location: str) -> tuple[Quantity, ...]:
                         "(Chrysler 1999 Concorde service manual, speed proportional steering gear); with v_half "
                         "40-80 km/h, G / (1 + (v / v_half)^2) keeps 61-86 % of the parking gain at 32 km/h and "
                         "14-39 % at 100 km/h"),
+        *table_quantities(name, location),
     )
 
 
@@ -194,10 +257,20 @@ class ElectricAssist(Effect):
 
     def motor_torque(self, model):
         scale = model.p("steering.handwheel_to_rack_ratio") if self.location == "rack" else 1
-        demand = self.gain(model) * deadband(self.sensor_torque(model), self.q(model, "dead_band"),
-                                                  self.q(model, "dead_band_smoothing")) * scale
+        sensor = self.sensor_torque(model)
+        demand = self.gain(model) * deadband(sensor, self.q(model, "dead_band"),
+                                             self.q(model, "dead_band_smoothing")) * scale
+        demand = demand + table_law(sensor, lambda key: self.q(model, key), model.p(VEHICLE_SPEED.key))
         at_motor = demand / (self.q(model, "efficiency") * self.q(model, "reduction_ratio"))
         return clamp(at_motor, self.q(model, "motor_torque_limit"), self.q(model, "limit_smoothing"))
+
+    def delivered_factor(self, model, motor):
+        """The gear's efficiency in the direction the power flows (eta_f driving, 1 / eta_b back-driven), smooth
+        through the power's sign (module docstring)."""
+        _, rate = point_of_action(model, self.location)
+        rack_speed = rate if self.location == "rack" else rate / model.p("steering.handwheel_to_rack_ratio")
+        return directional_efficiency(motor, rack_speed, self.q(model, "efficiency"), self.q(model, "back_efficiency"),
+                                      self.q(model, "limit_smoothing"), model.p("steering.friction_smoothing"))
 
     def bodies(self, model):
         k = model.kinematics
@@ -213,13 +286,14 @@ class ElectricAssist(Effect):
         rack_speed = rate if self.location == "rack" else rate / model.p("steering.handwheel_to_rack_ratio")
         friction = self.q(model, "motor_friction_torque") * sp.tanh(model.p("steering.friction_smoothing")
                                                                      * rack_speed)
-        delivered = self.q(model, "efficiency") * self.motor_torque(model)
+        motor = self.motor_torque(model)
+        delivered = self.delivered_factor(model, motor) * motor
         # Motor torque (less the gear's loss) and bearing friction on the rotor, reacted on the body.
         return torque_between(delivered - friction, k.B.y, frame, k.B)
 
     def outputs(self, model):
         motor = self.motor_torque(model)
-        at_x = self.q(model, "efficiency") * self.q(model, "reduction_ratio") * motor
+        at_x = self.delivered_factor(model, motor) * self.q(model, "reduction_ratio") * motor
         return [
             ("torsion_bar_torque_Nm", self.sensor_torque(model)),
             ("assist_force_N" if self.location == "rack" else "assist_torque_Nm", at_x),

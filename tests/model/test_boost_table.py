@@ -1,0 +1,147 @@
+"""Boost tables and the back-driven gear: physics checks of the electric assist's table law and of its gear's
+efficiency in both directions of power flow."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.interpolate import PchipInterpolator
+from scipy.optimize import brentq
+
+from model_helpers import first_ramp
+
+from parksteer.boost_table import BoostTableError, check_table, entries
+from parksteer.model.numeric.simulate import simulate
+from parksteer.model.symbolic.components import discover_effects
+from parksteer.model.symbolic.effects.assist_common import directional_efficiency, table_law
+
+discover_effects()  # declares the assists' own quantities
+
+# A progressive curve, 3.9 (|T| - 0.4)^1.6 N m beyond a 0.4 N m dead band (the Polo file's).
+TORQUES = [0.0, 0.4, 0.8, 1.2, 1.6, 2.0, 2.5, 3.0, 4.0]
+ASSIST = [0.0, 0.0, 0.9, 2.73, 5.22, 8.27, 12.78, 18.0, 30.3]
+NAME = "electric_assist_column"
+
+
+def law(values: dict, torque, speed=0.0):
+    return table_law(np.asarray(torque, dtype=float), values.__getitem__, speed)
+
+
+def as_overrides(values: dict, name: str = NAME) -> dict:
+    """The table's scalars as overrides of `name`, the straight line's gain off."""
+    return {**{f"{name}.{k}": v for k, v in values.items()}, f"{name}.gain": 0.0}
+
+
+def test_table_law_takes_its_points_exactly_and_is_monotone_odd_and_zero_in_the_dead_band():
+    """A calibration table is what the control unit commands at its points: the law gives each point's assist
+    exactly (bit for bit), rises between them (Fritsch-Carlson), is odd (a left turn is a mirrored right turn) and
+    is exactly zero inside the dead band, not merely small."""
+    values = entries(TORQUES, None, [ASSIST])
+    at_points = law(values, TORQUES)
+    assert list(at_points) == ASSIST
+    assert list(law(values, [-t for t in TORQUES])) == [-a for a in ASSIST]
+    t = np.linspace(-6.0, 6.0, 24001)
+    a = law(values, t)
+    assert np.all(np.diff(a) >= 0.0)
+    assert np.all(np.diff(a[np.abs(t) > 0.4]) > 0.0)  # strictly beyond the dead band: the inversion is sound
+    assert np.array_equal(a, -law(values, -t))
+    assert np.all(a[np.abs(t) <= 0.4] == 0.0)
+    # the same curve as an independent monotone cubic through the mirrored points (SciPy's PCHIP)
+    reference = PchipInterpolator([-x for x in TORQUES[:0:-1]] + TORQUES, [-y for y in ASSIST[:0:-1]] + ASSIST)
+    inside = np.abs(t) <= TORQUES[-1]
+    assert np.max(np.abs(a[inside] - reference(t[inside]))) < 1e-12
+
+
+def test_one_straight_segment_is_todays_linear_law():
+    """A table of two points (0, 0) and (T_1, A_1) is the straight line of gain A_1 / T_1 (no dead band), on both
+    sides of zero and beyond the point."""
+    values = entries([0.0, 2.0], None, [[0.0, 12.0]])
+    t = np.linspace(-10.0, 10.0, 401)
+    assert np.max(np.abs(law(values, t) - 6.0 * t)) < 1e-12
+
+
+def test_two_row_speed_map_is_linear_in_speed():
+    """A map with one row per vehicle speed is read, between the rows, as the linear interpolation in speed of the
+    two rows' curves (and as the nearer row beyond them): a car creeping at 2 km/h between rows at 0 and 5 km/h gets
+    60 % of the first row and 40 % of the second at every torque."""
+    slow = ASSIST
+    fast = [0.0, 0.0, 0.5, 1.5, 3.0, 5.0, 8.0, 11.0, 19.0]
+    speeds = [0.0, 5.0 / 3.6]
+    values = entries(TORQUES, speeds, [slow, fast])
+    t = np.linspace(-5.0, 5.0, 1001)
+    row0, row1 = law(values, t, 0.0), law(values, t, speeds[1])
+    between = law(values, t, 2.0 / 3.6)
+    assert np.max(np.abs(between - (0.6 * row0 + 0.4 * row1))) < 1e-12
+    assert np.array_equal(law(values, t, 10.0), row1)
+    assert np.array_equal(law(values, TORQUES, speeds[1]), np.array(fast))
+
+
+def test_tables_that_are_not_boost_curves_are_refused():
+    """A boost curve starts at (0, 0), never falls and rises strictly once it has left its dead band."""
+    for torques, rows in (([0.0, 1.0, 1.0], [[0.0, 1.0, 2.0]]), ([0.0, 1.0, 2.0], [[0.0, 2.0, 1.0]]),
+                          ([0.0, 1.0, 2.0], [[0.0, 1.0, 1.0]]), ([0.5, 1.0], [[0.0, 1.0]]),
+                          ([0.0, 1.0], [[0.0, 0.0]])):
+        with pytest.raises(BoostTableError):
+            check_table(torques, None, rows)
+
+
+def test_quasi_static_driver_torque_solves_t_plus_a_of_t_equals_the_road_torque(params):
+    """Quasi-statically the column carries the road torque as torsion-bar torque plus assist: T + A(T) = T_road. For
+    the progressive table, a lossless gear (eta_f = eta_b = 1: the motor's torque through N is the table's assist
+    either way), an ideal motor and no Hooke joint, the driver's torque on the slow steer to the right is the root of
+    that equation, solved here by hand (Brent's method on SciPy's PCHIP through the mirrored points) from the manual
+    car's torque at the same rack position, within 1 %."""
+    from test_assist import series_column
+
+    manual = simulate("unladen", effects="-hooke_joint", overrides=series_column(params, NAME), params=params)
+    gear = {f"{NAME}.motor_inertia": 0.0, f"{NAME}.motor_friction_torque": 0.0, f"{NAME}.efficiency": 1.0,
+            f"{NAME}.back_efficiency": 1.0, f"{NAME}.motor_torque_limit": 30.0}
+    assisted = simulate("unladen", effects=f"-hooke_joint,+{NAME}",
+                        overrides={**gear, **as_overrides(entries(TORQUES, None, [ASSIST]))}, params=params)
+    ramp, at = first_ramp(manual), first_ramp(assisted)
+    road = np.interp(assisted.columns["rack_m"][at], manual.columns["rack_m"][ramp],
+                     manual.columns["handwheel_torque_Nm"][ramp])
+    curve = PchipInterpolator([-x for x in TORQUES[:0:-1]] + TORQUES, [-y for y in ASSIST[:0:-1]] + ASSIST)
+    hand = np.array([brentq(lambda x, y=y: x + curve(x) - y, -10.0, 10.0) for y in road])
+    got = assisted.columns["handwheel_torque_Nm"][at]
+    assert np.max(np.abs(road)) > 10.0 and np.min(hand) > 0.4  # the steer reaches well into the progressive part
+    assert np.max(np.abs(got / hand - 1.0)) < 0.01
+
+
+def test_directional_efficiency_never_creates_power():
+    """The gear delivers eta_f of the motor's power when the motor drives and asks 1 / eta_b of it from the rack
+    when the rack drives the motor; through the smoothing the loss, motor power x (1 - factor), is never
+    negative."""
+    motor = np.linspace(-3.0, 3.0, 601)[:, None]
+    speed = np.linspace(-0.05, 0.05, 401)[None, :]
+    factor = directional_efficiency(motor, speed, 0.85, 0.8, 0.05, 1000.0)
+    power = motor * speed  # sign of the motor's power (the rotor turns with the rack)
+    assert np.all(power * (1.0 - factor) >= 0.0)
+    assert directional_efficiency(3.0, 0.05, 0.85, 0.8, 0.05, 1000.0) == pytest.approx(0.85, abs=1e-3)
+    assert directional_efficiency(3.0, -0.05, 0.85, 0.8, 0.05, 1000.0) == pytest.approx(1 / 0.8, abs=1e-3)
+
+
+def test_over_a_closed_cycle_the_gear_dissipates_and_is_back_driven_after_each_reversal(params):
+    """Energy: the gear's loss is the motor's power into it less the power it delivers at the column,
+    T_m N w - A w (w the column rate). On the lock-to-lock cycle of the Polo-like progressive assist it is never
+    negative at any sample and positive over the cycle, and part of the cycle is back-driven (the rack returning
+    against the assist's torque after a reversal: the gear delivers more than eta_f N T_m there, up to N T_m /
+    eta_b). A gear that kept eta_f both ways would create power in those samples."""
+    overrides = as_overrides(entries(TORQUES, None, [ASSIST]))
+    result = simulate("unladen", effects=f"+{NAME}", overrides=overrides, params=params)
+    c = result.columns
+    out = result.model.evaluate_outputs(c["time_s"], result.states, result.parameter_vector)
+    n = params[f"{NAME}.reduction_ratio"]
+    rate = out["column_angle_per_rack_rad_per_m"] * c["rack_speed_m_s"]
+    loss = c["motor_torque_Nm"] * n * rate - c["assist_torque_Nm"] * rate
+    scale = np.max(np.abs(c["motor_torque_Nm"] * n * rate))
+    assert np.min(loss) > -1e-9 * scale
+    total = np.trapezoid(loss, c["time_s"])
+    assert total > 0.0
+    strong = np.abs(c["assist_torque_Nm"]) > 1.0
+    factor = c["assist_torque_Nm"][strong] / (n * c["motor_torque_Nm"][strong])
+    back = factor > 1.0
+    assert 0.0 < np.mean(back) < 0.5
+    constant = params[f"{NAME}.efficiency"] * n * c["motor_torque_Nm"]
+    created = (c["motor_torque_Nm"] * n * rate - constant * rate)[strong][back]
+    assert np.min(created) < 0.0
