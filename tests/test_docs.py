@@ -40,13 +40,6 @@ import pytest
 
 REPO = Path(__file__).resolve().parents[1]
 DOCUMENTS = ["README.md", *sorted(str(p.relative_to(REPO)) for p in (REPO / "docs").glob("*.md"))]
-# Documents another branch is rewriting, not run here until they carry their markers: document -> reason.
-PENDING = {"docs/assist.md": "being rewritten on another branch: its placeholder polo_log.csv and its benchmark and "
-                             "pipeline lines need markers first"}
-# Blocks of sections another branch owns, skipped here rather than by a marker in the document: (document, a text
-# of the block) -> reason.
-SKIPPED_HERE = {("README.md", "quick start 1"): "installs and builds the whole pipeline; .ci/run runs these lines "
-                                                "as written, each in a fresh clone and venv"}
 BLOCK_TIMEOUT_S = 600
 
 FENCE = re.compile(r"^```(\w*)\n(.*?)^```\n", re.S | re.M)
@@ -113,8 +106,6 @@ def parse(document: str, text: str) -> list[Block]:
             last = None
             continue
         block = Block(document, line, body)
-        block.skip = next((reason for (doc, fragment), reason in SKIPPED_HERE.items()
-                           if doc == document and fragment in body), None)
         for marker in pending:
             if (m := SKIP.match(marker)) is not None:
                 block.skip = m.group(1)
@@ -269,8 +260,6 @@ def run_document(document, tmp_path, copy_repository, model_cache):
     """Each sh block of `document` runs in a scratch copy, in order, and ends with status 0 (or the status its exits
     marker states); each quote marker's value is what the block printed or wrote. Skipped blocks and lines are
     listed with their reasons on stdout."""
-    if document in PENDING:
-        pytest.skip(PENDING[document])
     text = (REPO / document).read_text(encoding="utf-8")
     blocks = parse(document, text)
     work = copy_repository(tmp_path / "repo")

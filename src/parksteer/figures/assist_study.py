@@ -64,7 +64,7 @@ QUOTED = {
 TURN_SLIP_QUOTED = ("spin_slope_coefficient", "camber_reduction")
 # The band of q_Dz8 (turn_slip.spin_slope_coefficient) the creeping result is shown over, car without assist: the
 # MF 6.1 default 0.05 (the effect's source), and 0.12 and 0.5, near the |q_Dz8| of fitted car-tyre sets (0.12 and
-# 0.53 as reported in the project's issue 36; no published property file was checked here). The larger q_Dz8, the
+# 0.53 are values quoted for such sets; no published property file was checked here). The larger q_Dz8, the
 # more of its standstill moment the rolling tyre keeps.
 SPIN_SLOPE_BAND = (0.05, 0.12, 0.5)
 SPIN_SLOPE_KEY = "turn_slip.spin_slope_coefficient"
