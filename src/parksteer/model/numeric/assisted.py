@@ -222,8 +222,9 @@ def solve_assisted(run, p: np.ndarray, rack: RackMotion, t_out, rtol: float = PR
     for key in boost_keys(law.name):
         p_off[run.parameter_index(key)] = 0.0
     electric = not law.hydraulic
+    # a column assist's law needs only the column angle per rack (the speed below), not the handwheel's twist
     road = solve(run, p_off, rack, t_out, rtol=rtol, atol_factor=atol_factor,
-                 outputs=law.location != "column" or electric, assist_off=True)
+                 outputs=law.location != "column" or electric, assist_off=True, handwheel=law.location != "column")
     y = road.torque_Nm
     if law.location != "column":
         y = y * road.outputs["column_angle_per_rack_rad_per_m"] / law.ratio

@@ -139,14 +139,17 @@ class PrescribedSolution:
 
 def solve(run, p: np.ndarray, rack: RackMotion, t_out, rtol: float = PRESCRIBED_RTOL,
           atol_factor: float = PRESCRIBED_ATOL_FACTOR, outputs: bool = False,
-          assist_off: bool = False) -> PrescribedSolution:
+          assist_off: bool = False, handwheel: bool = True) -> PrescribedSolution:
     """Solve the model of `run` (a PreparedRun) with parameter vector `p`, the rack following `rack`.
 
     The run starts from static equilibrium with the rack at its position at ``t_out[0]``;
     `t_out` (s, strictly increasing) are the output times. Tolerances: relative `rtol`, absolute
     `atol_factor` times the model's own (:mod:`parksteer.model.numeric.tolerances`). `assist_off`: the caller has
     switched an assist's boost off in `p` (its gain 0), so that no force depends on the column torque and the
-    drive, written at zero handwheel input, is exact (:mod:`.assisted` solves an assisted car so).
+    drive, written at zero handwheel input, is exact (:mod:`.assisted` solves an assisted car so). With `outputs`
+    and not `handwheel`, the named outputs are the linkage's alone, taken at zero handwheel twist: the column's
+    twist, an integration of its own through a deflection law, is not made (a caller that needs only the
+    kinematics, such as the column angle per rack, pays for none of it).
     """
     model = run.model
     if not model.info.get("rack_drive", True) and not assist_off:
@@ -173,7 +176,7 @@ def solve(run, p: np.ndarray, rack: RackMotion, t_out, rtol: float = PRESCRIBED_
     z0 = np.ascontiguousarray(np.concatenate([y_static[others], np.zeros(n_o)]))
     # The integrator interpolates at the output times without stepping to them, so the refined grid of the
     # twist changes no step.
-    grid, at_out = _refined(t_out, TWIST_SAMPLE_S) if outputs else (t_out, np.arange(len(t_out)))
+    grid, at_out = _refined(t_out, TWIST_SAMPLE_S) if outputs and handwheel else (t_out, np.arange(len(t_out)))
     corners = np.ascontiguousarray(rack_corners(rack, grid[0], grid[-1]))
     states = np.empty((len(grid), 2 * n_o))
     stats = np.zeros(4)
@@ -191,6 +194,10 @@ def solve(run, p: np.ndarray, rack: RackMotion, t_out, rtol: float = PRESCRIBED_
         raise FloatingPointError("prescribed rack: the equations for the accelerations and torque are singular")
     if not outputs:
         return PrescribedSolution(t_out, torque)
+    if not handwheel:
+        full, accs, torque = (a[at_out] for a in (full, accs, torque))
+        named = model.evaluate_outputs(t_out, full, p, accs, np.zeros((len(t_out), 2)))
+        return PrescribedSolution(t_out, torque, full, accs, None, named)
 
     i_k = run.parameter_index("steering.column_torsional_stiffness")
     i_c = run.parameter_index("steering.column_torsional_damping")
