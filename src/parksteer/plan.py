@@ -68,11 +68,28 @@ def diagnosis(config: dict, parameters_path: str, user_effect: str) -> dict:
     }
 
 
-def assisted_cases() -> list[str]:
-    """The case names of the assisted benchmark (parksteer.experiments.assisted_benchmark), in its order."""
-    from .experiments.assisted_benchmark import case_names
+def assisted_cases(section: dict | None = None) -> list[str]:
+    """The case names of the assisted benchmark (parksteer.experiments.assisted_benchmark), in its order: the full
+    design's, or those of the hands config["assisted_benchmark"] keeps (each case keeps its own seed, so a kept
+    case is the full grid's case of that name)."""
+    from dataclasses import replace
 
-    return case_names()
+    from .experiments.assisted_benchmark import AssistedDesign, case_names
+
+    design = AssistedDesign()
+    if section:
+        design = replace(design, null_replicates=int(section["null_replicates"]),
+                         hidden_variations=tuple(section["hidden_variations"]),
+                         out_of_class_variations=tuple(section["out_of_class_variations"]))
+    full = case_names()
+    kept = case_names(design)
+    unknown = [name for name in kept if name not in full]
+    if unknown:
+        from .errors import UsageError
+
+        raise UsageError(f"config assisted_benchmark: {unknown[0]} is not a case of the assisted benchmark "
+                         f"(its variations: {', '.join(AssistedDesign().null_variations)})")
+    return kept
 
 
 def sweep(path: str, parameters_path: str, full: bool, batch_size: int, index_dir: str) -> dict:

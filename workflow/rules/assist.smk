@@ -56,15 +56,15 @@ rule assist_study:
         "../scripts/assist_study.py"
 
 
-# The assisted benchmark (parksteer.diagnose.assisted_benchmark, parksteer.figures.assisted): records of the Polo
+# The assisted benchmark (parksteer.experiments.assisted_benchmark, parksteer.figures.assisted): records of the Polo
 # file's car with its column assist, hands of the variation benchmark and its logger with the car's torsion-bar and
 # current channels, with nothing, a candidate of an assisted car or an out-of-class change hidden, each diagnosed
-# from its written file; scored against the variation benchmark's targets. Its 62 cases are each made from their
-# own seed: diag_assisted_batch runs them in jobs of config["assisted_cases_per_job"] (dealt in turn, as the other
+# from its written file; scored against the variation benchmark's targets. Its cases (31 of the full design's 62,
+# config["assisted_benchmark"]; config/full_grids.yaml for all) are each made from their own seed: diag_assisted_batch runs them in jobs of config["assisted_cases_per_job"] (dealt in turn, as the other
 # diagnosis benchmarks' cases, so that the jobs run in parallel and each mixes costly and cheap cases), each job
 # writing one row per case, and diag_assisted scores and draws the rows. The candidate models are derived in the
 # jobs (the model cache locks each build: jobs that need one at once build it once). Part of `all` (FIGURES).
-DIAG_ASSISTED_CASES = planned("assisted_cases")
+DIAG_ASSISTED_CASES = planned("assisted_cases", config.get("assisted_benchmark"))
 DIAG_ASSISTED_BATCHES = case_batches("assisted_", DIAG_ASSISTED_CASES,
                                      int(config.get("assisted_cases_per_job", 16)))
 
