@@ -197,34 +197,28 @@ def test_the_core_dependencies_are_pinned_for_quick_start_1():
     assert not missing, f"pyproject.toml's dependencies not pinned in {PIPELINE_LOCK.name}: {missing}"
 
 
-def test_the_mdf_extra_missing_is_one_line_naming_it(tmp_path):
-    """Without asammdf, reading an MDF file stops with one line that names the file and the extra to install."""
-    sample = tmp_path / "run.mf4"
-    sample.write_bytes(b"MDF     4.10    " + bytes(48))
+MISSING_EXTRAS = [
+    # (the module hidden, the extra, the sample file's name and bytes, the arguments after it)
+    ("asammdf", "mdf", "run.mf4", b"MDF     4.10    " + bytes(48), []),
+    ("can", "bus", "run.log", b"(1700000000.000000) can0 0A0#0000000000000000\n", ["--bus", "vw_mqb"]),
+]
+
+
+@pytest.mark.parametrize(("module", "extra", "name", "content", "arguments"), MISSING_EXTRAS,
+                         ids=[row[1] for row in MISSING_EXTRAS])
+def test_a_missing_extra_is_one_line_naming_it(tmp_path, module, extra, name, content, arguments):
+    """Without the extra's module, reading a file that needs it (an MDF file; a raw CAN log) stops with exit
+    status 2 and one line that names the file read (the log, or the car's DBC, which python-can's cantools needs
+    too) and the extra to install."""
+    sample = tmp_path / name
+    sample.write_bytes(content)
     script = (
-        "import sys; sys.modules['asammdf'] = None\n"
+        f"import sys; sys.modules[{module!r}] = None\n"
         "from parksteer.cli import main\n"
-        f"sys.exit(main(['compare', {str(sample)!r}]))\n"
+        f"sys.exit(main(['compare', {str(sample)!r}, *{arguments!r}]))\n"
     )
     result = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120)
     assert result.returncode == 2, result.stderr
     lines = result.stderr.strip().splitlines()
     assert len(lines) == 1, result.stderr
-    assert str(sample) in lines[0] and "pip install 'parksteer[mdf]'" in lines[0]
-
-
-def test_the_bus_extra_missing_is_one_line_naming_it(tmp_path):
-    """Without python-can, reading a raw CAN log stops with one line that names the file and the extra."""
-    sample = tmp_path / "run.log"
-    sample.write_text("(1700000000.000000) can0 0A0#0000000000000000\n", encoding="utf-8")
-    script = (
-        "import sys; sys.modules['can'] = None\n"
-        "from parksteer.cli import main\n"
-        f"sys.exit(main(['compare', {str(sample)!r}, '--bus', 'vw_mqb']))\n"
-    )
-    result = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120)
-    assert result.returncode == 2, result.stderr
-    lines = result.stderr.strip().splitlines()
-    assert len(lines) == 1, result.stderr
-    # python-can is needed by cantools too: the line names the log, or the car's DBC when that is read first
-    assert ("run.log" in lines[0] or ".dbc" in lines[0]) and "pip install 'parksteer[bus]'" in lines[0]
+    assert (name in lines[0] or ".dbc" in lines[0]) and f"pip install 'parksteer[{extra}]'" in lines[0]
