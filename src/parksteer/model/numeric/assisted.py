@@ -39,6 +39,7 @@ tolerance at the column, the pinion and the rack, and in saturation.
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from functools import cached_property
 
 import numpy as np
 
@@ -46,7 +47,8 @@ from ...boost_table import MAX_POINTS, off_keys, table_keys
 from ...errors import UsageError
 from ...parameters import VEHICLE_SPEED
 from ..symbolic.components import power_assist_of
-from ..symbolic.effects.assist_common import clamp, deadband, directional_efficiency, speed_gain, table_law
+from ..symbolic.effects.assist_common import (clamp, deadband, directional_efficiency, speed_gain, table_law,
+                                              table_points)
 from .prescribed import PRESCRIBED_ATOL_FACTOR, PRESCRIBED_RTOL, PrescribedSolution, RackMotion, solve
 
 # The bisection stops when the bracket is this narrow (N m of torsion-bar torque), far below a sensor's resolution.
@@ -105,10 +107,16 @@ class BoostLaw:
         scale = self.ratio if self.location == "rack" else 1.0
         demand = self.gain * opening * scale
         if any(self.table):
-            values = dict(zip(table_keys(), self.table))
-            demand = demand + self.table_scale * table_law(np.asarray(torsion_bar_Nm, dtype=float), values.__getitem__,
-                                                           self.speed)
+            demand = demand + self.table_scale * table_law(np.asarray(torsion_bar_Nm, dtype=float), None, self.speed,
+                                                           self._table_points)
         return clamp(demand / (self.efficiency * self.reduction), self.limit, self.limit_width)
+
+    @cached_property
+    def _table_points(self):
+        """The table's points at this law's speed, read once: the inversion evaluates the law some 50 times a
+        sample."""
+        values = dict(zip(table_keys(), self.table))
+        return table_points(values.__getitem__, self.speed)
 
     def with_wider_dead_band(self, size_Nm: float) -> BoostLaw:
         """This law with its dead band wider by `size_Nm`: the line's band, and every point of a table but the

@@ -138,15 +138,25 @@ def _at_speed(speed, speeds, row_values):
     return _select(branches, row_values[-1])
 
 
-def table_law(torque, value, speed):
-    """The boost table's assist at the torsion-bar torque `torque` and the vehicle speed `speed` (module docstring);
-    `value(key)` gives the table's scalar (``boost_torque_<k>``, ...) as a symbol or a number."""
+def table_points(value, speed):
+    """(torque points, assists, slopes) of the boost table read at the vehicle speed `speed`, each point's assist
+    and slope linear in speed between the rows; `value(key)` gives the table's scalar (``boost_torque_<k>``, ...)
+    as a symbol or a number."""
     knots = [value(f"boost_torque_{k}") for k in range(MAX_POINTS)]
     speeds = [value(f"boost_speed_{r}") for r in range(MAX_SPEEDS)]
     assist = [_at_speed(speed, speeds, [value(f"boost_assist_{r}_{k}") for r in range(MAX_SPEEDS)])
               for k in range(MAX_POINTS)]
     slope = [_at_speed(speed, speeds, [value(f"boost_slope_{r}_{k}") for r in range(MAX_SPEEDS)])
              for k in range(MAX_POINTS)]
+    return knots, assist, slope
+
+
+def table_law(torque, value, speed, points=None):
+    """The boost table's assist at the torsion-bar torque `torque` and the vehicle speed `speed` (module docstring);
+    `value(key)` gives the table's scalar (``boost_torque_<k>``, ...) as a symbol or a number. `points`, the
+    :func:`table_points` of the same table and speed, spares a caller that evaluates the law many times reading
+    them again (the same numbers)."""
+    knots, assist, slope = points if points is not None else table_points(value, speed)
 
     def half(x):  # x >= 0
         branches = [(x < knots[k + 1], _hermite(x, knots[k], knots[k + 1], assist[k], assist[k + 1], slope[k],
