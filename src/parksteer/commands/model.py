@@ -70,6 +70,29 @@ def register(sub) -> None:
     p.set_defaults(func=_derive)
 
 
+def _assisted_vehicle_sets() -> list:
+    """(spec, effects) of the models a diagnosis with its assist (`--with-assist`) builds for each vehicle file of
+    the checkout's data/vehicles that has an [assist]: the README's assisted example and the assisted benchmark
+    (the Polo's) then compile them instead of deriving them."""
+    from ..diagnose.candidates import candidate_effects, models_to_build
+    from ..model.codegen.cache import checkout_root
+    from ..model.numeric.assist import effects_with_assist
+    from ..model.symbolic.components import resolve_effects
+    from ..vehicle import load_vehicle
+
+    root = checkout_root()
+    sets = []
+    for vehicle in sorted((root / "data" / "vehicles").glob("*.toml")) if root is not None else []:
+        params = load_vehicle(vehicle, load_parameters())
+        spec = effects_with_assist(None, params)
+        if spec is None:
+            continue
+        base = resolve_effects(spec)
+        sets += [([e.name for e in effects], effects)
+                 for effects in models_to_build(base, candidate_effects(base)[0], params)]
+    return sets
+
+
 def _manifest_spec(path: str):
     """The effects spec of a model manifest the pipeline's derive rule wrote (its `spec`), refused in one line."""
     try:
@@ -193,6 +216,7 @@ def _derive(args) -> int:
             raise UsageError("--prebuilt derives the default diagnosis' models and the manifests' sets: give it no "
                              "--effects or --out")
         sets = [([e.name for e in effects], effects) for effects in default_diagnosis_models()]
+        sets += _assisted_vehicle_sets()
         for path in args.manifests:
             spec = _manifest_spec(path)
             sets.append((spec, resolve_effects(spec)))

@@ -61,7 +61,7 @@ PREBUILT_DIR = MODEL_DIR / "prebuilt"
 STALE_SCRATCH_S = 6 * 3600.0
 
 
-def _checkout_root() -> Path | None:
+def checkout_root() -> Path | None:
     """The repository the package runs from (editable install, or src/ on the path); None when installed."""
     package = MODEL_DIR.parent
     try:
@@ -82,7 +82,7 @@ def cache_root() -> Path:
     env = os.environ.get(CACHE_ENV)
     if env:
         return Path(env)
-    root = _checkout_root()
+    root = checkout_root()
     if root is not None:
         return root / "results" / "model"
     base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
@@ -199,7 +199,7 @@ def write_prebuilt(effect_sets: list[tuple[str | list | None, list[Effect]]]) ->
 
     from ...tables import atomic_path
 
-    if _checkout_root() is None:
+    if checkout_root() is None:
         raise UsageError("--prebuilt writes into the package's source: run it in a checkout of the repository "
                          "(an editable install), not an installed package")
     PREBUILT_DIR.mkdir(parents=True, exist_ok=True)
