@@ -72,8 +72,9 @@ def register(sub) -> None:
 
 def _assisted_vehicle_sets() -> list:
     """(spec, effects) of the models a diagnosis with its assist (`--with-assist`) builds for each vehicle file of
-    the checkout's data/vehicles that has an [assist]: the README's assisted example and the assisted benchmark
-    (the Polo's) then compile them instead of deriving them."""
+    the checkout's data/vehicles that has an [assist], and of the car with each assisted candidate (what the
+    assisted benchmark makes its records with): the README's assisted example and the assisted benchmark (the
+    Polo's) then compile them instead of deriving them."""
     from ..diagnose.candidates import candidate_effects, models_to_build
     from ..model.codegen.cache import checkout_root
     from ..model.numeric.assist import effects_with_assist
@@ -88,8 +89,11 @@ def _assisted_vehicle_sets() -> list:
         if spec is None:
             continue
         base = resolve_effects(spec)
-        sets += [([e.name for e in effects], effects)
-                 for effects in models_to_build(base, candidate_effects(base)[0], params)]
+        candidates = candidate_effects(base)[0]
+        sets += [([e.name for e in effects], effects) for effects in models_to_build(base, candidates, params)]
+        for candidate in (c for c in candidates if c.assist_candidate):
+            effects = resolve_effects([*base, candidate])
+            sets.append(([e.name for e in effects], effects))
     return sets
 
 
