@@ -78,18 +78,17 @@ def assisted_cases(section: dict | None = None) -> list[str]:
 
     design = AssistedDesign()
     if section:
+        named = [*section["hidden_variations"], *section["out_of_class_variations"]]
+        unknown = [v for v in named if v not in design.null_variations]
+        if unknown:
+            from .errors import UsageError
+
+            raise UsageError(f"config assisted_benchmark: {unknown[0]} is not a hand of the assisted benchmark "
+                             f"(its hands: {', '.join(design.null_variations)})")
         design = replace(design, null_replicates=int(section["null_replicates"]),
                          hidden_variations=tuple(section["hidden_variations"]),
                          out_of_class_variations=tuple(section["out_of_class_variations"]))
-    full = case_names()
-    kept = case_names(design)
-    unknown = [name for name in kept if name not in full]
-    if unknown:
-        from .errors import UsageError
-
-        raise UsageError(f"config assisted_benchmark: {unknown[0]} is not a case of the assisted benchmark "
-                         f"(its variations: {', '.join(AssistedDesign().null_variations)})")
-    return kept
+    return case_names(design)
 
 
 def sweep(path: str, parameters_path: str, full: bool, batch_size: int, index_dir: str) -> dict:
