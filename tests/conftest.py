@@ -10,8 +10,7 @@ from pathlib import Path
 
 # One BLAS thread per test process, set before numpy loads here and inherited by the workers and every subprocess:
 # the workers already take every CPU (pytest-xdist -n auto), and BLAS threads on top of them oversubscribe the
-# CPUs (OpenBLAS's idle threads spin). Snakemake does the same for its jobs (its `threads`). On 2 cores this took
-# the suite from 186 s of user CPU to 164 s, and from 124 s to 113 s.
+# CPUs (OpenBLAS's idle threads spin). Snakemake does the same for its jobs (its `threads`).
 for _variable in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_variable, "1")
 

@@ -1,17 +1,12 @@
 """What the workflow takes from the package while it builds its DAG, as plain data (names, paths, cache keys).
 
-The Snakefile needs the effect set of every model it derives, the case names of the three benchmarks, the
-car data set's files and the rivals of the out-of-class benchmark. Computing them imports the effect registry
-(sympy) and the synthetic data sets (scipy): about 0.8 s, paid by every Snakemake run, a run with nothing to do
-included. Each function here returns JSON-ready data, so that workflow/rules/common.smk can keep its results in
-.snakemake/ between runs, keyed by the package's, configuration's and data's files, and import none of this
-when nothing they depend on changed.
+The Snakefile needs the effect set of every model it derives, the case names of the benchmarks, the car data
+set's files and the rivals of the out-of-class benchmark. Each function here returns JSON-ready data, which the
+rules pass on as parameters (workflow/rules/common.smk, `plan`).
 """
 
 from __future__ import annotations
 
-import os
-from pathlib import Path
 from typing import Any
 
 
@@ -108,24 +103,3 @@ def sweep(path: str, parameters_path: str, full: bool, batch_size: int, index_di
         "shared": declared.shared_spec,
         "batches": sorted(declared.batches(batch_size)),
     }
-
-
-def fingerprint(root: str | Path) -> list:
-    """What every value here may depend on, cheaply: the size and modification time (ns) of each file of the
-    checkout `root`'s package, configuration, data and examples, and the Python and sympy in use (a model's
-    cache key names the sympy version)."""
-    import importlib.util
-    import sys
-
-    root = Path(root)
-    stamps = []
-    for folder in ("src", "config", "data", "examples"):
-        for directory, subfolders, names in os.walk(root / folder):
-            subfolders[:] = sorted(d for d in subfolders if d != "__pycache__")
-            for name in sorted(names):
-                stat = os.stat(os.path.join(directory, name))
-                stamps.append([os.path.relpath(os.path.join(directory, name), root), stat.st_size, stat.st_mtime_ns])
-    spec = importlib.util.find_spec("sympy")  # located, not imported: its installed version's metadata folder
-    site = Path(spec.origin).parent.parent if spec is not None and spec.origin else None
-    sympy = sorted(p.name for p in site.glob("sympy-*-info")) if site is not None else None
-    return [sys.version, sympy, stamps]

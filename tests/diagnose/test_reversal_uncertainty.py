@@ -36,8 +36,8 @@ def test_the_replay_uncertainty_covers_the_rack_splines_error_at_a_reversal(polo
     """The chosen spline's replay against the replay of the rack the hand really drove (the record's own motion,
     at the car's own parameters: nothing hidden), at the samples within 0.15 s of each reversal: the error in units
     of each sample's attainable error (noise floor and replay uncertainty) is of order one, as it must be for a
-    weighted fit to count the reversals as the data allow (rms 1.0 and worst 2.3 here; when the ensemble only
-    redrew the noise about the chosen spline, 4.4 and 9.9: the spline was 1.3 N m off where it allowed 0.15 N m).
+    weighted fit to count the reversals as the data allow (an ensemble that only redrew the noise about the chosen
+    spline would give several units here).
     Away from the reversals (and the record's ends) the attainable error stays the noise floor: the ensemble does
     not blunt the strokes."""
     params, hand, record = polo

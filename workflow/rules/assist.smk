@@ -8,7 +8,6 @@ rule vehicle_assist_size:
         parameters=PARAMETERS,
         vehicle=vehicle_file("{vehicle}"),
         models=assist_models,
-        code=script_sources("vehicle_assist_size"),
     output:
         csv=figure_report("results/vehicles/{vehicle}/assist/sizing.csv", "vehicle", caption="vehicle_assist_size"),
         torque=figure_report("figures/vehicles/{vehicle}/assist_torque_against_rack.svg", "vehicle",
@@ -16,6 +15,7 @@ rule vehicle_assist_size:
         force=figure_report("figures/vehicles/{vehicle}/assist_rack_force_against_speed.svg", "vehicle",
                             caption="vehicle_assist_size"),
     params:
+        code=code("vehicle_assist_size"),
         target=config["assist"]["target_torque"],
         speeds=config["assist"]["speeds_kmh"],
     log:
@@ -41,11 +41,12 @@ rule assist_study:
     input:
         parameters=PARAMETERS,
         models=[CREEPING_MODEL, ASSIST_MODELS["column"], ASSIST_MODELS["hydraulic"]],
-        code=script_sources("assist_study"),
     output:
         svg=figure_report("figures/assist_study.svg", "model"),
         csv=figure_report("figures/assist_study.csv", "model"),
         json="results/assist_study.json",
+    params:
+        code=code("assist_study"),
     log:
         "logs/assist_study.log",
     benchmark:
@@ -64,7 +65,7 @@ rule assist_study:
 # diagnosis benchmarks' cases, so that the jobs run in parallel and each mixes costly and cheap cases), each job
 # writing one row per case, and diag_assisted scores and draws the rows. The candidate models are derived in the
 # jobs (the model cache locks each build: jobs that need one at once build it once). Part of `all` (FIGURES).
-DIAG_ASSISTED_CASES = planned("assisted_cases", config.get("assisted_benchmark"))
+DIAG_ASSISTED_CASES = plan("assisted_cases", config.get("assisted_benchmark"))
 DIAG_ASSISTED_BATCHES = case_batches("assisted_", DIAG_ASSISTED_CASES,
                                      int(config.get("assisted_cases_per_job", 16)))
 
@@ -74,10 +75,10 @@ rule diag_assisted_batch:
         parameters=PARAMETERS,
         vehicle="data/vehicles/polo_vi.toml",
         models=[ASSIST_MODELS["column"]],
-        code=script_sources("diag_assisted_batch"),
     output:
         directory("results/diagnose/assisted/{batch}"),
     params:
+        code=code("diag_assisted_batch"),
         cases=lambda wildcards: DIAG_ASSISTED_BATCHES[wildcards.batch],
     wildcard_constraints:
         batch="|".join(DIAG_ASSISTED_BATCHES) if DIAG_ASSISTED_BATCHES else "none",
@@ -95,12 +96,12 @@ rule diag_assisted:
     input:
         batches=expand("results/diagnose/assisted/{batch}", batch=DIAG_ASSISTED_BATCHES),
         vehicle="data/vehicles/polo_vi.toml",
-        code=script_sources("diag_assisted"),
     output:
         svg=figure_report("figures/diag_assisted.svg", "diagnose"),
         csv=figure_report("figures/diag_assisted.csv", "diagnose"),
         json="results/diag_assisted.json",
     params:
+        code=code("diag_assisted"),
         cases=DIAG_ASSISTED_CASES,
     log:
         "logs/diag_assisted.log",

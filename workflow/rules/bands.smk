@@ -8,11 +8,12 @@ rule bands:
     input:
         parameters=PARAMETERS,
         model=model_manifest("full", None),
-        code=script_sources("bands"),
     output:
         svg=figure_report("figures/bands.svg", "bands"),
         csv=figure_report("figures/bands.csv", "bands"),
         json="results/bands.json",
+    params:
+        code=code("bands"),
     log:
         "logs/bands.log",
     benchmark:

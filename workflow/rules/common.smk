@@ -2,8 +2,6 @@ import json
 import os
 from pathlib import Path
 
-import yaml
-
 # Shared names. FIGURES maps each figure or table target to the files it writes: the one list of them. These are
 # the files checksummed in figures/SHA256SUMS, the targets of rule `all` and the figures the paper shows.
 PARAMETERS = config["parameters"]
@@ -47,97 +45,35 @@ def paper_sources():
     return sorted(str(p) for p in Path("paper").glob("*.typ"))
 
 
-# --- exact rebuilds: each rule's inputs include the package files its script can run ------------------------
-# Read from the declaration workflow/code_inputs.yaml, which `parksteer plan` writes from the sources
-# (parksteer.code_inputs) and tests/workflow/test_code_inputs.py keeps current. A changed module then reruns
-# exactly the rules that can run it.
+# --- exact rebuilds: each rule passes the digest of the package code its script runs as the parameter `code` ----
+# (parksteer.code_inputs.code_digest: the modules the script imports, statically, without their docstrings).
+# Snakemake reruns a job whose parameters changed, so an edit of a module reruns exactly the rules that can run
+# it, and an edited docstring, comment or test reruns nothing.
 CHECKOUT = Path(workflow.current_basedir).parent.parent  # this file is workflow/rules/common.smk
 PACKAGE_DIR = CHECKOUT / "src" / "parksteer"
-CODE_INPUTS_FILE = CHECKOUT / "workflow" / "code_inputs.yaml"
-CODE_INPUTS = yaml.load(CODE_INPUTS_FILE.read_text(encoding="utf-8"), Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
-_CHECKOUT_HERE = os.path.relpath(CHECKOUT)  # "." unless Snakemake runs in another directory (--directory)
 
 
-def file_sources(path):
-    """The package files the workflow file `path` (a rule script or notebook, relative to the checkout) can run,
-    relative to the working directory."""
-    if path not in CODE_INPUTS:
-        sys.exit(f"parksteer: error: {CODE_INPUTS_FILE} has no entry for {path}: run `parksteer plan`")
-    return [os.path.normpath(os.path.join(_CHECKOUT_HERE, name)) for name in CODE_INPUTS[path]]
+def code(script):
+    """The digest of the package code the rule script workflow/scripts/<script>.py runs (or the notebook whose
+    path is `script`)."""
+    from parksteer.code_inputs import code_digest
+
+    path = script if script.endswith(".py") else f"workflow/scripts/{script}.py"
+    return code_digest(CHECKOUT, path)
 
 
-def script_sources(script):
-    """The package files the rule script workflow/scripts/<script>.py can run."""
-    return file_sources(f"workflow/scripts/{script}.py")
-
-
-# --- the plan: what the rules take from the package (parksteer.plan), kept between runs ---------------------
-# Effect sets, case names and cache keys come from code that imports sympy and scipy (about 0.8 s). They are kept
-# in .snakemake/ under a fingerprint of the package, configuration, data and examples (each file's size and
-# modification time), the Python and sympy in use and this file; a value is recomputed when any of these, or a
-# file its call names (`files`), changed. A missing or unreadable cache is rebuilt. The Snakefile saves what a
-# run computed (save_plan) once every rule file is read.
-PLAN_CACHE = Path(".snakemake") / "parksteer-plan.json"
-
-
-def _read_plan_cache():
-    from parksteer.plan import fingerprint
-
-    here = os.stat(Path(workflow.current_basedir) / "common.smk")  # this file writes and reads the cache
-    current = json.loads(json.dumps([fingerprint(CHECKOUT), [here.st_size, here.st_mtime_ns]]))
-    try:
-        cached = json.loads(PLAN_CACHE.read_text(encoding="utf-8"))
-    except (OSError, ValueError):
-        return current, {}
-    if not isinstance(cached, dict) or cached.get("fingerprint") != current or not isinstance(cached.get("values"), dict):
-        return current, {}
-    return current, cached["values"]
-
-
-_PLAN_FINGERPRINT, _PLAN_KNOWN = _read_plan_cache()
-_PLANNED = {}
-
-
-def planned(function, *args, files=()):
-    """parksteer.plan.<function>(*args), from the plan cache when nothing it depends on changed."""
-    stamps = []
-    for name in files:
-        try:
-            stat = os.stat(name)
-            stamps.append([str(name), stat.st_size, stat.st_mtime_ns])
-        except OSError:
-            stamps.append([str(name), None])
-    key = json.dumps([function, args, stamps], sort_keys=True)
-    if key in _PLANNED:
-        return _PLANNED[key]
-    if key in _PLAN_KNOWN:
-        return _PLAN_KNOWN[key]
+def plan(function, *args):
+    """parksteer.plan.<function>(*args) as plain JSON data: what the rules take from the package (effect sets, case
+    names). A configuration naming what is not defined (a rival that is not one) stops here with one line, before
+    any job."""
     import parksteer.plan
     from parksteer.errors import UsageError
 
-    try:  # a configuration naming what is not defined (a rival that is not one): one line, before any job
-        value = json.loads(json.dumps(getattr(parksteer.plan, function)(*args)))
+    try:
+        return json.loads(json.dumps(getattr(parksteer.plan, function)(*args)))
     except UsageError as error:
         print(f"parksteer: error: {error}", file=sys.stderr)
         sys.exit(2)
-    _PLANNED[key] = value
-    return value
-
-
-def save_plan():
-    """Keep the values this run computed for the next run, written atomically (key order kept: a planned value
-    read back must equal the value computed, since Snakemake compares rule parameters with the previous run's,
-    key order included). A read-only folder is fine: the next run computes them again."""
-    if not _PLANNED:
-        return
-    from parksteer.tables import atomic_path
-
-    try:
-        with atomic_path(PLAN_CACHE) as scratch:
-            values = {**_PLAN_KNOWN, **_PLANNED}
-            scratch.write_text(json.dumps({"fingerprint": _PLAN_FINGERPRINT, "values": values}), encoding="utf-8")
-    except OSError:
-        pass
 
 
 def case_batches(prefix, names, per_job):
@@ -152,7 +88,7 @@ def case_outputs(folder, names, batches, suffix):
     """The `suffix` file (truth or diagnosis) of each case of `names`, in its job's folder (where run_batch puts
     it: parksteer.experiments.benchmark.case_files), in the order of `names`."""
     job_of = {name: batch for batch, members in batches.items() for name in members}
-    return [planned("case_file", f"{folder}/{job_of[name]}", name, suffix) for name in names]
+    return [plan("case_file", f"{folder}/{job_of[name]}", name, suffix) for name in names]
 
 
 def benchmark_file(rule, *wildcards):
@@ -169,7 +105,7 @@ _MODEL_NAMES = {}  # the resolved effect names -> the name first registered for 
 def model_manifest(name, spec):
     """Register the effect set `spec` as `name` (or under the name of an identical set registered before) and
     return the path of its manifest, results/model/<name>.json, which rule derive writes."""
-    resolved = planned("model_set", spec, files=effect_files(spec))
+    resolved = plan("model_set", spec)
     name = _MODEL_NAMES.setdefault(tuple(resolved["effects"]), name)
     MODEL_SETS.setdefault(name, spec)
     return f"results/model/{name}.json"

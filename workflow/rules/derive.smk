@@ -8,11 +8,11 @@
 
 rule derive:
     input:
-        code=script_sources("derive"),
         effects=lambda w: effect_files(model_set(w.model)),
     output:
         manifest="results/model/{model}.json",
     params:
+        code=code("derive"),
         effects=lambda w: model_set(w.model),
     wildcard_constraints:
         model="[^/]+",

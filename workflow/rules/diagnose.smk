@@ -14,12 +14,11 @@
 # residual's signature and the suggested effect scored per signature class (parksteer.figures.signature).
 DIAG_USER_EFFECT = os.path.relpath(PACKAGE_DIR / "examples" / "column_imbalance.py")
 # candidate model specs, the car data set's files, the three benchmarks' case names (parksteer.plan.diagnosis)
-DIAG_PLAN = planned(
+DIAG_PLAN = plan(
     "diagnosis",
     {key: config[key] for key in ("car", "benchmark", "outclass", "variations", "signature")},
     PARAMETERS,
     DIAG_USER_EFFECT,
-    files=[PARAMETERS],
 )
 DIAG_MODELS = [model_manifest(name, spec) for name, spec in DIAG_PLAN["candidates"].items()]
 DIAG_CAR_FILES = [f"results/diagnose/car/{name}" for name in DIAG_PLAN["car_files"]]
@@ -40,11 +39,11 @@ rule diag_car_data:
     input:
         parameters=PARAMETERS,
         models=DIAG_MODELS,
-        code=script_sources("diag_car_data"),
     output:
         files=DIAG_CAR_FILES,
         truth="results/diagnose/car_truth.json",
     params:
+        code=code("diag_car_data"),
         car=config["car"],
         perturbation=config["benchmark"]["perturbation"],
     log:
@@ -61,11 +60,12 @@ rule diag_compare:
     input:
         parameters=PARAMETERS,
         files=DIAG_CAR_FILES,
-        code=script_sources("diag_compare"),
     output:
         svg=figure_report("figures/diag_compare.svg", "diagnose"),
         csv=figure_report("figures/diag_compare.csv", "diagnose"),
         json="results/diag_compare.json",
+    params:
+        code=code("diag_compare"),
     log:
         "logs/diag_compare.log",
     benchmark:
@@ -86,11 +86,13 @@ rule case_study:
         truth="results/diagnose/car_truth.json",
         assisted_record="data/measurements/example_polo_assisted.csv",
         assisted_vehicle="data/vehicles/polo_vi.toml",
-        code=sorted(set(script_sources("diag_case_study") + file_sources("workflow/notebooks/case_study.py"))),
     output:
         notebook="results/case_study.ipynb",
         json="results/case_study.json",
         residuals="results/case_study_residuals.csv",
+    params:
+        code=code("diag_case_study"),
+        notebook_code=code("workflow/notebooks/case_study.py"),
     log:
         "logs/case_study.log",
     benchmark:
@@ -105,11 +107,12 @@ rule diag_ladder:
     input:
         study="results/case_study.json",
         residuals="results/case_study_residuals.csv",
-        code=script_sources("diag_ladder"),
     output:
         svg=figure_report("figures/diag_ladder.svg", "diagnose"),
         csv=figure_report("figures/diag_ladder.csv", "diagnose"),
         json="results/diag_ladder.json",
+    params:
+        code=code("diag_ladder"),
     log:
         "logs/diag_ladder.log",
     benchmark:
@@ -124,10 +127,10 @@ rule diag_bench_batch:
     input:
         parameters=PARAMETERS,
         models=DIAG_MODELS,
-        code=script_sources("diag_bench_batch"),
     output:
         directory("results/diagnose/benchmark/{batch}"),
     params:
+        code=code("diag_bench_batch"),
         design=config["benchmark"],
         cases=lambda wildcards: DIAG_BENCH_BATCHES[wildcards.batch],
     wildcard_constraints:
@@ -145,12 +148,12 @@ rule diag_bench_batch:
 rule diag_benchmark:
     input:
         batches=expand("results/diagnose/benchmark/{batch}", batch=DIAG_BENCH_BATCHES),
-        code=script_sources("diag_benchmark"),
     output:
         svg=figure_report("figures/diag_benchmark.svg", "diagnose"),
         csv=figure_report("figures/diag_benchmark.csv", "diagnose"),
         json="results/diag_benchmark.json",
     params:
+        code=code("diag_benchmark"),
         design=config["benchmark"],
         truths=case_outputs("results/diagnose/benchmark", DIAG_BENCH_CASES, DIAG_BENCH_BATCHES, "truth"),
         diagnoses=case_outputs("results/diagnose/benchmark", DIAG_BENCH_CASES, DIAG_BENCH_BATCHES, "diagnosis"),
@@ -168,10 +171,10 @@ rule diag_outclass_batch:
     input:
         parameters=PARAMETERS,
         models=DIAG_MODELS + DIAG_OUTCLASS_MODELS,
-        code=script_sources("diag_outclass_batch"),
     output:
         directory("results/diagnose/outclass/{batch}"),
     params:
+        code=code("diag_outclass_batch"),
         design=config["outclass"],
         benchmark=config["benchmark"],
         cases=lambda wildcards: DIAG_OUTCLASS_BATCHES[wildcards.batch],
@@ -190,12 +193,12 @@ rule diag_outclass_batch:
 rule diag_outclass:
     input:
         batches=expand("results/diagnose/outclass/{batch}", batch=DIAG_OUTCLASS_BATCHES),
-        code=script_sources("diag_outclass"),
     output:
         svg=figure_report("figures/diag_outclass.svg", "diagnose"),
         csv=figure_report("figures/diag_outclass.csv", "diagnose"),
         json="results/diag_outclass.json",
     params:
+        code=code("diag_outclass"),
         design=config["outclass"],
         benchmark=config["benchmark"],
         truths=case_outputs("results/diagnose/outclass", DIAG_OUTCLASS_CASES, DIAG_OUTCLASS_BATCHES, "truth"),
@@ -214,10 +217,10 @@ rule diag_variation_batch:
     input:
         parameters=PARAMETERS,
         models=DIAG_MODELS,
-        code=script_sources("diag_variation_batch"),
     output:
         directory("results/diagnose/variations/{batch}"),
     params:
+        code=code("diag_variation_batch"),
         design=config["variations"],
         benchmark=config["benchmark"],
         cases=lambda wildcards: DIAG_VARIATION_BATCHES[wildcards.batch],
@@ -236,12 +239,12 @@ rule diag_variation_batch:
 rule diag_variations:
     input:
         batches=expand("results/diagnose/variations/{batch}", batch=DIAG_VARIATION_BATCHES),
-        code=script_sources("diag_variations"),
     output:
         svg=figure_report("figures/diag_variations.svg", "diagnose"),
         csv=figure_report("figures/diag_variations.csv", "diagnose"),
         json="results/diag_variations.json",
     params:
+        code=code("diag_variations"),
         design=config["variations"],
         benchmark=config["benchmark"],
         truths=case_outputs("results/diagnose/variations", DIAG_VARIATION_CASES, DIAG_VARIATION_BATCHES, "truth"),
@@ -260,10 +263,10 @@ rule diag_signature_batch:
     input:
         parameters=PARAMETERS,
         models=DIAG_MODELS,
-        code=script_sources("diag_signature_batch"),
     output:
         directory("results/diagnose/signature/{batch}"),
     params:
+        code=code("diag_signature_batch"),
         design=config["signature"],
         cases=lambda wildcards: DIAG_SIGNATURE_BATCHES[wildcards.batch],
     wildcard_constraints:
@@ -281,12 +284,12 @@ rule diag_signature_batch:
 rule diag_signature:
     input:
         batches=expand("results/diagnose/signature/{batch}", batch=DIAG_SIGNATURE_BATCHES),
-        code=script_sources("diag_signature"),
     output:
         svg=figure_report("figures/diag_signature.svg", "diagnose"),
         csv=figure_report("figures/diag_signature.csv", "diagnose"),
         json="results/diag_signature.json",
     params:
+        code=code("diag_signature"),
         design=config["signature"],
         rows=case_outputs("results/diagnose/signature", DIAG_SIGNATURE_CASES, DIAG_SIGNATURE_BATCHES, "diagnosis"),
     log:

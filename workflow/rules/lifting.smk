@@ -4,11 +4,12 @@
 rule figA3:
     input:
         parameters=PARAMETERS,
-        code=script_sources("figA3"),
     output:
         svg=figure_report("figures/figA3.svg", "lifting"),
         csv=figure_report("figures/figA3.csv", "lifting"),
         json="results/figA3.json",
+    params:
+        code=code("figA3"),
     log:
         "logs/figA3.log",
     benchmark:

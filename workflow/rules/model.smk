@@ -11,10 +11,10 @@ rule simulate_model:
     input:
         parameters=PARAMETERS,
         model=lambda w: VARIANT_MANIFESTS[w.variant],
-        code=script_sources("simulate_model"),
     output:
         csv="results/sim/{case}__{variant}.csv",
     params:
+        code=code("simulate_model"),
         effects=lambda w: FIGURE_DESIGN.variants[w.variant].effects,
         surface=lambda w: FIGURE_DESIGN.variants[w.variant].surface,
     wildcard_constraints:
@@ -34,12 +34,12 @@ rule model_figure:
     input:
         parameters=PARAMETERS,
         sims=lambda w: [f"results/sim/{case}__{variant}.csv" for case, variant in figure_runs(w)],
-        code=script_sources("model_figure"),
     output:
         svg=figure_report("figures/{figure}.svg", "model", caption="model_figure"),
         csv=figure_report("figures/{figure}.csv", "model", caption="model_figure"),
         json="results/{figure}.json",
     params:
+        code=code("model_figure"),
         runs=lambda w: [list(run) for run in figure_runs(w)],
         labels=lambda w: {
             v: FIGURE_DESIGN.variants[v].label for _, v in figure_runs(w) if FIGURE_DESIGN.variants[v].label

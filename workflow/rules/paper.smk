@@ -5,9 +5,10 @@
 rule effects:
     input:
         parameters=PARAMETERS,
-        code=script_sources("effects"),
     output:
         json="results/effects.json",
+    params:
+        code=code("effects"),
     log:
         "logs/effects.log",
     conda:
@@ -23,9 +24,10 @@ rule paper:
         effects="results/effects.json",
         figures=all_figure_files(),
         numbers=all_number_files(),
-        code=script_sources("paper"),
     output:
         pdf=figure_report("paper/parksteer.pdf", "paper", caption="paper"),
+    params:
+        code=code("paper"),
     log:
         "logs/paper.log",
     benchmark:

@@ -12,10 +12,10 @@ rule diag_peers_batch:
     input:
         parameters=PARAMETERS,
         models=DIAG_MODELS,
-        code=script_sources("diag_peers_batch"),
     output:
         directory("results/diagnose/peers/{batch}"),
     params:
+        code=code("diag_peers_batch"),
         design=config["variations"],
         benchmark=config["benchmark"],
         tuning_seed=config["peers"]["tuning_seed"],
@@ -37,11 +37,12 @@ rule diag_peers:
         batches=expand("results/diagnose/peers/{batch}", batch=list(PEER_BATCHES))
         + expand("results/diagnose/variations/{batch}", batch=DIAG_VARIATION_BATCHES)
         + expand("results/diagnose/outclass/{batch}", batch=DIAG_OUTCLASS_BATCHES),
-        code=script_sources("diag_peers"),
     output:
         svg=figure_report("figures/diag_peers.svg", "diagnose"),
         csv=figure_report("figures/diag_peers.csv", "diagnose"),
         json="results/diag_peers.json",
+    params:
+        code=code("diag_peers"),
     log:
         "logs/diag_peers.log",
     benchmark:

@@ -6,10 +6,11 @@ rule table1:
     input:
         parameters=PARAMETERS,
         printed="src/parksteer/data/table1_printed.csv",
-        code=script_sources("table1"),
     output:
         csv=figure_report("figures/table1.csv", "rig"),
         json="results/table1.json",
+    params:
+        code=code("table1"),
     log:
         "logs/table1.log",
     benchmark:
@@ -23,11 +24,12 @@ rule table1:
 rule fig3:
     input:
         parameters=PARAMETERS,
-        code=script_sources("fig3"),
     output:
         svg=figure_report("figures/fig3.svg", "rig"),
         csv=figure_report("figures/fig3.csv", "rig"),
         json="results/fig3.json",
+    params:
+        code=code("fig3"),
     log:
         "logs/fig3.log",
     benchmark:
@@ -41,11 +43,12 @@ rule fig3:
 rule fig4:
     input:
         parameters=PARAMETERS,
-        code=script_sources("fig4"),
     output:
         svg=figure_report("figures/fig4.svg", "rig"),
         csv=figure_report("figures/fig4.csv", "rig"),
         json="results/fig4.json",
+    params:
+        code=code("fig4"),
     log:
         "logs/fig4.log",
     benchmark:

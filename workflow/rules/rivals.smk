@@ -3,19 +3,19 @@
 # with it, to name the test that tells it from lifting (parksteer.figures.rivals). Writes the figure (SVG), the
 # table (CSV) and the numbers the paper quotes (results/rivals.json). The rivals are config["rivals"], a selection
 # of the effects that declare one.
-_RIVALS = planned("rival_names", config.get("rivals"))
+_RIVALS = plan("rival_names", config.get("rivals"))
 
 
 rule rivals:
     input:
         parameters=PARAMETERS,
         models=[model_manifest("full", None)] + [model_manifest(f"with_{r}", f"+{r}") for r in _RIVALS],
-        code=script_sources("rivals"),
     output:
         svg=figure_report("figures/rivals.svg", "bands"),
         csv=figure_report("figures/rivals.csv", "bands"),
         json="results/rivals.json",
     params:
+        code=code("rivals"),
         rivals=_RIVALS,
     log:
         "logs/rivals.log",

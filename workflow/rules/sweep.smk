@@ -19,8 +19,7 @@ SWEEP_INDEX_DIR = ".snakemake/parksteer-sweeps"
 # A bad declaration (empty axis, unknown key or effect, a value out of its bounds, a missing file) is refused
 # here, while the DAG is built, with one line naming the file and the key.
 try:
-    SWEEP = planned("sweep", SWEEP_FILE, PARAMETERS, SWEEP_FULL, SWEEP_BATCH_SIZE, SWEEP_INDEX_DIR,
-                    files=[SWEEP_FILE, PARAMETERS])
+    SWEEP = plan("sweep", SWEEP_FILE, PARAMETERS, SWEEP_FULL, SWEEP_BATCH_SIZE, SWEEP_INDEX_DIR)
     SWEEP_MODEL_MANIFESTS = [
         model_manifest(f"sweep_{SWEEP['name']}_{variant}", effects) for variant, effects in SWEEP["model_sets"].items()
     ]
@@ -29,28 +28,6 @@ except UsageError as error:  # SweepError is one
     sys.exit(2)
 SWEEP_NAME = SWEEP["name"]
 SWEEP_BATCH_FILES = expand("results/sweeps/{sweep}/batches/{batch}.json", sweep=SWEEP_NAME, batch=SWEEP["batches"])
-
-
-# The package modules a batch job runs (script_sources), as one input file of each batch job instead of some sixty:
-# the scheduler's cost per job is mostly its input files, and a sweep has many jobs. An edit of one of them reruns
-# this rule and so every batch, as the modules themselves would.
-SWEEP_BATCH_CODE = "results/sweeps/sweep_batch_code.txt"
-
-
-rule sweep_batch_code:
-    localrule: True
-    input:
-        code=script_sources("sweep_batch"),
-    output:
-        stamp=SWEEP_BATCH_CODE,
-    log:
-        "logs/sweep_batch_code.log",
-    benchmark:
-        benchmark_file("sweep_batch_code")
-    conda:
-        "../envs/parksteer.yaml"
-    script:
-        "../scripts/sweep_batch_code.py"
 
 
 # A batch's id hashes its points' ids and each point's id hashes what it simulates; what the points share (case,
@@ -62,10 +39,10 @@ rule sweep_batch:
         parameters=PARAMETERS,
         declaration=ancient(SWEEP_FILE),
         models=SWEEP_MODEL_MANIFESTS,
-        code=SWEEP_BATCH_CODE,
     output:
         batch="results/sweeps/{sweep}/batches/{batch}.json",
     params:
+        code=code("sweep_batch"),
         shared=SWEEP["shared"],
         index_dir=SWEEP_INDEX_DIR,
     wildcard_constraints:
@@ -91,12 +68,12 @@ rule:
         sweep=SWEEP_FILE,
         parameters=PARAMETERS,
         batches=SWEEP_BATCH_FILES,
-        code=script_sources("sweep_figure"),
     output:
         svg=figure_report(f"figures/sweep_{SWEEP_NAME}.svg", "sweep", caption="sweep"),
         csv=figure_report(f"figures/sweep_{SWEEP_NAME}.csv", "sweep", caption="sweep"),
         json=f"results/sweep_{SWEEP_NAME}.json",
     params:
+        code=code("sweep_figure"),
         full=SWEEP_FULL,
     log:
         f"logs/sweep_{SWEEP_NAME}.log",

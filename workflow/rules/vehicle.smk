@@ -17,10 +17,10 @@ rule vehicle_synthetic_data:
         parameters=PARAMETERS,
         vehicle=vehicle_file("{vehicle}"),
         models=DIAG_MODELS,
-        code=script_sources("vehicle_data"),
     output:
         files=directory("results/vehicles/{vehicle}/synthetic"),
     params:
+        code=code("vehicle_data"),
         runs=lambda w: vehicle_runs(w.vehicle),
         car=config["car"],
         perturbation=config["benchmark"]["perturbation"],
@@ -40,11 +40,11 @@ rule vehicle_compare:
         vehicle=vehicle_file("{vehicle}"),
         models=DIAG_MODELS,
         files=vehicle_measurements,
-        code=script_sources("vehicle_compare"),
     output:
         json="results/vehicles/{vehicle}/compare.json",
         svg=figure_report("figures/vehicles/{vehicle}/compare.svg", "vehicle", caption="vehicle_compare"),
     params:
+        code=code("vehicle_compare"),
         options=vehicle_options(),
     log:
         "logs/vehicles/{vehicle}/compare.log",
@@ -62,13 +62,13 @@ rule vehicle_diagnose:
         vehicle=vehicle_file("{vehicle}"),
         models=DIAG_MODELS,
         files=vehicle_measurements,
-        code=script_sources("vehicle_diagnose"),
     output:
         json="results/vehicles/{vehicle}/diagnosis.json",
         svg=figure_report("figures/vehicles/{vehicle}/diagnosis.svg", "vehicle", caption="vehicle_diagnose"),
         md="results/vehicles/{vehicle}/report.md",
         html=figure_report("results/vehicles/{vehicle}/report.html", "vehicle", caption="vehicle_report"),
     params:
+        code=code("vehicle_diagnose"),
         options=vehicle_options(),
     log:
         "logs/vehicles/{vehicle}/diagnose.log",

@@ -45,8 +45,8 @@ SYMBOLIC_DIRS = (MODEL_DIR / "symbolic", MODEL_DIR / "codegen")
 KEYED_FILES = (MODEL_DIR.parent / "names.py",)
 # This module stores entries and generates nothing, so its source is not part of the key.
 KEYLESS_SOURCE = Path(__file__).resolve()
-# How the generated C is compiled; part of the model key. -O1: the same integration time as -O2 on the default
-# model (4.8 ms a cycle) for two thirds of the compile time (1.0 s instead of 1.5 s). -ffp-contract=off: no fused
+# How the generated C is compiled; part of the model key. -O1: integrates these models about as fast as -O2 and
+# compiles in less time. -ffp-contract=off: no fused
 # multiply-add, which GCC otherwise forms wherever the target has one (aarch64, or x86 with -march=native), so
 # every product is rounded on its own and the bits do not depend on the target.
 COMPILE_FLAGS = ("-O1", "-ffp-contract=off", "-shared", "-fPIC")
