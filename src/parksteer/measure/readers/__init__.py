@@ -5,6 +5,7 @@ entry in the table.
 - :mod:`.native_csv`: the native format (data/measurements/README.md);
 - :mod:`.logger_csv`: a logger's or spreadsheet's text export (own names, units, dialect);
 - :mod:`.mdf`: ASAM MDF through the optional asammdf;
+- :mod:`.matlab`: MATLAB MAT-files (level 5) through scipy.io;
 - :mod:`.can_log`: raw CAN logs (candump, ASC, BLF, TRC, MDF4 bus logging), decoded with a DBC.
 """
 
@@ -13,6 +14,7 @@ from __future__ import annotations
 from .base import SNIFF_BYTES, Reader, Record, Source
 from .can_log import CanLogReader
 from .logger_csv import LoggerCsvReader
+from .matlab import MatlabReader
 from .mdf import MdfReader
 from .native_csv import NativeCsvReader
 
@@ -20,6 +22,7 @@ from .native_csv import NativeCsvReader
 READERS: dict[str, type[Reader]] = {
     "can_log": CanLogReader,
     "mdf": MdfReader,
+    "matlab": MatlabReader,
     "native_csv": NativeCsvReader,
     "logger_csv": LoggerCsvReader,
 }
