@@ -181,8 +181,9 @@ def size_assist(params: Parameters, case: str, target_torque_Nm: float, speeds_k
         if hydraulic:
             motor = current = float("nan")
             pressure = (demand + v("seal_friction_force")) / v("piston_area")
+            # the sized valve is the straight line of the sized gain: a table of the file is switched off
             sized = {f"{name}.valve_slope": gain * ratio / v("piston_area"),
-                     f"{name}.relief_pressure": max(MARGIN * pressure, 1.0e5)}
+                     f"{name}.relief_pressure": max(MARGIN * pressure, 1.0e5), **table_off(name)}
         else:
             pressure = float("nan")
             motor = motors[i]
