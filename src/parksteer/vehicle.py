@@ -66,9 +66,13 @@ ASSIST_SECTION = "assist"
 ASSIST_EFFECTS = {"column": "electric_assist_column", "pinion": "electric_assist_pinion",
                   "rack": "electric_assist_rack", "hydraulic": "hydraulic_assist"}
 
-# ``[assist.boost]``: the boost table of an electric assist (parksteer.boost_table) and the units its entries take.
+# ``[assist.boost]``: the boost table of an assist (parksteer.boost_table) and the units its entries take: the
+# assist at the point of action (N m at the column or pinion, N at the rack), or the hydraulic valve's pressure (bar
+# or Pa, read in Pa).
 BOOST_SECTION = "boost"
-BOOST_UNITS = {"torsion_bar_torque": ("N m",), "assist": ("N m", "N"), "vehicle_speed": ("km/h", "m/s")}
+BOOST_UNITS = {"torsion_bar_torque": ("N m",), "assist": ("N m", "N", "bar", "Pa"), "vehicle_speed": ("km/h", "m/s")}
+BOOST_ASSIST_UNITS = {"column": ("N m",), "pinion": ("N m",), "rack": ("N",), "hydraulic": ("bar", "Pa")}
+BAR_PA = 1.0e5
 
 MAX_CREEPING_SPEED_KMH = VEHICLE_SPEED.upper * 3.6  # the run's vehicle speed's upper bound, 3 m/s: 10.8 km/h
 
@@ -116,21 +120,22 @@ def _read_assist(path: Path, table: Any, sections: dict, sources: dict) -> None:
         sources[f"{name}.{key}"] = str(entry["source"])
         sources[f"{name}.{key}.unit"] = str(entry["unit"])
     if BOOST_SECTION in table:
-        # the table is the boost curve: the gain's straight line is not added to it
-        if values.get("gain", 0.0) != 0.0 or values.get("speed_dependence", 0.0) != 0.0:
-            raise ParameterError(f"{path}: assist: a boost table and a gain (or its speed dependence) give the "
-                                 "boost curve twice; drop gain, dead_band and speed_dependence (the table's rows "
-                                 "give the speeds)")
-        values.setdefault("gain", 0.0)
-        sources.setdefault(f"{name}.gain", "0: the boost table [assist.boost] gives the curve")
+        # the table is the boost curve: the gain's (or the valve slope's) straight line is not added to it
+        line = "valve_slope" if kind == "hydraulic" else "gain"
+        if values.get(line, 0.0) != 0.0 or values.get("speed_dependence", 0.0) != 0.0:
+            what = ("a valve slope give the valve's characteristic twice; drop valve_slope and dead_band"
+                    if kind == "hydraulic" else
+                    "a gain (or its speed dependence) give the boost curve twice; drop gain, dead_band and "
+                    "speed_dependence (the table's rows give the speeds)")
+            raise ParameterError(f"{path}: assist: a boost table and {what}")
+        values.setdefault(line, 0.0)
+        sources.setdefault(f"{name}.{line}", "0: the boost table [assist.boost] gives the curve")
     sections[name] = values
 
 
 def _read_boost(path: Path, kind: str, table: Any, name: str, sources: dict) -> dict[str, float]:
     """``[assist.boost]``: the boost table (:mod:`parksteer.boost_table`) as the effect's scalar entries."""
     where = f"{path}: assist.boost"
-    if kind == "hydraulic":
-        raise ParameterError(f"{where}: a boost table is for an electric assist (the valve takes its slope)")
     if not isinstance(table, dict) or not {"torsion_bar_torque", "assist"} <= set(table) or not set(table) <= set(
             BOOST_UNITS):
         raise ParameterError(f"{where}: expected torsion_bar_torque, assist and optionally vehicle_speed")
@@ -139,7 +144,7 @@ def _read_boost(path: Path, kind: str, table: Any, name: str, sources: dict) -> 
         if not isinstance(entry, dict) or not {"value", "unit"} <= set(entry) or not set(entry) <= {
                 "value", "unit", "source"}:
             raise ParameterError(f"{where}.{key}: expected {{ value, unit, source }}")
-        units = BOOST_UNITS[key] if key != "assist" else (("N",) if kind == "rack" else ("N m",))
+        units = BOOST_UNITS[key] if key != "assist" else BOOST_ASSIST_UNITS[kind]
         if entry["unit"] not in units:
             raise ParameterError(f"{where}.{key}: unit {entry['unit']!r}, expected {' or '.join(map(repr, units))}")
         read[key] = entry["value"]
@@ -150,7 +155,8 @@ def _read_boost(path: Path, kind: str, table: Any, name: str, sources: dict) -> 
         rows = [rows]
     try:
         torques = [float(t) for t in read["torsion_bar_torque"]]
-        rows = [[float(a) for a in row] for row in rows]
+        scale = BAR_PA if table["assist"]["unit"] == "bar" else 1.0
+        rows = [[float(a) * scale for a in row] for row in rows]
         if speeds is not None:
             scale = KMH if table["vehicle_speed"]["unit"] == "km/h" else 1.0
             speeds = [float(v) * scale for v in speeds]

@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 from scipy.interpolate import BPoly, PPoly
 
+from parksteer.boost_table import entries
 from parksteer.measure.smoothing import RackSpline
 from parksteer.model.numeric.assisted import solve_assisted
 from parksteer.model.numeric.simulate import prepare, simulate
@@ -18,6 +19,10 @@ CASES = [
     ("electric_assist_rack", {}),
     ("electric_assist_column", {"electric_assist_column.motor_torque_limit": 0.5}),  # saturated over the plateau
     ("hydraulic_assist", {}),
+    # a progressive valve table (pressure in Pa against torsion-bar torque), the valve's straight line off
+    ("hydraulic_assist", {"hydraulic_assist.valve_slope": 0.0, **{
+        f"hydraulic_assist.{k}": v for k, v in entries([0.0, 0.4, 0.8, 1.2, 1.6, 2.0, 2.5, 3.0, 3.5], None, [[
+            b * 1e5 for b in (0.0, 0.0, 1.7, 6.0, 12.5, 21.0, 34.2, 50.3, 69.0)]]).items()}}),
     # creeping at the half-gain speed of a speed-dependent boost curve: the replay's law must use G(v) = G / 2
     ("electric_assist_column", {"electric_assist_column.speed_dependence": 1.0,
                                 "electric_assist_column.gain_half_speed": 1.0, "run.vehicle_speed": 1.0}),
@@ -36,7 +41,7 @@ def exact_rack(result) -> RackSpline:
     return RackSpline.from_ppoly(PPoly.from_bernstein_basis(bernstein))
 
 
-@pytest.mark.parametrize(("name", "overrides"), CASES, ids=["column", "pinion", "rack", "saturated", "hydraulic", "speed_gain"])
+@pytest.mark.parametrize(("name", "overrides"), CASES, ids=["column", "pinion", "rack", "saturated", "hydraulic", "hydraulic_table", "speed_gain"])
 def test_replayed_rack_gives_back_the_torsion_bar_torque_and_motor_current(params, name, overrides):
     """Independent paths: the free (handwheel-driven) integration of the assisted model, whose boost feeds the
     torsion-bar torque back into the load, and the boost-free solve of the same rack followed by the boost law
@@ -45,7 +50,8 @@ def test_replayed_rack_gives_back_the_torsion_bar_torque_and_motor_current(param
     the rotor's inertia and friction being fixed by the rack's motion. Solved to convergence (rtol 1e-8), the
     replay gives the torsion-bar torque within 1e-4 N m (about 5e-6 N m found, of a 3 N m peak; 2e-5 N m of
     11 N m saturated) and the motor current within 1e-3 A (about 2e-5 A of 10-25 A); the hydraulic gear's
-    pressure within 100 Pa of 3.4 MPa."""
+    pressure within 100 Pa of 3.4 MPa, its valve's progressive table read alike by the generated C and the
+    replay."""
     free = simulate("unladen", effects=f"+{name}", overrides=overrides, params=params, output_dt_s=0.005, rtol=1e-8)
     c = free.columns
     t = np.round(np.arange(0.0, c["time_s"][-1] + 1e-9, 0.01), 12)

@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from scipy.interpolate import PchipInterpolator
+from scipy.integrate import cumulative_trapezoid
 from scipy.optimize import brentq
 
 from model_helpers import first_ramp
@@ -145,3 +146,94 @@ def test_over_a_closed_cycle_the_gear_dissipates_and_is_back_driven_after_each_r
     constant = params[f"{NAME}.efficiency"] * n * c["motor_torque_Nm"]
     created = (c["motor_torque_Nm"] * n * rate - constant * rate)[strong][back]
     assert np.min(created) < 0.0
+
+
+# The hydraulic valve's table: pressure (bar in the file, Pa in the model) against torsion-bar torque, progressive
+# (the Golf IV file's shape, 9 (|T| - 0.4)^1.8 bar), read through a vehicle file as a user writes it.
+HYDRAULIC = "hydraulic_assist"
+VALVE_TORQUES = [0.0, 0.4, 0.8, 1.2, 1.6, 2.0, 2.5, 3.0, 3.5]
+VALVE_BAR = [0.0, 0.0, 1.7, 6.0, 12.5, 21.0, 34.2, 50.3, 69.0]
+
+
+@pytest.fixture(scope="module")
+def golf():
+    from pathlib import Path
+
+    from parksteer.vehicle import load_vehicle
+
+    return load_vehicle(Path(__file__).resolve().parents[2] / "data" / "vehicles" / "golf_iv.toml")
+
+
+def valve_curve():
+    """An independent monotone cubic through the mirrored points, in Pa (SciPy's PCHIP)."""
+    pa = [b * 1e5 for b in VALVE_BAR]
+    return PchipInterpolator([-x for x in VALVE_TORQUES[:0:-1]] + VALVE_TORQUES, [-y for y in pa[:0:-1]] + pa)
+
+
+def test_valve_table_from_bar_takes_its_points_and_is_monotone_odd_and_zero_in_the_dead_band(golf):
+    """A rotary valve's characteristic given in bar is the pressure in Pa the piston sees: the vehicle file's
+    table gives each point's pressure exactly (bar x 1e5), rises between them, is odd (a left turn is a mirrored
+    right one) and exactly zero inside the valve's open centre; the valve's straight line is off (slope 0); the
+    replay's law (the valve below its relief) is the same curve as an independent monotone cubic, to 1e-9
+    relative."""
+    from parksteer.model.numeric.assisted import BoostLaw
+    from parksteer.boost_table import table_keys
+
+    values = {k: golf[f"{HYDRAULIC}.{k}"] for k in table_keys()}
+    assert golf[f"{HYDRAULIC}.valve_slope"] == 0.0
+    assert list(law(values, VALVE_TORQUES)) == [b * 1e5 for b in VALVE_BAR]
+    t = np.linspace(-5.0, 5.0, 20001)
+    p = law(values, t)
+    assert np.all(np.diff(p) >= 0.0) and np.all(np.diff(p[np.abs(t) > 0.4]) > 0.0)
+    assert np.array_equal(p, -law(values, -t)) and np.all(p[np.abs(t) <= 0.4] == 0.0)
+    inside = np.abs(t) <= VALVE_TORQUES[-1]
+    assert np.max(np.abs(p[inside] - valve_curve()(t[inside]))) < 1e-9 * 69e5
+    replay = BoostLaw(HYDRAULIC, "rack", 0.0, 0.5, 0.05, 3.0e7, 5.0e4, 131.4, area=8e-4,
+                      table=tuple(values[k] for k in table_keys()))
+    assert np.max(np.abs(replay.motor(t[inside]) - p[inside])) < 1e-3 * 69e5  # the relief's smoothing only
+
+
+def test_quasi_static_driver_torque_with_a_progressive_valve_solves_t_plus_a_of_t(golf):
+    """Quasi-statically the pinion carries the road torque as torsion-bar torque plus the piston's push through the
+    gear: T + a_p p(T) / G_hr = T_road (a_p the piston area, G_hr the handwheel-to-rack ratio). On the hydraulic Golf
+    with its progressive valve table, seals without friction, the relief out of reach and no Hooke joint, the
+    driver's torque on the slow steer to the right is the root of that equation, solved by hand (Brent's method on
+    SciPy's PCHIP through the table's points) from the manual car's torque at the same rack position, within 1 %."""
+    from test_assist import series_column
+
+    manual = simulate("kerb", effects="-hooke_joint", overrides=series_column(golf, HYDRAULIC), params=golf)
+    ideal = {f"{HYDRAULIC}.seal_friction_force": 0.0, f"{HYDRAULIC}.relief_pressure": 3.0e7}
+    assisted = simulate("kerb", effects=f"-hooke_joint,+{HYDRAULIC}", overrides=ideal, params=golf)
+    ramp, at = first_ramp(manual), first_ramp(assisted)
+    road = np.interp(assisted.columns["rack_m"][at], manual.columns["rack_m"][ramp],
+                     manual.columns["handwheel_torque_Nm"][ramp])
+    gain = golf[f"{HYDRAULIC}.piston_area"] / golf["steering.handwheel_to_rack_ratio"]
+    curve = valve_curve()
+    hand = np.array([brentq(lambda x, y=y: x + gain * curve(x) - y, -10.0, 10.0) for y in road])
+    got = assisted.columns["handwheel_torque_Nm"][at]
+    assert np.max(np.abs(road)) > 10.0 and np.min(hand) > 0.8  # well into the progressive part
+    assert np.max(np.abs(got / hand - 1.0)) < 0.01
+
+
+def test_over_a_closed_cycle_the_valve_adds_no_net_work_to_a_lossless_car(golf):
+    """Energy: without friction or dampers (air bearings, seals without friction) the driver's work plus the
+    piston's (the pump's) equals the change of kinetic and potential energy at every instant, with the valve's
+    table as its law; and the valve, whose pressure is a function of the torsion-bar torque alone, can put no net
+    work into a car that stores all it is given: over the closed lock-to-lock cycle (back at the centre at 18 s)
+    the pump's net work is below 0.1 % of the work it moves in and out."""
+    from model_helpers import DISSIPATION_OFF
+
+    overrides = {**DISSIPATION_OFF, f"{HYDRAULIC}.seal_friction_force": 0.0}
+    result = simulate("kerb", effects=f"+{HYDRAULIC}", overrides=overrides, surface="air_bearing", params=golf,
+                      output_dt_s=0.002, rtol=1e-10)
+    c = result.columns
+    out = result.model.evaluate_outputs(c["time_s"], result.states, result.parameter_vector)
+    energy = out["kinetic_energy_J"] + out["potential_energy_J"] + out["column_energy_J"]
+    power = c["assist_force_N"] * c["rack_speed_m_s"]
+    driver = cumulative_trapezoid(c["handwheel_torque_Nm"] * c["handwheel_rate_rad_s"], c["time_s"], initial=0.0)
+    pump = cumulative_trapezoid(power, c["time_s"], initial=0.0)
+    gross = np.trapezoid(np.abs(power), c["time_s"])
+    assert c["time_s"][-1] >= 18.0 and abs(c["rack_m"][-1]) < 1e-3 * np.max(np.abs(c["rack_m"]))
+    assert np.max(np.abs(c["pressure_Pa"])) > 2e5  # the valve opens into its table
+    assert np.max(np.abs(driver + pump - (energy - energy[0]))) < 1e-4 * gross
+    assert abs(pump[-1]) < 1e-3 * gross

@@ -78,6 +78,49 @@ def test_polo_progressive_table_drives_the_motor_as_the_table_says(tmp_path):
     assert np.max(np.abs(c["motor_torque_Nm"][used] / expected[used] - 1.0)) < 0.01
 
 
+def test_golf_valve_table_sets_the_pressure_as_the_table_says():
+    """The Golf IV's [assist.boost] is its rotary valve's progressive characteristic in bar: simulated with its
+    assist, the pressure against the torsion-bar torque is the table's (bar x 1e5), read by an independent monotone
+    cubic (SciPy's PCHIP through the mirrored points), within 1 % wherever the valve gives more than 1 bar."""
+    from scipy.interpolate import PchipInterpolator
+    import tomllib
+
+    boost = tomllib.loads(GOLF_IV.read_text(encoding="utf-8"))["assist"]["boost"]
+    assert boost["assist"]["unit"] == "bar"
+    t, p = boost["torsion_bar_torque"]["value"], [b * 1e5 for b in boost["assist"]["value"]]
+    curve = PchipInterpolator([-x for x in t[:0:-1]] + t, [-y for y in p[:0:-1]] + p)
+    params = load_vehicle(GOLF_IV)
+    name = check_assist(params)
+    result = simulate(params.case_names[0], effects=f"+{name}", params=params)
+    c = result.columns
+    expected = curve(c["torsion_bar_torque_Nm"])
+    used = np.abs(expected) > 1e5
+    assert np.max(np.abs(c["torsion_bar_torque_Nm"])) > 2.0
+    assert np.max(np.abs(c["pressure_Pa"][used] / expected[used] - 1.0)) < 0.01
+
+
+def test_new_hydraulic_with_boost_points_writes_the_valve_table_in_bar(tmp_path):
+    """A hydraulic gear's --assist-boost points are its valve's pressure in bar: written as the table
+    [assist.boost] (unit bar, the origin added in front), read in Pa, the valve's straight line off; a file that
+    gives both a table and a valve slope is refused naming the file."""
+    out = tmp_path / "hps.toml"
+    assert main(["vehicle", "new", "--out", str(out), *GOLF, "--assist", "hydraulic", "--assist-boost",
+                 "0.5:0,2:20,3.5:60"]) == 0
+    text = out.read_text(encoding="utf-8")
+    assert 'unit = "bar"' in text and "valve_slope" not in text
+    params = load_vehicle(out)
+    assert check_assist(params) == "hydraulic_assist"
+    assert params["hydraulic_assist.valve_slope"] == 0.0
+    assert [params[f"hydraulic_assist.boost_assist_0_{k}"] for k in range(4)] == [0.0, 0.0, 2.0e6, 6.0e6]
+    out.write_text(text.replace('type = "hydraulic"', 'type = "hydraulic"\nvalve_slope = { value = 1.5e6, unit = '
+                                '"Pa/(N m)", source = "x" }'))
+    with pytest.raises(ParameterError, match=r"hps.toml: assist: a boost table and a valve slope"):
+        load_vehicle(out)
+    # the unit --assist-boost-unit names is an electric gear's
+    assert main(["vehicle", "new", "--out", str(tmp_path / "x.toml"), *GOLF, "--assist", "hydraulic",
+                 "--assist-boost", "0.5:0,2:20", "--assist-boost-unit", "motor"]) == 2
+
+
 def test_implausible_assist_is_refused_in_one_line(tmp_path):
     """An assist that could push the rack with 400 kN (a relief pressure given in Pa where bar was meant, say) is
     no car's: refused naming the file and the section."""

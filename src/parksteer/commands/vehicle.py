@@ -55,8 +55,8 @@ def register(sub) -> None:
     n.add_argument("--assist-boost", default=None, metavar="T:A,T:A",
                    help="boost-curve points, torsion-bar torque (N m) : assist, rising (electric: written as the "
                         "table [assist.boost], 0:0 added in front if missing, the assist in the unit "
-                        "--assist-boost-unit says; hydraulic: pressure "
-                        "in bar, the least-squares line gives the valve's slope and dead band)")
+                        "--assist-boost-unit says; hydraulic: the valve's pressure "
+                        "in bar)")
     n.add_argument("--assist-boost-unit", choices=BOOST_POINT_UNITS, default=None,
                    help="electric: what the assist of --assist-boost is: the motor's torque (N m; turned into the "
                         "point of action's through eta N), or the torque at the column or pinion (N m), or the force "
@@ -178,7 +178,7 @@ def boost_table_text(args, efficiency: float, reduction: float) -> str:
     from ..boost_table import BoostTableError, check_table
 
     unit = args.assist_boost_unit or args.assist
-    if unit not in ("motor", args.assist):
+    if args.assist != "hydraulic" and unit not in ("motor", args.assist):
         raise UsageError(f"--assist-boost-unit {unit}: a {args.assist} assist takes its points as motor torque or "
                          f"as the assist at the {args.assist}")
     points = boost_points(args.assist_boost)
@@ -192,10 +192,11 @@ def boost_table_text(args, efficiency: float, reduction: float) -> str:
     except BoostTableError as exc:
         raise UsageError(f"--assist-boost {args.assist_boost}: {exc}") from None
     how = (f"motor torque x eta N = {scale:g} (the reduction and forward efficiency of [assist])" if unit == "motor"
-           else f"the assist at the {unit}")
-    assist_unit = "N" if args.assist == "rack" else "N m"
+           else "the valve's pressure" if unit == "hydraulic" else f"the assist at the {unit}")
+    assist_unit = {"rack": "N", "hydraulic": "bar"}.get(args.assist, "N m")
     source = f"specification: --assist-boost {args.assist_boost} ({how})"
-    return ("\n# The boost curve as the control unit's table (parksteer.boost_table): monotone cubic between the points.\n"
+    what = "valve's characteristic" if args.assist == "hydraulic" else "boost curve as the control unit's table"
+    return (f"\n# The {what} (parksteer.boost_table): monotone cubic between the points.\n"
             "[assist.boost]\n"
             f'torsion_bar_torque = {{ value = {[float(t) for t in torques]}, unit = "N m", source = "{source}" }}\n'
             f'assist = {{ value = {[float(f"{a:.10g}") for a in assist]}, unit = "{assist_unit}", source = "{source}" }}\n')
@@ -213,7 +214,7 @@ def assist_section(args, base) -> str:
         if given:
             raise UsageError(f"{given[0]} needs --assist")
         return ""
-    from ..model.numeric.assist import assist_template, boost_line, gear_values
+    from ..model.numeric.assist import assist_template, gear_values
 
     hydraulic = args.assist == "hydraulic"
     wrong = [o for o, v in (*electric_only, ("--assist-boost-unit", args.assist_boost_unit)) if v is not None
@@ -236,15 +237,9 @@ def assist_section(args, base) -> str:
         given["gain_half_speed"] = (args.assist_gain_half_speed_kmh / 3.6, source)
     if args.assist_relief_pressure_bar is not None:
         given["relief_pressure"] = (args.assist_relief_pressure_bar * BAR_PA, "specification (bar x 1e5)")
-    if args.assist_boost is not None and hydraulic:
-        points = boost_points(args.assist_boost)
-        slope, band = boost_line([(t, a * BAR_PA) for t, a in points], f"--assist-boost {args.assist_boost}")
-        source = f"specification: least-squares line through the boost-curve points {args.assist_boost}"
-        given["valve_slope"] = (slope, source)
-        given["dead_band"] = (max(band, 0.0), source)
-    if args.assist_boost is None or hydraulic:
+    if args.assist_boost is None:
         return assist_template(args.assist, given)
-    efficiency, reduction = gear_values(args.assist, given)
+    efficiency, reduction = (1.0, 1.0) if hydraulic else gear_values(args.assist, given)
     return assist_template(args.assist, given, table=True) + boost_table_text(args, efficiency, reduction)
 
 

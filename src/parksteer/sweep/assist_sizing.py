@@ -57,7 +57,8 @@ FRICTION_BAND = (0.67, 0.8, 1.0)
 # Standstill rack forces of current small and medium cars, N: 3-8 kN (Harrer & Pfeffer, Steering Handbook, Springer
 # 2017, ch. 8, as parksteer.model.numeric.assist cites it); rack-type EPS gears are built for up to 18 kN (small
 # utility vehicles: thyssenkrupp Automotive Technology, steering gears, rack EPS). No published standstill rack
-# force of a named small car was found for this project; a rack force below the lower end is reported as such.
+# force of a named small car was found for this project (docs/assist.md, "Loads over the tyre-ground friction", says
+# what was searched and what was found); a rack force below the lower end is reported as such.
 PUBLISHED_STANDSTILL_RACK_FORCE_N = (3.0e3, 8.0e3)
 
 
@@ -181,8 +182,9 @@ def size_assist(params: Parameters, case: str, target_torque_Nm: float, speeds_k
         if hydraulic:
             motor = current = float("nan")
             pressure = (demand + v("seal_friction_force")) / v("piston_area")
+            # the sized valve is the straight line of the sized gain: a table of the file is switched off
             sized = {f"{name}.valve_slope": gain * ratio / v("piston_area"),
-                     f"{name}.relief_pressure": max(MARGIN * pressure, 1.0e5)}
+                     f"{name}.relief_pressure": max(MARGIN * pressure, 1.0e5), **table_off(name)}
         else:
             pressure = float("nan")
             motor = motors[i]

@@ -74,26 +74,9 @@ def effects_with_assist(spec: str | None, params: Parameters) -> str | None:
     return f"{spec},+{name}" if spec else f"+{name}"
 
 
-def boost_line(points: list[tuple[float, float]], what: str) -> tuple[float, float]:
-    """Slope and dead band of the straight line through boost-curve points (torsion-bar torque, output): the least
-    squares line, whose zero crossing is the dead band."""
-    if len(points) < 2:
-        raise UsageError(f"{what}: give at least two points T:A")
-    n = float(len(points))
-    mean_t = sum(t for t, _ in points) / n
-    mean_a = sum(a for _, a in points) / n
-    sxx = sum((t - mean_t) ** 2 for t, _ in points)
-    if sxx == 0.0:
-        raise UsageError(f"{what}: the points need two different torsion-bar torques")
-    slope = sum((t - mean_t) * (a - mean_a) for t, a in points) / sxx
-    if not slope > 0.0:
-        raise UsageError(f"{what}: the assist must grow with the torsion-bar torque (slope {slope:g})")
-    return slope, mean_t - mean_a / slope
-
-
 # The quantities a boost table replaces (the straight line's) and those it fills (its scalars, derived by the
 # vehicle reader from [assist.boost]): neither is written into a vehicle file's [assist].
-LINE_KEYS = ("gain", "dead_band", "dead_band_smoothing", "speed_dependence", "gain_half_speed")
+LINE_KEYS = ("gain", "dead_band", "dead_band_smoothing", "speed_dependence", "gain_half_speed", "valve_slope")
 TABLE_KEYS = frozenset(table_keys())
 
 
@@ -103,7 +86,7 @@ def table_off(name: str) -> dict[str, float]:
 
 
 def has_table(params: Parameters, name: str) -> bool:
-    """Whether the electric assist `name` of `params` carries a boost table (a nonzero table assist)."""
+    """Whether the assist `name` of `params` carries a boost table (a nonzero table assist or pressure)."""
     return any(params.sections.get(name, {}).get(key, 0.0) for key in off_keys())
 
 

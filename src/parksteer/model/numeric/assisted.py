@@ -22,11 +22,11 @@ pinion, the column torque through the joint). Dividing R by c_col (column) or G_
 
     y = T_s + A(T_s),   y = T_road (column), T_road c_col / G_hr (pinion, rack, hydraulic),
     A(T_s) = e N clamp((G deadband(T_s) s + B(T_s)) / (eta N), T_max) / s,   s = 1 (column, pinion), G_hr (rack),
-    A(T_s) = a_p clamp(k_v deadband(T_s), p_relief) / G_hr          (hydraulic),
+    A(T_s) = a_p clamp(k_v deadband(T_s) + B(T_s), p_relief) / G_hr          (hydraulic),
 
 the boost laws of :mod:`parksteer.model.symbolic.effects.electric_assist` and ``hydraulic_assist`` with the same
-smoothed corners (:mod:`parksteer.model.symbolic.effects.assist_common`); B is the boost table's law (zero without
-a table) and e the gear's efficiency in the direction the power flows (eta_f driving, 1 / eta_b back-driven), read
+smoothed corners (:mod:`parksteer.model.symbolic.effects.assist_common`); B is the boost table's law (the motor's
+demand, or the valve's pressure; zero without a table) and e the gear's efficiency in the direction the power flows (eta_f driving, 1 / eta_b back-driven), read
 from the prescribed rack's speed (the point of action's rate, as the effect reads it) and the law's motor torque. A is increasing (deadband and clamp are,
 strictly for a smoothed clamp: its slope is -(f(a) + f(b))/2 > 0 with f(z) = z / sqrt(z^2 + w^2), a + b = -2 L),
 so y(T_s) rises with slope >= 1 and has one root, found pointwise by bisection in ``[y - B, y + B]`` (B bounds
@@ -59,11 +59,9 @@ GAIN_ERROR_KEY = "boost_gain_error.strength"
 
 
 def boost_keys(name: str) -> list[str]:
-    """The quantities that switch the boost off at 0: the gain and the boost table's assists and slopes (electric)
-    or the valve's slope (hydraulic)."""
-    if name == HYDRAULIC:
-        return [f"{name}.valve_slope"]
-    return [f"{name}.gain", *(f"{name}.{key}" for key in off_keys())]
+    """The quantities that switch the boost off at 0: the gain (electric) or the valve's slope (hydraulic), and the
+    boost table's assists and slopes."""
+    return [f"{name}.valve_slope" if name == HYDRAULIC else f"{name}.gain", *(f"{name}.{key}" for key in off_keys())]
 
 
 @dataclass(frozen=True)
@@ -102,13 +100,13 @@ class BoostLaw:
     def motor(self, torsion_bar_Nm):
         """The motor torque (N m; hydraulic: the pressure, Pa) at the torsion-bar torque (module docstring)."""
         opening = deadband(np.asarray(torsion_bar_Nm, dtype=float), self.dead_band, self.band_width)
-        if self.hydraulic:
-            return clamp(self.gain * opening, self.limit, self.limit_width)
-        scale = self.ratio if self.location == "rack" else 1.0
+        scale = self.ratio if self.location == "rack" and not self.hydraulic else 1.0
         demand = self.gain * opening * scale
         if any(self.table):
             demand = demand + self.table_scale * table_law(np.asarray(torsion_bar_Nm, dtype=float), None, self.speed,
                                                            self._table_points)
+        if self.hydraulic:
+            return clamp(demand, self.limit, self.limit_width)
         return clamp(demand / (self.efficiency * self.reduction), self.limit, self.limit_width)
 
     @cached_property
@@ -180,7 +178,9 @@ def boost_law(run, p: np.ndarray) -> BoostLaw | None:
     gain_factor = 1.0 + float(p[names.index(GAIN_ERROR_KEY)]) if GAIN_ERROR_KEY in names else 1.0
     if name == HYDRAULIC:
         return BoostLaw(name, "rack", v("valve_slope"), v("dead_band"), v("dead_band_smoothing"),
-                        v("relief_pressure"), v("pressure_smoothing"), ratio, area=v("piston_area"))
+                        v("relief_pressure"), v("pressure_smoothing"), ratio, area=v("piston_area"),
+                        table=tuple(v(key) for key in table_keys()),
+                        speed=float(p[run.parameter_index(VEHICLE_SPEED.key)]))
     gain = speed_gain(v("gain"), v("speed_dependence"), float(p[run.parameter_index(VEHICLE_SPEED.key)]),
                       v("gain_half_speed"))
     return BoostLaw(name, effect.location, gain * gain_factor, v("dead_band"), v("dead_band_smoothing"),

@@ -36,7 +36,8 @@ from __future__ import annotations
 import numpy as np
 import sympy as sp
 
-from ....boost_table import MAX_POINTS, MAX_SPEEDS
+from ....boost_table import MAX_POINTS, MAX_SPEEDS, PAD_STEP_MPS, PAD_STEP_NM
+from ....parameters import Quantity
 
 LOCATIONS = ("column", "pinion", "rack")
 
@@ -168,3 +169,27 @@ def table_law(torque, value, speed, points=None):
     torque = np.asarray(torque, dtype=float)
     magnitude = half(np.abs(torque))
     return np.where(torque >= 0, magnitude, -magnitude)
+
+
+def table_quantities(name: str, unit: str, slope_unit: str, where: str,
+                     upper: float = 1.0e6) -> tuple[Quantity, ...]:
+    """The scalar quantities of `name`'s boost table (:mod:`parksteer.boost_table`), the assist in `unit` (`where`
+    names the point of action), its slopes in `slope_unit`, both bounded by `upper` (the padded points beyond a
+    table's last continue its last slope); by default a table of zeros: no assist from the table."""
+    table = "derived from [assist.boost] of the vehicle file; default 0: no table"
+    out = [Quantity(f"{name}.boost_torque_{k}", "N m", 0.0, 100.0, lower_inclusive=True, default=k * PAD_STEP_NM,
+                    description=f"boost table: torsion-bar torque of point {k}",
+                    source="derived from [assist.boost] of the vehicle file (padded 1 N m apart beyond its last "
+                           "point); default evenly spaced, unused without a table") for k in range(MAX_POINTS)]
+    out += [Quantity(f"{name}.boost_speed_{r}", "m/s", 0.0, 200.0, lower_inclusive=True,
+                     default=r * PAD_STEP_MPS, description=f"boost table: vehicle speed of row {r}",
+                     source="derived from [assist.boost] of the vehicle file (one row: 0); default evenly spaced, "
+                            "unused without a table") for r in range(MAX_SPEEDS)]
+    for r in range(MAX_SPEEDS):
+        out += [Quantity(f"{name}.boost_assist_{r}_{k}", unit, 0.0, upper, lower_inclusive=True, default=0.0,
+                         description=f"boost table: assist {where} at point {k}, row {r}", source=table)
+                for k in range(MAX_POINTS)]
+        out += [Quantity(f"{name}.boost_slope_{r}_{k}", slope_unit, 0.0, upper, lower_inclusive=True, default=0.0,
+                         description=f"boost table: Fritsch-Carlson slope at point {k}, row {r}", source=table)
+                for k in range(MAX_POINTS)]
+    return tuple(out)

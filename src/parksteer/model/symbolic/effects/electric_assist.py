@@ -71,12 +71,11 @@ from typing import ClassVar
 import sympy as sp
 import sympy.physics.mechanics as me
 
-from ....boost_table import MAX_POINTS, MAX_SPEEDS, PAD_STEP_MPS, PAD_STEP_NM
 from ....parameters import VEHICLE_SPEED, Quantity
 from ..components import Effect
 from ..system import torque_between
 from .assist_common import (LOCATIONS, clamp, deadband, directional_efficiency, point_of_action,
-                            series_deflection, speed_gain, table_law, torsion_bar_torque)
+                            series_deflection, speed_gain, table_law, table_quantities, torsion_bar_torque)
 
 # Typical values by point of action: (reduction N, its unit, bounds, efficiency, motor torque limit N m,
 # motor inertia kg m^2, source of the reduction). Column and pinion: a worm gear; rack: a ball nut driven through
@@ -109,31 +108,6 @@ _BACK_EFFICIENCY = {
                    "forward 0.9-0.95 (Harrer & Pfeffer, ch. 8.4; THK and NSK ball screw catalogues, 'reverse "
                    "efficiency')"),
 }
-
-
-
-def table_quantities(name: str, location: str) -> tuple[Quantity, ...]:
-    """The scalar quantities of a boost table (:mod:`parksteer.boost_table`), by default a table of zeros: no
-    assist from the table, the law of the gain and dead band alone."""
-    unit, slope_unit = ("N", "N/(N m)") if location == "rack" else ("N m", "1")
-    where = "at the rack" if location == "rack" else f"at the {location}"
-    table = "derived from [assist.boost] of the vehicle file; default 0: no table"
-    out = [Quantity(f"{name}.boost_torque_{k}", "N m", 0.0, 100.0, lower_inclusive=True, default=k * PAD_STEP_NM,
-                    description=f"boost table: torsion-bar torque of point {k}",
-                    source="derived from [assist.boost] of the vehicle file (padded 1 N m apart beyond its last "
-                           "point); default evenly spaced, unused without a table") for k in range(MAX_POINTS)]
-    out += [Quantity(f"{name}.boost_speed_{r}", "m/s", 0.0, 200.0, lower_inclusive=True,
-                     default=r * PAD_STEP_MPS, description=f"boost table: vehicle speed of row {r}",
-                     source="derived from [assist.boost] of the vehicle file (one row: 0); default evenly spaced, "
-                            "unused without a table") for r in range(MAX_SPEEDS)]
-    for r in range(MAX_SPEEDS):
-        out += [Quantity(f"{name}.boost_assist_{r}_{k}", unit, 0.0, 1.0e6, lower_inclusive=True, default=0.0,
-                         description=f"boost table: assist {where} at point {k}, row {r}", source=table)
-                for k in range(MAX_POINTS)]
-        out += [Quantity(f"{name}.boost_slope_{r}_{k}", slope_unit, 0.0, 1.0e6, lower_inclusive=True, default=0.0,
-                         description=f"boost table: Fritsch-Carlson slope at point {k}, row {r}", source=table)
-                for k in range(MAX_POINTS)]
-    return tuple(out)
 
 
 def assist_quantities(name: str, location: str) -> tuple[Quantity, ...]:
@@ -192,7 +166,8 @@ def assist_quantities(name: str, location: str) -> tuple[Quantity, ...]:
                         "(Chrysler 1999 Concorde service manual, speed proportional steering gear); with v_half "
                         "40-80 km/h, G / (1 + (v / v_half)^2) keeps 61-86 % of the parking gain at 32 km/h and "
                         "14-39 % at 100 km/h"),
-        *table_quantities(name, location),
+        *(table_quantities(name, "N", "N/(N m)", "at the rack") if location == "rack"
+          else table_quantities(name, "N m", "1", f"at the {location}")),
     )
 
 

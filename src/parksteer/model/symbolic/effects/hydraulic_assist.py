@@ -5,7 +5,7 @@ sets a pressure difference across the piston on the rack (an integral rack-and-p
 returning through the open centre). The valve characteristic, pressure against torsion-bar torque, is taken as
 a dead band, a slope and the relief valve's limit, each corner smoothed (see :mod:`.assist_common`):
 
-    dp = clamp(k_v deadband(T_s, D), p_relief),     F_h = A dp   on the rack, reacted on the housing,
+    dp = clamp(k_v deadband(T_s, D) + B(T_s, v), p_relief),     F_h = A dp   on the rack, reacted on the housing,
 
 with T_s the torsion-bar torque at the pinion (the column torque through the intermediate shaft's joint), k_v
 the valve's slope (Pa per N m), A the piston's effective area (bore less rod). The piston's seals rub with a
@@ -14,10 +14,20 @@ slot, as for the electric assist; the two are refused together). The pump is the
 A dp times the rack speed. Not modelled: the pump's flow limit (at parking rates the rack needs about
 A x 0.1 m/s = 5 l/min, within a pump's 6-10 l/min) and the oil's compressibility and inertia.
 
+Valve table. A real rotary valve is progressive: the contours of its metering edges make the pressure rise slowly
+about the centre and steeply towards parking pressures. A vehicle file's ``[assist.boost]`` gives that
+characteristic as a table, the pressure (bar in the file, Pa here) against the torsion-bar torque, optionally one
+row per vehicle speed (a speed-sensitive valve, as ZF's Servotronic); B(T_s, v) is its law, the electric assist's
+(:func:`.assist_common.table_law`: exact at the points, monotone cubic between them, odd, exactly zero in the
+table's dead band, linear in speed between rows), read at the run's vehicle speed, and the file's valve slope is 0
+(the reader refuses both). The table's default, all zeros, adds exactly nothing: today's law. The relief valve still
+bounds the sum.
+
 Quasi-static consequences (the tests): in the linear range of the valve the gear carries T_s + A k_v T_s / G_hr
 = T_road at the pinion, so the driver's torque is T_road / (1 + G_h) with G_h = A k_v / G_hr (G_hr the
-handwheel-to-rack ratio); at the relief pressure the driver's torque rises with the unassisted slope; a valve
-of zero slope gives the manual steering with the seal friction added.
+handwheel-to-rack ratio); with a table, T_s is the root of T_s + A B(T_s) / G_hr = T_road; at the relief pressure
+the driver's torque rises with the unassisted slope; a valve of zero slope gives the manual steering with the seal
+friction added.
 
 Outputs: torsion_bar_torque_Nm, assist_force_N (A dp), pressure_Pa (dp); the simulation adds rack_force_N.
 Values: assumed, typical of hydraulic gears of small and medium cars, with range and source in each quantity.
@@ -27,10 +37,10 @@ from __future__ import annotations
 
 import sympy as sp
 
-from ....parameters import Quantity
+from ....parameters import VEHICLE_SPEED, Quantity
 from ..components import Effect
 from ..system import action_reaction
-from .assist_common import clamp, deadband, series_deflection, torsion_bar_torque
+from .assist_common import clamp, deadband, series_deflection, table_law, table_quantities, torsion_bar_torque
 
 NAME = "hydraulic_assist"
 HANDBOOK = "Harrer & Pfeffer, Steering Handbook, Springer 2017, ch. 7"
@@ -40,7 +50,8 @@ class HydraulicAssist(Effect):
     name = NAME
     description = (
         "Hydraulic power assistance: valve torsion bar in series with the column, valve pressure against "
-        "torsion-bar torque (dead band, slope, relief pressure), piston on the rack with seal friction; off by default"
+        "torsion-bar torque (dead band and slope, or a progressive table; relief pressure), piston on the rack with "
+        "seal friction; off by default"
     )
     in_default_set = False
     diagnosis_candidate = False
@@ -73,17 +84,22 @@ class HydraulicAssist(Effect):
         Quantity(f"{NAME}.torsion_bar_stiffness", "N m/rad", 10.0, 10000.0, default=90.0,
                  description="torsion bar of the rotary valve, in series with the column",
                  source=f"assumed: valve torsion bars 1-2 N m/deg, 57-115 N m/rad ({HANDBOOK}.3)"),
+        # a table's padded points continue its last slope up to 9 N m beyond its last point: 1e9 Pa leaves room
+        # for any table within the relief pressure's range
+        *table_quantities(NAME, "Pa", "Pa/(N m)", "(the valve's pressure)", upper=1.0e9),
     )
-    uses = (*(q.key for q in quantities), "steering.column_torsional_stiffness", "steering.handwheel_to_rack_ratio",
-            "steering.friction_smoothing")
+    uses = (*(q.key for q in quantities), VEHICLE_SPEED.key, "steering.column_torsional_stiffness",
+            "steering.handwheel_to_rack_ratio", "steering.friction_smoothing")
 
     def deflection(self, model, twist):
         return series_deflection(model, twist, f"{NAME}.torsion_bar_stiffness")
 
     def pressure(self, model):
         p = lambda key: model.p(f"{NAME}.{key}")  # noqa: E731
-        opening = deadband(torsion_bar_torque(model, "pinion"), p("dead_band"), p("dead_band_smoothing"))
-        return clamp(p("valve_slope") * opening, p("relief_pressure"), p("pressure_smoothing"))
+        sensor = torsion_bar_torque(model, "pinion")
+        opening = deadband(sensor, p("dead_band"), p("dead_band_smoothing"))
+        demand = p("valve_slope") * opening + table_law(sensor, p, model.p(VEHICLE_SPEED.key))
+        return clamp(demand, p("relief_pressure"), p("pressure_smoothing"))
 
     def loads(self, model):
         k = model.kinematics
