@@ -39,6 +39,10 @@ class Quantity:
     value of the active Table B1 case, or ``<effect>.<name>`` for a quantity only that effect has.
     ``default`` and ``source`` are given only by quantities declared in code (an effect's own, on the effect's
     class); every other quantity takes its value and source from the parameter file.
+
+    ``free`` marks an effect's own strength as one a diagnosis fits, within the bounds, together with the calibrated
+    parameters whenever the effect is in the model (``--effects=+FILE.py``), starting from its value (the default,
+    or ``--set``); a quantity not free keeps the value it is given.
     """
 
     key: str
@@ -52,6 +56,7 @@ class Quantity:
     why: str = ""  # the range of real cars behind the bounds, given with a refusal
     default: float | None = None
     source: str = ""
+    free: bool = False
 
     @property
     def section(self) -> str:

@@ -65,6 +65,7 @@ from .engine import ReplayEngine
 from .problem import FileData, Problem
 from .settings import DEFAULT_SETTINGS, DiagnosisSettings
 from .stages import STAGES, run_table
+from .stages.user_effect import with_user_effect_stage
 from .state import Diagnosis, DiagnosisState, frozen_mapping
 
 __all__ = ["Diagnosis", "diagnose"]
@@ -104,9 +105,11 @@ def diagnose(files: list[FileData], params: Parameters, effects=None, registry: 
     problem = Problem(copies, params, angle_offset_fitted=settings.angle_offset_fitted)
     progress = Progress(quiet)
     registry = registry if registry is not None else discover_effects()
+    # with a user's effect that declares free strengths, the error without it and with it (stages/user_effect.py)
     state = DiagnosisState(settings, problem, tuple(base), frozen_mapping(registry),
                            None if strengths is None else frozen_mapping(strengths),
-                           None if start is None else frozen_mapping(start), progress, tuple(stages))
+                           None if start is None else frozen_mapping(start), progress,
+                           with_user_effect_stage(tuple(stages), base))
     testable, _ = candidate_effects(base, registry)
     # The models the candidates replay in are built in the background while the base model's stages run (the base
     # model itself is built, if missing, when first replayed).
