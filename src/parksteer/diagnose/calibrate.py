@@ -385,9 +385,11 @@ def calibrate(engine: ReplayEngine, problem: Problem, effects: list[Effect], fix
     From the model's defaults, or from the values in `start` where it has them. `announce`, if given, is called
     with the keys of the calibrated parameters (the base model's, and with a fitted angle the column's).
     """
-    parameters = calibration_parameters(engine, problem, effects, keys, strengths, settings)
+    free = {q.key for q in free_strengths(effects)}
+    # a free strength given a value (`fixed`, e.g. compare's --set) keeps it
+    parameters = [p for p in calibration_parameters(engine, problem, effects, keys, strengths, settings)
+                  if not (p.key in free and p.key in (fixed or {}))]
     if announce is not None:
-        free = {q.key for q in free_strengths(effects)}
         announce([p.key for p in parameters if p.key not in (strengths or {}) and p.key not in free])
     start = start or {}
     theta0 = np.array([p.theta(start[p.key]) if p.key in start else
