@@ -345,7 +345,10 @@ def free_parameter(engine: ReplayEngine, problem: Problem, effects: list[Effect]
     value = engine.replay(problem, effects, 0).value(spec.key)
     span = spec.upper - spec.lower
     step = span * FREE_STEP_OF_RANGE if math.isfinite(span) else max(abs(value), 1.0) * FREE_STEP_OF_VALUE
-    return FitParameter(spec.key, "offset", value, spec.lower, spec.upper, step)
+    # an open bound is not a value the quantity may take: the fit stops just inside it
+    lower = spec.lower if spec.lower_inclusive else math.nextafter(spec.lower, math.inf)
+    upper = spec.upper if spec.upper_inclusive else math.nextafter(spec.upper, -math.inf)
+    return FitParameter(spec.key, "offset", value, lower, upper, step)
 
 
 def _used_keys(effects: list[Effect]) -> set[str]:

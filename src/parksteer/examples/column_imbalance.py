@@ -36,10 +36,9 @@ class ColumnImbalance(Effect):
     description = "Out-of-balance mass on the inclined column: torque -T_u sin(column angle - phase), once per turn"
     in_default_set = False
     # Quantities only this effect has, declared here as every effect declares its own (the parameter file holds the
-    # car's): they join the registry when the effect is loaded. The strength is free: with the effect in the model,
-    # a diagnosis fits it (within its bounds) together with the calibrated parameters; the phase keeps its value.
+    # car's): they join the registry when the effect is loaded.
     quantities = (
-        Quantity("column_imbalance.strength", "N m", 0.0, 20.0, lower_inclusive=True, default=0.0, free=True,
+        Quantity("column_imbalance.strength", "N m", 0.0, 20.0, lower_inclusive=True, default=0.0,
                  source="example: m g e sin(lambda); 0.2 kg at 30 mm on a column inclined 25 deg gives 0.025 N m "
                         "per 100 g, so a few tenths of a N m for a heavy yoke"),
         Quantity("column_imbalance.phase", "rad", -math.pi, math.pi, lower_inclusive=True, default=0.0,

@@ -54,6 +54,9 @@ def user_effect_figure(diagnosis, path: str | Path) -> None:
                             transform=ax.get_xaxis_transform(), label=phase.replace("_", " "))
     ax.plot(t, f.torque_Nm - before, ".", color=BEFORE, markersize=1.2, label="without it")
     ax.plot(t, f.torque_Nm - after, ".", color=AFTER, markersize=1.2, label="with it")
+    # the few samples at reversals where the rack cannot fix the instant friction turns over are left off the scale
+    limit = float(np.percentile(np.abs(np.concatenate([f.torque_Nm - before, f.torque_Nm - after])), 99.0))
+    ax.set_ylim(-1.3 * limit, 1.3 * limit)
     ax.set_ylabel("measured - model (N m)")
     ax.set_xlabel("time (s)")
     ax.legend(fontsize=6, ncol=4)

@@ -10,18 +10,19 @@ only when the model has free strengths (:func:`with_user_effect_stage`), shows w
   model calibrated (its own calibration, from the defaults), then the model with them (the diagnosis's calibration);
 - each free strength with its 95 % interval (:meth:`parksteer.diagnose.calibrate.Fit.intervals`) and unit;
 - the residual's RMS in each phase of each file, calibrated without the effects and with them;
-- a sweep: every free strength moved together from 0 (or its lower bound, where 0 is outside its range) to its
-  fitted value in :data:`SWEEP_POINTS` steps, the other parameters held at the fit, the weighted error at each.
+- a sweep: every free strength whose 0 means absent (0 within its bounds) moved together from 0 to its fitted
+  value in :data:`SWEEP_POINTS` steps, the other parameters (a free width or phase among them) held at the fit,
+  the weighted error at each.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, replace
 
 import numpy as np
 
 from ...measure.phases import PHASES
-from ...parameters import quantity
 from ..calibrate import Fit, calibrate, free_strengths
 from ..engine import ReplayEngine
 from ..state import DiagnosisState
@@ -106,8 +107,11 @@ class UserEffectLadder(Stage):
         free = free_strengths(mine)
         intervals = fit.intervals(problem, state.settings.interval_block_s)
         table = {q.key: {**intervals[q.key], "unit": q.unit, "bounds": [q.lower, q.upper]} for q in free}
-        fitted = {q.key: intervals[q.key]["value"] for q in free}
-        origin = {q.key: 0.0 if quantity(q.key).within(0.0) else q.lower for q in free}
+        # the strengths whose 0 means absent are swept (a width or a phase is held at its fit); when none has, every
+        # free strength from just inside its lower bound
+        swept = [q for q in free if q.within(0.0)] or free
+        fitted = {q.key: intervals[q.key]["value"] for q in swept}
+        origin = {q.key: 0.0 if q.within(0.0) else math.nextafter(q.lower, math.inf) for q in swept}
         fractions = np.linspace(0.0, 1.0, SWEEP_POINTS)
         errors = []
         for t in fractions:
