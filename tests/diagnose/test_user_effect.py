@@ -106,3 +106,18 @@ def test_a_file_effect_in_a_diagnosis_pickles_by_reference(hand_written):
     (before, only the command line registered it, and a diagnosis on several workers failed with a PicklingError)."""
     user = next(e for e in hand_written.base_effects if e.name == "centre_friction")
     assert type(pickle.loads(pickle.dumps(user))) is type(user)
+
+
+def test_compare_fits_the_free_strengths_it_is_not_given(record, params, repo_root):
+    """`parksteer compare` with the hand-written effect fits its free peak force and width with the calibrated
+    parameters (printed with their units) and compares the record with the fitted model, well below the model with
+    the peak force given as 0 by --set, which it holds."""
+    from parksteer.diagnose.compare import compare_files
+
+    effects = resolve_effects(f"+{repo_root / 'examples' / 'user_effect' / 'centre_friction.py'}")
+    fitted = compare_files(load_files(record, params), params, effects)
+    held = compare_files(load_files(record, params), params, effects, {"centre_friction.peak_force": 0.0})
+    assert fitted.fitted["centre_friction.peak_force"]["unit"] == "N"
+    assert fitted.fitted["centre_friction.peak_force"]["value"] > 50.0
+    assert "centre_friction.peak_force" not in held.fitted and held.overrides["centre_friction.peak_force"] == 0.0
+    assert fitted.statistics["weighted_rms_Nm"] < 0.7 * held.statistics["weighted_rms_Nm"]
