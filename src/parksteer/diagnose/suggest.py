@@ -86,8 +86,8 @@ def effect_source(signature: Signature, fitted: dict[str, float] | None = None, 
     fitted_line = ""
     if fitted:
         fitted_line = ("\nFitted with the calibrated parameters on the records it was suggested for, the strengths "
-                       "take the weighted RMS error from {before:.2f} to {after:.2f} noise floors; those values "
-                       "(START) are the file's defaults and the start of the fit.\n")
+                       "take\nthe weighted RMS error from {before:.2f} to {after:.2f} noise floors; those values "
+                       "(START) are the\nfile's defaults and the start of the fit.\n")
     header = f'''"""Suggested by parksteer diagnose --suggest-effect from the residual's signature: {signature.sentence}.
 
 A {kind} effect (class {kind!r} of parksteer.diagnose.signature), its magnitude shaped by {len(keys)} strength(s)

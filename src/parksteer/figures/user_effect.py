@@ -69,7 +69,8 @@ def user_effect_figure(diagnosis, path: str | Path) -> None:
         pooled = []
         for p in present:
             rows = [r for r in found.phases if r["phase"] == p]
-            pooled.append(float(np.sqrt(sum(r["samples"] * r[key] ** 2 for r in rows) / sum(r["samples"] for r in rows))))
+            count = sum(r["samples"] for r in rows)
+            pooled.append(float(np.sqrt(sum(r["samples"] * r[key] ** 2 for r in rows) / count)))
         ax.bar(xp + (k - 0.5) * 0.4, pooled, 0.4, color=colour, label=label)
     ax.axhline(float(np.median([r["noise_floor_Nm"] for r in found.phases])), color="black", linestyle=":",
                linewidth=1.0, label="noise floor")
