@@ -219,8 +219,9 @@ def suggest(problem: Problem, calibration: Fit, signature: Signature, path: str 
         # the effect's strengths are free (calibration_parameters adds them, last), each stepped by about a floor
         parameters = [replace(p, step=step) if p.key in keys else p
                       for p in calibration_parameters(engine, problem, model, settings=settings)]
-        start = calibration.values
-        theta0 = np.array([p.theta(start[p.key]) if p.key in start else 0.0 for p in parameters])
+        # from the calibration as it stands (its own theta, not a value's round trip) and zero strengths
+        start = {q.key: t for q, t in zip(calibration.parameters, calibration.theta)}
+        theta0 = np.array([start.get(p.key, 0.0) for p in parameters])
         fit = least_squares(engine, problem, model, parameters, theta0, calibration.fixed, settings=settings)
         after = fit_statistics(problem, fit.predictions)
         rho = lag1_autocorrelation(problem, fit.weighted)
