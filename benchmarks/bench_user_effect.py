@@ -18,7 +18,8 @@ perturb them, the prescribed-rack solve), the truth sized to `steps` converter s
 the nulls are the same records with nothing hidden. Every diagnosis is the command line's, on the written file, in
 a process of its own, as a user runs it (`--torque-lag` where the logger delays its torque channel).
 
-Scored: the diagnosis of the record says `unexplained` and writes a suggestion; the suggestion passed back gives
+Scored: the signature's class is the form's (dissipative, direction, and column for the pinched bearing); the
+diagnosis of the record says `unexplained` and writes a suggestion; the suggestion passed back gives
 `adequate` (the bar: 5 of 6); no null gets a suggestion. Printed: one line a record, then the counts.
 """
 
@@ -100,6 +101,10 @@ class PinchedBearing(Effect):
 
 
 FORMS = (CentreFriction(), OneWayDragLeft(), PinchedBearing())
+# the signature class each form should be read as (parksteer.diagnose.signature): the pinched bearing is a friction
+# shaped by the column angle, which the column class names
+EXPECTED_CLASS = {"bench_centre_friction": "dissipative", "bench_one_way_drag": "direction",
+                  "bench_pinched_bearing": "column"}
 
 
 def make_record(params, form: Effect | None, steps: float, variation, seed: int):
@@ -188,6 +193,7 @@ def summary(rows: list[dict]) -> dict:
     return {
         "records": len(hidden), "nulls": len(nulls),
         "unexplained": sum(r["verdict"] == "unexplained" for r in hidden),
+        "class_right": sum(r["class"] == EXPECTED_CLASS[r["form"]] for r in hidden),
         "suggested": sum(r["suggested"] for r in hidden),
         "adequate_when_passed_back": sum(r["passed_back"] == "adequate" for r in hidden),
         "by_form": {f.name: {"adequate": sum(r["passed_back"] == "adequate" for r in hidden if r["form"] == f.name),
@@ -211,6 +217,7 @@ def main(argv=None) -> int:
     rows = run(args)
     s = summary(rows)
     print(f"\n{s['records']} records of 3 forms, {s['nulls']} nulls, {time.perf_counter() - start:.0f} s")
+    print(f"class read right {s['class_right']} of {s['records']} (bar 5; the pinched bearing as column)")
     print(f"unexplained {s['unexplained']} of {s['records']}, suggestion written {s['suggested']} of {s['records']}, "
           f"adequate when passed back as it stands {s['adequate_when_passed_back']} of {s['records']} (bar 5)")
     for form, t in s["by_form"].items():
