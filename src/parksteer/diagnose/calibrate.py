@@ -398,4 +398,16 @@ def calibrate(engine: ReplayEngine, problem: Problem, effects: list[Effect], fix
     theta0 = np.array([p.theta(start[p.key]) if p.key in start else
                        {"log": 0.0, "offset": p.reference}.get(p.transform, p.lower)
                        for p in parameters])
+    moving = [i for i, p in enumerate(parameters) if p.key in free and p.key not in start]
+    if moving and len(moving) < len(parameters):
+        # A user's effect starts from its strengths' values (a suggested file's: its own fit): the car's parameters
+        # are calibrated first with those held, then everything together from there. Fitted together from the
+        # parameter file's values at once, a form that overlaps a calibrated parameter (knots of rack friction
+        # summing to a uniform one) wanders along the valley where the two trade, to the same error but other values.
+        rest = [i for i in range(len(parameters)) if i not in moving]
+        held = {**(fixed or {}), **{parameters[i].key: parameters[i].value(theta0[i]) for i in moving}}
+        first = least_squares(engine, problem, effects, [parameters[i] for i in rest], theta0[rest], held,
+                              settings=settings)
+        theta0 = theta0.copy()
+        theta0[rest] = first.theta
     return least_squares(engine, problem, effects, parameters, theta0, fixed, settings=settings)
