@@ -12,6 +12,12 @@ be tried on a fresh clone before any pipeline has run.
   its column assist, kerb load on the ground, as its powertrain CAN sends it on the shipped ``vw_mqb`` bus
   (:func:`parksteer.measure.bus.encode_frames`: driver's torque at the torsion bar, steering-wheel angle, speed 0).
 
+- ``worn_rack.csv``: the paper's car with a rack friction peaked at the centre in a form no candidate of the
+  library has (``A / (1 + (x / 12 mm)^2) tanh(beta v)``, A = :data:`WORN_PEAK_N`: a bore worn tight straight ahead),
+  its base parameters moved off the file's as the benchmarks move them, driven by another hand and logged by a
+  50 Hz logger with its quantisation and noise (the variation benchmark's ``rate_8pc_50Hz``): the record of the
+  README's loop, where the diagnosis is ``unexplained`` until the user's effect is added.
+
 Made again, byte for byte, by ``python data/samples/make_samples.py`` (a script beside them, not part of the package:
 it drives the command line, which the package's synthetic layer may not import) (seeded; the BLF's header
 times are the frames' own; tests/test_docs.py checks the bytes).
@@ -125,9 +131,60 @@ def write_polo_bus(folder: Path) -> list[Path]:
             write_log(frames, folder / "polo_kerb.blf", "blf")]
 
 
+WORN_PEAK_N = 150.0
+WORN_VARIATION = "rate_8pc_50Hz"
+
+
+def _worn_centre():
+    """The truth of ``worn_rack.csv``: an effect of this script, which the package and its diagnosis never see."""
+    import sympy as sp
+
+    from parksteer.model.symbolic.components import Effect
+    from parksteer.model.symbolic.system import action_reaction
+    from parksteer.parameters import Quantity
+
+    class WornCentre(Effect):
+        name = "sample_worn_centre"
+        description = "Rack friction peaked at the centre, A / (1 + (x / 12 mm)^2) tanh(beta v)"
+        in_default_set = False
+        diagnosis_candidate = False
+        quantities = (Quantity("sample_worn_centre.strength", "N", 0.0, 1e4, lower_inclusive=True, default=0.0,
+                               source="data/samples/make_samples.py: the hidden truth of worn_rack.csv"),)
+        uses = ("sample_worn_centre.strength", "steering.friction_smoothing")
+
+        def loads(self, model):
+            k = model.kinematics
+            s = sp.tanh(model.p("steering.friction_smoothing") * model.rack_u)
+            force = model.p("sample_worn_centre.strength") / (1 + (model.rack_q / 0.012) ** 2) * s
+            return action_reaction(k.rack_point, -force * k.B.y, k.rack_housing_point)
+
+    return WornCentre()
+
+
+def write_worn_rack(folder: Path) -> list[Path]:
+    """A record with a centre friction no candidate has, another hand and a 50 Hz logger's noise."""
+    from parksteer.experiments.benchmark import BASE_PERTURBATION
+    from parksteer.measure.io import write_measurement
+    from parksteer.model.symbolic.components import resolve_effects
+    from parksteer.parameters import load_parameters
+    from parksteer.synthetic.datasets import perturbed_base
+    from parksteer.synthetic.variations import VARIATIONS, variation_record
+
+    params = load_parameters()
+    variation = next(v for v in VARIATIONS if v.name == WORN_VARIATION)
+    hand, logger = variation.settings(SEED + 2)
+    base = perturbed_base(params, SEED + 2, BASE_PERTURBATION)
+    truth = _worn_centre()
+    record = variation_record(params, hand, logger, overrides={**base, "sample_worn_centre.strength": WORN_PEAK_N},
+                              effects=[*resolve_effects(None), truth])
+    out = folder / "worn_rack.csv"
+    write_measurement(out, record, params)
+    return [out]
+
+
 def write_samples(folder: str | Path) -> list[Path]:
     folder = Path(folder)
-    return [*write_car(folder / "car"), *write_my_car(folder), *write_polo_bus(folder)]
+    return [*write_car(folder / "car"), *write_my_car(folder), *write_polo_bus(folder), *write_worn_rack(folder)]
 
 
 if __name__ == "__main__":

@@ -39,6 +39,10 @@ class Quantity:
     value of the active Table B1 case, or ``<effect>.<name>`` for a quantity only that effect has.
     ``default`` and ``source`` are given only by quantities declared in code (an effect's own, on the effect's
     class); every other quantity takes its value and source from the parameter file.
+
+    ``free`` marks an effect's own strength as one a diagnosis fits, within the bounds, together with the calibrated
+    parameters whenever the effect is in the model (``--effects=+FILE.py``), starting from its value (the default,
+    or ``--set``); a quantity not free keeps the value it is given.
     """
 
     key: str
@@ -52,6 +56,7 @@ class Quantity:
     why: str = ""  # the range of real cars behind the bounds, given with a refusal
     default: float | None = None
     source: str = ""
+    free: bool = False
 
     @property
     def section(self) -> str:
@@ -306,8 +311,13 @@ def declare(q: Quantity) -> Quantity:
     if q.default is None or not q.source.strip():
         raise UsageError(f"{q.key}: a quantity declared in code needs a default and a source")
     known = _DECLARED.get(q.key)
-    if known is not None and known != q:
-        raise UsageError(f"{q.key}: declared twice with different unit, bounds or default")
+    # the same effect's file loaded again in one process (a suggested effect written again with its fitted values as
+    # defaults) declares its quantities anew: the latest default, source and freedom win; another unit or bounds is a
+    # clash
+    if known is not None and (known.unit, known.lower, known.upper, known.lower_inclusive, known.upper_inclusive,
+                              known.is_list) != (q.unit, q.lower, q.upper, q.lower_inclusive, q.upper_inclusive,
+                                                 q.is_list):
+        raise UsageError(f"{q.key}: declared twice with different unit or bounds")
     q.check(q.default)
     _DECLARED[q.key] = q
     return q

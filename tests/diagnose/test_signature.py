@@ -152,8 +152,9 @@ def bump_record(tmp_path_factory):
 @pytest.mark.slow
 def test_the_suggested_effect_loads_is_the_base_model_at_zero_and_takes_the_error_to_the_floor(bump_record):
     """The bump is unexplained by the library; its signature is dissipative; the suggested effect file loads as
-    a user's would, replays exactly the base model with its strengths at 0 (the defaults), and fitted with the
-    calibrated parameters brings the weighted error from several floors to within 1.3."""
+    a user's would, replays exactly the base model with its strengths at 0 and, as it stands, the fitted effect (its
+    defaults are the fitted strengths), which fitted with the calibrated parameters brings the weighted error from
+    several floors to within 1.3."""
     folder, _, diagnosis, truth = bump_record
     assert diagnosis.verdict == "unexplained"
     cal = diagnosis.calibration
@@ -166,12 +167,15 @@ def test_the_suggested_effect_loads_is_the_base_model_at_zero_and_takes_the_erro
     effect = load_effect_module(str(out))
     f = diagnosis.problem.files[0]
     base = simulate(f.case, overrides=cal.overrides, rack_drive=f.rack, params=PARAMS, t_end_s=4.0)
-    added = simulate(f.case, effects=[*resolve_effects(None), effect], overrides=cal.overrides, rack_drive=f.rack,
-                     params=PARAMS, t_end_s=4.0)
-    assert np.array_equal(base.columns["handwheel_torque_Nm"], added.columns["handwheel_torque_Nm"])
+    zero = simulate(f.case, effects=[*resolve_effects(None), effect], rack_drive=f.rack, params=PARAMS,
+                    t_end_s=4.0, overrides={**cal.overrides, **{key: 0.0 for key in suggestion.strengths}})
+    assert np.array_equal(base.columns["handwheel_torque_Nm"], zero.columns["handwheel_torque_Nm"])
     fitted = simulate(f.case, effects=[*resolve_effects(None), effect], rack_drive=f.rack, params=PARAMS,
                       t_end_s=4.0, overrides={**cal.overrides, **suggestion.strengths})
     assert not np.array_equal(base.columns["handwheel_torque_Nm"], fitted.columns["handwheel_torque_Nm"])
+    as_written = simulate(f.case, effects=[*resolve_effects(None), effect], overrides=cal.overrides,
+                          rack_drive=f.rack, params=PARAMS, t_end_s=4.0)
+    assert np.array_equal(fitted.columns["handwheel_torque_Nm"], as_written.columns["handwheel_torque_Nm"])
     schema = json.loads(data_file("diagnosis.schema.json").read_text(encoding="utf-8"))
     result = json.loads(json.dumps(with_suggestion(diagnosis_dict(diagnosis), suggestion)))
     jsonschema.validate(result, schema)

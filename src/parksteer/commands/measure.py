@@ -146,24 +146,11 @@ def effects_of(args, params) -> list:
 
 
 def _by_reference(effects: list) -> list:
-    """`effects`, each one's class findable by its module's name. An effect loaded from a file (--effects=+path.py)
-    is of a module kept out of sys.modules (its name carries a hash of the file's text:
-    parksteer.model.symbolic.components.load_effect_module), and the diagnosis's worker pool pickles the effects it
-    sends to its forked workers, which looks a class up by that name: the class is registered under it here, before
-    any pool forks, so the workers inherit it."""
-    import types
+    """`effects`, each one's class findable by its module's name before any worker process forks
+    (:func:`parksteer.diagnose.parallel.by_reference`)."""
+    from ..diagnose.parallel import by_reference
 
-    for effect in effects:
-        cls = type(effect)
-        module = sys.modules.get(cls.__module__)
-        if "." in cls.__qualname__ or (module is not None and not getattr(module, "_parksteer_by_reference", False)):
-            continue
-        if module is None:  # the file loaded again in one process is a new class of the same name: the latest wins
-            module = types.ModuleType(cls.__module__)
-            module._parksteer_by_reference = True
-            sys.modules[cls.__module__] = module
-        setattr(module, cls.__qualname__, cls)
-    return effects
+    return by_reference(effects)
 
 
 def _warn_unused_assist(args, params, effects) -> None:
@@ -261,6 +248,10 @@ def _compare(args) -> int:
     if args.json:
         _print_json(summary)
     else:
+        for key, e in summary.get("fitted", {}).items():  # a user's free strengths, fitted with the calibration
+            ci = e["ci95"]
+            print(f"fitted {key} = {e['value']:.4g} {e['unit']}"
+                  + (f" (95 %: {ci[0]:.4g} to {ci[1]:.4g})" if ci else ""))
         for f in summary["files"]:
             print(f"{f['file']} ({f['case']}, {f['surface']}): RMS {f['overall']['rms']:.3f} N m, "
                   f"peak {f['overall']['peak']:.3f} N m, weighted RMS {f['weighted_rms_Nm']:.3f} N m, "
@@ -319,21 +310,32 @@ def _diagnose(args) -> int:
              + ", ".join(with_angle))
     diagnosis = diagnose(files, params, effects, workers=workers, quiet=args.quiet, settings=settings)
     result = _with_suggestion(args, diagnosis_dict(diagnosis), diagnosis, settings)
+    user_plot = None
     if args.plot:
         from ..figures.diagnose import diagnosis_figure
 
         diagnosis_figure(diagnosis, args.plot)
+        if "user_effect" in diagnosis.outputs:  # a user's effect in the model: its own figure beside
+            from ..figures.user_effect import user_effect_figure, user_effect_path
+
+            user_plot = user_effect_path(args.plot)
+            user_effect_figure(diagnosis, user_plot)
+            note(f"the figure of {', '.join(diagnosis.outputs['user_effect'].effects)}: {user_plot}")
     if args.report:
-        figure = None
-        if args.plot:
-            figure = str(Path(args.plot).resolve().relative_to(Path(args.report).resolve().parent)) \
-                if Path(args.plot).resolve().is_relative_to(Path(args.report).resolve().parent) else args.plot
-        write_markdown(args.report, markdown_report(result, figure))
+        figure = _linked(args.plot, args.report) if args.plot else None
+        write_markdown(args.report, markdown_report(result, figure,
+                                                    _linked(user_plot, args.report) if user_plot else None))
     if args.html:
         _write_html(args.html, diagnosis, result, files, params, workers)
     if args.json:
         _print_json(result)
     return 0
+
+
+def _linked(figure, report) -> str:
+    """`figure` as the markdown `report` links it: relative to the report's folder when it lies under it."""
+    resolved, folder = Path(figure).resolve(), Path(report).resolve().parent
+    return str(resolved.relative_to(folder)) if resolved.is_relative_to(folder) else str(figure)
 
 
 def _with_suggestion(args, result: dict, diagnosis, settings) -> dict:
@@ -374,7 +376,15 @@ def _write_html(path: str, diagnosis, result: dict, files, params, workers: int 
         "ladder": "The error ladder: the paper's model, calibrated, then with each effect the diagnoses name, down "
                   "to the noise floor.",
     }
+    if "user_effect" in diagnosis.outputs:
+        captions["user_effect"] = ("Your effect: the error ladder without it and with it, the record (first file) "
+                                   "with both models and their residuals over the phases of the cycle, the residual "
+                                   "by phase, and the error as its strengths grow from 0 to their fitted values.")
     with tempfile.TemporaryDirectory() as tmp:
+        if "user_effect" in diagnosis.outputs:
+            from ..figures.user_effect import user_effect_figure
+
+            user_effect_figure(diagnosis, Path(tmp) / "user_effect.svg")
         diagnosis_figure(diagnosis, Path(tmp) / "diagnosis.svg")
         phase_residual_figure(phases, Path(tmp) / "phases.svg")
         ladder_figure(ladder.rungs, ladder.noise_floor_Nm, ladder.attainable_floor_Nm, Path(tmp) / "ladder.svg")

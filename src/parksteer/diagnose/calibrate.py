@@ -33,13 +33,16 @@ from scipy.special import stdtrit  # the t quantile, without importing scipy.sta
 from .. import portable as pm
 from ..model.symbolic.components import Effect
 from ..model.symbolic.system import CORE_PARAMETERS
-from ..parameters import quantity
+from ..parameters import Quantity, quantity
 from .settings import DEFAULT_SETTINGS, DiagnosisSettings
 from .engine import ReplayEngine
 from .problem import Problem
 from .statistics import lag1_autocorrelation
 
 Z95 = 1.959964  # two-sided 95 % quantile of the standard normal
+# A free strength's finite-difference step (free_parameter): of its declared range, or of its value when open.
+FREE_STEP_OF_RANGE = 1e-3
+FREE_STEP_OF_VALUE = 1e-2
 
 
 @dataclass(frozen=True)
@@ -323,7 +326,29 @@ def calibration_parameters(engine: ReplayEngine, problem: Problem, effects: list
     out = [log_parameter(engine, problem, effects, key, settings) for key in logs]
     out += [offset_parameter(engine, problem, effects, key, half_range, step) for key, half_range, step in offsets]
     out += [linear_parameter(effects, key, step) for key, step in (strengths or {}).items()]
+    if keys is None:
+        out += [free_parameter(engine, problem, effects, q) for q in free_strengths(effects)
+                if q.key not in (strengths or {})]
     return out
+
+
+def free_strengths(effects: list[Effect]) -> list[Quantity]:
+    """The strengths the model's effects declare free (``Quantity.free``: a user's effect, fitted whenever it is in
+    the model), in the order of the effects and of their quantities."""
+    return [q for e in effects for q in e.quantities if q.free]
+
+
+def free_parameter(engine: ReplayEngine, problem: Problem, effects: list[Effect], spec: Quantity) -> FitParameter:
+    """A free strength fitted as it stands within its declared bounds, from the model's value (its default, or the
+    value given); its finite-difference step a thousandth of its range (a strength of a linear law: any step
+    within the range gives the same slope), or a hundredth of its value where the range is open."""
+    value = engine.replay(problem, effects, 0).value(spec.key)
+    span = spec.upper - spec.lower
+    step = span * FREE_STEP_OF_RANGE if math.isfinite(span) else max(abs(value), 1.0) * FREE_STEP_OF_VALUE
+    # an open bound is not a value the quantity may take: the fit stops just inside it
+    lower = spec.lower if spec.lower_inclusive else math.nextafter(spec.lower, math.inf)
+    upper = spec.upper if spec.upper_inclusive else math.nextafter(spec.upper, -math.inf)
+    return FitParameter(spec.key, "offset", value, lower, upper, step)
 
 
 def _used_keys(effects: list[Effect]) -> set[str]:
@@ -357,16 +382,32 @@ def calibrate(engine: ReplayEngine, problem: Problem, effects: list[Effect], fix
               keys: tuple[str, ...] | None = None, strengths: dict[str, float] | None = None,
               start: dict[str, float] | None = None, settings: DiagnosisSettings = DEFAULT_SETTINGS,
               announce=None) -> Fit:
-    """Fit the base model's uncertain parameters (and any `strengths`) to all files.
+    """Fit the base model's uncertain parameters (and any `strengths`, and the strengths its effects declare free:
+    :func:`free_strengths`) to all files.
 
     From the model's defaults, or from the values in `start` where it has them. `announce`, if given, is called
     with the keys of the calibrated parameters (the base model's, and with a fitted angle the column's).
     """
-    parameters = calibration_parameters(engine, problem, effects, keys, strengths, settings)
+    free = {q.key for q in free_strengths(effects)}
+    # a free strength given a value (`fixed`, e.g. compare's --set) keeps it
+    parameters = [p for p in calibration_parameters(engine, problem, effects, keys, strengths, settings)
+                  if not (p.key in free and p.key in (fixed or {}))]
     if announce is not None:
-        announce([p.key for p in parameters if p.key not in (strengths or {})])
+        announce([p.key for p in parameters if p.key not in (strengths or {}) and p.key not in free])
     start = start or {}
     theta0 = np.array([p.theta(start[p.key]) if p.key in start else
                        {"log": 0.0, "offset": p.reference}.get(p.transform, p.lower)
                        for p in parameters])
+    moving = [i for i, p in enumerate(parameters) if p.key in free and p.key not in start]
+    if moving and len(moving) < len(parameters):
+        # A user's effect starts from its strengths' values (a suggested file's: its own fit): the car's parameters
+        # are calibrated first with those held, then everything together from there. Fitted together from the
+        # parameter file's values at once, a form that overlaps a calibrated parameter (knots of rack friction
+        # summing to a uniform one) wanders along the valley where the two trade, to the same error but other values.
+        rest = [i for i in range(len(parameters)) if i not in moving]
+        held = {**(fixed or {}), **{parameters[i].key: parameters[i].value(theta0[i]) for i in moving}}
+        first = least_squares(engine, problem, effects, [parameters[i] for i in rest], theta0[rest], held,
+                              settings=settings)
+        theta0 = theta0.copy()
+        theta0[rest] = first.theta
     return least_squares(engine, problem, effects, parameters, theta0, fixed, settings=settings)

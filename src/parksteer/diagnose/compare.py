@@ -12,14 +12,15 @@ equals the noise floor for a perfect model.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from ..errors import UsageError
 from ..measure.metrics import Comparison, compare
 from ..model.symbolic.components import Effect, power_assist_of, resolve_effects
-from ..parameters import Parameters
+from ..parameters import Parameters, quantity
+from .calibrate import calibrate, free_strengths
 from .engine import ReplayEngine
 from .ensemble import with_replay_uncertainty
 from .problem import FileData, Problem
@@ -36,6 +37,7 @@ class CompareResult:
     predictions: list[np.ndarray]
     comparisons: list[Comparison]
     statistics: dict
+    fitted: dict = field(default_factory=dict)  # with a user's free strengths: each fitted value and its interval
 
     def as_dict(self) -> dict:
         files = []
@@ -64,12 +66,15 @@ class CompareResult:
                                       "peak": float(np.max(np.abs(residual))),
                                       "weighted_rms": float(np.sqrt(np.mean(weighted_motor**2))),
                                       "noise_floor": f.motor_noise.as_dict()}
-        return {
+        out = {
             "effects": [e.name for e in self.effects],
             "overrides": dict(sorted(self.overrides.items())),
             "files": files,
             "overall": self.statistics,
         }
+        if self.fitted:
+            out["fitted"] = self.fitted
+        return out
 
 
 def check_torque_sensors(files: list[FileData], assisted: bool) -> None:
@@ -85,7 +90,9 @@ def check_torque_sensors(files: list[FileData], assisted: bool) -> None:
 
 def compare_files(files: list[FileData], params: Parameters, effects=None,
                   overrides: dict[str, float] | None = None) -> CompareResult:
-    """Replay every file through the model of `effects` (a spec or list) with `overrides`."""
+    """Replay every file through the model of `effects` (a spec or list) with `overrides`; with a user's effect that
+    declares free strengths, those not in `overrides` fitted first with the calibrated parameters
+    (:func:`parksteer.diagnose.calibrate.calibrate`), the files then compared with the fitted model."""
     chosen = effects if isinstance(effects, list) and all(isinstance(e, Effect) for e in effects) \
         else resolve_effects(effects)
     overrides = dict(overrides or {})
@@ -97,10 +104,18 @@ def compare_files(files: list[FileData], params: Parameters, effects=None,
     engine = ReplayEngine()
     predictions = engine.predict(problem, chosen, overrides)
     problem = with_replay_uncertainty(engine, problem, chosen, overrides)
+    fitted = {}
+    if any(q.key not in overrides for q in free_strengths(chosen)):
+        # a user's effect declares free strengths: fitted with the calibrated parameters (those not --set), from
+        # their values, and the files compared with the fitted model
+        fit = calibrate(engine, problem, chosen, fixed=overrides)
+        predictions, overrides = fit.predictions, {**overrides, **fit.values}
+        fitted = {key: {**entry, "unit": quantity(key).unit} for key, entry in fit.intervals(problem).items()}
     files = list(problem.files)
     comparisons = [
         compare(f.time_s, f.torque_Nm, f.torque_part(m), phases=f.phases,
                 quantisation_step=f.measurement.quantisation_step("handwheel_torque_Nm"))
         for f, m in zip(files, predictions)
     ]
-    return CompareResult(chosen, overrides, files, predictions, comparisons, fit_statistics(problem, predictions))
+    return CompareResult(chosen, overrides, files, predictions, comparisons, fit_statistics(problem, predictions),
+                         fitted)

@@ -70,8 +70,9 @@ def _identification_lines(result: dict) -> list[str]:
     return lines
 
 
-def markdown_report(result: dict, figure: str | None = None) -> str:
-    """A readable report of the JSON of a diagnosis."""
+def markdown_report(result: dict, figure: str | None = None, user_figure: str | None = None) -> str:
+    """A readable report of the JSON of a diagnosis (`figure`: the diagnosis's figure to link; `user_figure`: that of
+    a user's effect in the model)."""
     lines = ["# Diagnosis: model against measurement", ""]
     verdict = result["verdict"]
     floor = result["noise_floor_Nm"]
@@ -106,6 +107,7 @@ def markdown_report(result: dict, figure: str | None = None) -> str:
               f"{num(result['attainable_floor_Nm'])} N m. The weighted RMS counts each sample by its attainable "
               "error, so it is the noise floor for a perfect model; the plain RMS also holds the few samples at "
               "reversals where the rack data cannot fix the instant the rack friction turns over.", ""]
+    lines += user_effect_markdown(result, user_figure)
     if result.get("angle"):
         angle = result["angle"]
         lines += ["## Handwheel angle", "", f"Fitted beside the torque in {', '.join(angle['files'])} (noise floor "
@@ -168,6 +170,70 @@ def markdown_report(result: dict, figure: str | None = None) -> str:
         lines += ["", f"![diagnosis]({figure})"]
     lines += ["", f"Cost: {result['cost']['replays']} replays."]
     return "\n".join(lines) + "\n"
+
+
+# --- a user's own effect (parksteer.diagnose.stages.user_effect): without it and with it
+
+
+def _user_effect_tables(result: dict) -> list[tuple[str, list[str], list[list]]]:
+    """(title, head, rows) of each table of the ``user_effect`` section: the ladder, the fitted strengths, the
+    residual by phase, the sweep."""
+    found = result["user_effect"]
+    ladder = ("The error ladder", ["model", "effects", "RMS (N m)", "weighted RMS (N m)", "weighted RMS / floor"],
+              [[r["label"], ", ".join(r["effects"]), num(r["rms_Nm"]), num(r["weighted_rms_Nm"]),
+                num(r["over_floor"])] for r in found["rungs"]])
+    strengths = ("Fitted strengths (with the calibrated parameters)",
+                 ["strength", "fitted", "95 % interval", "unit", "declared bounds"],
+                 [[key, num(e["value"], 4), _interval(e["ci95"]), e["unit"],
+                   _interval(e["bounds"]) if e.get("bounds") else "-"] for key, e in found["strengths"].items()])
+    phases = ("Residual by phase", ["file", "phase", "samples", "without it, RMS (N m)", "with it, RMS (N m)",
+                                    "noise floor (N m)"],
+              [[r["file"], r["phase"].replace("_", " "), r["samples"], num(r["without_rms_Nm"]),
+                num(r["with_rms_Nm"]), num(r["noise_floor_Nm"])] for r in found["phases"]])
+    sweep = found["sweep"]
+    one = sweep["keys"][0] if len(sweep["keys"]) == 1 else None
+    unit = found["strengths"][one]["unit"] if one else ""
+    grow = ("The error as the strengths grow to their fitted values, the other parameters held at the fit",
+            ["fraction of the fitted strength" + ("" if one else "s")] + ([f"{one} ({unit})"] if one else [])
+            + ["weighted RMS (N m)", "weighted RMS / floor"],
+            [[num(f, 2)] + ([num(sweep["values"][one][i], 4)] if one else [])
+             + [num(sweep["weighted_rms_Nm"][i]), num(sweep["over_floor"][i])]
+             for i, f in enumerate(sweep["fractions"])])
+    return [ladder, strengths, phases, grow]
+
+
+def _user_effect_sentence(result: dict) -> str:
+    found = result["user_effect"]
+    rungs = found["rungs"]
+    return (f"With {', '.join(found['effects'])} in the model, its free strengths fitted with the calibrated "
+            f"parameters, the weighted RMS error goes from {num(rungs[1]['over_floor'])} noise floors (calibrated "
+            f"without it) to {num(rungs[-1]['over_floor'])} (noise floor {num(found['noise_floor_Nm'])} N m); the "
+            f"verdict above is on the model with it.")
+
+
+def user_effect_markdown(result: dict, figure: str | None = None) -> list[str]:
+    """The markdown section of a user's effect (none when the diagnosis has no ``user_effect``)."""
+    if not result.get("user_effect"):
+        return []
+    lines = [f"## Your effect: {', '.join(result['user_effect']['effects'])}", "", _user_effect_sentence(result)]
+    for title, head, rows in _user_effect_tables(result):
+        lines += ["", f"### {title}", "", "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+        lines += ["| " + " | ".join(str(c) for c in row) + " |" for row in rows]
+    if figure:
+        lines += ["", f"![your effect: the ladder, the record, the residual by phase, the error falling]({figure})"]
+    return lines + [""]
+
+
+def user_effect_html(result: dict) -> list[str]:
+    """The HTML section of a user's effect (none when the diagnosis has no ``user_effect``)."""
+    if not result.get("user_effect"):
+        return []
+    out = [f"<h2>Your effect: {html.escape(', '.join(result['user_effect']['effects']))}</h2>",
+           f"<p>{html.escape(_user_effect_sentence(result))}</p>"]
+    for title, head, rows in _user_effect_tables(result):
+        out.append(f"<h3>{html.escape(title)}</h3>")
+        out += _table(head, rows)
+    return out
 
 
 # --- the residual's signature and the suggested effect (parksteer.diagnose.signature, parksteer.diagnose.suggest)
@@ -239,6 +305,7 @@ def html_report(result: dict, figures: list[tuple[str, str]], phases: list[dict]
                    f" calibrated model's angle residual RMS {html.escape(num(angle['rms_rad']))} rad "
                    f"({html.escape(num(angle['rms_deg']))} degrees), noise floor "
                    f"{html.escape(num(result['angle']['noise_floor_rad']))} rad.</p>")
+    out += user_effect_html(result)
     for k, (caption, svg) in enumerate(figures):
         out += ["<figure>", inline_svg(svg, f"f{k}-"), f"<figcaption>{html.escape(caption)}</figcaption>", "</figure>"]
     out.append("<h2>Residual by phase</h2>")

@@ -119,3 +119,26 @@ class Progress:
             note(line)  # the package's one progress channel (stderr, a rule's log)
         else:
             print(line, file=self.stream, flush=True)
+
+
+def by_reference(effects) -> list:
+    """`effects`, each one's class findable by its module's name. An effect loaded from a file (--effects=+path.py)
+    is of a module kept out of sys.modules (its name carries a hash of the file's text:
+    parksteer.model.symbolic.components.load_effect_module), and a diagnosis's worker pool pickles the effects it
+    sends to its forked workers, which looks a class up by that name: the class is registered under it here, before
+    any pool forks, so the workers inherit it."""
+    import sys
+    import types
+
+    effects = list(effects)
+    for effect in effects:
+        cls = type(effect)
+        module = sys.modules.get(cls.__module__)
+        if "." in cls.__qualname__ or (module is not None and not getattr(module, "_parksteer_by_reference", False)):
+            continue
+        if module is None:  # the file loaded again in one process is a new class of the same name: the latest wins
+            module = types.ModuleType(cls.__module__)
+            module._parksteer_by_reference = True
+            sys.modules[cls.__module__] = module
+        setattr(module, cls.__qualname__, cls)
+    return effects

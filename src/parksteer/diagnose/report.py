@@ -173,6 +173,8 @@ def diagnosis_dict(diagnosis: Diagnosis) -> dict:
         }
     if "signature" in diagnosis.outputs:  # the residual's signature (stages/signature.py)
         out["signature"] = diagnosis.outputs["signature"].as_dict()
+    if "user_effect" in diagnosis.outputs:  # a user's effect with free strengths (stages/user_effect.py)
+        out["user_effect"] = diagnosis.outputs["user_effect"].as_dict()
     return _json_safe(out)
 
 

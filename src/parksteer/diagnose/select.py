@@ -60,11 +60,12 @@ from ..model.symbolic.components import Effect, discover_effects, power_assist_o
 from ..parameters import Parameters
 from .candidates import candidate_effects, models_to_build, replay_models
 from .compare import check_torque_sensors
-from .parallel import Progress
+from .parallel import Progress, by_reference
 from .engine import ReplayEngine
 from .problem import FileData, Problem
 from .settings import DEFAULT_SETTINGS, DiagnosisSettings
 from .stages import STAGES, run_table
+from .stages.user_effect import with_user_effect_stage
 from .state import Diagnosis, DiagnosisState, frozen_mapping
 
 __all__ = ["Diagnosis", "diagnose"]
@@ -104,9 +105,13 @@ def diagnose(files: list[FileData], params: Parameters, effects=None, registry: 
     problem = Problem(copies, params, angle_offset_fitted=settings.angle_offset_fitted)
     progress = Progress(quiet)
     registry = registry if registry is not None else discover_effects()
+    # an effect loaded from a file (the model's, or a candidate named in the environment) replays in the workers
+    by_reference([*base, *registry.values()])
+    # with a user's effect that declares free strengths, the error without it and with it (stages/user_effect.py)
     state = DiagnosisState(settings, problem, tuple(base), frozen_mapping(registry),
                            None if strengths is None else frozen_mapping(strengths),
-                           None if start is None else frozen_mapping(start), progress, tuple(stages))
+                           None if start is None else frozen_mapping(start), progress,
+                           with_user_effect_stage(tuple(stages), base))
     testable, _ = candidate_effects(base, registry)
     # The models the candidates replay in are built in the background while the base model's stages run (the base
     # model itself is built, if missing, when first replayed).

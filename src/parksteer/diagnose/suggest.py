@@ -13,12 +13,12 @@ used), written as sympy expressions code generation takes (exp, tanh, sin, cos; 
 - speed: ``-tanh(beta v) sum_k a_k phi_k(|v| / v_90)``, ``|v|`` smoothed as ``v tanh(beta v)``;
 - column: a torque on the column ``sum_m a_m sin(m theta_c) + b_m cos(m theta_c)`` (its phase free).
 
-Every strength is 0 by default, so that the file loaded as it stands is the base model exactly; the fitted
-values are written beside them (``FITTED``, used as the defaults when the file's ``FITTED_AS_DEFAULTS`` is set
-to True, and a ``--set`` line for ``parksteer compare`` in the docstring). The strengths are signed
-(a force may be larger or smaller than the calibrated model's along the axis); each is fitted as it stands,
-together with the calibrated parameters, by the diagnosis's Levenberg-Marquardt
-(:func:`parksteer.diagnose.calibrate.least_squares`), from the calibrated values and zero strengths.
+The strengths are declared free (``Quantity.free``) within wide bounds: passed back with ``--effects=+FILE.py``,
+the diagnosis (and ``parksteer compare``) fits them together with the calibrated parameters. They are signed (a
+force may be larger or smaller than the calibrated model's along the axis) and fitted first here, by the
+diagnosis's Levenberg-Marquardt (:func:`parksteer.diagnose.calibrate.least_squares`), from the calibrated values and
+zero strengths; the file is then written again with the fitted values as its defaults (``START``), so that the fit
+of the file passed back starts where this one ended and a replay of it as it stands is the fitted effect.
 :func:`suggest` returns the error before and after in noise floors and the BIC gain over the calibrated model.
 """
 
@@ -26,14 +26,14 @@ from __future__ import annotations
 
 import math
 import tempfile
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
 
 from ..errors import UsageError
 from ..model.symbolic.components import load_effect_module
-from .calibrate import Fit, FitParameter, calibration_parameters, least_squares
+from .calibrate import Fit, calibration_parameters, least_squares
 from .engine import ReplayEngine
 from .problem import Problem
 from .statistics import bic_gain, effective_samples, fit_statistics, lag1_autocorrelation
@@ -85,16 +85,16 @@ def effect_source(signature: Signature, fitted: dict[str, float] | None = None, 
         unit, bound = "N", FORCE_BOUND_N
     fitted_line = ""
     if fitted:
-        fitted_line = ("\nFitted with the calibrated parameters to the records it was suggested for (weighted RMS "
-                       "{before:.2f} -> {after:.2f} noise floors)::\n\n    parksteer compare RUN.csv "
-                       "--effects=+THIS_FILE.py "
-                       + " ".join(f"--set {k}={v:.6g}" for k, v in fitted.items() if k in keys) + "\n")
+        fitted_line = ("\nFitted with the calibrated parameters on the records it was suggested for, the strengths "
+                       "take\nthe weighted RMS error from {before:.2f} to {after:.2f} noise floors; those values "
+                       "(START) are the\nfile's defaults and the start of the fit.\n")
     header = f'''"""Suggested by parksteer diagnose --suggest-effect from the residual's signature: {signature.sentence}.
 
 A {kind} effect (class {kind!r} of parksteer.diagnose.signature), its magnitude shaped by {len(keys)} strength(s)
-along the axis the signature found. Every strength is 0 by default: loaded as it stands, this file is the base
-model exactly. Set FITTED_AS_DEFAULTS below to True and it is the fitted model (FITTED); or replay it with
-``parksteer compare RUN.csv`` and the ``--set`` line below. Edit the form as the physics you know suggests.
+along the axis the signature found. The strengths are free (``free=True``, within +-{bound:g} {unit}): passed back as
+it stands, ``parksteer diagnose RUN.csv --effects=+THIS_FILE.py`` fits them together with the calibrated parameters
+and gives its verdict on the model with this effect (``parksteer compare`` fits them too). Edit the form as the
+physics you know suggests.
 {{fitted}}"""
 
 from __future__ import annotations
@@ -107,9 +107,9 @@ from parksteer.parameters import Quantity
 
 NAME = {name!r}
 STRENGTHS = {tuple(keys)!r}
-# Fitted with the calibrated parameters to the records it was suggested for; the defaults when True.
-FITTED = {{fitted_values}}
-FITTED_AS_DEFAULTS = False
+# The strengths fitted with the calibrated parameters on the records the file was suggested for: the defaults, and
+# the start of the fit when the file is passed back.
+START = {{fitted_values}}
 '''
     if kind == "column":
         body = f'''ORDERS = {tuple(best.orders)!r}  # per column turn
@@ -122,7 +122,7 @@ class Suggested(Effect):
     in_default_set = False
     diagnosis_candidate = False
     quantities = tuple(Quantity(key, "N m", -{bound!r}, {bound!r}, lower_inclusive=True,
-                                default=FITTED.get(key, 0.0) if FITTED_AS_DEFAULTS else 0.0,
+                                default=START.get(key, 0.0), free=True,
                                 source="suggested from the residual's signature; 0 = absent") for key in STRENGTHS)
     uses = STRENGTHS
 
@@ -162,7 +162,7 @@ class Suggested(Effect):
     in_default_set = False
     diagnosis_candidate = False
     quantities = tuple(Quantity(key, "N", -{bound!r}, {bound!r}, lower_inclusive=True,
-                                default=FITTED.get(key, 0.0) if FITTED_AS_DEFAULTS else 0.0,
+                                default=START.get(key, 0.0), free=True,
                                 source="suggested from the residual's signature; 0 = absent") for key in STRENGTHS)
     uses = STRENGTHS + ("steering.friction_smoothing",)
 
@@ -192,7 +192,7 @@ def strength_keys(source: str) -> tuple[str, ...]:
 def suggest(problem: Problem, calibration: Fit, signature: Signature, path: str | Path | None = None,
             settings: DiagnosisSettings = DEFAULT_SETTINGS) -> Suggestion:
     """Write the effect `signature` points to, fit its strengths with the calibrated parameters on `problem`, and
-    write it again with the fitted values beside the zero defaults (to `path`, or a temporary file). Its replays
+    write it again with the fitted values as its defaults (to `path`, or a temporary file). Its replays
     run on a replay engine of its own, in line."""
     speed_90 = signature.numbers.get("speed_90_m_s")
     if signature.effect_class == "speed" and speed_90 is None:
@@ -214,12 +214,14 @@ def suggest(problem: Problem, calibration: Fit, signature: Signature, path: str 
         floor = before["noise_floor_Nm"]
         ratio = problem.params.sections["steering"]["handwheel_to_rack_ratio"]
         column = signature.effect_class == "column"
-        bound = TORQUE_BOUND_NM if column else FORCE_BOUND_N
         step = floor if column else floor * ratio  # a strength moving the torque by about a noise floor
         engine = ReplayEngine()
-        parameters = calibration_parameters(engine, problem, model, settings=settings)
-        parameters += [FitParameter(key, "linear", 1.0, -bound, bound, step) for key in keys]
-        theta0 = np.concatenate([calibration.theta, np.zeros(len(keys))])
+        # the effect's strengths are free (calibration_parameters adds them, last), each stepped by about a floor
+        parameters = [replace(p, step=step) if p.key in keys else p
+                      for p in calibration_parameters(engine, problem, model, settings=settings)]
+        # from the calibration as it stands (its own theta, not a value's round trip) and zero strengths
+        start = {q.key: t for q, t in zip(calibration.parameters, calibration.theta)}
+        theta0 = np.array([start.get(p.key, 0.0) for p in parameters])
         fit = least_squares(engine, problem, model, parameters, theta0, calibration.fixed, settings=settings)
         after = fit_statistics(problem, fit.predictions)
         rho = lag1_autocorrelation(problem, fit.weighted)

@@ -1,10 +1,11 @@
-"""The base model's uncertain parameters calibrated to all files (:mod:`parksteer.diagnose.calibrate`)."""
+"""The base model's uncertain parameters calibrated to all files (:mod:`parksteer.diagnose.calibrate`), with the
+strengths a user's effect in the model declares free."""
 
 from __future__ import annotations
 
 from dataclasses import replace
 
-from ..calibrate import Fit, calibrate
+from ..calibrate import Fit, calibrate, free_strengths
 from ..problem import Problem
 from ..engine import ReplayEngine
 from ..state import DiagnosisState
@@ -23,6 +24,9 @@ class Calibrate(Stage):
     name = "calibration"
 
     def run(self, state: DiagnosisState, engine: ReplayEngine) -> DiagnosisState:
+        free = free_strengths(list(state.base))
+        also = (f", with the {len(free)} free strength(s) of " + ", ".join(sorted({q.section for q in free}))
+                if free else "")
         fit = calibrated(state, engine, state.problem,
-                         announce=lambda keys: state.progress("calibrating " + ", ".join(keys)))
+                         announce=lambda keys: state.progress("calibrating " + ", ".join(keys) + also))
         return replace(state, calibration=fit)
