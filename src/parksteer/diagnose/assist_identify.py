@@ -11,7 +11,7 @@ Two steps, each a least-squares fit with its 95 % intervals:
    takes, so the samples (S, i) lie on one curve, i = K(S - c): a boost table in ampere
    (:mod:`parksteer.boost_table`'s law: monotone cubic Hermite, odd, exactly zero in its dead band |T| <= D), with
    c the map's zero in the logged torque (0 when the log and the control unit read one sensor). Its points are the
-   origin, the dead band D and :data:`SPAN_POINTS` points evenly spaced from D to the 98th percentile of |S|; the
+   origin, the dead band D and :data:`SPAN_POINTS` points evenly spaced from D to the largest |S|; the
    fitted values are D, c and the rises between points (positive, so the table is a boost curve). What the map
    cannot hold is reported: the residual's RMS against what the two channels' noise floors allow (scatter), and
    the mean residual on loading (|S| rising) less that on unloading at equal torque (hysteresis: a current that
@@ -178,8 +178,8 @@ def _map_law(torques: list[float], values: list[float]):
     return law
 
 
-def _knots(dead_band: float, top: float) -> list[float]:
-    return [0.0, dead_band] + [dead_band + (top - dead_band) * j / SPAN_POINTS for j in range(1, SPAN_POINTS + 1)]
+def _knots(dead_band: float, top: float, span: int = SPAN_POINTS) -> list[float]:
+    return [0.0, dead_band] + [dead_band + (top - dead_band) * j / span for j in range(1, span + 1)]
 
 
 def _blocks(time_s: np.ndarray, block_s: float) -> np.ndarray:
@@ -210,6 +210,8 @@ class _Map:
     centre: float
     covariance: np.ndarray
     jacobian_values: np.ndarray  # d(current at the points) / d(parameters)
+    representation: np.ndarray  # A: the table's own error at each point (a standard error)
+    torque_step: float  # N m: the logged torque's rounding
     rms: float
     noise: float
     hysteresis: float
@@ -220,52 +222,66 @@ class _Map:
         return _map_law(self.torques, self.current)
 
 
-def fit_map(files: list[FileData]) -> _Map:
-    """Step 1 of the module docstring: the current's map of the logged torsion-bar torque."""
+def _currents(x) -> list[float]:
+    return [0.0, 0.0, *(float(c) for c in np.cumsum(np.exp(x[2:])))]
+
+
+def _fit_table(S: np.ndarray, i: np.ndarray, top: float, d0: float, span: int):
+    """The least-squares table of `span` points beyond the dead band: parameters (D, c, log rises), residuals and
+    their Jacobian."""
     from scipy.optimize import least_squares
 
+    magnitude = np.abs(S)
+    active = magnitude > d0
+    start = []
+    previous = 0.0
+    for k in _knots(d0, top, span)[2:]:
+        near = active & (np.abs(magnitude - k) <= (top - d0) / span)
+        level = float(np.median(np.abs(i[near]))) if near.any() else previous + 1.0
+        start.append(math.log(max(level - previous, 0.05)))
+        previous = max(level, previous + 0.05)
+    x0 = np.array([d0, 0.0, *start])
+
+    def residual(x):
+        return _map_law(_knots(x[0], top, span), _currents(x))(S - x[1]) - i
+
+    lower = np.r_[0.01, -0.5, np.full(span, -12.0)]
+    upper = np.r_[0.9 * top, 0.5, np.full(span, 8.0)]
+    fit = least_squares(residual, np.clip(x0, lower + 1e-9, upper - 1e-9), bounds=(lower, upper), x_scale="jac")
+    return fit.x, fit.fun, fit.jac
+
+
+def fit_map(files: list[FileData]) -> _Map:
+    """Step 1 of the module docstring: the current's map of the logged torsion-bar torque."""
     from ..model.numeric.assisted import rack_speed_mps
 
     S = np.concatenate([f.torque_Nm for f in files])
     i = np.concatenate([f.motor for f in files])
     times = np.concatenate([f.time_s + 1e6 * k for k, f in enumerate(files)])
     magnitude = np.abs(S)
-    top = float(np.quantile(magnitude, 0.98))
+    top = float(np.max(magnitude))  # the last point at the largest torque: no sample on the straight continuation
     step_i = max(max(f.measurement.quantisation_step(f.motor_column) for f in files), 1e-6)
     quiet = magnitude[np.abs(i) <= 2.0 * step_i + 0.02 * np.max(np.abs(i))]
     d0 = float(np.clip(np.quantile(quiet, 0.9) if quiet.size else 0.1 * top, 0.02, 0.6 * top))
-    knots0 = _knots(d0, top)
-    active = magnitude > d0
-    start = []
-    previous = 0.0
-    for k in knots0[2:]:
-        near = active & (np.abs(magnitude - k) <= (top - d0) / SPAN_POINTS)
-        level = float(np.median(np.abs(i[near]))) if near.any() else previous + 1.0
-        start.append(math.log(max(level - previous, 0.05)))
-        previous = max(level, previous + 0.05)
-    x0 = np.array([d0, 0.0, *start])
-
-    def currents(x):
-        return list(np.concatenate([[0.0, 0.0], np.cumsum(np.exp(x[2:]))]))
-
-    def model(x):
-        return _map_law(_knots(x[0], top), currents(x))(S - x[1])
-
-    def residual(x):
-        return model(x) - i
-
-    lower = np.r_[0.01, -0.5, np.full(SPAN_POINTS, -12.0)]
-    upper = np.r_[0.9 * top, 0.5, np.full(SPAN_POINTS, 8.0)]
-    fit = least_squares(residual, np.clip(x0, lower + 1e-9, upper - 1e-9), bounds=(lower, upper), x_scale="jac")
-    x = fit.x
-    r = fit.fun
-    covariance = _sandwich(fit.jac, r, _blocks(times, BLOCK_S))
+    x, r, jacobian = _fit_table(S, i, top, d0, SPAN_POINTS)
+    covariance = _sandwich(jacobian, r, _blocks(times, BLOCK_S))
     # the points' currents against the parameters (exp of the rises, summed)
     rises = np.exp(x[2:])
     jac_values = np.zeros((SPAN_POINTS + 2, len(x)))
     for k in range(2, SPAN_POINTS + 2):
         jac_values[k, 2:k + 1] = rises[: k - 1]
-    torques, current = _knots(x[0], top), currents(x)
+    # what a table of these points cannot follow: the change at the points from a table of two points fewer (the
+    # cubic's error falls as the spacing's fourth power, so the finer table's is less than half of it), taken
+    # as a standard error of its own beside the noise's
+    coarse, _, _ = _fit_table(S, i, top, d0, SPAN_POINTS - 2)
+    coarse_law = _map_law(_knots(coarse[0], top, SPAN_POINTS - 2), _currents(coarse))
+    points = np.array(_knots(x[0], top))
+    representation = np.abs(coarse_law(points) - np.array(_currents(x))) / 2.0
+    # ... and the current's rounding: the control unit gives one current at one reading of the sensor, so repeated
+    # samples at a torque level carry the same rounding error and do not average it away
+    representation = np.hypot(representation, step_i / math.sqrt(12.0))
+    representation[:2] = 0.0
+    torques, current = _knots(x[0], top), _currents(x)
     # what the two channels' rounding allows: the current's step, and the torque's through the map's slope (the
     # control unit reads the sensor the log reads, so the sensor's own noise moves both together and is no scatter)
     law = _map_law(torques, current)
@@ -293,8 +309,8 @@ def fit_map(files: list[FileData]) -> _Map:
         hysteresis_Nm = hysteresis / float(np.median(slope[use])) if np.median(slope[use]) > 0 else math.nan
     else:
         hysteresis, hysteresis_se, hysteresis_Nm = 0.0, math.inf, math.nan
-    return _Map(torques, current, float(x[1]), covariance, jac_values, rms, expected, hysteresis, hysteresis_se,
-                hysteresis_Nm)
+    return _Map(torques, current, float(x[1]), covariance, jac_values, representation, step_s, rms, expected, hysteresis,
+                hysteresis_se, hysteresis_Nm)
 
 
 def _assist_name(effects) -> str:
@@ -408,7 +424,8 @@ def identify_boost(records, vehicle, case: str | None = None, surface: str | Non
 
     # the table at the point of action: P K, its interval from the map's and the product's
     P = p * product_file
-    point_cov = fitted.jacobian_values @ fitted.covariance @ fitted.jacobian_values.T
+    point_cov = fitted.jacobian_values @ fitted.covariance @ fitted.jacobian_values.T \
+        + np.diag(fitted.representation ** 2)
     current = np.array(fitted.current)
     assist = P * current
     rel_p = se_p / p if p > 0 else math.inf
@@ -431,8 +448,11 @@ def identify_boost(records, vehicle, case: str | None = None, surface: str | Non
         current_A=tuple(float(c) for c in current),
         current_ci95=tuple((float(c - Z95 * s), float(c + Z95 * s)) for c, s in
                            zip(current, np.sqrt(np.maximum(np.diag(point_cov), 0.0)))),
-        dead_band=_estimate(fitted.torques[1], math.sqrt(max(fitted.covariance[0, 0], 0.0)), "N m"),
-        map_centre=_estimate(fitted.centre, math.sqrt(max(fitted.covariance[1, 1], 0.0)), "N m"),
+        # the log and the control unit read the torque in steps: the map between two of them is never seen
+        dead_band=_estimate(fitted.torques[1], math.hypot(math.sqrt(max(fitted.covariance[0, 0], 0.0)),
+                                                          fitted.torque_step / math.sqrt(12.0)), "N m"),
+        map_centre=_estimate(fitted.centre, math.hypot(math.sqrt(max(fitted.covariance[1, 1], 0.0)),
+                                                       fitted.torque_step / math.sqrt(12.0)), "N m"),
         product=_estimate(P, se_p * product_file, "N/A" if location == "rack" else "N m/A"),
         motor_friction=mech["motor_friction_torque"], offset=_estimate(offset, se_o, "N m"),
         rack_friction=mech["steering.rack_friction_force"], tyre_friction=float(params[TYRE_FRICTION[0]]),
@@ -507,7 +527,7 @@ def replace_assist_section(text: str, found: Identified) -> str:
     assists = ", ".join(_number(max(a, 0.0)) for a in _strictly_rising(found.assist))
     intervals = "; ".join(f"{lo:.3g}-{hi:.3g}" for lo, hi in found.assist_ci95[2:])
     lines += ["", "[assist.boost]",
-              f"torsion_bar_torque = {{ value = [{torques}], unit = \"N m\", source = {_toml_string(where + ': the dead band ' + found.dead_band.text() + ', then evenly spaced to the 98th percentile of the records')} }}",
+              f"torsion_bar_torque = {{ value = [{torques}], unit = \"N m\", source = {_toml_string(where + ': the dead band ' + found.dead_band.text() + ', then evenly spaced to the largest of the records')} }}",
               f"assist = {{ value = [{assists}], unit = \"{unit}\", source = {_toml_string(where + ': the current map times the product k_t eta N; 95 % beyond the dead band ' + intervals)} }}",
               ""]
     return "\n".join(kept + lines)
