@@ -32,7 +32,11 @@ Two steps, each a least-squares fit with its 95 % intervals:
    them.
 
 Intervals are the least squares' with the residuals' correlation in time left in (a sandwich over blocks of
-:data:`BLOCK_S`): a record of a few cycles fixes less than its sample count says. The identified table is the map
+:data:`BLOCK_S`, with Student's t for its blocks): a record of a few cycles fixes less than its sample count says.
+The map's points carry two errors the samples do not average: the table's own (the change from a table of two
+points fewer, halved) and the current's rounding (one current per reading of the sensor); the dead band and the
+map's centre the torque's rounding (the map between two readings is never seen); the product the map's error,
+relative, since it is read through the map. The identified table is the map
 times the identified product, P K(S - c), at the point of action; the written file carries it in ``[assist.boost]``
 and the product as the torque constant k_t = P / (eta_f N) (only the product is fixed: eta_f and N stay the file's),
 and the motor friction; each entry's ``source`` names the records. The sensor offset and the map's centre have no
@@ -90,8 +94,15 @@ class Estimate:
                 f"{self.ci95[1]:.{digits}g})")
 
 
-def _estimate(value: float, se: float, unit: str) -> Estimate:
-    return Estimate(float(value), (float(value - Z95 * se), float(value + Z95 * se)), unit)
+def _estimate(value: float, se: float, unit: str, z: float = Z95) -> Estimate:
+    return Estimate(float(value), (float(value - z * se), float(value + z * se)), unit)
+
+
+def _t95(dof: int) -> float:
+    """The two-sided 95 % quantile of Student's t: a sandwich over few blocks estimates its variance from few."""
+    from scipy.stats import t
+
+    return float(t.ppf(0.975, max(dof, 1)))
 
 
 @dataclass(frozen=True)
@@ -419,6 +430,7 @@ def identify_boost(records, vehicle, case: str | None = None, surface: str | Non
     offset, p = float(solution[len(keys)]), float(solution[len(keys) + 1])
     se_o, se_p = float(se[len(keys)]), float(se[len(keys) + 1])
     product_per_tyre = (float(moved[len(keys) + 1]) - p) * product_file / tyre_step
+    z = _t95(len(np.unique(_blocks(t_all[use], BLOCK_S))) - design.shape[1])
     balance_rms = float(np.sqrt(np.mean((resid * sigma[use]) ** 2)))
     torque_noise = float(np.sqrt(np.mean(sigma ** 2)))
 
@@ -428,6 +440,10 @@ def identify_boost(records, vehicle, case: str | None = None, surface: str | Non
         + np.diag(fitted.representation ** 2)
     current = np.array(fitted.current)
     assist = P * current
+    # the product is read through the map: the map's own error at its points (not averaged by more samples) is a
+    # relative error of the product, weighted as the balance weighs the assist (by its size)
+    map_relative = float(np.sqrt(np.sum(fitted.representation ** 2) / np.sum(current ** 2)))
+    se_p = math.hypot(se_p, p * map_relative)
     rel_p = se_p / p if p > 0 else math.inf
     se_assist = np.sqrt((P ** 2) * np.maximum(np.diag(point_cov), 0.0) + (assist * rel_p) ** 2)
     step_i = max(f.measurement.quantisation_step(f.motor_column) for f in files)
@@ -440,7 +456,8 @@ def identify_boost(records, vehicle, case: str | None = None, surface: str | Non
         beyond.append(f"scatter: the current departs from the map by {fitted.rms:.3f} A RMS against {fitted.noise:.3f} "
                       "A of the channels' noise")
     names = [str(Path(r).name) for r in records]
-    mech = {k: _estimate(val, s, u) for (k, _), val, s, u in zip(MECHANICS, values, se[: len(keys)], ("N m", "N"))}
+    mech = {k: _estimate(val, s, u, z) for (k, _), val, s, u in zip(MECHANICS, values, se[: len(keys)],
+                                                                   ("N m", "N"))}
     return Identified(
         vehicle=str(vehicle_path), records=tuple(names), assist_name=name,
         torques=tuple(float(t) for t in fitted.torques), assist=tuple(float(a) for a in assist),
@@ -453,8 +470,8 @@ def identify_boost(records, vehicle, case: str | None = None, surface: str | Non
                                                           fitted.torque_step / math.sqrt(12.0)), "N m"),
         map_centre=_estimate(fitted.centre, math.hypot(math.sqrt(max(fitted.covariance[1, 1], 0.0)),
                                                        fitted.torque_step / math.sqrt(12.0)), "N m"),
-        product=_estimate(P, se_p * product_file, "N/A" if location == "rack" else "N m/A"),
-        motor_friction=mech["motor_friction_torque"], offset=_estimate(offset, se_o, "N m"),
+        product=_estimate(P, se_p * product_file, "N/A" if location == "rack" else "N m/A", z),
+        motor_friction=mech["motor_friction_torque"], offset=_estimate(offset, se_o, "N m", z),
         rack_friction=mech["steering.rack_friction_force"], tyre_friction=float(params[TYRE_FRICTION[0]]),
         product_per_tyre_friction=product_per_tyre,
         map_rms_A=fitted.rms, map_noise_A=fitted.noise,
