@@ -31,9 +31,9 @@ class Truth:
     exponent: float = 1.6
     torque_constant: float = 0.055  # N m/A (the file says 0.05)
     efficiency: float = 0.85
-    back_efficiency: float = 0.80
+    back_efficiency: float = 0.76  # the file says 0.80
     reduction: float = 18.0
-    rotor_inertia: float = 2e-4  # kg m^2
+    rotor_inertia: float = 3e-4  # kg m^2 (the file says 2e-4)
     motor_friction: float = 0.03  # N m at the motor
     offset: float = 0.04  # N m, the sensor's zero
     sensor_noise: float = 0.002  # N m RMS before the reading

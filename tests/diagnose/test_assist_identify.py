@@ -5,7 +5,7 @@ test (eps_truth.py: the torsion bar and a worm-gear motor sharing the column tor
 car's replay, a progressive map of its own form, the motor's Coulomb friction and rotor through the worm, the
 control unit reading a sensor rounded to 0.01 N m with a zero offset, the current logged in 0.1 A steps), on the
 Polo's vehicle file, whose gear data differ from the truth's (torque constant 0.05 against 0.055 N m/A, motor
-friction 0.02 against 0.03 N m). Each test names the physical fact the identification must recover.
+friction 0.02 against 0.03 N m, rotor inertia 2e-4 against 3e-4 kg m^2, back-driven efficiency 0.80 against 0.76). Each test names the physical fact the identification must recover.
 """
 
 from __future__ import annotations
@@ -51,7 +51,8 @@ def test_map_within_its_intervals(baseline):
 def test_gear_numbers_recovered(baseline):
     """The column balance fixes what the file had wrong: the product k_t eta N (the truth's 0.055 x 0.85 x 18 =
     0.8415 N m/A, the file's 0.765) within 0.5 %, the motor's Coulomb friction (0.03 N m, the file's 0.02) and the
-    sensor's zero offset (0.04 N m) within their intervals, and the rack friction the truth's car has (730 N); the
+    sensor's zero offset (0.04 N m), the rotor's inertia (3e-4 kg m^2, the file's 2e-4) and the back-driven
+    efficiency (0.76, the file's 0.80) within their intervals, and the rack friction the truth's car has (730 N); the
     identified assist at each point is the truth's delivered torque k_t eta N i within its interval and 1 % (or two
     steps of the torque, 0.02 N m, near the dead band)."""
     truth, _, found = baseline
@@ -61,6 +62,10 @@ def test_gear_numbers_recovered(baseline):
     assert found.offset.ci95[0] <= truth.offset <= found.offset.ci95[1]
     assert found.offset.ci95[1] - found.offset.ci95[0] < 0.03
     assert found.rack_friction.ci95[0] <= 730.0 <= found.rack_friction.ci95[1]
+    assert found.motor_inertia.ci95[0] <= truth.rotor_inertia <= found.motor_inertia.ci95[1]
+    assert found.motor_inertia.ci95[1] < 3.5e-4 and found.motor_inertia.ci95[0] > 2.5e-4
+    assert found.back_efficiency.ci95[0] <= truth.back_efficiency <= found.back_efficiency.ci95[1]
+    assert found.back_efficiency.ci95[1] < 0.8
     delivered = truth.product * truth.current(np.array(found.torques))
     for d, a, (lo, hi) in zip(delivered[2:], found.assist[2:], found.assist_ci95[2:]):
         assert lo <= d <= hi and a == pytest.approx(d, rel=0.01, abs=0.02)

@@ -27,9 +27,12 @@ Two steps, each a least-squares fit with its 95 % intervals:
    in the direction the power flows), p the factor on the product k_t eta_f N that the data fix, and y the column
    torque the car without boost needs on this rack (the assisted model replayed with its boost off: the rotor's
    inertia in it), which depends on the calibrated parameters theta (:data:`MECHANICS`: the motor's Coulomb
-   friction, the rack friction, the tyre-ground friction, the carcass stiffness). y is linear in the frictions and
-   smooth in the rest, so the fit is Gauss-Newton on finite-difference sensitivities, o and p in closed form with
-   them.
+   friction and rotor inertia, the rack friction), all linearly, so the fit is one linear least-squares step on
+   finite-difference sensitivities, o and p with them. Where enough samples are back-driven
+   (:data:`BACK_DRIVEN_SHARE`), D is split into the samples the motor drives and those it is driven back, with
+   factors p and p eta_b,file / eta_b: the back-driven efficiency is fitted too. The tyre-ground friction is not
+   fitted: it scales the road torque as p scales the assist, and S, their small difference, cannot tell them
+   apart; the product's change per step of it is reported.
 
 Intervals are the least squares' with the residuals' correlation in time left in (a sandwich over blocks of
 :data:`BLOCK_S`, with Student's t for its blocks): a record of a few cycles fixes less than its sample count says.
@@ -66,8 +69,12 @@ Z95 = 1.959963984540054
 # torque is linear in both frictions, so one linear least-squares step is exact.
 MECHANICS = (
     ("motor_friction_torque", 0.01),  # of the assist's section
+    ("motor_inertia", 1.0e-4),  # of the assist's section: its torque N^2 J theta'' is linear in J
     ("steering.rack_friction_force", 50.0),
 )
+# The back-driven efficiency is fitted when at least this share of the samples read while the gear moves is
+# back-driven (the rack returning the motor after a reversal); else the file's stays.
+BACK_DRIVEN_SHARE = 0.03
 # Not calibrated: the tyre-ground friction scales the road torque as the product scales the assist (the column
 # balance cannot tell them apart: S is the small difference of the two), so the product is identified at the file's
 # value, and its dependence on it reported (the product's change for this change of the friction).
@@ -124,6 +131,8 @@ class Identified:
     map_centre: Estimate
     product: Estimate  # k_t eta_f N, N m (or N) at the point of action per A
     motor_friction: Estimate
+    motor_inertia: Estimate
+    back_efficiency: Estimate | None  # None: too few back-driven samples, the file's kept
     offset: Estimate
     rack_friction: Estimate
     tyre_friction: float  # the file's, at which the product is identified
@@ -139,7 +148,8 @@ class Identified:
 
     def as_dict(self) -> dict:
         est = {k: getattr(self, k).as_dict() for k in ("dead_band", "map_centre", "product", "motor_friction",
-                                                         "offset", "rack_friction", "hysteresis_A")}
+                                                         "motor_inertia", "offset", "rack_friction", "hysteresis_A")}
+        est["back_efficiency"] = None if self.back_efficiency is None else self.back_efficiency.as_dict()
         return {"vehicle": self.vehicle, "records": list(self.records), "assist": self.assist_name,
                 "table": {"torsion_bar_torque_Nm": list(self.torques), "assist": list(self.assist),
                           "assist_ci95": [list(c) for c in self.assist_ci95], "current_A": list(self.current_A),
@@ -163,6 +173,11 @@ class Identified:
                   f"{self.product_per_tyre_friction * 0.05:+.4g} per +0.05 of it (the balance cannot tell them apart)",
                   f"motor friction {self.motor_friction.text()} (file: "
                   f"{self.file_values.get('motor_friction_torque', float('nan')):.4g})",
+                  f"motor inertia {self.motor_inertia.text()} (file: "
+                  f"{self.file_values.get('motor_inertia', float('nan')):.4g})",
+                  ("back-driven efficiency " + (self.back_efficiency.text() if self.back_efficiency is not None
+                                                else "not fixed (too few back-driven samples)")
+                   + f" (file: {self.file_values.get('back_efficiency', float('nan')):.4g})"),
                   f"torsion-bar offset {self.offset.text()}",
                   f"rack friction {self.rack_friction.text()}",
                   f"map residual RMS {self.map_rms_A:.3f} A against {self.map_noise_A:.3f} A of noise; hysteresis "
@@ -223,6 +238,7 @@ class _Map:
     jacobian_values: np.ndarray  # d(current at the points) / d(parameters)
     representation: np.ndarray  # A: the table's own error at each point (a standard error)
     torque_step: float  # N m: the logged torque's rounding
+    dead_band_representation: float  # N m: the table's own error of its dead band (the change from a coarser one)
     rms: float
     noise: float
     hysteresis: float
@@ -292,6 +308,7 @@ def fit_map(files: list[FileData]) -> _Map:
     # samples at a torque level carry the same rounding error and do not average it away
     representation = np.hypot(representation, step_i / math.sqrt(12.0))
     representation[:2] = 0.0
+    dead_band_representation = abs(float(coarse[0] - x[0])) / 2.0
     torques, current = _knots(x[0], top), _currents(x)
     # what the two channels' rounding allows: the current's step, and the torque's through the map's slope (the
     # control unit reads the sensor the log reads, so the sensor's own noise moves both together and is no scatter)
@@ -320,7 +337,8 @@ def fit_map(files: list[FileData]) -> _Map:
         hysteresis_Nm = hysteresis / float(np.median(slope[use])) if np.median(slope[use]) > 0 else math.nan
     else:
         hysteresis, hysteresis_se, hysteresis_Nm = 0.0, math.inf, math.nan
-    return _Map(torques, current, float(x[1]), covariance, jac_values, representation, step_s, rms, expected, hysteresis,
+    return _Map(torques, current, float(x[1]), covariance, jac_values, representation, step_s,
+                dead_band_representation, rms, expected, hysteresis,
                 hysteresis_se, hysteresis_Nm)
 
 
@@ -383,7 +401,7 @@ def identify_boost(records, vehicle, case: str | None = None, surface: str | Non
     boost_off = {key: 0.0 for key in boost_keys(name)}
     keys = [f"{name}.{k}" if "." not in k else k for k, _ in MECHANICS]
     theta = np.array([float(params[k]) for k in keys])
-    delivered, measured, times, moving = [], [], [], []
+    delivered, measured, times, moving, backward = [], [], [], [], []
     sharpness = float(params["steering.friction_smoothing"])
     for k, f in enumerate(files):
         S = f.torque_Nm
@@ -392,6 +410,7 @@ def identify_boost(records, vehicle, case: str | None = None, surface: str | Non
         e = directional_efficiency(motor, speed, eta, eta_b, v("limit_smoothing"), sharpness)
         delivered.append(e * reduction * motor / scale)
         moving.append(np.abs(np.tanh(sharpness * speed)) >= MOVING_SIGN)
+        backward.append(motor * speed < 0.0)
         measured.append(S)
         times.append(f.time_s + 1e6 * k)
     D = np.concatenate(delivered)
@@ -399,6 +418,8 @@ def identify_boost(records, vehicle, case: str | None = None, surface: str | Non
     t_all = np.concatenate(times)
     sigma = np.concatenate([np.full(f.n, f.noise.total_rms) for f in files])
     use = np.concatenate(moving)
+    back = np.concatenate(backward)
+    split = (use & back).sum() >= BACK_DRIVEN_SHARE * use.sum()
     if use.sum() < 20 * (len(MECHANICS) + 2):
         raise UsageError(f"{', '.join(str(r) for r in records)}: the steering hardly moves: identify needs records "
                          "in which the wheel turns (the column balance is read while the gear moves)")
@@ -416,9 +437,11 @@ def identify_boost(records, vehicle, case: str | None = None, surface: str | Non
         tyre_column = (road({tyre_key: float(params[tyre_key]) + tyre_step}) - y0) / tyre_step
     finally:
         engine.close()
-    # y0 + J dtheta + o - S - p D = 0  ->  [J, 1, -D] [dtheta, o, p] = S - y0
+    # y0 + J dtheta + o - S - p D = 0  ->  [J, 1, -D] [dtheta, o, p] = S - y0, with D split into the samples the
+    # motor drives and those it is driven back (their factor p_b = p eta_b,file / eta_b)
     # only while the gear moves: at rest its friction and the direction of its power are not defined
-    design = (np.column_stack([*columns, np.ones_like(S_all), -D]) / sigma[:, None])[use]
+    parts = [-D * ~back, -D * back] if split else [-D]
+    design = (np.column_stack([*columns, np.ones_like(S_all), *parts]) / sigma[:, None])[use]
     rhs = ((S_all - y0) / sigma)[use]
     solution, *_ = np.linalg.lstsq(design, rhs, rcond=None)
     resid = rhs - design @ solution
@@ -430,7 +453,17 @@ def identify_boost(records, vehicle, case: str | None = None, surface: str | Non
     offset, p = float(solution[len(keys)]), float(solution[len(keys) + 1])
     se_o, se_p = float(se[len(keys)]), float(se[len(keys) + 1])
     product_per_tyre = (float(moved[len(keys) + 1]) - p) * product_file / tyre_step
+    back_efficiency = None
+    if split:  # eta_b = eta_b,file p / p_b, its standard error by the delta method
+        j = len(keys) + 2
+        p_b = float(solution[j])
+        ratio = p / p_b
+        gradient = np.array([1.0 / p_b, -p / p_b ** 2])
+        block = cov[np.ix_([len(keys) + 1, j], [len(keys) + 1, j])]
+        back_se = eta_b * math.sqrt(max(float(gradient @ block @ gradient), 0.0))
     z = _t95(len(np.unique(_blocks(t_all[use], BLOCK_S))) - design.shape[1])
+    if split:
+        back_efficiency = _estimate(eta_b * ratio, back_se, "1", z)
     balance_rms = float(np.sqrt(np.mean((resid * sigma[use]) ** 2)))
     torque_noise = float(np.sqrt(np.mean(sigma ** 2)))
 
@@ -457,7 +490,7 @@ def identify_boost(records, vehicle, case: str | None = None, surface: str | Non
                       "A of the channels' noise")
     names = [str(Path(r).name) for r in records]
     mech = {k: _estimate(val, s, u, z) for (k, _), val, s, u in zip(MECHANICS, values, se[: len(keys)],
-                                                                   ("N m", "N"))}
+                                                                   ("N m", "kg m^2", "N"))}
     return Identified(
         vehicle=str(vehicle_path), records=tuple(names), assist_name=name,
         torques=tuple(float(t) for t in fitted.torques), assist=tuple(float(a) for a in assist),
@@ -467,17 +500,20 @@ def identify_boost(records, vehicle, case: str | None = None, surface: str | Non
                            zip(current, np.sqrt(np.maximum(np.diag(point_cov), 0.0)))),
         # the log and the control unit read the torque in steps: the map between two of them is never seen
         dead_band=_estimate(fitted.torques[1], math.hypot(math.sqrt(max(fitted.covariance[0, 0], 0.0)),
-                                                          fitted.torque_step / math.sqrt(12.0)), "N m"),
+                                                          fitted.torque_step / math.sqrt(12.0),
+                                                          fitted.dead_band_representation), "N m"),
         map_centre=_estimate(fitted.centre, math.hypot(math.sqrt(max(fitted.covariance[1, 1], 0.0)),
                                                        fitted.torque_step / math.sqrt(12.0)), "N m"),
         product=_estimate(P, se_p * product_file, "N/A" if location == "rack" else "N m/A", z),
-        motor_friction=mech["motor_friction_torque"], offset=_estimate(offset, se_o, "N m", z),
+        motor_friction=mech["motor_friction_torque"], motor_inertia=mech["motor_inertia"],
+        back_efficiency=back_efficiency, offset=_estimate(offset, se_o, "N m", z),
         rack_friction=mech["steering.rack_friction_force"], tyre_friction=float(params[TYRE_FRICTION[0]]),
         product_per_tyre_friction=product_per_tyre,
         map_rms_A=fitted.rms, map_noise_A=fitted.noise,
         hysteresis_A=_estimate(fitted.hysteresis, fitted.hysteresis_se, "A"), hysteresis_Nm=float(fitted.hysteresis_Nm),
         balance_rms_Nm=balance_rms, torque_noise_Nm=torque_noise, beyond_map=tuple(beyond),
         file_values={"product": product_file, "motor_friction_torque": v("motor_friction_torque"),
+                     "motor_inertia": v("motor_inertia"), "back_efficiency": eta_b,
                      "efficiency": eta, "reduction_ratio": reduction, "torque_constant": k_t},
     )
 
@@ -531,7 +567,14 @@ def replace_assist_section(text: str, found: Identified) -> str:
         "motor_friction_torque": (max(found.motor_friction.value, 0.0), "N m",
                                   f"{where}: {found.motor_friction.text()} (the column balance; the file gave "
                                   f"{found.file_values['motor_friction_torque']:g})"),
+        "motor_inertia": (max(found.motor_inertia.value, 0.0), "kg m^2",
+                          f"{where}: {found.motor_inertia.text()} (the column balance; the file gave "
+                          f"{found.file_values['motor_inertia']:g})"),
     }
+    if found.back_efficiency is not None:
+        replaced["back_efficiency"] = (min(max(found.back_efficiency.value, 0.5), 0.99), "1",
+                                       f"{where}: {found.back_efficiency.text()} (the column balance on the "
+                                       f"back-driven samples; the file gave {found.file_values['back_efficiency']:g})")
     for key, entry in old.items():
         if key in ("type", "boost") or key in _LINE_KEYS or key in replaced:
             continue
