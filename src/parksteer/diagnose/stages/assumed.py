@@ -11,7 +11,9 @@ calibrated model and the best candidate's refit each replayed with the value mov
 first order (projected off the fit's Jacobian columns: the calibrated parameters take up what they can), and
 :func:`~parksteer.diagnose.stages.verdict.choose_verdict` on the calibrated model's RMS over the floor, the
 candidate's BIC gain and the fraction of the excess it explains. A quantity whose band's end changes the verdict
-*decides* it: the report says it was assumed, and by how much the calibrated fit moves (in noise floors).
+*decides* it: the report says it was assumed, and by how much the calibrated fit moves (in noise floors). Where
+``parksteer assist identify`` fixed the product k_t eta_f N, the efficiency and the reduction are moved with the
+products the data fixed held (:func:`moved`).
 
 Four replays a quantity (two ends, the calibrated model and the best candidate's), none for a car without an
 assist. Quantities the data calibrate (the candidates' strengths, the calibrated parameters) are not here: the
@@ -76,6 +78,31 @@ def assumed_quantities(params, name: str, effect) -> list[tuple[str, float, str,
     return out
 
 
+def moved(params, name: str, key: str, value: float) -> dict[str, float]:
+    """The overrides that move `key` of the assist `name` to `value`, holding what the data fixed. Where a value
+    was identified (``parksteer assist identify``: its source says so), the column balance fixed a product, not
+    its factors: the product k_t eta_f N (the torque constant), the back-driven delivery N k_t / eta_b per ampere
+    (eta_f eta_b, with the torque constant held), the rotor's reflected inertia N^2 J_m and friction N T_f. Moving
+    the efficiency or the reduction keeps each identified product, its other factor taking up the rest."""
+    v = lambda k: float(params[f"{name}.{k}"])  # noqa: E731
+    fixed = lambda k: params.sources.get(f"{name}.{k}", "").startswith("identified")  # noqa: E731
+    out = {f"{name}.{key}": value}
+    if key == "efficiency":
+        if fixed("torque_constant"):
+            out[f"{name}.torque_constant"] = v("torque_constant") * v("efficiency") / value
+        if fixed("back_efficiency"):
+            out[f"{name}.back_efficiency"] = min(v("back_efficiency") * v("efficiency") / value, 1.0)
+    elif key == "reduction_ratio":
+        ratio = v("reduction_ratio") / value
+        if fixed("torque_constant"):
+            out[f"{name}.torque_constant"] = v("torque_constant") * ratio
+        if fixed("motor_inertia"):
+            out[f"{name}.motor_inertia"] = v("motor_inertia") * ratio * ratio
+        if fixed("motor_friction_torque"):
+            out[f"{name}.motor_friction_torque"] = v("motor_friction_torque") * ratio
+    return out
+
+
 def _refitted_rss(fit, problem, moved: list[np.ndarray]) -> tuple[float, np.ndarray]:
     """The weighted RSS of `fit` with its model moved to `moved`, refitted to first order on its Jacobian."""
     change = problem.scale([m - p for m, p in zip(moved, fit.predictions)])
@@ -122,10 +149,11 @@ class AssumedValues(Stage):
             full = f"{effect.name}.{key}"
             ends = []
             for end in band:
+                change = moved(problem.params, effect.name, key, end)
                 base_rss, _ = _refitted_rss(calibration, problem, engine.predict(
-                    problem, calibration.effects, {**calibration.overrides, full: end}))
+                    problem, calibration.effects, {**calibration.overrides, **change}))
                 with_fit = None if refit is None else _refitted_rss(refit, problem, engine.predict(
-                    problem, refit.effects, {**refit.overrides, full: end}))
+                    problem, refit.effects, {**refit.overrides, **change}))
                 ends.append({"value": end, **verdict_of(base_rss, with_fit)})
             rows.append({"quantity": full, "value": value, "source": source, "band": list(band), "ends": ends,
                          "decides": any(e["verdict"] != nominal["verdict"] for e in ends)})
