@@ -97,7 +97,8 @@ class Estimate:
         return {"value": self.value, "ci95": list(self.ci95), "unit": self.unit}
 
     def text(self, digits: int = 4) -> str:
-        return (f"{self.value:.{digits}g} {self.unit} (95 % {self.ci95[0]:.{digits}g} to "
+        unit = "" if self.unit == "1" else f" {self.unit}"
+        return (f"{self.value:.{digits}g}{unit} (95 % {self.ci95[0]:.{digits}g} to "
                 f"{self.ci95[1]:.{digits}g})")
 
 
