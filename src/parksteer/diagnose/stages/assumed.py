@@ -117,13 +117,14 @@ class AssumedValues(Stage):
     name = "assumed"
 
     def message(self, state: DiagnosisState) -> str | None:
-        if power_assist_of(state.base) is None:
+        if power_assist_of(state.base) is None or not state.settings.assumed_values_replayed:
             return None
         return "what the verdict owes to the assist's assumed values"
 
     def run(self, state: DiagnosisState, engine: ReplayEngine) -> DiagnosisState:
         effect = power_assist_of(state.base)
-        if effect is None or effect.name == "hydraulic_assist" or state.calibration is None:
+        if (effect is None or effect.name == "hydraulic_assist" or state.calibration is None
+                or not state.settings.assumed_values_replayed):
             return state
         problem, settings, calibration = state.problem, state.settings, state.calibration
         problem, settings, calibration = state.problem, state.settings, state.calibration
