@@ -90,8 +90,10 @@ def _solve(truth: Truth, rhs: np.ndarray, rate: np.ndarray, noise: np.ndarray, h
     return high, rounded(high, noise)
 
 
-def truth_record(truth: Truth, path: Path, seed: int = 1, case: str = "kerb") -> Path:
-    """Write the truth's record of the Polo's kerb cycle to `path` (native CSV, torsion-bar torque and current)."""
+def truth_record(truth: Truth, path: Path, seed: int = 1, case: str = "kerb", angle_only: bool = False) -> Path:
+    """Write the truth's record of the Polo's kerb cycle to `path` (native CSV, torsion-bar torque and current; the
+    rack, or with `angle_only` the handwheel angle instead, as a car's bus has it: the column angle plus the twist of
+    the column shaft and torsion bar in series, in 0.1 deg steps)."""
     from parksteer.diagnose.engine import ReplayEngine
     from parksteer.diagnose.problem import Problem, prepare_file
     from parksteer.measure.io import Measurement, write_measurement
@@ -126,17 +128,33 @@ def truth_record(truth: Truth, path: Path, seed: int = 1, case: str = "kerb") ->
     rng = np.random.default_rng(seed)
     noise = rng.normal(0.0, truth.sensor_noise, t.size)
     hysteresis = truth.hysteresis_current * np.tanh(column_rate / 0.05)
-    _, reading = _solve(truth, rhs, column_rate, noise, hysteresis)
+    bar, reading = _solve(truth, rhs, column_rate, noise, hysteresis)
     current = truth.current(reading) + hysteresis
     logged_current = np.round(current / truth.current_step) * truth.current_step
-    record = Measurement(None, {"time_s": t, "rack_m": np.round(rack / 1e-5) * 1e-5,
+    position = {"rack_m": np.round(rack / 1e-5) * 1e-5}
+    position_logger = {"bits_rack_m": "14", "full_scale_rack_m": f"{1e-5 * 16383 / 2:g}"}
+    if angle_only:
+        from parksteer.geometry import column_twist
+
+        k_c, c_c = s["column_torsional_stiffness"], s["column_torsional_damping"]
+        k_t = params["electric_assist_column.torsion_bar_stiffness"]
+        series = k_c * k_t / (k_c + k_t)
+        twist, _ = column_twist(t, bar, series, c_c * series / k_c)
+        step = np.radians(0.1)
+        position = {"handwheel_angle_rad": np.round((column + twist) / step) * step}
+        position_logger = {"bits_handwheel_angle_rad": "16", "full_scale_handwheel_angle_rad": f"{step * 65535 / 2:.9g}"}
+    record = Measurement(None, {"time_s": t, **position,
                                 "handwheel_torque_Nm": reading, "motor_current_A": logged_current},
                          {"case": case, "surface": "ground", "torque_sensor": "torsion_bar", "synthetic": "true",
                           "source": "tests/diagnose/eps_truth.py: a quasi-static column EPS over the manual replay",
                           # 0.01 N m and 0.1 A steps: 2 full_scale / (2**bits - 1)
                           "bits": "12", "full_scale_handwheel_torque_Nm": f"{truth.torque_step * 4095 / 2:g}",
                           "bits_motor_current_A": "12", "full_scale_motor_current_A":
-                              f"{truth.current_step * 4095 / 2:g}",
-                          "bits_rack_m": "14", "full_scale_rack_m": f"{1e-5 * 16383 / 2:g}"})
-    write_measurement(path, record, params)
+                              f"{truth.current_step * 4095 / 2:g}", **position_logger})
+    if angle_only:  # the native writer checks for a rack; the reader derives it from the angle
+        from parksteer.measure.io import format_measurement
+
+        path.write_text(format_measurement(record), encoding="utf-8")
+    else:
+        write_measurement(path, record, params)
     return path

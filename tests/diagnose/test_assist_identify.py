@@ -119,3 +119,15 @@ def test_record_without_current_refused(baseline, tmp_path, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "no_current.csv" in err[0] and "motor_current_A" in err[0]
     assert not out.exists()
+
+
+def test_angle_only_record(tmp_path):
+    """A car's bus logs no rack: the handwheel angle in 0.1 deg steps (the column angle plus the twist of the column
+    shaft and torsion bar in series) gives the rack through the torsion bar, and the gear's numbers come back as from
+    the rack: the product within 0.5 %, the motor friction, the offset and the rotor inertia within their intervals."""
+    truth = et.Truth()
+    found = identify_boost([et.truth_record(truth, tmp_path / "angle_only.csv", angle_only=True)], et.POLO)
+    assert found.product.value == pytest.approx(truth.product, rel=5e-3)
+    for estimate, value in ((found.motor_friction, truth.motor_friction), (found.offset, truth.offset),
+                            (found.motor_inertia, truth.rotor_inertia)):
+        assert estimate.ci95[0] <= value <= estimate.ci95[1]
