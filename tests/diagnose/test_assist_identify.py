@@ -23,6 +23,7 @@ from parksteer.model.symbolic.components import discover_effects
 from parksteer.vehicle import load_vehicle
 
 discover_effects()
+pytestmark = pytest.mark.slow  # each test replays the car (a few seconds)
 
 
 @pytest.fixture(scope="module")

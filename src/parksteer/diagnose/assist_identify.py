@@ -157,7 +157,7 @@ class Identified:
                           "current_ci95": [list(c) for c in self.current_ci95]},
                 **est, "tyre_friction": self.tyre_friction,
                 "product_per_tyre_friction": self.product_per_tyre_friction, "map_rms_A": self.map_rms_A, "map_noise_A": self.map_noise_A,
-                "hysteresis_Nm": self.hysteresis_Nm, "balance_rms_Nm": self.balance_rms_Nm,
+                "hysteresis_Nm": self.hysteresis_Nm if math.isfinite(self.hysteresis_Nm) else None, "balance_rms_Nm": self.balance_rms_Nm,
                 "torque_noise_Nm": self.torque_noise_Nm, "beyond_map": list(self.beyond_map),
                 "file_values": dict(self.file_values)}
 
