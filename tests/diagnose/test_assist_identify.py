@@ -132,3 +132,14 @@ def test_angle_only_record(tmp_path):
     for estimate, value in ((found.motor_friction, truth.motor_friction), (found.offset, truth.offset),
                             (found.motor_inertia, truth.rotor_inertia)):
         assert estimate.ci95[0] <= value <= estimate.ci95[1]
+
+
+def test_a_record_in_memory_is_its_file(baseline):
+    """A benchmark hands its records in memory: a Measurement identifies to the same numbers as the file it was
+    read from (the same preparation: rack smoothing, noise floors)."""
+    from parksteer.measure.importers import load_record
+
+    truth, path, found = baseline
+    again = identify_boost([load_record(path, None, params=load_vehicle(et.POLO))], et.POLO)
+    assert again.product == found.product and again.motor_friction == found.motor_friction
+    assert again.assist == found.assist and again.records == found.records

@@ -343,6 +343,30 @@ def fit_map(files: list[FileData]) -> _Map:
                 hysteresis_se, hysteresis_Nm)
 
 
+def _files(records, params, case, surface, channel_map, name) -> list[FileData]:
+    """The records ready to replay, in their order: paths read as ``parksteer diagnose`` reads them, and records
+    already in memory (:class:`parksteer.measure.io.Measurement`, e.g. a benchmark's) prepared the same way (an
+    angle-only one's rack derived through the column and the torsion bar)."""
+    from ..measure.column import rack_from_angle, rack_logger
+    from ..measure.converter import quantisation_step
+    from ..measure.io import Measurement
+    from .problem import load_files, prepare_file
+
+    out = []
+    for k, record in enumerate(records):
+        if isinstance(record, Measurement):
+            resolution = 0.0
+            if "rack_derived" in record.metadata:
+                record = rack_from_angle(record, params, name)
+                logger = rack_logger(record, params)
+                resolution = 0.0 if logger is None else quantisation_step(logger[0], logger[1])
+            label = record.path.name if record.path is not None else f"record {k + 1}"
+            out.append(prepare_file(record, case or record.case, label=label, rest_resolution_m=resolution))
+        else:
+            out += load_files([str(record)], params, case, surface, channel_map, name)
+    return out
+
+
 def _assist_name(effects) -> str:
     from ..model.symbolic.components import power_assist_of
 
@@ -358,7 +382,8 @@ def identify_boost(records, vehicle, case: str | None = None, surface: str | Non
     """The boost table and the gear's hidden numbers of an electric assist from its records (module docstring).
 
     `records`: paths of measurement files (any format :func:`parksteer.measure.importers.load_record` reads, with
-    `channel_map` for a logger's or a bus's), each with the torsion-bar torque (``torque_sensor: torsion_bar``),
+    `channel_map` for a logger's or a bus's) or records in memory (:class:`parksteer.measure.io.Measurement`), each
+    with the torsion-bar torque (``torque_sensor: torsion_bar``),
     the motor current ``motor_current_A`` and a rack or a handwheel angle. `vehicle`: the vehicle file's path (its
     ``[assist]`` gives the gear; its boost curve, table or line, is not used). `case`, `surface`: as for
     ``parksteer diagnose``. Returns an :class:`Identified`; :meth:`Identified.to_vehicle_toml` writes the file."""
@@ -367,7 +392,7 @@ def identify_boost(records, vehicle, case: str | None = None, surface: str | Non
     from ..model.symbolic.components import resolve_effects
     from ..vehicle import load_vehicle
     from .engine import ReplayEngine
-    from .problem import Problem, load_files
+    from .problem import Problem
 
     vehicle_path = Path(vehicle)
     params: Parameters = load_vehicle(vehicle_path)
@@ -376,7 +401,7 @@ def identify_boost(records, vehicle, case: str | None = None, surface: str | Non
                          "efficiency, torque constant)")
     effects = resolve_effects(effects_with_assist(None, params))
     name = _assist_name(effects)
-    files = load_files([str(r) for r in records], params, case, surface, channel_map, name)
+    files = _files(records, params, case, surface, channel_map, name)
     for f in files:
         if f.motor_column != "motor_current_A":
             raise UsageError(f"{f.measurement.path or f.label}: column 'motor_current_A': missing; identify reads the "
@@ -489,7 +514,7 @@ def identify_boost(records, vehicle, case: str | None = None, surface: str | Non
     if fitted.rms > 1.5 * fitted.noise and fitted.rms - fitted.noise > 0.5 * step_i:
         beyond.append(f"scatter: the current departs from the map by {fitted.rms:.3f} A RMS against {fitted.noise:.3f} "
                       "A of the channels' noise")
-    names = [str(Path(r).name) for r in records]
+    names = [f.label for f in files]
     mech = {k: _estimate(val, s, u, z) for (k, _), val, s, u in zip(MECHANICS, values, se[: len(keys)],
                                                                    ("N m", "kg m^2", "N"))}
     return Identified(
