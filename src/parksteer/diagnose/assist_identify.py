@@ -66,7 +66,7 @@ SPAN_POINTS = 7  # table points beyond the dead band (9 with the origin and the 
 BLOCK_S = 1.0  # s: the blocks of the intervals' sandwich (residuals closer than this are taken as correlated)
 Z95 = 1.959963984540054
 # The mechanics' calibrated parameters (key, finite-difference step) beside the offset and the product: the column
-# torque is linear in both frictions, so one linear least-squares step is exact.
+# torque is linear in the two frictions and the rotor's inertia, so one linear least-squares step is exact.
 MECHANICS = (
     ("motor_friction_torque", 0.01),  # of the assist's section
     ("motor_inertia", 1.0e-4),  # of the assist's section: its torque N^2 J theta'' is linear in J
