@@ -384,18 +384,23 @@ def identify_boost(records, vehicle, case: str | None = None, surface: str | Non
     `records`: paths of measurement files (any format :func:`parksteer.measure.importers.load_record` reads, with
     `channel_map` for a logger's or a bus's) or records in memory (:class:`parksteer.measure.io.Measurement`), each
     with the torsion-bar torque (``torque_sensor: torsion_bar``),
-    the motor current ``motor_current_A`` and a rack or a handwheel angle. `vehicle`: the vehicle file's path (its
-    ``[assist]`` gives the gear; its boost curve, table or line, is not used). `case`, `surface`: as for
+    the motor current ``motor_current_A`` and a rack or a handwheel angle. `vehicle`: the vehicle file's path, or
+    its loaded :class:`~parksteer.parameters.Parameters` (its ``[assist]`` gives the gear; its boost curve, table or
+    line, is not used). `case`, `surface`: as for
     ``parksteer diagnose``. Returns an :class:`Identified`; :meth:`Identified.to_vehicle_toml` writes the file."""
     from ..model.numeric.assist import check_assist, effects_with_assist
     from ..model.numeric.assisted import boost_keys, rack_speed_mps
-    from ..model.symbolic.components import resolve_effects
+    from ..model.symbolic.components import discover_effects, resolve_effects
     from ..vehicle import load_vehicle
     from .engine import ReplayEngine
     from .problem import Problem
 
-    vehicle_path = Path(vehicle)
-    params: Parameters = load_vehicle(vehicle_path)
+    discover_effects()  # a vehicle file's [assist] entries are the assist effect's quantities
+    if isinstance(vehicle, Parameters):
+        params, vehicle_path = vehicle, Path(vehicle.path)
+    else:
+        vehicle_path = Path(vehicle)
+        params = load_vehicle(vehicle_path)
     if check_assist(params) is None:
         raise UsageError(f"{vehicle_path}: no [assist] section: identify needs the gear's data (type, reduction, "
                          "efficiency, torque constant)")
