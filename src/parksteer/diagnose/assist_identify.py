@@ -582,8 +582,10 @@ def replace_assist_section(text: str, found: Identified) -> str:
     records = ", ".join(found.records)
     where = f"identified by parksteer assist identify from {records}"
     unit = "N" if found.assist_name.endswith("_rack") else "N m"
-    lines = ["", f"# Power assistance: the gear's data as the file gave them; the boost table, the product k_t eta N",
-             f"# (as the torque constant) and the motor friction {where}.",
+    lines = ["", "# Power assistance: the gear's data as the file gave them; the boost table, the product k_t eta N",
+             "# (as the torque constant), the motor's friction and inertia" + (" and the back-driven efficiency"
+                                                                              if found.back_efficiency is not None
+                                                                              else "") + f" {where}.",
              f"# Also identified, with no entry in a vehicle file: the torsion-bar sensor's offset {found.offset.text()};",
              f"# the map's centre in the logged torque {found.map_centre.text()}; the rack friction",
              f"# {found.rack_friction.text()} (a diagnosis calibrates it again).",
