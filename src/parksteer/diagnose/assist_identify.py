@@ -552,8 +552,6 @@ def identify_boost(records, vehicle, case: str | None = None, surface: str | Non
 # ---- writing the vehicle file again -------------------------------------------------------------------------------
 
 _HEADER = re.compile(r"^\s*\[([^\]]+)\]\s*(#.*)?$")
-# the boost line's quantities, which a table replaces (parksteer.model.numeric.assist.LINE_KEYS)
-_LINE_KEYS = ("gain", "dead_band", "dead_band_smoothing", "speed_dependence", "gain_half_speed")
 
 
 def _toml_string(text: str) -> str:
@@ -567,6 +565,8 @@ def _number(x: float) -> str:
 def replace_assist_section(text: str, found: Identified) -> str:
     """`text` (a vehicle file) with its ``[assist]`` and ``[assist.*]`` tables written again from `found`."""
     import tomllib
+
+    from ..model.numeric.assist import LINE_KEYS  # the boost line's quantities, which a table replaces
 
     doc = tomllib.loads(text)
     old = doc.get("assist", {})
@@ -592,7 +592,6 @@ def replace_assist_section(text: str, found: Identified) -> str:
              *(f"# The map cannot hold: {b}" for b in found.beyond_map),
              "[assist]", f"type = {_toml_string(old.get('type', 'column'))}"]
     k_t = found.product.value / (found.file_values["efficiency"] * found.file_values["reduction_ratio"])
-    scale = k_t / found.product.value
     replaced = {
         "torque_constant": (k_t, "N m/A", f"{where}: the product k_t eta N = {found.product.text()} through the "
                                           f"file's efficiency and reduction (only the product is fixed); the file "
@@ -609,13 +608,12 @@ def replace_assist_section(text: str, found: Identified) -> str:
                                        f"{where}: {found.back_efficiency.text()} (the column balance on the "
                                        f"back-driven samples; the file gave {found.file_values['back_efficiency']:g})")
     for key, entry in old.items():
-        if key in ("type", "boost") or key in _LINE_KEYS or key in replaced:
+        if key in ("type", "boost") or key in LINE_KEYS or key in replaced:
             continue
         lines.append(f"{key} = {{ value = {_number(entry['value'])}, unit = {_toml_string(entry['unit'])}, "
                      f"source = {_toml_string(entry['source'])} }}")
     for key, (value, u, source) in replaced.items():
         lines.append(f"{key} = {{ value = {_number(value)}, unit = {_toml_string(u)}, source = {_toml_string(source)} }}")
-    del scale
     torques = ", ".join(_number(t) for t in found.torques)
     assists = ", ".join(_number(max(a, 0.0)) for a in _strictly_rising(found.assist))
     intervals = "; ".join(f"{lo:.3g}-{hi:.3g}" for lo, hi in found.assist_ci95[2:])
