@@ -142,7 +142,8 @@ def truth_record(truth: Truth, path: Path, seed: int = 1, case: str = "kerb", an
         twist, _ = column_twist(t, bar, series, c_c * series / k_c)
         step = np.radians(0.1)
         position = {"handwheel_angle_rad": np.round((column + twist) / step) * step}
-        position_logger = {"bits_handwheel_angle_rad": "16", "full_scale_handwheel_angle_rad": f"{step * 65535 / 2:.9g}"}
+        position_logger = {"bits_handwheel_angle_rad": "16",
+                           "full_scale_handwheel_angle_rad": f"{step * 65535 / 2:.9g}"}
     record = Measurement(None, {"time_s": t, **position,
                                 "handwheel_torque_Nm": reading, "motor_current_A": logged_current},
                          {"case": case, "surface": "ground", "torque_sensor": "torsion_bar", "synthetic": "true",

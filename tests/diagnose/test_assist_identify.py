@@ -5,7 +5,8 @@ test (eps_truth.py: the torsion bar and a worm-gear motor sharing the column tor
 car's replay, a progressive map of its own form, the motor's Coulomb friction and rotor through the worm, the
 control unit reading a sensor rounded to 0.01 N m with a zero offset, the current logged in 0.1 A steps), on the
 Polo's vehicle file, whose gear data differ from the truth's (torque constant 0.05 against 0.055 N m/A, motor
-friction 0.02 against 0.03 N m, rotor inertia 2e-4 against 3e-4 kg m^2, back-driven efficiency 0.80 against 0.76). Each test names the physical fact the identification must recover.
+friction 0.02 against 0.03 N m, rotor inertia 2e-4 against 3e-4 kg m^2, back-driven efficiency 0.80 against
+0.76). Each test names the physical fact the identification must recover.
 """
 
 from __future__ import annotations

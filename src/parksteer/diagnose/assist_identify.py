@@ -156,8 +156,10 @@ class Identified:
                           "assist_ci95": [list(c) for c in self.assist_ci95], "current_A": list(self.current_A),
                           "current_ci95": [list(c) for c in self.current_ci95]},
                 **est, "tyre_friction": self.tyre_friction,
-                "product_per_tyre_friction": self.product_per_tyre_friction, "map_rms_A": self.map_rms_A, "map_noise_A": self.map_noise_A,
-                "hysteresis_Nm": self.hysteresis_Nm if math.isfinite(self.hysteresis_Nm) else None, "balance_rms_Nm": self.balance_rms_Nm,
+                "product_per_tyre_friction": self.product_per_tyre_friction, "map_rms_A": self.map_rms_A,
+                "map_noise_A": self.map_noise_A,
+                "hysteresis_Nm": self.hysteresis_Nm if math.isfinite(self.hysteresis_Nm) else None,
+                "balance_rms_Nm": self.balance_rms_Nm,
                 "torque_noise_Nm": self.torque_noise_Nm, "beyond_map": list(self.beyond_map),
                 "file_values": dict(self.file_values)}
 
@@ -169,7 +171,8 @@ class Identified:
             lines.append(f"  {t:15.3f}  {a:10.3f}   {lo:7.3f} to {hi:7.3f}   {i:9.2f}")
         lines += [f"dead band {self.dead_band.text()}",
                   f"map centre in the logged torque {self.map_centre.text()}",
-                  f"product k_t eta N {self.product.text()} (file: {self.file_values.get('product', float('nan')):.4g})",
+                  f"product k_t eta N {self.product.text()} "
+                  f"(file: {self.file_values.get('product', float('nan')):.4g})",
                   f"  at the file's tyre-ground friction {self.tyre_friction:g}: the product moves by "
                   f"{self.product_per_tyre_friction * 0.05:+.4g} per +0.05 of it (the balance cannot tell them apart)",
                   f"motor friction {self.motor_friction.text()} (file: "
@@ -586,7 +589,8 @@ def replace_assist_section(text: str, found: Identified) -> str:
              "# (as the torque constant), the motor's friction and inertia" + (" and the back-driven efficiency"
                                                                               if found.back_efficiency is not None
                                                                               else "") + f" {where}.",
-             f"# Also identified, with no entry in a vehicle file: the torsion-bar sensor's offset {found.offset.text()};",
+             "# Also identified, with no entry in a vehicle file: the torsion-bar sensor's offset "
+             f"{found.offset.text()};",
              f"# the map's centre in the logged torque {found.map_centre.text()}; the rack friction",
              f"# {found.rack_friction.text()} (a diagnosis calibrates it again).",
              *(f"# The map cannot hold: {b}" for b in found.beyond_map),
@@ -613,13 +617,18 @@ def replace_assist_section(text: str, found: Identified) -> str:
         lines.append(f"{key} = {{ value = {_number(entry['value'])}, unit = {_toml_string(entry['unit'])}, "
                      f"source = {_toml_string(entry['source'])} }}")
     for key, (value, u, source) in replaced.items():
-        lines.append(f"{key} = {{ value = {_number(value)}, unit = {_toml_string(u)}, source = {_toml_string(source)} }}")
+        lines.append(f"{key} = {{ value = {_number(value)}, unit = {_toml_string(u)}, "
+                     f"source = {_toml_string(source)} }}")
     torques = ", ".join(_number(t) for t in found.torques)
     assists = ", ".join(_number(max(a, 0.0)) for a in _strictly_rising(found.assist))
     intervals = "; ".join(f"{lo:.3g}-{hi:.3g}" for lo, hi in found.assist_ci95[2:])
     lines += ["", "[assist.boost]",
-              f"torsion_bar_torque = {{ value = [{torques}], unit = \"N m\", source = {_toml_string(where + ': the dead band ' + found.dead_band.text() + ', then evenly spaced to the largest of the records')} }}",
-              f"assist = {{ value = [{assists}], unit = \"{unit}\", source = {_toml_string(where + ': the current map times the product k_t eta N; 95 % beyond the dead band ' + intervals)} }}",
+              f"torsion_bar_torque = {{ value = [{torques}], unit = \"N m\", source = "
+              + _toml_string(f"{where}: the dead band {found.dead_band.text()}, then evenly spaced to the largest of "
+                             "the records") + " }",
+              f"assist = {{ value = [{assists}], unit = \"{unit}\", source = "
+              + _toml_string(f"{where}: the current map times the product k_t eta N; 95 % beyond the dead band "
+                             f"{intervals}") + " }",
               ""]
     return "\n".join(kept + lines)
 
