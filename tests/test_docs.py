@@ -217,7 +217,7 @@ def run_block(block: Block, work: Path, env: dict) -> tuple[int, str, float]:
 # The documents in two groups of about the same run time: pytest-xdist's loadscope gives each class its own worker.
 GROUPS = {
     "A": ["README.md", "docs/bus.md", "docs/model.md", "docs/assist.md", "docs/development.md", "docs/diagnosis.md"],
-    "B": ["docs/house.md", "docs/measurement.md", "docs/peers.md", "docs/reproducibility.md", "docs/scaling.md",
+    "B": ["docs/assist_identify.md", "docs/house.md", "docs/measurement.md", "docs/peers.md", "docs/reproducibility.md", "docs/scaling.md",
           "docs/signature.md", "docs/sweeps.md", "docs/targets.md", "docs/vehicles.md", "docs/workflow.md"],
 }
 

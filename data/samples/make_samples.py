@@ -11,12 +11,15 @@ be tried on a fresh clone before any pipeline has run.
 - ``polo_kerb.log`` (candump) and ``polo_kerb.blf`` (Vector BLF): the VW Polo VI of data/vehicles/polo_vi.toml with
   its column assist, kerb load on the ground, as its powertrain CAN sends it on the shipped ``vw_mqb`` bus
   (:func:`parksteer.measure.bus.encode_frames`: driver's torque at the torsion bar, steering-wheel angle, speed 0).
-
 - ``worn_rack.csv``: the paper's car with a rack friction peaked at the centre in a form no candidate of the
   library has (``A / (1 + (x / 12 mm)^2) tanh(beta v)``, A = :data:`WORN_PEAK_N`: a bore worn tight straight ahead),
   its base parameters moved off the file's as the benchmarks move them, driven by another hand and logged by a
   50 Hz logger with its quantisation and noise (the variation benchmark's ``rate_8pc_50Hz``): the record of the
   README's loop, where the diagnosis is ``unexplained`` until the user's effect is added.
+- ``polo_baseline.csv`` and ``polo_drag.csv``: the same Polo's kerb cycle as its bus logs it (torsion-bar torque,
+  motor current, rack), its gear as built (torque constant 0.055 N m/A, motor friction 0.03 N m) rather than as the
+  file's data say; then later with a motor that drags (0.09 N m): the baseline-then-diagnose example of
+  docs/assist_identify.md.
 
 Made again, byte for byte, by ``python data/samples/make_samples.py`` (a script beside them, not part of the package:
 it drives the command line, which the package's synthetic layer may not import) (seeded; the BLF's header
@@ -182,9 +185,50 @@ def write_worn_rack(folder: Path) -> list[Path]:
     return [out]
 
 
+# The Polo of the baseline-then-diagnose example (docs/assist_identify.md): its gear as built, not as the vehicle
+# file's data say (torque constant and motor friction), and later with a motor that drags.
+POLO_AS_BUILT = {"electric_assist_column.torque_constant": 0.055}
+POLO_MOTOR_FRICTION = {"polo_baseline.csv": 0.03, "polo_drag.csv": 0.09}
+
+
+def write_polo_records(folder: Path) -> list[Path]:
+    """Two records of the assisted Polo as its bus logs them (torsion-bar torque in 0.01 N m, motor current in 0.1 A
+    steps): a baseline, and a later one with a motor that drags; a hand of the variation benchmark, the assisted
+    replay of its rack (parksteer.synthetic.assisted, as the example record of docs/assist.md)."""
+    from parksteer.measure.io import write_measurement
+    from parksteer.model.symbolic.components import discover_effects
+    from parksteer.synthetic.assisted import AssistedLogger, assisted_clean, assisted_record
+    from parksteer.synthetic.variations import variation_by_name
+    from parksteer.vehicle import load_vehicle
+
+    root = Path(__file__).resolve().parents[2]
+    discover_effects()  # the vehicle file's effect quantities (its [ackermann], [assist])
+    params = load_vehicle(root / "data" / "vehicles" / "polo_vi.toml")
+    variation = variation_by_name("rest_after_stop")
+    out = []
+    for k, (name, friction) in enumerate(POLO_MOTOR_FRICTION.items()):
+        hand, _ = variation.settings(7 + k)
+        overrides = {**POLO_AS_BUILT, "electric_assist_column.motor_friction_torque": friction}
+        clean = assisted_clean(params, hand, "+electric_assist_column", "kerb", overrides=overrides)
+        # the bus's steps, 2 full_scale / (2**bits - 1): 0.01 N m and 0.1 A
+        logger = AssistedLogger(sample_rate_hz=100.0, rack_bits=variation.logger.rack_bits,
+                                rack_noise_m=variation.logger.rack_noise_m, torque_bits=12, torque_full_scale_Nm=20.475,
+                                torque_noise_Nm=0.003, current_bits=12, current_full_scale_A=204.75,
+                                current_noise_A=0.02, seed=SEED + 10 + k)
+        record = assisted_record(clean, logger, "kerb")
+        record.metadata["source"] = (f"data/samples/make_samples.py: the assisted Polo, torque constant "
+                                     f"{POLO_AS_BUILT['electric_assist_column.torque_constant']:g} N m/A, motor "
+                                     f"friction {friction:g} N m, hand rest_after_stop seed {7 + k}")
+        path = folder / name
+        write_measurement(path, record, params)
+        out.append(path)
+    return out
+
+
 def write_samples(folder: str | Path) -> list[Path]:
     folder = Path(folder)
-    return [*write_car(folder / "car"), *write_my_car(folder), *write_polo_bus(folder), *write_worn_rack(folder)]
+    return [*write_car(folder / "car"), *write_my_car(folder), *write_polo_bus(folder), *write_worn_rack(folder),
+            *write_polo_records(folder)]
 
 
 if __name__ == "__main__":

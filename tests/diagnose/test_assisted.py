@@ -89,12 +89,50 @@ def test_boost_gain_error_is_named_and_sized_by_the_current(polo):
 
 
 def test_a_record_of_the_assisted_car_with_nothing_hidden_is_adequate(polo):
-    """A null: the calibrated model leaves the torque and the current at their noise floors (within 10 %)."""
+    """A null: the calibrated model leaves the torque and the current at their noise floors (within 10 %).
+
+    Its assumed values are each replayed at their band's ends (stage ``assumed``): every [assist] entry the Polo's
+    file marks assumed is there, the boost line's are not (the file's table gives the curve); the torsion bar's
+    stiffness moves the fit by less than 0.1 % (the column is massless: with the rack given, its compliance barely
+    reaches the torque); a torque constant of 0.03 or 0.07 N m/A instead of the assumed 0.05 scales the current the
+    replay predicts by 5/3 or 5/7, tens of the current's noise floors, and decides the verdict."""
     result = diagnosed(polo, record(polo))
     assert result["verdict"] == "adequate"
     stats = result["statistics"]["calibrated"]
     assert stats["weighted_rms_Nm"] < 1.1 * stats["noise_floor_Nm"]
     assert stats["motor"]["weighted_rms"] < 1.1 * stats["motor"]["noise_floor"]
+    jsonschema.validate(result, json.loads(SCHEMA_PATH.read_text(encoding="utf-8")))
+    rows = {r["quantity"].split(".")[1]: r for r in result["assumed"]["quantities"]}
+    assert {"motor_friction_torque", "motor_inertia", "efficiency", "torque_constant"} <= set(rows)
+    assert not {"gain", "dead_band", "dead_band_smoothing"} & set(rows)
+    nominal = result["assumed"]["nominal"]["calibrated_over_floor"]
+    assert all(e["calibrated_over_floor"] == pytest.approx(nominal, rel=1e-3)
+               for e in rows["torsion_bar_stiffness"]["ends"])
+    assert rows["torque_constant"]["decides"] and not rows["torsion_bar_stiffness"]["decides"]
+    assert min(e["calibrated_over_floor"] for e in rows["torque_constant"]["ends"]) > 5.0
+
+
+def test_moving_a_factor_of_an_identified_product_holds_the_product(polo):
+    """Where `assist identify` fixed the product k_t eta N (the torque constant's source says so), the assumed-values
+    stage moves the efficiency with the torque constant taking up the product, and the reduction with the product,
+    the reflected inertia N^2 J and the reflected friction N T_f held; a file's own torque constant moves alone."""
+    from dataclasses import replace as copy
+
+    from parksteer.diagnose.stages.assumed import moved
+
+    name = "electric_assist_column"
+    assert moved(polo, name, "efficiency", 0.75) == {f"{name}.efficiency": 0.75}
+    sources = {**polo.sources, **{f"{name}.{k}": "identified by parksteer assist identify from run.csv"
+                                  for k in ("torque_constant", "motor_inertia", "motor_friction_torque")}}
+    identified = copy(polo, sources=sources)
+    v = lambda k: polo[f"{name}.{k}"]  # noqa: E731
+    out = moved(identified, name, "efficiency", 0.75)
+    assert out[f"{name}.torque_constant"] * 0.75 == pytest.approx(v("torque_constant") * v("efficiency"))
+    out = moved(identified, name, "reduction_ratio", 22.0)
+    assert out[f"{name}.torque_constant"] * 22.0 == pytest.approx(v("torque_constant") * v("reduction_ratio"))
+    assert out[f"{name}.motor_inertia"] * 22.0 ** 2 == pytest.approx(v("motor_inertia") * v("reduction_ratio") ** 2)
+    assert out[f"{name}.motor_friction_torque"] * 22.0 == pytest.approx(v("motor_friction_torque")
+                                                                         * v("reduction_ratio"))
 
 
 def test_compare_an_assisted_record_from_the_command_line(polo, tmp_path, capsys):

@@ -1,5 +1,6 @@
 """``parksteer assist size``: the rack force a car needs at standstill and creeping, and the assist that keeps the
-driver's torque under a target (parksteer.sweep.assist_sizing)."""
+driver's torque under a target (parksteer.sweep.assist_sizing). ``parksteer assist identify``: an electric assist's
+boost table and its gear's hidden numbers from the car's own records (parksteer.diagnose.assist_identify)."""
 
 from __future__ import annotations
 
@@ -10,6 +11,7 @@ from pathlib import Path
 from ..errors import UsageError
 from ..parameters import DEFAULT_PATH
 from ..vehicle import ASSIST_EFFECTS, MAX_CREEPING_SPEED_KMH
+from .measure import add_import_options, channel_map_of
 from .vehicle import parameters_of
 
 
@@ -33,6 +35,54 @@ def register(sub) -> None:
     s.add_argument("--out-dir", required=True, help="folder for sizing.csv and the two figures")
     s.add_argument("--parameters", default=str(DEFAULT_PATH), help="the base parameter file")
     s.set_defaults(func=_size)
+    i = asub.add_parser("identify", help="an electric assist's boost table, motor friction, product k_t eta N and "
+                                         "torque-sensor offset from the car's records (torsion-bar torque and motor "
+                                         "current), written into the vehicle file")
+    i.add_argument("files", nargs="+", metavar="FILE",
+                   help="records of the car (native CSV, a logger's CSV, MDF or a CAN log with --bus/--dbc), each with "
+                        "the torsion-bar torque, the motor current and a rack or handwheel angle")
+    i.add_argument("--vehicle", required=True, metavar="FILE.toml",
+                   help="the vehicle file: its [assist] gives the gear's data (its boost curve is not used)")
+    i.add_argument("--out", required=True, metavar="OUT.toml", help="the vehicle file written with what was identified")
+    i.add_argument("--case", default=None, help="the load case of every record (default: each record's own)")
+    i.add_argument("--surface", default=None, help="the surface of records that do not state one")
+    add_import_options(i)
+    i.add_argument("--json", action="store_true", help="print what was identified as JSON on stdout")
+    i.add_argument("--quiet", action="store_true", help="no progress lines")
+    i.set_defaults(func=_identify)
+
+
+def _identify(args) -> int:
+    import json
+    import sys
+
+    from ..diagnose.assist_identify import identify_boost
+    from ..vehicle import load_vehicle
+
+    out = Path(args.out)
+    if out.resolve() == Path(args.vehicle).resolve():
+        raise UsageError(f"--out {args.out}: the vehicle file given; write the identified file beside it")
+    if out.is_dir() or not out.resolve().parent.is_dir():
+        raise UsageError(f"--out {args.out}: name a file in an existing folder")
+    found = identify_boost(args.files, args.vehicle, args.case, args.surface, channel_map_of(args), quiet=args.quiet)
+    text = found.to_vehicle_toml(Path(args.vehicle).read_text(encoding="utf-8"))
+    # the written file must load as the vehicle it describes, or nothing is written
+    import tempfile
+
+    with tempfile.TemporaryDirectory() as folder:
+        probe = Path(folder) / out.name
+        probe.write_text(text, encoding="utf-8")
+        from ..model.numeric.assist import check_assist
+
+        check_assist(load_vehicle(probe))
+    out.write_text(text, encoding="utf-8")
+    if args.json:
+        json.dump(found.as_dict(), sys.stdout, indent=1)
+        sys.stdout.write("\n")
+    else:
+        print("\n".join(found.summary_lines()))
+    print(f"wrote {out}", file=sys.stderr if args.json else sys.stdout)
+    return 0
 
 
 def _speeds(text: str) -> tuple[float, ...]:

@@ -70,6 +70,29 @@ def _identification_lines(result: dict) -> list[str]:
     return lines
 
 
+def _assumed_lines(assumed: dict) -> list[str]:
+    """The assist's assumed values, each at its band's ends: the calibrated fit's RMS over the floor and the verdict
+    there (parksteer.diagnose.stages.assumed)."""
+    nominal = assumed["nominal"]
+    rows = assumed["quantities"]
+    if not rows:
+        return ["The vehicle file assumes none of the assist's values the model uses."]
+    deciding = [r["quantity"] for r in rows if r["decides"]]
+    lines = [f"Each value the vehicle file takes as assumed, replayed at the ends of its band (the calibrated fit "
+             f"refitted to first order; as it stands {num(nominal['calibrated_over_floor'])} noise floors, verdict "
+             f"{nominal['verdict']}). "
+             + (f"The verdict depends on {', '.join(f'`{q}`' for q in deciding)}: give its value (a data sheet, "
+                "`parksteer assist identify`) before trusting it." if deciding else
+                "No end of any band changes the verdict."), "",
+             "| quantity | value | band | over floor at its ends | verdict at its ends |", "|---|---|---|---|---|"]
+    for r in rows:
+        ends = r["ends"]
+        lines.append(f"| {r['quantity']} | {num(r['value'], 4)} | {num(r['band'][0], 4)} to {num(r['band'][1], 4)} | "
+                     f"{num(ends[0]['calibrated_over_floor'])}, {num(ends[1]['calibrated_over_floor'])} | "
+                     f"{ends[0]['verdict']}, {ends[1]['verdict']}{' (decides)' if r['decides'] else ''} |")
+    return lines
+
+
 def markdown_report(result: dict, figure: str | None = None, user_figure: str | None = None) -> str:
     """A readable report of the JSON of a diagnosis (`figure`: the diagnosis's figure to link; `user_figure`: that of
     a user's effect in the model)."""
@@ -159,6 +182,8 @@ def markdown_report(result: dict, figure: str | None = None, user_figure: str | 
             lines.append(line)
     if result.get("identification"):
         lines += ["", "## What these data fix", ""] + [f"- {line}" for line in _identification_lines(result)]
+    if result.get("assumed"):
+        lines += ["", "## What the verdict owes to the assist's assumed values", ""] + _assumed_lines(result["assumed"])
     if result["unobservable"]:
         lines += ["", f"Unobservable in these data as replayed (even the largest strength moves the replayed torque "
                   f"by less than a tenth of the noise floor): {', '.join(result['unobservable'])}."]

@@ -171,6 +171,8 @@ def diagnosis_dict(diagnosis: Diagnosis) -> dict:
             "attainable_floor_rad": calibrated["angle"]["attainable_floor_rad"],
             "offset_fitted": diagnosis.settings.angle_offset_fitted,
         }
+    if diagnosis.outputs.get("assumed") is not None:  # an assisted car's assumed values (stages/assumed.py)
+        out["assumed"] = diagnosis.outputs["assumed"]
     if "signature" in diagnosis.outputs:  # the residual's signature (stages/signature.py)
         out["signature"] = diagnosis.outputs["signature"].as_dict()
     if "user_effect" in diagnosis.outputs:  # a user's effect with free strengths (stages/user_effect.py)

@@ -71,6 +71,9 @@ class DiagnosisSettings:
     # a current channel of 0.1 A resolution reads the torsion bar to about 0.01 N m, and it fixes the law itself (its
     # gain, the sensor's zero). Off, or without an assist or such a channel, a diagnosis is the torque's alone.
     use_motor_channel: bool = True
+    # An assisted car: each value of its [assist] the vehicle file takes as assumed replayed at its band's ends, and
+    # the verdict there (parksteer.diagnose.stages.assumed: four replays a quantity). Off, the stage adds nothing.
+    assumed_values_replayed: bool = True
 
     # --- the torque channel's lag (parksteer.diagnose.stages.torque_lag) ---------------------------------------
     # A logger's torque channel may run behind its rack channel (a sensor's or an amplifier's filter delay,

@@ -26,6 +26,7 @@ the JSON). Settings the stage needs go in :class:`parksteer.diagnose.settings.Di
 
 from __future__ import annotations
 
+from .assumed import AssumedValues
 from .base import Stage, restart, run_table
 from .calibrate import Calibrate
 from .confound import Confound
@@ -47,6 +48,7 @@ STAGES: tuple[Stage, ...] = (
     Refit(),  # the best-scored few refitted in the full model
     Select(),  # their BIC gains over the effective sample size (again with the larger replay uncertainty)
     Verdict(),  # missing, adequate or unexplained
+    AssumedValues(),  # an assisted car: the verdict with each assumed value of its assist at its band's ends
     Separate(),  # where the indistinguishable candidates would differ
     Identify(),  # what these data fix, and the test that would fix the rest
     Confound(),  # where the confounded candidates would show

@@ -1,0 +1,161 @@
+"""What the verdict owes to the assist's assumed values: each one moved to the ends of its band, the verdict again.
+
+An assisted car's file gives some of its gear's numbers from a data sheet or from ``parksteer assist identify``,
+and takes the rest from the effect's defaults (the motor's friction and rotor, the gear's efficiencies, the
+corners the boost line and the motor limit are smoothed over...). On an assisted car's bus the torsion-bar torque is
+clean enough that a default harmless on a manual car's records decides the verdict. So for every quantity of the
+assist whose source in the vehicle file is ``assumed`` or ``numerical`` (or that the file leaves to the effect's
+default) and that the model uses, this stage replays the final comparison with it at each end of its band
+(:data:`BANDS`: the range the quantity's own source gives) and gives the verdict those replays would have: the
+calibrated model and the best candidate's refit each replayed with the value moved, their residuals refitted to
+first order (projected off the fit's Jacobian columns: the calibrated parameters take up what they can), and
+:func:`~parksteer.diagnose.stages.verdict.choose_verdict` on the calibrated model's RMS over the floor, the
+candidate's BIC gain and the fraction of the excess it explains. A quantity whose band's end changes the verdict
+*decides* it: the report says it was assumed, and by how much the calibrated fit moves (in noise floors). Where
+``parksteer assist identify`` fixed the product k_t eta_f N, the efficiency and the reduction are moved with the
+products the data fixed held (:func:`moved`).
+
+Four replays a quantity (two ends, the calibrated model and the best candidate's), none for a car without an
+assist. Quantities the data calibrate (the candidates' strengths, the calibrated parameters) are not here: the
+diagnosis fits them.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ...model.symbolic.components import power_assist_of
+from ..engine import ReplayEngine
+from ..state import DiagnosisState
+from ..statistics import bic_gain
+from .base import Stage
+from .verdict import choose_verdict, trimmed_rms
+
+# The band of each assumed quantity of an electric assist (low, high), as its own source gives it
+# (parksteer.model.symbolic.effects.electric_assist); the numerical smoothings' from a fifth of a bus's torque step
+# (0.01 N m) to the default.
+BANDS = {
+    "motor_friction_torque": (0.01, 0.05),  # 0.01-0.05 N m for EPS motors (Harrer & Pfeffer, ch. 8.6)
+    "motor_inertia": (1.0e-4, 5.0e-4),  # brushless EPS rotors 1-5e-4 kg m^2 (ch. 8.6)
+    "efficiency": (0.75, 0.90),  # worm gears of EPS 0.75-0.9 (Kim, Mech. Sci. 9, 201, 2018)
+    "back_efficiency": (0.75, 0.85),  # a back-driven worm, 0.75-0.85 (Shigley, ch. 13)
+    "torsion_bar_stiffness": (85.0, 170.0),  # EPS torsion bars 1.5-3 N m/deg (ch. 8.5)
+    "torque_constant": (0.03, 0.07),  # 12 V EPS motors 0.03-0.07 N m/A (ch. 8.6)
+    "motor_torque_limit": (3.0, 6.0),  # EPS motors 3-6 N m peak (ch. 8.6)
+    "limit_smoothing": (0.002, 0.05),  # numerical
+    "dead_band_smoothing": (0.002, 0.05),  # numerical: the boost line's corner
+    "gain": (4.0, 10.0),  # the parking gain of EPS boost curves (ch. 8.2)
+    "dead_band": (0.3, 1.5),  # published EPS boost curves (ch. 8.2)
+}
+BACK_EFFICIENCY_RACK = (0.80, 0.90)  # a back-driven ball nut (its forward 0.9-0.95)
+REDUCTION = {"column": (15.0, 22.0), "pinion": (15.0, 25.0), "rack": (1500.0, 3500.0)}  # worm 15-22:1 (15-25:1 at
+# the pinion), ball nut and belt 1500-3500 rad/m (ch. 8.3, 8.4)
+# The boost line's quantities, unused when the file's [assist.boost] table gives the curve.
+LINE_KEYS = ("gain", "dead_band", "dead_band_smoothing")
+
+
+def assumed_quantities(params, name: str, effect) -> list[tuple[str, float, str, tuple[float, float]]]:
+    """(key, value, source, band) of each quantity of the assist `name` the file takes as assumed (module
+    docstring), in the effect's order."""
+    table = any(params.sections.get(name, {}).get(k, 0.0) for k in params.sections.get(name, {})
+                if k.startswith("boost_assist_"))
+    out = []
+    for q in effect.quantities:
+        key = q.name
+        if (key not in BANDS and key != "reduction_ratio") or (table and key in LINE_KEYS):
+            continue
+        source = params.sources.get(f"{name}.{key}", "the effect's default")
+        if not source.startswith(("assumed", "numerical", "the effect's default")):
+            continue
+        band = BANDS.get(key)
+        if key == "reduction_ratio":
+            band = REDUCTION[name.rsplit("_", 1)[1]]
+        elif key == "back_efficiency" and name.endswith("_rack"):
+            band = BACK_EFFICIENCY_RACK
+        out.append((key, float(params[f"{name}.{key}"]), source, band))
+    return out
+
+
+def moved(params, name: str, key: str, value: float) -> dict[str, float]:
+    """The overrides that move `key` of the assist `name` to `value`, holding what the data fixed. Where a value
+    was identified (``parksteer assist identify``: its source says so), the column balance fixed a product, not
+    its factors: the product k_t eta_f N (the torque constant), the back-driven delivery N k_t / eta_b per ampere
+    (eta_f eta_b, with the torque constant held), the rotor's reflected inertia N^2 J_m and friction N T_f. Moving
+    the efficiency or the reduction keeps each identified product, its other factor taking up the rest."""
+    v = lambda k: float(params[f"{name}.{k}"])  # noqa: E731
+    fixed = lambda k: params.sources.get(f"{name}.{k}", "").startswith("identified")  # noqa: E731
+    out = {f"{name}.{key}": value}
+    if key == "efficiency":
+        if fixed("torque_constant"):
+            out[f"{name}.torque_constant"] = v("torque_constant") * v("efficiency") / value
+        if fixed("back_efficiency"):
+            out[f"{name}.back_efficiency"] = min(v("back_efficiency") * v("efficiency") / value, 1.0)
+    elif key == "reduction_ratio":
+        ratio = v("reduction_ratio") / value
+        if fixed("torque_constant"):
+            out[f"{name}.torque_constant"] = v("torque_constant") * ratio
+        if fixed("motor_inertia"):
+            out[f"{name}.motor_inertia"] = v("motor_inertia") * ratio * ratio
+        if fixed("motor_friction_torque"):
+            out[f"{name}.motor_friction_torque"] = v("motor_friction_torque") * ratio
+    return out
+
+
+def _refitted_rss(fit, problem, moved: list[np.ndarray]) -> tuple[float, np.ndarray]:
+    """The weighted RSS of `fit` with its model moved to `moved`, refitted to first order on its Jacobian."""
+    change = problem.scale([m - p for m, p in zip(moved, fit.predictions)])
+    weighted = fit.weighted - change
+    if fit.jacobian.size:
+        step, *_ = np.linalg.lstsq(fit.jacobian, weighted, rcond=None)
+        weighted = weighted - fit.jacobian @ step
+    return float(weighted @ weighted), weighted
+
+
+class AssumedValues(Stage):
+    name = "assumed"
+
+    def message(self, state: DiagnosisState) -> str | None:
+        if power_assist_of(state.base) is None or not state.settings.assumed_values_replayed:
+            return None
+        return "what the verdict owes to the assist's assumed values"
+
+    def run(self, state: DiagnosisState, engine: ReplayEngine) -> DiagnosisState:
+        effect = power_assist_of(state.base)
+        if (effect is None or effect.name == "hydraulic_assist" or state.calibration is None
+                or not state.settings.assumed_values_replayed):
+            return state
+        problem, settings, calibration = state.problem, state.settings, state.calibration
+        problem, settings, calibration = state.problem, state.settings, state.calibration
+        n = problem.n
+        best = state.best_candidate
+        refit = best.refit if best is not None else None
+
+        def verdict_of(base_rss: float, with_fit: tuple[float, np.ndarray] | None) -> dict:
+            delta_bic = after = spread = explained = None
+            if with_fit is not None:
+                with_rss, with_weighted = with_fit
+                delta_bic = bic_gain(base_rss, with_rss, state.n_eff or n, 1)
+                after = math.sqrt(with_rss / n)
+                spread = trimmed_rms(with_weighted, settings.missing_ceiling_trim)
+                explained = (base_rss - with_rss) / (base_rss - n) if base_rss > n else None
+            return {"calibrated_over_floor": math.sqrt(base_rss / n), "delta_bic": delta_bic,
+                    "verdict": choose_verdict(math.sqrt(base_rss / n), delta_bic, after, explained, settings, spread)}
+
+        # the same rule on the fits as they stand: the reference the moved values are held against
+        nominal = verdict_of(calibration.rss, None if refit is None else (refit.rss, refit.weighted))
+        rows = []
+        for key, value, source, band in assumed_quantities(problem.params, effect.name, effect):
+            full = f"{effect.name}.{key}"
+            ends = []
+            for end in band:
+                change = moved(problem.params, effect.name, key, end)
+                base_rss, _ = _refitted_rss(calibration, problem, engine.predict(
+                    problem, calibration.effects, {**calibration.overrides, **change}))
+                with_fit = None if refit is None else _refitted_rss(refit, problem, engine.predict(
+                    problem, refit.effects, {**refit.overrides, **change}))
+                ends.append({"value": end, **verdict_of(base_rss, with_fit)})
+            rows.append({"quantity": full, "value": value, "source": source, "band": list(band), "ends": ends,
+                         "decides": any(e["verdict"] != nominal["verdict"] for e in ends)})
+        return state.with_output(self.name, {"verdict": state.verdict, "nominal": nominal, "quantities": rows})
