@@ -38,9 +38,11 @@ from .rows import BenchmarkRow
 from ..diagnose.select import diagnose
 from ..diagnose.settings import DEFAULT_SETTINGS, DiagnosisSettings
 
-# The benchmarks' diagnoses: a user's, without the confound tests (where a confounded candidate would show), which
-# change no verdict, name or interval the benchmarks score. bench_variations.py --confound-tests turns them on.
-BENCHMARK_SETTINGS = replace(DEFAULT_SETTINGS, confound_tests=False, residual_signature=False)
+# The benchmarks' diagnoses: a user's, without the stages that only inform a report (the confound tests, the
+# residual's signature, the assist's assumed values at their bands' ends), which change no verdict, name or interval
+# the benchmarks score. bench_variations.py --confound-tests turns the confound tests on.
+BENCHMARK_SETTINGS = replace(DEFAULT_SETTINGS, confound_tests=False, residual_signature=False,
+                             assumed_values_replayed=False)
 
 # The base parameters of a benchmark record are perturbed by these relative 1-sigma fractions (in this order, which
 # sets the random draws); the pipeline's in-class benchmark reads the same from config/config.yaml
