@@ -42,7 +42,7 @@ from ..diagnose.report import diagnosis_dict
 from ..diagnose.select import diagnose
 from ..errors import UsageError
 from ..measure.io import format_measurement, write_measurement
-from ..parameters import Parameters
+from ..parameters import Parameters, load_parameters
 from ..synthetic.assisted_truth import (HIDDEN_TRUTH, OUT_OF_CLASS_TRUTH, Hidden, TruthGear, TruthLogger, TruthMap,
                                         manual_road, truth_clean, truth_record, with_hidden)
 from ..synthetic.datasets import SizeSearch, perturbed_base, rms_difference, strength_for_rms
@@ -87,6 +87,7 @@ class TruthDesign:
                                                     ("gear_backlash", 3.0), ("current_friction", 3.0))
     out_of_class_variations: tuple[str, ...] = ("uneven_strokes",)
     routes: tuple[str, ...] = ("map",)
+    baseline_variation: str = "rest_after_stop"
     seed: int = 4242
 
 
@@ -312,13 +313,35 @@ def describe(design: TruthDesign) -> dict:
             "gear": {k: getattr(g, k) for k in g.__dataclass_fields__},
             "torque_steps_Nm": [TruthLogger(torque_bits=b_, torque_full_scale_Nm=f).torque_step
                                 for b_, f in design.torque_converters],
-            "torque_noise_Nm": design.torque_noise_Nm, "current_noise_A": design.current_noise_A}
+            "torque_noise_Nm": design.torque_noise_Nm, "current_noise_A": design.current_noise_A,
+            "owner_file": {"motor_friction_Nm": _template_default("motor_friction_torque"),
+                           "friction_smoothing_s_per_m": float(load_parameters()["steering.friction_smoothing"])}}
 
 
-# The files a diagnosis can be given, by route: the owner's file with the map point by point ("map"). A route
-# "identified" (the file written by the assist's identification from the baseline null record of the tier) is one
-# function of this table: (owner, baseline record path, folder) -> Owner.
+def _template_default(key: str) -> float:
+    """The assumed default of the column assist's quantity `key` (what the owner's file keeps)."""
+    from ..model.symbolic.components import discover_effects
+
+    effect = discover_effects()["electric_assist_column"]
+    return float(next(q.default for q in effect.quantities if q.name == key))
+
+
+# The files a diagnosis can be given, by route: route -> (owner, baseline, folder) -> Owner, with `owner` the
+# owner's file (:func:`owner_file`), `baseline` the path of the tier's baseline record (a null of the truth's car
+# on ``TruthDesign.baseline_variation``, made apart from the cases) and `folder` a scratch folder. "map": the
+# owner's file as it is. A route that identifies the assist from the baseline (the file `parksteer assist
+# identify` writes, read as an Owner) is one more entry; its baseline is made only when a route of the design
+# is in BASELINE_ROUTES.
 ROUTES = {"map": lambda owner, baseline, folder: owner}
+BASELINE_ROUTES: set[str] = set()
+
+
+def baseline_record(params: Parameters, design: TruthDesign, tier: str):
+    """The tier's baseline record: a null of the truth's car on ``design.baseline_variation`` (the record an
+    owner logs first, from which a route may identify the assist), its seed apart from every case's."""
+    case = TruthCase(f"{tier}__baseline", tier, "null", design.baseline_variation, None, None,
+                     design.torque_converters[-1], _seed(design, design.baseline_variation) + 77)
+    return case_truth_and_record(params, design, case)[1]
 
 
 def run(params: Parameters, base_path: str | Path, design: TruthDesign = TruthDesign(), only=None,
@@ -332,6 +355,17 @@ def run(params: Parameters, base_path: str | Path, design: TruthDesign = TruthDe
     rows = []
     with tempfile.TemporaryDirectory() as folder:
         owner = owner_file(base_path, design, folder)
+        given: dict[tuple[str, str], Owner] = {}
+
+        def file_for(route: str, tier: str) -> Owner:
+            if (route, tier) not in given:
+                baseline = None
+                if route in BASELINE_ROUTES:
+                    baseline = Path(folder) / f"baseline_{tier}.csv"
+                    _write(baseline, baseline_record(params, design, tier), owner.params)
+                given[route, tier] = ROUTES[route](owner, baseline, folder)
+            return given[route, tier]
+
         for case in cases(design):
             if only and case.name not in only:
                 continue
@@ -341,10 +375,10 @@ def run(params: Parameters, base_path: str | Path, design: TruthDesign = TruthDe
             _write(path, record, owner.params)
             made = time.perf_counter()
             for route in design.routes:
-                given = ROUTES[route](owner, None, folder)
+                file = file_for(route, case.tier)
                 began = time.perf_counter()
-                files = load_files([path], given.params, assist=given.assist)
-                result = diagnosis_dict(diagnose(files, given.params, given.effects, settings=BENCHMARK_SETTINGS))
+                files = load_files([path], file.params, assist=file.assist)
+                result = diagnosis_dict(diagnose(files, file.params, file.effects, settings=BENCHMARK_SETTINGS))
                 result["cost"]["wall_s"] = time.perf_counter() - began
                 row = outcome(truth, result)
                 row["route"] = route
@@ -428,5 +462,6 @@ def design_from_config(section: dict | None) -> TruthDesign:
     return design
 
 
-__all__ = ["ROUTES", "TruthCase", "TruthDesign", "case_names", "case_truth_and_record", "cases", "design_from_config",
-           "outcome", "owner_vehicle_text", "read_rows", "run", "run_batch", "summarise"]
+__all__ = ["BASELINE_ROUTES", "ROUTES", "TruthCase", "TruthDesign", "baseline_record", "case_names",
+           "case_truth_and_record", "cases", "design_from_config", "outcome", "owner_vehicle_text", "read_rows", "run",
+           "run_batch", "summarise"]
