@@ -26,6 +26,7 @@ backlash, a friction that grows with the motor's torque) must never be named wit
 
 from __future__ import annotations
 
+import importlib.util
 import json
 import math
 import re
@@ -334,6 +335,29 @@ def _template_default(key: str) -> float:
 # is in BASELINE_ROUTES.
 ROUTES = {"map": lambda owner, baseline, folder: owner}
 BASELINE_ROUTES: set[str] = set()
+
+
+def identified_route(owner: Owner, baseline: Path, folder: str | Path) -> Owner:
+    """The file `parksteer assist identify` writes from the tier's baseline record and the owner's file (its
+    gear's data; its map is not used): the identified table, the product k_t eta_f N, the motor friction."""
+    from ..diagnose.assist_identify import identify_boost
+    from ..model.numeric.assist import effects_with_assist
+    from ..model.symbolic.components import resolve_effects
+    from ..vehicle import vehicle_from_text
+
+    source = Path(folder) / "owner.toml"
+    found = identify_boost([baseline], source, case=None)
+    path = Path(folder) / f"identified_{Path(baseline).stem}.toml"
+    text = found.to_vehicle_toml(source.read_text(encoding="utf-8"))
+    path.write_text(text, encoding="utf-8")
+    params = vehicle_from_text(text, path)
+    spec = effects_with_assist(None, params)
+    return Owner(params, spec.lstrip("+"), resolve_effects(spec))
+
+
+if importlib.util.find_spec("parksteer.diagnose.assist_identify") is not None:  # the identification, where built
+    ROUTES["identified"] = identified_route
+    BASELINE_ROUTES.add("identified")
 
 
 def baseline_record(params: Parameters, design: TruthDesign, tier: str):
