@@ -11,7 +11,10 @@ rungs change the truth, not the file, one owner-unknown at a time:
 - ``as_is``: the benchmark's truth;
 - ``friction``: the truth's rotor friction the file's 0.02 N m;
 - ``band``: the truth's friction and direction band 2.25 rad/s (as wide as the model's smoothing);
-- ``both``: both.
+- ``both``: both;
+- ``model``: the nulls made by the model's own assisted replay (the Polo file's assist, its table) on the same hands,
+  logged by the same loggers (rack, or the handwheel angle through the column and the torsion bar in series), and
+  diagnosed with the Polo file: what the method does when the file is the truth.
 
 Each rung diagnoses the same cases (nulls on the benchmark's eight hands, the four hidden candidates at 4 floors on
 one hand; `--tiers rack,angle`), about 5 s a case. Run:
@@ -44,7 +47,7 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser()
     parser.add_argument("out", nargs="?")
     parser.add_argument("--tiers", default="rack,angle")
-    parser.add_argument("--rungs", default="as_is,friction,band,both")
+    parser.add_argument("--rungs", default="as_is,friction,band,both,model")
     args = parser.parse_args(argv)
     discover_effects()
     vehicle = ROOT / "data" / "vehicles" / "polo_vi.toml"
@@ -53,6 +56,11 @@ def main(argv=None) -> int:
                        out_of_class_variations=())
     out = {}
     for name in args.rungs.split(","):
+        if name == "model":
+            out[name] = model_nulls(params, base)
+            for tier, counts in out[name].items():
+                print(f"{name:9s} {tier:6s} nulls adequate {counts[0]}/{counts[1]}", flush=True)
+            continue
         design = replace(base, gear=rungs(base.gear)[name])
         rows, summary = run(params, vehicle, design)
         out[name] = {tier: {"named": s["targets"]["named"]["count"],
@@ -67,6 +75,48 @@ def main(argv=None) -> int:
     if args.out:
         Path(args.out).write_text(json.dumps(out, indent=1), encoding="utf-8")
     return 0
+
+
+def model_nulls(params, design) -> dict:
+    """{tier: [adequate, nulls]} of the model's own assisted records on the design's null hands and loggers."""
+    import tempfile
+
+    from parksteer.diagnose.problem import load_files
+    from parksteer.diagnose.report import diagnosis_dict
+    from parksteer.diagnose.select import diagnose
+    from parksteer.experiments.assisted_truth import _logger, _write, cases
+    from parksteer.experiments.benchmark import BASE_PERTURBATION, BENCHMARK_SETTINGS
+    from parksteer.geometry import column_twist
+    from parksteer.model.numeric.assist import effects_with_assist
+    from parksteer.model.symbolic.components import resolve_effects
+    from parksteer.synthetic.assisted import assisted_clean
+    from parksteer.synthetic.assisted_truth import column_of_pinion, truth_record
+    from parksteer.synthetic.datasets import perturbed_base
+    from parksteer.synthetic.variations import variation_by_name
+
+    spec = effects_with_assist(None, params)
+    effects, name = resolve_effects(spec), spec.lstrip("+")
+    s = params.sections["steering"]
+    k, c, bar = s["column_torsional_stiffness"], s["column_torsional_damping"], params[f"{name}.torsion_bar_stiffness"]
+    series = k * bar / (k + bar)
+    out: dict[str, list[int]] = {}
+    with tempfile.TemporaryDirectory() as folder:
+        for case in (c_ for c_ in cases(design) if c_.kind == "null"):
+            hand, _ = variation_by_name(case.variation).settings(case.seed)
+            base = perturbed_base(params, case.seed, BASE_PERTURBATION)
+            clean = assisted_clean(params, hand, spec, design.case, overrides=base, dt_s=0.002)
+            theta_c = column_of_pinion(s["handwheel_to_rack_ratio"] * clean["rack_m"], s["hooke_joint_angle"],
+                                       s["hooke_joint_phase"])
+            twist, _ = column_twist(clean["time_s"], clean["handwheel_torque_Nm"], series, c * series / k)
+            clean["handwheel_angle_rad"] = theta_c + twist
+            path = Path(folder) / f"{case.name}.csv"
+            _write(path, truth_record(clean, _logger(design, case), design.case), params)
+            result = diagnosis_dict(diagnose(load_files([path], params, assist=name), params, effects,
+                                             settings=BENCHMARK_SETTINGS))
+            counts = out.setdefault(case.tier, [0, 0])
+            counts[0] += result["verdict"] == "adequate"
+            counts[1] += 1
+    return out
 
 
 if __name__ == "__main__":
