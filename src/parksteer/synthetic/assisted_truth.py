@@ -46,7 +46,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from .. import portable as pm
-from ..geometry import column_twist, pinion_angle_from_column
+from ..geometry import column_twist
 from ..measure.converter import add_noise, quantisation_step, quantise
 from ..measure.io import Measurement, metadata_text
 from ..parameters import Parameters
