@@ -63,6 +63,14 @@ def diagnosis(config: dict, parameters_path: str, user_effect: str) -> dict:
     }
 
 
+def assisted_truth_cases(section: dict | None = None) -> list[str]:
+    """The case names of the assisted benchmark on an independent truth (parksteer.experiments.assisted_truth), in
+    its order, of the design config["assisted_truth"] gives (each case keeps its own seed and converter)."""
+    from .experiments.assisted_truth import case_names, design_from_config
+
+    return case_names(design_from_config(section))
+
+
 def assisted_cases(section: dict | None = None) -> list[str]:
     """The case names of the assisted benchmark (parksteer.experiments.assisted_benchmark), in its order: the full
     design's, or those of the hands config["assisted_benchmark"] keeps (each case keeps its own seed, so a kept

@@ -29,6 +29,7 @@ FIGURES = {
     "rivals": ["figures/rivals.svg", "figures/rivals.csv"],
     "assist_study": ["figures/assist_study.svg", "figures/assist_study.csv"],
     "diag_assisted": ["figures/diag_assisted.svg", "figures/diag_assisted.csv"],
+    "diag_assisted_truth": ["figures/diag_assisted_truth.svg", "figures/diag_assisted_truth.csv"],
 }
 
 

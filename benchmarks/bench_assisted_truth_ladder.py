@@ -1,0 +1,123 @@
+"""What decides the assisted diagnosis on the independent truth: the owner's file against truths that share more
+with it.
+
+The assisted benchmark on an independent truth (parksteer.experiments.assisted_truth) diagnoses its records with
+the owner's file: the gear's data sheet and the map point by point, the motor's friction at the template's assumed
+0.02 N m. The truth's own rotor friction is 0.012 N m, Coulomb saturated linearly below 1 rad/s of the rotor, and its
+worm passes from driving to back-driven over the same 1 rad/s (0.4 mm/s of the rack); the model's frictions and its
+gear's direction pass over tanh(1000 s/m x rack speed), about 1 mm/s of the rack (2.25 rad/s of this rotor). The
+rungs change the truth, not the file, one owner-unknown at a time:
+
+- ``as_is``: the benchmark's truth;
+- ``friction``: the truth's rotor friction the file's 0.02 N m;
+- ``band``: the truth's friction and direction band 2.25 rad/s (as wide as the model's smoothing);
+- ``both``: both;
+- ``model``: the nulls made by the model's own assisted replay (the Polo file's assist, its table) on the same hands,
+  logged by the same loggers (rack, or the handwheel angle through the column and the torsion bar in series), and
+  diagnosed with the Polo file: what the method does when the file is the truth.
+
+Each rung diagnoses the same cases (nulls on the benchmark's eight hands, the four hidden candidates at 4 floors on
+one hand; `--tiers rack,angle`), about 5 s a case. Run:
+
+    PYTHONPATH=src python benchmarks/bench_assisted_truth_ladder.py [--tiers rack] [out.json]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from dataclasses import replace
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def rungs(gear):
+    return {"as_is": gear, "friction": replace(gear, motor_friction_Nm=0.02),
+            "band": replace(gear, friction_speed_rad_s=2.25, direction_speed_rad_s=2.25),
+            "both": replace(gear, motor_friction_Nm=0.02, friction_speed_rad_s=2.25, direction_speed_rad_s=2.25)}
+
+
+def main(argv=None) -> int:
+    from parksteer.experiments.assisted_truth import TruthDesign, run
+    from parksteer.model.symbolic.components import discover_effects
+    from parksteer.vehicle import load_vehicle
+
+    parser = argparse.ArgumentParser()
+    parser.add_argument("out", nargs="?")
+    parser.add_argument("--tiers", default="rack,angle")
+    parser.add_argument("--rungs", default="as_is,friction,band,both,model")
+    args = parser.parse_args(argv)
+    discover_effects()
+    vehicle = ROOT / "data" / "vehicles" / "polo_vi.toml"
+    params = load_vehicle(vehicle)
+    base = TruthDesign(tiers=tuple(args.tiers.split(",")), hidden_variations=("uneven_strokes",), floors=(4.0,),
+                       out_of_class_variations=())
+    out = {}
+    for name in args.rungs.split(","):
+        if name == "model":
+            out[name] = model_nulls(params, base)
+            for tier, counts in out[name].items():
+                print(f"{name:9s} {tier:6s} nulls adequate {counts[0]}/{counts[1]}", flush=True)
+            continue
+        design = replace(base, gear=rungs(base.gear)[name])
+        rows, summary = run(params, vehicle, design)
+        out[name] = {tier: {"named": s["targets"]["named"]["count"],
+                            "null_adequate": s["targets"]["null_adequate"]["count"],
+                            "false_alarms": [f"{a['name']}: {a['verdict']} {a['effect']}" for a in s["false_alarms"]],
+                            "missed": [f"{m['name']}: {m['verdict']} {m['effect']}" for m in s["missed"]]}
+                     for tier, s in summary["routes"]["map"].items()}
+        for tier, s in out[name].items():
+            print(f"{name:9s} {tier:6s} named {s['named'][0]}/{s['named'][1]}  nulls adequate "
+                  f"{s['null_adequate'][0]}/{s['null_adequate'][1]}  false alarms: {'; '.join(s['false_alarms'])}",
+                  flush=True)
+    if args.out:
+        Path(args.out).write_text(json.dumps(out, indent=1), encoding="utf-8")
+    return 0
+
+
+def model_nulls(params, design) -> dict:
+    """{tier: [adequate, nulls]} of the model's own assisted records on the design's null hands and loggers."""
+    import tempfile
+
+    from parksteer.diagnose.problem import load_files
+    from parksteer.diagnose.report import diagnosis_dict
+    from parksteer.diagnose.select import diagnose
+    from parksteer.experiments.assisted_truth import _logger, _write, cases
+    from parksteer.experiments.benchmark import BASE_PERTURBATION, BENCHMARK_SETTINGS
+    from parksteer.geometry import column_twist
+    from parksteer.model.numeric.assist import effects_with_assist
+    from parksteer.model.symbolic.components import resolve_effects
+    from parksteer.synthetic.assisted import assisted_clean
+    from parksteer.synthetic.assisted_truth import column_of_pinion, truth_record
+    from parksteer.synthetic.datasets import perturbed_base
+    from parksteer.synthetic.variations import variation_by_name
+
+    spec = effects_with_assist(None, params)
+    effects, name = resolve_effects(spec), spec.lstrip("+")
+    s = params.sections["steering"]
+    k, c, bar = s["column_torsional_stiffness"], s["column_torsional_damping"], params[f"{name}.torsion_bar_stiffness"]
+    series = k * bar / (k + bar)
+    out: dict[str, list[int]] = {}
+    with tempfile.TemporaryDirectory() as folder:
+        for case in (c_ for c_ in cases(design) if c_.kind == "null"):
+            hand, _ = variation_by_name(case.variation).settings(case.seed)
+            base = perturbed_base(params, case.seed, BASE_PERTURBATION)
+            clean = assisted_clean(params, hand, spec, design.case, overrides=base, dt_s=0.002)
+            theta_c = column_of_pinion(s["handwheel_to_rack_ratio"] * clean["rack_m"], s["hooke_joint_angle"],
+                                       s["hooke_joint_phase"])
+            twist, _ = column_twist(clean["time_s"], clean["handwheel_torque_Nm"], series, c * series / k)
+            clean["handwheel_angle_rad"] = theta_c + twist
+            path = Path(folder) / f"{case.name}.csv"
+            _write(path, truth_record(clean, _logger(design, case), design.case), params)
+            result = diagnosis_dict(diagnose(load_files([path], params, assist=name), params, effects,
+                                             settings=BENCHMARK_SETTINGS))
+            counts = out.setdefault(case.tier, [0, 0])
+            counts[0] += result["verdict"] == "adequate"
+            counts[1] += 1
+    return out
+
+
+if __name__ == "__main__":
+    sys.exit(main())

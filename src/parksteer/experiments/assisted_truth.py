@@ -1,0 +1,484 @@
+"""The assisted benchmark on an independent truth: records the model's assist did not make, diagnosed with the files
+an owner would have.
+
+The records (:mod:`parksteer.synthetic.assisted_truth`): a column EPS of its own (a progressive power-law map read
+through the torque sensor's steps, a worm gear with eta_f driving and 1 / eta_b back-driven, the rotor's inertia
+and Coulomb friction through the worm) over the manual replay of the Polo file's car, its base parameters moved
+as the other benchmarks move them (``perturbed_base``). Each case has a hand and a logger's rate and rack of the
+variation benchmark (:data:`parksteer.synthetic.variations.VARIATIONS`), a torsion-bar torque on one of the
+design's converters (10 bits on +-10 N m to 0.005 N m steps; the control unit reads the same steps) and a current
+in 0.05 A steps, and one of two tiers: the rack logged, or the handwheel angle only (a bus log: the diagnosis
+derives the rack through the column and the torsion bar, :func:`parksteer.measure.column.rack_from_angle`).
+
+The file the diagnosis is given is the owner's (:func:`owner_vehicle_text`): the Polo file with an ``[assist]``
+from the gear's data sheet (reduction, both efficiencies, torque constant, current limit as motor torque, rotor
+inertia, torsion-bar stiffness) and the map written point by point in ``[assist.boost]`` (the control unit's
+calibration read at the design's torques); what no data sheet gives (the motor's friction) stays at the
+template's assumed default. A second route, the file written from a baseline null record by the identification
+of the assist (``parksteer assist identify``), is one entry of :data:`ROUTES` when that function exists.
+
+Cases and what counts, as in :mod:`.assisted_benchmark`: nulls (``adequate`` right), hidden effects of the truth
+standing for the assisted candidates (the motor's extra friction, the sensor's offset, the map's gain error; the
+rack friction, calibrated: ``adequate`` right), sized by the RMS change of the clean torsion-bar reading in noise
+floors of its channel (noise and rounding, root sum of squares); out-of-class forms (cogging, map hysteresis, worm
+backlash, a friction that grows with the motor's torque) must never be named with confidence unless related.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import re
+import tempfile
+import time
+import zlib
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+
+import numpy as np
+
+from ..diagnose.problem import load_files
+from ..diagnose.report import diagnosis_dict
+from ..diagnose.select import diagnose
+from ..errors import UsageError
+from ..measure.io import format_measurement, write_measurement
+from ..parameters import Parameters, load_parameters
+from ..synthetic.assisted_truth import (HIDDEN_TRUTH, OUT_OF_CLASS_TRUTH, Hidden, TruthGear, TruthLogger, TruthMap,
+                                        manual_road, truth_clean, truth_record, with_hidden)
+from ..synthetic.datasets import SizeSearch, perturbed_base, rms_difference, strength_for_rms
+from ..synthetic.variations import variation_by_name
+from .benchmark import BASE_PERTURBATION, BENCHMARK_SETTINGS
+from .outclass import bic_margin
+from .variations import NAMED_TARGET, NULL_ADEQUATE_TARGET
+
+RACK_FRICTION = "steering.rack_friction_force"
+# The largest size searched for each hidden quantity (its unit the truth's: N m, 1, N, rad).
+UPPER = {"assist_motor_friction": 0.3, "torsion_bar_offset": 1.0, "boost_gain_error": 1.0, "rack_friction": 1500.0,
+         "cogging": 0.5, "boost_hysteresis": 1.0, "gear_backlash": 3.0, "current_friction": 0.8}
+SEARCH = SizeSearch(iterations=4, tolerance=0.05, max_lag_s=0.0)
+# Hidden effects at least this many noise floors RMS count towards the named rate (module docstring).
+NAMED_MIN_FLOORS = 2.0
+TIERS = ("rack", "angle")
+
+
+@dataclass(frozen=True)
+class TruthDesign:
+    """The truth's car (map, gear), the owner's file (the map's points), the loggers' torque converters
+    (bits, full scale), the cases (hands, sizes in noise floors, out-of-class forms), the tiers and the seed."""
+
+    case: str = "kerb"
+    boost: TruthMap = TruthMap()
+    gear: TruthGear = TruthGear()
+    map_points_Nm: tuple[float, ...] = (0.0, 0.4, 0.8, 1.2, 1.6, 2.0, 2.5, 3.0, 4.0)
+    torque_converters: tuple[tuple[int, float], ...] = ((10, 10.0), (11, 10.24), (12, 10.24))
+    # the channels' noise, the assisted benchmark's (parksteer.experiments.assisted_benchmark: relative to the
+    # parking range as the variation benchmark's)
+    torque_noise_Nm: float = 0.03
+    current_noise_A: float = 0.25
+    tiers: tuple[str, ...] = TIERS
+    null_variations: tuple[str, ...] = ("rest_after_stop", "mid_stroke_end", "pauses", "rate_8pc_50Hz",
+                                        "rate_3pc_200Hz", "uneven_strokes", "lock_overshoot",
+                                        "rack_16bit_torque_10bit")
+    null_replicates: int = 1
+    hidden_variations: tuple[str, ...] = ("pauses", "uneven_strokes")
+    hidden: tuple[str, ...] = tuple(HIDDEN_TRUTH)
+    floors: tuple[float, ...] = (2.0, 4.0)
+    out_of_class: tuple[tuple[str, float], ...] = (("cogging", 3.0), ("boost_hysteresis", 3.0),
+                                                    ("gear_backlash", 3.0), ("current_friction", 3.0))
+    out_of_class_variations: tuple[str, ...] = ("uneven_strokes",)
+    routes: tuple[str, ...] = ("map",)
+    baseline_variation: str = "rest_after_stop"
+    seed: int = 4242
+
+
+@dataclass(frozen=True)
+class TruthCase:
+    name: str
+    tier: str
+    kind: str  # null, hidden, outclass
+    variation: str
+    hidden: str | None
+    floors: float | None
+    converter: tuple[int, float]
+    seed: int
+
+
+def cases(design: TruthDesign) -> list[TruthCase]:
+    """Every case of `design`, in a fixed order. A case's seed follows its hand's place in
+    :data:`~parksteer.synthetic.variations.VARIATIONS`, its replicate and its tier, and its torque converter is one
+    of the design's picked by its name: a case kept by a smaller design is the full design's case of that name."""
+    out: list[TruthCase] = []
+    for tier in design.tiers:
+        made: list[tuple] = []
+        for replicate in range(design.null_replicates):
+            for v in design.null_variations:
+                made.append((f"{v}__r{replicate}__null", "null", v, None, None, _seed(design, v, replicate)))
+        for v in design.hidden_variations:
+            for effect in design.hidden:
+                for size in design.floors:
+                    made.append((f"{v}__{effect}_{size:g}", "hidden", v, effect, size, _seed(design, v)))
+        for v in design.out_of_class_variations:
+            for form, size in design.out_of_class:
+                made.append((f"{v}__{form}_{size:g}", "outclass", v, form, size, _seed(design, v)))
+        for name, kind, v, hidden, size, seed in made:
+            converter = design.torque_converters[zlib.crc32(f"{tier}__{name}".encode()) % len(design.torque_converters)]
+            out.append(TruthCase(f"{tier}__{name}__t{converter[0]}", tier, kind, v, hidden, size, converter,
+                                 seed + (500 if tier == "angle" else 0)))
+    return out
+
+
+def _seed(design: TruthDesign, variation: str, replicate: int = 0) -> int:
+    from ..synthetic.variations import VARIATIONS
+
+    names = [v.name for v in VARIATIONS]
+    if variation not in names:
+        raise UsageError(f"assisted truth: no hand {variation!r} (the hands: {', '.join(names)})")
+    return design.seed + 1000 * replicate + 10 * names.index(variation)
+
+
+def case_names(design: TruthDesign = TruthDesign()) -> list[str]:
+    return [c.name for c in cases(design)]
+
+
+def owner_vehicle_text(base_text: str, design: TruthDesign) -> str:
+    """The owner's vehicle file: `base_text` (a column-assisted car's file) with its ``[assist]`` and
+    ``[assist.boost]`` replaced by the gear's data sheet and the map written at ``design.map_points_Nm``; the
+    motor's friction, which no data sheet gives, at the assumed default of the assist template."""
+    from ..model.numeric.assist import assist_template
+
+    g = design.gear
+    sheet = "data sheet of the truth's gear (parksteer.synthetic.assisted_truth.TruthGear)"
+    given = {"torsion_bar_stiffness": (g.torsion_bar_stiffness, sheet), "reduction_ratio": (g.reduction, sheet),
+             "efficiency": (g.efficiency, sheet), "back_efficiency": (g.back_efficiency, sheet),
+             "torque_constant": (g.torque_constant_Nm_per_A, sheet),
+             "motor_torque_limit": (g.torque_constant_Nm_per_A * g.current_limit_A, sheet + ": current limit x k_t"),
+             "motor_inertia": (g.motor_inertia_kg_m2, sheet)}
+    section = assist_template("column", given, table=True)
+    torques = list(design.map_points_Nm)
+    assists = [float(a) for a in design.boost(np.array(torques))]
+    fmt = lambda xs: "[" + ", ".join(repr(round(x, 6)) for x in xs) + "]"  # noqa: E731
+    section += ("\n[assist.boost]\n"
+                f'torsion_bar_torque = {{ value = {fmt(torques)}, unit = "N m", source = "the control unit\'s map, '
+                'read point by point" }\n'
+                f'assist = {{ value = {fmt(assists)}, unit = "N m", source = "the control unit\'s map, read point by '
+                'point" }\n')
+    cut = re.search(r"^(# Power assistance.*\n)?\[assist\]", base_text, flags=re.M)
+    if cut is None:
+        raise UsageError("owner's file: the base vehicle file has no [assist] section")
+    return base_text[:cut.start()] + section
+
+
+@dataclass
+class Owner:
+    """The owner's file read as parameters, its assist effect's name and the effects a diagnosis uses."""
+
+    params: Parameters
+    assist: str
+    effects: list = field(default_factory=list)
+
+
+def owner_file(base_path: str | Path, design: TruthDesign, folder: str | Path) -> Owner:
+    from ..model.numeric.assist import effects_with_assist
+    from ..model.symbolic.components import discover_effects, resolve_effects
+    from ..vehicle import vehicle_from_text
+
+    discover_effects()
+    path = Path(folder) / "owner.toml"
+    text = owner_vehicle_text(Path(base_path).read_text(encoding="utf-8"), design)
+    path.write_text(text, encoding="utf-8")
+    params = vehicle_from_text(text, path)
+    spec = effects_with_assist(None, params)
+    return Owner(params, spec.lstrip("+"), resolve_effects(spec))
+
+
+def _logger(design: TruthDesign, case: TruthCase) -> TruthLogger:
+    base = variation_by_name(case.variation).logger
+    bits, full_scale = case.converter
+    return TruthLogger(sample_rate_hz=base.sample_rate_hz, rack_bits=base.rack_bits if case.tier == "rack" else 0,
+                       rack_noise_m=base.rack_noise_m, torque_bits=bits, torque_full_scale_Nm=full_scale,
+                       torque_noise_Nm=design.torque_noise_Nm, current_noise_A=design.current_noise_A, seed=case.seed)
+
+
+def floor_Nm(logger: TruthLogger) -> float:
+    """The torsion-bar channel's noise floor: its noise and its rounding (step / sqrt 12), root sum of squares."""
+    return math.hypot(logger.torque_noise_Nm, logger.torque_step / math.sqrt(12.0))
+
+
+def case_truth_and_record(params: Parameters, design: TruthDesign, case: TruthCase):
+    """(truth, measurement) of `case` on the car of `params` (the base file's manual part)."""
+    hand, _ = variation_by_name(case.variation).settings(case.seed)
+    logger = _logger(design, case)
+    base = perturbed_base(params, case.seed, BASE_PERTURBATION)
+    road = manual_road(params, hand, design.case, base, rack_friction=case.hidden == "rack_friction")
+
+    def reading(hidden: Hidden) -> np.ndarray:
+        return truth_clean(road, design.boost, design.gear, logger, hidden)["handwheel_torque_Nm"]
+
+    hidden, strength, size = Hidden(), None, 0.0
+    if case.kind != "null":
+        reference = reading(Hidden())
+        of = lambda s: reading(with_hidden(Hidden(), case.hidden, s))  # noqa: E731
+        target = case.floors * floor_Nm(logger)
+        strength = strength_for_rms(of, target, UPPER[case.hidden] * 1e-2, UPPER[case.hidden], SEARCH)
+        hidden = with_hidden(Hidden(), case.hidden, strength)
+        size = rms_difference(of(strength), reference) / floor_Nm(logger)
+    clean = truth_clean(road, design.boost, design.gear, logger, hidden, params)
+    record = truth_record(clean, logger, design.case)
+    true_value = base[RACK_FRICTION] + strength if case.hidden == "rack_friction" else None
+    related = OUT_OF_CLASS_TRUTH[case.hidden][2] if case.kind == "outclass" else ()
+    truth = {"name": case.name, "tier": case.tier, "kind": case.kind, "variation": case.variation,
+             "hidden": case.hidden, "floors_requested": case.floors, "floors": size, "strength": strength,
+             "true_value": true_value, "torque_step_Nm": logger.torque_step, "floor_Nm": floor_Nm(logger),
+             "related": list(related)}
+    return truth, record
+
+
+def outcome(truth: dict, result: dict) -> dict:
+    """How one diagnosis fares: named (hidden), adequate (nulls), confident and confident wrong (out of class)."""
+    missing = result["verdict"] == "missing"
+    named = result["effect"] if missing else None
+    group = [s["effect"] for s in result["indistinguishable"]]
+    row = {k: truth[k] for k in ("name", "tier", "kind", "variation", "floors", "floors_requested", "strength",
+                                 "torque_step_Nm")}
+    row.update({"hidden": truth["hidden"] or "nothing", "verdict": result["verdict"], "effect": named or "",
+                "indistinguishable": " ".join(group),
+                "calibrated_over_floor": result["statistics"]["calibrated"]["weighted_rms_Nm"]
+                / result["noise_floor_Nm"], "wall_s": result["cost"].get("wall_s")})
+    if truth["kind"] == "hidden":
+        if truth["hidden"] == "rack_friction":
+            ci = result["calibrated"][RACK_FRICTION].get("ci95")
+            row["named"] = result["verdict"] == "adequate"
+            row["covered"] = ci is not None and ci[0] <= truth["true_value"] <= ci[1]
+        else:
+            row["named"] = missing and (named == truth["hidden"] or truth["hidden"] in group)
+    elif truth["kind"] == "outclass":
+        margin = bic_margin(result) if named else None
+        band = result["selection"]["thresholds"]["bic_indistinguishable"]
+        related = set(truth["related"])
+        confident = bool(named and margin is not None and margin > band)
+        row["relation"] = ("related" if named in related else "unrelated") if named else result["verdict"]
+        row["bic_margin"] = margin
+        row["confident"] = confident
+        row["confident_wrong"] = confident and named not in related
+    return row
+
+
+def _rate(rows, key, test, target):
+    hit = sum(bool(test(r)) for r in rows)
+    return {"value": hit / len(rows) if rows else None, "count": [hit, len(rows)], "target": target,
+            "met": bool(rows and hit / len(rows) >= target)}
+
+
+def summarise_tier(rows: list[dict]) -> dict:
+    hidden = [r for r in rows if r["kind"] == "hidden" and r["floors"] >= NAMED_MIN_FLOORS * 0.95]
+    nulls = [r for r in rows if r["kind"] == "null"]
+    outclass = [r for r in rows if r["kind"] == "outclass"]
+    wrong = [r["name"] for r in outclass if r["confident_wrong"]]
+    targets = {"named": _rate(hidden, "named", lambda r: r["named"], NAMED_TARGET),
+               "null_adequate": _rate(nulls, "verdict", lambda r: r["verdict"] == "adequate", NULL_ADEQUATE_TARGET),
+               "confident_wrong_out_of_class": {"value": len(wrong), "cases": wrong, "target": 0, "met": not wrong}}
+    return {"records": len(rows), "targets": targets, "target_met": all(t["met"] for t in targets.values()),
+            "named_by_hidden": {h: [sum(r["named"] for r in hidden if r["hidden"] == h),
+                                    sum(r["hidden"] == h for r in hidden)]
+                                for h in dict.fromkeys(r["hidden"] for r in hidden)},
+            "missed": [{k: r[k] for k in ("name", "floors", "verdict", "effect", "indistinguishable")}
+                       for r in hidden if not r["named"]],
+            "false_alarms": [{k: r[k] for k in ("name", "verdict", "effect", "calibrated_over_floor")}
+                             for r in nulls if r["verdict"] != "adequate"],
+            "out_of_class": [{k: r[k] for k in ("name", "floors", "verdict", "effect", "relation", "bic_margin",
+                                                 "confident")} for r in outclass],
+            "out_of_class_not_named": [sum(not r["effect"] for r in outclass), len(outclass)],
+            "rack_friction_covered": [sum(r.get("covered", False) for r in rows if r["hidden"] == "rack_friction"),
+                                      sum(r["hidden"] == "rack_friction" for r in rows)],
+            "null_over_floor": {"min": min(r["calibrated_over_floor"] for r in nulls),
+                                "max": max(r["calibrated_over_floor"] for r in nulls)} if nulls else None}
+
+
+def summarise(rows: list[dict], design: TruthDesign = TruthDesign()) -> dict:
+    """The targets per route and tier (a row's ``route``), and the truth's description."""
+    out = {"records": len(rows), "named_min_floors": NAMED_MIN_FLOORS, "truth": describe(design), "routes": {}}
+    for route in dict.fromkeys(r["route"] for r in rows):
+        out["routes"][route] = {tier: summarise_tier([r for r in rows if r["route"] == route and r["tier"] == tier])
+                                for tier in design.tiers if any(r["tier"] == tier for r in rows)}
+    out["target_met"] = all(t["target_met"] for tiers in out["routes"].values() for t in tiers.values())
+    walls = [r["wall_s"] for r in rows if r["wall_s"] is not None]
+    out["diagnosis_wall_s_median"] = float(np.median(walls)) if walls else None
+    return out
+
+
+def describe(design: TruthDesign) -> dict:
+    b, g = design.boost, design.gear
+    return {"map": {"form": b.form, "dead_band_Nm": b.dead_band_Nm, "scale": b.scale, "exponent": b.exponent,
+                    "width_Nm": b.width_Nm, "points_Nm": list(design.map_points_Nm)},
+            "gear": {k: getattr(g, k) for k in g.__dataclass_fields__},
+            "torque_steps_Nm": [TruthLogger(torque_bits=b_, torque_full_scale_Nm=f).torque_step
+                                for b_, f in design.torque_converters],
+            "torque_noise_Nm": design.torque_noise_Nm, "current_noise_A": design.current_noise_A,
+            "owner_file": {"motor_friction_Nm": _template_default("motor_friction_torque"),
+                           "friction_smoothing_s_per_m": float(load_parameters()["steering.friction_smoothing"])}}
+
+
+def _template_default(key: str) -> float:
+    """The assumed default of the column assist's quantity `key` (what the owner's file keeps)."""
+    from ..model.symbolic.components import discover_effects
+
+    effect = discover_effects()["electric_assist_column"]
+    return float(next(q.default for q in effect.quantities if q.name == key))
+
+
+# The files a diagnosis can be given, by route: route -> (owner, baseline, folder) -> Owner, with `owner` the
+# owner's file (:func:`owner_file`), `baseline` the path of the tier's baseline record (a null of the truth's car
+# on ``TruthDesign.baseline_variation``, made apart from the cases) and `folder` a scratch folder. "map": the
+# owner's file as it is; "identified": the file `parksteer assist identify` writes from the baseline, read as an
+# Owner. The baseline is made only when a route of the design is in BASELINE_ROUTES.
+def identified_route(owner: Owner, baseline: Path, folder: str | Path) -> Owner:
+    """The file `parksteer assist identify` writes from the tier's baseline record and the owner's file (its
+    gear's data; its map is not used): the identified table, the product k_t eta_f N, the motor friction."""
+    from ..diagnose.assist_identify import identify_boost
+    from ..model.numeric.assist import effects_with_assist
+    from ..model.symbolic.components import resolve_effects
+    from ..vehicle import vehicle_from_text
+
+    source = Path(folder) / "owner.toml"
+    found = identify_boost([baseline], source, case=None)
+    path = Path(folder) / f"identified_{Path(baseline).stem}.toml"
+    text = found.to_vehicle_toml(source.read_text(encoding="utf-8"))
+    path.write_text(text, encoding="utf-8")
+    params = vehicle_from_text(text, path)
+    spec = effects_with_assist(None, params)
+    return Owner(params, spec.lstrip("+"), resolve_effects(spec))
+
+
+ROUTES = {"map": lambda owner, baseline, folder: owner, "identified": identified_route}
+BASELINE_ROUTES = {"identified"}
+
+
+def baseline_record(params: Parameters, design: TruthDesign, tier: str):
+    """The tier's baseline record: a null of the truth's car on ``design.baseline_variation`` (the record an
+    owner logs first, from which a route may identify the assist), its seed apart from every case's."""
+    case = TruthCase(f"{tier}__baseline", tier, "null", design.baseline_variation, None, None,
+                     design.torque_converters[-1], _seed(design, design.baseline_variation) + 77)
+    return case_truth_and_record(params, design, case)[1]
+
+
+def run(params: Parameters, base_path: str | Path, design: TruthDesign = TruthDesign(), only=None,
+        progress=None) -> tuple[list, dict]:
+    """Make, write, read back and diagnose every case of `design` (or those named in `only`) for each route of
+    the design; (rows, summary). `params` is the base vehicle file's (`base_path`), whose manual car the truth
+    drives."""
+    unknown = [r for r in design.routes if r not in ROUTES]
+    if unknown:
+        raise UsageError(f"assisted truth: no route {unknown[0]!r} (known: {', '.join(ROUTES)})")
+    rows = []
+    with tempfile.TemporaryDirectory() as folder:
+        owner = owner_file(base_path, design, folder)
+        given: dict[tuple[str, str], Owner] = {}
+
+        def file_for(route: str, tier: str) -> Owner:
+            if (route, tier) not in given:
+                baseline = None
+                if route in BASELINE_ROUTES:
+                    baseline = Path(folder) / f"baseline_{tier}.csv"
+                    _write(baseline, baseline_record(params, design, tier), owner.params)
+                given[route, tier] = ROUTES[route](owner, baseline, folder)
+            return given[route, tier]
+
+        for case in cases(design):
+            if only and case.name not in only:
+                continue
+            start = time.perf_counter()
+            truth, record = case_truth_and_record(params, design, case)
+            path = Path(folder) / f"{case.name}.csv"
+            _write(path, record, owner.params)
+            made = time.perf_counter()
+            for route in design.routes:
+                file = file_for(route, case.tier)
+                began = time.perf_counter()
+                files = load_files([path], file.params, assist=file.assist)
+                result = diagnosis_dict(diagnose(files, file.params, file.effects, settings=BENCHMARK_SETTINGS))
+                result["cost"]["wall_s"] = time.perf_counter() - began
+                row = outcome(truth, result)
+                row["route"] = route
+                row["generation_s"] = made - start
+                rows.append(row)
+                if progress is not None:
+                    progress(row)
+    return rows, summarise(rows, design)
+
+
+def _write(path: Path, record, params: Parameters) -> None:
+    """Write `record`: the native format with a rack; an angle-only record (a bus log's channels under their
+    native names, no rack) as its text, which the import layer reads and derives the rack of."""
+    if "rack_m" in record.columns:
+        write_measurement(path, record, params)
+    else:
+        path.write_text(format_measurement(record), encoding="utf-8")
+
+
+ROW_SUFFIX = ".row.json"
+
+
+def run_batch(params: Parameters, base_path, names: list[str], folder, design: TruthDesign = TruthDesign()) -> None:
+    """Run the cases `names` (one job of the rule diag_assisted_truth_batch); each case's rows (one a route) to
+    <folder>/<name>.row.json. A case is made from its own seed: the same rows whichever job runs it."""
+    from ..tables import atomic_path
+
+    known = set(case_names(design))
+    unknown = [n for n in names if n not in known]
+    if unknown:
+        raise UsageError(f"assisted truth: no case {unknown[0]!r}")
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    rows, _ = run(params, base_path, design, only=set(names))
+    for name in names:
+        mine = [r for r in rows if r["name"] == name]
+        with atomic_path(folder / f"{name}{ROW_SUFFIX}") as scratch:
+            scratch.write_text(json.dumps(mine), encoding="utf-8")
+
+
+def read_rows(folders, names: list[str]) -> list[dict]:
+    """The rows run_batch wrote of the cases `names`, in that order; a case with no rows, or rows in two folders,
+    is refused in one line."""
+    found: dict[str, Path] = {}
+    for folder in map(Path, folders):
+        for path in sorted(folder.glob(f"*{ROW_SUFFIX}")):
+            name = path.name[:-len(ROW_SUFFIX)]
+            if name in found:
+                raise UsageError(f"{path}: case {name} has rows in {found[name].parent} as well")
+            found[name] = path
+    missing = [n for n in names if n not in found]
+    if missing:
+        raise UsageError(f"assisted truth: no rows of case {missing[0]} in {', '.join(map(str, folders))}")
+    return [row for n in names for row in json.loads(found[n].read_text(encoding="utf-8"))]
+
+
+def design_from_config(section: dict | None) -> TruthDesign:
+    """The design of config/config.yaml's ``assisted_truth`` section (its keys the design's fields; ``boost`` and
+    ``gear`` as mappings of the map's and the gear's fields)."""
+    section = dict(section or {})
+    design = TruthDesign()
+    boost = replace(design.boost, **section.pop("boost", {}))
+    gear = replace(design.gear, **section.pop("gear", {}))
+    tuples = {"map_points_Nm", "tiers", "null_variations", "hidden_variations", "hidden", "floors",
+              "out_of_class_variations", "routes"}
+    fields = {k: tuple(v) if k in tuples else v for k, v in section.items()}
+    if "torque_converters" in fields:
+        fields["torque_converters"] = tuple((int(b), float(f)) for b, f in fields["torque_converters"])
+    if "out_of_class" in fields:
+        fields["out_of_class"] = tuple((str(n), float(s)) for n, s in fields["out_of_class"])
+    design = replace(design, boost=boost, gear=gear, **fields)
+    checks = (("tiers", design.tiers, TIERS), ("hidden", design.hidden, tuple(HIDDEN_TRUTH)),
+              ("out_of_class", [n for n, _ in design.out_of_class], tuple(OUT_OF_CLASS_TRUTH)),
+              ("routes", design.routes, tuple(ROUTES)))
+    for key, given, known in checks:
+        bad = [g for g in given if g not in known]
+        if bad:
+            raise UsageError(f"config assisted_truth.{key}: {bad[0]!r} is not one of {', '.join(known)}")
+    for v in (*design.null_variations, *design.hidden_variations, *design.out_of_class_variations):
+        _seed(design, v)
+    return design
+
+
+__all__ = ["BASELINE_ROUTES", "ROUTES", "TruthCase", "TruthDesign", "baseline_record", "case_names",
+           "case_truth_and_record", "cases", "design_from_config", "outcome", "owner_vehicle_text", "read_rows", "run",
+           "run_batch", "summarise"]
