@@ -65,10 +65,10 @@ def method_dict() -> dict:
 
 def forms_dict() -> dict:
     """Each truth form: its class, what it is, the mechanism it stands for."""
-    from ..synthetic.outoflibrary import FORMS
+    from ..synthetic.outoflibrary import ALL_FORMS
 
     return {f.effect.name: {"class": f.signature_class, "description": f.effect.description, "why": f.effect.why}
-            for f in FORMS}
+            for f in ALL_FORMS}
 
 
 def case_names(design: SignatureDesign) -> list[str]:
