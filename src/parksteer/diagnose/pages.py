@@ -8,7 +8,7 @@ import re
 from pathlib import Path
 
 from ..tables import atomic_path
-from .report import interval_text, num, separating, shown_unit, signature_lines, strength_text, tie_headline
+from .report import confound_separates, interval_text, num, separating, shown_unit, signature_lines, strength_text, tie_headline
 
 
 def _interval(ci, digits: int = 4, unit: str = "") -> str:
@@ -228,10 +228,13 @@ def markdown_report(result: dict, figure: str | None = None) -> str:
                     f"also made by `{c['confounded_with']}`; these data cannot tell it from a change of that "
                     "parameter, whose calibrated value holds only if it is absent.")
             m = c.get("separating_measurement")
-            if m and not separating(m, result):
-                line += (f" No test of this kind separates them: under every load case and surface the data lack "
-                         f"the calibrated parameters would take it up to within {num(m['predicted_difference_rms_Nm'])}"
-                         f" N m RMS ({num(m['over_noise_floor'])} noise floors).")
+            if m and not confound_separates(m):
+                line += (f" No test of this kind separates them: at a strength that changes this torque by "
+                         f"{num(m['change_here_rms_Nm'])} N m RMS the calibrated parameters leave "
+                         f"{num(m['left_here_rms_Nm'])} N m of it here, and under no load case or surface the data "
+                         f"lack would they leave more (at most {num(m['predicted_difference_rms_Nm'])} N m, "
+                         f"{num(m['over_noise_floor'])} noise floors, with the `{m['case']}` case on "
+                         f"`{m['surface'].replace('_', ' ')}`).")
             elif m:
                 line += (f" At a strength that changes this torque by {num(m['change_here_rms_Nm'])} N m RMS, the "
                          f"calibrated parameters take up all but {num(m['left_here_rms_Nm'])} N m "

@@ -208,6 +208,16 @@ def separating(measurement: dict | None, result: dict) -> bool:
     return measurement["over_noise_floor"] >= threshold
 
 
+def confound_separates(measurement: dict | None) -> bool:
+    """Whether the measurement offered for a confounded candidate shows it better than these data do: the torque
+    change left there by the calibrated parameters, at the probe strength, larger than the change left here. The
+    probe's strength is arbitrary (the data do not fix a confounded candidate's), so the ratio, not a number of
+    noise floors, says whether measuring there helps."""
+    if not measurement:
+        return False
+    return measurement["predicted_difference_rms_Nm"] > measurement["left_here_rms_Nm"]
+
+
 def tie(result: dict) -> dict | None:
     """For a named effect with candidates within the information criterion's threshold of it: the tied effects
     (the named one first), their BIC gains and fitted strengths, and the measurements that would separate the

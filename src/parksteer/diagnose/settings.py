@@ -183,9 +183,9 @@ class DiagnosisSettings:
     # A candidate whose signature keeps less than this fraction of its norm once the calibrated
     # parameters' directions are projected out is reported as confounded with them.
     confounded_fraction: float = 0.3
-    # A measurement is offered as separating two candidates (or a candidate from the calibrated parameters) only
-    # where it predicts a difference of at least this many noise floors RMS: below the floor the record of that
-    # measurement would not tell them apart either (parksteer.diagnose.report.separating).
+    # A measurement is offered as separating two candidates (or as fixing a calibrated parameter) only where it
+    # predicts a difference of at least this many noise floors RMS: below the floor the record of that measurement
+    # would not tell them apart either (parksteer.diagnose.report.separating).
     separating_over_floor: float = 1.0
 
     # --- what the data fix (parksteer.diagnose.stages.identify) ------------------------------------------------
