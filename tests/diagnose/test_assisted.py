@@ -96,7 +96,7 @@ def test_a_tie_is_the_headline_and_no_test_is_offered_below_the_noise_floor(moto
     assert "motor channel residual" in svg.read_text(encoding="utf-8")
 
 
-def test_hidden_motor_friction_is_named_from_the_torsion_bar_torque_and_current(polo):
+def test_hidden_motor_friction_is_named_from_the_torsion_bar_torque_and_current(polo, motor_friction):
     """A motor dragging 0.02 N m more than the file says (N = 18: 0.36 N m at the column, 0.05 N m of torsion-bar
     torque after the boost's division by about 1 + G = 7) is named. At a column assist it is the same load as a
     column friction of N T_e (both act on the column above the intermediate shaft), so the two are reported
@@ -104,7 +104,7 @@ def test_hidden_motor_friction_is_named_from_the_torsion_bar_torque_and_current(
     rack friction's varies with the Hooke joint's speed ratio (cos 0.45 to 1 / cos 0.45). The current, which the
     boost curve makes about 8 A per N m of torsion-bar torque, reads the torsion bar more finely than its own 10-bit
     channel: without it the same record is still named, with a BIC gain less than half as large."""
-    with_current = diagnosed(polo, record(polo, "assist_motor_friction", 0.02))
+    with_current = motor_friction[1]
     assert with_current["verdict"] == "missing"
     group = {with_current["effect"], *(s["effect"] for s in with_current["indistinguishable"])}
     assert "assist_motor_friction" in group and group <= {"assist_motor_friction", "column_friction"}
