@@ -3,9 +3,9 @@ effect scored per signature class, and the time the signature and the suggestion
 
     python benchmarks/bench_signature.py [--steps 5] [--nulls 4] [--seed 2411] [--first-variation 0] [--json OUT.json]
 
-The grid (parksteer.experiments.outoflibrary.SignatureDesign): the ten truth forms of
+The grid (parksteer.experiments.outoflibrary.SignatureDesign): the twelve truth forms of
 parksteer.synthetic.outoflibrary at each size, on the first six variations of the variation benchmark in
-turn, and the nulls: 14 records by default, a few minutes on one core (each suggestion compiles its own model).
+turn, and the nulls: 16 records by default, a few minutes on one core (each suggestion compiles its own model).
 """
 
 from __future__ import annotations

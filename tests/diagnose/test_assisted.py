@@ -58,7 +58,45 @@ def diagnosed(params, measurement):
     return diagnosis_dict(result)
 
 
-def test_hidden_motor_friction_is_named_from_the_torsion_bar_torque_and_current(polo):
+@pytest.fixture(scope="module")
+def motor_friction(polo):
+    """The diagnosis (object and JSON) of a record whose motor drags 0.02 N m more than the file says."""
+    result = diagnose([prepare_file(record(polo, "assist_motor_friction", 0.02), "kerb", label="polo")], polo,
+                      resolve_effects(ASSIST), settings=BENCHMARK_SETTINGS)
+    return result, diagnosis_dict(result)
+
+
+def test_a_tie_is_the_headline_and_no_test_is_offered_below_the_noise_floor(motor_friction, tmp_path):
+    """Motor friction and column friction are one load at a column assist: the reports' headline says the data
+    cannot tell them apart, naming both with their strengths, units and intervals; a load case or surface the
+    data lack would move the two fitted models apart by far less than the noise floor, so no such measurement is
+    offered as separating them; the motor current is shown beside the torque, as a table and as the figure's
+    measured, fitted and residual panels."""
+    from parksteer.diagnose.pages import html_report, markdown_report
+    from parksteer.figures.diagnose import diagnosis_figure
+
+    diagnosis, result = motor_friction
+    group = [result["effect"], *(s["effect"] for s in result["indistinguishable"])]
+    assert sorted(group) == ["assist_motor_friction", "column_friction"]
+    assert all(s["separating_measurement"]["over_noise_floor"] < 1.0 for s in result["indistinguishable"])
+    text = markdown_report(result)
+    headline = text.split("\n")[2]
+    assert "these data cannot tell them apart" in headline.split("**")[1]
+    assert "`assist_motor_friction`" in headline and "`column_friction`" in headline
+    assert "No test of this kind separates" in headline and "measure the" not in text
+    assert result["units"]["column_friction.friction_torque"] == "N m"
+    assert " N m (95 %: " in headline and " to " in headline
+    assert "| steering.rack_friction_force | N |" in text
+    assert "## Motor channel" in text and "residual RMS (A)" in text
+    page = html_report(result, [], [])
+    assert "these data cannot tell them apart" in page.split('class="verdict">')[1].split("</p>")[0]
+    assert "<h2>Motor channel</h2>" in page
+    svg = tmp_path / "diagnosis.svg"
+    diagnosis_figure(diagnosis, svg)
+    assert "motor channel residual" in svg.read_text(encoding="utf-8")
+
+
+def test_hidden_motor_friction_is_named_from_the_torsion_bar_torque_and_current(polo, motor_friction):
     """A motor dragging 0.02 N m more than the file says (N = 18: 0.36 N m at the column, 0.05 N m of torsion-bar
     torque after the boost's division by about 1 + G = 7) is named. At a column assist it is the same load as a
     column friction of N T_e (both act on the column above the intermediate shaft), so the two are reported
@@ -66,7 +104,7 @@ def test_hidden_motor_friction_is_named_from_the_torsion_bar_torque_and_current(
     rack friction's varies with the Hooke joint's speed ratio (cos 0.45 to 1 / cos 0.45). The current, which the
     boost curve makes about 8 A per N m of torsion-bar torque, reads the torsion bar more finely than its own 10-bit
     channel: without it the same record is still named, with a BIC gain less than half as large."""
-    with_current = diagnosed(polo, record(polo, "assist_motor_friction", 0.02))
+    with_current = motor_friction[1]
     assert with_current["verdict"] == "missing"
     group = {with_current["effect"], *(s["effect"] for s in with_current["indistinguishable"])}
     assert "assist_motor_friction" in group and group <= {"assist_motor_friction", "column_friction"}

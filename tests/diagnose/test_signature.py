@@ -23,7 +23,7 @@ from parksteer.diagnose.pages import markdown_report
 from parksteer.diagnose.select import diagnose
 from parksteer.diagnose.signature import signature_from_axes
 from parksteer.diagnose.signature_axes import Axes, column_angle
-from parksteer.diagnose.suggest import suggest
+from parksteer.diagnose.suggest import effect_source, suggest
 from parksteer.errors import UsageError
 from parksteer.measure.io import write_measurement
 from parksteer.model.numeric.simulate import simulate
@@ -84,6 +84,61 @@ def test_a_once_per_turn_column_torque_is_read_as_the_first_column_order():
     assert _axis(sig, "column angle, 2 per turn").excess_share < 0.05
 
 
+def _column_friction_residual(shape, seed: int):
+    """A friction torque at the column, 0.25 N m times `shape` of the column angle, reversing with the column's
+    rate through a breakaway of its own (tanh(omega / 0.5 rad/s), not the signature's tanh(beta v)), with the
+    calibrated rack friction's direction (the smoothed sign) fitted beside every basis as the diagnosis fits the
+    calibration's sensitivities: the axes, the residual and that nuisance column."""
+    x, v, noise = _cycle(seed=seed)
+    theta = column_angle(x, G, 0.0, 0.0)
+    residual = 0.25 * shape(theta) * pm.tanh(G * v / 0.5) + noise
+    axes = _axes(x, v, residual, theta)
+    return axes, (pm.tanh(BETA * v) / FLOOR)[:, None]
+
+
+def test_a_column_friction_pinched_once_per_turn_is_read_as_dissipative_and_periodic_in_the_column_angle():
+    """A column bearing pinched at one place of its turn: its friction a narrow peak once per turn,
+    exp((cos(theta - 0.9) - 1) / 0.25) (orders one to four and more, not a sinusoid). Its mean is a uniform
+    friction the calibration takes; what is left is the product class dissipative x column angle, not a
+    dissipative force along the stroke nor a torque that does not reverse, order 1 dominant, its peak found within
+    20 degrees of the 52 degrees put in, and its suggestion at the column."""
+    axes, nuisance = _column_friction_residual(lambda t: pm.exp((pm.cos(t - 0.9) - 1.0) / 0.25), seed=5)
+    sig = signature_from_axes(axes, nuisance=nuisance)
+    assert sig.effect_class == "dissipative_column", sig.sentence
+    assert sig.numbers["dominant_order"] == 1
+    assert abs(math.degrees(sig.numbers["peak_column_angle_rad"]) - math.degrees(0.9)) < 20.0
+    assert sig.as_dict()["where"] == "column"
+    assert "friction on the steering column" in sig.sentence
+
+
+def test_a_joint_friction_growing_twice_per_turn_is_read_with_its_second_order():
+    """A joint's friction growing with its angle twice per turn, sin(theta + 0.3)^4 (orders 2 and 4 about its
+    mean): the product class, order 2 dominant."""
+    axes, nuisance = _column_friction_residual(lambda t: pm.sin(t + 0.3) ** 4, seed=6)
+    sig = signature_from_axes(axes, nuisance=nuisance)
+    assert sig.effect_class == "dissipative_column", sig.sentence
+    assert sig.numbers["dominant_order"] == 2
+
+
+def test_the_suggested_effect_of_a_column_friction_is_a_torque_on_the_column_not_a_rack_force():
+    """The file written for the product class puts a torque between the column shaft and the body that reverses
+    with the motion (the smoothed sign of the rack speed times the periodic shape), strengths in N m, one sine and
+    one cosine per order the signature found; it loads as a user's effect file does."""
+    axes, nuisance = _column_friction_residual(lambda t: pm.exp((pm.cos(t - 0.9) - 1.0) / 0.25), seed=5)
+    sig = signature_from_axes(axes, nuisance=nuisance)
+    source = effect_source(sig)
+    assert "torque_between(torque, k.B.y, k.column_frame, k.B)" in source
+    assert "action_reaction" not in source.split("class Suggested", 1)[1]
+    assert "sp.tanh(beta * model.rack_u)" in source
+    namespace: dict = {}
+    exec(compile(source, "suggested.py", "exec"), namespace)
+    effect = namespace["EFFECT"]
+    assert effect.name == "suggested_dissipative_column"
+    assert {q.unit for q in effect.quantities} == {"N m"}
+    assert [q.key.rsplit(".", 1)[1] for q in effect.quantities] == [f"{f}{m}" for m in sig.best.orders
+                                                                      for f in ("sin", "cos")]
+
+
 def test_a_localised_friction_bump_is_found_where_it_is_and_as_wide_as_it_is():
     """An extra friction 150 N exp(-((x - 20 mm) / 12 mm)^2): dissipative, peaking at +20 mm (within 3 mm), its
     half width at half height 12 mm sqrt(ln 2) = 10 mm (within 3 mm), its height 150 N (within 10 %)."""
@@ -119,13 +174,16 @@ def test_a_force_growing_with_the_speed_is_read_as_viscous():
 
 
 def test_white_noise_at_the_floor_has_no_signature():
-    """A perfect model leaves white noise at the floor: no class, and no axis significant at p < 1e-3 (five
-    seeds)."""
+    """A perfect model leaves white noise at the floor: no class on any of five seeds, and the axes significant at
+    p < 1e-3 no more often than chance allows: ten axes on five records expect 0.05 false alarms, so two or more
+    (probability about 0.1 %) would say the significance is miscalibrated."""
+    alarms = []
     for seed in range(5):
         x, v, noise = _cycle(seed=10 + seed)
         sig = signature_from_axes(_axes(x, v, noise))
         assert sig.effect_class is None
-        assert not any(a.significant for a in sig.axes), [a for a in sig.axes if a.significant]
+        alarms += [a for a in sig.axes if a.significant]
+    assert len(alarms) <= 1, alarms
 
 
 def test_the_axes_refuse_mismatched_lengths():
@@ -180,6 +238,28 @@ def test_the_suggested_effect_loads_is_the_base_model_at_zero_and_takes_the_erro
     result = json.loads(json.dumps(with_suggestion(diagnosis_dict(diagnosis), suggestion)))
     jsonschema.validate(result, schema)
     assert "The residual's signature" in markdown_report(result)
+
+
+@pytest.mark.slow
+def test_a_pinched_column_bearing_is_read_at_the_column_and_its_suggestion_takes_the_error_to_the_floor(tmp_path):
+    """A column bearing pinched once per turn (an out-of-library truth form with its own breakaway smoothing), on a
+    record with an 8-bit rack beside a 12-bit torque (0.012 N m steps, the friction 20 of them RMS) and a hand of
+    its own, written and read back: the signature reads the product class dissipative x column angle, and the
+    suggested effect, a friction torque at the column, fitted with the calibrated parameters brings the weighted
+    error from twice the floor (the 8-bit rack's replay uncertainty weighs much of the record down) to within
+    1.3 floors."""
+    case = SignatureCase("pinched", "oolib_pinched_bearing", 20.0, "rack_8bit_torque_12bit", 977)
+    measurement, truth = make_record(PARAMS, case, SignatureDesign())
+    path = tmp_path / "pinched.csv"
+    write_measurement(path, measurement, PARAMS)
+    settings = replace(BENCHMARK_SETTINGS, residual_signature=True)
+    diagnosis = diagnose(load_files([path], PARAMS), PARAMS, settings=settings)
+    sig = diagnosis.outputs["signature"]
+    assert sig.effect_class == truth["class"] == "dissipative_column", sig.sentence
+    suggestion = suggest(diagnosis.problem, diagnosis.calibration, sig, tmp_path / "missing.py", BENCHMARK_SETTINGS)
+    assert suggestion.before_over_floor > 1.8
+    assert suggestion.after_over_floor < 1.3
+    assert "k.column_frame" in (tmp_path / "missing.py").read_text(encoding="utf-8")
 
 
 @pytest.mark.slow

@@ -11,7 +11,8 @@
 # the variation benchmark (config["variations"]): records of other hands, loggers and drives, with nothing or a
 # library effect hidden, scored against the targets of parksteer.experiments.variations. diag_signature_batch and
 # diag_signature are the signature benchmark (config["signature"]): out-of-library effects and nulls, the
-# residual's signature and the suggested effect scored per signature class (parksteer.figures.signature).
+# residual's signature and the suggested effect scored per signature class (parksteer.figures.signature), its cases
+# in jobs of config["signature_cases_per_job"].
 DIAG_USER_EFFECT = os.path.relpath(PACKAGE_DIR / "examples" / "column_imbalance.py")
 # candidate model specs, the car data set's files, the three benchmarks' case names (parksteer.plan.diagnosis)
 DIAG_PLAN = plan(
@@ -32,7 +33,8 @@ DIAG_BENCH_BATCHES = case_batches("bench_", DIAG_BENCH_CASES, DIAG_PER_JOB)
 DIAG_OUTCLASS_BATCHES = case_batches("outclass_", DIAG_OUTCLASS_CASES, DIAG_PER_JOB)
 DIAG_VARIATION_BATCHES = case_batches("variations_", DIAG_VARIATION_CASES, DIAG_PER_JOB)
 DIAG_SIGNATURE_CASES = DIAG_PLAN["signature_cases"]
-DIAG_SIGNATURE_BATCHES = case_batches("signature_", DIAG_SIGNATURE_CASES, DIAG_PER_JOB)
+DIAG_SIGNATURE_BATCHES = case_batches("signature_", DIAG_SIGNATURE_CASES,
+                                      int(config.get("signature_cases_per_job", DIAG_PER_JOB)))
 
 
 rule diag_car_data:

@@ -8,11 +8,92 @@ import re
 from pathlib import Path
 
 from ..tables import atomic_path
-from .report import num, signature_lines
+from .report import confound_separates, interval_text, num, separating, shown_unit, signature_lines, strength_text, tie_headline
 
 
-def _interval(ci, digits: int = 4) -> str:
-    return "-" if ci is None else f"{num(ci[0], digits)} to {num(ci[1], digits)}"
+def _interval(ci, digits: int = 4, unit: str = "") -> str:
+    return interval_text(ci, unit, digits)
+
+
+def _unit(result: dict, key: str) -> str:
+    return result.get("units", {}).get(key, "")
+
+
+def _value_unit(result: dict, key: str) -> str:
+    unit = shown_unit(_unit(result, key))
+    return f" {unit}" if unit else ""
+
+
+def _missing_headline(result: dict) -> tuple[str, str]:
+    """The verdict's sentence for a named effect, (head, body): the tie first where candidates lie within the
+    information criterion's threshold of it (:func:`parksteer.diagnose.report.tie_headline`)."""
+    stats, floor = result["statistics"], result["noise_floor_Nm"]
+    tied = tie_headline(result)
+    if tied is not None:
+        return f"Verdict: missing effect, {tied[0]}.", tied[1]
+    return (f"Verdict: missing effect `{result['effect']}`.", "Adding it takes the weighted RMS error from "
+            f"{num(stats['calibrated']['weighted_rms_Nm'])} N m to {num(stats['with_effect']['weighted_rms_Nm'])} "
+            f"N m, against a noise floor of {num(floor)} N m{_angle_change(result)}.")
+
+
+_MOTOR_UNITS = {"motor_current_A": "A", "motor_torque_Nm": "N m"}
+
+
+def _motor_rows(result: dict) -> tuple[str, str, list[list[str]]] | None:
+    """An assisted car's motor channel, where fitted: (its column, unit, rows of model, RMS, weighted RMS, peak)."""
+    stats = result["statistics"]
+    motor = (stats.get("calibrated") or {}).get("motor")
+    if not motor:
+        return None
+    unit = _MOTOR_UNITS.get(motor["column"], "")
+    rows = []
+    for label, key in (("nominal parameters", "nominal"), ("calibrated", "calibrated"),
+                       (f"with {result['effect']}", "with_effect")):
+        m = (stats.get(key) or {}).get("motor")
+        if m:
+            rows.append([label, num(m["rms"]), num(m["weighted_rms"]), num(m["peak"])])
+    return motor["column"], unit, rows
+
+
+def _motor_markdown(result: dict) -> list[str]:
+    found = _motor_rows(result)
+    if found is None:
+        return []
+    column, unit, rows = found
+    floor = result["statistics"]["calibrated"]["motor"]["noise_floor"]
+    return (["## Motor channel", "", f"The assisted car's `{column}`, fitted beside the torque (noise floor "
+             f"{num(floor)} {unit}; measured, fitted and residual drawn beside the torque in the figure).", "",
+             f"| model | residual RMS ({unit}) | weighted RMS ({unit}) | peak ({unit}) |", "|---|---|---|---|"]
+            + [f"| {' | '.join(r)} |" for r in rows] + [""])
+
+
+def _motor_html(result: dict) -> list[str]:
+    found = _motor_rows(result)
+    if found is None:
+        return []
+    column, unit, rows = found
+    floor = result["statistics"]["calibrated"]["motor"]["noise_floor"]
+    return ([f"<h2>Motor channel</h2>", f"<p>The assisted car's {html.escape(column)}, fitted beside the torque "
+             f"(noise floor {html.escape(num(floor))} {html.escape(unit)}).</p>"]
+            + _table(["model", f"residual RMS ({unit})", f"weighted RMS ({unit})", f"peak ({unit})"], rows))
+
+
+def _separation_lines(result: dict) -> list[str]:
+    """The candidates the data cannot tell from the named one, each with the measurement that would separate
+    them if one predicts a difference above the threshold, else that none of this kind does."""
+    lines = []
+    threshold = result["selection"]["thresholds"].get("separating_over_floor", 1.0)
+    for s in result["indistinguishable"]:
+        m = s["separating_measurement"]
+        where = (f"the `{m['case']}` case on `{m['surface'].replace('_', ' ')}`, where the two fitted models differ "
+                 f"by {num(m['predicted_difference_rms_Nm'])} N m RMS ({num(m['over_noise_floor'])} noise floors)")
+        if separating(m, result):
+            lines.append(f"`{s['effect']}` (ΔBIC {num(s['delta_bic'])}): measure {where}.")
+        else:
+            lines.append(f"`{s['effect']}` (ΔBIC {num(s['delta_bic'])}): no test of this kind separates them; the "
+                         f"most any load case or surface the data lack shows is {where}, below the "
+                         f"{num(threshold)} noise floor{'s' if threshold != 1 else ''} a test needs.")
+    return lines
 
 
 def _nearest(result: dict) -> str:
@@ -55,12 +136,19 @@ def _identification_lines(result: dict) -> list[str]:
     for row in result.get("identification", []):
         key, test = row["parameter"], row["fixed_by"]
         if row["status"] == "fixed":
-            lines.append(f"{key}: fixed by these data ({num(row['value'], 4)}, "
-                         f"95 % interval {_interval(row['ci95'])}).")
+            lines.append(f"{key}: fixed by these data ({num(row['value'], 4)}{_value_unit(result, key)}, "
+                         f"95 % interval {_interval(row['ci95'], unit=_unit(result, key))}).")
         elif row["status"] == "not calibrated":
             lines.append(f"{key}: not fixed by these data; {test} would fix it.")
+        elif isinstance(test, dict) and not separating(test, result):
+            lines.append(f"{key}: not fixed by these data (95 % interval "
+                         f"{_interval(row['ci95'], unit=_unit(result, key))}); no test of this kind fixes it (the "
+                         f"most its interval's ends differ under a load case or surface left to measure is "
+                         f"{num(test['predicted_difference_rms_Nm'])} N m RMS, {num(test['over_noise_floor'])} "
+                         "noise floors).")
         elif isinstance(test, dict):
-            lines.append(f"{key}: not fixed by these data (95 % interval {_interval(row['ci95'])}); the "
+            lines.append(f"{key}: not fixed by these data (95 % interval "
+                         f"{_interval(row['ci95'], unit=_unit(result, key))}); the "
                          f"{test['case']} case on {test['surface'].replace('_', ' ')} "
                          "would fix it: its interval's ends differ there by "
                          f"{num(test['predicted_difference_rms_Nm'])} "
@@ -101,10 +189,8 @@ def markdown_report(result: dict, figure: str | None = None, user_figure: str | 
     floor = result["noise_floor_Nm"]
     stats = result["statistics"]
     if verdict == "missing":
-        lines.append(f"**Verdict: missing effect `{result['effect']}`.** Adding it takes the weighted RMS error from "
-                     f"{num(stats['calibrated']['weighted_rms_Nm'])} N m to "
-                     f"{num(stats['with_effect']['weighted_rms_Nm'])} "
-                     f"N m, against a noise floor of {num(floor)} N m{_angle_change(result)}.")
+        head, body = _missing_headline(result)
+        lines.append(f"**{head}** {body}")
     elif verdict == "adequate":
         lines.append(f"**Verdict: adequate.** With its calibrated parameters the model's weighted RMS error "
                      f"({num(stats['calibrated']['weighted_rms_Nm'])} N m) is at the noise floor ({num(floor)} N m); "
@@ -144,26 +230,22 @@ def markdown_report(result: dict, figure: str | None = None, user_figure: str | 
                 lines.append(f"| {label} | {num(a['rms_rad'])} | {num(a['rms_deg'])} | {num(a['weighted_rms_rad'])} | "
                              f"{num(a['peak_rad'])} |")
         lines.append("")
-    lines += ["## Calibrated parameters", "", "| parameter | default | fitted | 95 % interval |", "|---|---|---|---|"]
+    lines += _motor_markdown(result)
+    lines += ["## Calibrated parameters", "", "| parameter | unit | default | fitted | 95 % interval |",
+              "|---|---|---|---|---|"]
     for key, entry in result["calibrated"].items():
         ci = entry["ci95"]
-        lines.append(f"| {key} | {num(entry['default'], 4)} | {num(entry['value'], 4)} | {_interval(ci)} |")
+        lines.append(f"| {key} | {_unit(result, key)} | {num(entry['default'], 4)} | {num(entry['value'], 4)} | "
+                     f"{_interval(ci, unit=_unit(result, key))} |")
     lines += ["", "## Candidates", "", "| candidate | score | ΔBIC | fitted strength | weighted RMS after (N m) | "
               "identifiable fraction |", "|---|---|---|---|---|---|"]
     for c in result["ranking"]:
-        strength = c["parameters"][c["strength_parameter"]]
-        ci = strength.get("ci95")
-        fitted = num(strength["value"]) + (f" ({num(ci[0])} to {num(ci[1])})" if ci else " (linear estimate)")
+        fitted = strength_text(c, result.get("units", {}))
         lines.append(f"| {c['effect']} | {num(c['score'])} | {num(c['delta_bic'])} | {fitted} | "
                      f"{num(c['weighted_rms_after_Nm'])} | {num(c['identifiable_fraction'], 2)} |")
     if result["indistinguishable"]:
         lines += ["", "## Indistinguishable by these data", ""]
-        for s in result["indistinguishable"]:
-            m = s["separating_measurement"]
-            lines.append(f"- `{s['effect']}` (ΔBIC {num(s['delta_bic'])}): measure the `{m['case']}` case on "
-                         f"`{m['surface'].replace('_', ' ')}`, where the two fitted models differ by "
-                         f"{num(m['predicted_difference_rms_Nm'])} N m RMS "
-                         f"({num(m['over_noise_floor'])} noise floors).")
+        lines += [f"- {line}" for line in _separation_lines(result)]
     if result["confounded"]:
         lines += ["", "## Confounded with the calibrated parameters", ""]
         for c in result["confounded"]:
@@ -171,7 +253,14 @@ def markdown_report(result: dict, figure: str | None = None, user_figure: str | 
                     f"also made by `{c['confounded_with']}`; these data cannot tell it from a change of that "
                     "parameter, whose calibrated value holds only if it is absent.")
             m = c.get("separating_measurement")
-            if m:
+            if m and not confound_separates(m):
+                line += (f" No test of this kind separates them: at a strength that changes this torque by "
+                         f"{num(m['change_here_rms_Nm'])} N m RMS the calibrated parameters leave "
+                         f"{num(m['left_here_rms_Nm'])} N m of it here, and under no load case or surface the data "
+                         f"lack would they leave more (at most {num(m['predicted_difference_rms_Nm'])} N m, "
+                         f"{num(m['over_noise_floor'])} noise floors, with the `{m['case']}` case on "
+                         f"`{m['surface'].replace('_', ' ')}`).")
+            elif m:
                 line += (f" At a strength that changes this torque by {num(m['change_here_rms_Nm'])} N m RMS, the "
                          f"calibrated parameters take up all but {num(m['left_here_rms_Nm'])} N m "
                          f"({num(m['left_here_over_noise_floor'])} noise floors) of it; measure the `{m['case']}` "
@@ -307,9 +396,7 @@ def html_report(result: dict, figures: list[tuple[str, str]], phases: list[dict]
     stats, floor = result["statistics"], result["noise_floor_Nm"]
     verdict = result["verdict"]
     if verdict == "missing":
-        text = (f"Verdict: missing effect {result['effect']}. Adding it takes the weighted RMS error from "
-                f"{num(stats['calibrated']['weighted_rms_Nm'])} N m to {num(stats['with_effect']['weighted_rms_Nm'])} "
-                f"N m, against a noise floor of {num(floor)} N m{_angle_change(result)}.")
+        text = " ".join(_missing_headline(result)).replace("`", "")
     elif verdict == "adequate":
         text = (f"Verdict: adequate. The calibrated model's weighted RMS error "
                 f"({num(stats['calibrated']['weighted_rms_Nm'])} N m) is at the noise floor ({num(floor)} N m).")
@@ -331,6 +418,7 @@ def html_report(result: dict, figures: list[tuple[str, str]], phases: list[dict]
                    f"({html.escape(num(angle['rms_deg']))} degrees), noise floor "
                    f"{html.escape(num(result['angle']['noise_floor_rad']))} rad.</p>")
     out += user_effect_html(result)
+    out += _motor_html(result)
     for k, (caption, svg) in enumerate(figures):
         out += ["<figure>", inline_svg(svg, f"f{k}-"), f"<figcaption>{html.escape(caption)}</figcaption>", "</figure>"]
     out.append("<h2>Residual by phase</h2>")
@@ -347,9 +435,9 @@ def html_report(result: dict, figures: list[tuple[str, str]], phases: list[dict]
         out.append(f"<p>Noise floor {html.escape(num(ladder['noise_floor_Nm']))} N m; with the replay's uncertainty "
                    f"{html.escape(num(ladder['attainable_floor_Nm']))} N m.</p>")
     out.append("<h2>Fitted values</h2>")
-    rows = [[key, num(e["default"], 4), num(e["value"], 4), _interval(e["ci95"])]
-            for key, e in result["calibrated"].items()]
-    out += _table(["parameter", "default", "fitted", "95 % interval"], rows)
+    rows = [[key, _unit(result, key), num(e["default"], 4), num(e["value"], 4),
+             _interval(e["ci95"], unit=_unit(result, key))] for key, e in result["calibrated"].items()]
+    out += _table(["parameter", "unit", "default", "fitted", "95 % interval"], rows)
     if result.get("identification"):
         out.append("<h2>What these data fix</h2>")
         out += ["<ul>"] + [f"<li>{html.escape(line)}</li>" for line in _identification_lines(result)] + ["</ul>"]
@@ -359,20 +447,14 @@ def html_report(result: dict, figures: list[tuple[str, str]], phases: list[dict]
     out.append("<h2>Ranking of the candidate effects</h2>")
     rows = []
     for c in result["ranking"]:
-        strength = c["parameters"][c["strength_parameter"]]
-        ci = strength.get("ci95")
-        rows.append([c["effect"], num(c["score"]), num(c["delta_bic"]),
-                     num(strength["value"]) + (f" ({num(ci[0])} to {num(ci[1])})" if ci else " (linear estimate)"),
+        rows.append([c["effect"], num(c["score"]), num(c["delta_bic"]), strength_text(c, result.get("units", {})),
                      num(c["weighted_rms_after_Nm"]), num(c["identifiable_fraction"], 2)])
     out += _table(["candidate", "score", "ΔBIC", "fitted strength (95 % interval)", "weighted RMS after (N m)",
                    "identifiable fraction"], rows)
     if result["indistinguishable"]:
         out.append("<h2>Indistinguishable by these data</h2>")
-        out += _table(["effect", "ΔBIC", "measure case", "on", "difference RMS (N m)"],
-                      [[s["effect"], num(s["delta_bic"]), s["separating_measurement"]["case"],
-                        s["separating_measurement"]["surface"].replace("_", " "),
-                        num(s["separating_measurement"]["predicted_difference_rms_Nm"])]
-                       for s in result["indistinguishable"]])
+        out += ["<ul>"] + [f"<li>{html.escape(line.replace('`', ''))}</li>"
+                           for line in _separation_lines(result)] + ["</ul>"]
     if result["unobservable"]:
         out.append(f"<p>Unobservable in these data: {html.escape(', '.join(result['unobservable']))}.</p>")
     out += [f"<p>Cost: {result['cost']['replays']} replays.</p>", "</body>", "</html>"]

@@ -159,6 +159,7 @@ def diagnosis_dict(diagnosis: Diagnosis) -> dict:
                 "missing_ceiling_trim": diagnosis.settings.missing_ceiling_trim,
                 "bic_indistinguishable": diagnosis.settings.bic_indistinguishable,
                 "confounded_fraction": diagnosis.settings.confounded_fraction,
+                "separating_over_floor": diagnosis.settings.separating_over_floor,
             },
         },
         "cost": {"replays": diagnosis.replays, "replays_by_stage": dict(diagnosis.replays_by_stage),
@@ -177,7 +178,128 @@ def diagnosis_dict(diagnosis: Diagnosis) -> dict:
         out["signature"] = diagnosis.outputs["signature"].as_dict()
     if "user_effect" in diagnosis.outputs:  # a user's effect with free strengths (stages/user_effect.py)
         out["user_effect"] = diagnosis.outputs["user_effect"].as_dict()
+    out["units"] = parameter_units(out)
     return _json_safe(out)
+
+
+# --------------------------------------------------------------------- how sure the diagnosis is: units, ties
+def parameter_units(result: dict) -> dict[str, str]:
+    """The unit of every parameter the JSON `result` gives a value or an interval of (calibrated, the candidates'
+    fitted strengths, what the data fix), from the registry of quantities (an effect loaded from a file has
+    declared its own there)."""
+    from ..errors import UsageError
+    from ..parameters import quantity
+
+    keys = set(result["calibrated"])
+    for c in result["ranking"]:
+        keys.update(c["parameters"])
+    keys.update(row["parameter"] for row in result.get("identification") or [])
+    units = {}
+    for k in sorted(keys):
+        try:
+            units[k] = quantity(k).unit
+        except UsageError:  # a key no loaded effect declares: shown without a unit
+            pass
+    return units
+
+
+def separating(measurement: dict | None, result: dict) -> bool:
+    """Whether a separating measurement (a dict with ``over_noise_floor``) predicts a difference above the
+    threshold of the settings (``separating_over_floor`` noise floors RMS): only then is it offered."""
+    if not measurement:
+        return False
+    threshold = result["selection"]["thresholds"].get("separating_over_floor", 1.0)
+    return measurement["over_noise_floor"] >= threshold
+
+
+def confound_separates(measurement: dict | None) -> bool:
+    """Whether the measurement offered for a confounded candidate shows it better than these data do: the torque
+    change left there by the calibrated parameters, at the probe strength, larger than the change left here. The
+    probe's strength is arbitrary (the data do not fix a confounded candidate's), so the ratio, not a number of
+    noise floors, says whether measuring there helps."""
+    if not measurement:
+        return False
+    return measurement["predicted_difference_rms_Nm"] > measurement["left_here_rms_Nm"]
+
+
+def tie(result: dict) -> dict | None:
+    """For a named effect with candidates within the information criterion's threshold of it: the tied effects
+    (the named one first), their BIC gains and fitted strengths, and the measurements that would separate the
+    named one from each (those above the threshold of :func:`separating` only). None without a tie."""
+    if result["verdict"] != "missing" or not result["indistinguishable"]:
+        return None
+    by_name = {c["effect"]: c for c in result["ranking"]}
+    names = [result["effect"], *(s["effect"] for s in result["indistinguishable"])]
+    tests = {s["effect"]: s["separating_measurement"] for s in result["indistinguishable"]}
+    return {"effects": names,
+            "delta_bic": {n: by_name[n]["delta_bic"] if n in by_name else None for n in names},
+            "strengths": {n: strength_text(by_name[n], result.get("units", {})) for n in names if n in by_name},
+            "tests": {n: m for n, m in tests.items() if separating(m, result)},
+            "best_rejected": {n: m for n, m in tests.items() if not separating(m, result)}}
+
+
+def strength_text(candidate: dict, units: dict[str, str]) -> str:
+    """A candidate's fitted strength with its unit and 95 % interval ('0.51 N m (95 %: 0.26 to 0.75 N m)')."""
+    key = candidate["strength_parameter"]
+    entry = candidate["parameters"][key]
+    unit = shown_unit(units.get(key, ""))
+    ci = entry.get("ci95")
+    text = f"{num(entry['value'])} {unit}".rstrip()
+    return text + (f" (95 %: {interval_text(ci, unit, 3)})" if ci else " (linear estimate)")
+
+
+def shown_unit(unit: str) -> str:
+    """A unit as a number is followed by it: none for a ratio (the registry's "1")."""
+    return "" if unit == "1" else unit
+
+
+def interval_text(ci, unit: str = "", digits: int = 4) -> str:
+    """'low to high UNIT', or '-' when there is no interval."""
+    if ci is None:
+        return "-"
+    return f"{num(ci[0], digits)} to {num(ci[1], digits)} {shown_unit(unit)}".rstrip()
+
+
+def tie_headline(result: dict) -> tuple[str, str] | None:
+    """The headline of a diagnosis whose named effect ties with others, (head, body): 'A or B: these data cannot
+    tell them apart', then each with its BIC gain and strength, the error, and what would separate them or that
+    no test of this kind does. None without a tie."""
+    t = tie(result)
+    if t is None:
+        return None
+    threshold = result["selection"]["thresholds"]["bic_indistinguishable"]
+    stats, floor = result["statistics"], result["noise_floor_Nm"]
+    names = " or ".join(f"`{n}`" for n in t["effects"])
+    each = "; ".join(f"`{n}` {t['strengths'][n]}, ΔBIC {num(t['delta_bic'][n])}" for n in t["effects"]
+                     if n in t["strengths"])
+    head = f"{names}: these data cannot tell them apart"
+    body = (f"Their BIC gains lie within {num(threshold)} of each other ({each}). Either takes the weighted RMS "
+            f"error from {num(stats['calibrated']['weighted_rms_Nm'])} N m to about "
+            f"{num(stats['with_effect']['weighted_rms_Nm'])} N m, against a noise floor of {num(floor)} N m.")
+    return head, body + " " + separation_text(result, t)
+
+
+def separation_text(result: dict, t: dict) -> str:
+    """What would separate the tied effects: each test above the threshold, or that no test of this kind does."""
+    named = t["effects"][0]
+    threshold = result["selection"]["thresholds"].get("separating_over_floor", 1.0)
+    parts = []
+    for other in t["effects"][1:]:
+        m = t["tests"].get(other)
+        if m:
+            parts.append(f"measuring the {m['case']} case on {m['surface'].replace('_', ' ')} would separate "
+                         f"`{named}` from `{other}`: the two fitted models differ there by "
+                         f"{num(m['predicted_difference_rms_Nm'])} N m RMS ({num(m['over_noise_floor'])} noise floors)")
+        else:
+            m = t["best_rejected"].get(other)
+            best = (f" (the most any load case or surface the data lack would show is "
+                    f"{num(m['predicted_difference_rms_Nm'])} N m RMS, {num(m['over_noise_floor'])} noise floors, "
+                    f"with the {m['case']} case on {m['surface'].replace('_', ' ')})") if m else ""
+            parts.append(f"no test of this kind separates `{named}` from `{other}`: no load case or surface "
+                         f"predicts a difference of {num(threshold)} noise floor{'s' if threshold != 1 else ''}"
+                         f"{best}")
+    text = "; ".join(parts)
+    return text[:1].upper() + text[1:] + "." if text else ""
 
 
 def _json_safe(obj):

@@ -31,13 +31,17 @@ class SignatureSettings:
     7 teeth, the middle of the 6-8 of passenger-car rack-and-pinion gears, ripples 7 times per pinion turn).
     A class is named when its best basis gains more than the diagnosis's ``bic_missing_threshold`` in BIC over
     the null, and another class within the diagnosis's ``bic_indistinguishable`` of it is named beside it.
-    ``significance``: the p-value below which an axis counts as significant.
+    ``significance``: the p-value below which an axis counts as significant. ``combined_orders``: the orders of
+    the products dissipative x column angle, each tuple one model: a friction on the column periodic in its angle
+    once or twice per turn, both, or peaked (a bearing pinched at one place of its turn carries the orders one to
+    four and more; a joint's friction that grows with its angle, two and four).
     """
 
     position_knots: tuple[int, ...] = (5, 9, 15, 27)
     speed_knots: int = 6
     mesh_order: int = 7
     column_orders: tuple[tuple[int, ...], ...] = ((1,), (2,), (1, 2))
+    combined_orders: tuple[tuple[int, ...], ...] = ((1,), (2,), (1, 2), (2, 4), (1, 2, 3, 4))
     significance: float = 1e-3
 
 
@@ -182,6 +186,10 @@ class DiagnosisSettings:
     # A candidate whose signature keeps less than this fraction of its norm once the calibrated
     # parameters' directions are projected out is reported as confounded with them.
     confounded_fraction: float = 0.3
+    # A measurement is offered as separating two candidates (or as fixing a calibrated parameter) only where it
+    # predicts a difference of at least this many noise floors RMS: below the floor the record of that measurement
+    # would not tell them apart either (parksteer.diagnose.report.separating).
+    separating_over_floor: float = 1.0
 
     # --- what the data fix (parksteer.diagnose.stages.identify) ------------------------------------------------
     # A calibrated parameter is fixed by the data when its 95 % interval lies within this fraction of its value

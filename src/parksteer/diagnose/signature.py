@@ -21,7 +21,13 @@ angle and radial basis functions ``phi_k(z) = exp(-((z - c_k) / h)^2)`` on knots
 - speed: ``s phi_k(|v| / v_90)`` (v_90 the 90th percentile of |v|): viscous when the shape grows with the
   speed, Stribeck-like when it falls;
 - column: ``sin(m theta), cos(m theta)`` for the orders m of the settings (once, twice per turn, a mesh
-  order).
+  order);
+- dissipative x column (``dissipative_column``), a product of two classes: ``s sin(m theta), s cos(m theta)``
+  for the combined orders of the settings (once, twice per turn, both, two and four, one to four): a friction on the column shaft that rises and falls with the
+  column angle (a bearing pinched once per turn, a joint's friction that grows twice per turn with its angle).
+  Its uniform part is the dissipative class's; a product counts where the information criterion prefers it to
+  the classes apart (a friction periodic in the column angle also reads, with more columns, as a dissipative
+  force along the stroke).
 
 Each family member is one model; they compete with the null (no structure) by the information criterion of the
 diagnosis, ``BIC = n_eff ln(RSS / n) + k ln(n_eff)`` with ``n_eff = n (1 - rho) / (1 + rho)`` and rho the lag-1
@@ -59,8 +65,11 @@ from .settings import DEFAULT_SETTINGS, DiagnosisSettings
 from .signature_axes import Axes, Basis, axes_of, bases, rbf, smooth_sign, steering_values
 from .statistics import bic_gain, effective_samples, pooled_lag1
 
-CLASSES = ("dissipative", "elastic", "direction", "speed", "column")
-WHERE = {"dissipative": "rack", "elastic": "rack", "direction": "rack", "speed": "rack", "column": "column"}
+CLASSES = ("dissipative", "elastic", "direction", "speed", "column", "dissipative_column")
+WHERE = {"dissipative": "rack", "elastic": "rack", "direction": "rack", "speed": "rack", "column": "column",
+         "dissipative_column": "column"}
+# the classes whose suggested effect is a torque on the column shaft (the others: a force on the rack)
+COLUMN_CLASSES = frozenset(c for c, where in WHERE.items() if where == "column")
 
 
 
@@ -154,6 +163,8 @@ def _axis_groups(axes: Axes, models: list[Basis]) -> list[tuple[str, np.ndarray]
              "speed": "odd in rack speed, by speed magnitude"}
     out = [(names[f], richest[f].columns) for f in ("dissipative", "elastic", "direction", "speed") if f in richest]
     out += [(f"column angle, {b.label}", b.columns) for b in models if b.family == "column" and len(b.orders) == 1]
+    out += [(f"odd in rack speed times column angle, {b.label}", b.columns) for b in models
+            if b.family == "dissipative_column" and len(b.orders) == 1]
     s = smooth_sign(axes)
     present = [p for p in PHASES if np.any(axes.phase == p)]
     if present:
@@ -255,6 +266,8 @@ def describe(axes: Axes, best: Basis, coefficients, friction_N: float | None) ->
     torque)."""
     G = axes.ratio_rad_m
     c = np.asarray(coefficients, dtype=float)
+    if best.family == "dissipative_column":
+        return _describe_dissipative_column(best, c)
     if best.family == "column":
         amplitudes = {m: float(pm.hypot(c[2 * i], c[2 * i + 1])) for i, m in enumerate(best.orders)}
         top = max(amplitudes, key=amplitudes.get)
@@ -299,6 +312,22 @@ def describe(axes: Axes, best: Basis, coefficients, friction_N: float | None) ->
         return (f"{what}, growing toward the lock at {1000 * where:+.0f} mm by {peak:+.3g} N{relative}", numbers)
     return (f"{what}, larger by {peak:+.3g} N{relative} within +-{1000 * half:.0f} mm of {1000 * where:+.0f} mm",
             numbers)
+
+
+def _describe_dissipative_column(best: Basis, c: np.ndarray) -> tuple[str, dict]:
+    """The sentence of a friction periodic in the column angle: each order's amplitude (N m at the handwheel, the
+    torque's swing above and below the friction's mean) and the column angle where the friction is largest."""
+    amplitudes = {m: float(pm.hypot(c[2 * i], c[2 * i + 1])) for i, m in enumerate(best.orders)}
+    # the angle where sum_m a_m sin(m theta) + b_m cos(m theta) peaks, on a grid of one turn
+    grid = np.linspace(0.0, 2.0 * np.pi, 361)[:-1]
+    shape = sum(c[2 * i] * np.sin(m * grid) + c[2 * i + 1] * np.cos(m * grid) for i, m in enumerate(best.orders))
+    peak = float(grid[int(np.argmax(shape))])
+    top = max(amplitudes, key=amplitudes.get)
+    orders = " and ".join(f"{m} per column turn ({amplitudes[m]:.3g} N m)" for m in best.orders)
+    return (f"a friction on the steering column (reversing with the motion) that rises and falls with the column "
+            f"angle, {orders}, largest near {np.degrees(peak):.0f} deg of column angle",
+            {"orders": list(best.orders), "amplitudes_Nm": {str(m): a for m, a in amplitudes.items()},
+             "dominant_order": top, "peak_column_angle_rad": peak})
 
 
 def signature_of(files, predictions: list[np.ndarray], params: Parameters, overrides: dict[str, float] | None = None,

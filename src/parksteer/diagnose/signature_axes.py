@@ -112,6 +112,20 @@ def bases(axes: Axes, settings: DiagnosisSettings = DEFAULT_SETTINGS) -> list[Ba
         columns = np.column_stack([f(m * axes.column_rad) for m in orders for f in (pm.sin, pm.cos)])
         label = " + ".join(f"{m} per turn" for m in orders)
         out.append(Basis("column", label, columns, orders=tuple(orders)))
+    out += combined_bases(axes, s, settings)
+    return out
+
+
+def combined_bases(axes: Axes, s: np.ndarray, settings: DiagnosisSettings = DEFAULT_SETTINGS) -> list[Basis]:
+    """The products of two classes: a dissipative force shaped by the column angle, ``s sin(m theta)``,
+    ``s cos(m theta)`` for the combined orders of the settings (a column bearing pinched once per turn, a joint's
+    friction rising twice per turn). Its uniform part is the dissipative class's (and the calibrated friction's):
+    only the periodic part is a column of its own."""
+    out = []
+    for orders in settings.signature.combined_orders:
+        columns = np.column_stack([s * f(m * axes.column_rad) for m in orders for f in (pm.sin, pm.cos)])
+        label = " + ".join(f"{m} per turn" for m in orders)
+        out.append(Basis("dissipative_column", label, columns, orders=tuple(orders)))
     return out
 
 

@@ -11,7 +11,9 @@ used), written as sympy expressions code generation takes (exp, tanh, sin, cos; 
 - direction: ``-tanh(beta v)^2 sum_k a_k phi_k(x)`` (zero at rest, the same sign both ways);
 - elastic: ``-sum_k a_k phi_k(x)``;
 - speed: ``-tanh(beta v) sum_k a_k phi_k(|v| / v_90)``, ``|v|`` smoothed as ``v tanh(beta v)``;
-- column: a torque on the column ``sum_m a_m sin(m theta_c) + b_m cos(m theta_c)`` (its phase free).
+- column: a torque on the column ``sum_m a_m sin(m theta_c) + b_m cos(m theta_c)`` (its phase free);
+- dissipative x column: a friction torque on the column ``-tanh(beta v) sum_m a_m sin(m theta_c) + b_m
+  cos(m theta_c)`` (:func:`dissipative_column_body`).
 
 The strengths are declared free (``Quantity.free``) within wide bounds: passed back with ``--effects=+FILE.py``,
 the diagnosis (and ``parksteer compare``) fits them together with the calibrated parameters. They are signed (a
@@ -38,7 +40,7 @@ from .engine import ReplayEngine
 from .problem import Problem
 from .statistics import bic_gain, effective_samples, fit_statistics, lag1_autocorrelation
 from .settings import DEFAULT_SETTINGS, DiagnosisSettings
-from .signature import Signature
+from .signature import COLUMN_CLASSES, Signature
 
 FORCE_BOUND_N = 20000.0  # a knot's rack force: far above any steering-gear force at parking speed
 TORQUE_BOUND_NM = 50.0  # a column torque's amplitude: far above any handwheel torque at parking speed
@@ -76,7 +78,7 @@ def effect_source(signature: Signature, fitted: dict[str, float] | None = None, 
         raise UsageError("suggest: the residual shows no structure beyond the noise; there is no effect to suggest")
     kind, best = signature.effect_class, signature.best
     name = f"suggested_{kind}"
-    if kind == "column":
+    if kind in COLUMN_CLASSES:
         keys = [f"{name}.{f}{m}" for m in best.orders for f in ("sin", "cos")]
         unit, bound = "N m", TORQUE_BOUND_NM
     else:
@@ -111,7 +113,9 @@ STRENGTHS = {tuple(keys)!r}
 # the start of the fit when the file is passed back.
 START = {{fitted_values}}
 '''
-    if kind == "column":
+    if kind == "dissipative_column":
+        body = dissipative_column_body(best.orders, bound)
+    elif kind == "column":
         body = f'''ORDERS = {tuple(best.orders)!r}  # per column turn
 
 
@@ -182,6 +186,36 @@ class Suggested(Effect):
                                                          after=fitted.get("_after", math.nan)) if fitted else "")
 
 
+def dissipative_column_body(orders: tuple[int, ...], bound: float) -> str:
+    """The effect class of a friction on the column shaft periodic in the column angle: a torque between column
+    and body, ``-tanh(beta v) sum_m a_m sin(m theta_c) + b_m cos(m theta_c)``, reversing with the motion (the
+    column turns with the rack, so the rack speed's smoothed sign is the column's)."""
+    return f'''ORDERS = {tuple(orders)!r}  # per column turn
+
+
+class Suggested(Effect):
+    name = NAME
+    description = ("Suggested: a friction torque on the column, sign(v) times a sum of sin and cos of the column "
+                   "angle times " + ", ".join(str(m) for m in ORDERS) + " (per turn); 0 = absent")
+    in_default_set = False
+    diagnosis_candidate = False
+    quantities = tuple(Quantity(key, "N m", -{bound!r}, {bound!r}, lower_inclusive=True,
+                                default=START.get(key, 0.0), free=True,
+                                source="suggested from the residual's signature; 0 = absent") for key in STRENGTHS)
+    uses = STRENGTHS + ("steering.friction_smoothing",)
+
+    def loads(self, model):
+        k = model.kinematics
+        theta = k.column_angle
+        beta = model.p("steering.friction_smoothing")
+        shape = sum(model.p(f"{{NAME}}.sin{{m}}") * sp.sin(m * theta) + model.p(f"{{NAME}}.cos{{m}}") * sp.cos(m * theta)
+                    for m in ORDERS)
+        # Opposes the motion: the column turns the way the rack moves.
+        torque = -sp.tanh(beta * model.rack_u) * shape
+        return torque_between(torque, k.B.y, k.column_frame, k.B)
+'''
+
+
 def strength_keys(source: str) -> tuple[str, ...]:
     namespace: dict = {}
     line = next(l for l in source.splitlines() if l.startswith("STRENGTHS = "))
@@ -213,7 +247,7 @@ def suggest(problem: Problem, calibration: Fit, signature: Signature, path: str 
         before = fit_statistics(problem, calibration.predictions)
         floor = before["noise_floor_Nm"]
         ratio = problem.params.sections["steering"]["handwheel_to_rack_ratio"]
-        column = signature.effect_class == "column"
+        column = signature.effect_class in COLUMN_CLASSES
         step = floor if column else floor * ratio  # a strength moving the torque by about a noise floor
         engine = ReplayEngine()
         # the effect's strengths are free (calibration_parameters adds them, last), each stepped by about a floor

@@ -32,7 +32,7 @@ from ..model.symbolic.components import resolve_effects
 from ..parameters import Parameters
 from ..synthetic.datasets import perturbed_base, rms_difference
 from ..measure.converter import quantisation_step
-from ..synthetic.outoflibrary import FORMS, form_by_name
+from ..synthetic.outoflibrary import COMBINED_FORMS, FORMS, form_by_name
 from ..synthetic.variations import VARIATIONS, variation_rack, variation_record
 from .benchmark import BASE_PERTURBATION, BENCHMARK_SETTINGS
 from ..diagnose.problem import load_files
@@ -58,13 +58,16 @@ class SignatureCase:
 @dataclass(frozen=True)
 class SignatureDesign:
     """The grid: every truth form at each size in `steps`, on variations taken in turn from `variations` of
-    VARIATIONS starting at `first_variation`, and `nulls` records with nothing hidden."""
+    VARIATIONS starting at `first_variation`, and `nulls` records with nothing hidden; then the forms named in
+    `combined` of those that are products of two classes (COMBINED_FORMS) at each size, the variations still in
+    turn."""
 
     steps: tuple[float, ...] = (5.0,)
     nulls: int = 4
     variations: int = 6
     seed: int = 2411
     first_variation: int = 0
+    combined: tuple[str, ...] = tuple(f.effect.name for f in COMBINED_FORMS)
     perturbation: dict = field(default_factory=lambda: dict(BASE_PERTURBATION))
 
     def cases(self) -> list[SignatureCase]:
@@ -79,6 +82,12 @@ class SignatureDesign:
             variation = VARIATIONS[self.first_variation + k % self.variations]
             out.append(SignatureCase(f"null_{i}", None, 0.0, variation.name, self.seed + k))
             k += 1
+        for steps in self.steps:
+            for form in [f for f in COMBINED_FORMS if f.effect.name in self.combined]:
+                variation = VARIATIONS[self.first_variation + k % self.variations]
+                out.append(SignatureCase(f"{form.effect.name}_{steps:g}", form.effect.name, steps, variation.name,
+                                         self.seed + k))
+                k += 1
         return out
 
 

@@ -100,11 +100,16 @@ def make_compare_figure(parameters: str | Path, files: list[str | Path], svg: st
 
 
 def diagnosis_figure(diagnosis, path: str | Path) -> None:
-    """First file: torque and residual against rack for the calibrated model and with the best candidate; ranking."""
+    """First file: torque and residual against rack for the calibrated model and with the best candidate; for an
+    assisted car whose motor channel is fitted, that channel measured and fitted, and its residual, beside the
+    torque's; ranking."""
     from ..diagnose.report import candidate_predictions
 
-    fig, axes = new_figure(7.0, 8.0, nrows=3)
     f = diagnosis.problem.files[0]
+    fig, axes = new_figure(7.0, 12.0 if f.uses_motor else 8.0, nrows=5 if f.uses_motor else 3)
+    if f.uses_motor:
+        _motor_panels(diagnosis, axes[2], axes[3])
+        axes = [axes[0], axes[1], axes[4]]
     rack_mm = f.rack_m * 1000
     calibrated = f.torque_part(diagnosis.calibration.predictions[0])
     axes[0].plot(rack_mm, f.torque_Nm, ".", color=MEASURED, markersize=1.5, label=f"measured ({f.label})")
@@ -141,6 +146,35 @@ def diagnosis_figure(diagnosis, path: str | Path) -> None:
     axes[2].set_title(f"verdict: {diagnosis.verdict}", fontsize=9)
     fig.tight_layout()
     save_svg(fig, path)
+
+
+def _motor_panels(diagnosis, channel_ax, residual_ax) -> None:
+    """The first file's motor channel (an assisted car's current or motor torque): measured, the calibrated model
+    and with the best candidate against rack; and the residual of each."""
+    from ..diagnose.report import candidate_predictions
+
+    f = diagnosis.problem.files[0]
+    rack_mm = f.rack_m * 1000
+    unit = "A" if f.motor_column == "motor_current_A" else "N m"
+    name = f.motor_column.removesuffix("_A").removesuffix("_Nm").replace("_", " ")
+    calibrated = f.motor_part(diagnosis.calibration.predictions[0])
+    channel_ax.plot(rack_mm, f.motor, ".", color=MEASURED, markersize=1.5, label="measured")
+    channel_ax.plot(rack_mm, calibrated, color=COLOURS[0], linewidth=1.0, label="calibrated model")
+    residual_ax.plot(rack_mm, f.motor - calibrated, ".", color=COLOURS[0], markersize=1.5, label="calibrated model")
+    if diagnosis.best is not None:
+        with_best = f.motor_part(candidate_predictions(diagnosis, diagnosis.best)[0])
+        label = f"+ {diagnosis.best.name}"
+        channel_ax.plot(rack_mm, with_best, color=COLOURS[1], linewidth=1.0, label=label)
+        residual_ax.plot(rack_mm, f.motor - with_best, ".", color=COLOURS[1], markersize=1.5, label=label)
+    residual_ax.axhline(f.motor_noise.total_rms, color="black", linestyle=":", linewidth=0.8)
+    residual_ax.axhline(-f.motor_noise.total_rms, color="black", linestyle=":", linewidth=0.8)
+    channel_ax.set_ylabel(f"{name} ({unit})")
+    channel_ax.set_title("assisted car's motor channel: measured (dots) and fitted (lines)", fontsize=9)
+    channel_ax.legend(fontsize=7)
+    residual_ax.set_ylabel(f"measured - model ({unit})")
+    residual_ax.set_xlabel("rack displacement (mm)")
+    residual_ax.set_title("motor channel residual (dotted: its noise floor RMS)", fontsize=9)
+    residual_ax.legend(fontsize=7)
 
 
 def ladder_figure(rungs: list[dict], noise_floor_Nm: float, attainable_floor_Nm: float, path: str | Path,

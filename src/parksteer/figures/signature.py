@@ -40,16 +40,24 @@ ROW_KEYS = ("name", "form", "class", "variation", "steps", "said_class", "class_
 def design_from_config(config: dict) -> SignatureDesign:
     """The grid of config["signature"] (config/config.yaml)."""
     try:
-        return SignatureDesign(steps=tuple(float(s) for s in config["steps"]), nulls=int(config["nulls"]),
-                               variations=int(config["variations"]), seed=int(config["seed"]),
-                               first_variation=int(config["first_variation"]))
+        design = SignatureDesign(steps=tuple(float(s) for s in config["steps"]), nulls=int(config["nulls"]),
+                                 variations=int(config["variations"]), seed=int(config["seed"]),
+                                 first_variation=int(config["first_variation"]),
+                                 combined=tuple(str(n) for n in config["combined_forms"]))
     except KeyError as missing:
         raise UsageError(f"config signature: no {missing.args[0]!r}") from None
+    from ..synthetic.outoflibrary import COMBINED_FORMS
+
+    known = [f.effect.name for f in COMBINED_FORMS]
+    unknown = [n for n in design.combined if n not in known]
+    if unknown:
+        raise UsageError(f"config signature: combined_forms: no form {unknown[0]!r} (the forms: {', '.join(known)})")
+    return design
 
 
 def design_dict(design: SignatureDesign) -> dict:
     return {"steps": list(design.steps), "nulls": design.nulls, "variations": design.variations,
-            "seed": design.seed, "first_variation": design.first_variation}
+            "seed": design.seed, "first_variation": design.first_variation, "combined_forms": list(design.combined)}
 
 
 def method_dict() -> dict:
@@ -59,16 +67,18 @@ def method_dict() -> dict:
     sig = BENCHMARK_SETTINGS.signature
     return {"position_knots": list(sig.position_knots), "speed_knots": sig.speed_knots,
             "column_orders": [list(o) for o in sig.column_orders], "mesh_order": sig.mesh_order,
+            "combined_orders": [list(o) for o in sig.combined_orders],
             "significance": sig.significance, "bic_missing_threshold": BENCHMARK_SETTINGS.bic_missing_threshold,
             "bic_indistinguishable": BENCHMARK_SETTINGS.bic_indistinguishable, "after_limit": AFTER_LIMIT}
 
 
-def forms_dict() -> dict:
-    """Each truth form: its class, what it is, the mechanism it stands for."""
-    from ..synthetic.outoflibrary import FORMS
+def forms_dict(names=None) -> dict:
+    """Each truth form (of `names`, if given: the forms the rows hold): its class, what it is, the mechanism it
+    stands for."""
+    from ..synthetic.outoflibrary import ALL_FORMS
 
     return {f.effect.name: {"class": f.signature_class, "description": f.effect.description, "why": f.effect.why}
-            for f in FORMS}
+            for f in ALL_FORMS if names is None or f.effect.name in names}
 
 
 def case_names(design: SignatureDesign) -> list[str]:
@@ -286,7 +296,7 @@ def make_signature_figure(row_paths, svg: str | Path, csv: str | Path, json_path
     times = [r.get("timings_s", {}) for r in rows]
     summary["settings"] = design_dict(design) if design is not None else None
     summary["method"] = method_dict()
-    summary["forms"] = forms_dict()
+    summary["forms"] = forms_dict({r["form"] for r in rows if r["form"] is not None})
     summary["sentences"] = {r["name"]: r["sentence"] for r in rows}
     summary["timings_s"] = {k: float(np.median([t[k] for t in times])) for k in (*TIME_KEYS, "case_s")
                             if times and all(k in t for t in times)}

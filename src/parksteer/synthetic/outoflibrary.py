@@ -17,7 +17,12 @@ in the signature's classes (:data:`parksteer.diagnose.signature.CLASSES`), sever
 - speed: rack damping ``c v (1 + (v / v_c)^2)`` with the cubic term dominant above v_c = 20 mm/s (grease
   shearing thicker than Newtonian); a quadratic drag ``c v |v|`` (a fluid forced through the boot's vents);
 - column: a once-per-turn column torque ``A sin(theta_c - 0.7)`` (an eccentric column bearing); a second-order
-  ripple ``A sin(2 theta_c + 0.4)`` (a worn intermediate joint, on top of the Hooke joint's own).
+  ripple ``A sin(2 theta_c + 0.4)`` (a worn intermediate joint, on top of the Hooke joint's own);
+- dissipative x column (a product of two classes): a column bearing pinched once per turn, its friction torque
+  ``A exp((cos(theta_c - 0.9) - 1) / 0.25) tanh(omega_c / 0.5 rad/s)`` (a narrow peak once per turn, orders
+  1-4 and more, not a sinusoid); a joint friction that grows with the joint's angle twice per turn,
+  ``A sin(theta_c + 0.3)^4 tanh(omega_c / 0.5 rad/s)`` (orders 2 and 4 about a mean). Both reverse with the
+  column's rate ``omega_c`` through a smoothing of their own, softer than the model's friction smoothing.
 
 Forces act between rack and housing, torques on the column shaft against the body, as the library's do.
 """
@@ -176,6 +181,50 @@ class ColumnSecond(_ColumnTorque):
         return sp.sin(2 * theta + 0.4)
 
 
+COLUMN_RATE_SCALE_RAD_S = 0.5  # the truth column frictions' breakaway: tanh(omega_c / 0.5 rad/s)
+
+
+class _ColumnFriction(Effect):
+    """A friction torque on the column shaft, -strength * shape(theta_c) * tanh(omega_c / 0.5 rad/s), between
+    the column and the body."""
+
+    in_default_set = False
+    diagnosis_candidate = False
+    why = ""
+
+    def __init_subclass__(cls, **kwargs):
+        super().__init_subclass__(**kwargs)
+        cls.quantities = (_strength(cls.name, "N m", TORQUE_UPPER_NM, cls.why),)
+        cls.uses = (f"{cls.name}.strength",)
+
+    def shape(self, theta):
+        raise NotImplementedError
+
+    def loads(self, model):
+        k = model.kinematics
+        torque = -model.p(f"{self.name}.strength") * self.shape(k.column_angle) * sp.tanh(
+            k.column_rate / COLUMN_RATE_SCALE_RAD_S)
+        return torque_between(torque, k.B.y, k.column_frame, k.B)
+
+
+class PinchedBearing(_ColumnFriction):
+    name = "oolib_pinched_bearing"
+    description = "Column friction pinched once per turn, exp((cos(theta_c - 0.9) - 1) / 0.25), per N m"
+    why = "a column bearing pinched at one place of its turn"
+
+    def shape(self, theta):
+        return sp.exp((sp.cos(theta - 0.9) - 1) / 0.25)
+
+
+class JointFriction(_ColumnFriction):
+    name = "oolib_joint_friction"
+    description = "Column friction growing twice per turn with the joint's angle, sin(theta_c + 0.3)^4, per N m"
+    why = "an intermediate joint whose friction grows with its articulation"
+
+    def shape(self, theta):
+        return sp.sin(theta + 0.3) ** 4
+
+
 @dataclass(frozen=True)
 class TruthForm:
     effect: Effect
@@ -189,10 +238,16 @@ FORMS: tuple[TruthForm, ...] = (
     TruthForm(CubicDamping(), "speed"), TruthForm(QuadraticDrag(), "speed"),
     TruthForm(ColumnOnce(), "column"), TruthForm(ColumnSecond(), "column"),
 )
+# the products of two classes, after the single classes (their records follow the nulls in a grid, so that adding
+# them left every other record of the grid as it was)
+COMBINED_FORMS: tuple[TruthForm, ...] = (
+    TruthForm(PinchedBearing(), "dissipative_column"), TruthForm(JointFriction(), "dissipative_column"),
+)
+ALL_FORMS = FORMS + COMBINED_FORMS
 
 
 def form_by_name(name: str) -> TruthForm:
-    for form in FORMS:
+    for form in ALL_FORMS:
         if form.effect.name == name:
             return form
     raise KeyError(name)
