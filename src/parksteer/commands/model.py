@@ -97,6 +97,17 @@ def _assisted_vehicle_sets() -> list:
     return sets
 
 
+def _signature_truth_sets() -> list:
+    """(spec, effects) of the models the signature benchmark makes its records with: the default set and each truth
+    form outside the library (parksteer.synthetic.outoflibrary), spec ``{"truth_form": name}``; its jobs then
+    compile them instead of deriving them."""
+    from ..model.symbolic.components import resolve_effects
+    from ..synthetic.outoflibrary import ALL_FORMS
+
+    base = resolve_effects(None)
+    return [({"truth_form": form.effect.name}, resolve_effects([*base, form.effect])) for form in ALL_FORMS]
+
+
 def _manifest_spec(path: str):
     """The effects spec of a model manifest the pipeline's derive rule wrote (its `spec`), refused in one line."""
     try:
@@ -220,7 +231,7 @@ def _derive(args) -> int:
             raise UsageError("--prebuilt derives the default diagnosis' models and the manifests' sets: give it no "
                              "--effects or --out")
         sets = [([e.name for e in effects], effects) for effects in default_diagnosis_models()]
-        sets += _assisted_vehicle_sets()
+        sets += _assisted_vehicle_sets() + _signature_truth_sets()
         for path in args.manifests:
             spec = _manifest_spec(path)
             sets.append((spec, resolve_effects(spec)))

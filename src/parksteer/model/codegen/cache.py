@@ -179,9 +179,10 @@ def prebuilt_source(key: str) -> tuple[str, dict] | None:
     return source, info
 
 
-def prebuilt_specs() -> dict[str, str | list | None]:
+def prebuilt_specs() -> dict[str, str | list | dict | None]:
     """The effects spec (:func:`~parksteer.model.symbolic.components.resolve_effects`) of each pre-derived model,
-    by its key: what `parksteer derive --prebuilt` was asked for, so that a stale key can be told."""
+    by its key: what `parksteer derive --prebuilt` was asked for, so that a stale key can be told (a model of the
+    signature benchmark's records: ``{"truth_form": name}``, the default set with that truth form)."""
     specs = {}
     for json_path in sorted(PREBUILT_DIR.glob("*.json")):
         try:
