@@ -53,6 +53,26 @@ def test_table_law_takes_its_points_exactly_and_is_monotone_odd_and_zero_in_the_
     assert np.max(np.abs(a[inside] - reference(t[inside]))) < 1e-12
 
 
+def test_the_numbers_take_one_segment_per_sample_and_give_the_piecewise_law_bit_for_bit():
+    """The replay evaluates the table on numbers by finding each sample's segment; the generated C evaluates the
+    piecewise form (every segment's condition in turn). On random monotone tables and torques across and beyond
+    the points (the points themselves, both signs, zero) the two are the same numbers, bit for bit."""
+    from parksteer.model.symbolic.effects.assist_common import MAX_POINTS, _hermite, _select
+
+    rng = np.random.default_rng(7)
+    for _ in range(50):
+        knots = np.concatenate([[0.0], np.cumsum(rng.uniform(0.05, 1.0, MAX_POINTS - 1))])
+        assist = np.concatenate([[0.0], np.cumsum(rng.uniform(0.0, 5.0, MAX_POINTS - 1))])
+        slope = rng.uniform(0.0, 5.0, MAX_POINTS)
+        x = np.concatenate([rng.uniform(-1.3, 1.3, 500) * knots[-1], knots, -knots, [0.0]])
+        branches = [(np.abs(x) < knots[k + 1], _hermite(np.abs(x), knots[k], knots[k + 1], assist[k], assist[k + 1],
+                                                          slope[k], slope[k + 1])) for k in range(MAX_POINTS - 1)]
+        half = _select(branches, assist[-1] + slope[-1] * (np.abs(x) - knots[-1]))
+        piecewise = np.where(x >= 0, half, -half)
+        fast = table_law(x, None, 0.0, points=(list(knots), list(assist), list(slope)))
+        assert np.array_equal(fast, piecewise)
+
+
 def test_one_straight_segment_is_todays_linear_law():
     """A table of two points (0, 0) and (T_1, A_1) is the straight line of gain A_1 / T_1 (no dead band), on both
     sides of zero and beyond the point."""

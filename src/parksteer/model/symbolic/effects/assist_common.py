@@ -167,8 +167,21 @@ def table_law(torque, value, speed, points=None):
     if isinstance(torque, sp.Basic):
         return sp.Piecewise((half(torque), torque >= 0), (-half(-torque), True))
     torque = np.asarray(torque, dtype=float)
-    magnitude = half(np.abs(torque))
+    if all(np.ndim(v) == 0 and not isinstance(v, sp.Basic) for v in (*knots, *assist, *slope)):
+        magnitude = _half_numeric(np.abs(torque), knots, assist, slope)
+    else:  # a point read at a speed that varies by sample: every segment, one kept
+        magnitude = half(np.abs(torque))
     return np.where(torque >= 0, magnitude, -magnitude)
+
+
+def _half_numeric(x, knots, assist, slope):
+    """:func:`table_law`'s law for x >= 0 on numbers: each sample's own segment found (the first k with x <
+    knots[k + 1], as the piecewise form selects it) and only that segment evaluated, with the same operations."""
+    knots, assist, slope = (np.asarray(v, dtype=float) for v in (knots, assist, slope))
+    k = np.searchsorted(knots[1:], x, side="right")  # len(knots) - 1 beyond the last point
+    inner = np.minimum(k, len(knots) - 2)
+    value = _hermite(x, knots[inner], knots[inner + 1], assist[inner], assist[inner + 1], slope[inner], slope[inner + 1])
+    return np.where(k < len(knots) - 1, value, assist[-1] + slope[-1] * (x - knots[-1]))
 
 
 def table_quantities(name: str, unit: str, slope_unit: str, where: str,
