@@ -18,8 +18,8 @@ perturb them, the prescribed-rack solve), the truth sized to `steps` converter s
 the nulls are the same records with nothing hidden. Every diagnosis is the command line's, on the written file, in
 a process of its own, as a user runs it (`--torque-lag` where the logger delays its torque channel).
 
-Scored: the signature's class is the form's (dissipative, direction, and column for the pinched bearing); the
-diagnosis of the record says `unexplained` and writes a suggestion; the suggestion passed back gives
+Scored: the signature's class is the form's (dissipative, direction, and dissipative x column for the pinched
+bearing); the diagnosis of the record says `unexplained` and writes a suggestion; the suggestion passed back gives
 `adequate` (the bar: 5 of 6); no null gets a suggestion. Printed: one line a record, then the counts.
 """
 
@@ -102,9 +102,9 @@ class PinchedBearing(Effect):
 
 FORMS = (CentreFriction(), OneWayDragLeft(), PinchedBearing())
 # the signature class each form should be read as (parksteer.diagnose.signature): the pinched bearing is a friction
-# shaped by the column angle, which the column class names
+# shaped by the column angle, the product class dissipative x column
 EXPECTED_CLASS = {"bench_centre_friction": "dissipative", "bench_one_way_drag": "direction",
-                  "bench_pinched_bearing": "column"}
+                  "bench_pinched_bearing": "dissipative_column"}
 
 
 def make_record(params, form: Effect | None, steps: float, variation, seed: int):

@@ -56,6 +56,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .. import portable as pm
 from ..boost_table import entries
 from ..errors import UsageError
 from ..model.symbolic.effects.assist_common import directional_efficiency, table_law
@@ -220,15 +221,15 @@ def _sandwich(jacobian: np.ndarray, residual: np.ndarray, blocks: np.ndarray) ->
     """Covariance of a least-squares fit with residuals correlated within blocks (the cluster sandwich), scaled
     so that it is never smaller than the plain one of independent residuals."""
     n, k = jacobian.shape
-    bread = np.linalg.pinv(jacobian.T @ jacobian)
+    bread = pm.generalized_inverse(pm.matmul(jacobian.T, jacobian))
     meat = np.zeros((k, k))
     for b in np.unique(blocks):
-        g = jacobian[blocks == b].T @ residual[blocks == b]
+        g = pm.matmul(jacobian[blocks == b].T, residual[blocks == b])
         meat += np.outer(g, g)
     count = len(np.unique(blocks))
     correction = count / max(count - k, 1)
-    plain = bread * float(residual @ residual) / max(n - k, 1)
-    cluster = bread @ meat @ bread * correction
+    plain = bread * pm.dot(residual, residual) / max(n - k, 1)
+    cluster = pm.matmul(pm.matmul(bread, meat), bread) * correction
     return np.where(np.diag(cluster)[:, None] * np.diag(cluster)[None, :] >=
                     np.diag(plain)[:, None] * np.diag(plain)[None, :], cluster, plain)
 
@@ -254,14 +255,12 @@ class _Map:
 
 
 def _currents(x) -> list[float]:
-    return [0.0, 0.0, *(float(c) for c in np.cumsum(np.exp(x[2:])))]
+    return [0.0, 0.0, *(float(c) for c in np.cumsum(pm.exp(np.asarray(x[2:], dtype=float))))]
 
 
 def _fit_table(S: np.ndarray, i: np.ndarray, top: float, d0: float, span: int):
     """The least-squares table of `span` points beyond the dead band: parameters (D, c, log rises), residuals and
     their Jacobian."""
-    from scipy.optimize import least_squares
-
     magnitude = np.abs(S)
     active = magnitude > d0
     start = []
@@ -278,8 +277,54 @@ def _fit_table(S: np.ndarray, i: np.ndarray, top: float, d0: float, span: int):
 
     lower = np.r_[0.01, -0.5, np.full(span, -12.0)]
     upper = np.r_[0.9 * top, 0.5, np.full(span, 8.0)]
-    fit = least_squares(residual, np.clip(x0, lower + 1e-9, upper - 1e-9), bounds=(lower, upper), x_scale="jac")
-    return fit.x, fit.fun, fit.jac
+    return bounded_least_squares(residual, np.clip(x0, lower + 1e-9, upper - 1e-9), lower, upper)
+
+
+def bounded_least_squares(residual, x0: np.ndarray, lower: np.ndarray, upper: np.ndarray,
+                          max_iterations: int = 200, tolerance: float = 1e-12):
+    """(x, residual(x), its Jacobian) minimising the sum of squares of `residual` within the box [lower, upper]:
+    Levenberg-Marquardt with a forward-difference Jacobian, on the fixed-order arithmetic of parksteer.portable,
+    so that the same records give the same table on any machine (a BLAS-backed solver rounds by its kernel)."""
+    def jacobian(x, r):
+        out = np.empty((r.size, x.size))
+        for j in range(x.size):
+            h = 1e-7 * max(1.0, abs(float(x[j])))
+            moved = x.copy()
+            moved[j] = x[j] + h if x[j] + h <= upper[j] else x[j] - h
+            out[:, j] = (residual(moved) - r) / (moved[j] - x[j])
+        return out
+
+    x = np.clip(np.asarray(x0, dtype=float), lower, upper)
+    r = residual(x)
+    rss = pm.dot(r, r)
+    J = jacobian(x, r)
+    damping = 1e-3
+    for _ in range(max_iterations):
+        JTJ = pm.matmul(J.T, J)
+        scale = np.diag(JTJ).copy()
+        scale[scale <= 0] = 1.0
+        try:
+            step = -pm.solve(JTJ + damping * np.diag(scale), pm.matmul(J.T, r))
+        except pm.LinAlgError:
+            damping *= 4.0
+            continue
+        trial = np.clip(x + step, lower, upper)
+        if not np.any(trial != x):
+            break
+        trial_r = residual(trial)
+        trial_rss = pm.dot(trial_r, trial_r)
+        if trial_rss < rss:
+            done = rss - trial_rss <= tolerance * rss
+            x, r, rss = trial, trial_r, trial_rss
+            J = jacobian(x, r)
+            damping = max(damping / 3.0, 1e-12)
+            if done:
+                break
+        else:
+            damping *= 4.0
+            if damping > 1e12:
+                break
+    return x, r, J
 
 
 def fit_map(files: list[FileData]) -> _Map:
@@ -297,7 +342,7 @@ def fit_map(files: list[FileData]) -> _Map:
     x, r, jacobian = _fit_table(S, i, top, d0, SPAN_POINTS)
     covariance = _sandwich(jacobian, r, _blocks(times, BLOCK_S))
     # the points' currents against the parameters (exp of the rises, summed)
-    rises = np.exp(x[2:])
+    rises = pm.exp(np.asarray(x[2:], dtype=float))
     jac_values = np.zeros((SPAN_POINTS + 2, len(x)))
     for k in range(2, SPAN_POINTS + 2):
         jac_values[k, 2:k + 1] = rises[: k - 1]
@@ -310,7 +355,7 @@ def fit_map(files: list[FileData]) -> _Map:
     representation = np.abs(coarse_law(points) - np.array(_currents(x))) / 2.0
     # ... and the current's rounding: the control unit gives one current at one reading of the sensor, so repeated
     # samples at a torque level carry the same rounding error and do not average it away
-    representation = np.hypot(representation, step_i / math.sqrt(12.0))
+    representation = pm.hypot(representation, np.full_like(representation, step_i / math.sqrt(12.0)))
     representation[:2] = 0.0
     dead_band_representation = abs(float(coarse[0] - x[0])) / 2.0
     torques, current = _knots(x[0], top), _currents(x)
@@ -333,11 +378,11 @@ def fit_map(files: list[FileData]) -> _Map:
     up, down = use & (loading > 0), use & (loading < 0)
     if up.sum() > 10 and down.sum() > 10:
         design = np.column_stack([up[use].astype(float), down[use].astype(float)])
-        coef, *_ = np.linalg.lstsq(design, signed[use], rcond=None)
-        resid = signed[use] - design @ coef
+        coef = pm.lstsq(design, signed[use])
+        resid = signed[use] - pm.matmul(design, coef)
         cov = _sandwich(design, resid, _blocks(times[use], BLOCK_S))
         contrast = np.array([1.0, -1.0])
-        hysteresis, hysteresis_se = float(coef[0] - coef[1]), float(math.sqrt(contrast @ cov @ contrast))
+        hysteresis, hysteresis_se = float(coef[0] - coef[1]), math.sqrt(pm.dot(contrast, pm.matmul(cov, contrast)))
         hysteresis_Nm = hysteresis / float(np.median(slope[use])) if np.median(slope[use]) > 0 else math.nan
     else:
         hysteresis, hysteresis_se, hysteresis_Nm = 0.0, math.inf, math.nan
@@ -443,7 +488,7 @@ def identify_boost(records, vehicle, case: str | None = None, surface: str | Non
         speed = rack_speed_mps(f.rack, f.time_s)
         e = directional_efficiency(motor, speed, eta, eta_b, v("limit_smoothing"), sharpness)
         delivered.append(e * reduction * motor / scale)
-        moving.append(np.abs(np.tanh(sharpness * speed)) >= MOVING_SIGN)
+        moving.append(np.abs(pm.tanh(sharpness * speed)) >= MOVING_SIGN)
         backward.append(motor * speed < 0.0)
         measured.append(S)
         times.append(f.time_s + 1e6 * k)
@@ -477,11 +522,11 @@ def identify_boost(records, vehicle, case: str | None = None, surface: str | Non
     parts = [-D * ~back, -D * back] if split else [-D]
     design = (np.column_stack([*columns, np.ones_like(S_all), *parts]) / sigma[:, None])[use]
     rhs = ((S_all - y0) / sigma)[use]
-    solution, *_ = np.linalg.lstsq(design, rhs, rcond=None)
-    resid = rhs - design @ solution
+    solution = pm.lstsq(design, rhs)
+    resid = rhs - pm.matmul(design, solution)
     cov = _sandwich(design, resid, _blocks(t_all[use], BLOCK_S))
     # the product at the tyre friction moved by its step: the same fit on y0 + step x its column
-    moved, *_ = np.linalg.lstsq(design, ((S_all - y0 - tyre_step * tyre_column) / sigma)[use], rcond=None)
+    moved = pm.lstsq(design, ((S_all - y0 - tyre_step * tyre_column) / sigma)[use])
     se = np.sqrt(np.maximum(np.diag(cov), 0.0))
     values = theta + solution[: len(keys)]
     offset, p = float(solution[len(keys)]), float(solution[len(keys) + 1])
@@ -494,7 +539,7 @@ def identify_boost(records, vehicle, case: str | None = None, surface: str | Non
         ratio = p / p_b
         gradient = np.array([1.0 / p_b, -p / p_b ** 2])
         block = cov[np.ix_([len(keys) + 1, j], [len(keys) + 1, j])]
-        back_se = eta_b * math.sqrt(max(float(gradient @ block @ gradient), 0.0))
+        back_se = eta_b * math.sqrt(max(pm.dot(gradient, pm.matmul(block, gradient)), 0.0))
     z = _t95(len(np.unique(_blocks(t_all[use], BLOCK_S))) - design.shape[1])
     if split:
         back_efficiency = _estimate(eta_b * ratio, back_se, "1", z)
@@ -503,7 +548,7 @@ def identify_boost(records, vehicle, case: str | None = None, surface: str | Non
 
     # the table at the point of action: P K, its interval from the map's and the product's
     P = p * product_file
-    point_cov = fitted.jacobian_values @ fitted.covariance @ fitted.jacobian_values.T \
+    point_cov = pm.matmul(pm.matmul(fitted.jacobian_values, fitted.covariance), fitted.jacobian_values.T) \
         + np.diag(fitted.representation ** 2)
     current = np.array(fitted.current)
     assist = P * current
