@@ -217,7 +217,7 @@ def main(argv=None) -> int:
     rows = run(args)
     s = summary(rows)
     print(f"\n{s['records']} records of 3 forms, {s['nulls']} nulls, {time.perf_counter() - start:.0f} s")
-    print(f"class read right {s['class_right']} of {s['records']} (bar 5; the pinched bearing as column)")
+    print(f"class read right {s['class_right']} of {s['records']} (bar 5; the pinched bearing as dissipative x column)")
     print(f"unexplained {s['unexplained']} of {s['records']}, suggestion written {s['suggested']} of {s['records']}, "
           f"adequate when passed back as it stands {s['adequate_when_passed_back']} of {s['records']} (bar 5)")
     for form, t in s["by_form"].items():
