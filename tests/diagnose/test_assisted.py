@@ -232,10 +232,10 @@ def test_the_assisted_benchmark_rows_come_back_in_the_design_order(tmp_path):
     assert [row["name"] for row in read_rows(folders, names)] == names
     for folder in folders:
         (folder / f"{names[0]}{ROW_SUFFIX}").unlink(missing_ok=True)
-    with pytest.raises(UsageError, match=f"no row of case {names[0]}"):
+    with pytest.raises(UsageError, match=f"no rows of case {names[0]}"):
         read_rows(folders, names)
     for folder in folders:  # names[1] in both folders
         (folder / f"{names[1]}{ROW_SUFFIX}").write_text("{}")
     (folders[0] / f"{names[0]}{ROW_SUFFIX}").write_text("{}")
-    with pytest.raises(UsageError, match=f"case {names[1]} has a row"):
+    with pytest.raises(UsageError, match=f"case {names[1]} has rows"):
         read_rows(folders, names)

@@ -47,6 +47,7 @@ from .outclass import bic_margin
 from ..diagnose.problem import load_files
 from ..diagnose.report import diagnosis_dict
 from ..diagnose.select import diagnose
+from .rows import ROW_SUFFIX, read_case_files
 from .variations import NAMED_MIN_STEPS, NAMED_TARGET, NULL_ADEQUATE_TARGET
 
 RACK_FRICTION = "steering.rack_friction_force"
@@ -261,7 +262,6 @@ def run(params: Parameters, design: AssistedDesign = AssistedDesign(), only=None
     return rows, summarise(rows)
 
 
-ROW_SUFFIX = ".row.json"
 
 
 def run_batch(params: Parameters, names: list[str], folder: str | Path, design: AssistedDesign = AssistedDesign()
@@ -286,17 +286,7 @@ def run_batch(params: Parameters, names: list[str], folder: str | Path, design: 
 def read_rows(folders, names: list[str]) -> list[dict]:
     """The rows run_batch wrote into `folders` of the cases `names`, in that order; a case with no row, or with
     rows in two folders, is refused in one line."""
-    found: dict[str, Path] = {}
-    for folder in map(Path, folders):
-        for path in sorted(folder.glob(f"*{ROW_SUFFIX}")):
-            name = path.name[:-len(ROW_SUFFIX)]
-            if name in found:
-                raise UsageError(f"{path}: case {name} has a row in {found[name].parent} as well")
-            found[name] = path
-    missing = [name for name in names if name not in found]
-    if missing:
-        raise UsageError(f"assisted benchmark: no row of case {missing[0]} in {', '.join(map(str, folders))}")
-    return [json.loads(found[name].read_text(encoding="utf-8")) for name in names]
+    return read_case_files(folders, names, "assisted benchmark")
 
 
 __all__ = ["AssistedDesign", "case_names", "cases", "outcome", "read_rows", "run", "run_batch", "summarise"]

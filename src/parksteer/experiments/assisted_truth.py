@@ -49,6 +49,7 @@ from ..synthetic.datasets import SizeSearch, perturbed_base, rms_difference, str
 from ..synthetic.variations import variation_by_name
 from .benchmark import BASE_PERTURBATION, BENCHMARK_SETTINGS
 from .outclass import bic_margin
+from .rows import ROW_SUFFIX, read_case_files
 from .variations import NAMED_TARGET, NULL_ADEQUATE_TARGET
 
 RACK_FRICTION = "steering.rack_friction_force"
@@ -415,7 +416,6 @@ def _write(path: Path, record, params: Parameters) -> None:
         path.write_text(format_measurement(record), encoding="utf-8")
 
 
-ROW_SUFFIX = ".row.json"
 
 
 def run_batch(params: Parameters, base_path, names: list[str], folder, design: TruthDesign = TruthDesign()) -> None:
@@ -439,17 +439,7 @@ def run_batch(params: Parameters, base_path, names: list[str], folder, design: T
 def read_rows(folders, names: list[str]) -> list[dict]:
     """The rows run_batch wrote of the cases `names`, in that order; a case with no rows, or rows in two folders,
     is refused in one line."""
-    found: dict[str, Path] = {}
-    for folder in map(Path, folders):
-        for path in sorted(folder.glob(f"*{ROW_SUFFIX}")):
-            name = path.name[:-len(ROW_SUFFIX)]
-            if name in found:
-                raise UsageError(f"{path}: case {name} has rows in {found[name].parent} as well")
-            found[name] = path
-    missing = [n for n in names if n not in found]
-    if missing:
-        raise UsageError(f"assisted truth: no rows of case {missing[0]} in {', '.join(map(str, folders))}")
-    return [row for n in names for row in json.loads(found[n].read_text(encoding="utf-8"))]
+    return [row for rows in read_case_files(folders, names, "assisted truth") for row in rows]
 
 
 def design_from_config(section: dict | None) -> TruthDesign:

@@ -15,7 +15,15 @@ plain (unweighted) RMS error with the named effect over the same floor.
 from __future__ import annotations
 
 import dataclasses
+import json
 from dataclasses import dataclass
+from pathlib import Path
+
+from ..errors import UsageError
+
+# The file of a case's rows in its job's folder (<folder>/<case><ROW_SUFFIX>), as the batch jobs of the assisted
+# benchmarks write them.
+ROW_SUFFIX = ".row.json"
 
 
 @dataclass(frozen=True)
@@ -108,3 +116,19 @@ def csv_columns(rows, leave_out=frozenset(), none=None) -> dict[str, list]:
     if none is None:
         return {name: [getattr(r, name) for r in rows] for name in names}
     return {name: [none if getattr(r, name) is None else getattr(r, name) for r in rows] for name in names}
+
+
+def read_case_files(folders, names: list[str], benchmark: str) -> list:
+    """The JSON of each case of `names` that the batch jobs wrote into `folders` (<case><ROW_SUFFIX>), in the order
+    of `names`; a case with no file, or with files in two folders, is refused in one line naming the `benchmark`."""
+    found: dict[str, Path] = {}
+    for folder in map(Path, folders):
+        for path in sorted(folder.glob(f"*{ROW_SUFFIX}")):
+            name = path.name[:-len(ROW_SUFFIX)]
+            if name in found:
+                raise UsageError(f"{path}: case {name} has rows in {found[name].parent} as well")
+            found[name] = path
+    missing = [name for name in names if name not in found]
+    if missing:
+        raise UsageError(f"{benchmark}: no rows of case {missing[0]} in {', '.join(map(str, folders))}")
+    return [json.loads(found[name].read_text(encoding="utf-8")) for name in names]
