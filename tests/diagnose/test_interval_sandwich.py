@@ -12,7 +12,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.stats import t as student_t
 
-from parksteer.diagnose.calibrate import Z95, block_sandwich
+from parksteer.diagnose.calibrate import Z95
+from parksteer.diagnose.statistics import block_sandwich
 
 
 @dataclass
@@ -86,7 +87,7 @@ class _ReplayFile:  # a torque-only file: its fitted signals are the torque's
 def test_replay_covariance_is_the_spread_of_the_shifts_the_racks_would_cause():
     """If each replayed rack changed the torque exactly as a parameter change a_d would (d = sigma J a_d), a fit
     would absorb it as that change: the replay's covariance is then the sample covariance of the a_d."""
-    from parksteer.diagnose.calibrate import replay_covariance
+    from parksteer.diagnose.statistics import replay_covariance
 
     rng = np.random.default_rng(7)
     t = np.arange(0.0, 18.0, 0.02)

@@ -37,7 +37,7 @@ from ..parameters import Quantity, quantity
 from .settings import DEFAULT_SETTINGS, DiagnosisSettings
 from .engine import ReplayEngine
 from .problem import Problem
-from .statistics import lag1_autocorrelation
+from .statistics import block_sandwich, lag1_autocorrelation, replay_covariance
 
 Z95 = 1.959964  # two-sided 95 % quantile of the standard normal
 # A free strength's finite-difference step (free_parameter): of its declared range, or of its value when open.
@@ -105,12 +105,12 @@ class Fit:
 
         The standard error is the larger of two: the model-based one (module docstring) and a
         block sandwich over `block_s` segments of each file, ``B/(B-k) (J^T J)^-1 (sum_b g_b g_b^T)
-        (J^T J)^-1`` with ``g_b = J_b^T r_b`` the block's score (:func:`block_sandwich`). The
+        (J^T J)^-1`` with ``g_b = J_b^T r_b`` the block's score (:func:`parksteer.diagnose.statistics.block_sandwich`). The
         model-based one is right only if the model is exact and the residual is noise; the
         sandwich takes the residual as it is, a structured misfit included, so its
         intervals widen when the model class is not exact. Neither sees an error of the replayed
         rack itself, which is one error for the whole record and so shifts the fit rather than
-        the residual: its share (:func:`replay_covariance`, the spread of the fitted values the
+        the residual: its share (:func:`parksteer.diagnose.statistics.replay_covariance`, the spread of the fitted values the
         replay ensemble's racks would give) is added in quadrature. With the sandwich the 95 % point is
         Student's t with B - k degrees of freedom (B blocks), since the meat is estimated from B blocks.
         """
@@ -151,44 +151,6 @@ class Fit:
             out[p.key] = {"value": p.value(t), "ci95": [low, high],
                           "standard_error": (p.value(t) * se if p.transform == "log" else se)}
         return out
-
-
-def block_sandwich(jacobian: np.ndarray, weighted: np.ndarray, problem: Problem, block_s: float
-                   ) -> tuple[np.ndarray, int]:
-    """(Block sandwich covariance of the fitted parameters, number of blocks B): residuals grouped in segments
-    of `block_s` of each file (a last segment shorter than half a block joins the one before)."""
-    ids, start, offset = [], 0, 0
-    for f in problem.files:
-        t = f.time_s - f.time_s[0]
-        count = max(int(round(t[-1] / block_s)), 1)
-        block = np.minimum((t / (t[-1] / count)).astype(int), count - 1) if t[-1] > 0 else np.zeros(f.n, dtype=int)
-        ids.extend([block + offset] * f.signals)  # a file's signals at the same instants share their segment
-        offset += count
-        start += f.n
-    ids = np.concatenate(ids)
-    k = jacobian.shape[1]
-    bread = pm.inv(pm.matmul(jacobian.T, jacobian))
-    meat = np.zeros((k, k))
-    for b in range(offset):
-        rows = ids == b
-        score = pm.matmul(jacobian[rows].T, weighted[rows])
-        meat += np.outer(score, score)
-    scale = offset / max(offset - k, 1)
-    return pm.matmul(pm.matmul(scale * bread, meat), bread), offset
-
-
-def replay_covariance(jacobian: np.ndarray, problem: Problem) -> np.ndarray:
-    """Covariance of the fitted parameters from the replay's own uncertainty: each rack of the replay ensemble
-    (:func:`parksteer.diagnose.ensemble.with_replay_uncertainty`) changes the replayed torque by its
-    deviation d from the ensemble mean, which a fit absorbs as the parameter shift (J^T J)^-1 J^T (d / sigma);
-    the covariance of these shifts over the draws. Zero when the ensemble was not run."""
-    k = jacobian.shape[1]
-    draws = [f.replay_draws for f in problem.files]
-    if any(d is None for d in draws) or len({d.shape[0] for d in draws}) != 1 or draws[0].shape[0] < 2:
-        return np.zeros((k, k))
-    deviations = np.concatenate([d / f.sigma for d, f in zip(draws, problem.files)], axis=1)
-    shifts = pm.solve(pm.matmul(jacobian.T, jacobian), pm.matmul(jacobian.T, deviations.T))  # k x draws
-    return pm.matmul(shifts, shifts.T) / (shifts.shape[1] - 1)
 
 
 def _predict(engine: ReplayEngine, problem: Problem, effects: list[Effect], parameters: list[FitParameter],

@@ -8,7 +8,9 @@ import re
 from pathlib import Path
 
 from ..tables import atomic_path
-from .report import confound_separates, interval_text, num, separating, shown_unit, signature_lines, strength_text, tie_headline
+from .report import (confound_separates, html_table, interval_text, num, separating, shown_unit, signature_lines,
+                     strength_text, tie_headline)
+from .user_effect_pages import user_effect_html, user_effect_markdown
 
 
 def _interval(ci, digits: int = 4, unit: str = "") -> str:
@@ -73,9 +75,9 @@ def _motor_html(result: dict) -> list[str]:
         return []
     column, unit, rows = found
     floor = result["statistics"]["calibrated"]["motor"]["noise_floor"]
-    return ([f"<h2>Motor channel</h2>", f"<p>The assisted car's {html.escape(column)}, fitted beside the torque "
+    return (["<h2>Motor channel</h2>", f"<p>The assisted car's {html.escape(column)}, fitted beside the torque "
              f"(noise floor {html.escape(num(floor))} {html.escape(unit)}).</p>"]
-            + _table(["model", f"residual RMS ({unit})", f"weighted RMS ({unit})", f"peak ({unit})"], rows))
+            + html_table(["model", f"residual RMS ({unit})", f"weighted RMS ({unit})", f"peak ({unit})"], rows))
 
 
 def _separation_lines(result: dict) -> list[str]:
@@ -286,70 +288,6 @@ def markdown_report(result: dict, figure: str | None = None, user_figure: str | 
     return "\n".join(lines) + "\n"
 
 
-# --- a user's own effect (parksteer.diagnose.stages.user_effect): without it and with it
-
-
-def _user_effect_tables(result: dict) -> list[tuple[str, list[str], list[list]]]:
-    """(title, head, rows) of each table of the ``user_effect`` section: the ladder, the fitted strengths, the
-    residual by phase, the sweep."""
-    found = result["user_effect"]
-    ladder = ("The error ladder", ["model", "effects", "RMS (N m)", "weighted RMS (N m)", "weighted RMS / floor"],
-              [[r["label"], ", ".join(r["effects"]), num(r["rms_Nm"]), num(r["weighted_rms_Nm"]),
-                num(r["over_floor"])] for r in found["rungs"]])
-    strengths = ("Fitted strengths (with the calibrated parameters)",
-                 ["strength", "fitted", "95 % interval", "unit", "declared bounds"],
-                 [[key, num(e["value"], 4), _interval(e["ci95"]), e["unit"],
-                   _interval(e["bounds"]) if e.get("bounds") else "-"] for key, e in found["strengths"].items()])
-    phases = ("Residual by phase", ["file", "phase", "samples", "without it, RMS (N m)", "with it, RMS (N m)",
-                                    "noise floor (N m)"],
-              [[r["file"], r["phase"].replace("_", " "), r["samples"], num(r["without_rms_Nm"]),
-                num(r["with_rms_Nm"]), num(r["noise_floor_Nm"])] for r in found["phases"]])
-    sweep = found["sweep"]
-    one = sweep["keys"][0] if len(sweep["keys"]) == 1 else None
-    unit = found["strengths"][one]["unit"] if one else ""
-    grow = ("The error as the strengths grow to their fitted values, the other parameters held at the fit",
-            ["fraction of the fitted strength" + ("" if one else "s")] + ([f"{one} ({unit})"] if one else [])
-            + ["weighted RMS (N m)", "weighted RMS / floor"],
-            [[num(f, 2)] + ([num(sweep["values"][one][i], 4)] if one else [])
-             + [num(sweep["weighted_rms_Nm"][i]), num(sweep["over_floor"][i])]
-             for i, f in enumerate(sweep["fractions"])])
-    return [ladder, strengths, phases, grow]
-
-
-def _user_effect_sentence(result: dict) -> str:
-    found = result["user_effect"]
-    rungs = found["rungs"]
-    return (f"With {', '.join(found['effects'])} in the model, its free strengths fitted with the calibrated "
-            f"parameters, the weighted RMS error goes from {num(rungs[1]['over_floor'])} noise floors (calibrated "
-            f"without it) to {num(rungs[-1]['over_floor'])} (noise floor {num(found['noise_floor_Nm'])} N m); the "
-            f"verdict above is on the model with it.")
-
-
-def user_effect_markdown(result: dict, figure: str | None = None) -> list[str]:
-    """The markdown section of a user's effect (none when the diagnosis has no ``user_effect``)."""
-    if not result.get("user_effect"):
-        return []
-    lines = [f"## Your effect: {', '.join(result['user_effect']['effects'])}", "", _user_effect_sentence(result)]
-    for title, head, rows in _user_effect_tables(result):
-        lines += ["", f"### {title}", "", "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
-        lines += ["| " + " | ".join(str(c) for c in row) + " |" for row in rows]
-    if figure:
-        lines += ["", f"![your effect: the ladder, the record, the residual by phase, the error falling]({figure})"]
-    return lines + [""]
-
-
-def user_effect_html(result: dict) -> list[str]:
-    """The HTML section of a user's effect (none when the diagnosis has no ``user_effect``)."""
-    if not result.get("user_effect"):
-        return []
-    out = [f"<h2>Your effect: {html.escape(', '.join(result['user_effect']['effects']))}</h2>",
-           f"<p>{html.escape(_user_effect_sentence(result))}</p>"]
-    for title, head, rows in _user_effect_tables(result):
-        out.append(f"<h3>{html.escape(title)}</h3>")
-        out += _table(head, rows)
-    return out
-
-
 # --- the residual's signature and the suggested effect (parksteer.diagnose.signature, parksteer.diagnose.suggest)
 
 
@@ -381,10 +319,6 @@ th:first-child,td:first-child{text-align:left}figure{margin:1em 0}figure svg{max
 figcaption{font-size:.9em;color:#555}.verdict{font-size:1.1em;padding:.6em;background:#f3f3f3}"""
 
 
-def _table(head: list[str], rows: list[list]) -> list[str]:
-    out = ["<table>", "<tr>" + "".join(f"<th>{html.escape(h)}</th>" for h in head) + "</tr>"]
-    out += ["<tr>" + "".join(f"<td>{html.escape(str(c))}</td>" for c in row) + "</tr>" for row in rows]
-    return out + ["</table>"]
 
 
 def html_report(result: dict, figures: list[tuple[str, str]], phases: list[dict], ladder: dict | None = None,
@@ -408,7 +342,7 @@ def html_report(result: dict, figures: list[tuple[str, str]], phases: list[dict]
            f"<title>{html.escape(title)}</title>", f"<style>{_STYLE}</style>", "</head>", "<body>",
            f"<h1>{html.escape(title)}</h1>", f'<p class="verdict">{html.escape(text)}</p>',
            f"<p>Model: {html.escape(', '.join(result['model']['effects']))}.</p>", "<h2>Files</h2>"]
-    out += _table(["file", "case", "surface", "samples", "noise floor (N m)"],
+    out += html_table(["file", "case", "surface", "samples", "noise floor (N m)"],
                   [[f["file"], f["case"], f["surface"], f["samples"], num(f["noise_floor"]["total_rms"])]
                    for f in result["files"]])
     if result.get("angle"):
@@ -424,12 +358,12 @@ def html_report(result: dict, figures: list[tuple[str, str]], phases: list[dict]
     out.append("<h2>Residual by phase</h2>")
     effect = result["effect"] if verdict == "missing" else None
     head = ["file", "phase", "samples", "calibrated RMS (N m)"] + ([f"with {effect} RMS (N m)"] if effect else [])
-    out += _table(head + ["noise floor (N m)"],
+    out += html_table(head + ["noise floor (N m)"],
                   [[r["file"], r["phase"].replace("_", " "), r["samples"], num(r["calibrated_rms_Nm"])]
                    + ([num(r["with_effect_rms_Nm"])] if effect else []) + [num(r["noise_floor_Nm"])] for r in phases])
     if ladder is not None:
         out.append("<h2>Error ladder</h2>")
-        out += _table(["rung", "effects", "RMS (N m)", "weighted RMS (N m)", "weighted RMS / noise floor"],
+        out += html_table(["rung", "effects", "RMS (N m)", "weighted RMS (N m)", "weighted RMS / noise floor"],
                       [[r["label"], ", ".join(r["effects"]), num(r["rms_Nm"]), num(r["weighted_rms_Nm"]),
                         num(r["over_floor"])] for r in ladder["rungs"]])
         out.append(f"<p>Noise floor {html.escape(num(ladder['noise_floor_Nm']))} N m; with the replay's uncertainty "
@@ -437,7 +371,7 @@ def html_report(result: dict, figures: list[tuple[str, str]], phases: list[dict]
     out.append("<h2>Fitted values</h2>")
     rows = [[key, _unit(result, key), num(e["default"], 4), num(e["value"], 4),
              _interval(e["ci95"], unit=_unit(result, key))] for key, e in result["calibrated"].items()]
-    out += _table(["parameter", "unit", "default", "fitted", "95 % interval"], rows)
+    out += html_table(["parameter", "unit", "default", "fitted", "95 % interval"], rows)
     if result.get("identification"):
         out.append("<h2>What these data fix</h2>")
         out += ["<ul>"] + [f"<li>{html.escape(line)}</li>" for line in _identification_lines(result)] + ["</ul>"]
@@ -449,7 +383,7 @@ def html_report(result: dict, figures: list[tuple[str, str]], phases: list[dict]
     for c in result["ranking"]:
         rows.append([c["effect"], num(c["score"]), num(c["delta_bic"]), strength_text(c, result.get("units", {})),
                      num(c["weighted_rms_after_Nm"]), num(c["identifiable_fraction"], 2)])
-    out += _table(["candidate", "score", "ΔBIC", "fitted strength (95 % interval)", "weighted RMS after (N m)",
+    out += html_table(["candidate", "score", "ΔBIC", "fitted strength (95 % interval)", "weighted RMS after (N m)",
                    "identifiable fraction"], rows)
     if result["indistinguishable"]:
         out.append("<h2>Indistinguishable by these data</h2>")

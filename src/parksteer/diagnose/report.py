@@ -3,6 +3,8 @@ read from it; the pages (markdown and HTML) are :mod:`parksteer.diagnose.pages`.
 
 from __future__ import annotations
 
+import html
+
 import math
 
 import numpy as np
@@ -369,3 +371,11 @@ def num(x, digits: int = 3) -> str:
     if x is None:
         return "-"
     return f"{x:.{digits}g}" if abs(x) < 1e4 else f"{x:.3e}"
+
+
+def html_table(head: list[str], rows: list[list]) -> list[str]:
+    """An HTML table of `head` and `rows`, every cell escaped."""
+    out = ["<table>", "<tr>" + "".join(f"<th>{html.escape(h)}</th>" for h in head) + "</tr>"]
+    out += ["<tr>" + "".join(f"<td>{html.escape(str(c))}</td>" for c in row) + "</tr>" for row in rows]
+    return out + ["</table>"]
+

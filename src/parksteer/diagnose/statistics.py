@@ -1,5 +1,6 @@
 """Fit statistics of a diagnosis: how far predictions are from the measured signals, the residuals' lag-1
-autocorrelation, the effective sample size it implies, and the information criterion's gain of a richer model."""
+autocorrelation, the effective sample size it implies, the information criterion's gain of a richer model, and the
+covariances of fitted parameters (the block sandwich, the replay's own)."""
 
 from __future__ import annotations
 
@@ -95,3 +96,41 @@ def bic_gain(rss_without: float, rss_with: float, n_eff: float, parameters: int)
     `parameters` more columns take the weighted residual sum of squares from `rss_without` to `rss_with`:
     ``n_eff ln(rss_without / rss_with) - k ln(n_eff)`` (positive: the richer model is the better)."""
     return n_eff * pm.log(rss_without / max(rss_with, 1e-300)) - parameters * pm.log(n_eff)
+
+
+def block_sandwich(jacobian: np.ndarray, weighted: np.ndarray, problem: Problem, block_s: float
+                   ) -> tuple[np.ndarray, int]:
+    """(Block sandwich covariance of the fitted parameters, number of blocks B): residuals grouped in segments
+    of `block_s` of each file (a last segment shorter than half a block joins the one before)."""
+    ids, start, offset = [], 0, 0
+    for f in problem.files:
+        t = f.time_s - f.time_s[0]
+        count = max(int(round(t[-1] / block_s)), 1)
+        block = np.minimum((t / (t[-1] / count)).astype(int), count - 1) if t[-1] > 0 else np.zeros(f.n, dtype=int)
+        ids.extend([block + offset] * f.signals)  # a file's signals at the same instants share their segment
+        offset += count
+        start += f.n
+    ids = np.concatenate(ids)
+    k = jacobian.shape[1]
+    bread = pm.inv(pm.matmul(jacobian.T, jacobian))
+    meat = np.zeros((k, k))
+    for b in range(offset):
+        rows = ids == b
+        score = pm.matmul(jacobian[rows].T, weighted[rows])
+        meat += np.outer(score, score)
+    scale = offset / max(offset - k, 1)
+    return pm.matmul(pm.matmul(scale * bread, meat), bread), offset
+
+
+def replay_covariance(jacobian: np.ndarray, problem: Problem) -> np.ndarray:
+    """Covariance of the fitted parameters from the replay's own uncertainty: each rack of the replay ensemble
+    (:func:`parksteer.diagnose.ensemble.with_replay_uncertainty`) changes the replayed torque by its
+    deviation d from the ensemble mean, which a fit absorbs as the parameter shift (J^T J)^-1 J^T (d / sigma);
+    the covariance of these shifts over the draws. Zero when the ensemble was not run."""
+    k = jacobian.shape[1]
+    draws = [f.replay_draws for f in problem.files]
+    if any(d is None for d in draws) or len({d.shape[0] for d in draws}) != 1 or draws[0].shape[0] < 2:
+        return np.zeros((k, k))
+    deviations = np.concatenate([d / f.sigma for d, f in zip(draws, problem.files)], axis=1)
+    shifts = pm.solve(pm.matmul(jacobian.T, jacobian), pm.matmul(jacobian.T, deviations.T))  # k x draws
+    return pm.matmul(shifts, shifts.T) / (shifts.shape[1] - 1)
