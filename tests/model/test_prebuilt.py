@@ -18,9 +18,10 @@ REFRESH = "run `parksteer derive --prebuilt results/model/*.json` and commit src
 def _effects(spec):
     """The effects of a shipped model's spec: an effects spec, or a truth form of the signature benchmark."""
     if isinstance(spec, dict):
+        from parksteer.experiments.outoflibrary import truth_effects
         from parksteer.synthetic.outoflibrary import form_by_name
 
-        return resolve_effects([*resolve_effects(None), form_by_name(spec["truth_form"]).effect])
+        return truth_effects(form_by_name(spec["truth_form"]))
     return resolve_effects(spec)
 
 

@@ -101,11 +101,10 @@ def _signature_truth_sets() -> list:
     """(spec, effects) of the models the signature benchmark makes its records with: the default set and each truth
     form outside the library (parksteer.synthetic.outoflibrary), spec ``{"truth_form": name}``; its jobs then
     compile them instead of deriving them."""
-    from ..model.symbolic.components import resolve_effects
+    from ..experiments.outoflibrary import truth_effects
     from ..synthetic.outoflibrary import ALL_FORMS
 
-    base = resolve_effects(None)
-    return [({"truth_form": form.effect.name}, resolve_effects([*base, form.effect])) for form in ALL_FORMS]
+    return [({"truth_form": form.effect.name}, truth_effects(form)) for form in ALL_FORMS]
 
 
 def _manifest_spec(path: str):

@@ -32,7 +32,7 @@ from ..model.symbolic.components import resolve_effects
 from ..parameters import Parameters
 from ..synthetic.datasets import perturbed_base, rms_difference
 from ..measure.converter import quantisation_step
-from ..synthetic.outoflibrary import COMBINED_FORMS, FORMS, form_by_name
+from ..synthetic.outoflibrary import COMBINED_FORMS, FORMS, TruthForm, form_by_name
 from ..synthetic.variations import VARIATIONS, variation_rack, variation_record
 from .benchmark import BASE_PERTURBATION, BENCHMARK_SETTINGS
 from ..diagnose.problem import load_files
@@ -91,6 +91,12 @@ class SignatureDesign:
         return out
 
 
+def truth_effects(form: TruthForm) -> list:
+    """The effects a record of the truth form `form` is made with: the default set and the form (the set the
+    package ships pre-derived, `parksteer derive --prebuilt`)."""
+    return resolve_effects([*resolve_effects(None), form.effect])
+
+
 def make_record(params: Parameters, case: SignatureCase, design: SignatureDesign):
     """(measurement, truth) of `case`: the variation's hand and logger, the perturbed base, the truth form sized
     to `steps` converter steps of clean torque change RMS (one probe, module docstring)."""
@@ -104,7 +110,7 @@ def make_record(params: Parameters, case: SignatureCase, design: SignatureDesign
     if case.form is None:
         return variation_record(params, hand, logger, overrides=base), truth
     form = form_by_name(case.form)
-    effects = [*resolve_effects(None), form.effect]
+    effects = truth_effects(form)
     key = f"{form.effect.name}.strength"
     drive = variation_rack(params, hand)
 
