@@ -89,6 +89,30 @@ def test_boost_law_inverse_is_exact_where_the_closed_form_holds(params):
     assert np.max(np.abs(law.torsion_bar(y) - y / (1 + gain))) < 1e-3
 
 
+def test_boost_law_inverse_balances_the_column_at_the_corners_of_the_law(params):
+    """The torsion bar carries what the assist does not: T_s + f A(T_s) = y, at every sample, also where the law
+    bends hardest (the dead band's corner, the motor's limit, the gear's power turning from driving to back-driven
+    as the rack reverses) and for motors delivering 0 to 2 times what the law commands. Checked against a plain
+    bisection of the same balance (an independent root finder: halve the bracket 200 times)."""
+    from parksteer.model.numeric.assisted import boost_law
+
+    name = "electric_assist_column"
+    run = prepare("unladen", f"+{name}", {f"{name}.back_efficiency": 0.6}, params=params)
+    law = boost_law(run, run.p)
+    rng = np.random.default_rng(7)
+    y = np.concatenate([rng.uniform(-30.0, 30.0, 400), law.dead_band + rng.uniform(-0.2, 0.2, 200), [0.0]])
+    speed = rng.choice([-0.02, -1e-4, 0.0, 1e-4, 0.02], size=y.size)
+    factor = rng.choice([0.0, 0.5, 1.0, 2.0], size=y.size)
+    t_s = law.torsion_bar(y, factor, speed)
+    assert np.max(np.abs(t_s + factor * law.assist(t_s, speed) - y)) < 1e-9
+    low, high = y - 100.0, y + 100.0
+    for _ in range(200):
+        mid = 0.5 * (low + high)
+        above = mid + factor * law.assist(mid, speed) > y
+        low, high = np.where(above, low, mid), np.where(above, mid, high)
+    assert np.max(np.abs(t_s - 0.5 * (low + high))) < 1e-11
+
+
 def _sweep(params, effects: str, overrides: dict):
     """The assisted replay of a smooth steer to the right and back (no free run needed: the candidates act in the
     replay), at rtol 1e-8."""

@@ -51,7 +51,7 @@ from ..symbolic.effects.assist_common import (clamp, deadband, directional_effic
                                               table_points)
 from .prescribed import PRESCRIBED_ATOL_FACTOR, PRESCRIBED_RTOL, PrescribedSolution, RackMotion, solve
 
-# The bisection stops when the bracket is this narrow (N m of torsion-bar torque), far below a sensor's resolution.
+# The inversion stops when the bracket is this narrow (N m of torsion-bar torque), far below a sensor's resolution.
 INVERSION_TOLERANCE_NM = 1e-12
 HYDRAULIC = "hydraulic_assist"
 OFFSET_KEY = "torsion_bar_offset.strength"
@@ -149,18 +149,52 @@ class BoostLaw:
         return max(self.efficiency, 1.0 / self.back_efficiency) * self.reduction * (self.limit + self.limit_width) / scale
 
     def torsion_bar(self, y, factor=1.0, rack_speed_mps=0.0) -> np.ndarray:
-        """The torsion-bar torque T_s with T_s + factor A(T_s) = y, elementwise (bisection; A is increasing, and
-        so is the sum for any factor >= 0: a motor whose delivered torque departs from the law by `factor`)."""
+        """The torsion-bar torque T_s with T_s + factor A(T_s) = y, elementwise. The left side rises with T_s (A is
+        increasing, and factor >= 0: a motor whose delivered torque departs from the law by `factor`), so the root
+        is bracketed and kept bracketed: regula falsi with the Illinois rule (the end that stays has its value
+        halved), falling back to the bracket's midpoint where the secant leaves it, until the bracket is
+        INVERSION_TOLERANCE_NM wide. Only comparisons and the four operations: the same bits on any machine."""
         y = np.asarray(y, dtype=float)
-        width = self.bound() * float(np.max(factor)) + 1.0
-        low, high = y - width, y + width
+        speed = np.broadcast_to(np.asarray(rack_speed_mps, dtype=float), y.shape)
+        gain = np.broadcast_to(np.asarray(factor, dtype=float), y.shape)
+
+        def excess(x, rows):
+            return x + gain[rows] * self.assist(x, speed[rows]) - y[rows]
+
+        # A has the sign of its argument, so the root lies between 0 and y; where rounding says otherwise, a
+        # bracket as wide as the assist can be
+        low, high = np.minimum(y, 0.0), np.maximum(y, 0.0)
+        f_low, f_high = excess(low, slice(None)), excess(high, slice(None))
+        wide = np.flatnonzero((f_low > 0.0) | (f_high < 0.0))
+        if wide.size:
+            width = self.bound() * float(np.max(factor)) + 1.0
+            low[wide], high[wide] = y[wide] - width, y[wide] + width
+            f_low[wide], f_high[wide] = excess(low[wide], wide), excess(high[wide], wide)
+        low = np.where(f_high == 0.0, high, low)  # an end that is the root
+        high = np.where(f_low == 0.0, low, high)
+        side = np.zeros(y.shape, dtype=np.int8)  # the end the last step moved: -1 low, +1 high
+        open_ = np.flatnonzero(high - low > INVERSION_TOLERANCE_NM)
         for _ in range(200):
-            mid = 0.5 * (low + high)
-            above = mid + factor * self.assist(mid, rack_speed_mps) > y
-            high = np.where(above, mid, high)
-            low = np.where(above, low, mid)
-            if np.all(high - low <= INVERSION_TOLERANCE_NM):
+            if open_.size == 0:
                 break
+            lo, hi, flo, fhi = low[open_], high[open_], f_low[open_], f_high[open_]
+            with np.errstate(divide="ignore", invalid="ignore"):
+                x = lo - flo * (hi - lo) / (fhi - flo)
+            x = np.where((x > lo) & (x < hi), x, 0.5 * (lo + hi))
+            fx = excess(x, open_)
+            above = fx > 0.0
+            last = side[open_]
+            # Illinois: the end that did not move twice in a row has its value halved
+            flo = np.where(above & (last == 1), 0.5 * flo, flo)
+            fhi = np.where(~above & (last == -1), 0.5 * fhi, fhi)
+            low[open_] = np.where(above, lo, x)
+            f_low[open_] = np.where(above, flo, fx)
+            high[open_] = np.where(above, x, hi)
+            f_high[open_] = np.where(above, fx, fhi)
+            side[open_] = np.where(above, 1, -1)
+            exact = fx == 0.0
+            low[open_[exact]] = high[open_[exact]] = x[exact]
+            open_ = open_[high[open_] - low[open_] > INVERSION_TOLERANCE_NM]
         return 0.5 * (low + high)
 
 
