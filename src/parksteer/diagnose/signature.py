@@ -41,7 +41,7 @@ significance against the noise floor: a perfect model leaves weighted residuals 
 squares an axis of k columns removes is, without any structure, chi-square with k degrees of freedom -- for
 independent samples. Autocorrelated noise inflates that sum by about n / n_eff (the variance of a slowly varying
 projection of an AR(1) sequence), so the likelihood-ratio statistic is ``LR = Delta RSS n_eff / n`` against
-chi-square(k) (:func:`scipy.stats.chi2.sf`).
+chi-square(k) (its survival function :func:`scipy.special.chdtrc`, what ``scipy.stats.chi2.sf`` calls).
 
 A torque residual at the handwheel is turned into a force on the rack by the handwheel-to-rack ratio (a rack
 force F gives a handwheel torque F / G through the rigid column; the Hooke joint's ripple of a few per cent is
@@ -55,7 +55,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.stats import chi2
+from scipy.special import chdtrc  # chi2.sf, without importing all of scipy.stats
 
 from .. import portable as pm
 from ..errors import UsageError
@@ -214,7 +214,7 @@ def signature_from_axes(axes: Axes, settings: DiagnosisSettings = DEFAULT_SETTIN
         _, rss = _fit(columns, weighted, sigma, nuisance)
         k = columns.shape[1]
         statistic = (rss0 - rss) * n_eff / n
-        p = float(chi2.sf(statistic, k))
+        p = float(chdtrc(k, statistic))
         shares.append(AxisShare(name, k, float((rss0 - rss) / rss0), float((rss0 - rss) / excess) if excess > 0 else None,
                                 float(statistic), p, p < settings.signature.significance))
     best_index = max(range(len(models)), key=lambda i: (scores[i].delta_bic, -scores[i].columns))
