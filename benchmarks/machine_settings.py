@@ -11,8 +11,7 @@ from the first setting (none expected); it exits 1 if verify_strict fails or any
     python benchmarks/machine_settings.py results/machine_settings.json [--cores 2] [--keep-models] [--only NAME ...]
 
 On 2 cores a setting takes as long as the pipeline (about 2.5 min with the models kept). docs/reproducibility.md
-records a run; tests/workflow/test_machine_independence.py checks a part of the pipeline under three settings in
-the test suite.
+records a run; CI's .ci/other_kernels checks a part of the pipeline under three settings in every CI run.
 """
 
 from __future__ import annotations
