@@ -110,13 +110,17 @@ def _symbolic_half_source() -> bytes:
                     for path in sorted(p for p in [*sources, *KEYED_FILES] if p != KEYLESS_SOURCE))
 
 
+@lru_cache(maxsize=None)
+def _sympy_version() -> str:
+    return metadata.version("sympy")
+
+
 def model_key(effects: list[Effect]) -> str:
     """Hash of the effect set, the symbolic half's source (symbolic/ and codegen/, Python and C), external effects'
-    source, the sympy version and the compiler flags."""
-    import sympy
-
+    source, the sympy version (its distribution's: a replay keys its model without importing sympy) and the compiler
+    flags."""
     digest = hashlib.sha256()
-    digest.update(f"format {FORMAT_VERSION}\nsympy {sympy.__version__}\ncc {' '.join(COMPILE_FLAGS)}\n".encode())
+    digest.update(f"format {FORMAT_VERSION}\nsympy {_sympy_version()}\ncc {' '.join(COMPILE_FLAGS)}\n".encode())
     digest.update(("effects " + ",".join(e.name for e in effects) + "\n").encode())
     digest.update(_symbolic_half_source())
     for effect in effects:

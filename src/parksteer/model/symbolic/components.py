@@ -86,7 +86,9 @@ class Effect:
     - ``rival``: a rival of the paper's mechanisms (:class:`Rival`), never a candidate;
     - ``power_assist``: ``"electric"`` or ``"hydraulic"`` for a power assist, None otherwise: its push is the
       gear's own, left out of the rack force, and a record of the car is replayed through its boost law
-      (:mod:`parksteer.model.numeric.assisted`).
+      (:mod:`parksteer.model.numeric.assisted`);
+    - ``location``: a power assist's point of action, ``"column"``, ``"pinion"`` or ``"rack"`` (its torsion bar is
+      in the column for a column assist, on the pinion otherwise), None for any other effect.
     """
 
     name: ClassVar[str] = ""
@@ -101,6 +103,7 @@ class Effect:
     assist_candidate: ClassVar[bool] = False
     rival: ClassVar[Rival | None] = None
     power_assist: ClassVar[str | None] = None
+    location: ClassVar[str | None] = None
 
     def __init_subclass__(cls, **kwargs: Any) -> None:
         super().__init_subclass__(**kwargs)

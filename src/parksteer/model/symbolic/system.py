@@ -42,8 +42,7 @@ from dataclasses import dataclass, field
 from types import SimpleNamespace
 from typing import Any
 
-import sympy as sp
-import sympy.physics.mechanics as me
+from .lazy_sympy import me, sp
 
 from ...names import SIDES
 
@@ -112,7 +111,7 @@ class Coordinate:
     owner: str
 
 
-Weight = tuple[me.Point, Any, "me.Point | None"]  # (true point, mass, chassis-fixed twin at zero steer or None)
+Weight = "tuple[me.Point, Any, me.Point | None]"  # (true point, mass, chassis-fixed twin at zero steer or None)
 
 
 @dataclass

@@ -22,7 +22,7 @@ lock (0.56 rad).
 
 from __future__ import annotations
 
-import sympy as sp
+from ..lazy_sympy import sp
 
 from ....parameters import Quantity
 from ..components import Effect

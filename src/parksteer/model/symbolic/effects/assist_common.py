@@ -34,7 +34,7 @@ arrays they compute them, with products for squares (no ``pow``) so the numbers 
 from __future__ import annotations
 
 import numpy as np
-import sympy as sp
+from ..lazy_sympy import sp
 
 from ....boost_table import MAX_POINTS, MAX_SPEEDS, PAD_STEP_MPS, PAD_STEP_NM
 from ....parameters import Quantity

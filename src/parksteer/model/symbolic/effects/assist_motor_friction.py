@@ -16,7 +16,7 @@ Strength 0 is no extra friction, exactly. Requires an electric assist in the set
 
 from __future__ import annotations
 
-import sympy as sp
+from ..lazy_sympy import sp
 
 from ....errors import UsageError
 from ....parameters import Quantity

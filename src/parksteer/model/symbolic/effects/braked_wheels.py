@@ -37,8 +37,9 @@ Requires the tyre_friction effect (its friction law and quantities).
 
 from __future__ import annotations
 
-import sympy as sp
-import sympy.physics.mechanics as me
+from fractions import Fraction
+
+from ..lazy_sympy import me, sp
 
 from ....names import SIDES
 from ....parameters import Quantity
@@ -46,10 +47,10 @@ from ..components import Effect
 from .tyre_friction import EFFECT as TYRE_FRICTION
 
 # f(k) - 1 inside the patch, as a polynomial in m = k^2 (series of the elliptic closed form)
-_INSIDE_COEFFICIENTS = (sp.Rational(3, 4), -sp.Rational(3, 64), -sp.Rational(1, 256), -sp.Rational(15, 16384),
-                        -sp.Rational(21, 65536))
+_INSIDE_COEFFICIENTS = (Fraction(3, 4), -Fraction(3, 64), -Fraction(1, 256), -Fraction(15, 16384),
+                        -Fraction(21, 65536))
 # f(k) / (3 k / 2) outside the patch, as a polynomial in 1 / k^2 (far-field series of the same integral)
-_OUTSIDE_COEFFICIENTS = (1, sp.Rational(1, 8), sp.Rational(1, 192), sp.Rational(1, 1024))
+_OUTSIDE_COEFFICIENTS = (1, Fraction(1, 8), Fraction(1, 192), Fraction(1, 1024))
 
 
 def braked_excess_ratio(k_squared):

@@ -37,8 +37,9 @@ rounding modelled here is an upper bound, reached when the bristles carry all th
 
 from __future__ import annotations
 
-import sympy as sp
-import sympy.physics.mechanics as me
+from fractions import Fraction
+
+from ..lazy_sympy import me, sp
 
 from ....names import SIDES
 from ....parameters import Quantity
@@ -47,12 +48,12 @@ from ..system import torque_between
 from .carcass_compliance import EFFECT as CARCASS
 from .tyre_friction import EFFECT as TYRE_FRICTION
 
-ANNULUS_RADII = (sp.Rational(53, 100), sp.Rational(78, 100))  # inner boundaries, in patch radii
+ANNULUS_RADII = (Fraction(53, 100), Fraction(78, 100))  # inner boundaries, in patch radii
 ANNULI = len(ANNULUS_RADII) + 1
-INERTIA_FLOOR = sp.Rational(1, 1000)  # of an annulus's inertia share, so that M stays positive definite at s = 0
+INERTIA_FLOOR = Fraction(1, 1000)  # of an annulus's inertia share, so that M stays positive definite at s = 0
 
 
-def annulus_shares() -> list[tuple[sp.Rational, sp.Rational]]:
+def annulus_shares() -> list[tuple[Fraction, Fraction]]:
     """(stiffness share, friction share) of each annulus of the uniform-pressure brush disc, centre to rim."""
     radii = (0, *ANNULUS_RADII, 1)
     return [(radii[j] ** 4 - radii[j - 1] ** 4, radii[j] ** 3 - radii[j - 1] ** 3) for j in range(1, len(radii))]

@@ -29,8 +29,9 @@ Provenance: a candidate beyond the paper; s and tau are chosen (tyre relaxation 
 
 from __future__ import annotations
 
-import sympy as sp
-import sympy.physics.mechanics as me
+from fractions import Fraction
+
+from ..lazy_sympy import me
 
 from ....names import SIDES
 from ....parameters import Quantity
@@ -38,8 +39,8 @@ from ..components import Effect, Rival
 from ..system import torque_between
 from .carcass_compliance import EFFECT as CARCASS
 
-NODE_INERTIA_SHARE = sp.Rational(1, 100)  # of the tread ring's yaw inertia: the branch's node is nearly massless
-INERTIA_FLOOR = sp.Rational(1, 1000)  # of the node's inertia share, so that M stays positive definite at s = 0
+NODE_INERTIA_SHARE = Fraction(1, 100)  # of the tread ring's yaw inertia: the branch's node is nearly massless
+INERTIA_FLOOR = Fraction(1, 1000)  # of the node's inertia share, so that M stays positive definite at s = 0
 
 
 class CarcassHysteresis(Effect):

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-import sympy as sp
+from ..lazy_sympy import sp
 
 from ....parameters import Quantity
 from ..components import Effect

@@ -66,10 +66,8 @@ the quantity; a vehicle file's ``[assist]`` gives the car's own.
 
 from __future__ import annotations
 
-from typing import ClassVar
 
-import sympy as sp
-import sympy.physics.mechanics as me
+from ..lazy_sympy import me, sp
 
 from ....parameters import VEHICLE_SPEED, Quantity
 from ..components import Effect
@@ -176,7 +174,6 @@ class ElectricAssist(Effect):
     gives the effect class of that point (its name, quantities and description are class attributes, so that an
     instance keeps no state; module docstring)."""
 
-    location: ClassVar[str] = ""
     in_default_set = False
     diagnosis_candidate = False
     power_assist = "electric"  # the simulation's rack force leaves its contribution out (the gear's own push)

@@ -34,8 +34,7 @@ with the spacer offset. Provenance: a candidate beyond the paper (textbook gear-
 
 from __future__ import annotations
 
-import sympy as sp
-import sympy.physics.mechanics as me
+from ..lazy_sympy import me, sp
 
 from ....parameters import Quantity
 from ..components import Effect, Rival

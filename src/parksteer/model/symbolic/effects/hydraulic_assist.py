@@ -35,7 +35,7 @@ Values: assumed, typical of hydraulic gears of small and medium cars, with range
 
 from __future__ import annotations
 
-import sympy as sp
+from ..lazy_sympy import sp
 
 from ....parameters import VEHICLE_SPEED, Quantity
 from ..components import Effect
@@ -56,6 +56,7 @@ class HydraulicAssist(Effect):
     in_default_set = False
     diagnosis_candidate = False
     power_assist = "hydraulic"  # the simulation's rack force leaves its contribution out (the gear's own push)
+    location = "rack"  # the piston pushes the rack; the valve and its torsion bar sit on the pinion
     replaces = "column_deflection"
     quantities = (
         Quantity(f"{NAME}.valve_slope", "Pa/(N m)", 0.0, 1.0e8, lower_inclusive=True, default=1.5e6,

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-import sympy as sp
+from ..lazy_sympy import sp
 
 from ..components import Effect
 from ..system import action_reaction

@@ -24,7 +24,7 @@ the handwheel angle has a flat step at zero torque 2b * G wide.
 
 from __future__ import annotations
 
-import sympy as sp
+from ..lazy_sympy import sp
 
 from ....parameters import Quantity
 from ..components import Effect

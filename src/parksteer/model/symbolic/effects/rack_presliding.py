@@ -36,8 +36,7 @@ bristle of Dupont et al., 2002); F_d and x_p are chosen, not measured.
 
 from __future__ import annotations
 
-import sympy as sp
-import sympy.physics.mechanics as me
+from ..lazy_sympy import me, sp
 
 from ....parameters import Quantity
 from ..components import Effect, Rival

@@ -24,8 +24,7 @@ is returned on the way back, this one follows the rack speed. It is small: 0.012
 
 from __future__ import annotations
 
-import sympy as sp
-import sympy.physics.mechanics as me
+from ..lazy_sympy import me, sp
 
 from ....names import SIDES
 from ....parameters import Quantity

@@ -30,8 +30,7 @@ stand for a typical passenger-car tyre until a fitted .tir file is at hand.
 
 from __future__ import annotations
 
-import sympy as sp
-import sympy.physics.mechanics as me
+from ..lazy_sympy import me, sp
 
 from ....names import SIDES
 from ....parameters import VEHICLE_SPEED, Quantity

@@ -2,8 +2,7 @@
 
 from __future__ import annotations
 
-import sympy as sp
-import sympy.physics.mechanics as me
+from ..lazy_sympy import me, sp
 
 from ....names import SIDES
 from ..components import Effect

@@ -25,8 +25,7 @@ are chosen, none are measured for this tyre.
 
 from __future__ import annotations
 
-import sympy as sp
-import sympy.physics.mechanics as me
+from ..lazy_sympy import me, sp
 
 from ....names import SIDES
 from ....parameters import Quantity
