@@ -132,8 +132,15 @@ class Identified:
                 "torque_noise_Nm": self.torque_noise_Nm, "beyond_map": list(self.beyond_map),
                 "file_values": dict(self.file_values)}
 
+    @property
+    def assist_unit(self) -> str:
+        """The unit of the assist at its point of action: N at the rack, N m at the column or pinion."""
+        from ..model.symbolic.components import discover_effects
+
+        return "N" if discover_effects()[self.assist_name].location == "rack" else "N m"
+
     def summary_lines(self) -> list[str]:
-        unit = "N" if self.assist_name.endswith("_rack") else "N m"
+        unit = self.assist_unit
         lines = [f"boost table from {', '.join(self.records)} ({self.assist_name}):",
                  "  torsion-bar N m   assist " + unit + "   95 %              current A"]
         for t, a, (lo, hi), i in zip(self.torques, self.assist, self.assist_ci95, self.current_A):
@@ -197,7 +204,7 @@ def _assist_name(effects) -> str:
     from ..model.symbolic.components import power_assist_of
 
     effect = power_assist_of(effects)
-    if effect is None or not effect.name.startswith("electric_assist_"):
+    if effect is None or effect.power_assist != "electric":
         raise UsageError("assist identify: the vehicle file's [assist] must be an electric one (type column, pinion "
                          "or rack): a hydraulic gear has no motor current to read its map from")
     return effect.name

@@ -36,7 +36,7 @@ def replace_assist_section(text: str, found) -> str:
         kept.pop()
     records = ", ".join(found.records)
     where = f"identified by parksteer assist identify from {records}"
-    unit = "N" if found.assist_name.endswith("_rack") else "N m"
+    unit = found.assist_unit
     lines = ["", "# Power assistance: the gear's data as the file gave them; the boost table, the product k_t eta N",
              "# (as the torque constant), the motor's friction and inertia" + (" and the back-driven efficiency"
                                                                               if found.back_efficiency is not None

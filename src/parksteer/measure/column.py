@@ -14,6 +14,7 @@ from pathlib import Path
 
 from ..errors import UsageError
 from ..geometry import column_twist, pinion_angle_from_column
+from ..model.symbolic.components import discover_effects
 from ..parameters import Parameters
 from .converter import quantisation_step
 from .importers import ANGLE, TORQUE, load_record
@@ -85,7 +86,7 @@ def rack_from_angle(measurement: Measurement, params: Parameters, assist: str | 
     twist, _ = column_twist(columns["time_s"], torque, stiffness, damping)
     joint = (s["hooke_joint_angle"], s["hooke_joint_phase"])
     pinion = pinion_angle_from_column(columns[ANGLE] - twist, *joint)
-    if assist is not None and not assist.endswith("_column"):
+    if assist is not None and discover_effects()[assist].location != "column":
         # the bar on the pinion reads T_s = T dtheta_c/dtheta_p: the column carries T_s dtheta_p/dtheta_c, the
         # joint's speed ratio taken at the column angle of the first pass (it varies by 1e-4 over the twist)
         column = columns[ANGLE] - twist

@@ -71,8 +71,8 @@ def assumed_quantities(params, name: str, effect) -> list[tuple[str, float, str,
             continue
         band = BANDS.get(key)
         if key == "reduction_ratio":
-            band = REDUCTION[name.rsplit("_", 1)[1]]
-        elif key == "back_efficiency" and name.endswith("_rack"):
+            band = REDUCTION[effect.location]
+        elif key == "back_efficiency" and effect.location == "rack":
             band = BACK_EFFICIENCY_RACK
         out.append((key, float(params[f"{name}.{key}"]), source, band))
     return out
@@ -123,7 +123,7 @@ class AssumedValues(Stage):
 
     def run(self, state: DiagnosisState, engine: ReplayEngine) -> DiagnosisState:
         effect = power_assist_of(state.base)
-        if (effect is None or effect.name == "hydraulic_assist" or state.calibration is None
+        if (effect is None or effect.power_assist != "electric" or state.calibration is None
                 or not state.settings.assumed_values_replayed):
             return state
         problem, settings, calibration = state.problem, state.settings, state.calibration

@@ -206,7 +206,7 @@ def solve(run, p: np.ndarray, rack: RackMotion, t_out, rtol: float = PRESCRIBED_
     full, accs, torque, twist, twist_rate = (a[at_out] for a in (full, accs, torque, twist, twist_rate))
     column = model.evaluate_outputs(t_out, full, p, accs, np.zeros((len(t_out), 2)))
     column_rate = column["column_angle_per_rack_rad_per_m"] * full[:, n + i_rack]
-    if any(getattr(e, "replaces", None) == "column_deflection" for e in run.effects):
+    if any(e.replaces == "column_deflection" for e in run.effects):
         # The spring and damper act on the deflection g(twist): what column_twist gave is the deflection that
         # passes the torque; the twist is the one whose deflection that is (a dead band widens it by +-band).
         law = ColumnLaw(model, p, i_k, i_c, t_out[0], full[0], accs[0], column["column_angle_rad"][0], column_rate[0])
@@ -350,7 +350,7 @@ def twist_spread(run, p: np.ndarray, solution: PrescribedSolution, torque_error:
     i_k = run.parameter_index("steering.column_torsional_stiffness")
     stiffness = p[i_k]
     torque_error = np.asarray(torque_error, dtype=float)
-    if not any(getattr(e, "replaces", None) == "column_deflection" for e in run.effects):
+    if not any(e.replaces == "column_deflection" for e in run.effects):
         return torque_error / stiffness
     model = run.model
     i_rack = model.index("rack")
