@@ -218,8 +218,9 @@ def solve_assisted(run, p: np.ndarray, rack: RackMotion, t_out, rtol: float = PR
                    delivered=None) -> AssistedSolution:
     """The torsion-bar torque and the motor's torque and current of `run`'s assisted car with its rack following
     `rack`, at the output times `t_out` (module docstring: the boost-free solve, then the law inverted). The
-    law-side candidates of a diagnosis act here: a sensor offset o (the reading S solves S + A(S) = y + o, the log
-    and the law take S) and a gain error (the law's gain G (1 + e)). `law` replaces the run's own law (a record
+    law-side effects of the model act here, each through its ``Effect.boost_law`` (:func:`boost_law`): a sensor
+    offset o (the reading S solves S + A(S) = y + o, the log and the law take S), a gain error (the law's gain
+    G (1 + e)), a user's own (a derated motor limit). `law` replaces the run's own law (a record
     made with another curve than the file's); `delivered` (a factor per output time, >= 0) scales what the motor
     delivers against what the law commands (a torque ripple), the current unchanged."""
     law = law if law is not None else boost_law(run, p)
