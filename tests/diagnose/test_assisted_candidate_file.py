@@ -81,6 +81,7 @@ def test_a_user_file_is_an_assisted_candidate_of_an_assisted_car_only(candidate_
     """Registered as a user's effect module (the environment variable a user sets), the derating is a testable
     candidate of a diagnosis of the electrically assisted car, and not of a car without assist; the package's own
     effects do not include it."""
+    monkeypatch.delenv(MODULES_ENV, raising=False)
     assert NAME not in discover_effects()
     monkeypatch.setenv(MODULES_ENV, str(candidate_file))
     registry = discover_effects()
