@@ -54,8 +54,6 @@ from .prescribed import PRESCRIBED_ATOL_FACTOR, PRESCRIBED_RTOL, PrescribedSolut
 # The inversion stops when the bracket is this narrow (N m of torsion-bar torque), far below a sensor's resolution.
 INVERSION_TOLERANCE_NM = 1e-12
 HYDRAULIC = "hydraulic_assist"
-OFFSET_KEY = "torsion_bar_offset.strength"
-GAIN_ERROR_KEY = "boost_gain_error.strength"
 
 
 def boost_keys(name: str) -> list[str]:
@@ -206,23 +204,25 @@ def boost_law(run, p: np.ndarray) -> BoostLaw | None:
     name = effect.name
     v = lambda key: float(p[run.parameter_index(f"{name}.{key}")])  # noqa: E731
     ratio = float(p[run.parameter_index("steering.handwheel_to_rack_ratio")])
-    names = run.model.info["parameters"]
-    # the law-side candidates of an assisted car's diagnosis (effects torsion_bar_offset, boost_gain_error)
-    offset = float(p[names.index(OFFSET_KEY)]) if OFFSET_KEY in names else 0.0
-    gain_factor = 1.0 + float(p[names.index(GAIN_ERROR_KEY)]) if GAIN_ERROR_KEY in names else 1.0
     if name == HYDRAULIC:
-        return BoostLaw(name, "rack", v("valve_slope"), v("dead_band"), v("dead_band_smoothing"),
-                        v("relief_pressure"), v("pressure_smoothing"), ratio, area=v("piston_area"),
-                        table=tuple(v(key) for key in table_keys()),
-                        speed=float(p[run.parameter_index(VEHICLE_SPEED.key)]))
-    gain = speed_gain(v("gain"), v("speed_dependence"), float(p[run.parameter_index(VEHICLE_SPEED.key)]),
-                      v("gain_half_speed"))
-    return BoostLaw(name, effect.location, gain * gain_factor, v("dead_band"), v("dead_band_smoothing"),
-                    v("motor_torque_limit"), v("limit_smoothing"), ratio, v("reduction_ratio"), v("efficiency"),
-                    v("torque_constant"), offset=offset, table=tuple(v(key) for key in table_keys()),
-                    speed=float(p[run.parameter_index(VEHICLE_SPEED.key)]), table_scale=gain_factor,
-                    back_efficiency=v("back_efficiency"), direction_width=v("limit_smoothing"),
-                    sharpness=float(p[run.parameter_index("steering.friction_smoothing")]))
+        law = BoostLaw(name, "rack", v("valve_slope"), v("dead_band"), v("dead_band_smoothing"),
+                       v("relief_pressure"), v("pressure_smoothing"), ratio, area=v("piston_area"),
+                       table=tuple(v(key) for key in table_keys()),
+                       speed=float(p[run.parameter_index(VEHICLE_SPEED.key)]))
+    else:
+        gain = speed_gain(v("gain"), v("speed_dependence"), float(p[run.parameter_index(VEHICLE_SPEED.key)]),
+                          v("gain_half_speed"))
+        law = BoostLaw(name, effect.location, gain, v("dead_band"), v("dead_band_smoothing"),
+                       v("motor_torque_limit"), v("limit_smoothing"), ratio, v("reduction_ratio"), v("efficiency"),
+                       v("torque_constant"), table=tuple(v(key) for key in table_keys()),
+                       speed=float(p[run.parameter_index(VEHICLE_SPEED.key)]),
+                       back_efficiency=v("back_efficiency"), direction_width=v("limit_smoothing"),
+                       sharpness=float(p[run.parameter_index("steering.friction_smoothing")]))
+    # the law-side effects of the model (a diagnosis's candidates acting in the control unit: Effect.boost_law)
+    value = lambda key: float(p[run.parameter_index(key)])  # noqa: E731
+    for other in run.effects:
+        law = other.boost_law(law, value)
+    return law
 
 
 def rack_speed_mps(rack: RackMotion, t) -> np.ndarray:
@@ -252,8 +252,9 @@ def solve_assisted(run, p: np.ndarray, rack: RackMotion, t_out, rtol: float = PR
                    delivered=None) -> AssistedSolution:
     """The torsion-bar torque and the motor's torque and current of `run`'s assisted car with its rack following
     `rack`, at the output times `t_out` (module docstring: the boost-free solve, then the law inverted). The
-    law-side candidates of a diagnosis act here: a sensor offset o (the reading S solves S + A(S) = y + o, the log
-    and the law take S) and a gain error (the law's gain G (1 + e)). `law` replaces the run's own law (a record
+    law-side effects of the model act here, each through its ``Effect.boost_law`` (:func:`boost_law`): a sensor
+    offset o (the reading S solves S + A(S) = y + o, the log and the law take S), a gain error (the law's gain
+    G (1 + e)), a user's own (a derated motor limit). `law` replaces the run's own law (a record
     made with another curve than the file's); `delivered` (a factor per output time, >= 0) scales what the motor
     delivers against what the law commands (a torque ripple), the current unchanged."""
     law = law if law is not None else boost_law(run, p)

@@ -129,6 +129,17 @@ class Effect:
         """Extra named outputs of every run (name with its SI unit, expression), e.g. an assist's motor current."""
         return []
 
+    def boost_law(self, law, value):
+        """Law-side: the boost law of an assisted car's replay with this effect acting in it.
+
+        `law` is the replay's :class:`parksteer.model.numeric.assisted.BoostLaw` (a frozen dataclass: return
+        ``dataclasses.replace(law, ...)``), `value(key)` the value of a quantity this effect uses in the run. An
+        effect that acts in the control unit (a sensor's offset, the curve's gain, the motor's limit) changes the
+        law here and adds no load; one output carrying its strength keeps that quantity in the compiled model's
+        parameter vector, where the replay reads it. Called for every effect of the replayed model, so at strength
+        0 it must return the law unchanged. A handwheel-driven simulation does not call it. Default: `law`."""
+        return law
+
     def own_keys(self) -> tuple[str, ...]:
         """The keys of the quantities only this effect has (``<name>.*``, declared in ``quantities``)."""
         return tuple(k for k in self.uses if k.partition(".")[0] == self.name)

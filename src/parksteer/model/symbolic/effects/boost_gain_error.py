@@ -5,13 +5,15 @@ parking map the file does not know): the motor torque is clamp(G (1 + e) deadban
 torsion-bar torque falls as 1 / (1 + G (1 + e)) in the linear range and the current per torsion-bar torque rises
 as (1 + e): the current channel fixes e directly, the torque alone only through the ratio of the two slopes.
 
-Law-side: it acts in the boost law of the assisted replay (:mod:`parksteer.model.numeric.assisted`), not in the
-mechanics (no load; its one output carries its value into the compiled model's parameter vector). A
+Law-side: it acts in the boost law of the assisted replay (:meth:`boost_law`, :mod:`parksteer.model.numeric.assisted`),
+not in the mechanics (no load; its one output carries its value into the compiled model's parameter vector). A
 handwheel-driven simulation leaves it out. Strength 0 is the file's gain, exactly; it may be negative (a weaker
 curve).
 """
 
 from __future__ import annotations
+
+from dataclasses import replace
 
 from ....parameters import Quantity
 from ..components import Effect
@@ -37,6 +39,11 @@ class BoostGainError(Effect):
     def outputs(self, model):
         electric_assist_of(model, NAME)
         return [("boost_gain_error", model.p(KEY))]
+
+    def boost_law(self, law, value):
+        """The law's gain and its table scaled by 1 + e."""
+        factor = 1.0 + value(KEY)
+        return replace(law, gain=law.gain * factor, table_scale=factor)
 
 
 EFFECT = BoostGainError()

@@ -7,12 +7,14 @@ reading solves ``S + A(S) = y + o``. An offset is thus a constant torque added t
 the assist's linear range it moves the reading by o / (1 + G) only, while the current, which follows the reading,
 moves by G o / (1 + G) in torque units; unlike a friction it does not flip with the direction of motion.
 
-Law-side: it acts in the boost law of the assisted replay, not in the mechanics (the effect adds no load; its one
-output carries its value into the compiled model's parameter vector, where the replay reads it). A handwheel-driven
-simulation leaves it out. Strength 0 is no offset, exactly; it may be negative.
+Law-side: it acts in the boost law of the assisted replay (:meth:`boost_law`), not in the mechanics (the effect adds
+no load; its one output carries its value into the compiled model's parameter vector, where the replay reads it). A
+handwheel-driven simulation leaves it out. Strength 0 is no offset, exactly; it may be negative.
 """
 
 from __future__ import annotations
+
+from dataclasses import replace
 
 from ....parameters import Quantity
 from ..components import Effect
@@ -39,6 +41,10 @@ class TorsionBarOffset(Effect):
     def outputs(self, model):
         electric_assist_of(model, NAME)
         return [("torsion_bar_offset_Nm", model.p(KEY))]
+
+    def boost_law(self, law, value):
+        """The law's reading offset by o (the replay solves S + A(S) = y + o)."""
+        return replace(law, offset=value(KEY))
 
 
 EFFECT = TorsionBarOffset()
