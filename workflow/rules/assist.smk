@@ -68,13 +68,16 @@ rule assist_study:
 DIAG_ASSISTED_CASES = plan("assisted_cases", config.get("assisted_benchmark"))
 DIAG_ASSISTED_BATCHES = case_batches("assisted_", DIAG_ASSISTED_CASES,
                                      int(config.get("assisted_cases_per_job", 16)))
+# the models its jobs replay and make records with, derived before them: parallel jobs compile none side by side
+DIAG_ASSISTED_MODELS = [model_manifest(name, spec) for name, spec in
+                        plan("assisted_benchmark_models", "data/vehicles/polo_vi.toml").items()]
 
 
 rule diag_assisted_batch:
     input:
         parameters=PARAMETERS,
         vehicle="data/vehicles/polo_vi.toml",
-        models=[ASSIST_MODELS["column"]],
+        models=[ASSIST_MODELS["column"], *DIAG_ASSISTED_MODELS],
     output:
         directory("results/diagnose/assisted/{batch}"),
     params:
