@@ -108,3 +108,41 @@ def test_the_strength_is_the_parameter_whose_default_means_absent():
     assert strength_parameter(_Candidate()).name == "strength"
     assert strength_parameter(_OneZeroDefault()).name == "force"
     assert strength_parameter(_TwoZeroDefaults()) is None
+
+
+class _Saturating:
+    """A replay engine whose torque change grows as strength^3: a probe sized from a linear guess overshoots and
+    undershoots in turn, so a short search ends without reaching its target."""
+
+    def __init__(self) -> None:
+        self.shape = np.linspace(-1.0, 1.0, 50)
+
+    def predict(self, problem, effects, overrides):
+        s = overrides["toy_candidate.strength"]
+        return [self.shape * s**3]
+
+
+class _Files:
+    uses_angle = False
+
+    def scale(self, arrays):
+        return np.concatenate(arrays) / 0.1
+
+
+def test_a_probe_that_runs_out_of_tries_divides_its_change_by_the_strength_it_was_made_at():
+    """A signature is a derivative: the torque change of the last probe over the strength that probe was made at.
+    When the search stops at its last try, the strength it would have tried next was never replayed, and the
+    signature's strength must be the one behind its torque: its probed torque is the replay at its strength, and its
+    weighted signature times that strength is the weighted change."""
+    from dataclasses import replace
+
+    from parksteer.diagnose.candidates import probe_signature
+    from parksteer.diagnose.settings import DEFAULT_SETTINGS
+
+    engine = _Saturating()
+    settings = replace(DEFAULT_SETTINGS, probe_max_tries=2)
+    signature = probe_signature(engine, _Files(), [], _Candidate(), {}, target_Nm=0.01, settings=settings)
+    assert not 0.5 <= signature.rms_change_Nm / 0.01 <= 2.0  # the search did run out of tries
+    replayed = engine.predict(None, [], {"toy_candidate.strength": signature.probe})[0]
+    assert np.allclose(signature.probed[0], replayed, rtol=1e-12, atol=0.0)
+    assert np.allclose(signature.weighted * signature.probe, replayed / 0.1, rtol=1e-12, atol=0.0)

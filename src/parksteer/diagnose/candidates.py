@@ -168,15 +168,15 @@ def probe_signature(engine: ReplayEngine, problem: Problem, base_effects: list[E
     zero = engine.predict(problem, effects, {**overrides, key: 0.0})
     strength = max(spec.upper * settings.probe_start_fraction, 1e-12)
     probed, change = None, 0.0
-    for _ in range(settings.probe_max_tries):
+    for attempt in range(settings.probe_max_tries):
         probed = engine.predict(problem, effects, {**overrides, key: strength})
         change = _rms_change(problem, probed, zero)
         if change > 0.0 and 0.5 <= change / target_Nm <= 2.0:
             break
         factor = target_Nm / change if change > 0.0 else 100.0
         new_strength = min(spec.upper, strength * factor)
-        if new_strength == strength:
-            break
+        if new_strength == strength or attempt + 1 == settings.probe_max_tries:
+            break  # the signature is the last probe's, at the strength it was made with
         strength = new_strength
     weighted = problem.scale([p - z for p, z in zip(probed, zero)]) / strength
     observable = change >= settings.unobservable_noise_floors * target_Nm / settings.probe_effect_noise_floors
