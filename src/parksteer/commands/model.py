@@ -97,6 +97,16 @@ def _assisted_vehicle_sets() -> list:
     return sets
 
 
+def _suggestion_shape_sets() -> list:
+    """(spec, effects) of the models a suggestion on the default car is fitted with: the default set and each form
+    of a suggested effect (parksteer.diagnose.suggest.shape_forms), spec ``{"shape": name}``."""
+    from ..diagnose.suggest import shape_forms
+    from ..model.symbolic.components import resolve_effects
+
+    base = resolve_effects(None)
+    return [({"shape": form.name}, sorted([*base, form], key=lambda e: e.name)) for form in shape_forms()]
+
+
 def _signature_truth_sets() -> list:
     """(spec, effects) of the models the signature benchmark makes its records with: the default set and each truth
     form outside the library (parksteer.synthetic.outoflibrary), spec ``{"truth_form": name}``; its jobs then
@@ -230,7 +240,7 @@ def _derive(args) -> int:
             raise UsageError("--prebuilt derives the default diagnosis' models and the manifests' sets: give it no "
                              "--effects or --out")
         sets = [([e.name for e in effects], effects) for effects in default_diagnosis_models()]
-        sets += _assisted_vehicle_sets() + _signature_truth_sets()
+        sets += _assisted_vehicle_sets() + _signature_truth_sets() + _suggestion_shape_sets()
         for path in args.manifests:
             spec = _manifest_spec(path)
             sets.append((spec, resolve_effects(spec)))

@@ -19,22 +19,23 @@ The strengths are declared free (``Quantity.free``) within wide bounds: passed b
 the diagnosis (and ``parksteer compare``) fits them together with the calibrated parameters. They are signed (a
 force may be larger or smaller than the calibrated model's along the axis) and fitted first here, by the
 diagnosis's Levenberg-Marquardt (:func:`parksteer.diagnose.calibrate.least_squares`), from the calibrated values and
-zero strengths; the file is then written again with the fitted values as its defaults (``START``), so that the fit
-of the file passed back starts where this one ended and a replay of it as it stands is the fitted effect.
+zero strengths, on the effect's form (:mod:`parksteer.model.symbolic.shapes`: the same terms with the knots as
+given values, one compiled model per form, so a suggestion derives no model of its own); the file is then written
+again with the fitted values as its defaults (``START``), so that the fit of the file passed back starts where
+this one ended and a replay of it as it stands is the fitted effect.
 :func:`suggest` returns the error before and after in noise floors and the BIC gain over the calibrated model.
 """
 
 from __future__ import annotations
 
 import math
-import tempfile
 from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
 
 from ..errors import UsageError
-from ..model.symbolic.components import load_effect_module
+from ..model.symbolic.shapes import FORCE_BOUND_N, TORQUE_BOUND_NM, shape_effect
 from .calibrate import Fit, calibration_parameters, least_squares
 from .engine import ReplayEngine
 from .problem import Problem
@@ -42,8 +43,6 @@ from .statistics import bic_gain, effective_samples, fit_statistics, lag1_autoco
 from .settings import DEFAULT_SETTINGS, DiagnosisSettings
 from .signature import COLUMN_CLASSES, Signature
 
-FORCE_BOUND_N = 20000.0  # a knot's rack force: far above any steering-gear force at parking speed
-TORQUE_BOUND_NM = 50.0  # a column torque's amplitude: far above any handwheel torque at parking speed
 
 
 @dataclass(frozen=True)
@@ -223,53 +222,74 @@ def strength_keys(source: str) -> tuple[str, ...]:
     return namespace["STRENGTHS"]
 
 
+def shape_forms(settings: DiagnosisSettings = DEFAULT_SETTINGS) -> list:
+    """Every form a suggestion can take under `settings` (the signature's bases,
+    :mod:`parksteer.diagnose.signature_axes`): the uniform frictions, the position classes at each knot count, the
+    speed class, the column orders and the dissipative x column orders."""
+    sig = settings.signature
+    forms = [shape_effect("dissipative"), shape_effect("direction")]
+    forms += [shape_effect(kind, count) for count in sig.position_knots for kind in ("dissipative", "elastic", "direction")]
+    forms.append(shape_effect("speed", sig.speed_knots))
+    forms += [shape_effect("column", orders=tuple(o)) for o in (*sig.column_orders, (sig.mesh_order,))]
+    forms += [shape_effect("dissipative_column", orders=tuple(o)) for o in sig.combined_orders]
+    return forms
+
+
+def shape_of(signature: Signature, speed_90_m_s: float | None = None):
+    """The suggested effect's form (:func:`parksteer.model.symbolic.shapes.shape_effect`) and the values of its
+    knots, width and speed scale, those the written file (:func:`effect_source`) has as numbers."""
+    kind, best = signature.effect_class, signature.best
+    if kind in COLUMN_CLASSES:
+        return shape_effect(kind, orders=tuple(best.orders)), {}
+    shape = shape_effect(kind, len(best.knots))
+    values = {f"{shape.name}.c{k}": float(c) for k, c in enumerate(best.knots)}
+    if best.knots:
+        values[f"{shape.name}.width"] = float(best.width)
+    if kind == "speed":
+        values[f"{shape.name}.speed_scale"] = round(float(speed_90_m_s or 0.05), 3)  # as the file writes it
+    return shape, values
+
+
 def suggest(problem: Problem, calibration: Fit, signature: Signature, path: str | Path | None = None,
             settings: DiagnosisSettings = DEFAULT_SETTINGS) -> Suggestion:
     """Write the effect `signature` points to, fit its strengths with the calibrated parameters on `problem`, and
-    write it again with the fitted values as its defaults (to `path`, or a temporary file). Its replays
-    run on a replay engine of its own, in line."""
+    write it again with the fitted values as its defaults (to `path`, if given). The fit runs on the effect's form
+    (:func:`shape_of`: the same terms, its knots given as values), on a replay engine of its own, in line."""
     speed_90 = signature.numbers.get("speed_90_m_s")
     if signature.effect_class == "speed" and speed_90 is None:
         speed_90 = float(np.quantile(np.abs(np.concatenate([f.rack.evaluate(f.replay_time_s)[1]
                                                             for f in problem.files])), 0.9))
     source = effect_source(signature, speed_90_m_s=speed_90)
     keys = strength_keys(source)
-    folder = None
-    if path is None:
-        folder = tempfile.TemporaryDirectory(prefix="parksteer_suggest_")
-        target = Path(folder.name) / "suggested_effect.py"
-    else:
-        target = Path(path)
-    try:
-        target.write_text(source, encoding="utf-8")
-        effect = load_effect_module(str(target))
-        model = sorted([*calibration.effects, effect], key=lambda e: e.name)
-        before = fit_statistics(problem, calibration.predictions)
-        floor = before["noise_floor_Nm"]
-        ratio = problem.params.sections["steering"]["handwheel_to_rack_ratio"]
-        column = signature.effect_class in COLUMN_CLASSES
-        step = floor if column else floor * ratio  # a strength moving the torque by about a noise floor
-        engine = ReplayEngine()
-        # the effect's strengths are free (calibration_parameters adds them, last), each stepped by about a floor
-        parameters = [replace(p, step=step) if p.key in keys else p
-                      for p in calibration_parameters(engine, problem, model, settings=settings)]
-        # from the calibration as it stands (its own theta, not a value's round trip) and zero strengths
-        start = {q.key: t for q, t in zip(calibration.parameters, calibration.theta)}
-        theta0 = np.array([start.get(p.key, 0.0) for p in parameters])
-        fit = least_squares(engine, problem, model, parameters, theta0, calibration.fixed, settings=settings)
-        after = fit_statistics(problem, fit.predictions)
-        rho = lag1_autocorrelation(problem, fit.weighted)
-        n_eff = effective_samples(problem.n, rho)
-        gain = bic_gain(calibration.rss, fit.rss, n_eff, len(keys))
-        values = fit.values if isinstance(fit.values, dict) else {}
-        strengths = {k: float(values.get(k, fit.theta[len(calibration.theta) + i])) for i, k in enumerate(keys)}
-        before_ratio = before["weighted_rms_Nm"] / floor
-        after_ratio = after["weighted_rms_Nm"] / floor
-        final = effect_source(signature, {**strengths, "_before": before_ratio, "_after": after_ratio}, speed_90)
-        if path is not None:
-            target.write_text(final, encoding="utf-8")
-        return Suggestion(effect.name, signature.effect_class, str(path) if path is not None else None, final,
-                          strengths, float(before_ratio), float(after_ratio), float(gain), fit)
-    finally:
-        if folder is not None:
-            folder.cleanup()
+    shape, places = shape_of(signature, speed_90)
+    shape_keys = [f"{shape.name}.{key.partition('.')[2]}" for key in keys]
+    model = sorted([*calibration.effects, shape], key=lambda e: e.name)
+    before = fit_statistics(problem, calibration.predictions)
+    floor = before["noise_floor_Nm"]
+    ratio = problem.params.sections["steering"]["handwheel_to_rack_ratio"]
+    column = signature.effect_class in COLUMN_CLASSES
+    step = floor if column else floor * ratio  # a strength moving the torque by about a noise floor
+    engine = ReplayEngine()
+    # the form's strengths are free (calibration_parameters adds them, last), each stepped by about a floor
+    parameters = [replace(p, step=step) if p.key in shape_keys else p
+                  for p in calibration_parameters(engine, problem, model, settings=settings)]
+    # from the calibration as it stands (its own theta, not a value's round trip) and zero strengths
+    start = {q.key: t for q, t in zip(calibration.parameters, calibration.theta)}
+    theta0 = np.array([start.get(p.key, 0.0) for p in parameters])
+    fit = least_squares(engine, problem, model, parameters, theta0, {**calibration.fixed, **places},
+                        settings=settings)
+    after = fit_statistics(problem, fit.predictions)
+    rho = lag1_autocorrelation(problem, fit.weighted)
+    n_eff = effective_samples(problem.n, rho)
+    gain = bic_gain(calibration.rss, fit.rss, n_eff, len(keys))
+    values = fit.values if isinstance(fit.values, dict) else {}
+    strengths = {k: float(values.get(s, fit.theta[len(calibration.theta) + i]))
+                 for i, (k, s) in enumerate(zip(keys, shape_keys))}
+    before_ratio = before["weighted_rms_Nm"] / floor
+    after_ratio = after["weighted_rms_Nm"] / floor
+    final = effect_source(signature, {**strengths, "_before": before_ratio, "_after": after_ratio}, speed_90)
+    if path is not None:
+        Path(path).write_text(final, encoding="utf-8")
+    return Suggestion(f"suggested_{signature.effect_class}", signature.effect_class,
+                      str(path) if path is not None else None, final, strengths, float(before_ratio),
+                      float(after_ratio), float(gain), fit)

@@ -192,6 +192,12 @@ def _register_quantities(effect: Effect, where: str) -> Effect:
     return effect
 
 
+def register_effect(effect: Effect, where: str) -> Effect:
+    """An effect made in code (not a module's EFFECT), its quantities joined to the registry and its keys checked;
+    `where` names it in an error."""
+    return _register_quantities(effect, where)
+
+
 def _effect_of(obj: Any, where: str) -> Effect:
     if inspect.isclass(obj) and issubclass(obj, Effect):
         obj = obj()
