@@ -19,7 +19,7 @@ import pytest
 
 import eps_truth as et
 from parksteer.cli import main
-from parksteer.diagnose.assist_identify import identify_boost
+from parksteer.diagnose.assist_identify import BAND_GRID, _band_estimate, identify_boost
 from parksteer.model.symbolic.components import discover_effects
 from parksteer.vehicle import load_vehicle
 
@@ -144,3 +144,29 @@ def test_a_record_in_memory_is_its_file(baseline):
     again = identify_boost([load_record(path, None, params=load_vehicle(et.POLO))], et.POLO)
     assert again.product == found.product and again.motor_friction == found.motor_friction
     assert again.assist == found.assist and again.records == found.records
+
+
+def test_friction_band_read_from_the_reversals(baseline):
+    """The truth's motor friction changes over as tanh(column rate / 0.02 rad/s), a band of N x 0.02 = 0.36 rad/s of
+    rotor speed: the column balance across the reversals holds the records and its 95 % interval for the band
+    contains 0.36 rad/s and excludes the car-wide friction smoothing's 2.25 rad/s (1 mm/s of the rack)."""
+    truth, _, found = baseline
+    assert found.balance_holds
+    assert found.friction_speed is not None
+    lo, hi = found.friction_speed.ci95
+    assert lo <= truth.reduction * 0.02 <= hi < 2.25
+
+
+@pytest.mark.parametrize("rise", [0.0, 50.0])
+def test_a_flat_balance_fixes_no_band(rise):
+    """Records that change the column balance's RSS by less than the chi-square quantile of one degree of freedom
+    (counted in blocks of correlated residuals) across every width tried do not fix the band; a profile that rises
+    steeply either side of its least fixes it there, its interval inside the neighbouring widths."""
+    blocks, rss = 20, 2000.0
+    per_block = rss / blocks
+    profile = [(b, rss + rise * per_block * abs(np.log2(b / 0.5))) for b in BAND_GRID]
+    found = _band_estimate(profile, blocks)
+    if rise == 0.0:
+        assert found is None
+    else:
+        assert found.value == 0.5 and 0.25 < found.ci95[0] < 0.5 < found.ci95[1] < 1.0

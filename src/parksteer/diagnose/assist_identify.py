@@ -78,6 +78,20 @@ BACK_DRIVEN_SHARE = 0.03
 TYRE_FRICTION = ("tyre.friction_coefficient", 0.05)
 # The column balance is read where the gear moves: the friction's smooth sign tanh(beta v) at least this.
 MOVING_SIGN = 0.95
+# The band of rotor speed (rad/s) over which the motor's friction and the gear's direction change over at a reversal
+# (the assist's friction_speed) is read off the column balance at these widths, a factor 2 apart: from a tenth of
+# the car-wide friction smoothing's width at a column worm (2.25 rad/s of the rotor: 1 mm/s of the rack at N = 18,
+# G_hr = 125 rad/m) to twice it.
+BAND_GRID = (0.125, 0.25, 0.5, 1.0, 2.0, 4.0)
+# The column balance fixes the gear's numbers only where it holds the records: its RMS (over every sample where the
+# gear turns, at its best band) within this many torque noise floors. Beyond, its residual is the mechanics' misfit
+# (the car's own parameters, which a diagnosis calibrates and this step does not), not the gear's: the file's values
+# are kept and the report says so. Three floors: a residual three times the noise is no longer noise at any of the
+# records' lengths (tens of blocks).
+BALANCE_HOLDS_FLOORS = 3.0
+CHI2_95 = 3.841  # the 95 % quantile of chi-square with one degree of freedom
+# A rotor slower than this (rad/s) is at rest: the smoothed rack is held constant where the hand pauses.
+HELD_RAD_S = 1.0e-6
 # A residual shape counts as beyond the noise at this many of its standard errors.
 BEYOND_SE = 4.0
 
@@ -114,13 +128,19 @@ class Identified:
     balance_rms_Nm: float
     torque_noise_Nm: float
     beyond_map: tuple[str, ...]
+    friction_speed: Estimate | None = None  # the band (rad/s of the rotor); None: the records do not fix it
+    balance_holds: bool = True  # False: the column balance does not hold the records; the file's gear kept
+    balance_floors: float = math.nan  # the balance's RMS in noise floors (the torque's, through the map's slope)
+    kept: tuple[str, ...] = ()  # the file's values the written file keeps: the records do not contradict them
     file_values: dict = field(default_factory=dict)
 
     def as_dict(self) -> dict:
         est = {k: getattr(self, k).as_dict() for k in ("dead_band", "map_centre", "product", "motor_friction",
                                                          "motor_inertia", "offset", "rack_friction", "hysteresis_A")}
         est["back_efficiency"] = None if self.back_efficiency is None else self.back_efficiency.as_dict()
+        est["friction_speed"] = None if self.friction_speed is None else self.friction_speed.as_dict()
         return {"vehicle": self.vehicle, "records": list(self.records), "assist": self.assist_name,
+                "balance_holds": self.balance_holds, "balance_floors": self.balance_floors, "kept": list(self.kept),
                 "table": {"torsion_bar_torque_Nm": list(self.torques), "assist": list(self.assist),
                           "assist_ci95": [list(c) for c in self.assist_ci95], "current_A": list(self.current_A),
                           "current_ci95": [list(c) for c in self.current_ci95]},
@@ -151,12 +171,18 @@ class Identified:
                   ("back-driven efficiency " + (self.back_efficiency.text() if self.back_efficiency is not None
                                                 else "not fixed (too few back-driven samples)")
                    + f" (file: {self.file_values.get('back_efficiency', float('nan')):.4g})"),
+                  ("friction and direction band " + (self.friction_speed.text() if self.friction_speed is not None
+                                                     else "not fixed (the balance is flat across the widths tried)")
+                   + f" of rotor speed (file: {self.file_values.get('friction_speed', float('nan')):.4g} rad/s)"),
                   f"torsion-bar offset {self.offset.text()}",
                   f"rack friction {self.rack_friction.text()}",
                   f"map residual RMS {self.map_rms_A:.3f} A against {self.map_noise_A:.3f} A of noise; hysteresis "
                   f"{self.hysteresis_A.text()} ({self.hysteresis_Nm:.4f} N m of torque)",
                   f"column balance RMS {self.balance_rms_Nm:.4f} N m against a torque noise floor of "
-                  f"{self.torque_noise_Nm:.4f} N m"]
+                  f"{self.torque_noise_Nm:.4f} N m: {self.balance_floors:.2f} floors, the torque's noise taken "
+                  "through the map's slope"]
+        if self.kept:
+            lines.append(f"kept as the file gives them (the records do not contradict them): {', '.join(self.kept)}")
         lines += [f"the map cannot hold: {b}" for b in self.beyond_map] or ["the map holds the records within "
                                                                             "their noise"]
         return lines
@@ -167,6 +193,31 @@ class Identified:
         from .identified_file import replace_assist_section
 
         return replace_assist_section(text, self)
+
+
+def _band_estimate(profile: list[tuple[float, float]], blocks: int) -> Estimate | None:
+    """The band at the least weighted RSS of the column balance over `profile` [(band, RSS)], with the range of
+    bands whose RSS lies within the 95 % quantile of chi-square with one degree of freedom, counted in blocks (the
+    residuals correlate within a block: the RSS per block is the unit; geometric interpolation between the grid's
+    widths). None when the profile is flat to that level: the records do not fix the band."""
+    bands = np.array([b for b, _ in profile])
+    rss = np.array([r for _, r in profile])
+    best = int(np.argmin(rss))
+    rise = (rss - rss[best]) * blocks / rss[best]  # in units of one block's RSS
+    if np.all(rise <= CHI2_95):
+        return None
+    logs = np.log(bands)
+
+    def edge(direction: int) -> float:
+        k = best
+        while 0 <= k + direction < len(bands) and rise[k + direction] <= CHI2_95:
+            k += direction
+        if not 0 <= k + direction < len(bands):
+            return float(bands[k])  # the grid's end: at most (least) this
+        f = (CHI2_95 - rise[k]) / (rise[k + direction] - rise[k])
+        return float(np.exp(logs[k] + f * (logs[k + direction] - logs[k])))
+
+    return Estimate(float(bands[best]), (edge(-1), edge(1)), "rad/s")
 
 
 def _files(records, params, case, surface, channel_map, name) -> list[FileData]:
@@ -258,53 +309,81 @@ def identify_boost(records, vehicle, case: str | None = None, surface: str | Non
     boost_off = {key: 0.0 for key in boost_keys(name)}
     keys = [f"{name}.{k}" if "." not in k else k for k, _ in MECHANICS]
     theta = np.array([float(params[k]) for k in keys])
-    delivered, measured, times, moving, backward = [], [], [], [], []
-    sharpness = float(params["steering.friction_smoothing"])
-    for k, f in enumerate(files):
-        S = f.torque_Nm
-        motor = law(S - fitted.centre) * k_t
-        speed = rack_speed_mps(f.rack, f.time_s)
-        e = directional_efficiency(motor, speed, eta, eta_b, v("limit_smoothing"), sharpness)
-        delivered.append(e * reduction * motor / scale)
-        moving.append(np.abs(pm.tanh(sharpness * speed)) >= MOVING_SIGN)
-        backward.append(motor * speed < 0.0)
-        measured.append(S)
-        times.append(f.time_s + 1e6 * k)
-    D = np.concatenate(delivered)
-    S_all = np.concatenate(measured)
-    t_all = np.concatenate(times)
+    # the rotor's speed: N times the point of action's rate (at the column the joint's ratio taken as G_hr: a few
+    # per cent of a band's width)
+    lever = 1.0 if location == "rack" else ratio
+    rotor = [rack_speed_mps(f.rack, f.time_s) * reduction * lever for f in files]
+    motors = [law(f.torque_Nm - fitted.centre) * k_t for f in files]
+    S_all = np.concatenate([f.torque_Nm for f in files])
+    t_all = np.concatenate([f.time_s + 1e6 * k for k, f in enumerate(files)])
     sigma = np.concatenate([np.full(f.n, f.noise.total_rms) for f in files])
-    use = np.concatenate(moving)
-    back = np.concatenate(backward)
-    split = (use & back).sum() >= BACK_DRIVEN_SHARE * use.sum()
-    if use.sum() < 20 * (len(MECHANICS) + 2):
-        raise UsageError(f"{', '.join(str(r) for r in records)}: the steering hardly moves: identify needs records "
-                         "in which the wheel turns (the column balance is read while the gear moves)")
+    # The balance reads the assist through the logged torque, whose noise the map amplifies by its slope (the
+    # control unit acts on its own reading, not the logged noise): a sample's residual has the torque's noise times
+    # 1 + dD/dS, so it is weighted by that (errors in the variable the map reads).
+    h = 1e-4
+    slope = np.concatenate([(law(f.torque_Nm - fitted.centre + h) - law(f.torque_Nm - fitted.centre - h)) / (2 * h)
+                            for f in files]) * k_t * eta * reduction / scale
+    spread = sigma * (1.0 + np.abs(slope))
+    back = np.concatenate([m * w < 0.0 for m, w in zip(motors, rotor)])
+    turning = np.abs(np.concatenate(rotor)) > HELD_RAD_S
+
+    def delivered(band: float) -> np.ndarray:
+        """What the file's gear delivers for the identified current, its direction changing over `band`."""
+        return np.concatenate([directional_efficiency(m, w, eta, eta_b, v("limit_smoothing"), 1.0 / band)
+                               * reduction * m / scale for m, w in zip(motors, rotor)])
+
+    def moving(band: float) -> np.ndarray:
+        return np.abs(pm.tanh(np.concatenate(rotor) / band)) >= MOVING_SIGN
 
     def road(changes: dict[str, float]):
         overrides = {**boost_off, **dict(zip(keys, theta)), **changes}
         return np.concatenate([engine.replay(problem, effects, k).solve(overrides).torque_Nm[: f.n]
                                for k, f in enumerate(files)])
 
+    def balance(band: float, use: np.ndarray, split: bool):
+        """(y0, the parameters' columns, the design matrix's D parts, solution, residual) of the column balance
+        with the motor's friction and the gear's direction changing over `band`, on the samples `use`."""
+        band_key = {f"{name}.friction_speed": band}
+        y0 = road(band_key)
+        columns = [(road({**band_key, key: value + step}) - y0) / step
+                   for key, value, (_, step) in zip(keys, theta, MECHANICS)]
+        D = delivered(band)
+        parts = [-D * ~back, -D * back] if split else [-D]
+        matrix = (np.column_stack([*columns, np.ones_like(S_all), *parts]) / spread[:, None])[use]
+        rhs = ((S_all - y0) / spread)[use]
+        solution = pm.lstsq(matrix, rhs)
+        return y0, matrix, rhs, solution, rhs - pm.matmul(matrix, solution)
+
+    band_file = v("friction_speed")
     say("identify: the column balance on the car's replay")
     try:
-        y0 = road({})
-        columns = [(road({key: value + step}) - y0) / step for key, value, (_, step) in zip(keys, theta, MECHANICS)]
+        # the band: the balance over every sample where the gear turns, reversals included (where the band acts)
+        split_all = (turning & back).sum() >= BACK_DRIVEN_SHARE * turning.sum()
+        profile = []
+        for band in BAND_GRID:
+            residual = balance(band, turning, split_all)[4]
+            profile.append((band, float(residual @ residual)))
+        # the balance's RMS in noise floors at its best band: the weighted RSS per sample
+        holds = math.sqrt(min(r for _, r in profile) / turning.sum()) <= BALANCE_HOLDS_FLOORS
+        band_estimate = _band_estimate(profile, len(np.unique(_blocks(t_all[turning], BLOCK_S)))) if holds else None
+        band = band_estimate.value if band_estimate is not None else band_file
+        use = moving(band)
+        split = (use & back).sum() >= BACK_DRIVEN_SHARE * use.sum()
+        if use.sum() < 20 * (len(MECHANICS) + 2):
+            raise UsageError(f"{', '.join(str(r) for r in records)}: the steering hardly moves: identify needs "
+                             "records in which the wheel turns (the column balance is read while the gear moves)")
+        y0, design, rhs, solution, resid = balance(band, use, split)
         tyre_key, tyre_step = TYRE_FRICTION
-        tyre_column = (road({tyre_key: float(params[tyre_key]) + tyre_step}) - y0) / tyre_step
+        tyre_column = (road({f"{name}.friction_speed": band, tyre_key: float(params[tyre_key]) + tyre_step})
+                       - y0) / tyre_step
     finally:
         engine.close()
     # y0 + J dtheta + o - S - p D = 0  ->  [J, 1, -D] [dtheta, o, p] = S - y0, with D split into the samples the
     # motor drives and those it is driven back (their factor p_b = p eta_b,file / eta_b)
     # only while the gear moves: at rest its friction and the direction of its power are not defined
-    parts = [-D * ~back, -D * back] if split else [-D]
-    design = (np.column_stack([*columns, np.ones_like(S_all), *parts]) / sigma[:, None])[use]
-    rhs = ((S_all - y0) / sigma)[use]
-    solution = pm.lstsq(design, rhs)
-    resid = rhs - pm.matmul(design, solution)
     cov = _sandwich(design, resid, _blocks(t_all[use], BLOCK_S))
     # the product at the tyre friction moved by its step: the same fit on y0 + step x its column
-    moved = pm.lstsq(design, ((S_all - y0 - tyre_step * tyre_column) / sigma)[use])
+    moved = pm.lstsq(design, ((S_all - y0 - tyre_step * tyre_column) / spread)[use])
     se = np.sqrt(np.maximum(np.diag(cov), 0.0))
     values = theta + solution[: len(keys)]
     offset, p = float(solution[len(keys)]), float(solution[len(keys) + 1])
@@ -321,11 +400,27 @@ def identify_boost(records, vehicle, case: str | None = None, surface: str | Non
     z = _t95(len(np.unique(_blocks(t_all[use], BLOCK_S))) - design.shape[1])
     if split:
         back_efficiency = _estimate(eta_b * ratio, back_se, "1", z)
-    balance_rms = float(np.sqrt(np.mean((resid * sigma[use]) ** 2)))
+    balance_rms = float(np.sqrt(np.mean((resid * spread[use]) ** 2)))
+    balance_floors = float(np.sqrt(np.mean(resid ** 2)))
     torque_noise = float(np.sqrt(np.mean(sigma ** 2)))
 
     # the table at the point of action: P K, its interval from the map's and the product's
-    P = p * product_file
+    # What the written file takes from the balance: each number the file's value (a data sheet's or an assumed one)
+    # unless the number's 95 % interval excludes it; the file's kept too where the estimate is no physical value (a
+    # friction or an inertia below zero: the balance's misfit, not the gear's), and everywhere when the balance does
+    # not hold. (value, interval's low, high, the file's value) by key:
+    judged = {
+        "torque_constant": (p * product_file, (p - z * se_p) * product_file, (p + z * se_p) * product_file,
+                            product_file),
+        "motor_friction_torque": (values[0], values[0] - z * se[0], values[0] + z * se[0], v("motor_friction_torque")),
+        "motor_inertia": (values[1], values[1] - z * se[1], values[1] + z * se[1], v("motor_inertia")),
+    }
+    if back_efficiency is not None:
+        judged["back_efficiency"] = (back_efficiency.value, *back_efficiency.ci95, eta_b)
+    kept = [key for key, (value, lo, hi, file_value) in judged.items()
+            if not holds or lo <= file_value <= hi or value < 0.0]
+    # the product the table is written with: the balance's, or the file's where it is kept
+    P = product_file if "torque_constant" in kept else p * product_file
     point_cov = pm.matmul(pm.matmul(fitted.jacobian_values, fitted.covariance), fitted.jacobian_values.T) \
         + np.diag(fitted.representation ** 2)
     current = np.array(fitted.current)
@@ -342,6 +437,11 @@ def identify_boost(records, vehicle, case: str | None = None, surface: str | Non
         beyond.append(f"hysteresis: the current on loading is {fitted.hysteresis:+.3f} A from that on unloading at "
                       f"equal torsion-bar torque (+-{Z95 * fitted.hysteresis_se:.3f} A; {fitted.hysteresis_Nm:.4f} N m "
                       "of torque), a current that depends on the way the steering turns (outward or back)")
+    if not holds:
+        beyond.append(f"the column balance: {balance_floors:.2f} noise floors RMS (the torque's noise through the "
+                      f"map's slope; more than {BALANCE_HOLDS_FLOORS:g}): the gear's numbers it "
+                      "would fix are not written, the file's kept (the table is the current map times the file's "
+                      "product k_t eta N)")
     if fitted.rms > 1.5 * fitted.noise and fitted.rms - fitted.noise > 0.5 * step_i:
         beyond.append(f"scatter: the current departs from the map by {fitted.rms:.3f} A RMS against {fitted.noise:.3f} "
                       "A of the channels' noise")
@@ -369,8 +469,9 @@ def identify_boost(records, vehicle, case: str | None = None, surface: str | Non
         map_rms_A=fitted.rms, map_noise_A=fitted.noise,
         hysteresis_A=_estimate(fitted.hysteresis, fitted.hysteresis_se, "A"), hysteresis_Nm=float(fitted.hysteresis_Nm),
         balance_rms_Nm=balance_rms, torque_noise_Nm=torque_noise, beyond_map=tuple(beyond),
+        friction_speed=band_estimate, balance_holds=holds, balance_floors=balance_floors, kept=tuple(kept),
         file_values={"product": product_file, "motor_friction_torque": v("motor_friction_torque"),
-                     "motor_inertia": v("motor_inertia"), "back_efficiency": eta_b,
+                     "motor_inertia": v("motor_inertia"), "back_efficiency": eta_b, "friction_speed": band_file,
                      "efficiency": eta, "reduction_ratio": reduction, "torque_constant": k_t},
     )
 
