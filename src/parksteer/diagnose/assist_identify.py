@@ -34,6 +34,11 @@ Two steps, each a least-squares fit with its 95 % intervals:
    fitted: it scales the road torque as p scales the assist, and S, their small difference, cannot tell them
    apart; the product's change per step of it is reported.
 
+3. **The band** of rotor speed over which the motor's friction and the worm's direction change over at a reversal
+   (the assist's ``friction_speed``): the balance solved over every sample where the gear turns, reversals
+   included, at each width of :data:`BAND_GRID`; the width of least misfit, where the profile rises beyond
+   chi-square's 95 % level either side (:func:`_band_estimate`), else not fixed.
+
 Intervals are the least squares' with the residuals' correlation in time left in (a sandwich over blocks of
 :data:`BLOCK_S`, with Student's t for its blocks): a record of a few cycles fixes less than its sample count says.
 The map's points carry two errors the samples do not average: the table's own (the change from a table of two
@@ -42,7 +47,9 @@ map's centre the torque's rounding (the map between two readings is never seen);
 relative, since it is read through the map. The identified table is the map
 times the identified product, P K(S - c), at the point of action; the written file carries it in ``[assist.boost]``
 and the product as the torque constant k_t = P / (eta_f N) (only the product is fixed: eta_f and N stay the file's),
-and the motor friction; each entry's ``source`` names the records. The sensor offset and the map's centre have no
+and the motor friction; each entry's ``source`` names the records. A number of the gear is written only where the
+balance holds the records (:data:`BALANCE_HOLDS_FLOORS`), the number is physical and its interval excludes the
+file's value; otherwise the file's stays (:attr:`Identified.kept`). The sensor offset and the map's centre have no
 place in a vehicle file (the model's law is odd about the reading's zero): they are reported, and a later
 diagnosis that names an offset of the same size names the baseline's.
 """
@@ -84,10 +91,11 @@ MOVING_SIGN = 0.95
 # G_hr = 125 rad/m) to twice it.
 BAND_GRID = (0.125, 0.25, 0.5, 1.0, 2.0, 4.0)
 # The column balance fixes the gear's numbers only where it holds the records: its RMS (over every sample where the
-# gear turns, at its best band) within this many torque noise floors. Beyond, its residual is the mechanics' misfit
-# (the car's own parameters, which a diagnosis calibrates and this step does not), not the gear's: the file's values
-# are kept and the report says so. Three floors: a residual three times the noise is no longer noise at any of the
-# records' lengths (tens of blocks).
+# gear turns, at its best band) within this many torque noise floors. Beyond, its residual is not the torque's noise
+# but what the balance leaves out (the car's own parameters, which a diagnosis calibrates and this step does not; a
+# logged torque noisier than the reading the control unit acts on, which the map's slope amplifies in the assist
+# read from it): its numbers are not the gear's, the file's values are kept and the report says so. Three floors:
+# a residual three times the noise is no longer noise at any of the records' lengths (tens of blocks).
 BALANCE_HOLDS_FLOORS = 3.0
 CHI2_95 = 3.841  # the 95 % quantile of chi-square with one degree of freedom
 # A rotor slower than this (rad/s) is at rest: the smoothed rack is held constant where the hand pauses.
@@ -130,7 +138,7 @@ class Identified:
     beyond_map: tuple[str, ...]
     friction_speed: Estimate | None = None  # the band (rad/s of the rotor); None: the records do not fix it
     balance_holds: bool = True  # False: the column balance does not hold the records; the file's gear kept
-    balance_floors: float = math.nan  # the balance's RMS in noise floors (the torque's, through the map's slope)
+    balance_floors: float = math.nan  # the balance's RMS in torque noise floors
     kept: tuple[str, ...] = ()  # the file's values the written file keeps: the records do not contradict them
     file_values: dict = field(default_factory=dict)
 
@@ -179,8 +187,7 @@ class Identified:
                   f"map residual RMS {self.map_rms_A:.3f} A against {self.map_noise_A:.3f} A of noise; hysteresis "
                   f"{self.hysteresis_A.text()} ({self.hysteresis_Nm:.4f} N m of torque)",
                   f"column balance RMS {self.balance_rms_Nm:.4f} N m against a torque noise floor of "
-                  f"{self.torque_noise_Nm:.4f} N m: {self.balance_floors:.2f} floors, the torque's noise taken "
-                  "through the map's slope"]
+                  f"{self.torque_noise_Nm:.4f} N m ({self.balance_floors:.2f} floors)"]
         if self.kept:
             lines.append(f"kept as the file gives them (the records do not contradict them): {', '.join(self.kept)}")
         lines += [f"the map cannot hold: {b}" for b in self.beyond_map] or ["the map holds the records within "
@@ -317,13 +324,6 @@ def identify_boost(records, vehicle, case: str | None = None, surface: str | Non
     S_all = np.concatenate([f.torque_Nm for f in files])
     t_all = np.concatenate([f.time_s + 1e6 * k for k, f in enumerate(files)])
     sigma = np.concatenate([np.full(f.n, f.noise.total_rms) for f in files])
-    # The balance reads the assist through the logged torque, whose noise the map amplifies by its slope (the
-    # control unit acts on its own reading, not the logged noise): a sample's residual has the torque's noise times
-    # 1 + dD/dS, so it is weighted by that (errors in the variable the map reads).
-    h = 1e-4
-    slope = np.concatenate([(law(f.torque_Nm - fitted.centre + h) - law(f.torque_Nm - fitted.centre - h)) / (2 * h)
-                            for f in files]) * k_t * eta * reduction / scale
-    spread = sigma * (1.0 + np.abs(slope))
     back = np.concatenate([m * w < 0.0 for m, w in zip(motors, rotor)])
     turning = np.abs(np.concatenate(rotor)) > HELD_RAD_S
 
@@ -332,8 +332,15 @@ def identify_boost(records, vehicle, case: str | None = None, surface: str | Non
         return np.concatenate([directional_efficiency(m, w, eta, eta_b, v("limit_smoothing"), 1.0 / band)
                                * reduction * m / scale for m, w in zip(motors, rotor)])
 
-    def moving(band: float) -> np.ndarray:
-        return np.abs(pm.tanh(np.concatenate(rotor) / band)) >= MOVING_SIGN
+    # where the motion is defined: the smoothed rack's speed beyond the car-wide friction smoothing's band (its sign
+    # sure; nearer a reversal the spline's timing of it is not), whatever band the gear's friction has
+    sharpness = float(params["steering.friction_smoothing"])
+    use = np.concatenate([np.abs(pm.tanh(sharpness * rack_speed_mps(f.rack, f.time_s))) >= MOVING_SIGN
+                          for f in files])
+    split = (use & back).sum() >= BACK_DRIVEN_SHARE * use.sum()
+    if use.sum() < 20 * (len(MECHANICS) + 2):
+        raise UsageError(f"{', '.join(str(r) for r in records)}: the steering hardly moves: identify needs "
+                         "records in which the wheel turns (the column balance is read while the gear moves)")
 
     def road(changes: dict[str, float]):
         overrides = {**boost_off, **dict(zip(keys, theta)), **changes}
@@ -349,8 +356,8 @@ def identify_boost(records, vehicle, case: str | None = None, surface: str | Non
                    for key, value, (_, step) in zip(keys, theta, MECHANICS)]
         D = delivered(band)
         parts = [-D * ~back, -D * back] if split else [-D]
-        matrix = (np.column_stack([*columns, np.ones_like(S_all), *parts]) / spread[:, None])[use]
-        rhs = ((S_all - y0) / spread)[use]
+        matrix = (np.column_stack([*columns, np.ones_like(S_all), *parts]) / sigma[:, None])[use]
+        rhs = ((S_all - y0) / sigma)[use]
         solution = pm.lstsq(matrix, rhs)
         return y0, matrix, rhs, solution, rhs - pm.matmul(matrix, solution)
 
@@ -363,16 +370,12 @@ def identify_boost(records, vehicle, case: str | None = None, surface: str | Non
         for band in BAND_GRID:
             residual = balance(band, turning, split_all)[4]
             profile.append((band, float(residual @ residual)))
-        # the balance's RMS in noise floors at its best band: the weighted RSS per sample
-        holds = math.sqrt(min(r for _, r in profile) / turning.sum()) <= BALANCE_HOLDS_FLOORS
-        band_estimate = _band_estimate(profile, len(np.unique(_blocks(t_all[turning], BLOCK_S)))) if holds else None
+        band_estimate = _band_estimate(profile, len(np.unique(_blocks(t_all[turning], BLOCK_S))))
         band = band_estimate.value if band_estimate is not None else band_file
-        use = moving(band)
-        split = (use & back).sum() >= BACK_DRIVEN_SHARE * use.sum()
-        if use.sum() < 20 * (len(MECHANICS) + 2):
-            raise UsageError(f"{', '.join(str(r) for r in records)}: the steering hardly moves: identify needs "
-                             "records in which the wheel turns (the column balance is read while the gear moves)")
         y0, design, rhs, solution, resid = balance(band, use, split)
+        # the balance's RMS in noise floors where the motion is defined: the weighted RSS per sample
+        holds = math.sqrt(float(resid @ resid) / use.sum()) <= BALANCE_HOLDS_FLOORS
+        band_estimate = band_estimate if holds else None
         tyre_key, tyre_step = TYRE_FRICTION
         tyre_column = (road({f"{name}.friction_speed": band, tyre_key: float(params[tyre_key]) + tyre_step})
                        - y0) / tyre_step
@@ -383,7 +386,7 @@ def identify_boost(records, vehicle, case: str | None = None, surface: str | Non
     # only while the gear moves: at rest its friction and the direction of its power are not defined
     cov = _sandwich(design, resid, _blocks(t_all[use], BLOCK_S))
     # the product at the tyre friction moved by its step: the same fit on y0 + step x its column
-    moved = pm.lstsq(design, ((S_all - y0 - tyre_step * tyre_column) / spread)[use])
+    moved = pm.lstsq(design, ((S_all - y0 - tyre_step * tyre_column) / sigma)[use])
     se = np.sqrt(np.maximum(np.diag(cov), 0.0))
     values = theta + solution[: len(keys)]
     offset, p = float(solution[len(keys)]), float(solution[len(keys) + 1])
@@ -400,7 +403,7 @@ def identify_boost(records, vehicle, case: str | None = None, surface: str | Non
     z = _t95(len(np.unique(_blocks(t_all[use], BLOCK_S))) - design.shape[1])
     if split:
         back_efficiency = _estimate(eta_b * ratio, back_se, "1", z)
-    balance_rms = float(np.sqrt(np.mean((resid * spread[use]) ** 2)))
+    balance_rms = float(np.sqrt(np.mean((resid * sigma[use]) ** 2)))
     balance_floors = float(np.sqrt(np.mean(resid ** 2)))
     torque_noise = float(np.sqrt(np.mean(sigma ** 2)))
 
@@ -438,10 +441,9 @@ def identify_boost(records, vehicle, case: str | None = None, surface: str | Non
                       f"equal torsion-bar torque (+-{Z95 * fitted.hysteresis_se:.3f} A; {fitted.hysteresis_Nm:.4f} N m "
                       "of torque), a current that depends on the way the steering turns (outward or back)")
     if not holds:
-        beyond.append(f"the column balance: {balance_floors:.2f} noise floors RMS (the torque's noise through the "
-                      f"map's slope; more than {BALANCE_HOLDS_FLOORS:g}): the gear's numbers it "
-                      "would fix are not written, the file's kept (the table is the current map times the file's "
-                      "product k_t eta N)")
+        beyond.append(f"the column balance: {balance_floors:.2f} torque noise floors RMS (more than "
+                      f"{BALANCE_HOLDS_FLOORS:g}): the gear's numbers it would fix are not written, the file's kept (the "
+                      "table is the current map times the file's product k_t eta N)")
     if fitted.rms > 1.5 * fitted.noise and fitted.rms - fitted.noise > 0.5 * step_i:
         beyond.append(f"scatter: the current departs from the map by {fitted.rms:.3f} A RMS against {fitted.noise:.3f} "
                       "A of the channels' noise")
