@@ -102,27 +102,24 @@ def _sweep(params, effects: str, overrides: dict):
 
 def test_motor_friction_at_a_column_assist_is_a_column_friction_of_n_times_it(params):
     """Independent effects, one load: extra friction T_e on the rotor of a column assist turning at N times the
-    column is a torque N T_e on the column above the intermediate shaft. The two change over at a reversal on their
-    own bands (the motor's on the assist's ``friction_speed`` w of rotor speed, the column's on the car-wide friction
-    smoothing beta of the rack-equivalent speed): with w = N G_hr / beta, the same band, +assist_motor_friction at
-    T_e and +column_friction at N T_e give the same torsion-bar torque (within 1e-6 N m), and strength 0 gives the
-    assist alone exactly; at the assist's narrower default band the torque about the reversal is another (by more
-    than 1e-3 N m): the band is the assist's, not the car's."""
+    column is a torque N T_e on the column above the intermediate shaft, smoothed over the same rack-equivalent
+    speed as the column friction effect's (a candidate's drag has the car-wide friction shape); so
+    +assist_motor_friction at T_e and +column_friction at N T_e give the same torsion-bar torque (within 1e-6 N m),
+    and strength 0 gives the assist alone exactly. The assist's own motor friction changes over on the assist's own
+    band of rotor speed: moving that band from its default to the car-wide smoothing's width (N G_hr / beta) moves
+    the torque about the reversal (by more than 1e-3 N m)."""
     name = "electric_assist_column"
     n = next(q.default for q in discover_effects()[name].quantities if q.key == f"{name}.reduction_ratio")
-    same_band = {f"{name}.friction_speed": n * params["steering.handwheel_to_rack_ratio"]
-                 / params["steering.friction_smoothing"]}
-    motor = _sweep(params, f"+{name},+assist_motor_friction",
-                   {"assist_motor_friction.friction_torque": 0.05, **same_band})
-    column = _sweep(params, f"+{name},+column_friction", {"column_friction.friction_torque": n * 0.05, **same_band})
-    plain = _sweep(params, f"+{name}", same_band)
-    absent = _sweep(params, f"+{name},+assist_motor_friction",
-                    {"assist_motor_friction.friction_torque": 0.0, **same_band})
+    motor = _sweep(params, f"+{name},+assist_motor_friction", {"assist_motor_friction.friction_torque": 0.05})
+    column = _sweep(params, f"+{name},+column_friction", {"column_friction.friction_torque": n * 0.05})
+    plain = _sweep(params, f"+{name}", {})
+    absent = _sweep(params, f"+{name},+assist_motor_friction", {"assist_motor_friction.friction_torque": 0.0})
     assert np.max(np.abs(motor.torque_Nm - plain.torque_Nm)) > 0.05  # a real change
     assert np.max(np.abs(motor.torque_Nm - column.torque_Nm)) < 1e-6
     assert np.max(np.abs(absent.torque_Nm - plain.torque_Nm)) < 1e-9
-    narrow = _sweep(params, f"+{name},+assist_motor_friction", {"assist_motor_friction.friction_torque": 0.05})
-    assert np.max(np.abs(narrow.torque_Nm - motor.torque_Nm)) > 1e-3  # the band is the assist's own
+    wide = _sweep(params, f"+{name}", {f"{name}.friction_speed": n * params["steering.handwheel_to_rack_ratio"]
+                                       / params["steering.friction_smoothing"]})
+    assert np.max(np.abs(wide.torque_Nm - plain.torque_Nm)) > 1e-3
 
 
 def test_sensor_offset_and_gain_error_follow_the_linear_law(params):

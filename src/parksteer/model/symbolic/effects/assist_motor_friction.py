@@ -1,9 +1,9 @@
 """Extra Coulomb friction at an electric assist's motor: a candidate of the diagnosis of an assisted car.
 
 Mechanism. The motor's bearings, seals and worm (or ball nut) drag more than the assist's own
-``motor_friction_torque`` says (wear, a tight worm mesh, a dry seal): a torque T_e s(omega) opposing the
-rotor, reacted on the body, changing over at a reversal as the assist's own friction does (tanh(omega / w), w the
-assist's ``friction_speed`` of rotor speed omega). The
+``motor_friction_torque`` says (wear, a tight worm mesh, a dry seal): a torque T_e tanh(beta v) opposing the
+rotor, reacted on the body, v the rack speed the rotor's speed corresponds to (the car-wide friction smoothing
+beta, the shape of every friction candidate: a drag of unknown cause, not the assist's own band). The
 rotor turns at N dx/dt (x the point of action, N the reduction), so at x the friction is N T_e: at a column assist
 a torque on the column above the intermediate shaft, the same load as a column friction of N T_e there; at a
 pinion or rack assist a force on the rack N T_e G_hr or N T_e, the same as a rack friction. The motor's current
@@ -16,6 +16,8 @@ Strength 0 is no extra friction, exactly. Requires an electric assist in the set
 """
 
 from __future__ import annotations
+
+import sympy as sp
 
 from ....errors import UsageError
 from ....parameters import Quantity
@@ -36,7 +38,7 @@ def electric_assist_of(model, who: str):
 
 class AssistMotorFriction(Effect):
     name = NAME
-    description = ("Extra Coulomb friction of an electric assist's motor, -T_e tanh(omega / w) on the rotor (N T_e at "
+    description = ("Extra Coulomb friction of an electric assist's motor, -T_e tanh(beta v) on the rotor (N T_e at "
                    "the point of action); 0 = absent")
     in_default_set = False
     diagnosis_candidate = False  # not a candidate of a car without assist
@@ -47,14 +49,20 @@ class AssistMotorFriction(Effect):
                         "worm gears 0.01-0.05 N m new (Harrer & Pfeffer, Steering Handbook, ch. 8.6), up to several "
                         "times that worn; 0 = absent"),
     )
-    uses = (f"{NAME}.friction_torque",)
+    uses = (f"{NAME}.friction_torque", "steering.friction_smoothing", "steering.handwheel_to_rack_ratio")
 
     def loads(self, model):
         assist = electric_assist_of(model, NAME)
         k = model.kinematics
         frame = assist._motor_frame(model)  # the rotor's frame, turning at N dx/dt (electric_assist.py)
-        # the motor's own band: tanh(rotor speed / the assist's friction_speed), as the assist's friction
-        friction = model.p(f"{NAME}.friction_torque") * assist.friction_sign(model)
+        ratio = model.p("steering.handwheel_to_rack_ratio")
+        if assist.location == "column":
+            rack_speed = k.column_rate / ratio
+        elif assist.location == "pinion":
+            rack_speed = model.rack_u
+        else:
+            rack_speed = model.rack_u
+        friction = model.p(f"{NAME}.friction_torque") * sp.tanh(model.p("steering.friction_smoothing") * rack_speed)
         return torque_between(-friction, k.B.y, frame, k.B)
 
 
