@@ -34,10 +34,10 @@ Two steps, each a least-squares fit with its 95 % intervals:
    fitted: it scales the road torque as p scales the assist, and S, their small difference, cannot tell them
    apart; the product's change per step of it is reported.
 
-3. **The band** of rotor speed over which the motor's friction and the worm's direction change over at a reversal
-   (the assist's ``friction_speed``): the balance solved over every sample where the gear turns, reversals
-   included, at each width of :data:`BAND_GRID`; the width of least misfit, where the profile rises beyond
-   chi-square's 95 % level either side (:func:`_band_estimate`), else not fixed.
+The band of rotor speed over which the motor's friction and the worm's direction change over at a reversal (the
+assist's ``friction_speed``) is the file's: the balance read across the reversals does not fix it from the
+records of a bus (the smoothed rack places a reversal no finer than about 1 mm/s of the rack, and a narrower band
+reads wider than it is); the diagnosis replays it at its band's ends (stage ``assumed``).
 
 Intervals are the least squares' with the residuals' correlation in time left in (a sandwich over blocks of
 :data:`BLOCK_S`, with Student's t for its blocks): a record of a few cycles fixes less than its sample count says.
@@ -47,9 +47,8 @@ map's centre the torque's rounding (the map between two readings is never seen);
 relative, since it is read through the map. The identified table is the map
 times the identified product, P K(S - c), at the point of action; the written file carries it in ``[assist.boost]``
 and the product as the torque constant k_t = P / (eta_f N) (only the product is fixed: eta_f and N stay the file's),
-and the motor friction; each entry's ``source`` names the records. A number of the gear is written only where the
-balance holds the records (:data:`BALANCE_HOLDS_FLOORS`), the number is physical and its interval excludes the
-file's value; otherwise the file's stays (:attr:`Identified.kept`). The sensor offset and the map's centre have no
+and the motor friction; each entry's ``source`` names the records. A number of the gear is written only where it is
+physical and its interval excludes the file's value; otherwise the file's stays (:attr:`Identified.kept`). The sensor offset and the map's centre have no
 place in a vehicle file (the model's law is odd about the reading's zero): they are reported, and a later
 diagnosis that names an offset of the same size names the baseline's.
 """
@@ -85,21 +84,6 @@ BACK_DRIVEN_SHARE = 0.03
 TYRE_FRICTION = ("tyre.friction_coefficient", 0.05)
 # The column balance is read where the gear moves: the friction's smooth sign tanh(beta v) at least this.
 MOVING_SIGN = 0.95
-# The band of rotor speed (rad/s) over which the motor's friction and the gear's direction change over at a reversal
-# (the assist's friction_speed) is read off the column balance at these widths, a factor 2 apart: from a tenth of
-# the car-wide friction smoothing's width at a column worm (2.25 rad/s of the rotor: 1 mm/s of the rack at N = 18,
-# G_hr = 125 rad/m) to twice it.
-BAND_GRID = (0.125, 0.25, 0.5, 1.0, 2.0, 4.0)
-# The column balance fixes the gear's numbers only where it holds the records: its RMS (over every sample where the
-# gear turns, at its best band) within this many torque noise floors. Beyond, its residual is not the torque's noise
-# but what the balance leaves out (the car's own parameters, which a diagnosis calibrates and this step does not; a
-# logged torque noisier than the reading the control unit acts on, which the map's slope amplifies in the assist
-# read from it): its numbers are not the gear's, the file's values are kept and the report says so. Three floors:
-# a residual three times the noise is no longer noise at any of the records' lengths (tens of blocks).
-BALANCE_HOLDS_FLOORS = 3.0
-CHI2_95 = 3.841  # the 95 % quantile of chi-square with one degree of freedom
-# A rotor slower than this (rad/s) is at rest: the smoothed rack is held constant where the hand pauses.
-HELD_RAD_S = 1.0e-6
 # A residual shape counts as beyond the noise at this many of its standard errors.
 BEYOND_SE = 4.0
 
@@ -136,8 +120,6 @@ class Identified:
     balance_rms_Nm: float
     torque_noise_Nm: float
     beyond_map: tuple[str, ...]
-    friction_speed: Estimate | None = None  # the band (rad/s of the rotor); None: the records do not fix it
-    balance_holds: bool = True  # False: the column balance does not hold the records; the file's gear kept
     balance_floors: float = math.nan  # the balance's RMS in torque noise floors
     kept: tuple[str, ...] = ()  # the file's values the written file keeps: the records do not contradict them
     file_values: dict = field(default_factory=dict)
@@ -146,9 +128,8 @@ class Identified:
         est = {k: getattr(self, k).as_dict() for k in ("dead_band", "map_centre", "product", "motor_friction",
                                                          "motor_inertia", "offset", "rack_friction", "hysteresis_A")}
         est["back_efficiency"] = None if self.back_efficiency is None else self.back_efficiency.as_dict()
-        est["friction_speed"] = None if self.friction_speed is None else self.friction_speed.as_dict()
         return {"vehicle": self.vehicle, "records": list(self.records), "assist": self.assist_name,
-                "balance_holds": self.balance_holds, "balance_floors": self.balance_floors, "kept": list(self.kept),
+                "balance_floors": self.balance_floors, "kept": list(self.kept),
                 "table": {"torsion_bar_torque_Nm": list(self.torques), "assist": list(self.assist),
                           "assist_ci95": [list(c) for c in self.assist_ci95], "current_A": list(self.current_A),
                           "current_ci95": [list(c) for c in self.current_ci95]},
@@ -179,9 +160,6 @@ class Identified:
                   ("back-driven efficiency " + (self.back_efficiency.text() if self.back_efficiency is not None
                                                 else "not fixed (too few back-driven samples)")
                    + f" (file: {self.file_values.get('back_efficiency', float('nan')):.4g})"),
-                  ("friction and direction band " + (self.friction_speed.text() if self.friction_speed is not None
-                                                     else "not fixed (the balance is flat across the widths tried)")
-                   + f" of rotor speed (file: {self.file_values.get('friction_speed', float('nan')):.4g} rad/s)"),
                   f"torsion-bar offset {self.offset.text()}",
                   f"rack friction {self.rack_friction.text()}",
                   f"map residual RMS {self.map_rms_A:.3f} A against {self.map_noise_A:.3f} A of noise; hysteresis "
@@ -200,31 +178,6 @@ class Identified:
         from .identified_file import replace_assist_section
 
         return replace_assist_section(text, self)
-
-
-def _band_estimate(profile: list[tuple[float, float]], blocks: int) -> Estimate | None:
-    """The band at the least weighted RSS of the column balance over `profile` [(band, RSS)], with the range of
-    bands whose RSS lies within the 95 % quantile of chi-square with one degree of freedom, counted in blocks (the
-    residuals correlate within a block: the RSS per block is the unit; geometric interpolation between the grid's
-    widths). None when the profile is flat to that level: the records do not fix the band."""
-    bands = np.array([b for b, _ in profile])
-    rss = np.array([r for _, r in profile])
-    best = int(np.argmin(rss))
-    rise = (rss - rss[best]) * blocks / rss[best]  # in units of one block's RSS
-    if np.all(rise <= CHI2_95):
-        return None
-    logs = np.log(bands)
-
-    def edge(direction: int) -> float:
-        k = best
-        while 0 <= k + direction < len(bands) and rise[k + direction] <= CHI2_95:
-            k += direction
-        if not 0 <= k + direction < len(bands):
-            return float(bands[k])  # the grid's end: at most (least) this
-        f = (CHI2_95 - rise[k]) / (rise[k + direction] - rise[k])
-        return float(np.exp(logs[k] + f * (logs[k + direction] - logs[k])))
-
-    return Estimate(float(bands[best]), (edge(-1), edge(1)), "rad/s")
 
 
 def _files(records, params, case, surface, channel_map, name) -> list[FileData]:
@@ -325,7 +278,6 @@ def identify_boost(records, vehicle, case: str | None = None, surface: str | Non
     t_all = np.concatenate([f.time_s + 1e6 * k for k, f in enumerate(files)])
     sigma = np.concatenate([np.full(f.n, f.noise.total_rms) for f in files])
     back = np.concatenate([m * w < 0.0 for m, w in zip(motors, rotor)])
-    turning = np.abs(np.concatenate(rotor)) > HELD_RAD_S
 
     def delivered(band: float) -> np.ndarray:
         """What the file's gear delivers for the identified current, its direction changing over `band`."""
@@ -361,21 +313,11 @@ def identify_boost(records, vehicle, case: str | None = None, surface: str | Non
         solution = pm.lstsq(matrix, rhs)
         return y0, matrix, rhs, solution, rhs - pm.matmul(matrix, solution)
 
-    band_file = v("friction_speed")
+    band = v("friction_speed")
     say("identify: the column balance on the car's replay")
     try:
-        # the band: the balance over every sample where the gear turns, reversals included (where the band acts)
-        split_all = (turning & back).sum() >= BACK_DRIVEN_SHARE * turning.sum()
-        profile = []
-        for band in BAND_GRID:
-            residual = balance(band, turning, split_all)[4]
-            profile.append((band, float(residual @ residual)))
-        band_estimate = _band_estimate(profile, len(np.unique(_blocks(t_all[turning], BLOCK_S))))
-        band = band_estimate.value if band_estimate is not None else band_file
         y0, design, rhs, solution, resid = balance(band, use, split)
         # the balance's RMS in noise floors where the motion is defined: the weighted RSS per sample
-        holds = math.sqrt(float(resid @ resid) / use.sum()) <= BALANCE_HOLDS_FLOORS
-        band_estimate = band_estimate if holds else None
         tyre_key, tyre_step = TYRE_FRICTION
         tyre_column = (road({f"{name}.friction_speed": band, tyre_key: float(params[tyre_key]) + tyre_step})
                        - y0) / tyre_step
@@ -410,8 +352,8 @@ def identify_boost(records, vehicle, case: str | None = None, surface: str | Non
     # the table at the point of action: P K, its interval from the map's and the product's
     # What the written file takes from the balance: each number the file's value (a data sheet's or an assumed one)
     # unless the number's 95 % interval excludes it; the file's kept too where the estimate is no physical value (a
-    # friction or an inertia below zero: the balance's misfit, not the gear's), and everywhere when the balance does
-    # not hold. (value, interval's low, high, the file's value) by key:
+    # friction or an inertia below zero: the balance's misfit, not the gear's). (value, interval's low, high, the
+    # file's value) by key:
     judged = {
         "torque_constant": (p * product_file, (p - z * se_p) * product_file, (p + z * se_p) * product_file,
                             product_file),
@@ -421,7 +363,7 @@ def identify_boost(records, vehicle, case: str | None = None, surface: str | Non
     if back_efficiency is not None:
         judged["back_efficiency"] = (back_efficiency.value, *back_efficiency.ci95, eta_b)
     kept = [key for key, (value, lo, hi, file_value) in judged.items()
-            if not holds or lo <= file_value <= hi or value < 0.0]
+            if lo <= file_value <= hi or value < 0.0]
     # the product the table is written with: the balance's, or the file's where it is kept
     P = product_file if "torque_constant" in kept else p * product_file
     point_cov = pm.matmul(pm.matmul(fitted.jacobian_values, fitted.covariance), fitted.jacobian_values.T) \
@@ -440,10 +382,6 @@ def identify_boost(records, vehicle, case: str | None = None, surface: str | Non
         beyond.append(f"hysteresis: the current on loading is {fitted.hysteresis:+.3f} A from that on unloading at "
                       f"equal torsion-bar torque (+-{Z95 * fitted.hysteresis_se:.3f} A; {fitted.hysteresis_Nm:.4f} N m "
                       "of torque), a current that depends on the way the steering turns (outward or back)")
-    if not holds:
-        beyond.append(f"the column balance: {balance_floors:.2f} torque noise floors RMS (more than "
-                      f"{BALANCE_HOLDS_FLOORS:g}): the gear's numbers it would fix are not written, the file's kept (the "
-                      "table is the current map times the file's product k_t eta N)")
     if fitted.rms > 1.5 * fitted.noise and fitted.rms - fitted.noise > 0.5 * step_i:
         beyond.append(f"scatter: the current departs from the map by {fitted.rms:.3f} A RMS against {fitted.noise:.3f} "
                       "A of the channels' noise")
@@ -471,9 +409,9 @@ def identify_boost(records, vehicle, case: str | None = None, surface: str | Non
         map_rms_A=fitted.rms, map_noise_A=fitted.noise,
         hysteresis_A=_estimate(fitted.hysteresis, fitted.hysteresis_se, "A"), hysteresis_Nm=float(fitted.hysteresis_Nm),
         balance_rms_Nm=balance_rms, torque_noise_Nm=torque_noise, beyond_map=tuple(beyond),
-        friction_speed=band_estimate, balance_holds=holds, balance_floors=balance_floors, kept=tuple(kept),
+        balance_floors=balance_floors, kept=tuple(kept),
         file_values={"product": product_file, "motor_friction_torque": v("motor_friction_torque"),
-                     "motor_inertia": v("motor_inertia"), "back_efficiency": eta_b, "friction_speed": band_file,
+                     "motor_inertia": v("motor_inertia"), "back_efficiency": eta_b,
                      "efficiency": eta, "reduction_ratio": reduction, "torque_constant": k_t},
     )
 

@@ -41,10 +41,8 @@ def replace_assist_section(text: str, found) -> str:
                                         ("motor_friction_torque", "the motor's friction"),
                                         ("motor_inertia", "the rotor's inertia"),
                                         ("back_efficiency", "the back-driven efficiency"))
-               if found.balance_holds and key not in found.kept
+               if key not in found.kept
                and (key != "back_efficiency" or found.back_efficiency is not None)]
-    if found.friction_speed is not None and found.balance_holds:
-        written.append("the band its friction and direction change over")
     own = "; the file's own " + ", ".join(found.kept) if found.kept else ""
     lines = ["", "# Power assistance: the gear's data as the file gave them; the boost table"
              + "".join(f", {w}" for w in written), f"# {where}{own}.",
@@ -55,7 +53,7 @@ def replace_assist_section(text: str, found) -> str:
              *(f"# The map cannot hold: {b}" for b in found.beyond_map),
              "[assist]", f"type = {_toml_string(old.get('type', 'column'))}"]
     k_t = found.product.value / (found.file_values["efficiency"] * found.file_values["reduction_ratio"])
-    replaced = {} if not found.balance_holds else {
+    replaced = {
         "torque_constant": (k_t, "N m/A", f"{where}: the product k_t eta N = {found.product.text()} through the "
                                           f"file's efficiency and reduction (only the product is fixed); the file "
                                           f"gave {found.file_values['torque_constant']:g}"),
@@ -66,11 +64,7 @@ def replace_assist_section(text: str, found) -> str:
                           f"{where}: {found.motor_inertia.text()} (the column balance; the file gave "
                           f"{found.file_values['motor_inertia']:g})"),
     }
-    if found.friction_speed is not None and found.balance_holds:
-        replaced["friction_speed"] = (found.friction_speed.value, "rad/s",
-                                      f"{where}: {found.friction_speed.text()} (the column balance across the "
-                                      f"reversals; the file gave {found.file_values['friction_speed']:g})")
-    if found.back_efficiency is not None and found.balance_holds:
+    if found.back_efficiency is not None:
         replaced["back_efficiency"] = (min(max(found.back_efficiency.value, 0.5), 0.99), "1",
                                        f"{where}: {found.back_efficiency.text()} (the column balance on the "
                                        f"back-driven samples; the file gave {found.file_values['back_efficiency']:g})")
