@@ -48,7 +48,8 @@ relative, since it is read through the map. The identified table is the map
 times the identified product, P K(S - c), at the point of action; the written file carries it in ``[assist.boost]``
 and the product as the torque constant k_t = P / (eta_f N) (only the product is fixed: eta_f and N stay the file's),
 and the motor friction; each entry's ``source`` names the records. A number of the gear is written only where it is
-physical and its interval excludes the file's value; otherwise the file's stays (:attr:`Identified.kept`). The sensor offset and the map's centre have no
+physical and its interval excludes the file's value (a data sheet's even widened by the tyre-ground friction's
+step); otherwise the file's stays (:attr:`Identified.kept`). The sensor offset and the map's centre have no
 place in a vehicle file (the model's law is odd about the reading's zero): they are reported, and a later
 diagnosis that names an offset of the same size names the baseline's.
 """
@@ -350,20 +351,31 @@ def identify_boost(records, vehicle, case: str | None = None, surface: str | Non
     torque_noise = float(np.sqrt(np.mean(sigma ** 2)))
 
     # the table at the point of action: P K, its interval from the map's and the product's
-    # What the written file takes from the balance: each number the file's value (a data sheet's or an assumed one)
-    # unless the number's 95 % interval excludes it; the file's kept too where the estimate is no physical value (a
-    # friction or an inertia below zero: the balance's misfit, not the gear's). (value, interval's low, high, the
-    # file's value) by key:
+    # What the written file takes from the balance: each number the file's value unless the number's 95 % interval
+    # excludes it, and the file's kept where the estimate is no physical value (a friction or an inertia below zero:
+    # the balance's misfit, not the gear's). A value the file gives from a data sheet (its source not assumed) is
+    # evidence of its own: it stands unless the interval excludes it even widened by what the tyre-ground friction's
+    # step moves the number (the balance cannot tell that friction from the gear, and a diagnosis calibrates it).
+    # (value, interval's low, high, the file's value, the tyre step's move) by key:
+    shift = np.abs(np.asarray(moved) - np.asarray(solution))
     judged = {
         "torque_constant": (p * product_file, (p - z * se_p) * product_file, (p + z * se_p) * product_file,
-                            product_file),
-        "motor_friction_torque": (values[0], values[0] - z * se[0], values[0] + z * se[0], v("motor_friction_torque")),
-        "motor_inertia": (values[1], values[1] - z * se[1], values[1] + z * se[1], v("motor_inertia")),
+                            product_file, shift[len(keys) + 1] * product_file),
+        "motor_friction_torque": (values[0], values[0] - z * se[0], values[0] + z * se[0], v("motor_friction_torque"),
+                                  shift[0]),
+        "motor_inertia": (values[1], values[1] - z * se[1], values[1] + z * se[1], v("motor_inertia"), shift[1]),
     }
     if back_efficiency is not None:
-        judged["back_efficiency"] = (back_efficiency.value, *back_efficiency.ci95, eta_b)
-    kept = [key for key, (value, lo, hi, file_value) in judged.items()
-            if lo <= file_value <= hi or value < 0.0]
+        moved_eta_b = eta_b * float(moved[len(keys) + 1]) / float(moved[len(keys) + 2])
+        judged["back_efficiency"] = (back_efficiency.value, *back_efficiency.ci95, eta_b,
+                                     abs(moved_eta_b - back_efficiency.value))
+
+    def given(key: str) -> bool:
+        return not params.sources.get(f"{name}.{key}", "assumed").startswith(
+            ("assumed", "numerical", "the effect's default"))
+
+    kept = [key for key, (value, lo, hi, file_value, move) in judged.items()
+            if value < 0.0 or (lo - (move if given(key) else 0.0)) <= file_value <= (hi + (move if given(key) else 0.0))]
     # the product the table is written with: the balance's, or the file's where it is kept
     P = product_file if "torque_constant" in kept else p * product_file
     point_cov = pm.matmul(pm.matmul(fitted.jacobian_values, fitted.covariance), fitted.jacobian_values.T) \
