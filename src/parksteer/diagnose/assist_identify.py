@@ -374,8 +374,11 @@ def identify_boost(records, vehicle, case: str | None = None, surface: str | Non
         return not params.sources.get(f"{name}.{key}", "assumed").startswith(
             ("assumed", "numerical", "the effect's default"))
 
-    kept = [key for key, (value, lo, hi, file_value, move) in judged.items()
-            if value < 0.0 or (lo - (move if given(key) else 0.0)) <= file_value <= (hi + (move if given(key) else 0.0))]
+    kept = []
+    for key, (value, lo, hi, file_value, move) in judged.items():
+        wide = move if given(key) else 0.0
+        if value < 0.0 or lo - wide <= file_value <= hi + wide:
+            kept.append(key)
     # the product the table is written with: the balance's, or the file's where it is kept
     P = product_file if "torque_constant" in kept else p * product_file
     point_cov = pm.matmul(pm.matmul(fitted.jacobian_values, fitted.covariance), fitted.jacobian_values.T) \
