@@ -106,8 +106,8 @@ FRICTION_SPEED_SOURCE = (
     "assumed: narrower than a 100 Hz bus resolves at a parking reversal, 0.1-2.25 rad/s: a column worm's rotor "
     "(N = 18, G_hr = 125 rad/m: 2250 rad/s of rotor per m/s of rack) crosses +-0.5 rad/s within one 10 ms sample "
     "wherever the rack reverses at more than 0.045 m/s^2, so a narrower band reads the same; the car-wide friction "
-    "smoothing's width, 1 mm/s of the rack, is 2.25 rad/s of this rotor; parksteer assist identify reads it from "
-    "the column balance across the reversals where that holds")
+    "smoothing's width, 1 mm/s of the rack, is 2.25 rad/s of this rotor; no data sheet gives it, and a diagnosis "
+    "replays its band's ends (stage assumed)")
 
 _BACK_EFFICIENCY = {
     "column": (0.80, "assumed: back-driven worm gear, 0.75-0.85: tan(lambda - rho) / tan(lambda) for the lead angle "
