@@ -301,8 +301,9 @@ def identify_boost(records, vehicle, case: str | None = None, surface: str | Non
                                for k, f in enumerate(files)])
 
     def balance(band: float, use: np.ndarray, split: bool):
-        """(y0, the parameters' columns, the design matrix's D parts, solution, residual) of the column balance
-        with the motor's friction and the gear's direction changing over `band`, on the samples `use`."""
+        """(y0, the weighted design matrix, its right-hand side, the solution, the residual) of the column balance
+        with the motor's friction and the gear's direction changing over `band` (rotor rad/s), on the samples
+        `use`."""
         band_key = {f"{name}.friction_speed": band}
         y0 = road(band_key)
         columns = [(road({**band_key, key: value + step}) - y0) / step
@@ -318,7 +319,6 @@ def identify_boost(records, vehicle, case: str | None = None, surface: str | Non
     say("identify: the column balance on the car's replay")
     try:
         y0, design, rhs, solution, resid = balance(band, use, split)
-        # the balance's RMS in noise floors where the motion is defined: the weighted RSS per sample
         tyre_key, tyre_step = TYRE_FRICTION
         tyre_column = (road({f"{name}.friction_speed": band, tyre_key: float(params[tyre_key]) + tyre_step})
                        - y0) / tyre_step
