@@ -3,23 +3,26 @@ with it.
 
 The assisted benchmark on an independent truth (parksteer.experiments.assisted_truth) diagnoses its records with
 the owner's file: the gear's data sheet and the map point by point, the motor's friction at the template's assumed
-0.02 N m. The truth's own rotor friction is 0.012 N m, Coulomb saturated linearly below 1 rad/s of the rotor, and its
-worm passes from driving to back-driven over the same 1 rad/s (0.4 mm/s of the rack); the model's frictions and its
-gear's direction pass over tanh(1000 s/m x rack speed), about 1 mm/s of the rack (2.25 rad/s of this rotor). The
-rungs change the truth, not the file, one owner-unknown at a time:
+0.02 N m and the band its friction and the worm's direction change over at the assumed ``friction_speed`` (rad/s
+of the rotor; the model's tanh(rotor speed / w)). The truth's own rotor friction is 0.012 N m, Coulomb saturated
+linearly below 1 rad/s of the rotor, and its worm passes from driving to back-driven over the same 1 rad/s (0.4 mm/s
+of the rack); the car-wide friction smoothing, tanh(1000 s/m x rack speed), is about 1 mm/s of the rack (2.25 rad/s of
+this rotor). The rungs change the truth, not the file, one owner-unknown at a time:
 
 - ``as_is``: the benchmark's truth;
 - ``friction``: the truth's rotor friction the file's 0.02 N m;
-- ``band``: the truth's friction and direction band 2.25 rad/s (as wide as the model's smoothing);
+- ``band``: the truth's friction and direction band 2.25 rad/s (as wide as the car-wide smoothing);
 - ``both``: both;
 - ``model``: the nulls made by the model's own assisted replay (the Polo file's assist, its table) on the same hands,
   logged by the same loggers (rack, or the handwheel angle through the column and the torsion bar in series), and
   diagnosed with the Polo file: what the method does when the file is the truth.
 
 Each rung diagnoses the same cases (nulls on the benchmark's eight hands, the four hidden candidates at 4 floors on
-one hand; `--tiers rack,angle`), about 5 s a case. Run:
+one hand; `--tiers rack,angle`), about 5 s a case; `--routes map,identified` diagnoses each also with the file
+`parksteer assist identify` writes from the tier's baseline record, `--outclass` adds the four out-of-class forms at 3
+floors (the bar of the owner's routes: `--rungs as_is --routes map,identified --outclass`). Run:
 
-    PYTHONPATH=src python benchmarks/bench_assisted_truth_ladder.py [--tiers rack] [out.json]
+    PYTHONPATH=src python benchmarks/bench_assisted_truth_ladder.py [--tiers rack] [--routes map] [out.json]
 """
 
 from __future__ import annotations
@@ -48,12 +51,15 @@ def main(argv=None) -> int:
     parser.add_argument("out", nargs="?")
     parser.add_argument("--tiers", default="rack,angle")
     parser.add_argument("--rungs", default="as_is,friction,band,both,model")
+    parser.add_argument("--routes", default="map", help="the files diagnosed with: map, identified or both")
+    parser.add_argument("--outclass", action="store_true", help="also the four out-of-class forms at 3 floors")
     args = parser.parse_args(argv)
     discover_effects()
     vehicle = ROOT / "data" / "vehicles" / "polo_vi.toml"
     params = load_vehicle(vehicle)
     base = TruthDesign(tiers=tuple(args.tiers.split(",")), hidden_variations=("uneven_strokes",), floors=(4.0,),
-                       out_of_class_variations=())
+                       out_of_class_variations=("uneven_strokes",) if args.outclass else (),
+                       routes=tuple(args.routes.split(",")))
     out = {}
     for name in args.rungs.split(","):
         if name == "model":
@@ -63,15 +69,19 @@ def main(argv=None) -> int:
             continue
         design = replace(base, gear=rungs(base.gear)[name])
         rows, summary = run(params, vehicle, design)
-        out[name] = {tier: {"named": s["targets"]["named"]["count"],
-                            "null_adequate": s["targets"]["null_adequate"]["count"],
-                            "false_alarms": [f"{a['name']}: {a['verdict']} {a['effect']}" for a in s["false_alarms"]],
-                            "missed": [f"{m['name']}: {m['verdict']} {m['effect']}" for m in s["missed"]]}
-                     for tier, s in summary["routes"]["map"].items()}
-        for tier, s in out[name].items():
-            print(f"{name:9s} {tier:6s} named {s['named'][0]}/{s['named'][1]}  nulls adequate "
-                  f"{s['null_adequate'][0]}/{s['null_adequate'][1]}  false alarms: {'; '.join(s['false_alarms'])}",
-                  flush=True)
+        out[name] = {route: {tier: {
+            "named": s["targets"]["named"]["count"], "null_adequate": s["targets"]["null_adequate"]["count"],
+            "out_of_class_not_named": s["out_of_class_not_named"],
+            "confident_wrong": s["targets"]["confident_wrong_out_of_class"]["value"],
+            "false_alarms": [f"{a['name']}: {a['verdict']} {a['effect']}" for a in s["false_alarms"]],
+            "missed": [f"{m['name']}: {m['verdict']} {m['effect']}" for m in s["missed"]]}
+            for tier, s in tiers.items()} for route, tiers in summary["routes"].items()}
+        for route, tiers in out[name].items():
+            for tier, s in tiers.items():
+                print(f"{name:9s} {route:10s} {tier:6s} named {s['named'][0]}/{s['named'][1]}  nulls adequate "
+                      f"{s['null_adequate'][0]}/{s['null_adequate'][1]}  out of class not named "
+                      f"{s['out_of_class_not_named'][0]}/{s['out_of_class_not_named'][1]}  confident wrong "
+                      f"{s['confident_wrong']}  false alarms: {'; '.join(s['false_alarms'])}", flush=True)
     if args.out:
         Path(args.out).write_text(json.dumps(out, indent=1), encoding="utf-8")
     return 0

@@ -144,3 +144,20 @@ def test_a_record_in_memory_is_its_file(baseline):
     again = identify_boost([load_record(path, None, params=load_vehicle(et.POLO))], et.POLO)
     assert again.product == found.product and again.motor_friction == found.motor_friction
     assert again.assist == found.assist and again.records == found.records
+
+
+def test_what_the_balance_does_not_fix_is_not_written(baseline, tmp_path):
+    """A number of the gear whose 95 % interval holds the file's value is not written: with the file's rotor inertia
+    set to the truth's (3e-4 kg m^2 against the shipped 2e-4, which the records contradict), the identified file
+    keeps the file's entry as the file gave it (its source still the file's), and the band of the motor's friction,
+    which a bus's records do not fix, stays the file's."""
+    truth, path, found = baseline
+    text = et.POLO.read_text(encoding="utf-8")
+    vehicle = tmp_path / "polo.toml"
+    vehicle.write_text(text.replace("motor_inertia = { value = 0.0002,", "motor_inertia = { value = 0.0003,"),
+                       encoding="utf-8")
+    again = identify_boost([path], vehicle)
+    assert "motor_inertia" in again.kept and "motor_inertia" not in found.kept
+    written = tomllib.loads(again.to_vehicle_toml(vehicle.read_text(encoding="utf-8")))["assist"]
+    assert written["motor_inertia"]["source"].startswith("assumed")
+    assert "friction_speed" not in written or written["friction_speed"]["source"].startswith("assumed")

@@ -21,7 +21,9 @@ POLO = ROOT / "data" / "vehicles" / "polo_vi.toml"
 def test_owner_file_holds_the_map_at_its_points_and_assumes_the_motor_friction(tmp_path):
     """The owner's file is what an owner has: the control unit's map at the design's points (a progressive
     power law 3.9 (|T| - 0.4)^1.6 here: 0 in the dead band, 3.9 x 0.4^1.6 = 0.900 N m at 0.8 N m), the gear's data
-    sheet, and the motor friction no data sheet gives left at the template's assumed default, not the truth's."""
+    sheet, and the motor friction no data sheet gives left at the template's assumed default, not the truth's; so is
+    the band of rotor speed over which that friction and the worm's direction change over at a reversal (the
+    truth's is 1 rad/s)."""
     discover_effects()
     design = TruthDesign()
     params = vehicle_from_text(owner_vehicle_text(POLO.read_text(encoding="utf-8"), design), tmp_path / "o.toml")
@@ -35,6 +37,8 @@ def test_owner_file_holds_the_map_at_its_points_and_assumes_the_motor_friction(t
     assert params[f"{name}.motor_torque_limit"] == pytest.approx(4.0)
     assert params[f"{name}.motor_friction_torque"] != design.gear.motor_friction_Nm
     assert params.sources[f"{name}.motor_friction_torque"].startswith("assumed")
+    assert params[f"{name}.friction_speed"] != design.gear.friction_speed_rad_s
+    assert params.sources[f"{name}.friction_speed"].startswith("assumed")
 
 
 def test_a_case_kept_by_the_default_grid_is_the_full_grids_case():

@@ -9,7 +9,7 @@ from scipy.interpolate import BPoly, PPoly
 
 from parksteer.boost_table import entries
 from parksteer.measure.smoothing import RackSpline
-from parksteer.model.numeric.assisted import solve_assisted
+from parksteer.model.numeric.assisted import BoostLaw, solve_assisted
 from parksteer.model.numeric.simulate import prepare, simulate
 from parksteer.model.symbolic.components import discover_effects
 
@@ -127,8 +127,11 @@ def _sweep(params, effects: str, overrides: dict):
 def test_motor_friction_at_a_column_assist_is_a_column_friction_of_n_times_it(params):
     """Independent effects, one load: extra friction T_e on the rotor of a column assist turning at N times the
     column is a torque N T_e on the column above the intermediate shaft, smoothed over the same rack-equivalent
-    speed as the column friction effect's; so +assist_motor_friction at T_e and +column_friction at N T_e give the
-    same torsion-bar torque (within 1e-6 N m), and strength 0 gives the assist alone exactly."""
+    speed as the column friction effect's (a candidate's drag has the car-wide friction shape); so
+    +assist_motor_friction at T_e and +column_friction at N T_e give the same torsion-bar torque (within 1e-6 N m),
+    and strength 0 gives the assist alone exactly. The assist's own motor friction changes over on the assist's own
+    band of rotor speed: moving that band from its default to the car-wide smoothing's width (N G_hr / beta) moves
+    the torque about the reversal (by more than 1e-3 N m)."""
     name = "electric_assist_column"
     n = next(q.default for q in discover_effects()[name].quantities if q.key == f"{name}.reduction_ratio")
     motor = _sweep(params, f"+{name},+assist_motor_friction", {"assist_motor_friction.friction_torque": 0.05})
@@ -138,6 +141,9 @@ def test_motor_friction_at_a_column_assist_is_a_column_friction_of_n_times_it(pa
     assert np.max(np.abs(motor.torque_Nm - plain.torque_Nm)) > 0.05  # a real change
     assert np.max(np.abs(motor.torque_Nm - column.torque_Nm)) < 1e-6
     assert np.max(np.abs(absent.torque_Nm - plain.torque_Nm)) < 1e-9
+    wide = _sweep(params, f"+{name}", {f"{name}.friction_speed": n * params["steering.handwheel_to_rack_ratio"]
+                                       / params["steering.friction_smoothing"]})
+    assert np.max(np.abs(wide.torque_Nm - plain.torque_Nm)) > 1e-3
 
 
 def test_sensor_offset_and_gain_error_follow_the_linear_law(params):
@@ -159,3 +165,20 @@ def test_sensor_offset_and_gain_error_follow_the_linear_law(params):
     assert np.max(np.abs(offset.torque_Nm - (y + 0.3) / (1 + gain))) < 1e-4
     assert np.max(np.abs(error.torque_Nm - y / (1 + gain * 1.25))) < 1e-4
     assert np.max(np.abs(offset.road_torque_Nm - y)) < 1e-9  # law-side: the mechanics do not move
+
+
+def test_worm_direction_changes_over_on_the_assists_own_band():
+    """A worm passes from driving (eta_f of the motor's torque delivered) to back-driven (1 / eta_b) as the rotor
+    reverses, over the assist's own band of rotor speed (``friction_speed``), not the car-wide friction smoothing: at
+    three bands either side the factor is the data sheet's within 1 %, and at a tenth of a band, the rotor nearly at
+    rest, it has moved less than a fifth of the way from 1 (a worm at rest loses no power)."""
+    eta_f, eta_b, band = 0.85, 0.80, 0.5
+    law = BoostLaw("electric_assist_column", "column", 6.0, 0.5, 0.05, 4.0, 0.05, 125.0, 18.0, eta_f, 0.05,
+                   back_efficiency=eta_b, direction_width=0.05, friction_speed=band)
+    assert float(law.delivered(1.0, 3 * band)) == pytest.approx(eta_f, rel=0.01)
+    assert float(law.delivered(1.0, -3 * band)) == pytest.approx(1 / eta_b, rel=0.01)
+    assert abs(float(law.delivered(1.0, band / 10)) - 1.0) < 0.2 * (1 - eta_f)
+    assert abs(float(law.delivered(1.0, -band / 10)) - 1.0) < 0.2 * (1 / eta_b - 1)
+    wider = BoostLaw("electric_assist_column", "column", 6.0, 0.5, 0.05, 4.0, 0.05, 125.0, 18.0, eta_f, 0.05,
+                     back_efficiency=eta_b, direction_width=0.05, friction_speed=10 * band)
+    assert abs(float(wider.delivered(1.0, 3 * band)) - 1.0) < 0.5 * (1 - eta_f)  # the same speed, not yet over

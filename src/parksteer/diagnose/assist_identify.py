@@ -34,6 +34,11 @@ Two steps, each a least-squares fit with its 95 % intervals:
    fitted: it scales the road torque as p scales the assist, and S, their small difference, cannot tell them
    apart; the product's change per step of it is reported.
 
+The band of rotor speed over which the motor's friction and the worm's direction change over at a reversal (the
+assist's ``friction_speed``) is the file's: the balance read across the reversals does not fix it from the
+records of a bus (the smoothed rack places a reversal no finer than about 1 mm/s of the rack, and a narrower band
+reads wider than it is); the diagnosis replays it at its band's ends (stage ``assumed``).
+
 Intervals are the least squares' with the residuals' correlation in time left in (a sandwich over blocks of
 :data:`BLOCK_S`, with Student's t for its blocks): a record of a few cycles fixes less than its sample count says.
 The map's points carry two errors the samples do not average: the table's own (the change from a table of two
@@ -42,7 +47,9 @@ map's centre the torque's rounding (the map between two readings is never seen);
 relative, since it is read through the map. The identified table is the map
 times the identified product, P K(S - c), at the point of action; the written file carries it in ``[assist.boost]``
 and the product as the torque constant k_t = P / (eta_f N) (only the product is fixed: eta_f and N stay the file's),
-and the motor friction; each entry's ``source`` names the records. The sensor offset and the map's centre have no
+and the motor friction; each entry's ``source`` names the records. A number of the gear is written only where it is
+physical and its interval excludes the file's value (a data sheet's even widened by the tyre-ground friction's
+step); otherwise the file's stays (:attr:`Identified.kept`). The sensor offset and the map's centre have no
 place in a vehicle file (the model's law is odd about the reading's zero): they are reported, and a later
 diagnosis that names an offset of the same size names the baseline's.
 """
@@ -114,6 +121,8 @@ class Identified:
     balance_rms_Nm: float
     torque_noise_Nm: float
     beyond_map: tuple[str, ...]
+    balance_floors: float = math.nan  # the balance's RMS in torque noise floors
+    kept: tuple[str, ...] = ()  # the file's values the written file keeps: the records do not contradict them
     file_values: dict = field(default_factory=dict)
 
     def as_dict(self) -> dict:
@@ -121,6 +130,7 @@ class Identified:
                                                          "motor_inertia", "offset", "rack_friction", "hysteresis_A")}
         est["back_efficiency"] = None if self.back_efficiency is None else self.back_efficiency.as_dict()
         return {"vehicle": self.vehicle, "records": list(self.records), "assist": self.assist_name,
+                "balance_floors": self.balance_floors, "kept": list(self.kept),
                 "table": {"torsion_bar_torque_Nm": list(self.torques), "assist": list(self.assist),
                           "assist_ci95": [list(c) for c in self.assist_ci95], "current_A": list(self.current_A),
                           "current_ci95": [list(c) for c in self.current_ci95]},
@@ -163,7 +173,9 @@ class Identified:
                   f"map residual RMS {self.map_rms_A:.3f} A against {self.map_noise_A:.3f} A of noise; hysteresis "
                   f"{self.hysteresis_A.text()} ({self.hysteresis_Nm:.4f} N m of torque)",
                   f"column balance RMS {self.balance_rms_Nm:.4f} N m against a torque noise floor of "
-                  f"{self.torque_noise_Nm:.4f} N m"]
+                  f"{self.torque_noise_Nm:.4f} N m ({self.balance_floors:.2f} floors)"]
+        if self.kept:
+            lines.append(f"kept as the file gives them (the records do not contradict them): {', '.join(self.kept)}")
         lines += [f"the map cannot hold: {b}" for b in self.beyond_map] or ["the map holds the records within "
                                                                             "their noise"]
         return lines
@@ -265,50 +277,63 @@ def identify_boost(records, vehicle, case: str | None = None, surface: str | Non
     boost_off = {key: 0.0 for key in boost_keys(name)}
     keys = [f"{name}.{k}" if "." not in k else k for k, _ in MECHANICS]
     theta = np.array([float(params[k]) for k in keys])
-    delivered, measured, times, moving, backward = [], [], [], [], []
-    sharpness = float(params["steering.friction_smoothing"])
-    for k, f in enumerate(files):
-        S = f.torque_Nm
-        motor = law(S - fitted.centre) * k_t
-        speed = rack_speed_mps(f.rack, f.time_s)
-        e = directional_efficiency(motor, speed, eta, eta_b, v("limit_smoothing"), sharpness)
-        delivered.append(e * reduction * motor / scale)
-        moving.append(np.abs(pm.tanh(sharpness * speed)) >= MOVING_SIGN)
-        backward.append(motor * speed < 0.0)
-        measured.append(S)
-        times.append(f.time_s + 1e6 * k)
-    D = np.concatenate(delivered)
-    S_all = np.concatenate(measured)
-    t_all = np.concatenate(times)
+    # the rotor's speed: N times the point of action's rate (at the column the joint's ratio taken as G_hr: a few
+    # per cent of a band's width)
+    lever = 1.0 if location == "rack" else ratio
+    rotor = [rack_speed_mps(f.rack, f.time_s) * reduction * lever for f in files]
+    motors = [law(f.torque_Nm - fitted.centre) * k_t for f in files]
+    S_all = np.concatenate([f.torque_Nm for f in files])
+    t_all = np.concatenate([f.time_s + 1e6 * k for k, f in enumerate(files)])
     sigma = np.concatenate([np.full(f.n, f.noise.total_rms) for f in files])
-    use = np.concatenate(moving)
-    back = np.concatenate(backward)
+    back = np.concatenate([m * w < 0.0 for m, w in zip(motors, rotor)])
+
+    def delivered(band: float) -> np.ndarray:
+        """What the file's gear delivers for the identified current, its direction changing over `band`."""
+        return np.concatenate([directional_efficiency(m, w, eta, eta_b, v("limit_smoothing"), 1.0 / band)
+                               * reduction * m / scale for m, w in zip(motors, rotor)])
+
+    # where the motion is defined: the smoothed rack's speed beyond the car-wide friction smoothing's band (its sign
+    # sure; nearer a reversal the spline's timing of it is not), whatever band the gear's friction has
+    sharpness = float(params["steering.friction_smoothing"])
+    use = np.concatenate([np.abs(pm.tanh(sharpness * rack_speed_mps(f.rack, f.time_s))) >= MOVING_SIGN
+                          for f in files])
     split = (use & back).sum() >= BACK_DRIVEN_SHARE * use.sum()
     if use.sum() < 20 * (len(MECHANICS) + 2):
-        raise UsageError(f"{', '.join(str(r) for r in records)}: the steering hardly moves: identify needs records "
-                         "in which the wheel turns (the column balance is read while the gear moves)")
+        raise UsageError(f"{', '.join(str(r) for r in records)}: the steering hardly moves: identify needs "
+                         "records in which the wheel turns (the column balance is read while the gear moves)")
 
     def road(changes: dict[str, float]):
         overrides = {**boost_off, **dict(zip(keys, theta)), **changes}
         return np.concatenate([engine.replay(problem, effects, k).solve(overrides).torque_Nm[: f.n]
                                for k, f in enumerate(files)])
 
+    def balance(band: float, use: np.ndarray, split: bool):
+        """(y0, the weighted design matrix, its right-hand side, the solution, the residual) of the column balance
+        with the motor's friction and the gear's direction changing over `band` (rotor rad/s), on the samples
+        `use`."""
+        band_key = {f"{name}.friction_speed": band}
+        y0 = road(band_key)
+        columns = [(road({**band_key, key: value + step}) - y0) / step
+                   for key, value, (_, step) in zip(keys, theta, MECHANICS)]
+        D = delivered(band)
+        parts = [-D * ~back, -D * back] if split else [-D]
+        matrix = (np.column_stack([*columns, np.ones_like(S_all), *parts]) / sigma[:, None])[use]
+        rhs = ((S_all - y0) / sigma)[use]
+        solution = pm.lstsq(matrix, rhs)
+        return y0, matrix, rhs, solution, rhs - pm.matmul(matrix, solution)
+
+    band = v("friction_speed")
     say("identify: the column balance on the car's replay")
     try:
-        y0 = road({})
-        columns = [(road({key: value + step}) - y0) / step for key, value, (_, step) in zip(keys, theta, MECHANICS)]
+        y0, design, rhs, solution, resid = balance(band, use, split)
         tyre_key, tyre_step = TYRE_FRICTION
-        tyre_column = (road({tyre_key: float(params[tyre_key]) + tyre_step}) - y0) / tyre_step
+        tyre_column = (road({f"{name}.friction_speed": band, tyre_key: float(params[tyre_key]) + tyre_step})
+                       - y0) / tyre_step
     finally:
         engine.close()
     # y0 + J dtheta + o - S - p D = 0  ->  [J, 1, -D] [dtheta, o, p] = S - y0, with D split into the samples the
     # motor drives and those it is driven back (their factor p_b = p eta_b,file / eta_b)
     # only while the gear moves: at rest its friction and the direction of its power are not defined
-    parts = [-D * ~back, -D * back] if split else [-D]
-    design = (np.column_stack([*columns, np.ones_like(S_all), *parts]) / sigma[:, None])[use]
-    rhs = ((S_all - y0) / sigma)[use]
-    solution = pm.lstsq(design, rhs)
-    resid = rhs - pm.matmul(design, solution)
     cov = _sandwich(design, resid, _blocks(t_all[use], BLOCK_S))
     # the product at the tyre friction moved by its step: the same fit on y0 + step x its column
     moved = pm.lstsq(design, ((S_all - y0 - tyre_step * tyre_column) / sigma)[use])
@@ -329,10 +354,40 @@ def identify_boost(records, vehicle, case: str | None = None, surface: str | Non
     if split:
         back_efficiency = _estimate(eta_b * ratio, back_se, "1", z)
     balance_rms = float(np.sqrt(np.mean((resid * sigma[use]) ** 2)))
+    balance_floors = float(np.sqrt(np.mean(resid ** 2)))
     torque_noise = float(np.sqrt(np.mean(sigma ** 2)))
 
     # the table at the point of action: P K, its interval from the map's and the product's
-    P = p * product_file
+    # What the written file takes from the balance: each number the file's value unless the number's 95 % interval
+    # excludes it, and the file's kept where the estimate is no physical value (a friction or an inertia below zero:
+    # the balance's misfit, not the gear's). A value the file gives from a data sheet (its source not assumed) is
+    # evidence of its own: it stands unless the interval excludes it even widened by what the tyre-ground friction's
+    # step moves the number (the balance cannot tell that friction from the gear, and a diagnosis calibrates it).
+    # (value, interval's low, high, the file's value, the tyre step's move) by key:
+    shift = np.abs(np.asarray(moved) - np.asarray(solution))
+    judged = {
+        "torque_constant": (p * product_file, (p - z * se_p) * product_file, (p + z * se_p) * product_file,
+                            product_file, shift[len(keys) + 1] * product_file),
+        "motor_friction_torque": (values[0], values[0] - z * se[0], values[0] + z * se[0], v("motor_friction_torque"),
+                                  shift[0]),
+        "motor_inertia": (values[1], values[1] - z * se[1], values[1] + z * se[1], v("motor_inertia"), shift[1]),
+    }
+    if back_efficiency is not None:
+        moved_eta_b = eta_b * float(moved[len(keys) + 1]) / float(moved[len(keys) + 2])
+        judged["back_efficiency"] = (back_efficiency.value, *back_efficiency.ci95, eta_b,
+                                     abs(moved_eta_b - back_efficiency.value))
+
+    def given(key: str) -> bool:
+        return not params.sources.get(f"{name}.{key}", "assumed").startswith(
+            ("assumed", "numerical", "the effect's default"))
+
+    kept = []
+    for key, (value, lo, hi, file_value, move) in judged.items():
+        wide = move if given(key) else 0.0
+        if value < 0.0 or lo - wide <= file_value <= hi + wide:
+            kept.append(key)
+    # the product the table is written with: the balance's, or the file's where it is kept
+    P = product_file if "torque_constant" in kept else p * product_file
     point_cov = pm.matmul(pm.matmul(fitted.jacobian_values, fitted.covariance), fitted.jacobian_values.T) \
         + np.diag(fitted.representation ** 2)
     current = np.array(fitted.current)
@@ -376,6 +431,7 @@ def identify_boost(records, vehicle, case: str | None = None, surface: str | Non
         map_rms_A=fitted.rms, map_noise_A=fitted.noise,
         hysteresis_A=_estimate(fitted.hysteresis, fitted.hysteresis_se, "A"), hysteresis_Nm=float(fitted.hysteresis_Nm),
         balance_rms_Nm=balance_rms, torque_noise_Nm=torque_noise, beyond_map=tuple(beyond),
+        balance_floors=balance_floors, kept=tuple(kept),
         file_values={"product": product_file, "motor_friction_torque": v("motor_friction_torque"),
                      "motor_inertia": v("motor_inertia"), "back_efficiency": eta_b,
                      "efficiency": eta, "reduction_ratio": reduction, "torque_constant": k_t},

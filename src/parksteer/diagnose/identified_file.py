@@ -37,10 +37,15 @@ def replace_assist_section(text: str, found) -> str:
     records = ", ".join(found.records)
     where = f"identified by parksteer assist identify from {records}"
     unit = found.assist_unit
-    lines = ["", "# Power assistance: the gear's data as the file gave them; the boost table, the product k_t eta N",
-             "# (as the torque constant), the motor's friction and inertia" + (" and the back-driven efficiency"
-                                                                              if found.back_efficiency is not None
-                                                                              else "") + f" {where}.",
+    written = [label for key, label in (("torque_constant", "the product k_t eta N (as the torque constant)"),
+                                        ("motor_friction_torque", "the motor's friction"),
+                                        ("motor_inertia", "the rotor's inertia"),
+                                        ("back_efficiency", "the back-driven efficiency"))
+               if key not in found.kept
+               and (key != "back_efficiency" or found.back_efficiency is not None)]
+    own = "; the file's own " + ", ".join(found.kept) if found.kept else ""
+    lines = ["", "# Power assistance: the gear's data as the file gave them; the boost table"
+             + "".join(f", {w}" for w in written), f"# {where}{own}.",
              "# Also identified, with no entry in a vehicle file: the torsion-bar sensor's offset "
              f"{found.offset.text()};",
              f"# the map's centre in the logged torque {found.map_centre.text()}; the rack friction",
@@ -63,6 +68,7 @@ def replace_assist_section(text: str, found) -> str:
         replaced["back_efficiency"] = (min(max(found.back_efficiency.value, 0.5), 0.99), "1",
                                        f"{where}: {found.back_efficiency.text()} (the column balance on the "
                                        f"back-driven samples; the file gave {found.file_values['back_efficiency']:g})")
+    replaced = {k: e for k, e in replaced.items() if k not in found.kept}
     for key, entry in old.items():
         if key in ("type", "boost") or key in LINE_KEYS or key in replaced:
             continue

@@ -13,9 +13,10 @@ derives the rack through the column and the torsion bar, :func:`parksteer.measur
 The file the diagnosis is given is the owner's (:func:`owner_vehicle_text`): the Polo file with an ``[assist]``
 from the gear's data sheet (reduction, both efficiencies, torque constant, current limit as motor torque, rotor
 inertia, torsion-bar stiffness) and the map written point by point in ``[assist.boost]`` (the control unit's
-calibration read at the design's torques); what no data sheet gives (the motor's friction) stays at the
-template's assumed default. A second route, the file written from a baseline null record by the identification
-of the assist (``parksteer assist identify``), is one entry of :data:`ROUTES` when that function exists.
+calibration read at the design's torques); what no data sheet gives (the motor's friction, the band of rotor speed
+over which it and the worm's direction change over at a reversal) stays at the template's assumed default. A
+second route, the file written from a baseline null record by the identification of the assist (``parksteer assist
+identify``), is the entry ``identified`` of :data:`ROUTES`.
 
 Cases and what counts, as in :mod:`.assisted_benchmark`: nulls (``adequate`` right), hidden effects of the truth
 standing for the assisted candidates (the motor's extra friction, the sensor's offset, the map's gain error; the
@@ -316,6 +317,7 @@ def describe(design: TruthDesign) -> dict:
                                 for b_, f in design.torque_converters],
             "torque_noise_Nm": design.torque_noise_Nm, "current_noise_A": design.current_noise_A,
             "owner_file": {"motor_friction_Nm": _template_default("motor_friction_torque"),
+                           "friction_speed_rad_s": _template_default("friction_speed"),
                            "friction_smoothing_s_per_m": float(load_parameters()["steering.friction_smoothing"])}}
 
 

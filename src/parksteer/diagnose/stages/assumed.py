@@ -46,6 +46,7 @@ BANDS = {
     "motor_torque_limit": (3.0, 6.0),  # EPS motors 3-6 N m peak (ch. 8.6)
     "limit_smoothing": (0.002, 0.05),  # numerical
     "dead_band_smoothing": (0.002, 0.05),  # numerical: the boost line's corner
+    "friction_speed": (0.1, 2.25),  # rad/s of the rotor: below a bus sample's reach to the car-wide smoothing's width
     "gain": (4.0, 10.0),  # the parking gain of EPS boost curves (ch. 8.2)
     "dead_band": (0.3, 1.5),  # published EPS boost curves (ch. 8.2)
 }

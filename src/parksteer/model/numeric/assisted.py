@@ -89,7 +89,7 @@ class BoostLaw:
     table_scale: float = 1.0  # the boost gain error's factor on the table (1 + e)
     back_efficiency: float = 1.0  # eta_b of the gear back-driven
     direction_width: float = 0.0  # motor torque (N m) over which the power's sign is smoothed (limit_smoothing)
-    sharpness: float = 0.0  # s/m: the friction smoothing beta of tanh(beta rack speed)
+    friction_speed: float = 1.0  # rad/s: the rotor speed w of tanh(omega / w) over which the direction changes
 
     @property
     def hydraulic(self) -> bool:
@@ -123,20 +123,21 @@ class BoostLaw:
                 table[k] += size_Nm  # boost_torque_<k>: the first MAX_POINTS scalars (table_keys)
         return replace(self, dead_band=self.dead_band + size_Nm, table=tuple(table))
 
-    def delivered(self, motor, rack_speed_mps):
+    def delivered(self, motor, rotor_speed):
         """What the gear delivers per motor torque, in the direction the power flows (eta_f driving, 1 / eta_b
-        back-driven; :func:`~parksteer.model.symbolic.effects.assist_common.directional_efficiency`)."""
-        return directional_efficiency(motor, np.asarray(rack_speed_mps, dtype=float), self.efficiency,
-                                      self.back_efficiency, self.direction_width, self.sharpness)
+        back-driven; :func:`~parksteer.model.symbolic.effects.assist_common.directional_efficiency`), the rotor
+        turning at `rotor_speed` (rad/s)."""
+        return directional_efficiency(motor, np.asarray(rotor_speed, dtype=float), self.efficiency,
+                                      self.back_efficiency, self.direction_width, 1.0 / self.friction_speed)
 
-    def assist(self, torsion_bar_Nm, rack_speed_mps=0.0):
+    def assist(self, torsion_bar_Nm, rotor_speed=0.0):
         """A(T_s): the assist in torsion-bar torque units (what it adds to the torsion bar's torque in y), with the
-        rack moving at `rack_speed_mps` (the direction of the gear's power flow)."""
+        rotor turning at `rotor_speed` (rad/s: the direction of the gear's power flow)."""
         motor = self.motor(torsion_bar_Nm)
         if self.hydraulic:
             return self.area * motor / self.ratio
         scale = self.ratio if self.location == "rack" else 1.0
-        return self.delivered(motor, rack_speed_mps) * self.reduction * motor / scale
+        return self.delivered(motor, rotor_speed) * self.reduction * motor / scale
 
     def bound(self) -> float:
         """An upper bound of |A| (the clamp's magnitude is below limit + width; a back-driven gear delivers at most
@@ -146,14 +147,14 @@ class BoostLaw:
         scale = self.ratio if self.location == "rack" else 1.0
         return max(self.efficiency, 1.0 / self.back_efficiency) * self.reduction * (self.limit + self.limit_width) / scale
 
-    def torsion_bar(self, y, factor=1.0, rack_speed_mps=0.0) -> np.ndarray:
+    def torsion_bar(self, y, factor=1.0, rotor_speed=0.0) -> np.ndarray:
         """The torsion-bar torque T_s with T_s + factor A(T_s) = y, elementwise. The left side rises with T_s (A is
         increasing, and factor >= 0: a motor whose delivered torque departs from the law by `factor`), so the root
         is bracketed and kept bracketed: regula falsi with the Illinois rule (the end that stays has its value
         halved), falling back to the bracket's midpoint where the secant leaves it, until the bracket is
         INVERSION_TOLERANCE_NM wide. Only comparisons and the four operations: the same bits on any machine."""
         y = np.asarray(y, dtype=float)
-        speed = np.broadcast_to(np.asarray(rack_speed_mps, dtype=float), y.shape)
+        speed = np.broadcast_to(np.asarray(rotor_speed, dtype=float), y.shape)
         gain = np.broadcast_to(np.asarray(factor, dtype=float), y.shape)
 
         def excess(x, rows):
@@ -217,7 +218,7 @@ def boost_law(run, p: np.ndarray) -> BoostLaw | None:
                        v("torque_constant"), table=tuple(v(key) for key in table_keys()),
                        speed=float(p[run.parameter_index(VEHICLE_SPEED.key)]),
                        back_efficiency=v("back_efficiency"), direction_width=v("limit_smoothing"),
-                       sharpness=float(p[run.parameter_index("steering.friction_smoothing")]))
+                       friction_speed=v("friction_speed"))
     # the law-side effects of the model (a diagnosis's candidates acting in the control unit: Effect.boost_law)
     value = lambda key: float(p[run.parameter_index(key)])  # noqa: E731
     for other in run.effects:
@@ -271,11 +272,11 @@ def solve_assisted(run, p: np.ndarray, rack: RackMotion, t_out, rtol: float = PR
     y = road.torque_Nm
     if law.location != "column":
         y = y * road.outputs["column_angle_per_rack_rad_per_m"] / law.ratio
-    # the speed the gear's direction of power flow is read from: the point of action's rate over G_hr (the column's
-    # through the joint), as the effect reads it
-    speed = rack_speed_mps(rack, road.time_s) if electric else 0.0
-    if electric and law.location == "column":
-        speed = speed * road.outputs["column_angle_per_rack_rad_per_m"] / law.ratio
+    # the speed the gear's direction of power flow is read from: the rotor's, N times the point of action's rate (the
+    # column's through the joint), as the effect reads it
+    speed = rack_speed_mps(rack, road.time_s) * law.reduction if electric else 0.0
+    if electric and law.location != "rack":
+        speed = speed * (road.outputs["column_angle_per_rack_rad_per_m"] if law.location == "column" else law.ratio)
     # A sensor reading S = T_s + o, taken by the law: S - o + A(S) = y (effect torsion_bar_offset).
     factor = 1.0 if delivered is None else np.asarray(delivered, dtype=float)
     torsion_bar = law.torsion_bar(y + law.offset, factor, speed)

@@ -2,7 +2,8 @@
 
 Mechanism. The motor's bearings, seals and worm (or ball nut) drag more than the assist's own
 ``motor_friction_torque`` says (wear, a tight worm mesh, a dry seal): a torque T_e tanh(beta v) opposing the
-rotor, reacted on the body, v the rack speed the rotor's speed corresponds to (the assist's own smoothing). The
+rotor, reacted on the body, v the rack speed the rotor's speed corresponds to (the car-wide friction smoothing
+beta, the shape of every friction candidate: a drag of unknown cause, not the assist's own band). The
 rotor turns at N dx/dt (x the point of action, N the reduction), so at x the friction is N T_e: at a column assist
 a torque on the column above the intermediate shaft, the same load as a column friction of N T_e there; at a
 pinion or rack assist a force on the rack N T_e G_hr or N T_e, the same as a rack friction. The motor's current

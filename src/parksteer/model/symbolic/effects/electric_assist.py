@@ -45,11 +45,13 @@ flows: e = eta_f when the motor drives (T_m and dx/dt of one sign), e = 1 / eta_
 the motor against its torque (after a reversal, the tyre's wind-up returning the rack): a back-driven worm or
 ball nut passes on eta_b of the power put in at the rack, so the motor's torque N T_m / eta_b at the point of
 action, not eta_f N T_m. Between the two, smoothly through the power's sign
-(:func:`.assist_common.directional_efficiency`, sharp over the friction smoothing's rack speed and
+(:func:`.assist_common.directional_efficiency`, sharp over the assist's ``friction_speed`` w of rotor speed and
 limit_smoothing of motor torque), so that the gear's loss, T_m N dx/dt (1 - e), is never negative. The control
-unit commands T_m = A_cmd / (eta_f N): while the motor drives, the assist is the demand. The rotor's inertia J_m turns at N dx/dt (kinetic
-energy J_m (N dx/dt)^2 / 2, N^2 J_m reflected to x), its bearings' Coulomb friction T_f tanh(beta v) opposes it
-(v the rack speed it corresponds to, beta the project's friction smoothing).
+unit commands T_m = A_cmd / (eta_f N): while the motor drives, the assist is the demand. The rotor's inertia J_m
+turns at omega = N dx/dt (kinetic energy J_m omega^2 / 2, N^2 J_m reflected to x), its bearings' Coulomb friction
+T_f tanh(omega / w) opposes it. The band w is the assist's own: how sharply the motor's friction and the worm's
+direction change over at a reversal is a property of the gear, not the car-wide smoothing of the rack's sliding
+contacts, and on a torsion-bar channel of a bus's resolution it decides whether a reversal is read right.
 
 Quasi-static consequences (the tests): with no dead band and the motor below its limit, the column carries
 T_s + G(v) T_s = T_road, so the driver's torque is T_road / (1 + G(v)) (with a table, the root of T_s + A(T_s) =
@@ -95,6 +97,16 @@ _GEARS = {
 # tan(lambda) backward (Shigley's Mechanical Engineering Design, ch. 13, worm gearing); an EPS worm is built to be
 # back-driven (the wheels' self-centring returns the handwheel through it). A ball nut's rolling contact gives
 # nearly the same efficiency both ways.
+# How sharply the motor's friction and the gear's direction of power flow change over at a reversal: the rotor speed
+# w of tanh(omega / w) (the assist's own, not the car-wide friction smoothing of the rack's sliding contacts).
+FRICTION_SPEED = 0.5
+FRICTION_SPEED_SOURCE = (
+    "assumed: narrower than a 100 Hz bus resolves at a parking reversal, 0.1-2.25 rad/s: a column worm's rotor "
+    "(N = 18, G_hr = 125 rad/m: 2250 rad/s of rotor per m/s of rack) crosses +-0.5 rad/s within one 10 ms sample "
+    "wherever the rack reverses at more than 0.045 m/s^2, so a narrower band reads the same; the car-wide friction "
+    "smoothing's width, 1 mm/s of the rack, is 2.25 rad/s of this rotor; no data sheet gives it, and a diagnosis "
+    "replays its band's ends (stage assumed)")
+
 _BACK_EFFICIENCY = {
     "column": (0.80, "assumed: back-driven worm gear, 0.75-0.85: tan(lambda - rho) / tan(lambda) for the lead angle "
                      "that gives eta_f = 0.85 (about 25 deg at rho = 3 deg) is 0.86, 0.80 at rho = 4.5 deg "
@@ -151,6 +163,10 @@ def assist_quantities(name: str, location: str) -> tuple[Quantity, ...]:
         Quantity(f"{name}.motor_friction_torque", "N m", 0.0, 1.0, lower_inclusive=True, default=0.02,
                  description="Coulomb friction of the rotor's bearings and seals, at the motor",
                  source="assumed: 0.01-0.05 N m for EPS motors (Harrer & Pfeffer, ch. 8.6)"),
+        Quantity(f"{name}.friction_speed", "rad/s", 0.0, 100.0, default=FRICTION_SPEED,
+                 description="rotor speed over which the motor's Coulomb friction and the gear's direction of power "
+                             "flow change over at a reversal: the width w of tanh(rotor speed / w)",
+                 source=FRICTION_SPEED_SOURCE),
         Quantity(f"{name}.speed_dependence", "1", 0.0, 1.0, lower_inclusive=True, default=0.0,
                  description="1: the gain falls with the vehicle speed as G / (1 + (v / v_half)^2); 0: a "
                              "speed-independent boost curve (between: the same fall with v_half / sqrt(s))",
@@ -195,7 +211,7 @@ class ElectricAssist(Effect):
                 "inertia and friction; off by default"),
             "quantities": quantities,
             "uses": (*(q.key for q in quantities), VEHICLE_SPEED.key, "steering.column_torsional_stiffness",
-                     "steering.handwheel_to_rack_ratio", "steering.friction_smoothing"),
+                     "steering.handwheel_to_rack_ratio"),
             "__module__": cls.__module__,
         })
 
@@ -236,13 +252,22 @@ class ElectricAssist(Effect):
         at_motor = demand / (self.q(model, "efficiency") * self.q(model, "reduction_ratio"))
         return clamp(at_motor, self.q(model, "motor_torque_limit"), self.q(model, "limit_smoothing"))
 
+    def rotor_speed(self, model):
+        """The rotor's speed, N times the point of action's rate (rad/s)."""
+        _, rate = point_of_action(model, self.location)
+        return self.q(model, "reduction_ratio") * rate
+
+    def friction_sign(self, model):
+        """The smooth sign of the rotor's speed, tanh(omega / w), w the assist's ``friction_speed``: how the motor's
+        friction and the gear's direction of power flow change over at a reversal."""
+        return sp.tanh(self.rotor_speed(model) / self.q(model, "friction_speed"))
+
     def delivered_factor(self, model, motor):
         """The gear's efficiency in the direction the power flows (eta_f driving, 1 / eta_b back-driven), smooth
         through the power's sign (module docstring)."""
-        _, rate = point_of_action(model, self.location)
-        rack_speed = rate if self.location == "rack" else rate / model.p("steering.handwheel_to_rack_ratio")
-        return directional_efficiency(motor, rack_speed, self.q(model, "efficiency"), self.q(model, "back_efficiency"),
-                                      self.q(model, "limit_smoothing"), model.p("steering.friction_smoothing"))
+        return directional_efficiency(motor, self.rotor_speed(model), self.q(model, "efficiency"),
+                                      self.q(model, "back_efficiency"), self.q(model, "limit_smoothing"),
+                                      1 / self.q(model, "friction_speed"))
 
     def bodies(self, model):
         k = model.kinematics
@@ -253,11 +278,7 @@ class ElectricAssist(Effect):
     def loads(self, model):
         k = model.kinematics
         frame = self._motor_frame(model)
-        _, rate = point_of_action(model, self.location)
-        # the friction is smoothed over the rack speed the rotor's speed corresponds to
-        rack_speed = rate if self.location == "rack" else rate / model.p("steering.handwheel_to_rack_ratio")
-        friction = self.q(model, "motor_friction_torque") * sp.tanh(model.p("steering.friction_smoothing")
-                                                                     * rack_speed)
+        friction = self.q(model, "motor_friction_torque") * self.friction_sign(model)
         motor = self.motor_torque(model)
         delivered = self.delivered_factor(model, motor) * motor
         # Motor torque (less the gear's loss) and bearing friction on the rotor, reacted on the body.
