@@ -76,11 +76,15 @@ def assisted_diagnosis_models(vehicle_path: str) -> dict[str, str]:
     (:func:`parksteer.diagnose.candidates.models_to_build` over its candidates), by name, as effects specs: the
     base model, the diagnosis model and each candidate's own. Derived before the assisted benchmarks' jobs, so that
     their parallel jobs do not compile the same models side by side."""
+    from pathlib import Path
+
     from .diagnose.candidates import candidate_effects, models_to_build
     from .model.numeric.assist import effects_with_assist
     from .model.symbolic.components import resolve_effects
     from .vehicle import load_vehicle
 
+    if not Path(vehicle_path).is_file():  # a workflow copy without the car: its rules say what input is missing
+        return {}
     params = load_vehicle(vehicle_path)
     base = resolve_effects(effects_with_assist(None, params))
     names = {e.name for e in base}
@@ -99,6 +103,8 @@ def assisted_benchmark_models(vehicle_path: str) -> dict[str, str]:
     from .experiments.assisted_benchmark import HIDDEN
 
     out = assisted_diagnosis_models(vehicle_path)
+    if not out:
+        return out
     base = out["assisted_base"].split(",")
     for hidden in HIDDEN:
         if hidden not in base:

@@ -200,6 +200,7 @@ def test_an_angle_only_record_gives_the_rack_through_the_torsion_bar(params, nam
     1 um over a 0.07 m stroke (2e-7 m found, column and pinion assist); taken through the shaft alone (the car
     without its assist's bar, k_c = 1000 N m/rad against the series 103 N m/rad) the rack is off by 1.5e-4 m, the
     bar's twist T / k_t through the ratio."""
+    from parksteer.diagnose.problem import torsion_bar
     from parksteer.measure.column import rack_from_angle
     from parksteer.measure.io import Measurement
     from parksteer.model.numeric.simulate import simulate
@@ -208,7 +209,7 @@ def test_an_angle_only_record_gives_the_rack_through_the_torsion_bar(params, nam
     measurement = Measurement(None, {"time_s": run["time_s"], "handwheel_angle_rad": run["handwheel_angle_rad"],
                                      "handwheel_torque_Nm": run["torsion_bar_torque_Nm"]},
                               {"case": "unladen", "surface": "ground", "torque_sensor": "torsion_bar"})
-    through_bar = rack_from_angle(measurement, params, name).rack_m
+    through_bar = rack_from_angle(measurement, params, torsion_bar(name)).rack_m
     through_shaft = rack_from_angle(measurement, params).rack_m
     error, naive = (float(np.max(np.abs(r - run["rack_m"]))) for r in (through_bar, through_shaft))
     assert error < 1e-6 and naive > 100 * error

@@ -195,14 +195,14 @@ def _files(records, params, case, surface, channel_map, name) -> list[FileData]:
     from ..measure.column import rack_from_angle, rack_logger
     from ..measure.converter import quantisation_step
     from ..measure.io import Measurement
-    from .problem import load_files, prepare_file
+    from .problem import load_files, prepare_file, torsion_bar
 
     out = []
     for k, record in enumerate(records):
         if isinstance(record, Measurement):
             resolution = 0.0
             if "rack_derived" in record.metadata:
-                record = rack_from_angle(record, params, name)
+                record = rack_from_angle(record, params, torsion_bar(name))
                 logger = rack_logger(record, params)
                 resolution = 0.0 if logger is None else quantisation_step(logger[0], logger[1])
             label = record.path.name if record.path is not None else f"record {k + 1}"

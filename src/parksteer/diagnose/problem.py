@@ -33,7 +33,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import UsageError, naming
-from ..measure.column import load_measurements
+from ..measure.column import TorsionBar, load_measurements
 from ..measure.importers import ANGLE, TORQUE
 from ..measure.io import Measurement
 from ..measure.metrics import NoiseFloor, noise_floor
@@ -188,13 +188,22 @@ def prepare_file(measurement: Measurement, case: str | None = None, label: str |
                     angle_noise=angle_floor, motor_column=motor_column, motor=motor, motor_noise=motor_floor)
 
 
+def torsion_bar(assist: str | None) -> TorsionBar | None:
+    """The torsion bar of the assist effect named `assist` (None: no assist): in the column for a column assist."""
+    if assist is None:
+        return None
+    from ..model.symbolic.components import discover_effects
+
+    return TorsionBar(assist, discover_effects()[assist].location == "column")
+
+
 def load_files(paths: list[str | Path], params: Parameters, case: str | None = None, surface: str | None = None,
                channel_map=None, assist: str | None = None) -> list[FileData]:
     """Read and validate measurement files (:func:`parksteer.measure.column.load_measurements`, which says what
     `case`, `surface`, `channel_map` and `assist` do) and prepare each (:func:`prepare_file`)."""
     files = []
     for path, measurement, chosen, resolution in load_measurements(paths, params, case, surface, channel_map,
-                                                                   assist):
+                                                                   torsion_bar(assist)):
         with naming(path):
             files.append(prepare_file(measurement, chosen, rest_resolution_m=resolution))
     return files

@@ -9,12 +9,11 @@ channel's logger carried through the ratio (:func:`rack_logger`).
 from __future__ import annotations
 
 from collections.abc import Iterator
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 from ..errors import UsageError
 from ..geometry import column_twist, pinion_angle_from_column
-from ..model.symbolic.components import discover_effects
 from ..parameters import Parameters
 from .converter import quantisation_step
 from .importers import ANGLE, TORQUE, load_record
@@ -22,13 +21,22 @@ from .io import Measurement
 from .metrics import noise_floor
 
 
+@dataclass(frozen=True)
+class TorsionBar:
+    """An assisted car's torque sensor: the assist effect whose quantities it has (``<assist>.torsion_bar_stiffness``)
+    and whether the bar is in the column (a column assist) or on the pinion (pinion, rack and hydraulic gears)."""
+
+    assist: str
+    in_column: bool
+
+
 def load_measurements(paths: list[str | Path], params: Parameters, case: str | None = None,
-                      surface: str | None = None, channel_map=None, assist: str | None = None
+                      surface: str | None = None, channel_map=None, assist: TorsionBar | None = None
                       ) -> Iterator[tuple[str | Path, Measurement, str, float]]:
     """Read (through :func:`parksteer.measure.importers.load_record`) and validate measurement files, one at a time:
     (path, measurement, its case, the rest resolution of its rack) each. `case` replaces the case every file
     names, `surface` fills the surface a file does not state; an angle-only record's rack is derived through the
-    model's column (:func:`rack_from_angle`; with `assist`, an assisted car's effect, through its torsion bar) and
+    model's column (:func:`rack_from_angle`; with `assist`, an assisted car's torsion bar, through it) and
     its rest resolution is its logger's step (:func:`rack_logger`; 0 for a measured rack)."""
     if not paths:
         raise UsageError("no measurement file given")
@@ -54,7 +62,7 @@ def load_measurements(paths: list[str | Path], params: Parameters, case: str | N
         yield path, measurement, chosen, resolution
 
 
-def rack_from_angle(measurement: Measurement, params: Parameters, assist: str | None = None) -> Measurement:
+def rack_from_angle(measurement: Measurement, params: Parameters, assist: TorsionBar | None = None) -> Measurement:
     """A copy of an angle-only record (its rack derived by the importer) with the rack derived through the model's
     column: the column angle is the handwheel angle less the twist that passes the measured torque through the
     column's spring and damper, ``c dtwist/dt + k twist = T`` (:func:`parksteer.geometry.column_twist`,
@@ -70,7 +78,7 @@ def rack_from_angle(measurement: Measurement, params: Parameters, assist: str | 
     reversals, where the rack friction flips, and made a null record unexplained. The torque's noise reaches the
     rack through the twist only, divided by k and the ratio (0.1 N m: 5e-7 m) and low-passed by the damper.
 
-    Of an assisted car (`assist`, the effect's name), the torque is the torsion bar's and the bar is in series with
+    Of an assisted car (`assist`, its torsion bar), the torque is the torsion bar's and the bar is in series with
     the column shaft: the twist is through their series stiffness k k_t / (k + k_t), with the damping that keeps
     the column's time constant (as the assist's deflection law); a bar on the pinion (pinion, rack and hydraulic
     gears) reads the column torque through the joint, T_s = T dtheta_c/dtheta_p.
@@ -80,13 +88,13 @@ def rack_from_angle(measurement: Measurement, params: Parameters, assist: str | 
     stiffness, damping = s["column_torsional_stiffness"], s["column_torsional_damping"]
     torque = columns[TORQUE]
     if assist is not None:  # the torsion bar in series with the column shaft (assist_common.series_deflection)
-        bar = params[f"{assist}.torsion_bar_stiffness"]
+        bar = params[f"{assist.assist}.torsion_bar_stiffness"]
         series = stiffness * bar / (stiffness + bar)
         stiffness, damping = series, damping * series / stiffness
     twist, _ = column_twist(columns["time_s"], torque, stiffness, damping)
     joint = (s["hooke_joint_angle"], s["hooke_joint_phase"])
     pinion = pinion_angle_from_column(columns[ANGLE] - twist, *joint)
-    if assist is not None and discover_effects()[assist].location != "column":
+    if assist is not None and not assist.in_column:
         # the bar on the pinion reads T_s = T dtheta_c/dtheta_p: the column carries T_s dtheta_p/dtheta_c, the
         # joint's speed ratio taken at the column angle of the first pass (it varies by 1e-4 over the twist)
         column = columns[ANGLE] - twist
@@ -100,7 +108,7 @@ def rack_from_angle(measurement: Measurement, params: Parameters, assist: str | 
         f"from c dtwist/dt + k twist = T with k {stiffness:g} N m/rad and c "
         f"{damping:g} N m s/rad, Hooke joint angle {s['hooke_joint_angle']:g} rad and phase "
         f"{s['hooke_joint_phase']:g} rad, ratio {s['handwheel_to_rack_ratio']:g} rad/m"
-        + (f"; the torsion bar of {assist} in series" if assist is not None else "")
+        + (f"; the torsion bar of {assist.assist} in series" if assist is not None else "")
     )
     return replace(measurement, columns={**columns, "rack_m": pinion / s["handwheel_to_rack_ratio"]},
                    metadata=metadata)
