@@ -100,6 +100,39 @@ def test_the_suggested_file_passed_back_as_it_stands_gives_the_error_it_promises
     assert again.verdict == "adequate"
 
 
+def test_the_form_a_suggestion_is_fitted_on_is_the_force_its_file_writes(record, params, tmp_path, monkeypatch):
+    """A suggestion is fitted on its form (its knots given as values) and written as a file with the knots as
+    numbers: the two are one force. The file replayed as it stands (its strengths at the fitted START) and the form
+    replayed at the fitted strengths give the same torque on the calibrated car, to 1e-6 N m (against a 0.03 N m
+    floor) once the two compiled models are integrated tightly (relative 1e-10; at the diagnosis's 1e-5 their
+    different steps leave about 1e-3 N m)."""
+    import numpy as np
+
+    from parksteer.model.numeric import prescribed
+
+    from parksteer.diagnose.engine import ReplayEngine
+    from parksteer.diagnose.suggest import shape_of
+
+    files = load_files(record, params)
+    first = diagnose(files, params, registry={})
+    signature = first.outputs["signature"]
+    path = tmp_path / "missing.py"
+    suggestion = suggest(first.problem, first.calibration, signature, path)
+    form, _ = shape_of(signature)
+    rtol, atol_factor, *rest = prescribed.solve.__defaults__
+    monkeypatch.setattr(prescribed.solve, "__defaults__", (1e-10, atol_factor * 1e-4, *rest))
+    fitted = suggestion.fit.overrides
+    base = {k: v for k, v in fitted.items() if not k.startswith(f"{form.name}.")}
+    engine = ReplayEngine()
+    on_form = engine.predict(first.problem, suggestion.fit.effects, fitted)
+    written = next(e for e in resolve_effects(f"+{path}") if e.name == suggestion.effect_name)
+    model = sorted([*first.calibration.effects, written], key=lambda e: e.name)
+    on_file = engine.predict(first.problem, model, base)
+    gap = max(float(np.max(np.abs(a - b))) for a, b in zip(on_form, on_file))
+    change = max(float(np.max(np.abs(a - b))) for a, b in zip(on_form, first.calibration.predictions))
+    assert change > 0.05 and gap < 1e-6
+
+
 def test_a_file_effect_in_a_diagnosis_pickles_by_reference(hand_written):
     """An effect loaded from its file and handed to diagnose() (the Python route, not only the command line's) is
     findable by its module's name once the diagnosis has started, so a worker process it forks can be sent it
