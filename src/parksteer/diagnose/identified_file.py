@@ -1,9 +1,14 @@
-"""The vehicle file written again by ``parksteer assist identify``: its ``[assist]`` section replaced by what was
-identified (:class:`parksteer.diagnose.assist_identify.Identified`), every other line kept as the owner wrote it."""
+"""What ``parksteer assist identify`` found (:class:`Identified`, :func:`parksteer.diagnose.assist_identify.identify_boost`)
+and the vehicle file it writes again: its ``[assist]`` section replaced by what was identified, every other line
+kept as the owner wrote it."""
 
 from __future__ import annotations
 
+import math
 import re
+from dataclasses import dataclass, field
+
+from .boost_map import Estimate
 
 
 _HEADER = re.compile(r"^\s*\[([^\]]+)\]\s*(#.*)?$")
@@ -15,6 +20,103 @@ def _toml_string(text: str) -> str:
 
 def _number(x: float) -> str:
     return repr(float(f"{x:.6g}"))
+
+
+@dataclass(frozen=True)
+class Identified:
+    """What :func:`parksteer.diagnose.assist_identify.identify_boost` found (that module's docstring). ``torques`` (N m) and ``assist`` (at the point of
+    action, N m at the column or pinion, N at the rack) are the table with ``assist_ci95`` per point; ``current_A``
+    the same map in motor current. ``beyond_map`` lists what the map cannot hold (empty: scatter and hysteresis
+    within the noise)."""
+
+    vehicle: str
+    records: tuple[str, ...]
+    assist_name: str
+    torques: tuple[float, ...]
+    assist: tuple[float, ...]
+    assist_ci95: tuple[tuple[float, float], ...]
+    current_A: tuple[float, ...]
+    current_ci95: tuple[tuple[float, float], ...]
+    dead_band: Estimate
+    map_centre: Estimate
+    product: Estimate  # k_t eta_f N, N m (or N) at the point of action per A
+    motor_friction: Estimate
+    motor_inertia: Estimate
+    back_efficiency: Estimate | None  # None: too few back-driven samples, the file's kept
+    offset: Estimate
+    rack_friction: Estimate
+    tyre_friction: float  # the file's, at which the product is identified
+    product_per_tyre_friction: float  # the product's change per unit of the tyre-ground friction
+    map_rms_A: float
+    map_noise_A: float
+    hysteresis_A: Estimate
+    hysteresis_Nm: float
+    balance_rms_Nm: float
+    torque_noise_Nm: float
+    beyond_map: tuple[str, ...]
+    balance_floors: float = math.nan  # the balance's RMS in torque noise floors
+    kept: tuple[str, ...] = ()  # the file's values the written file keeps: the records do not contradict them
+    file_values: dict = field(default_factory=dict)
+
+    def as_dict(self) -> dict:
+        est = {k: getattr(self, k).as_dict() for k in ("dead_band", "map_centre", "product", "motor_friction",
+                                                         "motor_inertia", "offset", "rack_friction", "hysteresis_A")}
+        est["back_efficiency"] = None if self.back_efficiency is None else self.back_efficiency.as_dict()
+        return {"vehicle": self.vehicle, "records": list(self.records), "assist": self.assist_name,
+                "balance_floors": self.balance_floors, "kept": list(self.kept),
+                "table": {"torsion_bar_torque_Nm": list(self.torques), "assist": list(self.assist),
+                          "assist_ci95": [list(c) for c in self.assist_ci95], "current_A": list(self.current_A),
+                          "current_ci95": [list(c) for c in self.current_ci95]},
+                **est, "tyre_friction": self.tyre_friction,
+                "product_per_tyre_friction": self.product_per_tyre_friction, "map_rms_A": self.map_rms_A,
+                "map_noise_A": self.map_noise_A,
+                "hysteresis_Nm": self.hysteresis_Nm if math.isfinite(self.hysteresis_Nm) else None,
+                "balance_rms_Nm": self.balance_rms_Nm,
+                "torque_noise_Nm": self.torque_noise_Nm, "beyond_map": list(self.beyond_map),
+                "file_values": dict(self.file_values)}
+
+    @property
+    def assist_unit(self) -> str:
+        """The unit of the assist at its point of action: N at the rack, N m at the column or pinion."""
+        from ..model.symbolic.components import discover_effects
+
+        return "N" if discover_effects()[self.assist_name].location == "rack" else "N m"
+
+    def summary_lines(self) -> list[str]:
+        unit = self.assist_unit
+        lines = [f"boost table from {', '.join(self.records)} ({self.assist_name}):",
+                 "  torsion-bar N m   assist " + unit + "   95 %              current A"]
+        for t, a, (lo, hi), i in zip(self.torques, self.assist, self.assist_ci95, self.current_A):
+            lines.append(f"  {t:15.3f}  {a:10.3f}   {lo:7.3f} to {hi:7.3f}   {i:9.2f}")
+        lines += [f"dead band {self.dead_band.text()}",
+                  f"map centre in the logged torque {self.map_centre.text()}",
+                  f"product k_t eta N {self.product.text()} "
+                  f"(file: {self.file_values.get('product', float('nan')):.4g})",
+                  f"  at the file's tyre-ground friction {self.tyre_friction:g}: the product moves by "
+                  f"{self.product_per_tyre_friction * 0.05:+.4g} per +0.05 of it (the balance cannot tell them apart)",
+                  f"motor friction {self.motor_friction.text()} (file: "
+                  f"{self.file_values.get('motor_friction_torque', float('nan')):.4g})",
+                  f"motor inertia {self.motor_inertia.text()} (file: "
+                  f"{self.file_values.get('motor_inertia', float('nan')):.4g})",
+                  ("back-driven efficiency " + (self.back_efficiency.text() if self.back_efficiency is not None
+                                                else "not fixed (too few back-driven samples)")
+                   + f" (file: {self.file_values.get('back_efficiency', float('nan')):.4g})"),
+                  f"torsion-bar offset {self.offset.text()}",
+                  f"rack friction {self.rack_friction.text()}",
+                  f"map residual RMS {self.map_rms_A:.3f} A against {self.map_noise_A:.3f} A of noise; hysteresis "
+                  f"{self.hysteresis_A.text()} ({self.hysteresis_Nm:.4f} N m of torque)",
+                  f"column balance RMS {self.balance_rms_Nm:.4f} N m against a torque noise floor of "
+                  f"{self.torque_noise_Nm:.4f} N m ({self.balance_floors:.2f} floors)"]
+        if self.kept:
+            lines.append(f"kept as the file gives them (the records do not contradict them): {', '.join(self.kept)}")
+        lines += [f"the map cannot hold: {b}" for b in self.beyond_map] or ["the map holds the records within "
+                                                                            "their noise"]
+        return lines
+
+    def to_vehicle_toml(self, text: str) -> str:
+        """The vehicle file `text` with its ``[assist]`` written again: the identified table, the product as the
+        torque constant, the motor friction; every other entry kept, the boost line's quantities dropped."""
+        return replace_assist_section(text, self)
 
 
 def replace_assist_section(text: str, found) -> str:
