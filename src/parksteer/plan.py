@@ -71,44 +71,25 @@ def assisted_truth_cases(section: dict | None = None) -> list[str]:
     return case_names(design_from_config(section))
 
 
-def assisted_diagnosis_models(vehicle_path: str) -> dict[str, str]:
-    """The compiled models a diagnosis of the vehicle file's car with its assist replays
-    (:func:`parksteer.diagnose.candidates.models_to_build` over its candidates), by name, as effects specs: the
-    base model, the diagnosis model and each candidate's own. Derived before the assisted benchmarks' jobs, so that
-    their parallel jobs do not compile the same models side by side."""
+def assisted_models(vehicle_path: str) -> dict[str, str]:
+    """The compiled models of the assisted benchmarks' jobs (:func:`parksteer.diagnose.candidates.assisted_models`
+    of the vehicle file's car: those its diagnoses replay, and the car with each assisted candidate its records
+    hide), by name, as effects specs. Derived before the jobs, so that parallel jobs do not compile the same models
+    side by side."""
     from pathlib import Path
 
-    from .diagnose.candidates import candidate_effects, models_to_build
-    from .model.numeric.assist import effects_with_assist
-    from .model.symbolic.components import resolve_effects
+    from .diagnose.candidates import assisted_models as models
     from .vehicle import load_vehicle
 
     if not Path(vehicle_path).is_file():  # a workflow copy without the car: its rules say what input is missing
         return {}
-    params = load_vehicle(vehicle_path)
-    base = resolve_effects(effects_with_assist(None, params))
-    names = {e.name for e in base}
+    sets = models(load_vehicle(vehicle_path))
+    names = {e.name for e in sets[0]} if sets else set()
     out = {}
-    for model in models_to_build(base, candidate_effects(base)[0], params):
+    for model in sets:
         extra = sorted(e.name for e in model if e.name not in names)
         name = "assisted_" + ("base" if not extra else f"with_{extra[0]}" if len(extra) == 1 else "diagnosis")
         out[name] = ",".join(e.name for e in model)
-    return out
-
-
-def assisted_benchmark_models(vehicle_path: str) -> dict[str, str]:
-    """The compiled models of the assisted benchmark's jobs: those its diagnoses replay
-    (:func:`assisted_diagnosis_models`) and those its records are made with (the car with each hidden candidate,
-    :data:`parksteer.experiments.assisted_benchmark.HIDDEN`)."""
-    from .experiments.assisted_benchmark import HIDDEN
-
-    out = assisted_diagnosis_models(vehicle_path)
-    if not out:
-        return out
-    base = out["assisted_base"].split(",")
-    for hidden in HIDDEN:
-        if hidden not in base:
-            out.setdefault(f"assisted_with_{hidden}", ",".join(sorted([*base, hidden])))
     return out
 
 

@@ -68,9 +68,10 @@ rule assist_study:
 DIAG_ASSISTED_CASES = plan("assisted_cases", config.get("assisted_benchmark"))
 DIAG_ASSISTED_BATCHES = case_batches("assisted_", DIAG_ASSISTED_CASES,
                                      int(config.get("assisted_cases_per_job", 16)))
-# the models its jobs replay and make records with, derived before them: parallel jobs compile none side by side
+# the models its jobs (and those of the independent truth's, assisted_truth.smk) replay and make records with,
+# derived before them: parallel jobs compile none side by side
 DIAG_ASSISTED_MODELS = [model_manifest(name, spec) for name, spec in
-                        plan("assisted_benchmark_models", "data/vehicles/polo_vi.toml").items()]
+                        plan("assisted_models", "data/vehicles/polo_vi.toml").items()]
 
 
 rule diag_assisted_batch:

@@ -9,16 +9,13 @@
 DIAG_ASSISTED_TRUTH_CASES = plan("assisted_truth_cases", config.get("assisted_truth"))
 DIAG_ASSISTED_TRUTH_BATCHES = case_batches("truth_", DIAG_ASSISTED_TRUTH_CASES,
                                            int(config.get("assisted_truth_cases_per_job", 8)))
-# the models its diagnoses replay (the owner's file is the Polo's gear), derived before its jobs
-DIAG_ASSISTED_TRUTH_MODELS = [model_manifest(name, spec) for name, spec in
-                              plan("assisted_diagnosis_models", "data/vehicles/polo_vi.toml").items()]
 
 
 rule diag_assisted_truth_batch:
     input:
         parameters=PARAMETERS,
         vehicle="data/vehicles/polo_vi.toml",
-        models=[ASSIST_MODELS["column"], *DIAG_ASSISTED_TRUTH_MODELS],
+        models=[ASSIST_MODELS["column"], *DIAG_ASSISTED_MODELS],  # the owner's file has the Polo's gear
     output:
         directory("results/diagnose/assisted_truth/{batch}"),
     params:

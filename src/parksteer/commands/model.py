@@ -75,25 +75,14 @@ def _assisted_vehicle_sets() -> list:
     the checkout's data/vehicles that has an [assist], and of the car with each assisted candidate (what the
     assisted benchmark makes its records with): the README's assisted example and the assisted benchmark (the
     Polo's) then compile them instead of deriving them."""
-    from ..diagnose.candidates import candidate_effects, models_to_build
+    from ..diagnose.candidates import assisted_models
     from ..model.codegen.cache import checkout_root
-    from ..model.numeric.assist import effects_with_assist
-    from ..model.symbolic.components import resolve_effects
     from ..vehicle import load_vehicle
 
     root = checkout_root()
     sets = []
     for vehicle in sorted((root / "data" / "vehicles").glob("*.toml")) if root is not None else []:
-        params = load_vehicle(vehicle, load_parameters())
-        spec = effects_with_assist(None, params)
-        if spec is None:
-            continue
-        base = resolve_effects(spec)
-        candidates = candidate_effects(base)[0]
-        sets += [([e.name for e in effects], effects) for effects in models_to_build(base, candidates, params)]
-        for candidate in (c for c in candidates if c.assist_candidate):
-            effects = resolve_effects([*base, candidate])
-            sets.append(([e.name for e in effects], effects))
+        sets += [([e.name for e in effects], effects) for effects in assisted_models(load_vehicle(vehicle, load_parameters()))]
     return sets
 
 

@@ -126,6 +126,25 @@ def models_to_build(base_effects: list[Effect], candidates: list[Effect], params
     return out
 
 
+def assisted_models(params) -> list[list[Effect]]:
+    """The compiled models of the car of `params` with its assist ([] without one): those a diagnosis with its assist
+    (``--with-assist``) replays (:func:`models_to_build` over its candidates), then the car with each assisted
+    candidate (what a benchmark hides one in), each set once."""
+    from ..model.numeric.assist import effects_with_assist
+
+    spec = effects_with_assist(None, params)
+    if spec is None:
+        return []
+    base = resolve_effects(spec)
+    candidates = candidate_effects(base)[0]
+    out = models_to_build(base, candidates, params)
+    for candidate in (c for c in candidates if c.assist_candidate):
+        effects = resolve_effects([*base, candidate])
+        if all([e.name for e in effects] != [e.name for e in m] for m in out):
+            out.append(effects)
+    return out
+
+
 def default_diagnosis_models(params=None) -> list[list[Effect]]:
     """The compiled models a diagnosis of a car with the default effects builds (:func:`models_to_build`): the ones
     the package ships pre-derived (``parksteer derive --prebuilt``). The same for every vehicle file that leaves the

@@ -175,14 +175,16 @@ def case_truth_and_record(params: Parameters, design: AssistedDesign, case: Assi
     return truth, record
 
 
-def outcome(truth: dict, result: dict) -> dict:
-    """How one diagnosis fares (module docstring): named, adequate (nulls), confident wrong (out of class)."""
+def judged(truth: dict, result: dict) -> dict:
+    """A diagnosis's answer on an assisted record and how it fares: the verdict, the effect named and its group, the
+    calibrated error over the floor; named (a hidden candidate, or adequate with the rack friction's interval
+    holding the truth), and for an out-of-class change its relation, BIC margin, confident and confident wrong.
+    Shared by the assisted benchmark and the one on an independent truth (their rows add what their records are)."""
     missing = result["verdict"] == "missing"
     named = result["effect"] if missing else None
     group = [s["effect"] for s in result["indistinguishable"]]
-    row = {"name": truth["name"], "kind": truth["kind"], "variation": truth["variation"],
-           "hidden": truth["hidden"] or "nothing", "steps": truth["steps"], "steps_requested": truth["steps_requested"],
-           "verdict": result["verdict"], "effect": named or "", "indistinguishable": " ".join(group),
+    row = {"hidden": truth["hidden"] or "nothing", "verdict": result["verdict"], "effect": named or "",
+           "indistinguishable": " ".join(group),
            "calibrated_over_floor": result["statistics"]["calibrated"]["weighted_rms_Nm"] / result["noise_floor_Nm"],
            "wall_s": result["cost"].get("wall_s")}
     if truth["kind"] == "hidden":
@@ -196,9 +198,20 @@ def outcome(truth: dict, result: dict) -> dict:
         margin = bic_margin(result) if named else None
         band = result["selection"]["thresholds"]["bic_indistinguishable"]
         related = set(truth["related"])
+        confident = bool(named and margin is not None and margin > band)
         row["relation"] = ("related" if named in related else "unrelated") if named else result["verdict"]
         row["bic_margin"] = margin
-        row["confident_wrong"] = bool(named and named not in related and margin is not None and margin > band)
+        row["confident"] = confident
+        row["confident_wrong"] = confident and named not in related
+    return row
+
+
+def outcome(truth: dict, result: dict) -> dict:
+    """How one diagnosis fares (module docstring): named, adequate (nulls), confident wrong (out of class)."""
+    row = {"name": truth["name"], "kind": truth["kind"], "variation": truth["variation"]}
+    judgement = judged(truth, result)
+    row["hidden"] = judgement.pop("hidden")
+    row.update({"steps": truth["steps"], "steps_requested": truth["steps_requested"], **judgement})
     return row
 
 

@@ -49,11 +49,10 @@ from ..synthetic.assisted_truth import (HIDDEN_TRUTH, OUT_OF_CLASS_TRUTH, Hidden
 from ..synthetic.datasets import SizeSearch, perturbed_base, rms_difference, strength_for_rms
 from ..synthetic.variations import variation_by_name
 from .benchmark import BASE_PERTURBATION, BENCHMARK_SETTINGS
-from .outclass import bic_margin
+from .assisted_benchmark import RACK_FRICTION, judged
 from .rows import ROW_SUFFIX, read_case_files
 from .variations import NAMED_TARGET, NULL_ADEQUATE_TARGET
 
-RACK_FRICTION = "steering.rack_friction_force"
 # The largest size searched for each hidden quantity (its unit the truth's: N m, 1, N, rad).
 UPPER = {"assist_motor_friction": 0.3, "torsion_bar_offset": 1.0, "boost_gain_error": 1.0, "rack_friction": 1500.0,
          "cogging": 0.5, "boost_hysteresis": 1.0, "gear_backlash": 3.0, "current_friction": 0.8}
@@ -237,31 +236,9 @@ def case_truth_and_record(params: Parameters, design: TruthDesign, case: TruthCa
 
 def outcome(truth: dict, result: dict) -> dict:
     """How one diagnosis fares: named (hidden), adequate (nulls), confident and confident wrong (out of class)."""
-    missing = result["verdict"] == "missing"
-    named = result["effect"] if missing else None
-    group = [s["effect"] for s in result["indistinguishable"]]
     row = {k: truth[k] for k in ("name", "tier", "kind", "variation", "floors", "floors_requested", "strength",
                                  "torque_step_Nm")}
-    row.update({"hidden": truth["hidden"] or "nothing", "verdict": result["verdict"], "effect": named or "",
-                "indistinguishable": " ".join(group),
-                "calibrated_over_floor": result["statistics"]["calibrated"]["weighted_rms_Nm"]
-                / result["noise_floor_Nm"], "wall_s": result["cost"].get("wall_s")})
-    if truth["kind"] == "hidden":
-        if truth["hidden"] == "rack_friction":
-            ci = result["calibrated"][RACK_FRICTION].get("ci95")
-            row["named"] = result["verdict"] == "adequate"
-            row["covered"] = ci is not None and ci[0] <= truth["true_value"] <= ci[1]
-        else:
-            row["named"] = missing and (named == truth["hidden"] or truth["hidden"] in group)
-    elif truth["kind"] == "outclass":
-        margin = bic_margin(result) if named else None
-        band = result["selection"]["thresholds"]["bic_indistinguishable"]
-        related = set(truth["related"])
-        confident = bool(named and margin is not None and margin > band)
-        row["relation"] = ("related" if named in related else "unrelated") if named else result["verdict"]
-        row["bic_margin"] = margin
-        row["confident"] = confident
-        row["confident_wrong"] = confident and named not in related
+    row.update(judged(truth, result))
     return row
 
 
