@@ -72,3 +72,29 @@ def test_record_beyond_the_size_cap_is_refused_before_reading(tmp_path, params, 
     monkeypatch.setattr(importers, "MAX_RECORD_BYTES", 1000)
     with pytest.raises(UsageError, match=r"huge\.csv: .* MiB"):
         load_record(path, params=params)
+
+
+def test_a_decimated_record_keeps_the_step_its_converter_rounded_to(tmp_path, params):
+    """Filtered samples are off the converter's levels, so a decimated record states no levels (full scale and bits
+    are dropped), but where a channel moves by less than a step the filter averages no rounding away: each channel
+    keeps the step it was rounded to (2 full_scale / 255 of the file's 8 bits), and an angle-only record's derived
+    rack is rounded by the angle's step over the steering ratio (parksteer.measure.column.rack_rounding)."""
+    from parksteer.measure.column import rack_rounding
+    from parksteer.measure.converter import quantisation_step
+
+    meta, header, data = base_record(1)
+    meta = [m for m in meta if not m.startswith("# sample_rate")]
+    t = np.arange(data[0, 0], data[-1, 0], 1.0 / 400.0)
+    keep = [j for j, name in enumerate(header) if name != "rack_m"]
+    cols = [t] + [np.interp(t, data[:, 0], data[:, j]) for j in keep[1:]]
+    body = "\n".join(",".join(f"{v:.9g}" for v in row) for row in zip(*cols))
+    path = tmp_path / "fast_angle_only.csv"
+    path.write_text("\n".join(meta + [",".join(header[j] for j in keep)]) + "\n" + body + "\n", encoding="utf-8")
+    m = load_record(path, params=params)
+    assert "decimated" in m.metadata and "rack_derived" in m.metadata
+    angle = "handwheel_angle_rad"
+    assert m.quantisation_step(angle) == 0.0
+    assert m.rounding_step(angle) == pytest.approx(quantisation_step(16.0, 8), rel=1e-12)
+    assert m.rounding_step("handwheel_torque_Nm") == pytest.approx(quantisation_step(25.0, 8), rel=1e-12)
+    ratio = params.sections["steering"]["handwheel_to_rack_ratio"]
+    assert rack_rounding(m, params) == pytest.approx(quantisation_step(16.0, 8) / ratio, rel=1e-12)

@@ -93,21 +93,18 @@ def _files(records, params, case, surface, channel_map, name) -> list[FileData]:
     """The records ready to replay, in their order: paths read as ``parksteer diagnose`` reads them, and records
     already in memory (:class:`parksteer.measure.io.Measurement`, e.g. a benchmark's) prepared the same way (an
     angle-only one's rack derived through the column and the torsion bar)."""
-    from ..measure.column import rack_from_angle, rack_logger
-    from ..measure.converter import quantisation_step
+    from ..measure.column import rack_from_angle, rack_rounding
     from ..measure.io import Measurement
     from .problem import load_files, prepare_file, torsion_bar
 
     out = []
     for k, record in enumerate(records):
         if isinstance(record, Measurement):
-            resolution = 0.0
             if "rack_derived" in record.metadata:
                 record = rack_from_angle(record, params, torsion_bar(name))
-                logger = rack_logger(record, params)
-                resolution = 0.0 if logger is None else quantisation_step(logger[0], logger[1])
             label = record.path.name if record.path is not None else f"record {k + 1}"
-            out.append(prepare_file(record, case or record.case, label=label, rest_resolution_m=resolution))
+            out.append(prepare_file(record, case or record.case, label=label,
+                                    rest_resolution_m=rack_rounding(record, params)))
         else:
             out += load_files([str(record)], params, case, surface, channel_map, name)
     return out

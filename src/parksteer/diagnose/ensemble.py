@@ -9,7 +9,10 @@ whole logging and smoothing); otherwise splines are drawn from the least-squares
 distribution of the coefficients, as if the rack noise were white
 (:meth:`parksteer.measure.smoothing.SmoothedRack.perturbed`). The draws start from the rack smoothed at each
 knot spacing the data allow (:func:`ensemble_sources`), not from the chosen spline alone: at a reversal the
-spacing, not the data, sets how the spline eases through zero speed. Replaying them and taking the
+spacing, not the data, sets how the spline eases through zero speed. A rack whose rounding is coarser than its
+noise and not dithered by it (one derived from a bus's handwheel angle: ``FileData.rack.rest_resolution_m``) is
+relogged to the same levels at every draw, so each draw also moves it within its rounding where it is slow
+(:func:`parksteer.measure.smoothing.rounding_draw`). Replaying them and taking the
 spread of the torque at each sample gives how far the replay alone can be off there (where the
 smoothing held an end of the record or a pause of the hand at rest, every other draw leaves
 them free: a record cut while the hand is still slowing passes the smoothing's rest test, the
@@ -31,7 +34,7 @@ from scipy.ndimage import maximum_filter1d
 
 from .. import portable as pm
 from ..measure.converter import add_noise, quantise
-from ..measure.smoothing import SmoothedRack, smooth_rack
+from ..measure.smoothing import SmoothedRack, rounding_draw, smooth_rack
 from ..model.symbolic.components import Effect
 from .engine import ReplayEngine
 from ..measure.column import rack_logger
@@ -68,6 +71,9 @@ def with_replay_uncertainty(engine: ReplayEngine, problem: Problem, effects: lis
                 rack = relogged_rack(source, f.time_s, *logger, rng, hold_rest=hold)
             else:
                 rack = source.perturbed(rng)
+            if f.rack.rest_resolution_m > 0.0:  # a rounding coarser than the noise: the rack within its levels
+                rack = rounding_draw(rack, f.time_s, f.rack.rest_resolution_m, rng,
+                                     held=rack.rest_intervals_s if hold else ())
             racks.append((base, rack))
         engine.count(draws)  # the draws' solves (on one-off replays)
     owners = [i for i in range(len(problem.files)) for _ in range(draws)]

@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..measure.smoothing import SmoothedRack
+from ..measure.smoothing import RackSpline
 from ..errors import UsageError
 from ..model.numeric.assisted import solve_assisted
 from ..model.numeric.compiled import CompiledModels
@@ -49,7 +49,7 @@ class Replay:
     case: str
     surface: str
     params: Parameters
-    rack: SmoothedRack
+    rack: RackSpline  # the file's smoothed rack, or a draw of the replay's uncertainty
     time_s: np.ndarray
     base_overrides: dict[str, float] = field(default_factory=dict)
     evaluations: int = 0
@@ -76,7 +76,7 @@ class Replay:
             self.models = CompiledModels()
         self._base = self._prepared(self.base_overrides)
 
-    def on_rack(self, rack: SmoothedRack) -> Replay:
+    def on_rack(self, rack: RackSpline) -> Replay:
         """The same model, case and surface driven by another rack, at the same times: the prepared runs
         (which do not depend on the rack) are shared, not made again."""
         return self._sharing(rack, self.time_s)
@@ -86,7 +86,7 @@ class Replay:
         runs are shared, not made again."""
         return self._sharing(self.rack, time_s)
 
-    def _sharing(self, rack: SmoothedRack, time_s: np.ndarray) -> Replay:
+    def _sharing(self, rack: RackSpline, time_s: np.ndarray) -> Replay:
         return Replay(self.effects, self.case, self.surface, self.params, rack, time_s, dict(self.base_overrides),
                       runs=self._runs, model_effects=self.model_effects, direct=self.direct,
                       models=self.models)

@@ -15,7 +15,6 @@ from pathlib import Path
 from ..errors import UsageError
 from ..geometry import column_twist, pinion_angle_from_column
 from ..parameters import Parameters
-from .converter import quantisation_step
 from .importers import ANGLE, TORQUE, load_record
 from .io import Measurement
 from .metrics import noise_floor
@@ -37,7 +36,7 @@ def load_measurements(paths: list[str | Path], params: Parameters, case: str | N
     (path, measurement, its case, the rest resolution of its rack) each. `case` replaces the case every file
     names, `surface` fills the surface a file does not state; an angle-only record's rack is derived through the
     model's column (:func:`rack_from_angle`; with `assist`, an assisted car's torsion bar, through it) and
-    its rest resolution is its logger's step (:func:`rack_logger`; 0 for a measured rack)."""
+    its rest resolution is the angle's step carried to the rack (:func:`rack_rounding`; 0 for a measured rack)."""
     if not paths:
         raise UsageError("no measurement file given")
     if case is not None:
@@ -54,12 +53,19 @@ def load_measurements(paths: list[str | Path], params: Parameters, case: str | N
                 f"{path}: extra_offset_m = {stated:g} m but case {chosen} has "
                 f"{params.case(chosen)['extra_offset']:g} m; name the matching case (--case)"
             )
-        resolution = 0.0
         if "rack_derived" in measurement.metadata:
             measurement = rack_from_angle(measurement, params, assist)
-            logger = rack_logger(measurement, params)
-            resolution = 0.0 if logger is None else quantisation_step(logger[0], logger[1])
-        yield path, measurement, chosen, resolution
+        yield path, measurement, chosen, rack_rounding(measurement, params)
+
+
+def rack_rounding(measurement: Measurement, params: Parameters) -> float:
+    """The rounding of a rack derived from the handwheel angle (m): the angle's step
+    (:meth:`parksteer.measure.io.Measurement.rounding_step`, kept through a decimation) over
+    handwheel_to_rack_ratio. A bus's angle is far coarser than its noise, so this rounding is not dithered away;
+    0 for a measured rack, whose rounding its own noise dithers, or an angle whose step the file does not state."""
+    if "rack_derived" not in measurement.metadata:
+        return 0.0
+    return measurement.rounding_step(ANGLE) / params.sections["steering"]["handwheel_to_rack_ratio"]
 
 
 def rack_from_angle(measurement: Measurement, params: Parameters, assist: TorsionBar | None = None) -> Measurement:

@@ -617,7 +617,14 @@ def _decimate(path: Path, columns: dict[str, np.ndarray], metadata: dict[str, st
     for name, values in columns.items():
         if name != TIME:
             out[name] = resample_poly(values, 1, factor, window=fir)[: len(out[TIME])]
-    for column in list(metadata):  # a quantisation step no longer describes filtered samples
+    # A converter's levels no longer describe filtered samples, but its rounding stays in them where the signal
+    # moves by less than a step (the filter averages rounding errors only across the levels crossed): the step is
+    # kept as the column's rounding (Measurement.rounding_step).
+    for name in columns:
+        step = Measurement(None, {}, metadata).quantisation_step(name) if name != TIME else 0.0
+        if step > 0.0:
+            metadata[f"rounding_step_{name}"] = repr(step)
+    for column in list(metadata):
         if column.startswith("full_scale_") or column == "bits":
             del metadata[column]
     metadata["decimated"] = (f"from {1.0 / dt:.6g} Hz by {factor} to {1.0 / (dt * factor):.6g} Hz with an FIR "

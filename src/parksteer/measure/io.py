@@ -175,6 +175,12 @@ class Measurement:
             return 0.0
         return quantisation_step(full_scale, bits)
 
+    def rounding_step(self, column: str) -> float:
+        """The step `column` was rounded to: the logger's (:meth:`quantisation_step`), or, where the import
+        filtered the samples off the converter's levels (a decimation), the step the converter had
+        (``rounding_step_<column>``); 0 if neither is known."""
+        return self.quantisation_step(column) or float(self.metadata.get(f"rounding_step_{column}", 0.0))
+
 
 def _where(path: Path | str, column: str, row: int, line_numbers: list[int] | None) -> str:
     """'file: column 'c', row r (line l)' for data row `row` (1-based)."""

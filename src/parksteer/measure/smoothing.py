@@ -22,7 +22,8 @@ that uncertainty at every sample. Nor do the data fix how the rack eases into an
 of a second of it the rack moves by less than a converter step or its noise, so there the spline's speed follows
 its knots, and every spacing that passes the discrepancy test (``SmoothedRack.passing_spacings_s``) is as
 consistent with the data as the one kept; the replay's uncertainty smooths at each of them
-(:func:`parksteer.diagnose.ensemble.ensemble_sources`).
+(:func:`parksteer.diagnose.ensemble.ensemble_sources`). A rack rounded more coarsely than its noise (one derived
+from a bus's handwheel angle) hides a motion of up to a step wherever it is slow; :func:`rounding_draw` adds one.
 
 Every rack here is a :class:`RackSpline` (a piecewise polynomial: ``breaks``, ``coefficients``, ``start_s`` and
 ``end_s``), the rack motion :func:`parksteer.model.numeric.prescribed.solve` takes.
@@ -124,6 +125,21 @@ class RackSpline:
             speed = speed * h + position
             position = position * h + c[i]
         return position, speed, accel
+
+    def plus(self, other: RackSpline) -> RackSpline:
+        """This motion plus `other` (both cubic), on the union of their breaks, over this one's span."""
+        if len(self.coefficients) != 4 or len(other.coefficients) != 4:
+            raise ValueError("RackSpline.plus adds cubic splines only")
+        breaks = np.union1d(self.breaks, other.breaks)
+        breaks = breaks[(breaks >= self.start_s) & (breaks <= self.end_s)]
+        starts = breaks[:-1]
+        cubic = np.zeros(len(starts))
+        for spline in (self, other):  # each piece's cubic coefficient, from the piece the start lies in
+            k = np.clip(np.searchsorted(spline.breaks, starts, side="right") - 1, 0, len(spline.breaks) - 2)
+            inside = (starts >= spline.start_s) & (starts < spline.end_s)
+            cubic += np.where(inside, spline.coefficients[0, k], 0.0)
+        position, speed, accel = (a + b for a, b in zip(self.evaluate(starts), other.evaluate(starts)))
+        return RackSpline(breaks, np.vstack([cubic, 0.5 * accel, speed, position]))
 
 
 def interpolate_rack(time_s, rack_m) -> RackSpline:
@@ -235,6 +251,39 @@ class SmoothedRack(RackSpline):
             "turning_times_s": list(self.turning_times_s),
             "rest_intervals_s": [list(r) for r in self.rest_intervals_s],
         }
+
+
+def rounding_draw(rack: RackSpline, time_s: np.ndarray, step_m: float, rng: np.random.Generator,
+                  held: tuple[tuple[float, float], ...] = ()) -> RackSpline:
+    """`rack` plus a motion its data cannot see: the rack moving within the rounding of a logger whose rounding
+    is coarser than its noise and not dithered by it (`step_m`; a rack derived from a bus's handwheel angle).
+
+    Such a rounding's error is the same from sample to sample while the rack stays within one level: through a
+    reversal, at the edges of a pause, in any slow creep, the rack can move by up to a step in ways the samples do
+    not show, and the spline's speed there follows its knots, not the data. Redrawing the logger's noise does not
+    reach this (the noise is too small to move the rack across a level), so the draw adds a cubic B-spline on knots
+    RACK_MIN_SAMPLES_PER_KNOT samples apart (the finest spline the smoothing admits), its coefficients independent
+    and normal with the rounding's RMS, step / sqrt(12), divided by the square root of the number of levels the
+    rack crosses over a knot interval at `rack`'s speed there (the rounding's errors average out only across the
+    levels crossed): the draw moves where the rack is slow and is left as it is where the rack moves. Over a
+    stretch in `held` (a pause the draw holds at rest) it fades out within four knot intervals of the stretch's ends
+    (the B-splines wholly inside get nothing), so the pause's edges keep their doubt and its middle stays at rest."""
+    from scipy.interpolate import BSpline, PPoly
+
+    t = np.asarray(time_s, dtype=float)
+    interval = RACK_MIN_SAMPLES_PER_KNOT * float(np.median(np.diff(t)))
+    pieces = max(1, int(round((t[-1] - t[0]) / interval)))
+    inner = t[0] + (t[-1] - t[0]) * np.arange(pieces + 1) / pieces
+    knots = np.concatenate([[t[0]] * 3, inner, [t[-1]] * 3])
+    count = len(knots) - 4
+    first, last = knots[:count], knots[4 : count + 4]  # the span of each B-spline
+    centres = 0.5 * (first + last)
+    crossed = np.abs(rack.evaluate(centres)[1]) * interval / step_m
+    sigma = step_m / math.sqrt(12.0) / np.sqrt(np.maximum(crossed, 1.0))
+    for a, b in held:
+        sigma[(first >= a) & (last <= b)] = 0.0
+    draw = sigma * rng.standard_normal(count)
+    return rack.plus(RackSpline.from_ppoly(PPoly.from_spline(BSpline(knots, draw, 3, extrapolate=False))))
 
 
 def _knot_vector(t: np.ndarray, spacing_s: float, turns: tuple[float, ...] = (),
