@@ -161,3 +161,30 @@ def test_what_the_balance_does_not_fix_is_not_written(baseline, tmp_path):
     written = tomllib.loads(again.to_vehicle_toml(vehicle.read_text(encoding="utf-8")))["assist"]
     assert written["motor_inertia"]["source"].startswith("assumed")
     assert "friction_speed" not in written or written["friction_speed"]["source"].startswith("assumed")
+
+
+def test_a_data_sheets_product_stands_against_a_balance_read_at_the_wrong_tyre_friction(baseline, tmp_path):
+    """The column balance reads the assist against the road's load, which scales with the tyre-ground friction as
+    the assist scales with the product k_t eta N: the balance cannot tell the two apart. With the truth's torque
+    constant given as a data sheet's (0.055 N m/A) and the file's tyre-ground friction 0.60 (the truth's car has
+    0.666), the balance reads another product, the written file keeps the data sheet's, and the friction at which
+    the balance would read the data sheet's is the car's own. Given as assumed instead, the same balance's product
+    is written: only a data sheet is held against it."""
+    truth, path, _ = baseline
+    text = et.POLO.read_text(encoding="utf-8")
+    sheet = 'torque_constant = { value = 0.055, unit = "N m/A", source = "data sheet of the motor" }'
+    text = "\n".join(sheet if line.startswith("torque_constant = ") else line for line in text.splitlines())
+    friction = 'friction_coefficient = { value = 0.60, unit = "1", source = "assumed: not this car\'s" }'
+    text = "\n".join(friction if line.startswith("friction_coefficient = ") else line for line in text.splitlines())
+    vehicle = tmp_path / "sheet.toml"
+    vehicle.write_text(text + "\n", encoding="utf-8")
+    found = identify_boost([path], vehicle)
+    product = 0.055 * 0.85 * 18.0
+    assert "torque_constant" in found.kept
+    assert abs(found.balance_product / product - 1.0) > 0.05  # the balance alone would overturn the data sheet
+    agree = found.tyre_friction + (product - found.balance_product) / found.product_per_tyre_friction
+    assert agree == pytest.approx(0.666, abs=0.01)  # 0.665 measured: the balance is linear in the friction
+    assumed = tmp_path / "assumed.toml"
+    assumed.write_text(text.replace('source = "data sheet of the motor"', 'source = "assumed: a guess"') + "\n",
+                       encoding="utf-8")
+    assert "torque_constant" not in identify_boost([path], assumed).kept

@@ -49,7 +49,10 @@ times the identified product, P K(S - c), at the point of action; the written fi
 and the product as the torque constant k_t = P / (eta_f N) (only the product is fixed: eta_f and N stay the file's),
 and the motor friction; each entry's ``source`` names the records. A number of the gear is written only where it is
 physical and its interval excludes the file's value (a data sheet's even widened by the tyre-ground friction's
-step); otherwise the file's stays (:attr:`Identified.kept`). The sensor offset and the map's centre have no
+step); otherwise the file's stays (:attr:`Identified.kept`). A data sheet's product always stays: the balance's
+product moves by about a tenth per 0.05 of the tyre-ground friction, which an owner's file takes from elsewhere (the
+Polo's from the paper's loading plate), and a product overturned on a friction the file has wrong leaves every later
+record of the car unexplained. The report says at which friction the balance would agree with the data sheet. The sensor offset and the map's centre have no
 place in a vehicle file (the model's law is odd about the reading's zero): they are reported, and a later
 diagnosis that names an offset of the same size names the baseline's.
 """
@@ -282,7 +285,9 @@ def identify_boost(records, vehicle, case: str | None = None, surface: str | Non
     kept = []
     for key, (value, lo, hi, file_value, move) in judged.items():
         wide = move if given(key) else 0.0
-        if value < 0.0 or lo - wide <= file_value <= hi + wide:
+        # a data sheet's product always stands: the balance reads it at the file's tyre-ground friction, which moves
+        # it by about a tenth per 0.05 and which an owner does not know that well (the diagnosis calibrates it)
+        if value < 0.0 or lo - wide <= file_value <= hi + wide or (key == "torque_constant" and given(key)):
             kept.append(key)
     # the product the table is written with: the balance's, or the file's where it is kept
     P = product_file if "torque_constant" in kept else p * product_file
@@ -330,6 +335,7 @@ def identify_boost(records, vehicle, case: str | None = None, surface: str | Non
         hysteresis_A=_estimate(fitted.hysteresis, fitted.hysteresis_se, "A"), hysteresis_Nm=float(fitted.hysteresis_Nm),
         balance_rms_Nm=balance_rms, torque_noise_Nm=torque_noise, beyond_map=tuple(beyond),
         balance_floors=balance_floors, kept=tuple(kept),
+        balance_product=p * product_file,
         file_values={"product": product_file, "motor_friction_torque": v("motor_friction_torque"),
                      "motor_inertia": v("motor_inertia"), "back_efficiency": eta_b,
                      "efficiency": eta, "reduction_ratio": reduction, "torque_constant": k_t},

@@ -56,6 +56,7 @@ class Identified:
     beyond_map: tuple[str, ...]
     balance_floors: float = math.nan  # the balance's RMS in torque noise floors
     kept: tuple[str, ...] = ()  # the file's values the written file keeps: the records do not contradict them
+    balance_product: float = math.nan  # the balance's own product at the file's tyre-ground friction
     file_values: dict = field(default_factory=dict)
 
     def as_dict(self) -> dict:
@@ -64,6 +65,7 @@ class Identified:
         est["back_efficiency"] = None if self.back_efficiency is None else self.back_efficiency.as_dict()
         return {"vehicle": self.vehicle, "records": list(self.records), "assist": self.assist_name,
                 "balance_floors": self.balance_floors, "kept": list(self.kept),
+                "balance_product": self.balance_product if math.isfinite(self.balance_product) else None,
                 "table": {"torsion_bar_torque_Nm": list(self.torques), "assist": list(self.assist),
                           "assist_ci95": [list(c) for c in self.assist_ci95], "current_A": list(self.current_A),
                           "current_ci95": [list(c) for c in self.current_ci95]},
@@ -109,6 +111,12 @@ class Identified:
                   f"{self.torque_noise_Nm:.4f} N m ({self.balance_floors:.2f} floors)"]
         if self.kept:
             lines.append(f"kept as the file gives them (the records do not contradict them): {', '.join(self.kept)}")
+        file_product = self.file_values.get("product")
+        if "torque_constant" in self.kept and file_product is not None and math.isfinite(self.balance_product) \
+                and self.product_per_tyre_friction:
+            agree = self.tyre_friction + (file_product - self.balance_product) / self.product_per_tyre_friction
+            lines.append(f"the file's product {file_product:.4g} stands; the balance reads {self.balance_product:.4g} "
+                         f"at the file's tyre-ground friction {self.tyre_friction:g}, and the file's at {agree:.3g}")
         lines += [f"the map cannot hold: {b}" for b in self.beyond_map] or ["the map holds the records within "
                                                                             "their noise"]
         return lines
