@@ -23,6 +23,15 @@ one hand; `--tiers rack,angle`), about 5 s a case; `--routes map,identified` dia
 floors (the bar of the owner's routes: `--rungs as_is --routes map,identified --outclass`). Run:
 
     PYTHONPATH=src python benchmarks/bench_assisted_truth_ladder.py [--tiers rack] [--routes map] [out.json]
+
+Other cars of the truth: `--seed`, with `--hands`, `--floors`, `--replicates` and `--bits` for the cases, e.g. the
+two quoted in docs/assist.md:
+
+    PYTHONPATH=src python benchmarks/bench_assisted_truth_ladder.py --rungs as_is --routes map,identified --outclass \
+        --seed 777 --hands mid_stroke_end,rate_8pc_50Hz,lock_overshoot --outclass-hand pauses --floors 3 \
+        --replicates 2 --bits 12
+
+and `--seed 31337 --hands rest_after_stop,pauses,uneven_strokes --outclass-hand uneven_strokes --replicates 1`.
 """
 
 from __future__ import annotations
@@ -34,16 +43,18 @@ from dataclasses import replace
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "src"))
+from parksteer.experiments.assisted_truth import TruthDesign, run  # noqa: E402
 
 
 def rungs(gear):
+    """The truth's gear at each rung (module docstring)."""
     return {"as_is": gear, "friction": replace(gear, motor_friction_Nm=0.02),
             "band": replace(gear, friction_speed_rad_s=2.25, direction_speed_rad_s=2.25),
             "both": replace(gear, motor_friction_Nm=0.02, friction_speed_rad_s=2.25, direction_speed_rad_s=2.25)}
 
 
 def main(argv=None) -> int:
-    from parksteer.experiments.assisted_truth import TruthDesign, run
     from parksteer.model.symbolic.components import discover_effects
     from parksteer.vehicle import load_vehicle
 
@@ -53,12 +64,24 @@ def main(argv=None) -> int:
     parser.add_argument("--rungs", default="as_is,friction,band,both,model")
     parser.add_argument("--routes", default="map", help="the files diagnosed with: map, identified or both")
     parser.add_argument("--outclass", action="store_true", help="also the four out-of-class forms at 3 floors")
+    parser.add_argument("--seed", type=int, default=TruthDesign.seed, help="the design's seed: another set of cars")
+    parser.add_argument("--hands", default="uneven_strokes", help="the hands of the hidden cases")
+    parser.add_argument("--outclass-hand", default="uneven_strokes", help="the hand of the out-of-class cases")
+    parser.add_argument("--floors", type=float, default=4.0, help="the hidden cases' size in noise floors")
+    parser.add_argument("--replicates", type=int, default=1, help="null records on each of the eight hands")
+    parser.add_argument("--bits", type=int, choices=(10, 11, 12), help="one torsion-bar converter (default: the "
+                        "design's three)")
     args = parser.parse_args(argv)
     discover_effects()
     vehicle = ROOT / "data" / "vehicles" / "polo_vi.toml"
     params = load_vehicle(vehicle)
-    base = TruthDesign(tiers=tuple(args.tiers.split(",")), hidden_variations=("uneven_strokes",), floors=(4.0,),
-                       out_of_class_variations=("uneven_strokes",) if args.outclass else (),
+    converters = TruthDesign.torque_converters
+    if args.bits is not None:
+        converters = tuple(c for c in converters if c[0] == args.bits)
+    base = TruthDesign(tiers=tuple(args.tiers.split(",")), hidden_variations=tuple(args.hands.split(",")),
+                       floors=(args.floors,), null_replicates=args.replicates, seed=args.seed,
+                       torque_converters=converters,
+                       out_of_class_variations=(args.outclass_hand,) if args.outclass else (),
                        routes=tuple(args.routes.split(",")))
     out = {}
     for name in args.rungs.split(","):

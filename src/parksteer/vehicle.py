@@ -70,7 +70,13 @@ ASSIST_EFFECTS = {"column": "electric_assist_column", "pinion": "electric_assist
 # assist at the point of action (N m at the column or pinion, N at the rack), or the hydraulic valve's pressure (bar
 # or Pa, read in Pa).
 BOOST_SECTION = "boost"
-BOOST_UNITS = {"torsion_bar_torque": ("N m",), "assist": ("N m", "N", "bar", "Pa"), "vehicle_speed": ("km/h", "m/s")}
+BOOST_UNITS = {"torsion_bar_torque": ("N m",), "assist": ("N m", "N", "bar", "Pa"), "vehicle_speed": ("km/h", "m/s"),
+               "gain_uncertainty": ("1",)}
+# An identified table's ``gain_uncertainty`` (``parksteer assist identify``): the 95 % half-width of the table's
+# common gain, relative. It is no quantity of the model (the law does not read it): the diagnosis reads it as
+# params[BOOST_GAIN_UNCERTAINTY] (parksteer.diagnose.stages.baseline).
+BOOST_GAIN_UNCERTAINTY = "boost.gain_uncertainty"
+MAX_GAIN_UNCERTAINTY = 0.5
 BOOST_ASSIST_UNITS = {"column": ("N m",), "pinion": ("N m",), "rack": ("N",), "hydraulic": ("bar", "Pa")}
 BAR_PA = 1.0e5
 
@@ -107,6 +113,10 @@ def _read_assist(path: Path, table: Any, sections: dict, sources: dict) -> None:
             continue
         if key == BOOST_SECTION:
             values.update(_read_boost(path, kind, entry, name, sources))
+            if isinstance(entry, dict) and "gain_uncertainty" in entry:
+                section, _, field_name = BOOST_GAIN_UNCERTAINTY.partition(".")
+                sections[section] = {field_name: _gain_uncertainty(path, entry["gain_uncertainty"])}
+                sources[BOOST_GAIN_UNCERTAINTY] = str(entry["gain_uncertainty"].get("source", ""))
             continue
         if key.startswith("boost_"):
             raise ParameterError(f"{path}: assist.{key}: a boost table is written as [assist.boost] (torsion_bar_torque, "
@@ -133,12 +143,22 @@ def _read_assist(path: Path, table: Any, sections: dict, sources: dict) -> None:
     sections[name] = values
 
 
+def _gain_uncertainty(path: Path, entry: dict) -> float:
+    """``[assist.boost] gain_uncertainty``: a relative half-width in [0, MAX_GAIN_UNCERTAINTY]."""
+    value = entry["value"]
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0.0 <= value <= MAX_GAIN_UNCERTAINTY:
+        raise ParameterError(f"{path}: assist.boost.gain_uncertainty: value {value!r}, expected a relative "
+                             f"half-width from 0 to {MAX_GAIN_UNCERTAINTY:g}")
+    return float(value)
+
+
 def _read_boost(path: Path, kind: str, table: Any, name: str, sources: dict) -> dict[str, float]:
-    """``[assist.boost]``: the boost table (:mod:`parksteer.boost_table`) as the effect's scalar entries."""
+    """``[assist.boost]``: the boost table (:mod:`parksteer.boost_table`) as the effect's scalar entries (its
+    ``gain_uncertainty`` is read apart, :func:`_gain_uncertainty`)."""
     where = f"{path}: assist.boost"
     if not isinstance(table, dict) or not {"torsion_bar_torque", "assist"} <= set(table) or not set(table) <= set(
             BOOST_UNITS):
-        raise ParameterError(f"{where}: expected torsion_bar_torque, assist and optionally vehicle_speed")
+        raise ParameterError(f"{where}: expected torsion_bar_torque, assist and optionally vehicle_speed and gain_uncertainty")
     read: dict[str, list] = {}
     for key, entry in table.items():
         if not isinstance(entry, dict) or not {"value", "unit"} <= set(entry) or not set(entry) <= {
@@ -147,6 +167,8 @@ def _read_boost(path: Path, kind: str, table: Any, name: str, sources: dict) -> 
         units = BOOST_UNITS[key] if key != "assist" else BOOST_ASSIST_UNITS[kind]
         if entry["unit"] not in units:
             raise ParameterError(f"{where}.{key}: unit {entry['unit']!r}, expected {' or '.join(map(repr, units))}")
+        if key == "gain_uncertainty":
+            continue
         read[key] = entry["value"]
         sources[f"{name}.boost.{key}"] = str(entry.get("source", ""))
     speeds = read.get("vehicle_speed")

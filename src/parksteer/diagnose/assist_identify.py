@@ -336,6 +336,7 @@ def identify_boost(records, vehicle, case: str | None = None, surface: str | Non
         balance_rms_Nm=balance_rms, torque_noise_Nm=torque_noise, beyond_map=tuple(beyond),
         balance_floors=balance_floors, kept=tuple(kept),
         balance_product=p * product_file,
+        gain_uncertainty=Z95 / math.sqrt(float(np.sum((assist[assist > 0] / se_assist[assist > 0]) ** 2))),
         file_values={"product": product_file, "motor_friction_torque": v("motor_friction_torque"),
                      "motor_inertia": v("motor_inertia"), "back_efficiency": eta_b,
                      "efficiency": eta, "reduction_ratio": reduction, "torque_constant": k_t},

@@ -57,6 +57,9 @@ class Identified:
     balance_floors: float = math.nan  # the balance's RMS in torque noise floors
     kept: tuple[str, ...] = ()  # the file's values the written file keeps: the records do not contradict them
     balance_product: float = math.nan  # the balance's own product at the file's tyre-ground friction
+    # the 95 % half-width of the table's common gain, relative: what its points' intervals leave of a scale of all
+    # of them together (1 / sqrt(sum (A_k / se_k)^2), times the 95 % factor)
+    gain_uncertainty: float = math.nan
     file_values: dict = field(default_factory=dict)
 
     def as_dict(self) -> dict:
@@ -66,6 +69,7 @@ class Identified:
         return {"vehicle": self.vehicle, "records": list(self.records), "assist": self.assist_name,
                 "balance_floors": self.balance_floors, "kept": list(self.kept),
                 "balance_product": self.balance_product if math.isfinite(self.balance_product) else None,
+                "gain_uncertainty": self.gain_uncertainty if math.isfinite(self.gain_uncertainty) else None,
                 "table": {"torsion_bar_torque_Nm": list(self.torques), "assist": list(self.assist),
                           "assist_ci95": [list(c) for c in self.assist_ci95], "current_A": list(self.current_A),
                           "current_ci95": [list(c) for c in self.current_ci95]},
@@ -103,6 +107,7 @@ class Identified:
                   ("back-driven efficiency " + (self.back_efficiency.text() if self.back_efficiency is not None
                                                 else "not fixed (too few back-driven samples)")
                    + f" (file: {self.file_values.get('back_efficiency', float('nan')):.4g})"),
+                  f"the table's common gain known to +-{100 * self.gain_uncertainty:.2g} % (95 %)",
                   f"torsion-bar offset {self.offset.text()}",
                   f"rack friction {self.rack_friction.text()}",
                   f"map residual RMS {self.map_rms_A:.3f} A against {self.map_noise_A:.3f} A of noise; hysteresis "
@@ -196,8 +201,13 @@ def replace_assist_section(text: str, found) -> str:
                              "the records") + " }",
               f"assist = {{ value = [{assists}], unit = \"{unit}\", source = "
               + _toml_string(f"{where}: the current map times the product k_t eta N; 95 % beyond the dead band "
-                             f"{intervals}") + " }",
-              ""]
+                             f"{intervals}") + " }"]
+    if math.isfinite(found.gain_uncertainty):
+        lines.append(f"gain_uncertainty = {{ value = {_number(min(found.gain_uncertainty, 0.5))}, unit = \"1\", "
+                     "source = " + _toml_string(f"{where}: the 95 % half-width of the table's common gain, "
+                                                "relative (a later record's gain error within it is this baseline's)")
+                     + " }")
+    lines.append("")
     return "\n".join(kept + lines)
 
 

@@ -275,6 +275,16 @@ def markdown_report(result: dict, figure: str | None = None, user_figure: str | 
         lines += ["", "## What these data fix", ""] + [f"- {line}" for line in _identification_lines(result)]
     if result.get("assumed"):
         lines += ["", "## What the verdict owes to the assist's assumed values", ""] + _assumed_lines(result["assumed"])
+    if result.get("baseline") is not None:
+        b = result["baseline"]
+        lo, hi = b["ci95"]
+        lines += ["", "## The identified boost table's gain", "",
+                  f"This record's gain differs from the table's by {num(100 * b['strength'])} % (95 %: {num(100 * lo)} "
+                  f"to {num(100 * hi)} %); the baseline the table was identified from fixes its gain to "
+                  f"+-{num(100 * b['gain_uncertainty'])} %. "
+                  + ("Within that, the difference is the baseline's own, not an effect of the car: the verdict is "
+                     "adequate." if b["within"] else "The difference reaches beyond it: the car's map has changed "
+                     "since the baseline, or the baseline was too short to fix it.")]
     if result["unobservable"]:
         lines += ["", f"Unobservable in these data as replayed (even the largest strength moves the replayed torque "
                   f"by less than a tenth of the noise floor): {', '.join(result['unobservable'])}."]

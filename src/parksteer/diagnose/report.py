@@ -176,6 +176,8 @@ def diagnosis_dict(diagnosis: Diagnosis) -> dict:
         }
     if diagnosis.outputs.get("assumed") is not None:  # an assisted car's assumed values (stages/assumed.py)
         out["assumed"] = diagnosis.outputs["assumed"]
+    if diagnosis.outputs.get("baseline") is not None:  # a gain error against an identified table (stages/baseline.py)
+        out["baseline"] = diagnosis.outputs["baseline"]
     if "signature" in diagnosis.outputs:  # the residual's signature (stages/signature.py)
         out["signature"] = diagnosis.outputs["signature"].as_dict()
     if "user_effect" in diagnosis.outputs:  # a user's effect with free strengths (stages/user_effect.py)

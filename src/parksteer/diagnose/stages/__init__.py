@@ -28,6 +28,7 @@ from __future__ import annotations
 
 from .assumed import AssumedValues
 from .base import Stage, restart, run_table
+from .baseline import Baseline
 from .calibrate import Calibrate
 from .confound import Confound
 from .identify import Identify
@@ -48,6 +49,7 @@ STAGES: tuple[Stage, ...] = (
     Refit(),  # the best-scored few refitted in the full model
     Select(),  # their BIC gains over the effective sample size (again with the larger replay uncertainty)
     Verdict(),  # missing, adequate or unexplained
+    Baseline(),  # against an identified boost table: a gain error within the table's own uncertainty is the baseline's
     AssumedValues(),  # an assisted car: the verdict with each assumed value of its assist at its band's ends
     Separate(),  # where the indistinguishable candidates would differ
     Identify(),  # what these data fix, and the test that would fix the rest
