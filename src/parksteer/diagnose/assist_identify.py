@@ -48,11 +48,13 @@ relative, since it is read through the map. The identified table is the map
 times the identified product, P K(S - c), at the point of action; the written file carries it in ``[assist.boost]``
 and the product as the torque constant k_t = P / (eta_f N) (only the product is fixed: eta_f and N stay the file's),
 and the motor friction; each entry's ``source`` names the records. A number of the gear is written only where it is
-physical and its interval excludes the file's value (a data sheet's even widened by the tyre-ground friction's
-step); otherwise the file's stays (:attr:`Identified.kept`). A data sheet's product always stays: the balance's
-product moves by about a tenth per 0.05 of the tyre-ground friction, which an owner's file takes from elsewhere (the
-Polo's from the paper's loading plate), and a product overturned on a friction the file has wrong leaves every later
-record of the car unexplained. The report says at which friction the balance would agree with the data sheet. The sensor offset and the map's centre have no
+physical and its interval excludes the file's value; otherwise the file's stays (:attr:`Identified.kept`). A value
+the file gives from a data sheet always stays: the balance reads the gear through what it cannot check. The product
+moves by about a tenth per 0.05 of the tyre-ground friction, which an owner's file takes from elsewhere (the Polo's
+from the paper's loading plate), and the back-driven efficiency through the few samples after each reversal, whose
+timing a rack derived from a bus's angle does not fix; a data sheet's value overturned on either leaves every later
+record of the car unexplained. The report gives the balance's reading beside it, and for the product the friction at
+which the balance would agree with the data sheet. The sensor offset and the map's centre have no
 place in a vehicle file (the model's law is odd about the reading's zero): they are reported, and a later
 diagnosis that names an offset of the same size names the baseline's.
 """
@@ -262,33 +264,25 @@ def identify_boost(records, vehicle, case: str | None = None, surface: str | Non
     # What the written file takes from the balance: each number the file's value unless the number's 95 % interval
     # excludes it, and the file's kept where the estimate is no physical value (a friction or an inertia below zero:
     # the balance's misfit, not the gear's). A value the file gives from a data sheet (its source not assumed) is
-    # evidence of its own: it stands unless the interval excludes it even widened by what the tyre-ground friction's
-    # step moves the number (the balance cannot tell that friction from the gear, and a diagnosis calibrates it).
-    # (value, interval's low, high, the file's value, the tyre step's move) by key:
-    shift = np.abs(np.asarray(moved) - np.asarray(solution))
+    # a measurement of the part and stands: the balance reads the gear through the replayed road load (the product
+    # moves with the tyre-ground friction) and through the rack's timing at the reversals (the back-driven samples),
+    # and neither is known as well as a data sheet (module docstring).
+    # (value, interval's low, high, the file's value) by key:
     judged = {
         "torque_constant": (p * product_file, (p - z * se_p) * product_file, (p + z * se_p) * product_file,
-                            product_file, shift[len(keys) + 1] * product_file),
-        "motor_friction_torque": (values[0], values[0] - z * se[0], values[0] + z * se[0], v("motor_friction_torque"),
-                                  shift[0]),
-        "motor_inertia": (values[1], values[1] - z * se[1], values[1] + z * se[1], v("motor_inertia"), shift[1]),
+                            product_file),
+        "motor_friction_torque": (values[0], values[0] - z * se[0], values[0] + z * se[0], v("motor_friction_torque")),
+        "motor_inertia": (values[1], values[1] - z * se[1], values[1] + z * se[1], v("motor_inertia")),
     }
     if back_efficiency is not None:
-        moved_eta_b = eta_b * float(moved[len(keys) + 1]) / float(moved[len(keys) + 2])
-        judged["back_efficiency"] = (back_efficiency.value, *back_efficiency.ci95, eta_b,
-                                     abs(moved_eta_b - back_efficiency.value))
+        judged["back_efficiency"] = (back_efficiency.value, *back_efficiency.ci95, eta_b)
 
     def given(key: str) -> bool:
         return not params.sources.get(f"{name}.{key}", "assumed").startswith(
             ("assumed", "numerical", "the effect's default"))
 
-    kept = []
-    for key, (value, lo, hi, file_value, move) in judged.items():
-        wide = move if given(key) else 0.0
-        # a data sheet's product always stands: the balance reads it at the file's tyre-ground friction, which moves
-        # it by about a tenth per 0.05 and which an owner does not know that well (the diagnosis calibrates it)
-        if value < 0.0 or lo - wide <= file_value <= hi + wide or (key == "torque_constant" and given(key)):
-            kept.append(key)
+    kept = [key for key, (value, lo, hi, file_value) in judged.items()
+            if given(key) or value < 0.0 or lo <= file_value <= hi]
     # the product the table is written with: the balance's, or the file's where it is kept
     P = product_file if "torque_constant" in kept else p * product_file
     point_cov = pm.matmul(pm.matmul(fitted.jacobian_values, fitted.covariance), fitted.jacobian_values.T) \

@@ -55,7 +55,7 @@ class Identified:
     torque_noise_Nm: float
     beyond_map: tuple[str, ...]
     balance_floors: float = math.nan  # the balance's RMS in torque noise floors
-    kept: tuple[str, ...] = ()  # the file's values the written file keeps: the records do not contradict them
+    kept: tuple[str, ...] = ()  # the file's values the written file keeps: a data sheet's, or not contradicted
     balance_product: float = math.nan  # the balance's own product at the file's tyre-ground friction
     # the 95 % half-width of the table's common gain, relative: what its points' intervals leave of a scale of all
     # of them together (1 / sqrt(sum (A_k / se_k)^2), times the 95 % factor)
@@ -115,7 +115,8 @@ class Identified:
                   f"column balance RMS {self.balance_rms_Nm:.4f} N m against a torque noise floor of "
                   f"{self.torque_noise_Nm:.4f} N m ({self.balance_floors:.2f} floors)"]
         if self.kept:
-            lines.append(f"kept as the file gives them (the records do not contradict them): {', '.join(self.kept)}")
+            lines.append(f"kept as the file gives them (a data sheet's, or what the records do not contradict): "
+                         f"{', '.join(self.kept)}")
         file_product = self.file_values.get("product")
         if "torque_constant" in self.kept and file_product is not None and math.isfinite(self.balance_product) \
                 and self.product_per_tyre_friction:
