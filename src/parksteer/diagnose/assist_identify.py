@@ -73,6 +73,7 @@ from ..parameters import Parameters
 from .boost_map import BLOCK_S, Z95, _blocks, _estimate, _sandwich, _t95, fit_map
 from .identified_file import Identified
 from .problem import FileData
+from .stages.assumed import assumed_source
 
 # The mechanics' calibrated parameters (key, finite-difference step) beside the offset and the product: the column
 # torque is linear in the two frictions and the rotor's inertia, so one linear least-squares step is exact.
@@ -98,18 +99,16 @@ def _files(records, params, case, surface, channel_map, name) -> list[FileData]:
     """The records ready to replay, in their order: paths read as ``parksteer diagnose`` reads them, and records
     already in memory (:class:`parksteer.measure.io.Measurement`, e.g. a benchmark's) prepared the same way (an
     angle-only one's rack derived through the column and the torsion bar)."""
-    from ..measure.column import rack_from_angle, rack_rounding
+    from ..measure.column import with_derived_rack
     from ..measure.io import Measurement
     from .problem import load_files, prepare_file, torsion_bar
 
     out = []
     for k, record in enumerate(records):
         if isinstance(record, Measurement):
-            if "rack_derived" in record.metadata:
-                record = rack_from_angle(record, params, torsion_bar(name))
+            record, resolution = with_derived_rack(record, params, torsion_bar(name))
             label = record.path.name if record.path is not None else f"record {k + 1}"
-            out.append(prepare_file(record, case or record.case, label=label,
-                                    rest_resolution_m=rack_rounding(record, params)))
+            out.append(prepare_file(record, case or record.case, label=label, rest_resolution_m=resolution))
         else:
             out += load_files([str(record)], params, case, surface, channel_map, name)
     return out
@@ -183,23 +182,18 @@ def identify_boost(records, vehicle, case: str | None = None, surface: str | Non
     # the rotor's speed: N times the point of action's rate (at the column the joint's ratio taken as G_hr: a few
     # per cent of a band's width)
     lever = 1.0 if location == "rack" else ratio
-    rotor = [rack_speed_mps(f.rack, f.time_s) * reduction * lever for f in files]
+    rack_speeds = [rack_speed_mps(f.rack, f.time_s) for f in files]
+    rotor = [speed * reduction * lever for speed in rack_speeds]
     motors = [law(f.torque_Nm - fitted.centre) * k_t for f in files]
     S_all = np.concatenate([f.torque_Nm for f in files])
     t_all = np.concatenate([f.time_s + 1e6 * k for k, f in enumerate(files)])
     sigma = np.concatenate([np.full(f.n, f.noise.total_rms) for f in files])
     back = np.concatenate([m * w < 0.0 for m, w in zip(motors, rotor)])
 
-    def delivered(band: float) -> np.ndarray:
-        """What the file's gear delivers for the identified current, its direction changing over `band`."""
-        return np.concatenate([directional_efficiency(m, w, eta, eta_b, v("limit_smoothing"), 1.0 / band)
-                               * reduction * m / scale for m, w in zip(motors, rotor)])
-
     # where the motion is defined: the smoothed rack's speed beyond the car-wide friction smoothing's band (its sign
     # sure; nearer a reversal the spline's timing of it is not), whatever band the gear's friction has
     sharpness = float(params["steering.friction_smoothing"])
-    use = np.concatenate([np.abs(pm.tanh(sharpness * rack_speed_mps(f.rack, f.time_s))) >= MOVING_SIGN
-                          for f in files])
+    use = np.concatenate([np.abs(pm.tanh(sharpness * speed)) >= MOVING_SIGN for speed in rack_speeds])
     split = (use & back).sum() >= BACK_DRIVEN_SHARE * use.sum()
     if use.sum() < 20 * (len(MECHANICS) + 2):
         raise UsageError(f"{', '.join(str(r) for r in records)}: the steering hardly moves: identify needs "
@@ -210,33 +204,25 @@ def identify_boost(records, vehicle, case: str | None = None, surface: str | Non
         return np.concatenate([engine.replay(problem, effects, k).solve(overrides).torque_Nm[: f.n]
                                for k, f in enumerate(files)])
 
-    def balance(band: float, use: np.ndarray, split: bool):
-        """(y0, the weighted design matrix, its right-hand side, the solution, the residual) of the column balance
-        with the motor's friction and the gear's direction changing over `band` (rotor rad/s), on the samples
-        `use`."""
-        band_key = {f"{name}.friction_speed": band}
-        y0 = road(band_key)
-        columns = [(road({**band_key, key: value + step}) - y0) / step
-                   for key, value, (_, step) in zip(keys, theta, MECHANICS)]
-        D = delivered(band)
-        parts = [-D * ~back, -D * back] if split else [-D]
-        matrix = (np.column_stack([*columns, np.ones_like(S_all), *parts]) / sigma[:, None])[use]
-        rhs = ((S_all - y0) / sigma)[use]
-        solution = pm.lstsq(matrix, rhs)
-        return y0, matrix, rhs, solution, rhs - pm.matmul(matrix, solution)
-
-    band = v("friction_speed")
     say("identify: the column balance on the car's replay")
     try:
-        y0, design, rhs, solution, resid = balance(band, use, split)
+        y0 = road({})
+        columns = [(road({key: value + step}) - y0) / step for key, value, (_, step) in zip(keys, theta, MECHANICS)]
         tyre_key, tyre_step = TYRE_FRICTION
-        tyre_column = (road({f"{name}.friction_speed": band, tyre_key: float(params[tyre_key]) + tyre_step})
-                       - y0) / tyre_step
+        tyre_column = (road({tyre_key: float(params[tyre_key]) + tyre_step}) - y0) / tyre_step
     finally:
         engine.close()
+    # what the file's gear delivers for the identified current, its direction changing over the file's band of
+    # rotor speed
+    D = np.concatenate([directional_efficiency(m, w, eta, eta_b, v("limit_smoothing"), 1.0 / v("friction_speed"))
+                        * reduction * m / scale for m, w in zip(motors, rotor)])
     # y0 + J dtheta + o - S - p D = 0  ->  [J, 1, -D] [dtheta, o, p] = S - y0, with D split into the samples the
     # motor drives and those it is driven back (their factor p_b = p eta_b,file / eta_b)
     # only while the gear moves: at rest its friction and the direction of its power are not defined
+    parts = [-D * ~back, -D * back] if split else [-D]
+    design = (np.column_stack([*columns, np.ones_like(S_all), *parts]) / sigma[:, None])[use]
+    solution = pm.lstsq(design, ((S_all - y0) / sigma)[use])
+    resid = ((S_all - y0) / sigma)[use] - pm.matmul(design, solution)
     cov = _sandwich(design, resid, _blocks(t_all[use], BLOCK_S))
     # the product at the tyre friction moved by its step: the same fit on y0 + step x its column
     moved = pm.lstsq(design, ((S_all - y0 - tyre_step * tyre_column) / sigma)[use])
@@ -277,12 +263,9 @@ def identify_boost(records, vehicle, case: str | None = None, surface: str | Non
     if back_efficiency is not None:
         judged["back_efficiency"] = (back_efficiency.value, *back_efficiency.ci95, eta_b)
 
-    def given(key: str) -> bool:
-        return not params.sources.get(f"{name}.{key}", "assumed").startswith(
-            ("assumed", "numerical", "the effect's default"))
-
     kept = [key for key, (value, lo, hi, file_value) in judged.items()
-            if given(key) or value < 0.0 or lo <= file_value <= hi]
+            if not assumed_source(params.sources.get(f"{name}.{key}", "assumed")) or value < 0.0
+            or lo <= file_value <= hi]
     # the product the table is written with: the balance's, or the file's where it is kept
     P = product_file if "torque_constant" in kept else p * product_file
     point_cov = pm.matmul(pm.matmul(fitted.jacobian_values, fitted.covariance), fitted.jacobian_values.T) \

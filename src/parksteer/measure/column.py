@@ -53,9 +53,18 @@ def load_measurements(paths: list[str | Path], params: Parameters, case: str | N
                 f"{path}: extra_offset_m = {stated:g} m but case {chosen} has "
                 f"{params.case(chosen)['extra_offset']:g} m; name the matching case (--case)"
             )
-        if "rack_derived" in measurement.metadata:
-            measurement = rack_from_angle(measurement, params, assist)
-        yield path, measurement, chosen, rack_rounding(measurement, params)
+        measurement, resolution = with_derived_rack(measurement, params, assist)
+        yield path, measurement, chosen, resolution
+
+
+def with_derived_rack(measurement: Measurement, params: Parameters, assist: TorsionBar | None = None
+                      ) -> tuple[Measurement, float]:
+    """(the record, the rounding of its rack): an angle-only record with its rack derived through the model's
+    column (:func:`rack_from_angle`) and that rack's rounding (:func:`rack_rounding`); a record with a rack as it
+    is, its rounding 0."""
+    if "rack_derived" in measurement.metadata:
+        measurement = rack_from_angle(measurement, params, assist)
+    return measurement, rack_rounding(measurement, params)
 
 
 def rack_rounding(measurement: Measurement, params: Parameters) -> float:

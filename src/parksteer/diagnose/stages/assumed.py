@@ -57,6 +57,12 @@ REDUCTION = {"column": (15.0, 22.0), "pinion": (15.0, 25.0), "rack": (1500.0, 35
 LINE_KEYS = ("gain", "dead_band", "dead_band_smoothing")
 
 
+def assumed_source(source: str) -> bool:
+    """Whether a vehicle file's `source` of a value says it is assumed: ``assumed``, ``numerical`` (a smoothing), or
+    no entry at all (the effect's default); anything else is a data sheet's or a measurement's."""
+    return source.startswith(("assumed", "numerical", "the effect's default"))
+
+
 def assumed_quantities(params, name: str, effect) -> list[tuple[str, float, str, tuple[float, float]]]:
     """(key, value, source, band) of each quantity of the assist `name` the file takes as assumed (module
     docstring), in the effect's order."""
@@ -68,7 +74,7 @@ def assumed_quantities(params, name: str, effect) -> list[tuple[str, float, str,
         if (key not in BANDS and key != "reduction_ratio") or (table and key in LINE_KEYS):
             continue
         source = params.sources.get(f"{name}.{key}", "the effect's default")
-        if not source.startswith(("assumed", "numerical", "the effect's default")):
+        if not assumed_source(source):
             continue
         band = BANDS.get(key)
         if key == "reduction_ratio":

@@ -14,6 +14,8 @@ change of the map since the baseline, or a table read on too short a baseline). 
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 from ...vehicle import BOOST_GAIN_UNCERTAINTY
 from ..engine import ReplayEngine
 from ..state import DiagnosisState
@@ -45,7 +47,5 @@ class Baseline(Stage):
                  "gain_uncertainty": band, "within": within, "verdict_before": state.verdict}
         state = state.with_output(self.name, found)
         if within and state.verdict == "missing":
-            from dataclasses import replace
-
             state = replace(state, verdict="adequate")
         return state
