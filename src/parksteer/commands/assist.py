@@ -130,8 +130,9 @@ def _size(args) -> int:
 
 
 def print_friction_band(study) -> None:
-    """The standstill rack force over the tyre-ground friction band, against the published forces; a warning on
-    stderr when even the band's top is below them."""
+    """The standstill rack force over the tyre-ground friction band, with and without the rack's own friction,
+    against the published class range, and the assist sized at the range's ends; a warning on stderr when a force
+    of the band is below the range."""
     import sys
 
     from ..sweep.assist_sizing import PUBLISHED_STANDSTILL_RACK_FORCE_N
@@ -140,10 +141,16 @@ def print_friction_band(study) -> None:
     hydraulic = study.assist == ASSIST_EFFECTS["hydraulic"]
     print(f"standstill over the tyre-ground friction of dry asphalt (published for small and medium cars: "
           f"{low / 1e3:g}-{high / 1e3:g} kN)")
-    print("friction  peak rack force N" + ("" if hydraulic else "  motor torque N m  motor current A"))
+    print("friction  peak rack force N  without rack friction N" + ("" if hydraulic else
+                                                                    "  motor torque N m  motor current A"))
     for r in study.friction_band:
-        print(f"{r.friction:8.2f}  {r.peak_rack_force_N:17.0f}"
+        print(f"{r.friction:8.2f}  {r.peak_rack_force_N:17.0f}  {r.peak_rack_force_without_rack_friction_N:23.0f}"
               + ("" if hydraulic else f"  {r.motor_torque_Nm:16.2f}  {r.motor_current_A:15.1f}"))
+    print("sized at the class range's ends (quasi-static, through this car's gear at its standstill peak)")
+    print("rack force N  " + ("pressure bar" if hydraulic else "motor torque N m  motor current A"))
+    for r in study.class_load:
+        print(f"{r.rack_force_N:12.0f}  " + (f"{r.pressure_Pa / 1e5:12.1f}" if hydraulic else
+                                            f"{r.motor_torque_Nm:16.2f}  {r.motor_current_A:15.1f}"))
     below = study.below_published()
     if below:
         frictions = ", ".join(f"{r.friction:g}" for r in below)
@@ -151,7 +158,7 @@ def print_friction_band(study) -> None:
         print(f"warning: at tyre-ground friction {frictions} the standstill rack force is below the "
               f"{low / 1e3:g}-{high / 1e3:g} kN published for current small and medium cars ({top:.0f} N at the "
               "band's top): the tyre's bore torque (equation (2)) or the car's loads may be those of an older or "
-              "lighter car; size the motor for the band's top", file=sys.stderr)
+              "lighter car; size the motor for the band's top or the class range's", file=sys.stderr)
 
 
 def with_gain_half_speed(params, args):
