@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from parksteer.cli import main
 from parksteer.figures.assist_creep import CREEP_SPEEDS_KMH, crossover, creep_study, plateau_terms
 from parksteer.figures.assist_study import CASE, SPIN_SLOPE_KEY
 from parksteer.model.numeric.simulate import simulate
@@ -91,3 +92,15 @@ def test_the_bisection_finds_a_known_root_and_none_without_a_sign_change():
     assert crossover(lambda q: np.log(q / 0.3)) == pytest.approx(0.3, rel=1e-5)
     assert crossover(lambda q: q + 1.0) is None
     assert crossover(lambda q: -q) is None
+
+
+def test_the_command_prints_the_study_and_refuses_an_unknown_case(creep, capsys):
+    """`parksteer assist creep` prints, for the paper's car, the same crossovers and verdicts as the study (the
+    first at 1 km/h, to the printed three decimals), and an unknown load case is refused in one line, status 2."""
+    assert main(["assist", "creep"]) == 0
+    out = capsys.readouterr().out
+    first = creep["crossover_q_dz8"][f"{CREEP_SPEEDS_KMH[0]:g}"]
+    assert f"1 km/h: tyre and rack friction carry alike at q_Dz8 {first:.3f}" in out
+    assert main(["assist", "creep", "--case", "no_such_case"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--case no_such_case" in err[0]

@@ -1,5 +1,6 @@
 """``parksteer assist size``: the rack force a car needs at standstill and creeping, and the assist that keeps the
-driver's torque under a target (parksteer.sweep.assist_sizing). ``parksteer assist identify``: an electric assist's
+driver's torque under a target (parksteer.sweep.assist_sizing). ``parksteer assist creep``: how much of the tyre's
+moment a creeping car keeps over the turn-slip slope (parksteer.figures.assist_creep). ``parksteer assist identify``: an electric assist's
 boost table and its gear's hidden numbers from the car's own records (parksteer.diagnose.assist_identify)."""
 
 from __future__ import annotations
@@ -35,6 +36,13 @@ def register(sub) -> None:
     s.add_argument("--out-dir", required=True, help="folder for sizing.csv and the two figures")
     s.add_argument("--parameters", default=str(DEFAULT_PATH), help="the base parameter file")
     s.set_defaults(func=_size)
+    c = asub.add_parser("creep", help="creeping without assist at 1, 3 and 5 km/h over the tyre's turn-slip slope "
+                                      "q_Dz8: the share of the standstill tyre moment kept, and where the tyre's "
+                                      "share of the parking torque equals the rack friction's")
+    c.add_argument("--vehicle", default=None, metavar="FILE.toml", help="a vehicle file (default: the paper's car)")
+    c.add_argument("--case", default=None, help="its load case (default: its first)")
+    c.add_argument("--parameters", default=str(DEFAULT_PATH), help="the base parameter file")
+    c.set_defaults(func=_creep)
     i = asub.add_parser("identify", help="an electric assist's boost table, motor friction, product k_t eta N and "
                                          "torque-sensor offset from the car's records (torsion-bar torque and motor "
                                          "current), written into the vehicle file")
@@ -82,6 +90,18 @@ def _identify(args) -> int:
     else:
         print("\n".join(found.summary_lines()))
     print(f"wrote {out}", file=sys.stderr if args.json else sys.stdout)
+    return 0
+
+
+def _creep(args) -> int:
+    from ..figures.assist_creep import creep_study, summary_lines
+
+    params = parameters_of(args)
+    case = args.case or params.case_names[0]
+    if case not in params.case_names:
+        raise UsageError(f"--case {case}: not a case of {args.vehicle or args.parameters} "
+                         f"({', '.join(params.case_names)})")
+    print("\n".join(summary_lines(creep_study(params, case))))
     return 0
 
 

@@ -61,17 +61,18 @@ def plateau_terms(result: SimulationResult, params: Parameters) -> dict:
             "lifting_share": terms["lifting"] / road}
 
 
-def creep_study(params: Parameters, run=simulate, progress=None) -> dict:
-    """Every run of the study and the numbers the paper quotes (module docstring)."""
+def creep_study(params: Parameters, case: str = CASE, run=simulate, progress=None) -> dict:
+    """Every run of the study and the numbers the paper quotes (module docstring), for the car of `params` in load
+    case `case` (the paper's car unladen by default)."""
     def at(q: float, speed: float) -> SimulationResult:
-        return run(CASE, effects=CREEPING_EFFECTS, params=params,
+        return run(case, effects=CREEPING_EFFECTS, params=params,
                    overrides={**creeping_overrides(speed), SPIN_SLOPE_KEY: q})
 
     band = spin_band()
-    standstill = plateau_terms(run(CASE, effects=CREEPING_EFFECTS, overrides=creeping_overrides(0.0), params=params),
+    standstill = plateau_terms(run(case, effects=CREEPING_EFFECTS, overrides=creeping_overrides(0.0), params=params),
                                params)
     grid = q_grid()
-    out: dict = {"case": CASE, "speeds_kmh": list(CREEP_SPEEDS_KMH), "q_dz8": grid,
+    out: dict = {"case": case, "speeds_kmh": list(CREEP_SPEEDS_KMH), "q_dz8": grid,
                  "standstill": {k: v for k, v in standstill.items()},
                  "band": {"q_dz8": list(band["band"]), "mf_default": band["mf_default"],
                           "passenger_car": band["passenger_car"], "passenger_car_tyre": band["passenger_car_tyre"],
@@ -138,6 +139,31 @@ def conclusion(out: dict) -> dict:
             where = "conditional"
         result[key] = {"band": where, "passenger_car_tyre_below": below_at[f"{car:g}"], "crossover_q_dz8": q}
     return result
+
+
+def summary_lines(out: dict) -> list[str]:
+    """The study as a reader's table: per speed, the kept share and the tyre's and rack friction's shares at the
+    band's ends and the passenger-car value, the crossover and the verdict."""
+    band = out["band"]
+    lines = [f"creeping without assist over |q_Dz8| (assumed band {band['q_dz8'][0]:g}-{band['q_dz8'][1]:g}; "
+             f"a {band['passenger_car_tyre']}: {band['passenger_car']:g}, {band['passenger_car_access'].split(':')[0]})",
+             f"standstill: tyre {100 * out['standstill']['tyre_share']:.1f} %, rack friction "
+             f"{100 * out['standstill']['rack_friction_share']:.1f} % of the plateau's road torque",
+             "speed km/h  q_Dz8  tyre moment kept %  tyre share %  rack friction share %"]
+    for speed in out["speeds_kmh"]:
+        for q, row in out["at"][f"{speed:g}"].items():
+            lines.append(f"{speed:10g}  {float(q):5.3f}  {100 * row['kept']:18.1f}  {100 * row['tyre_share']:12.1f}  "
+                         f"{100 * row['rack_friction_share']:21.1f}")
+    words = {"conditional": "conditional on the tyre (the crossover inside the band)",
+             "tyre_below": "rack friction above the tyre over the whole band",
+             "tyre_above": "the tyre above rack friction over the whole band"}
+    for speed in out["speeds_kmh"]:
+        key = f"{speed:g}"
+        q = out["crossover_q_dz8"][key]
+        where = (f"tyre and rack friction carry alike at q_Dz8 {q:.3f}" if q is not None else
+                 f"no crossover in {Q_RANGE[0]:g}-{Q_RANGE[1]:g}")
+        lines.append(f"{speed:g} km/h: {where}; {words[out['conclusion'][key]['band']]}")
+    return lines
 
 
 def creep_table(out: dict) -> dict[str, list]:
