@@ -60,8 +60,8 @@ rule assist_study:
 
 # Creeping over speed and tyre (parksteer.figures.assist_creep): the paper's car without assist at 1, 3 and 5 km/h
 # over the turn-slip slope q_Dz8, the share of its standstill moment the rolling tyre keeps and the crossover where
-# the tyre's share of the plateau equals the rack friction's; 79 cycles and a bisection, a few seconds once the
-# creeping model is compiled. Writes the figure, its table and results/assist_creep.json; part of `all` (FIGURES).
+# the tyre's share of the plateau equals the rack friction's; about 130 cycles of 25 ms, bisection included, once
+# the creeping model is compiled. Writes the figure, its table and results/assist_creep.json; part of `all` (FIGURES).
 rule assist_creep:
     input:
         parameters=PARAMETERS,
