@@ -12,8 +12,11 @@ from parksteer.model.numeric.simulate import simulate
 
 
 @pytest.fixture(scope="module")
-def study(params):
-    return assist_study(params)
+def study(params, repo_root):
+    import yaml
+
+    config = yaml.safe_load((repo_root / "config" / "config.yaml").read_text(encoding="utf-8"))
+    return assist_study(params, config["assist"]["target_torque"])
 
 
 @pytest.mark.parametrize("kind", ASSISTS)

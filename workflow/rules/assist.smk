@@ -48,6 +48,7 @@ rule assist_study:
         json="results/assist_study.json",
     params:
         code=code("assist_study"),
+        target=config["assist"]["target_torque"],
     log:
         "logs/assist_study.log",
     benchmark:

@@ -35,7 +35,7 @@ Loads. The standstill cycle without assist runs again over the tyre-ground frict
 (parksteer.sweep.assist_sizing.FRICTION_BAND), its peak rack force, with and without the rack's own friction, set
 against the published class range of standstill rack forces of small and medium cars
 (PUBLISHED_STANDSTILL_RACK_FORCE_N there): below, within or above it at each friction. The column assist at its
-defaults is sized for a 3 N m driver against the model's standstill load and against the class range's ends
+defaults is sized for the driver's target torque (the pipeline's assist.target_torque) against the model's standstill load and against the class range's ends
 (class_load).
 
 Numbers on this path reach a checksummed figure: elementwise arithmetic, means and extrema only.
@@ -181,7 +181,7 @@ def back_driven(result: SimulationResult, params: Parameters, least_Nm: float = 
             "forward_factor": float(np.min(factor))}
 
 
-def class_load(standstill: SimulationResult, params: Parameters, target_torque_Nm: float = 3.0) -> dict:
+def class_load(standstill: SimulationResult, params: Parameters, target_torque_Nm: float) -> dict:
     """The column assist at its defaults sized, quasi-statically, to leave the driver `target_torque_Nm` against
     the model's standstill peak rack force and against the ends of the published class range, through the car's gear
     at the standstill peak (parksteer.sweep.assist_sizing.size_for_rack_force); with the defaults' motor limit."""
@@ -202,8 +202,9 @@ def _spread(values: dict) -> float:
     return max(values.values()) - min(values.values())
 
 
-def assist_study(params: Parameters, run=simulate, progress=None) -> dict:
-    """Every run of the study and the numbers the paper quotes (module docstring). `run` is the simulation
+def assist_study(params: Parameters, target_torque_Nm: float, run=simulate, progress=None) -> dict:
+    """Every run of the study and the numbers the paper quotes (module docstring); `target_torque_Nm` is the driver's
+    torque the class-load sizing keeps (the pipeline's config, assist.target_torque). `run` is the simulation
     (simulate's signature); `progress`, if given, is called with a line per run."""
     discover_effects()  # the assists' own quantities, with their assumed defaults
     kinds = (None, *ASSISTS)
@@ -271,7 +272,7 @@ def assist_study(params: Parameters, run=simulate, progress=None) -> dict:
         "below_published_at": [f for f, force in zip(FRICTION_BAND, band) if force < low],
         "within_published_at": [f for f, force in zip(FRICTION_BAND, band) if low <= force <= high],
         "above_published_at": [f for f, force in zip(FRICTION_BAND, band) if force > high]}
-    numbers["class_load"] = class_load(results[(None, CASE, 0.0)], params)
+    numbers["class_load"] = class_load(results[(None, CASE, 0.0)], params, target_torque_Nm)
     standstill_tyre = _tyre_term(results[(None, CASE, 0.0)], params)
     numbers["spin_slope_band"] = {
         "q_dz8": list(SPIN_SLOPE_BAND),
@@ -348,12 +349,12 @@ def plot_study(numbers: dict, params: Parameters):
 
 
 def make_assist_study(parameters_path: str | Path, svg_path: str | Path, csv_path: str | Path,
-                      json_path: str | Path, progress=None) -> dict:
+                      json_path: str | Path, target_torque_Nm: float, progress=None) -> dict:
     """Write the study's figure (SVG), its table (CSV) and the numbers the paper quotes (JSON)."""
     from ..plotting import save_svg
 
     params = load_parameters(parameters_path)
-    numbers = assist_study(params, progress=progress)
+    numbers = assist_study(params, target_torque_Nm, progress=progress)
     header = {"table": "the paper's car over the lock-to-lock cycle without and with each assist at its assumed "
                        "defaults: the four wheel offsets at standstill, the unladen car at creeping speeds",
               "peak_rack_force_N": "pinion and assist together on the rack; given for the unladen car"}
