@@ -1,7 +1,8 @@
 """``parksteer assist size``: the rack force a car needs at standstill and creeping, and the assist that keeps the
 driver's torque under a target (parksteer.sweep.assist_sizing). ``parksteer assist creep``: how much of the tyre's
-moment a creeping car keeps over the turn-slip slope (parksteer.figures.assist_creep). ``parksteer assist identify``: an electric assist's
-boost table and its gear's hidden numbers from the car's own records (parksteer.diagnose.assist_identify)."""
+moment a creeping car keeps over the turn-slip slope (parksteer.figures.assist_creep). ``parksteer assist
+identify``: an electric assist's boost table and its gear's hidden numbers from the car's own records
+(parksteer.diagnose.assist_identify)."""
 
 from __future__ import annotations
 

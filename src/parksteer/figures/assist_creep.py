@@ -145,8 +145,9 @@ def summary_lines(out: dict) -> list[str]:
     """The study as a reader's table: per speed, the kept share and the tyre's and rack friction's shares at the
     band's ends and the passenger-car value, the crossover and the verdict."""
     band = out["band"]
+    access = band["passenger_car_access"].split(":")[0]
     lines = [f"creeping without assist over |q_Dz8| (assumed band {band['q_dz8'][0]:g}-{band['q_dz8'][1]:g}; "
-             f"a {band['passenger_car_tyre']}: {band['passenger_car']:g}, {band['passenger_car_access'].split(':')[0]})",
+             f"a {band['passenger_car_tyre']}: {band['passenger_car']:g}, {access})",
              f"standstill: tyre {100 * out['standstill']['tyre_share']:.1f} %, rack friction "
              f"{100 * out['standstill']['rack_friction_share']:.1f} % of the plateau's road torque",
              "speed km/h  q_Dz8  tyre moment kept %  tyre share %  rack friction share %"]

@@ -35,8 +35,8 @@ Loads. The standstill cycle without assist runs again over the tyre-ground frict
 (parksteer.sweep.assist_sizing.FRICTION_BAND), its peak rack force, with and without the rack's own friction, set
 against the published class range of standstill rack forces of small and medium cars
 (PUBLISHED_STANDSTILL_RACK_FORCE_N there): below, within or above it at each friction. The column assist at its
-defaults is sized for the driver's target torque (the pipeline's assist.target_torque) against the model's standstill load and against the class range's ends
-(class_load).
+defaults is sized for the driver's target torque (the pipeline's assist.target_torque) against the model's
+standstill load and against the class range's ends (class_load).
 
 Numbers on this path reach a checksummed figure: elementwise arithmetic, means and extrema only.
 """
@@ -194,7 +194,8 @@ def class_load(standstill: SimulationResult, params: Parameters, target_torque_N
     rows = [size_for_rack_force(name, params, f, at_peak, target_torque_Nm)
             for f in (float(np.abs(force[peak])), *PUBLISHED_STANDSTILL_RACK_FORCE_N)]
     return {"target_torque_Nm": target_torque_Nm, "rack_force_N": [r.rack_force_N for r in rows],
-            "motor_torque_Nm": [r.motor_torque_Nm for r in rows], "motor_current_A": [r.motor_current_A for r in rows],
+            "motor_torque_Nm": [r.motor_torque_Nm for r in rows],
+            "motor_current_A": [r.motor_current_A for r in rows],
             "motor_torque_limit_Nm": assumed_values("column")["motor_torque_limit"]["value"]}
 
 
@@ -266,7 +267,8 @@ def assist_study(params: Parameters, target_torque_Nm: float, run=simulate, prog
     numbers["friction_band"] = {
         "friction": list(FRICTION_BAND), "peak_rack_force_N": band,
         "peak_rack_force_without_rack_friction_N": [
-            float(np.max(np.abs(rack_force_without_rack_friction_N(results[("friction", f)])))) for f in FRICTION_BAND],
+            float(np.max(np.abs(rack_force_without_rack_friction_N(results[("friction", f)]))))
+            for f in FRICTION_BAND],
         "rack_friction_force_N": float(params["steering.rack_friction_force"]),
         "published_standstill_rack_force_N": [low, high],
         "below_published_at": [f for f, force in zip(FRICTION_BAND, band) if force < low],
