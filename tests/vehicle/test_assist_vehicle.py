@@ -278,3 +278,30 @@ def test_sizing_reports_the_rack_force_over_the_friction_band(tmp_path, capsys):
     slope_lo, slope_hi = (5000.0 / (c * gear) for c in (100.0, 300.0))  # c' of any current gear lies in between
     rise = float(ends[1][1]) - float(ends[0][1])
     assert slope_hi < rise < slope_lo
+
+
+@pytest.mark.slow  # derives the two models of the Polo with the nonlinear linkage on an empty cache: about 20 s of CPU
+def test_a_linkage_ratio_rising_toward_lock_raises_the_wheels_share_of_the_rack_force(tmp_path, capsys):
+    """A linkage steer = G x (1 + c (G x)^2) passes the road wheels' moments to the rack through d(steer)/dx =
+    G (1 + 3 c (G x)^2): with c = 0.1 in the Polo's file ([linkage_nonlinearity]) the sizing runs carry the effect,
+    and the standstill force without rack friction rises at every friction of the band. The tyre's bore moment,
+    most of the load, is Coulomb and so the same at any steer angle: its share rises by at most the ratio's factor
+    at lock, 1 + 3 c (G x_lock)^2 = 1.107 for the Polo's 0.597 rad; lifting, which grows with the wider steer at
+    lock, adds a little more, so the whole rise stays below 1.2. A file giving c = 0 sizes exactly as the file
+    without the key (the linear linkage is the default)."""
+    text = POLO.read_text(encoding="utf-8")
+    rows = {}
+    for c in (None, 0.0, 0.1):
+        path = tmp_path / f"polo_{c}.toml"
+        extra = "" if c is None else (f"\n[linkage_nonlinearity]\ncubic_coefficient = {{ value = {c}, unit = \"1\", "
+                                      "source = \"test\" }\n")
+        path.write_text(text + extra, encoding="utf-8")
+        assert main(["assist", "size", "--vehicle", str(path), "--target-torque", "3", "--speeds-kmh", "0",
+                     "--out-dir", str(tmp_path / f"out_{c}")]) == 0
+        out = capsys.readouterr().out
+        rows[c] = [line.split()[:3] for line in out.splitlines() if line.strip()[:4] in ("0.67", "0.80", "1.00")]
+    assert len(rows[None]) == 3 and rows[0.0] == rows[None]
+    for linear, rising in zip(rows[None], rows[0.1]):
+        ratio = float(rising[2]) / float(linear[2])
+        assert 1.0 < ratio < 1.2
+        assert float(rising[1]) > float(linear[1])

@@ -31,7 +31,9 @@ dead band D. Without it each speed's check sizes its own gain, the assist a spee
 
 Loads. The standstill cycle runs again over the tyre-ground friction band (FRICTION_BAND), its peak rack force
 given with and without the rack's own friction (the rack friction's term taken out of the handwheel torque: the
-linkage's load alone). The model's load is one car's; the motor is also sized at the ends of the published class
+linkage's load alone). A vehicle file whose linkage ratio rises toward lock gives the linkage_nonlinearity effect's
+coefficient c (steer = G x (1 + c (G x)^2), G = roadwheel_to_rack_ratio: the ratio rises by 1 + 3 c delta^2); every
+run of the study then carries that effect (with_linkage), the check runs too. The model's load is one car's; the motor is also sized at the ends of the published class
 range of standstill rack forces (PUBLISHED_STANDSTILL_RACK_FORCE_N), quasi-statically through the car's gear at its
 standstill peak (size_for_rack_force). Both ranges, with their sources, are in ``parksteer/data/published_loads.toml``.
 
@@ -56,6 +58,7 @@ from ..vehicle import ASSIST_EFFECTS, ASSISTED_EFFECTS, CREEPING_EFFECTS, creepi
 
 SPEEDS_KMH = (0.0, 1.0, 3.0, 5.0)
 MARGIN = 1.1  # the sized motor limit or relief pressure over the quasi-static demand
+LINKAGE_EFFECT = "linkage_nonlinearity"  # the linkage ratio rising toward lock, where the vehicle file gives it
 
 @functools.cache
 def published_loads() -> dict:
@@ -181,7 +184,8 @@ def size_assist(params: Parameters, case: str, target_torque_Nm: float, speeds_k
 
     manual_runs, demands, gains, motors = [], [], [], []
     for speed in speeds_kmh:
-        manual = simulate(case, effects=CREEPING_EFFECTS, overrides=creeping_overrides(speed), params=params)
+        manual = simulate(case, effects=with_linkage(CREEPING_EFFECTS, params), overrides=creeping_overrides(speed),
+                          params=params)
         per_rack = manual.outputs()["column_angle_per_rack_rad_per_m"]
         torque = manual.columns["handwheel_torque_Nm"]
         demand = float(np.max(demand_at_action(name, params, torque, per_rack, target_torque_Nm)))
@@ -216,7 +220,7 @@ def size_assist(params: Parameters, case: str, target_torque_Nm: float, speeds_k
             # the sized assist is the straight line of the sized gain: a table of the file is switched off
             sized = one_assist if falloff else {f"{name}.gain": gain, f"{name}.motor_torque_limit": MARGIN * motor,
                                                 **table_off(name)}
-        assisted = simulate(case, effects=ASSISTED_EFFECTS[kind], overrides={**creeping_overrides(speed), **sized},
+        assisted = simulate(case, effects=with_linkage(ASSISTED_EFFECTS[kind], params), overrides={**creeping_overrides(speed), **sized},
                             params=params)
         c = assisted.columns
         rows.append(SizingRow(speed, _peak(torque * per_rack), _peak(torque), demand, motor, current, pressure, gain,
@@ -249,6 +253,14 @@ def size_for_rack_force(name: str, params: Parameters, force_N: float, per_rack:
     return ClassLoadRow(force_N, demand, motor, motor / v("torque_constant"), float("nan"))
 
 
+def with_linkage(effects: str, params: Parameters) -> str:
+    """`effects` with the linkage ratio rising toward lock (the linkage_nonlinearity effect) when the vehicle file
+    gives its coefficient (``[linkage_nonlinearity] cubic_coefficient`` > 0); unchanged for a linear linkage."""
+    if float(params[f"{LINKAGE_EFFECT}.cubic_coefficient"]) > 0.0:
+        return f"{effects},+{LINKAGE_EFFECT}"
+    return effects
+
+
 def rack_force_without_rack_friction_N(result: SimulationResult) -> np.ndarray:
     """The force on the rack less the rack's own friction, per sample: the handwheel torque less the rack friction's
     term (its contribution output), through the gear. What the tie rods carry, quasi-statically."""
@@ -265,9 +277,8 @@ def friction_band(params: Parameters, case: str, name: str, target_torque_Nm: fl
     hydraulic = name == ASSIST_EFFECTS["hydraulic"]
     out = []
     for friction in frictions:
-        manual = simulate(case, effects=CREEPING_EFFECTS, overrides={**creeping_overrides(0.0),
-                                                                     "tyre.friction_coefficient": friction},
-                          params=params)
+        manual = simulate(case, effects=with_linkage(CREEPING_EFFECTS, params), params=params,
+                          overrides={**creeping_overrides(0.0), "tyre.friction_coefficient": friction})
         per_rack = manual.outputs()["column_angle_per_rack_rad_per_m"]
         torque = manual.columns["handwheel_torque_Nm"]
         motor = current = float("nan")
