@@ -1,9 +1,10 @@
 """Every command block of README.md and docs/*.md runs as written, and every number a document quotes from a
 command's output is the one the command prints.
 
-Each ```sh block is run by bash (`set -e -o pipefail`: the first failing command fails the block) in a scratch copy
-of the repository (its tracked and new files: no results, no model cache), one copy per document, its blocks in
-the document's order, as a reader following it would; `parksteer`, `snakemake` and `python` are this
+Each ```sh block is run by bash (`set -e -o pipefail`: the first failing command fails the block) in one scratch
+copy of the repository (its tracked and new files: no results, no model cache), the documents in README order
+(README.md, then the order of its "More" list), each document's blocks in order, as one reader following them all
+would: two pages writing one file, or one needing what another has not yet written, fail; `parksteer`, `snakemake` and `python` are this
 environment's, the package is the copy's (PYTHONPATH), and the model cache is one for the session, seeded with the
 worktree's compiled models (a model a document's commands need and no earlier run built is derived there once).
 
@@ -21,8 +22,8 @@ What a document may say about a block, in HTML comments the rendered page does n
   stderr, or a file the block wrote, relative to the copy) must match REGEX, its first group must be VALUE, and
   VALUE must appear in the document's text outside the markers: a number the prose quotes is the one printed.
 
-The marker checks are quick; running the blocks (TestDocuments*, in two groups that xdist runs side by side) and
-regenerating data/samples/ are marked slow.
+The marker checks are quick; running the blocks (one test, one copy) and regenerating data/samples/ are marked
+slow.
 """
 
 from __future__ import annotations
@@ -214,55 +215,57 @@ def run_block(block: Block, work: Path, env: dict) -> tuple[int, str, float]:
     return done.returncode, done.stdout + done.stderr, time.perf_counter() - start
 
 
-# The documents in two groups of about the same run time: pytest-xdist's loadscope gives each class its own worker.
-GROUPS = {
-    "A": ["README.md", "docs/bus.md", "docs/model.md", "docs/assist.md", "docs/development.md", "docs/diagnosis.md"],
-    "B": ["docs/assist_identify.md", "docs/house.md", "docs/measurement.md", "docs/peers.md", "docs/reproducibility.md", "docs/scaling.md",
-          "docs/signature.md", "docs/sweeps.md", "docs/targets.md", "docs/vehicles.md", "docs/workflow.md"],
-}
+def readme_order() -> list[str]:
+    """README.md, then docs/*.md in the order README.md's "More" list links them (a reader's order)."""
+    text = (REPO / "README.md").read_text(encoding="utf-8")
+    more = text[text.index("\n## More"):]
+    linked = list(dict.fromkeys(re.findall(r"\]\((docs/[\w.-]+\.md)\)", more)))
+    return ["README.md", *linked]
 
 
-def test_every_document_in_one_group():
-    """A new document is run: each of README.md and docs/*.md is in exactly one group."""
-    grouped = [d for docs in GROUPS.values() for d in docs]
-    assert sorted(grouped) == sorted(DOCUMENTS)
-
-
-@pytest.mark.slow
-class TestDocumentsA:
-    @pytest.mark.parametrize("document", GROUPS["A"])
-    def test_document_runs(self, document, tmp_path, copy_repository, model_cache):
-        run_document(document, tmp_path, copy_repository, model_cache)
+def test_every_document_in_readme_order():
+    """A new document is run: each of README.md and docs/*.md is linked once from README.md's "More" list, whose
+    order the documents run in."""
+    assert sorted(readme_order()) == sorted(DOCUMENTS)
 
 
 @pytest.mark.slow
-class TestDocumentsB:
-    @pytest.mark.parametrize("document", GROUPS["B"])
-    def test_document_runs(self, document, tmp_path, copy_repository, model_cache):
-        run_document(document, tmp_path, copy_repository, model_cache)
-
-    def test_samples_are_their_generator_s(self, tmp_path):
-        """data/samples/ holds what `python data/samples/make_samples.py` writes, byte for byte."""
-        import importlib.util
-
-        spec = importlib.util.spec_from_file_location("make_samples", REPO / "data" / "samples" / "make_samples.py")
-        module = importlib.util.module_from_spec(spec)
-        spec.loader.exec_module(module)
-        written = module.write_samples(tmp_path)
-        shipped = sorted(p.relative_to(REPO / "data" / "samples") for p in (REPO / "data" / "samples").rglob("*")
-                         if p.is_file() and p.suffix not in (".md", ".py"))
-        assert sorted(p.relative_to(tmp_path) for p in written) == shipped
-        for name in shipped:
-            assert (tmp_path / name).read_bytes() == (REPO / "data" / "samples" / name).read_bytes(), name
+def test_documents_run_in_readme_order(tmp_path, copy_repository, model_cache):
+    """Every document's blocks run in one scratch copy, the documents in README order, as one reader following
+    them all would: a file one page writes is there for the next, so two pages that write one file (or one that
+    needs what another has not yet written) fail here."""
+    work = copy_repository(tmp_path / "repo")
+    failures, report = [], []
+    for document in readme_order():
+        found, lines = run_document(document, work, model_cache)
+        failures += found
+        report += lines
+    print("\n".join(report))
+    assert not failures, "\n\n".join(failures)
 
 
-def run_document(document, tmp_path, copy_repository, model_cache):
-    """Each sh block of `document` runs in a scratch copy, in order, and ends with status 0 (or the status its exits
-    marker states); each quote marker's value is what the block printed or wrote. Skipped blocks and lines are
-    listed with their reasons on stdout."""
+@pytest.mark.slow
+def test_samples_are_their_generator_s(tmp_path):
+    """data/samples/ holds what `python data/samples/make_samples.py` writes, byte for byte."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("make_samples", REPO / "data" / "samples" / "make_samples.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    written = module.write_samples(tmp_path)
+    shipped = sorted(p.relative_to(REPO / "data" / "samples") for p in (REPO / "data" / "samples").rglob("*")
+                     if p.is_file() and p.suffix not in (".md", ".py"))
+    assert sorted(p.relative_to(tmp_path) for p in written) == shipped
+    for name in shipped:
+        assert (tmp_path / name).read_bytes() == (REPO / "data" / "samples" / name).read_bytes(), name
+
+
+def run_document(document: str, work: Path, model_cache: Path) -> tuple[list[str], list[str]]:
+    """Each sh block of `document` runs in the scratch copy `work`, in order, and ends with status 0 (or the status
+    its exits marker states); each quote marker's value is what the block printed or wrote. Returns the failures
+    and the lines of what ran (skipped blocks and lines with their reasons)."""
     text = (REPO / document).read_text(encoding="utf-8")
     blocks = parse(document, text)
-    work = copy_repository(tmp_path / "repo")
     bin_dir = str(Path(sys.executable).parent)
     env = dict(os.environ, PYTHONPATH=str(work / "src"), PARKSTEER_MODEL_CACHE=str(model_cache),
                PATH=bin_dir + os.pathsep + os.environ.get("PATH", ""))
@@ -284,5 +287,4 @@ def run_document(document, tmp_path, copy_repository, model_cache):
             problem = check_quote(block, prose(text), value, source, regex, work, output)
             if problem is not None:
                 failures.append(problem)
-    print("\n".join(report))
-    assert not failures, "\n\n".join(failures)
+    return failures, report
