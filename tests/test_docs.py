@@ -51,6 +51,10 @@ HEAVY = re.compile(r'heavy\s+"([^"]+)"\s+\((.+)\)$', re.S)
 FULL = os.environ.get("PARKSTEER_DOCS_TEST") == "full"
 EXITS = re.compile(r"exits\s+(\d+)$")
 QUOTES = re.compile(r"quotes\s+(\S+)\s+from\s+(\S+?):\s+(.+)$", re.S)
+APPEAR = re.compile(r"appear\s+(.+?)\s+in\s+(\S+)$", re.S)
+GIVEN = re.compile(r"given\s+(.+?)\s+\((.+)\)$", re.S)
+# A number as a command prints it: a decimal point or an exponent (counts, years and percentages are left out).
+NUMBER = re.compile(r"(?<![\w.])-?\d+\.\d+(?:e[+-]?\d+)?(?![\w.]*\d)|(?<![\w.])\d+(?:\.\d+)?e[+-]?\d+(?!\w)")
 
 
 @dataclass
@@ -62,6 +66,10 @@ class Block:
     skip_lines: list[tuple[str, str]] = field(default_factory=list)
     exits: int = 0
     quotes: list[tuple[str, str, str]] = field(default_factory=list)
+    appears: list[tuple[tuple[str, ...], str]] = field(default_factory=list)  # (values, source)
+    given: list[str] = field(default_factory=list)  # values the prose quotes that are not the block's output
+    after: str = ""  # the prose after the block, to the next block or heading (markers removed)
+    heavy_left_out: bool = False  # lines of a heavy marker left out (PARKSTEER_DOCS_TEST not full)
 
     def commands(self) -> list[str]:
         """The block's commands (continuation lines joined), those a skip-line marker names left out."""
@@ -90,15 +98,22 @@ def parse(document: str, text: str) -> list[Block]:
         line = text.count("\n", 0, start) + 1
         if kind == "marker":
             body = item
-            if QUOTES.match(body):
+            if QUOTES.match(body) or APPEAR.match(body) or GIVEN.match(body):
                 if last is None:
-                    raise AssertionError(f"{document}:{line}: a quotes marker before any block")
-                last.quotes.append(QUOTES.match(body).groups())
+                    raise AssertionError(f"{document}:{line}: a quotes, appear or given marker before any block")
+                if QUOTES.match(body):
+                    last.quotes.append(QUOTES.match(body).groups())
+                elif APPEAR.match(body):
+                    values, source = APPEAR.match(body).groups()
+                    last.appears.append((tuple(values.split()), source))
+                else:
+                    last.given += GIVEN.match(body).group(1).replace(",", " ").split()
             elif SKIP.match(body) or SKIP_LINE.match(body) or HEAVY.match(body) or EXITS.match(body):
                 pending.append(body)
             else:
                 raise AssertionError(f"{document}:{line}: unknown docs-test marker {body!r} (skip (REASON), "
-                                     "skip-line \"TEXT\" (REASON), heavy \"TEXT\" (REASON), exits N, quotes VALUE from SOURCE: REGEX)")
+                                     "skip-line \"TEXT\" (REASON), heavy \"TEXT\" (REASON), exits N, quotes VALUE from SOURCE: REGEX, "
+                                     "appear VALUES in SOURCE, given VALUES (REASON))")
             continue
         language, body = item.group(1), item.group(2)
         if language != "sh":
@@ -107,6 +122,9 @@ def parse(document: str, text: str) -> list[Block]:
             last = None
             continue
         block = Block(document, line, body)
+        rest = text[item.end():]
+        stop = re.search(r"^(```|#)", rest, re.M)
+        block.after = prose(rest[:stop.start() if stop else len(rest)])
         for marker in pending:
             if (m := SKIP.match(marker)) is not None:
                 block.skip = m.group(1)
@@ -115,6 +133,7 @@ def parse(document: str, text: str) -> list[Block]:
             elif (m := HEAVY.match(marker)) is not None:
                 if not FULL:
                     block.skip_lines.append((m.group(1), f"heavy, run with PARKSTEER_DOCS_TEST=full: {m.group(2)}"))
+                    block.heavy_left_out = True
             else:
                 block.exits = int(EXITS.match(marker).group(1))
         pending = []
@@ -154,6 +173,36 @@ def check_quote(block: Block, doc_prose: str, value: str, source: str, regex: st
     return None
 
 
+def check_appear(block: Block, doc_prose: str, values: tuple[str, ...], source: str, work: Path,
+                 output: str) -> list[str]:
+    """What is wrong with an appear marker (one line each): each value must be in the document's text and be a
+    number of SOURCE (``output`` or a file the block wrote), whole (0.05 is not found in 0.051)."""
+    where = f"{block.document}:{block.line}"
+    if source == "output":
+        subject = output
+    else:
+        path = work / source
+        if not path.is_file():
+            return [f"{where}: source {source} was not written by the block"]
+        subject = path.read_text(encoding="utf-8", errors="replace")
+        if path.suffix == ".html":  # the page's text, not the coordinates of its inline figures
+            subject = re.sub(r"<svg\b.*?</svg>", "", subject, flags=re.S)
+    problems = []
+    for value in values:
+        if value not in doc_prose:
+            problems.append(f"{where}: value {value!r} does not appear in the document's text")
+        elif not re.search(rf"(?<![\w.]){re.escape(value)}(?![\w]|\.\d)", subject):
+            problems.append(f"{where}: the document quotes {value!r}, which {source} does not print")
+    return problems
+
+
+def untied_numbers(block: Block) -> list[str]:
+    """The numbers the prose after a block quotes (:data:`NUMBER`) that no marker ties to its output (quotes,
+    appear) or declares given, and that its commands do not hold."""
+    tied = {v for v, _, _ in block.quotes} | {v for values, _ in block.appears for v in values} | set(block.given)
+    return [n for n in NUMBER.findall(block.after) if n not in tied and n not in block.text]
+
+
 # --- the markers: quick --------------------------------------------------------------------------------------------
 
 def test_markers_parse_and_every_skip_has_a_reason():
@@ -175,6 +224,19 @@ def test_markers_parse_and_every_skip_has_a_reason():
     assert total >= 20 and skipped < total  # the parser found the blocks; most run
 
 
+def test_every_number_after_a_run_block_is_tied_or_given():
+    """Each number the prose after a block that runs quotes (to the next block or heading) is tied to what the block
+    prints or writes (a quotes or appear marker, checked when the block runs), or declared given with a reason (an
+    input, a record's hidden truth, a published value), or is in the block's commands: a number cannot drift
+    unseen."""
+    problems = []
+    for name, text in documents().items():
+        for block in parse(name, text):
+            if block.skip is None and (untied := untied_numbers(block)):
+                problems.append(f"{name}:{block.line}: {', '.join(dict.fromkeys(untied))}")
+    assert not problems, "numbers neither tied nor given:\n" + "\n".join(problems)
+
+
 def test_marker_checks_can_fail(tmp_path):
     """The quote check refuses a number the command does not print, a value missing from the prose and a source the
     block did not write; an unknown marker is refused."""
@@ -186,6 +248,11 @@ def test_marker_checks_can_fail(tmp_path):
     assert "does not appear" in check_quote(block, "no number here", "0.051", "output", r"floor ([0-9.]+)",
                                             tmp_path, "floor 0.051")
     assert "was not written" in check_quote(block, "0.051", "0.051", "report.md", r"([0-9.]+)", tmp_path, "")
+    assert check_appear(block, "0.05 and 0.12", ("0.05", "0.12"), "output", tmp_path, "0.05 N m, 0.12 N m") == []
+    assert "does not print" in check_appear(block, "0.05", ("0.05",), "output", tmp_path, "0.051 N m")[0]
+    marked = parse("doc.md", "```sh\necho 1.5\n```\n<!-- docs-test: given 0.75 (an input) -->\n\n"
+                             "It prints 1.5 from 0.75 and 2.25.\n")[0]
+    assert untied_numbers(marked) == ["2.25"]
     with pytest.raises(AssertionError, match="unknown docs-test marker"):
         parse("doc.md", "<!-- docs-test: skipp (typo) -->\n```sh\ntrue\n```\n")
     blocks = parse("doc.md", '<!-- docs-test: skip-line "pip" (installing) -->\n```sh\npip install x\nls \\\n  -l\n```\n')
@@ -284,7 +351,24 @@ def run_document(document: str, work: Path, model_cache: Path) -> tuple[list[str
             failures.append(f"{document}:{block.line}: status {status} (expected {block.exits}):\n{tail}")
             continue
         for value, source, regex in block.quotes:
+            if heavy_source(block, source, work):
+                report.append(f"{document}:{block.line}: {value!r} from {source} not checked (written by a heavy line)")
+                continue
             problem = check_quote(block, prose(text), value, source, regex, work, output)
             if problem is not None:
                 failures.append(problem)
+        for values, source in block.appears:
+            if heavy_source(block, source, work):
+                report.append(f"{document}:{block.line}: {' '.join(values)} from {source} not checked (written by a "
+                              "heavy line)")
+                continue
+            failures += check_appear(block, prose(text), values, source, work, output)
     return failures, report
+
+
+def heavy_source(block: Block, source: str, work: Path) -> bool:
+    """Whether `source` is a file only a heavy line the run left out writes: not there, and named in such a line."""
+    if not block.heavy_left_out or source == "output" or (work / source).exists():
+        return False
+    return any(source in command for command in block.text.splitlines()
+               if any(text in command for text, reason in block.skip_lines if reason.startswith("heavy")))
