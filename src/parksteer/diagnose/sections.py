@@ -187,6 +187,22 @@ def _identification_lines(result: dict) -> list[str]:
     return lines
 
 
+# What `parksteer assist identify` measures (parksteer.diagnose.assist_identify): the product k_t eta N (written as
+# the torque constant, so it also fixes the efficiency and the reduction as a product), the motor's friction and
+# inertia, the back-driven efficiency.
+_IDENTIFIED = ("torque_constant", "motor_friction_torque", "motor_inertia", "back_efficiency")
+_PRODUCT_FACTORS = ("efficiency", "reduction_ratio")
+
+
+def _identify_measures(quantity: str, rows: list[dict]) -> bool:
+    """Whether `parksteer assist identify` would measure the assumed `quantity`: one it identifies, or a factor of the
+    product while the product (the torque constant) is still assumed (once identified, only a data sheet helps)."""
+    name, _, key = quantity.rpartition(".")
+    if key in _IDENTIFIED:
+        return True
+    return key in _PRODUCT_FACTORS and any(r["quantity"] == f"{name}.torque_constant" for r in rows)
+
+
 def _assumed_parts(assumed: dict) -> list:
     """The assist's assumed values, each at its band's ends: the calibrated fit's RMS over the floor and the verdict
     there (parksteer.diagnose.stages.assumed)."""
@@ -195,12 +211,18 @@ def _assumed_parts(assumed: dict) -> list:
     if not rows:
         return [Paragraph("The vehicle file assumes none of the assist's values the model uses.")]
     deciding = [r["quantity"] for r in rows if r["decides"]]
+    measurable = [q for q in deciding if _identify_measures(q, rows)]
+    factors = any(q.rpartition(".")[2] in _PRODUCT_FACTORS for q in measurable)
+    where = "a data sheet" + (f"; `parksteer assist identify` on a baseline record fixes "
+                              f"{', '.join(f'`{q}`' for q in measurable)}"
+                              + (", the efficiency and the reduction through their product with the torque "
+                                 "constant" if factors else "") if measurable else "")
     text = (f"Each value the vehicle file takes as assumed, replayed at the ends of its band (the calibrated fit "
             f"refitted to first order; as it stands {num(nominal['calibrated_over_floor'])} noise floors, verdict "
             f"{nominal['verdict']}). "
             + (f"The verdict depends on {', '.join(f'`{q}`' for q in deciding)}: give "
-               f"{'its value' if len(deciding) == 1 else 'their values'} (a data sheet, `parksteer assist identify`) "
-               "before trusting it." if deciding else "No end of any band changes the verdict."))
+               f"{'its value' if len(deciding) == 1 else 'their values'} ({where}) before trusting it."
+               if deciding else "No end of any band changes the verdict."))
     body = [[r["quantity"], num(r["value"], 4), f"{num(r['band'][0], 4)} to {num(r['band'][1], 4)}",
              f"{num(r['ends'][0]['calibrated_over_floor'])}, {num(r['ends'][1]['calibrated_over_floor'])}",
              f"{r['ends'][0]['verdict']}, {r['ends'][1]['verdict']}{' (decides)' if r['decides'] else ''}"]
