@@ -21,6 +21,15 @@ What a document may say about a block, in HTML comments the rendered page does n
 - ``<!-- docs-test: quotes VALUE from SOURCE: REGEX -->`` after a block: SOURCE (``output``, the block's stdout and
   stderr, or a file the block wrote, relative to the copy) must match REGEX, its first group must be VALUE, and
   VALUE must appear in the document's text outside the markers: a number the prose quotes is the one printed.
+- ``<!-- docs-test: appear VALUES in SOURCE -->`` after a block: each of VALUES (space-separated) is a whole number
+  of SOURCE (an HTML page's text, its inline figures left out) and appears in the document's text;
+- ``<!-- docs-test: given VALUES (REASON) -->`` after a block: numbers the prose after it quotes that are not the
+  block's output (an input, a record's hidden truth, a published value, another tool's measurement).
+
+Every number with a decimal point or an exponent in the prose after a block that runs (to the next block or heading)
+must be tied by a quotes or appear marker, declared given, or be in the block's commands
+(:func:`untied_numbers`). A quotes or appear marker whose source only a heavy line writes is checked in the full
+run.
 
 The marker checks are quick; running the blocks (one test, one copy) and regenerating data/samples/ are marked
 slow.
