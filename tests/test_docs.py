@@ -1,9 +1,10 @@
 """Every command block of README.md and docs/*.md runs as written, and every number a document quotes from a
 command's output is the one the command prints.
 
-Each ```sh block is run by bash (`set -e -o pipefail`: the first failing command fails the block) in a scratch copy
-of the repository (its tracked and new files: no results, no model cache), one copy per document, its blocks in
-the document's order, as a reader following it would; `parksteer`, `snakemake` and `python` are this
+Each ```sh block is run by bash (`set -e -o pipefail`: the first failing command fails the block) in one scratch
+copy of the repository (its tracked and new files: no results, no model cache), the documents in README order
+(README.md, then the order of its "More" list), each document's blocks in order, as one reader following them all
+would: two pages writing one file, or one needing what another has not yet written, fail; `parksteer`, `snakemake` and `python` are this
 environment's, the package is the copy's (PYTHONPATH), and the model cache is one for the session, seeded with the
 worktree's compiled models (a model a document's commands need and no earlier run built is derived there once).
 
@@ -20,9 +21,18 @@ What a document may say about a block, in HTML comments the rendered page does n
 - ``<!-- docs-test: quotes VALUE from SOURCE: REGEX -->`` after a block: SOURCE (``output``, the block's stdout and
   stderr, or a file the block wrote, relative to the copy) must match REGEX, its first group must be VALUE, and
   VALUE must appear in the document's text outside the markers: a number the prose quotes is the one printed.
+- ``<!-- docs-test: appear VALUES in SOURCE -->`` after a block: each of VALUES (space-separated) is a whole number
+  of SOURCE (an HTML page's text, its inline figures left out) and appears in the document's text;
+- ``<!-- docs-test: given VALUES (REASON) -->`` after a block: numbers the prose after it quotes that are not the
+  block's output (an input, a record's hidden truth, a published value, another tool's measurement).
 
-The marker checks are quick; running the blocks (TestDocuments*, in two groups that xdist runs side by side) and
-regenerating data/samples/ are marked slow.
+Every number with a decimal point or an exponent in the prose after a block that runs (to the next block or heading)
+must be tied by a quotes or appear marker, declared given, or be in the block's commands
+(:func:`untied_numbers`). A quotes or appear marker whose source only a heavy line writes is checked in the full
+run.
+
+The marker checks are quick; running the blocks (one test, one copy) and regenerating data/samples/ are marked
+slow.
 """
 
 from __future__ import annotations
@@ -50,6 +60,10 @@ HEAVY = re.compile(r'heavy\s+"([^"]+)"\s+\((.+)\)$', re.S)
 FULL = os.environ.get("PARKSTEER_DOCS_TEST") == "full"
 EXITS = re.compile(r"exits\s+(\d+)$")
 QUOTES = re.compile(r"quotes\s+(\S+)\s+from\s+(\S+?):\s+(.+)$", re.S)
+APPEAR = re.compile(r"appear\s+(.+?)\s+in\s+(\S+)$", re.S)
+GIVEN = re.compile(r"given\s+(.+?)\s+\((.+)\)$", re.S)
+# A number as a command prints it: a decimal point or an exponent (counts, years and percentages are left out).
+NUMBER = re.compile(r"(?<![\w.])-?\d+\.\d+(?:e[+-]?\d+)?(?![\w.]*\d)|(?<![\w.])\d+(?:\.\d+)?e[+-]?\d+(?!\w)")
 
 
 @dataclass
@@ -61,6 +75,10 @@ class Block:
     skip_lines: list[tuple[str, str]] = field(default_factory=list)
     exits: int = 0
     quotes: list[tuple[str, str, str]] = field(default_factory=list)
+    appears: list[tuple[tuple[str, ...], str]] = field(default_factory=list)  # (values, source)
+    given: list[str] = field(default_factory=list)  # values the prose quotes that are not the block's output
+    after: str = ""  # the prose after the block, to the next block or heading (markers removed)
+    heavy_left_out: bool = False  # lines of a heavy marker left out (PARKSTEER_DOCS_TEST not full)
 
     def commands(self) -> list[str]:
         """The block's commands (continuation lines joined), those a skip-line marker names left out."""
@@ -89,15 +107,22 @@ def parse(document: str, text: str) -> list[Block]:
         line = text.count("\n", 0, start) + 1
         if kind == "marker":
             body = item
-            if QUOTES.match(body):
+            if QUOTES.match(body) or APPEAR.match(body) or GIVEN.match(body):
                 if last is None:
-                    raise AssertionError(f"{document}:{line}: a quotes marker before any block")
-                last.quotes.append(QUOTES.match(body).groups())
+                    raise AssertionError(f"{document}:{line}: a quotes, appear or given marker before any block")
+                if QUOTES.match(body):
+                    last.quotes.append(QUOTES.match(body).groups())
+                elif APPEAR.match(body):
+                    values, source = APPEAR.match(body).groups()
+                    last.appears.append((tuple(values.split()), source))
+                else:
+                    last.given += GIVEN.match(body).group(1).replace(",", " ").split()
             elif SKIP.match(body) or SKIP_LINE.match(body) or HEAVY.match(body) or EXITS.match(body):
                 pending.append(body)
             else:
                 raise AssertionError(f"{document}:{line}: unknown docs-test marker {body!r} (skip (REASON), "
-                                     "skip-line \"TEXT\" (REASON), heavy \"TEXT\" (REASON), exits N, quotes VALUE from SOURCE: REGEX)")
+                                     "skip-line \"TEXT\" (REASON), heavy \"TEXT\" (REASON), exits N, quotes VALUE from SOURCE: REGEX, "
+                                     "appear VALUES in SOURCE, given VALUES (REASON))")
             continue
         language, body = item.group(1), item.group(2)
         if language != "sh":
@@ -106,6 +131,9 @@ def parse(document: str, text: str) -> list[Block]:
             last = None
             continue
         block = Block(document, line, body)
+        rest = text[item.end():]
+        stop = re.search(r"^(```|#)", rest, re.M)
+        block.after = prose(rest[:stop.start() if stop else len(rest)])
         for marker in pending:
             if (m := SKIP.match(marker)) is not None:
                 block.skip = m.group(1)
@@ -114,6 +142,7 @@ def parse(document: str, text: str) -> list[Block]:
             elif (m := HEAVY.match(marker)) is not None:
                 if not FULL:
                     block.skip_lines.append((m.group(1), f"heavy, run with PARKSTEER_DOCS_TEST=full: {m.group(2)}"))
+                    block.heavy_left_out = True
             else:
                 block.exits = int(EXITS.match(marker).group(1))
         pending = []
@@ -153,6 +182,36 @@ def check_quote(block: Block, doc_prose: str, value: str, source: str, regex: st
     return None
 
 
+def check_appear(block: Block, doc_prose: str, values: tuple[str, ...], source: str, work: Path,
+                 output: str) -> list[str]:
+    """What is wrong with an appear marker (one line each): each value must be in the document's text and be a
+    number of SOURCE (``output`` or a file the block wrote), whole (0.05 is not found in 0.051)."""
+    where = f"{block.document}:{block.line}"
+    if source == "output":
+        subject = output
+    else:
+        path = work / source
+        if not path.is_file():
+            return [f"{where}: source {source} was not written by the block"]
+        subject = path.read_text(encoding="utf-8", errors="replace")
+        if path.suffix == ".html":  # the page's text, not the coordinates of its inline figures
+            subject = re.sub(r"<svg\b.*?</svg>", "", subject, flags=re.S)
+    problems = []
+    for value in values:
+        if value not in doc_prose:
+            problems.append(f"{where}: value {value!r} does not appear in the document's text")
+        elif not re.search(rf"(?<![\w.]){re.escape(value)}(?![\w]|\.\d)", subject):
+            problems.append(f"{where}: the document quotes {value!r}, which {source} does not print")
+    return problems
+
+
+def untied_numbers(block: Block) -> list[str]:
+    """The numbers the prose after a block quotes (:data:`NUMBER`) that no marker ties to its output (quotes,
+    appear) or declares given, and that its commands do not hold."""
+    tied = {v for v, _, _ in block.quotes} | {v for values, _ in block.appears for v in values} | set(block.given)
+    return [n for n in NUMBER.findall(block.after) if n not in tied and n not in block.text]
+
+
 # --- the markers: quick --------------------------------------------------------------------------------------------
 
 def test_markers_parse_and_every_skip_has_a_reason():
@@ -174,6 +233,19 @@ def test_markers_parse_and_every_skip_has_a_reason():
     assert total >= 20 and skipped < total  # the parser found the blocks; most run
 
 
+def test_every_number_after_a_run_block_is_tied_or_given():
+    """Each number the prose after a block that runs quotes (to the next block or heading) is tied to what the block
+    prints or writes (a quotes or appear marker, checked when the block runs), or declared given with a reason (an
+    input, a record's hidden truth, a published value), or is in the block's commands: a number cannot drift
+    unseen."""
+    problems = []
+    for name, text in documents().items():
+        for block in parse(name, text):
+            if block.skip is None and (untied := untied_numbers(block)):
+                problems.append(f"{name}:{block.line}: {', '.join(dict.fromkeys(untied))}")
+    assert not problems, "numbers neither tied nor given:\n" + "\n".join(problems)
+
+
 def test_marker_checks_can_fail(tmp_path):
     """The quote check refuses a number the command does not print, a value missing from the prose and a source the
     block did not write; an unknown marker is refused."""
@@ -185,6 +257,11 @@ def test_marker_checks_can_fail(tmp_path):
     assert "does not appear" in check_quote(block, "no number here", "0.051", "output", r"floor ([0-9.]+)",
                                             tmp_path, "floor 0.051")
     assert "was not written" in check_quote(block, "0.051", "0.051", "report.md", r"([0-9.]+)", tmp_path, "")
+    assert check_appear(block, "0.05 and 0.12", ("0.05", "0.12"), "output", tmp_path, "0.05 N m, 0.12 N m") == []
+    assert "does not print" in check_appear(block, "0.05", ("0.05",), "output", tmp_path, "0.051 N m")[0]
+    marked = parse("doc.md", "```sh\necho 1.5\n```\n<!-- docs-test: given 0.75 (an input) -->\n\n"
+                             "It prints 1.5 from 0.75 and 2.25.\n")[0]
+    assert untied_numbers(marked) == ["2.25"]
     with pytest.raises(AssertionError, match="unknown docs-test marker"):
         parse("doc.md", "<!-- docs-test: skipp (typo) -->\n```sh\ntrue\n```\n")
     blocks = parse("doc.md", '<!-- docs-test: skip-line "pip" (installing) -->\n```sh\npip install x\nls \\\n  -l\n```\n')
@@ -214,55 +291,57 @@ def run_block(block: Block, work: Path, env: dict) -> tuple[int, str, float]:
     return done.returncode, done.stdout + done.stderr, time.perf_counter() - start
 
 
-# The documents in two groups of about the same run time: pytest-xdist's loadscope gives each class its own worker.
-GROUPS = {
-    "A": ["README.md", "docs/bus.md", "docs/model.md", "docs/assist.md", "docs/development.md", "docs/diagnosis.md"],
-    "B": ["docs/assist_identify.md", "docs/house.md", "docs/measurement.md", "docs/peers.md", "docs/reproducibility.md", "docs/scaling.md",
-          "docs/signature.md", "docs/sweeps.md", "docs/targets.md", "docs/vehicles.md", "docs/workflow.md"],
-}
+def readme_order() -> list[str]:
+    """README.md, then docs/*.md in the order README.md's "More" list links them (a reader's order)."""
+    text = (REPO / "README.md").read_text(encoding="utf-8")
+    more = text[text.index("\n## More"):]
+    linked = list(dict.fromkeys(re.findall(r"\]\((docs/[\w.-]+\.md)\)", more)))
+    return ["README.md", *linked]
 
 
-def test_every_document_in_one_group():
-    """A new document is run: each of README.md and docs/*.md is in exactly one group."""
-    grouped = [d for docs in GROUPS.values() for d in docs]
-    assert sorted(grouped) == sorted(DOCUMENTS)
-
-
-@pytest.mark.slow
-class TestDocumentsA:
-    @pytest.mark.parametrize("document", GROUPS["A"])
-    def test_document_runs(self, document, tmp_path, copy_repository, model_cache):
-        run_document(document, tmp_path, copy_repository, model_cache)
+def test_every_document_in_readme_order():
+    """A new document is run: each of README.md and docs/*.md is linked once from README.md's "More" list, whose
+    order the documents run in."""
+    assert sorted(readme_order()) == sorted(DOCUMENTS)
 
 
 @pytest.mark.slow
-class TestDocumentsB:
-    @pytest.mark.parametrize("document", GROUPS["B"])
-    def test_document_runs(self, document, tmp_path, copy_repository, model_cache):
-        run_document(document, tmp_path, copy_repository, model_cache)
-
-    def test_samples_are_their_generator_s(self, tmp_path):
-        """data/samples/ holds what `python data/samples/make_samples.py` writes, byte for byte."""
-        import importlib.util
-
-        spec = importlib.util.spec_from_file_location("make_samples", REPO / "data" / "samples" / "make_samples.py")
-        module = importlib.util.module_from_spec(spec)
-        spec.loader.exec_module(module)
-        written = module.write_samples(tmp_path)
-        shipped = sorted(p.relative_to(REPO / "data" / "samples") for p in (REPO / "data" / "samples").rglob("*")
-                         if p.is_file() and p.suffix not in (".md", ".py"))
-        assert sorted(p.relative_to(tmp_path) for p in written) == shipped
-        for name in shipped:
-            assert (tmp_path / name).read_bytes() == (REPO / "data" / "samples" / name).read_bytes(), name
+def test_documents_run_in_readme_order(tmp_path, copy_repository, model_cache):
+    """Every document's blocks run in one scratch copy, the documents in README order, as one reader following
+    them all would: a file one page writes is there for the next, so two pages that write one file (or one that
+    needs what another has not yet written) fail here."""
+    work = copy_repository(tmp_path / "repo")
+    failures, report = [], []
+    for document in readme_order():
+        found, lines = run_document(document, work, model_cache)
+        failures += found
+        report += lines
+    print("\n".join(report))
+    assert not failures, "\n\n".join(failures)
 
 
-def run_document(document, tmp_path, copy_repository, model_cache):
-    """Each sh block of `document` runs in a scratch copy, in order, and ends with status 0 (or the status its exits
-    marker states); each quote marker's value is what the block printed or wrote. Skipped blocks and lines are
-    listed with their reasons on stdout."""
+@pytest.mark.slow
+def test_samples_are_their_generator_s(tmp_path):
+    """data/samples/ holds what `python data/samples/make_samples.py` writes, byte for byte."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("make_samples", REPO / "data" / "samples" / "make_samples.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    written = module.write_samples(tmp_path)
+    shipped = sorted(p.relative_to(REPO / "data" / "samples") for p in (REPO / "data" / "samples").rglob("*")
+                     if p.is_file() and p.suffix not in (".md", ".py"))
+    assert sorted(p.relative_to(tmp_path) for p in written) == shipped
+    for name in shipped:
+        assert (tmp_path / name).read_bytes() == (REPO / "data" / "samples" / name).read_bytes(), name
+
+
+def run_document(document: str, work: Path, model_cache: Path) -> tuple[list[str], list[str]]:
+    """Each sh block of `document` runs in the scratch copy `work`, in order, and ends with status 0 (or the status
+    its exits marker states); each quote marker's value is what the block printed or wrote. Returns the failures
+    and the lines of what ran (skipped blocks and lines with their reasons)."""
     text = (REPO / document).read_text(encoding="utf-8")
     blocks = parse(document, text)
-    work = copy_repository(tmp_path / "repo")
     bin_dir = str(Path(sys.executable).parent)
     env = dict(os.environ, PYTHONPATH=str(work / "src"), PARKSTEER_MODEL_CACHE=str(model_cache),
                PATH=bin_dir + os.pathsep + os.environ.get("PATH", ""))
@@ -281,8 +360,24 @@ def run_document(document, tmp_path, copy_repository, model_cache):
             failures.append(f"{document}:{block.line}: status {status} (expected {block.exits}):\n{tail}")
             continue
         for value, source, regex in block.quotes:
+            if heavy_source(block, source, work):
+                report.append(f"{document}:{block.line}: {value!r} from {source} not checked (written by a heavy line)")
+                continue
             problem = check_quote(block, prose(text), value, source, regex, work, output)
             if problem is not None:
                 failures.append(problem)
-    print("\n".join(report))
-    assert not failures, "\n\n".join(failures)
+        for values, source in block.appears:
+            if heavy_source(block, source, work):
+                report.append(f"{document}:{block.line}: {' '.join(values)} from {source} not checked (written by a "
+                              "heavy line)")
+                continue
+            failures += check_appear(block, prose(text), values, source, work, output)
+    return failures, report
+
+
+def heavy_source(block: Block, source: str, work: Path) -> bool:
+    """Whether `source` is a file only a heavy line the run left out writes: not there, and named in such a line."""
+    if not block.heavy_left_out or source == "output" or (work / source).exists():
+        return False
+    return any(source in command for command in block.text.splitlines()
+               if any(text in command for text, reason in block.skip_lines if reason.startswith("heavy")))

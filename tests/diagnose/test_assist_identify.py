@@ -146,11 +146,14 @@ def test_a_record_in_memory_is_its_file(baseline):
     assert again.assist == found.assist and again.records == found.records
 
 
-def test_what_the_balance_does_not_fix_is_not_written(baseline, tmp_path):
-    """A number of the gear whose 95 % interval holds the file's value is not written: with the file's rotor inertia
-    set to the truth's (3e-4 kg m^2 against the shipped 2e-4, which the records contradict), the identified file
-    keeps the file's entry as the file gave it (its source still the file's), and the band of the motor's friction,
-    which a bus's records do not fix, stays the file's."""
+def test_a_value_the_balance_confirms_is_kept_and_written_as_measured(baseline, tmp_path):
+    """A number of the gear whose 95 % interval holds the file's assumed value keeps that value, now measured: with
+    the file's rotor inertia set to the truth's (3e-4 kg m^2 against the shipped 2e-4, which the records
+    contradict), the identified file keeps 3e-4 and its source names the record and the interval, so a later
+    diagnosis no longer replays it as assumed (nor tells the owner to run the identification just run); the band
+    of the motor's friction, which a bus's records do not fix, stays the file's, assumed."""
+    from parksteer.diagnose.stages.assumed import assumed_source
+
     truth, path, found = baseline
     text = et.POLO.read_text(encoding="utf-8")
     vehicle = tmp_path / "polo.toml"
@@ -159,7 +162,9 @@ def test_what_the_balance_does_not_fix_is_not_written(baseline, tmp_path):
     again = identify_boost([path], vehicle)
     assert "motor_inertia" in again.kept and "motor_inertia" not in found.kept
     written = tomllib.loads(again.to_vehicle_toml(vehicle.read_text(encoding="utf-8")))["assist"]
-    assert written["motor_inertia"]["source"].startswith("assumed")
+    inertia = written["motor_inertia"]
+    assert inertia["value"] == 0.0003 and not assumed_source(inertia["source"])
+    assert "baseline.csv" in inertia["source"] and "holds the file's 0.0003" in inertia["source"]
     assert "friction_speed" not in written or written["friction_speed"]["source"].startswith("assumed")
 
 

@@ -17,6 +17,8 @@ import jsonschema
 import numpy as np
 import pytest
 
+from pages_check import assert_same_sections
+
 from parksteer.cli import main
 from parksteer.experiments.benchmark import BENCHMARK_SETTINGS
 from parksteer.diagnose.problem import prepare_file
@@ -100,6 +102,30 @@ def test_a_tie_is_the_headline_and_no_test_is_offered_below_the_noise_floor(moto
     assert "motor channel residual" in svg.read_text(encoding="utf-8")
 
 
+def test_both_pages_show_the_same_sections_and_the_figure_the_table_s_numbers(motor_friction, monkeypatch, tmp_path):
+    """The markdown report and the HTML page render one structure: each section of one is in the other, in order,
+    the confounded candidates among them; neither advises the handwheel angle (--angle), which the diagnosis of an
+    assisted car refuses. The figure's bar for each candidate is the weighted RMS the ranking table gives, to the
+    last digit (the figure and the table read one number)."""
+    import matplotlib.axes
+
+    from parksteer.figures.diagnose import diagnosis_figure
+
+    diagnosis, result = motor_friction
+    text, page = assert_same_sections(result, phases=[])
+    assert result["confounded"] and "<h2>Confounded with the calibrated parameters</h2>" in page
+    assert "--angle" not in text and "--angle" not in page
+    rows = {r["parameter"]: r for r in result["identification"]}
+    assert rows["steering.column_torsional_stiffness"]["status"] == "not calibrated"
+    assert rows["steering.column_torsional_stiffness"]["fixed_by"] is None
+    drawn = []
+    original = matplotlib.axes.Axes.barh
+    monkeypatch.setattr(matplotlib.axes.Axes, "barh",
+                        lambda self, y, width, *a, **k: drawn.append(list(width)) or original(self, y, width, *a, **k))
+    diagnosis_figure(diagnosis, tmp_path / "diagnosis.svg")
+    assert drawn == [[c["weighted_rms_after_Nm"] for c in result["ranking"]]]
+
+
 def test_hidden_motor_friction_is_named_from_the_torsion_bar_torque_and_current(polo, motor_friction):
     """A motor dragging 0.02 N m more than the file says (N = 18: 0.36 N m at the column, 0.05 N m of torsion-bar
     torque after the boost's division by about 1 + G = 7) is named. At a column assist it is the same load as a
@@ -152,6 +178,9 @@ def test_a_record_of_the_assisted_car_with_nothing_hidden_is_adequate(polo):
                for e in rows["torsion_bar_stiffness"]["ends"])
     assert rows["torque_constant"]["decides"] and not rows["torsion_bar_stiffness"]["decides"]
     assert min(e["calibrated_over_floor"] for e in rows["torque_constant"]["ends"]) > 5.0
+    # the assumed values' section is on both pages (one structure renders both)
+    text, page = assert_same_sections(result)
+    assert "<h2>What the verdict owes to the assist&#x27;s assumed values</h2>" in page
 
 
 def test_moving_a_factor_of_an_identified_product_holds_the_product(polo):

@@ -15,6 +15,7 @@ import pickle
 
 import jsonschema
 import pytest
+from pages_check import assert_same_sections
 
 from parksteer.diagnose.calibrate import free_strengths
 from parksteer.diagnose.problem import load_files
@@ -98,6 +99,32 @@ def test_the_suggested_file_passed_back_as_it_stands_gives_the_error_it_promises
     after = again.outputs["user_effect"].rungs[-1]["over_floor"]
     assert after == pytest.approx(suggestion.after_over_floor, rel=0.05)
     assert again.verdict == "adequate"
+    # what the reports say of it (one test, for one diagnosis more than this module can spend)
+    result, before = diagnosis_dict(again), diagnosis_dict(first)
+    check_suggested_intervals(result, before)
+
+
+def check_suggested_intervals(result, before):
+    """The suggested effect's strengths each carry a 95 % interval or say why they have none (here: 15 strengths
+    and 3 car parameters against 9 two-second blocks of an 18 s record, and the block sandwich needs more blocks
+    than parameters); the car's calibrated intervals stay what the data fix: finite, each no wider than twice its
+    width without the effect, where unconditioned they reach the parameters' bounds. The suggested shape (bumps
+    along the rack, times the sign of the rack's speed) sums to a uniform rack friction, so the rack friction
+    force's signature is nearly all the strengths' too, and both reports say its value holds only with the shape
+    as fitted; the two pages show the same sections."""
+    strengths = result["user_effect"]["strengths"]
+    assert len(strengths) == 15
+    for entry in strengths.values():
+        assert entry["ci95"] is not None or "more blocks than parameters" in entry["why_not_fixed"]
+    for key, entry in before["calibrated"].items():
+        low, high = result["calibrated"][key]["ci95"]
+        assert high - low <= 2.0 * (entry["ci95"][1] - entry["ci95"][0]), key
+    shares = result["user_effect"]["not_made_by_strengths"]
+    assert shares["steering.rack_friction_force"] < 0.1 < shares["tyre.friction_coefficient"]
+    text, page = assert_same_sections(result)
+    assert "holds only with the effect's shape as fitted" in text and "more blocks than parameters" in page
+    fixed = next(line for line in text.splitlines() if line.startswith("- steering.rack_friction_force:"))
+    assert "held at their fit" in fixed
 
 
 def test_the_form_a_suggestion_is_fitted_on_is_the_force_its_file_writes(record, params, tmp_path, monkeypatch):

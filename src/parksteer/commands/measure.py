@@ -321,12 +321,24 @@ def _diagnose(args) -> int:
             user_plot = user_effect_path(args.plot)
             user_effect_figure(diagnosis, user_plot)
             note(f"the figure of {', '.join(diagnosis.outputs['user_effect'].effects)}: {user_plot}")
+    # both pages render the same sections: the residual by phase for both, the error ladder (a diagnosis more for
+    # each effect it names) where the HTML page asks for it, and then in both
+    phases = ladder = None
+    if args.report or args.html:
+        from ..diagnose.report import phase_residuals
+
+        phases = phase_residuals(diagnosis)
+    if args.html:
+        from ..diagnose.ladder import error_ladder
+
+        ladder = error_ladder(files, params, list(diagnosis.base_effects), first=diagnosis, workers=workers)
     if args.report:
         figure = _linked(args.plot, args.report) if args.plot else None
         write_markdown(args.report, markdown_report(result, figure,
-                                                    _linked(user_plot, args.report) if user_plot else None))
+                                                    _linked(user_plot, args.report) if user_plot else None,
+                                                    phases, ladder.as_dict() if ladder is not None else None))
     if args.html:
-        _write_html(args.html, diagnosis, result, files, params, workers)
+        _write_html(args.html, diagnosis, result, phases, ladder)
     if args.json:
         _print_json(result)
     return 0
@@ -358,17 +370,13 @@ def _with_suggestion(args, result: dict, diagnosis, settings) -> dict:
     return with_suggestion(result, suggestion)
 
 
-def _write_html(path: str, diagnosis, result: dict, files, params, workers: int = 1) -> None:
+def _write_html(path: str, diagnosis, result: dict, phases: list[dict], ladder) -> None:
     """The diagnosis and its error ladder as one self-contained HTML page (parksteer.diagnose.pages.html_report)."""
     import tempfile
 
-    from ..diagnose.ladder import error_ladder
-    from ..diagnose.report import phase_residuals
     from ..diagnose.pages import html_report, write_markdown
     from ..figures.diagnose import diagnosis_figure, ladder_figure, phase_residual_figure
 
-    phases = phase_residuals(diagnosis)
-    ladder = error_ladder(files, params, list(diagnosis.base_effects), first=diagnosis, workers=workers)
     captions = {
         "diagnosis": "Measured handwheel torque and the calibrated model (with the best candidate) against rack, "
                      "their residual, and the weighted RMS error with each candidate (first file).",
@@ -388,6 +396,6 @@ def _write_html(path: str, diagnosis, result: dict, files, params, workers: int 
         diagnosis_figure(diagnosis, Path(tmp) / "diagnosis.svg")
         phase_residual_figure(phases, Path(tmp) / "phases.svg")
         ladder_figure(ladder.rungs, ladder.noise_floor_Nm, ladder.attainable_floor_Nm, Path(tmp) / "ladder.svg")
-        figures = [(caption, (Path(tmp) / f"{name}.svg").read_text(encoding="utf-8"))
+        figures = [(name, caption, (Path(tmp) / f"{name}.svg").read_text(encoding="utf-8"))
                    for name, caption in captions.items()]
     write_markdown(path, html_report(result, figures, phases, ladder.as_dict()))

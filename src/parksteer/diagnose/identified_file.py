@@ -159,7 +159,10 @@ def replace_assist_section(text: str, found) -> str:
                                         ("back_efficiency", "the back-driven efficiency"))
                if key not in found.kept
                and (key != "back_efficiency" or found.back_efficiency is not None)]
-    own = "; the file's own " + ", ".join(found.kept) if found.kept else ""
+    confirmed = _confirmed(found, old, where)
+    own = [k for k in found.kept if k not in confirmed]
+    own = ("; the file's own " + ", ".join(own) if own else "") + (
+        "; measured, holding the file's " + ", ".join(confirmed) if confirmed else "")
     lines = ["", "# Power assistance: the gear's data as the file gave them; the boost table"
              + "".join(f", {w}" for w in written), f"# {where}{own}.",
              "# Also identified, with no entry in a vehicle file: the torsion-bar sensor's offset "
@@ -185,6 +188,9 @@ def replace_assist_section(text: str, found) -> str:
                                        f"{where}: {found.back_efficiency.text()} (the column balance on the "
                                        f"back-driven samples; the file gave {found.file_values['back_efficiency']:g})")
     replaced = {k: e for k, e in replaced.items() if k not in found.kept}
+    # A value the records measured and whose interval holds the file's assumed value: the file's value stays, now
+    # measured, so its source says so (a diagnosis replays only what is still assumed: stages/assumed.py)
+    replaced.update(confirmed)
     for key, entry in old.items():
         if key in ("type", "boost") or key in LINE_KEYS or key in replaced:
             continue
@@ -210,6 +216,28 @@ def replace_assist_section(text: str, found) -> str:
                      + " }")
     lines.append("")
     return "\n".join(kept + lines)
+
+
+def _confirmed(found, old: dict, where: str) -> dict[str, tuple[float, str, str]]:
+    """(value, unit, source) of each value of the gear the file assumed and the records measured with an interval
+    holding it (kept as the file gives it: :attr:`Identified.kept`): the file's value, its source the estimate."""
+    from .stages.assumed import assumed_source
+
+    estimates = {"torque_constant": found.product, "motor_friction_torque": found.motor_friction,
+                 "motor_inertia": found.motor_inertia, "back_efficiency": found.back_efficiency}
+    out = {}
+    for key in found.kept:
+        estimate, entry = estimates.get(key), old.get(key)
+        if estimate is None or entry is None or not assumed_source(entry.get("source", "assumed")):
+            continue
+        measured = "the product k_t eta N = " if key == "torque_constant" else ""
+        file_value = found.file_values.get("product" if key == "torque_constant" else key, entry["value"])
+        low, high = estimate.ci95
+        if estimate.value < 0.0 or not low <= file_value <= high:
+            continue  # not a physical reading of the part: the file's value stays as assumed as it was
+        out[key] = (entry["value"], entry["unit"],
+                    f"{where}: {measured}{estimate.text()} holds the file's {file_value:.4g}, which stays")
+    return out
 
 
 def _strictly_rising(values) -> list[float]:

@@ -11,6 +11,8 @@ import numpy as np
 
 from ..measure.phases import PHASES
 from ..resources import data_file
+from .calibrate import free_strengths
+from .stages.user_effect import conditioned_on_strengths
 from .state import Candidate, Diagnosis
 
 SCHEMA_ID = "parksteer.diagnosis/1"
@@ -31,12 +33,20 @@ def candidate_predictions(diagnosis: Diagnosis, candidate: Candidate) -> list[np
             for m, p, z in zip(diagnosis.calibration.predictions, sig.probed, sig.zero)]
 
 
-def _ranking_entry(diagnosis: Diagnosis, candidate: Candidate, before: dict) -> dict:
+def candidate_statistics(diagnosis: Diagnosis, candidate: Candidate, before: dict | None = None) -> dict:
+    """The error statistics with `candidate` (:func:`candidate_predictions`); for a candidate not refitted, its
+    weighted RMS is the linear estimate's: the calibrated one (`before`, computed if not given) scaled by the sum
+    of squares the score test says the strength removes. The one number the report's table and the figure show."""
     after = diagnosis.statistics(candidate_predictions(diagnosis, candidate))
     if candidate.refit is None:
-        # the linear estimate: the sum of squares the score test says the strength removes
+        before = before if before is not None else diagnosis.statistics(diagnosis.calibration.predictions)
         rss = diagnosis.calibration.rss - candidate.score.removed_rss
         after["weighted_rms_Nm"] = before["weighted_rms_Nm"] * math.sqrt(max(rss, 0.0) / diagnosis.calibration.rss)
+    return after
+
+
+def _ranking_entry(diagnosis: Diagnosis, candidate: Candidate, before: dict) -> dict:
+    after = candidate_statistics(diagnosis, candidate, before)
     excess = diagnosis.calibration.rss - diagnosis.problem.n
     removed = diagnosis.calibration.rss - candidate.rss_after(diagnosis.calibration.rss)
     if candidate.refit is not None:
@@ -88,9 +98,12 @@ def diagnosis_dict(diagnosis: Diagnosis) -> dict:
     if diagnosis.verdict == "missing":
         with_effect = diagnosis.statistics(diagnosis.best.refit.predictions)
     defaults = {p.key: p.reference for p in diagnosis.calibration.parameters}
-    calibrated_parameters = {
-        key: {**entry, "default": defaults[key]} for key, entry in diagnosis.calibration.intervals(problem).items()
-    }
+    intervals = diagnosis.calibration.intervals(problem, diagnosis.settings.interval_block_s)
+    free = [q.key for q in free_strengths(diagnosis.calibration.effects)]
+    if free:  # a user's free strengths: the car's intervals with them held at their fit (stages/user_effect.py)
+        intervals.update(conditioned_on_strengths(diagnosis.calibration, problem, free,
+                                                  diagnosis.settings.interval_block_s))
+    calibrated_parameters = {key: {**entry, "default": defaults[key]} for key, entry in intervals.items()}
     files = []
     for f in problem.files:
         delta = f.replay_uncertainty_Nm

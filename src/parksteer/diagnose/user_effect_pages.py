@@ -1,17 +1,13 @@
 """The report's section on a user's own effect (:mod:`parksteer.diagnose.stages.user_effect`): the ladder without it
 and with it, its fitted strengths with their intervals, the residual by phase before and after, and the sweep of its
-strengths from 0, as markdown and as HTML."""
+strengths from 0 (the section itself: :func:`parksteer.diagnose.sections.report_sections`)."""
 
 from __future__ import annotations
 
-import html
-
-from .report import html_table, interval_text, num
+from .report import interval_text, num
 
 
-
-
-def _user_effect_tables(result: dict) -> list[tuple[str, list[str], list[list]]]:
+def user_effect_tables(result: dict) -> list[tuple[str, list[str], list[list]]]:
     """(title, head, rows) of each table of the ``user_effect`` section: the ladder, the fitted strengths, the
     residual by phase, the sweep."""
     found = result["user_effect"]
@@ -22,7 +18,7 @@ def _user_effect_tables(result: dict) -> list[tuple[str, list[str], list[list]]]
                  ["strength", "fitted", "95 % interval", "unit", "declared bounds"],
                  [[key, num(e["value"], 4), interval_text(e["ci95"], "", 4), e["unit"],
                    interval_text(e["bounds"], "", 4) if e.get("bounds") else "-"] for key, e in found["strengths"].items()])
-    phases = ("Residual by phase", ["file", "phase", "samples", "without it, RMS (N m)", "with it, RMS (N m)",
+    phases = ("Residual by phase, without it and with it", ["file", "phase", "samples", "without it, RMS (N m)", "with it, RMS (N m)",
                                     "noise floor (N m)"],
               [[r["file"], r["phase"].replace("_", " "), r["samples"], num(r["without_rms_Nm"]),
                 num(r["with_rms_Nm"]), num(r["noise_floor_Nm"])] for r in found["phases"]])
@@ -38,7 +34,7 @@ def _user_effect_tables(result: dict) -> list[tuple[str, list[str], list[list]]]
     return [ladder, strengths, phases, grow]
 
 
-def _user_effect_sentence(result: dict) -> str:
+def user_effect_sentence(result: dict) -> str:
     found = result["user_effect"]
     rungs = found["rungs"]
     return (f"With {', '.join(found['effects'])} in the model, its free strengths fitted with the calibrated "
@@ -47,26 +43,22 @@ def _user_effect_sentence(result: dict) -> str:
             f"verdict above is on the model with it.")
 
 
-def user_effect_markdown(result: dict, figure: str | None = None) -> list[str]:
-    """The markdown section of a user's effect (none when the diagnosis has no ``user_effect``)."""
-    if not result.get("user_effect"):
-        return []
-    lines = [f"## Your effect: {', '.join(result['user_effect']['effects'])}", "", _user_effect_sentence(result)]
-    for title, head, rows in _user_effect_tables(result):
-        lines += ["", f"### {title}", "", "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
-        lines += ["| " + " | ".join(str(c) for c in row) + " |" for row in rows]
-    if figure:
-        lines += ["", f"![your effect: the ladder, the record, the residual by phase, the error falling]({figure})"]
-    return lines + [""]
-
-
-def user_effect_html(result: dict) -> list[str]:
-    """The HTML section of a user's effect (none when the diagnosis has no ``user_effect``)."""
-    if not result.get("user_effect"):
-        return []
-    out = [f"<h2>Your effect: {html.escape(', '.join(result['user_effect']['effects']))}</h2>",
-           f"<p>{html.escape(_user_effect_sentence(result))}</p>"]
-    for title, head, rows in _user_effect_tables(result):
-        out.append(f"<h3>{html.escape(title)}</h3>")
-        out += html_table(head, rows)
-    return out
+def user_effect_intervals(result: dict) -> str:
+    """What the intervals are: the strengths' (or why they have none), and the car's, held at the strengths' fit,
+    naming each car parameter whose signature the strengths mostly make too."""
+    found = result["user_effect"]
+    reasons = sorted({e["why_not_fixed"] for e in found["strengths"].values() if e.get("why_not_fixed")})
+    without = [k for k, e in found["strengths"].items() if e.get("why_not_fixed")]
+    text = ""
+    if reasons:
+        which = "No strength has" if len(without) == len(found["strengths"]) else \
+            f"{', '.join(f'`{k}`' for k in without)} {'has' if len(without) == 1 else 'have'}"
+        text = f"{which} a 95 % interval: {'; '.join(reasons)}. "
+    text += ("The car's calibrated parameters' intervals (below, and what these data fix) are those with the "
+             "strengths held at their fitted values.")
+    threshold = result["selection"]["thresholds"]["confounded_fraction"]
+    shared = {k: v for k, v in found.get("not_made_by_strengths", {}).items() if v < threshold}
+    for key, share in shared.items():
+        text += (f" Only {num(100 * share, 2)} % of `{key}`'s signature is not also made by the strengths: its value "
+                 "holds only with the effect's shape as fitted.")
+    return text

@@ -103,7 +103,7 @@ def diagnosis_figure(diagnosis, path: str | Path) -> None:
     """First file: torque and residual against rack for the calibrated model and with the best candidate; for an
     assisted car whose motor channel is fitted, that channel measured and fitted, and its residual, beside the
     torque's; ranking."""
-    from ..diagnose.report import candidate_predictions
+    from ..diagnose.report import candidate_predictions, candidate_statistics
 
     f = diagnosis.problem.files[0]
     fig, axes = new_figure(7.0, 12.0 if f.uses_motor else 8.0, nrows=5 if f.uses_motor else 3)
@@ -127,14 +127,8 @@ def diagnosis_figure(diagnosis, path: str | Path) -> None:
     axes[1].legend(fontsize=7)
     ranked = diagnosis.ranked
     names = [c.name for c in ranked]
-    after = []
-    for c in ranked:
-        s = diagnosis.statistics(candidate_predictions(diagnosis, c))
-        if c.refit is None:
-            s["weighted_rms_Nm"] *= np.sqrt(max(diagnosis.calibration.rss - c.score.removed_rss, 0.0)
-                                            / diagnosis.calibration.rss)
-        after.append(s["weighted_rms_Nm"])
     stats = diagnosis.statistics(diagnosis.calibration.predictions)
+    after = [candidate_statistics(diagnosis, c, stats)["weighted_rms_Nm"] for c in ranked]  # the report's numbers
     y = np.arange(len(names))
     axes[2].barh(y, after, color=[COLOURS[1] if c is diagnosis.best else COLOURS[5] for c in ranked])
     axes[2].axvline(stats["weighted_rms_Nm"], color=COLOURS[0], linestyle="--", linewidth=1.0, label="calibrated model")

@@ -8,7 +8,12 @@ only when the model has free strengths (:func:`with_user_effect_stage`), shows w
 
 - the ladder: the model without the effects that declare free strengths at the parameter file's values, the same
   model calibrated (its own calibration, from the defaults), then the model with them (the diagnosis's calibration);
-- each free strength with its 95 % interval (:meth:`parksteer.diagnose.calibrate.Fit.intervals`) and unit;
+- each free strength with its 95 % interval (:meth:`parksteer.diagnose.calibrate.Fit.intervals`) and unit, or why
+  these data give it none (:func:`why_not_fixed`);
+- the car's calibrated parameters' intervals with the free strengths held at their fit
+  (:func:`conditioned_on_strengths`: the intervals the report and "what these data fix" give), and for each the
+  share of its signature the strengths do not also make (:func:`not_made_by_strengths`): a strength's shape
+  that sums to a uniform rack friction leaves the rack friction force's value to hold only with that shape;
 - the residual's RMS in each phase of each file, calibrated without the effects and with them;
 - a sweep: every free strength whose 0 means absent (0 within its bounds) moved together from 0 to its fitted
   value in :data:`SWEEP_POINTS` steps, the other parameters (a free width or phase among them) held at the fit,
@@ -25,6 +30,7 @@ import numpy as np
 from ...measure.phases import PHASES
 from ..calibrate import Fit, calibrate, free_strengths
 from ..engine import ReplayEngine
+from ..statistics import block_sandwich
 from ..state import DiagnosisState
 from ..statistics import fit_statistics
 from .base import Stage
@@ -45,10 +51,60 @@ class UserEffect:
     nominal: tuple[np.ndarray, ...]
     without: Fit
     noise_floor_Nm: float
+    not_made_by_strengths: dict
 
     def as_dict(self) -> dict:
         return {"effects": list(self.effects), "rungs": list(self.rungs), "strengths": self.strengths,
-                "phases": list(self.phases), "sweep": self.sweep, "noise_floor_Nm": self.noise_floor_Nm}
+                "phases": list(self.phases), "sweep": self.sweep, "noise_floor_Nm": self.noise_floor_Nm,
+                "not_made_by_strengths": self.not_made_by_strengths}
+
+
+def _others(fit: Fit, free_keys) -> list[int]:
+    return [i for i, p in enumerate(fit.parameters) if p.key not in set(free_keys)]
+
+
+def conditioned_on_strengths(fit: Fit, problem, free_keys, block_s: float) -> dict[str, dict]:
+    """The intervals (:meth:`Fit.intervals`) of `fit`'s parameters other than `free_keys`, with those held at their
+    fitted values: what these data fix of the car given the user's effect as fitted. Unconditioned, a user's shape
+    of many strengths takes the car's parameters' intervals with it wherever the strengths together can make the
+    same torque (a sum of bumps along the rack is a uniform rack friction), and the block sandwich needs more
+    blocks than parameters."""
+    keep = _others(fit, free_keys)
+    sub = replace(fit, parameters=[fit.parameters[i] for i in keep], theta=np.asarray(fit.theta)[keep],
+                  jacobian=fit.jacobian[:, keep])
+    return sub.intervals(problem, block_s)
+
+
+def not_made_by_strengths(fit: Fit, free_keys) -> dict[str, float]:
+    """For each parameter of `fit` other than `free_keys`: the share (0 to 1, of its Jacobian column's norm) of its
+    signature that no combination of the free strengths' signatures makes (the least-squares residual)."""
+    keep, free = _others(fit, free_keys), [i for i in range(len(fit.parameters)) if i not in _others(fit, free_keys)]
+    strengths = fit.jacobian[:, free]
+    out = {}
+    for i in keep:
+        column = fit.jacobian[:, i]
+        norm = float(np.linalg.norm(column))
+        if norm == 0.0 or not free:
+            out[fit.parameters[i].key] = 1.0 if norm > 0.0 else 0.0
+            continue
+        coefficients = np.linalg.lstsq(strengths, column, rcond=None)[0]
+        out[fit.parameters[i].key] = float(np.linalg.norm(column - strengths @ coefficients) / norm)
+    return out
+
+
+def why_not_fixed(fit: Fit, problem, block_s: float) -> str:
+    """Why a free strength has no 95 % interval: the block sandwich's degrees of freedom (blocks less parameters),
+    which the interval needs, counted; or, with blocks to spare, that these data leave it free."""
+    try:
+        blocks = block_sandwich(fit.jacobian, fit.weighted, problem, block_s)[1]
+    except np.linalg.LinAlgError:
+        blocks = None
+    k = len(fit.parameters)
+    if blocks is not None and blocks <= k:
+        return (f"the records hold {blocks} blocks of {block_s:g} s and the fit {k} parameters: an interval needs "
+                f"more blocks than parameters (records {(k + 1) * block_s:g} s long or more in all, or fewer "
+                "strengths)")
+    return "these data leave it free: other strengths make the same torque"
 
 
 def user_effects(effects) -> list:
@@ -105,8 +161,15 @@ class UserEffectLadder(Stage):
         rungs = (_rung("paper's model", without, stats[0]), _rung("calibrated", without, stats[1]),
                  _rung(f"+ {names}", state.base, stats[2]))
         free = free_strengths(mine)
-        intervals = fit.intervals(problem, state.settings.interval_block_s)
-        table = {q.key: {**intervals[q.key], "unit": q.unit, "bounds": [q.lower, q.upper]} for q in free}
+        block_s = state.settings.interval_block_s
+        intervals = fit.intervals(problem, block_s)
+        table = {}
+        for q in free:
+            entry = {**intervals[q.key], "unit": q.unit, "bounds": [q.lower, q.upper], "why_not_fixed": None}
+            if not all(math.isfinite(c) for c in entry["ci95"]):
+                entry = {**entry, "ci95": None, "standard_error": None,
+                         "why_not_fixed": why_not_fixed(fit, problem, block_s)}
+            table[q.key] = entry
         # the strengths whose 0 means absent are swept (a width or a phase is held at its fit); when none has, every
         # free strength from just inside its lower bound
         swept = [q for q in free if q.within(0.0)] or free
@@ -123,5 +186,6 @@ class UserEffectLadder(Stage):
                  "over_floor": [e["weighted_rms_Nm"] / floor for e in errors]}
         found = UserEffect(tuple(e.name for e in mine), rungs, table,
                            tuple(phase_rows(problem, calibrated.predictions, fit.predictions)), sweep,
-                           tuple(nominal), replace(calibrated, effects=without), floor)
+                           tuple(nominal), replace(calibrated, effects=without), floor,
+                           not_made_by_strengths(fit, [q.key for q in free]))
         return state.with_output(NAME, found)
