@@ -14,6 +14,7 @@ import os
 import sys
 from importlib import metadata
 
+from .commands.effect_files import effect_files_checked
 from .errors import UsageError
 from .progress import quiet_while
 
@@ -74,7 +75,8 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(_join_dash_values(sys.argv[1:] if argv is None else list(argv)))
     try:
         with quiet_while(getattr(args, "quiet", False)):  # --quiet means the same in every subcommand that has it
-            status = int(args.func(args) or 0)
+            with effect_files_checked(getattr(args, "effects", None)):  # a user's effect files, at the door
+                status = int(args.func(args) or 0)
         sys.stdout.flush()  # a closed pipe shows here, inside the handler, not at interpreter exit
         return status
     except UsageError as exc:
