@@ -211,10 +211,15 @@ def hook_error(exc: BaseException, users: list[UserEffect]) -> str | None:
 
 
 @contextmanager
-def effect_files_checked(spec: str | None) -> Iterator[None]:
+def effect_files_checked(spec: str | None, outputs: dict[str, str | None] | None = None) -> Iterator[None]:
     """Check the user's effect files of `spec` and the environment at the door, then run the block with an
-    exception in one of their hooks reported as one line (module docstring)."""
+    exception in one of their hooks reported as one line (module docstring). `outputs` ({option: path}) are files
+    the command writes: none may be one of the effect files it reads (``--suggest-effect`` onto the file given with
+    ``--effects=+``)."""
     users = check_effect_files(spec)
+    for option, value in (outputs or {}).items():
+        if value is not None and any(u.path == os.path.abspath(value) for u in users):
+            raise UsageError(f"{option} {value}: the effect file the model is built with; write the new one beside it")
     if not users:
         yield
         return
