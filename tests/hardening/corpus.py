@@ -781,6 +781,10 @@ def effect_file_cases() -> list[Case]:
         text = effect_text(name="hook_raises", loads_body="1 / 0")
         return _effect_argv("compare", f"+{_write(f, 'mine.py', text)}", f) + ["--quiet"]
 
+    def hook_returns(f):  # the package fails on what loads() gave: the line names the hook all the same
+        text = effect_text(name="hook_returns", loads_body="return 5")
+        return _effect_argv("compare", f"+{_write(f, 'mine.py', text)}", f) + ["--quiet"]
+
     def removed_after(f):
         return _effect_argv("compare", f"+{_write(f, 'mine.py', effect_text(name='column_friction'))},-column_friction",
                             f)
@@ -795,6 +799,8 @@ def effect_file_cases() -> list[Case]:
              env=(("PARKSTEER_EFFECT_MODULES", "{scratch}/mine.py"),)),
         Case("compare:effect_hook_loads_raises", "compare", hook_raises,
              "mine.py: its hook loads() raised ZeroDivisionError: division by zero (line ", ("out.svg",)),
+        Case("compare:effect_hook_loads_returns_a_number", "compare", hook_returns,
+             "mine.py: its hook loads() returned what the model cannot use (TypeError: ", ("out.svg",)),
         Case("compare:effect_library_removed_after_it", "compare", removed_after,
              "--effects=-column_friction,+", ("out.svg",)),
         Case("compare:effect_file_missing", "compare",

@@ -12,7 +12,8 @@ An effect written by the user (``--effects=+FILE.py`` or ``+my_pkg.my_effect``, 
   registry, unseen) unless the spec removes the library's first (``--effects=-column_friction,+FILE.py``), and not
   a section of the parameter file (``tyre``, ``case``, ``run``), whose keys its quantities would share;
 - while the command runs, an exception raised in one of its hooks (``loads``, ``configure``, ``boost_law``, ...),
-  in this process or in a worker, becomes one line naming the file, the hook and the line.
+  in this process or in a worker, becomes one line naming the file, the hook and the line; so does one the model
+  raises on what a hook returned, where the package's call of the hook is on the traceback.
 """
 
 from __future__ import annotations
@@ -197,9 +198,31 @@ def _first_line(exc: BaseException) -> str:
     return f"{type(exc).__name__}: {text[0]}" if text else type(exc).__name__
 
 
+_HOOK_CALL = re.compile(r"\beffect\.(\w+)\(")
+
+
+def _returned_by_hook(exc: BaseException, users: list[UserEffect]) -> str | None:
+    """The one line of an exception raised by the package on what a user's hook returned (a load that is no
+    (point, vector) pair, say): the package's frame that called the hook holds the effect as ``effect``, and its line
+    names the hook. None when no such frame is on the traceback."""
+    modules = {type(u.effect).__module__: u for u in users}
+    tb = exc.__traceback__
+    while tb is not None:
+        effect = tb.tb_frame.f_locals.get("effect")
+        user = modules.get(type(effect).__module__) if effect is not None else None
+        if user is not None:
+            line = traceback.extract_tb(tb, limit=1)[0].line or ""
+            match = _HOOK_CALL.search(line)
+            hook = f"its hook {match.group(1)}()" if match else "one of its hooks"
+            return (f"effect file {user.ref}: {hook} returned what the model cannot use ({_first_line(exc)}); see "
+                    "what each hook returns in parksteer.model.symbolic.components.Effect")
+        tb = tb.tb_next
+    return None
+
+
 def hook_error(exc: BaseException, users: list[UserEffect]) -> str | None:
-    """The one line of an exception raised in a user's effect (its file, the hook the model called, the line), or
-    None when no frame of the exception is in a user's file."""
+    """The one line of an exception raised in a user's effect (its file, the hook the model called, the line) or on
+    what one of its hooks returned, or None when the exception has nothing to do with a user's file."""
     for user in users:
         if user.path is None:
             continue
@@ -207,7 +230,7 @@ def hook_error(exc: BaseException, users: list[UserEffect]) -> str | None:
         if mine:
             hook, line = mine[0][1], mine[-1][0]
             return f"effect file {user.ref}: its hook {hook}() raised {_first_line(exc)} (line {line})"
-    return None
+    return _returned_by_hook(exc, users)
 
 
 @contextmanager
