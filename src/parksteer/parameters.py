@@ -347,7 +347,8 @@ def declare(q: Quantity) -> Quantity:
     if known is not None and (known.unit, known.lower, known.upper, known.lower_inclusive, known.upper_inclusive,
                               known.is_list) != (q.unit, q.lower, q.upper, q.lower_inclusive, q.upper_inclusive,
                                                  q.is_list):
-        raise UsageError(f"{q.key}: declared twice with different unit or bounds")
+        raise UsageError(f"{q.key}: declared twice with different unit or bounds ({known.unit} {known.bounds_text()}, "
+                         f"then {q.unit} {q.bounds_text()}): another effect named {q.section!r} is loaded")
     if not (math.isfinite(q.default) and q.within(q.default)):
         raise UsageError(f"{q.key}: default {q.default:g} {q.unit} is outside its bounds {q.bounds_text()}")
     _DECLARED[q.key] = q

@@ -14,7 +14,7 @@ import pytest
 from parksteer.commands import effect_files
 from parksteer.errors import UsageError
 from parksteer.model.symbolic import components
-from parksteer.parameters import Quantity, declaration_problem, registry
+from parksteer.parameters import CASE_SCHEMA, SCHEMA, VEHICLE_SPEED, Quantity, declaration_problem
 
 from .corpus import REPO, effect_text
 
@@ -32,7 +32,9 @@ def test_every_library_quantity_passes_the_door():
     """Every quantity the library declares or the parameter file holds has a declaration the door accepts and an SI
     unit pint knows: the checks refuse no quantity of the library's own (its effects' and the file's keys)."""
     library = effect_files.library_effects()
-    quantities = {q.key: q for e in library.values() for q in e.quantities} | registry()
+    quantities = ({q.key: q for e in library.values() for q in e.quantities}
+                  | {q.key: q for table in (*SCHEMA.values(), CASE_SCHEMA) for q in table.values()}
+                  | {VEHICLE_SPEED.key: VEHICLE_SPEED})
     assert len(library) >= 20 and len(quantities) > 100
     refused = {k: declaration_problem(q) for k, q in quantities.items()
                if q.default is not None and declaration_problem(q) is not None}
