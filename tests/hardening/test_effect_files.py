@@ -123,3 +123,27 @@ def test_an_exception_elsewhere_is_left_alone(tmp_path):
         raise KeyError("x")
     except KeyError as exc:
         assert effect_files.hook_error(exc, [user]) is None
+
+
+def test_an_exception_in_a_real_worker_names_the_file_and_the_hook(tmp_path):
+    """A user's function raising in a forked pool worker (as a diagnosis's replay workers call an effect's
+    boost_law): the exception the parent receives is reported with the file, the hook called and the innermost
+    line of the file (the division, line 5)."""
+    import importlib.util
+    import multiprocessing
+    import sys
+
+    path = tmp_path / "mine.py"
+    path.write_text("def boost_law(x):\n    return _gain(x)\n\ndef _gain(x):\n    return 1 / x\n", encoding="utf-8")
+    spec = importlib.util.spec_from_file_location("door_worker_probe", path)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module  # found by name in the forked worker, as parksteer.diagnose.parallel arranges
+    try:
+        spec.loader.exec_module(module)
+        with multiprocessing.get_context("fork").Pool(1) as pool, pytest.raises(ZeroDivisionError) as raised:
+            pool.apply(module.boost_law, (0.0,))
+    finally:
+        del sys.modules[spec.name]
+    user = effect_files.UserEffect(str(path), object(), os.path.abspath(path))
+    assert effect_files.hook_error(raised.value, [user]) == (
+        f"effect file {path}: its hook boost_law() raised ZeroDivisionError: float division by zero (line 5)")
