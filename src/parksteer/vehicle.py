@@ -200,6 +200,8 @@ def _read_boost(path: Path, kind: str, table: Any, name: str, sources: dict) -> 
     speeds = read.get("vehicle_speed")
     torques = _numbers(f"{where}.torsion_bar_torque", read["torsion_bar_torque"])
     if speeds is None:
+        if isinstance(read["assist"], list) and any(isinstance(row, list) for row in read["assist"]):
+            raise ParameterError(f"{where}.assist: rows for several vehicle speeds need vehicle_speed, one per row")
         rows = [_numbers(f"{where}.assist", read["assist"])]
     else:
         speeds = _numbers(f"{where}.vehicle_speed", speeds)
