@@ -794,6 +794,9 @@ def effect_file_cases() -> list[Case]:
         return _effect_argv("diagnose", f"+{path}", f) + ["--suggest-effect", str(path)]
 
     return cases + [
+        Case("compare:effect_file_example", "compare",
+             lambda f: _effect_argv("compare", f"+{REPO / 'examples' / 'user_effect' / 'centre_friction.py'}", f),
+             ACCEPTED),
         Case("compare:effect_environment_name_of_library", "compare", env_clash,
              "mine.py: effect 'rack_friction' has the name of the library's", ("out.svg",),
              env=(("PARKSTEER_EFFECT_MODULES", "{scratch}/mine.py"),)),
