@@ -938,6 +938,8 @@ def assist_cases() -> list[Case]:
         Case("assist:identify_out_exists", "assist", out_exists, "kept.toml: exists (--force to overwrite)"),
         Case("assist:identify_out_not_toml", "assist",
              lambda f: identify(f)[:-1] + [str(f / "id.txt")], "name it .toml", ("id.txt",)),
+        Case("assist:identify_out_in_proc", "assist", lambda f: identify(f)[:-1] + ["/proc/id.toml"],
+             "--out /proc/id.toml: cannot write in folder /proc"),
         Case("assist:identify_out_is_the_vehicle", "assist",
              lambda f: identify(f)[:-1] + [str(POLO)], "the vehicle file given"),
         Case("assist:identify_zero_current", "assist",

@@ -70,6 +70,7 @@ def _identify(args) -> int:
         raise UsageError(f"--out {args.out}: a vehicle file is TOML; name it .toml")
     if out.exists() and not args.force:
         raise UsageError(f"--out {args.out}: exists (--force to overwrite)")
+    _check_writable(out)
     # what the identification prints while it runs is progress: stderr, so that stdout holds the result alone
     with contextlib.redirect_stdout(sys.stderr):
         found = identify_boost(args.files, args.vehicle, args.case, args.surface, channel_map_of(args),
@@ -85,6 +86,19 @@ def _identify(args) -> int:
         print("\n".join(found.summary_lines()))
     print(f"wrote {out}", file=sys.stderr if args.json else sys.stdout)
     return 0
+
+
+def _check_writable(out: Path) -> None:
+    """Refuse a folder nothing can be written in before the work, not after it (a probe file made and removed:
+    permissions alone do not tell, e.g. for root or a read-only mount)."""
+    import tempfile
+
+    folder = out.resolve().parent
+    try:
+        with tempfile.NamedTemporaryFile(dir=folder, prefix=".parksteer-probe-"):
+            pass
+    except OSError as exc:
+        raise UsageError(f"--out {out}: cannot write in folder {folder} ({exc.strerror})") from None
 
 
 # A map whose largest current is below this many times the map's own noise has not seen the motor work.
