@@ -70,7 +70,7 @@ def _identify(args) -> int:
         raise UsageError(f"--out {args.out}: a vehicle file is TOML; name it .toml")
     if out.exists() and not args.force:
         raise UsageError(f"--out {args.out}: exists (--force to overwrite)")
-    _check_writable(out)
+    _check_writable("--out", args.out, out.resolve().parent)
     # what the identification prints while it runs is progress: stderr, so that stdout holds the result alone
     with contextlib.redirect_stdout(sys.stderr):
         found = identify_boost(args.files, args.vehicle, args.case, args.surface, channel_map_of(args),
@@ -88,17 +88,29 @@ def _identify(args) -> int:
     return 0
 
 
-def _check_writable(out: Path) -> None:
+def _check_writable(option: str, value: str, folder: Path) -> None:
     """Refuse a folder nothing can be written in before the work, not after it (a probe file made and removed:
     permissions alone do not tell, e.g. for root or a read-only mount)."""
     import tempfile
 
-    folder = out.resolve().parent
     try:
         with tempfile.NamedTemporaryFile(dir=folder, prefix=".parksteer-probe-"):
             pass
     except OSError as exc:
-        raise UsageError(f"--out {out}: cannot write in folder {folder} ({exc.strerror})") from None
+        raise UsageError(f"{option} {value}: cannot write in folder {folder} ({exc.strerror})") from None
+
+
+def _check_out_dir(value: str) -> None:
+    """--out-dir: a folder, or one that can be made, in a place that can be written (checked before the work)."""
+    folder = Path(value).resolve()
+    if folder.exists() and not folder.is_dir():
+        raise UsageError(f"--out-dir {value}: is a file, not a folder")
+    existing = folder
+    while not existing.exists():
+        existing = existing.parent
+    if not existing.is_dir():
+        raise UsageError(f"--out-dir {value}: {existing} is a file, not a folder")
+    _check_writable("--out-dir", value, existing)
 
 
 # A map whose largest current is below this many times the map's own noise has not seen the motor work.
@@ -144,6 +156,7 @@ def _size(args) -> int:
     from ..sweep.assist_sizing import size_assist
     from ..vehicle import vehicle_name
 
+    _check_out_dir(args.out_dir)
     params = parameters_of(args)
     case = args.case or params.case_names[0]
     if case not in params.case_names:
