@@ -989,6 +989,11 @@ def assist_cases() -> list[Case]:
         Case("vehicle:new_assist_boost_falls", "vehicle", lambda f: _boost_spec(f, "0:0,1:2,2:1"),
              "the assist must rise strictly beyond the dead band (2 then 1", ("car.toml",)),
         Case("vehicle:new_assist_boost", "vehicle", lambda f: _boost_spec(f, "0:0,1:2,3:6"), ACCEPTED),
+        Case("vehicle:new_out_in_proc", "vehicle",
+             lambda f: _spec(f, "--out", "/proc/car.toml"), "/proc/car.toml: cannot write in folder /proc"),
+        Case("simulate:out_in_proc", "simulate",
+             lambda f: ["simulate", "--case", "unladen", "--output-dt", "0.5", "--out", "/proc/out.csv"],
+             "/proc/out.csv: cannot write in folder /proc"),
         Case("vehicle:new_out_exists", "vehicle",
              lambda f: (_write(f, "car.toml", "# kept\n"), _spec(f))[1], "exists (--force to overwrite)"),
     ]
