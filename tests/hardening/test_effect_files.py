@@ -18,8 +18,7 @@ from parksteer.parameters import CASE_SCHEMA, SCHEMA, VEHICLE_SPEED, Quantity, d
 
 from .corpus import REPO, effect_text
 
-EXAMPLES = (REPO / "examples" / "user_effect" / "centre_friction.py",
-            REPO / "src" / "parksteer" / "examples" / "column_imbalance.py")
+EXAMPLES = (*sorted((REPO / "examples").glob("*/*.py")), REPO / "src" / "parksteer" / "examples" / "column_imbalance.py")
 
 
 def test_environment_variable_is_the_registrys():
@@ -68,9 +67,9 @@ def test_declaration_problems_of_bounds():
 
 
 def test_the_shipped_examples_pass_the_door():
-    """The two example effects of examples/user_effect/README.md load through the door unchanged."""
+    """The example effects (examples/*/ and the package's column imbalance) load through the door unchanged."""
     found = effect_files.check_effect_files(",".join(f"+{p}" for p in EXAMPLES))
-    assert [u.effect.name for u in found] == ["centre_friction", "column_imbalance"]
+    assert [u.effect.name for u in found] == ["current_derating", "centre_friction", "column_imbalance"]
     assert [u.path for u in found] == [str(p) for p in EXAMPLES]
 
 
