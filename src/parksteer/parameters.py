@@ -17,6 +17,7 @@ from functools import lru_cache
 
 import dataclasses
 import math
+import numbers
 import tomllib
 from dataclasses import dataclass, field
 from collections.abc import Callable
@@ -305,7 +306,8 @@ def unknown_key_message(key: str) -> str:
 
 
 def _is_number(value: Any) -> bool:
-    return not isinstance(value, bool) and isinstance(value, (int, float))
+    """A real number as code writes one (int, float, a NumPy scalar), not a boolean, a string or None."""
+    return not isinstance(value, bool) and isinstance(value, numbers.Real)
 
 
 def declaration_problem(q: Quantity) -> str | None:
