@@ -14,6 +14,8 @@ import os
 import sys
 from importlib import metadata
 
+from .commands import add_quiet_option
+from .commands.effect_files import effect_files_checked
 from .errors import UsageError
 from .progress import quiet_while
 
@@ -40,7 +42,20 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
     for name in COMMAND_MODULES:
         importlib.import_module(name).register(sub)
+    _quiet_everywhere(parser)
     return parser
+
+
+def _quiet_everywhere(parser: argparse.ArgumentParser) -> None:
+    """Give every subcommand ``--quiet`` (a command with no progress lines takes it too, so that one option works
+    across a script of commands), where its module did not add it."""
+    groups = [a for a in parser._actions if isinstance(a, argparse._SubParsersAction)]
+    if not groups:
+        if not any("--quiet" in a.option_strings for a in parser._actions):
+            add_quiet_option(parser)
+        return
+    for child in groups[0].choices.values():
+        _quiet_everywhere(child)
 
 
 def _version() -> str:
@@ -51,8 +66,9 @@ def _version() -> str:
         return "unknown (not installed)"
 
 
-# Options whose value may start with "-" (an effects spec such as "-rack_friction,+hooke_joint").
-DASH_VALUE_OPTIONS = ("--effects",)
+# Options whose value may start with "-" (an effects spec such as "-rack_friction,+hooke_joint", boost points
+# such as "-0.5:0,...", refused by the table's own check with its reason rather than by argparse).
+DASH_VALUE_OPTIONS = ("--effects", "--assist-boost")
 
 
 def _join_dash_values(argv: list[str]) -> list[str]:
@@ -74,7 +90,9 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(_join_dash_values(sys.argv[1:] if argv is None else list(argv)))
     try:
         with quiet_while(getattr(args, "quiet", False)):  # --quiet means the same in every subcommand that has it
-            status = int(args.func(args) or 0)
+            with effect_files_checked(getattr(args, "effects", None),  # a user's effect files, at the door
+                                      {"--suggest-effect": getattr(args, "suggest_effect", None)}):
+                status = int(args.func(args) or 0)
         sys.stdout.flush()  # a closed pipe shows here, inside the handler, not at interpreter exit
         return status
     except UsageError as exc:

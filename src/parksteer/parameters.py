@@ -17,6 +17,7 @@ from functools import lru_cache
 
 import dataclasses
 import math
+import numbers
 import tomllib
 from dataclasses import dataclass, field
 from collections.abc import Callable
@@ -304,12 +305,43 @@ def unknown_key_message(key: str) -> str:
     return f"{key}: unknown key (a key of the parameter file, case.<name>, or an effect's own quantity)"
 
 
+def _is_number(value: Any) -> bool:
+    """A real number as code writes one (int, float, a NumPy scalar), not a boolean, a string or None."""
+    return not isinstance(value, bool) and isinstance(value, numbers.Real)
+
+
+def declaration_problem(q: Quantity) -> str | None:
+    """What is wrong with the declaration of `q` (an effect's own quantity, written in code), or None: a unit
+    given as text, both bounds numbers and not NaN, the lower below the upper, finite bounds for a quantity a
+    diagnosis fits (``free``: the fit may take any value between them), a default and a source."""
+    if not isinstance(q.unit, str) or not q.unit.strip():
+        return f"unit {q.unit!r}: give its SI unit as text, e.g. 'N m'"
+    for side, bound in (("lower", q.lower), ("upper", q.upper)):
+        if not _is_number(bound):
+            return (f"{side} bound {bound!r} is not a number: give both bounds, the range the physics allows "
+                    "(Quantity(key, unit, lower, upper, ...))")
+        if math.isnan(bound):
+            return f"{side} bound is NaN: give the range the physics allows"
+    if not q.lower < q.upper:
+        return f"bounds out of order: the lower bound {q.lower:g} must be below the upper {q.upper:g}"
+    if q.free and not (math.isfinite(q.lower) and math.isfinite(q.upper)):
+        return (f"free within {q.bounds_text()} {q.unit}: a quantity the diagnosis fits needs finite bounds, the "
+                "range its physics allows (a friction's from 0)")
+    if q.default is None or not isinstance(q.source, str) or not q.source.strip():
+        return "a quantity declared in code needs a default and a source"
+    if not _is_number(q.default):
+        return f"default {q.default!r} is not a number"
+    return None
+
+
 def declare(q: Quantity) -> Quantity:
-    """Join a quantity declared in code (an effect's own, with default and source) to the registry."""
+    """Join a quantity declared in code (an effect's own, with default and source) to the registry; a declaration
+    :func:`declaration_problem` finds wrong is a one-line UsageError naming the key."""
     if q.section in SCHEMA or q.section == CASE:
         raise UsageError(f"{q.key}: section {q.section} belongs to the parameter file; declare {q.section}.* there")
-    if q.default is None or not q.source.strip():
-        raise UsageError(f"{q.key}: a quantity declared in code needs a default and a source")
+    problem = declaration_problem(q)
+    if problem is not None:
+        raise UsageError(f"{q.key}: {problem}")
     known = _DECLARED.get(q.key)
     # the same effect's file loaded again in one process (a suggested effect written again with its fitted values as
     # defaults) declares its quantities anew: the latest default, source and freedom win; another unit or bounds is a
@@ -317,8 +349,10 @@ def declare(q: Quantity) -> Quantity:
     if known is not None and (known.unit, known.lower, known.upper, known.lower_inclusive, known.upper_inclusive,
                               known.is_list) != (q.unit, q.lower, q.upper, q.lower_inclusive, q.upper_inclusive,
                                                  q.is_list):
-        raise UsageError(f"{q.key}: declared twice with different unit or bounds")
-    q.check(q.default)
+        raise UsageError(f"{q.key}: declared twice with different unit or bounds ({known.unit} {known.bounds_text()}, "
+                         f"then {q.unit} {q.bounds_text()}): another effect named {q.section!r} is loaded")
+    if not (math.isfinite(q.default) and q.within(q.default)):
+        raise UsageError(f"{q.key}: default {q.default:g} {q.unit} is outside its bounds {q.bounds_text()}")
     _DECLARED[q.key] = q
     return q
 

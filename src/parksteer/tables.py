@@ -101,13 +101,16 @@ def atomic_path(path: str | Path) -> Iterator[Path]:
         raise UsageError(f"{path}: is a directory; name a file to write")
     if path.parent.exists() and not path.parent.is_dir():
         raise UsageError(f"{path}: {path.parent} is a file, not a directory")
-    path.parent.mkdir(parents=True, exist_ok=True)
     host = _host()
-    for old in path.parent.glob(f".{glob.escape(path.name)}.*{TEMPORARY_SUFFIX}"):
-        if _stale_temporary(old, host, time.time()):
-            old.unlink(missing_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.{host}.{os.getpid()}.", suffix=TEMPORARY_SUFFIX,
-                               dir=path.parent)
+    try:  # a folder nothing can be written in (read-only, /proc): the user's path in one line, not a traceback
+        path.parent.mkdir(parents=True, exist_ok=True)
+        for old in path.parent.glob(f".{glob.escape(path.name)}.*{TEMPORARY_SUFFIX}"):
+            if _stale_temporary(old, host, time.time()):
+                old.unlink(missing_ok=True)
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.{host}.{os.getpid()}.", suffix=TEMPORARY_SUFFIX,
+                                   dir=path.parent)
+    except OSError as exc:
+        raise UsageError(f"{path}: cannot write in folder {path.parent} ({exc.strerror})") from None
     os.close(fd)
     umask = os.umask(0)
     os.umask(umask)

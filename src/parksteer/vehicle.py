@@ -17,6 +17,7 @@ the wheel centre and meeting the ground on its own side, and the road-wheel lock
 from __future__ import annotations
 
 import dataclasses
+import json
 import math
 import tomllib
 from pathlib import Path
@@ -104,7 +105,7 @@ def _read_assist(path: Path, table: Any, sections: dict, sources: dict) -> None:
     if not isinstance(table, dict):
         raise ParameterError(f"{path}: assist: expected a table")
     kind = table.get("type")
-    if kind not in ASSIST_EFFECTS:
+    if not isinstance(kind, str) or kind not in ASSIST_EFFECTS:
         raise ParameterError(f"{path}: assist.type: {kind!r}, expected one of {', '.join(ASSIST_EFFECTS)}")
     name = ASSIST_EFFECTS[kind]
     values = {}
@@ -123,6 +124,7 @@ def _read_assist(path: Path, table: Any, sections: dict, sources: dict) -> None:
                                  "assist, optionally vehicle_speed)")
         if not isinstance(entry, dict) or set(entry) != {"value", "unit", "source"}:
             raise ParameterError(f"{path}: assist.{key}: expected {{ value, unit, source }}")
+        _check_text(f"{path}: assist.{key}", entry)
         value = entry["value"]
         if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
             raise ParameterError(f"{path}: assist.{key}: value {value!r} is not a finite number")
@@ -141,6 +143,29 @@ def _read_assist(path: Path, table: Any, sections: dict, sources: dict) -> None:
         values.setdefault(line, 0.0)
         sources.setdefault(f"{name}.{line}", "0: the boost table [assist.boost] gives the curve")
     sections[name] = values
+
+
+def _check_text(where: str, entry: dict) -> None:
+    """An entry's unit and source are text (a number or a table there is a slip of the hand)."""
+    for field_name in ("unit", "source"):
+        if field_name in entry and not isinstance(entry[field_name], str):
+            raise ParameterError(f"{where}: {field_name} {_toml_text(entry[field_name])} is not a string")
+
+
+def _toml_text(value: Any) -> str:
+    """`value` as the file wrote it (``true``, ``"0.9"``), for a message."""
+    return json.dumps(value) if isinstance(value, (bool, str)) else repr(value)
+
+
+def _numbers(where: str, values: Any, row: str = "") -> list[float]:
+    """A list of numbers from a vehicle file: each a TOML integer or float, not a boolean or a string (``true`` or
+    ``"0.9"``, which float() would take); one-line ParameterError naming the row and the point otherwise."""
+    if not isinstance(values, list) or not values:
+        raise ParameterError(f"{where}: {row}expected a list of numbers")
+    for k, value in enumerate(values, 1):
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise ParameterError(f"{where}: {row}point {k}: {_toml_text(value)} is not a number")
+    return [float(v) for v in values]
 
 
 def _gain_uncertainty(path: Path, entry: dict) -> float:
@@ -165,6 +190,7 @@ def _read_boost(path: Path, kind: str, table: Any, name: str, sources: dict) -> 
                 "value", "unit", "source"}:
             raise ParameterError(f"{where}.{key}: expected {{ value, unit, source }}")
         units = BOOST_UNITS[key] if key != "assist" else BOOST_ASSIST_UNITS[kind]
+        _check_text(f"{where}.{key}", entry)
         if entry["unit"] not in units:
             raise ParameterError(f"{where}.{key}: unit {entry['unit']!r}, expected {' or '.join(map(repr, units))}")
         if key == "gain_uncertainty":
@@ -172,20 +198,25 @@ def _read_boost(path: Path, kind: str, table: Any, name: str, sources: dict) -> 
         read[key] = entry["value"]
         sources[f"{name}.boost.{key}"] = str(entry.get("source", ""))
     speeds = read.get("vehicle_speed")
-    rows = read["assist"]
+    torques = _numbers(f"{where}.torsion_bar_torque", read["torsion_bar_torque"])
     if speeds is None:
-        rows = [rows]
+        if isinstance(read["assist"], list) and any(isinstance(row, list) for row in read["assist"]):
+            raise ParameterError(f"{where}.assist: rows for several vehicle speeds need vehicle_speed, one per row")
+        rows = [_numbers(f"{where}.assist", read["assist"])]
+    else:
+        speeds = _numbers(f"{where}.vehicle_speed", speeds)
+        if not isinstance(read["assist"], list) or not all(isinstance(row, list) for row in read["assist"]):
+            raise ParameterError(f"{where}.assist: expected one list of numbers per vehicle speed")
+        rows = [_numbers(f"{where}.assist", row, f"row {r}, ") for r, row in enumerate(read["assist"], 1)]
     try:
-        torques = [float(t) for t in read["torsion_bar_torque"]]
         scale = BAR_PA if table["assist"]["unit"] == "bar" else 1.0
-        rows = [[float(a) * scale for a in row] for row in rows]
+        rows = [[a * scale for a in row] for row in rows]
         if speeds is not None:
             scale = KMH if table["vehicle_speed"]["unit"] == "km/h" else 1.0
-            speeds = [float(v) * scale for v in speeds]
+            speeds = [v * scale for v in speeds]
         out = entries(torques, speeds, rows)
-    except (TypeError, ValueError) as exc:
-        detail = str(exc) if isinstance(exc, BoostTableError) else "lists of numbers (one row per vehicle speed)"
-        raise ParameterError(f"{where}: {detail}") from None
+    except BoostTableError as exc:
+        raise ParameterError(f"{where}: {exc}") from None
     source = f"derived: [assist.boost] ({sources[f'{name}.boost.assist']})"
     for key in out:
         sources[f"{name}.{key}"] = source

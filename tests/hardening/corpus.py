@@ -8,6 +8,7 @@ accepted replay takes a second or two.
 
 from __future__ import annotations
 
+import re
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -57,6 +58,7 @@ class Case:
     expect: str  # ACCEPTED or a fragment of the one-line error
     outputs: tuple[str, ...] = ()  # files (relative to the scratch folder) that must not exist after an error
     status: int = 2  # 2: a usage error on stderr; 1: a verification that found a problem (one stdout line)
+    env: tuple[tuple[str, str], ...] = ()  # environment variables of the run ({scratch} in a value: its folder)
 
 
 def _write(folder: Path, name: str, text: str | bytes) -> Path:
@@ -692,6 +694,312 @@ def bus_cases() -> list[Case]:
     ]
 
 
+# ------------------------------------------------------------------------------------------ a user's effect file
+
+def effect_text(*, name: str = "bore_friction", bounds: str = "0.0, 2000.0", unit: str = "N", default: str = "0.0",
+                free: bool = True, candidate: bool = False, loads_body: str = "", extra: str = "") -> str:
+    """A user's effect file in the form of examples/user_effect/centre_friction.py: a rack friction of one free
+    strength `<name>.force` with the given bounds, unit and default; `loads_body` a line run first in loads()."""
+    return f'''"""A rack friction written by a user (a corpus input)."""
+import sympy as sp
+
+from parksteer.model.symbolic.components import Effect
+from parksteer.model.symbolic.system import action_reaction
+from parksteer.parameters import Quantity
+
+
+class BoreFriction(Effect):
+    name = {name!r}
+    description = "a rack friction: -F tanh(beta v)"
+    in_default_set = False
+    diagnosis_candidate = {candidate!r}
+    quantities = (Quantity("{name}.force", {unit!r}, {bounds}, lower_inclusive=True, default={default},
+                           free={free!r}, source="a corpus input"),)
+    uses = ("{name}.force", "steering.friction_smoothing")
+{extra}
+    def loads(self, model):
+        {loads_body or "pass"}
+        k = model.kinematics
+        force = model.p("{name}.force") * sp.tanh(model.p("steering.friction_smoothing") * model.rack_u)
+        return action_reaction(k.rack_point, -force * k.B.y, k.rack_housing_point)
+
+
+EFFECT = BoreFriction()
+'''
+
+
+EFFECT_DEFECTS: dict[str, tuple[dict, str]] = {
+    "bounds_none": (dict(bounds="None, None"), "bounds_none.force: lower bound None is not a number"),
+    "bounds_text": (dict(bounds="0.0, '2000'"), "upper bound '2000' is not a number"),
+    "bounds_nan": (dict(bounds="0.0, float('nan')"), "upper bound is NaN"),
+    "bounds_reversed": (dict(bounds="10.0, 0.0"), "bounds out of order: the lower bound 10 must be below the upper 0"),
+    "bounds_infinite_free": (dict(bounds="-float('inf'), float('inf')"), "needs finite bounds"),
+    "default_outside": (dict(default="-5.0"), "default -5 N is outside its bounds [0, 2000]"),
+    "default_text": (dict(default="'0'"), "default '0' is not a number"),
+    "unit_furlong": (dict(unit="furlong"), "unit 'furlong' is not SI (1 furlong = 201.168 m)"),
+    "unit_unknown": (dict(unit="furlongz"), "unit 'furlongz' is not a unit pint knows"),
+    "unit_millimetres": (dict(unit="mm", bounds="0.0, 2.0"), "unit 'mm' is not SI"),
+    "unit_not_text": (dict(unit=5), "unit 5: give its SI unit as text"),
+    "name_of_library_effect": (dict(name="column_friction"),
+                               "effect 'column_friction' has the name of the library's; name it otherwise, or "
+                               "remove the library's first: --effects=-column_friction,+"),
+    "name_of_parameter_section": (dict(name="tyre"), "section tyre belongs to the parameter file"),
+    "name_of_run_section": (dict(name="run"), "effect name 'run' is a section of the parameter file's keys"),
+    "candidate_strength_unbounded": (dict(bounds="0.0, float('inf')", free=False, candidate=True),
+                                     "a diagnosis candidate's strength needs a finite upper"),
+}
+
+
+def _effect_argv(entry: str, spec: str, folder: Path) -> list[str]:
+    record = str(_write(folder, "r.csv", record_text()))
+    if entry == "simulate":
+        return ["simulate", "--case", "unladen", "--effects", spec, "--out", str(folder / "out.csv")]
+    if entry == "diagnose":
+        return ["diagnose", record, "--effects", spec, "--report", str(folder / "out.md")]
+    return ["compare", record, "--effects", spec, "--plot", str(folder / "out.svg")]
+
+
+def effect_file_cases() -> list[Case]:
+    """A user's effect file (--effects=+FILE.py, PARKSTEER_EFFECT_MODULES) with each defect of its declarations,
+    its name or its hooks: refused at the door, naming the file, by every command that builds a model from it."""
+    cases = []
+    for name, (kw, fragment) in EFFECT_DEFECTS.items():
+        # each defect's effect of its own name: the corpus runs in one process, where a key once declared keeps its
+        # unit and bounds
+        kw = {"name": name, **kw}
+        for entry in ("compare", "diagnose", "simulate"):
+            def make(f, kw=kw, entry=entry):
+                return _effect_argv(entry, f"+{_write(f, 'mine.py', effect_text(**kw))}", f)
+
+            cases.append(Case(f"{entry}:effect_{name}", entry, make, fragment, OUTPUTS[entry]))
+
+    def env_clash(f):
+        _write(f, "mine.py", effect_text(name="rack_friction"))
+        return _effect_argv("compare", "+hooke_joint", f)
+
+    def hook_raises(f):  # found while the model is derived: --quiet leaves the one line alone on stderr
+        text = effect_text(name="hook_raises", loads_body="1 / 0")
+        return _effect_argv("compare", f"+{_write(f, 'mine.py', text)}", f) + ["--quiet"]
+
+    def hook_returns(f):  # the package fails on what loads() gave: the line names the hook all the same
+        text = effect_text(name="hook_returns", loads_body="return 5")
+        return _effect_argv("compare", f"+{_write(f, 'mine.py', text)}", f) + ["--quiet"]
+
+    def removed_after(f):
+        return _effect_argv("compare", f"+{_write(f, 'mine.py', effect_text(name='column_friction'))},-column_friction",
+                            f)
+
+    def suggest_onto_effect(f):
+        path = _write(f, "mine.py", effect_text(name="suggest_onto"))
+        return _effect_argv("diagnose", f"+{path}", f) + ["--suggest-effect", str(path)]
+
+    return cases + [
+        Case("compare:effect_file_example", "compare",
+             lambda f: _effect_argv("compare", f"+{REPO / 'examples' / 'user_effect' / 'centre_friction.py'}", f),
+             ACCEPTED),
+        Case("compare:effect_environment_name_of_library", "compare", env_clash,
+             "mine.py: effect 'rack_friction' has the name of the library's", ("out.svg",),
+             env=(("PARKSTEER_EFFECT_MODULES", "{scratch}/mine.py"),)),
+        Case("compare:effect_hook_loads_raises", "compare", hook_raises,
+             "mine.py: its hook loads() raised ZeroDivisionError: division by zero (line ", ("out.svg",)),
+        Case("compare:effect_hook_loads_returns_a_number", "compare", hook_returns,
+             "mine.py: its hook loads() returned what the model cannot use (TypeError: ", ("out.svg",)),
+        Case("compare:effect_library_removed_after_it", "compare", removed_after,
+             "--effects=-column_friction,+", ("out.svg",)),
+        Case("compare:effect_file_missing", "compare",
+             lambda f: _effect_argv("compare", f"+{f / 'nope.py'}", f), "nope.py: no such file", ("out.svg",)),
+        Case("compare:effect_file_syntax_error", "compare",
+             lambda f: _effect_argv("compare", f"+{_write(f, 'mine.py', 'def (:')}", f), "mine.py: cannot load",
+             ("out.svg",)),
+        Case("compare:effect_file_without_effect", "compare",
+             lambda f: _effect_argv("compare", f"+{_write(f, 'mine.py', 'X = 1')}", f), "module defines no EFFECT",
+             ("out.svg",)),
+        Case("diagnose:suggest_effect_onto_the_effect_file", "diagnose", suggest_onto_effect,
+             "the effect file the model is built with"),
+    ]
+
+
+def suggest_effect_cases() -> list[Case]:
+    """diagnose --suggest-effect where the file cannot be written."""
+    def argv(f, target):
+        return ["diagnose", str(_write(f, "r.csv", record_text())), "--suggest-effect", target]
+
+    return [
+        Case("diagnose:suggest_effect_not_py", "diagnose", lambda f: argv(f, str(f / "s.txt")), "name it .py",
+             ("s.txt",)),
+        Case("diagnose:suggest_effect_is_directory", "diagnose",
+             lambda f: argv(f, str((f / "d.py").mkdir() or f / "d.py")), "d.py: is a directory"),
+        Case("diagnose:suggest_effect_folder_missing", "diagnose", lambda f: argv(f, str(f / "no" / "s.py")),
+             "does not exist"),
+    ]
+
+
+# ------------------------------------------------------------------------------------- boost tables, assist commands
+
+POLO = REPO / "data" / "vehicles" / "polo_vi.toml"
+BASELINE = REPO / "data" / "samples" / "polo_baseline.csv"
+POLO_ASSIST_ROW = "value = [0.0, 0.0, 0.9, 2.73, 5.22, 8.27, 12.78, 18.0, 30.3], unit = \"N m\""
+SPEED_TABLE = ('torsion_bar_torque = { value = [0.0, 1.0, 2.0], unit = "N m", source = "x" }\n'
+               'vehicle_speed = { value = [0.0, 5.0], unit = "km/h", source = "x" }\n'
+               'assist = { value = [[0.0, 2.0, 6.0], %s], unit = "N m", source = "x" }\n')
+
+
+def _polo_text(old: str | None = None, new: str | None = None) -> str:
+    text = POLO.read_text(encoding="utf-8")
+    if old is not None:
+        assert old in text, old
+        text = text.replace(old, new, 1)
+    return text
+
+
+def _speed_table(second_row: str) -> str:
+    """The Polo with a boost table of two vehicle speeds, its second row `second_row` (TOML)."""
+    text = _polo_text()
+    head, _, rest = text.partition("[assist.boost]\n")
+    tail = rest.split("\n", 2)[2]  # the Polo's two lines of its table replaced
+    return head + "[assist.boost]\n" + SPEED_TABLE % second_row + tail
+
+
+BOOST_DEFECTS: dict[str, tuple[Callable[[], str], str]] = {
+    "true_in_assist": (lambda: _polo_text("[0.0, 0.0, 0.9, 2.73", "[0.0, 0.0, true, 2.73"),
+                       "assist.boost.assist: point 3: true is not a number"),
+    "text_in_assist": (lambda: _polo_text("[0.0, 0.0, 0.9, 2.73", '[0.0, 0.0, "0.9", 2.73'),
+                       'assist.boost.assist: point 3: "0.9" is not a number'),
+    "text_in_torques": (lambda: _polo_text("[0.0, 0.4, 0.8,", '[0.0, "0.4", 0.8,'),
+                        'assist.boost.torsion_bar_torque: point 2: "0.4" is not a number'),
+    "torques_a_number": (lambda: _polo_text("value = [0.0, 0.4, 0.8, 1.2, 1.6, 2.0, 2.5, 3.0, 4.0]", "value = 4.0"),
+                         "assist.boost.torsion_bar_torque: expected a list of numbers"),
+    "unit_a_number": (lambda: _polo_text(POLO_ASSIST_ROW, "value = [0.0, 0.0, 0.9, 2.73, 5.22, 8.27, 12.78, 18.0, "
+                                                          "30.3], unit = 3"),
+                      "assist.boost.assist: unit 3 is not a string"),
+    "row_with_true": (lambda: _speed_table("[0.0, true, 5.0]"), "assist.boost.assist: row 2, point 2: true is not"),
+    "rows_without_speeds": (lambda: _polo_text("value = [0.0, 0.0, 0.9, 2.73, 5.22, 8.27, 12.78, 18.0, 30.3]",
+                                               "value = [[0.0, 0.0, 0.9, 2.73, 5.22, 8.27, 12.78, 18.0, 30.3]]"),
+                            "assist.boost.assist: rows for several vehicle speeds need vehicle_speed"),
+    "row_not_a_list": (lambda: _speed_table("7.0"), "assist.boost.assist: expected one list of numbers per vehicle speed"),
+    "type_a_list": (lambda: _polo_text('type = "column"', 'type = ["column"]'),
+                    "assist.type: ['column'], expected one of"),
+    "source_a_number": (lambda: re.sub(r'(reduction_ratio = \{ value = 18.0, unit = "1", source = )"[^"]*"',
+                                       r"\g<1>18", _polo_text()),
+                        "assist.reduction_ratio: source 18 is not a string"),
+    "assist_falls": (lambda: _polo_text("[0.0, 0.0, 0.9, 2.73", "[0.0, 0.0, 0.9, 0.5"),
+                     "assist.boost: assist: the assist must rise strictly beyond the dead band (0.9 then 0.5"),
+}
+
+
+def boost_table_cases() -> list[Case]:
+    """A vehicle file's boost table with a value of the wrong type or shape (a TOML true, a number in quotes, a row
+    that is no list): refused by `vehicle check` and by a run of the car, naming the file, the key, row and point."""
+    cases = [Case("vehicle:check_boost_shipped", "vehicle",
+                  lambda f: ["vehicle", "check", str(_write(f, "car.toml", _polo_text()))], ACCEPTED)]
+    for name, (text, fragment) in BOOST_DEFECTS.items():
+        cases.append(Case(f"vehicle:check_boost_{name}", "vehicle",
+                          lambda f, text=text: ["vehicle", "check", str(_write(f, "car.toml", text()))],
+                          f"car.toml: {fragment}"))
+    text, fragment = BOOST_DEFECTS["true_in_assist"]
+    cases.append(Case("compare:with_assist_boost_true", "compare",
+                      lambda f: ["compare", str(_write(f, "r.csv", BASELINE.read_text(encoding="utf-8"))), "--vehicle",
+                                 str(_write(f, "car.toml", text())), "--with-assist", "--plot", str(f / "out.svg")],
+                      f"car.toml: {fragment}", ("out.svg",)))
+    return cases
+
+
+def _zero_current_text() -> str:
+    """The Polo's baseline with its motor current 0 throughout (a logger that lost the channel's scaling, or the
+    assist off)."""
+    out = []
+    for line in BASELINE.read_text(encoding="utf-8").splitlines():
+        if line.startswith(("#", "time")):
+            out.append(line)
+        else:
+            out.append(",".join(line.split(",")[:3] + ["0"]))
+    return "\n".join(out) + "\n"
+
+
+def _boost_spec(folder: Path, points: str) -> list[str]:
+    return _spec(folder) + ["--assist", "column", "--assist-boost", points]
+
+
+def assist_cases() -> list[Case]:
+    """`assist identify` and `assist size`, and `vehicle new --assist-boost`, on bad inputs."""
+    def identify(f, *extra, record=None):
+        record = record or _write(f, "base.csv", BASELINE.read_text(encoding="utf-8"))
+        return ["assist", "identify", str(record), "--vehicle", str(POLO), "--out", str(f / "id.toml"), *extra]
+
+    def out_exists(f):
+        _write(f, "kept.toml", "# the user's own file\n")
+        argv = identify(f)
+        argv[argv.index("--out") + 1] = str(f / "kept.toml")
+        return argv
+
+    no_current = "".join(line.rsplit(",", 1)[0] + "\n" if not line.startswith("#") else line + "\n"
+                         for line in BASELINE.read_text(encoding="utf-8").splitlines())
+    return [
+        Case("assist:identify_out_exists", "assist", out_exists, "kept.toml: exists (--force to overwrite)"),
+        Case("assist:identify_out_not_toml", "assist",
+             lambda f: identify(f)[:-1] + [str(f / "id.txt")], "name it .toml", ("id.txt",)),
+        Case("assist:identify_out_in_proc", "assist", lambda f: identify(f)[:-1] + ["/proc/id.toml"],
+             "--out /proc/id.toml: cannot write in folder /proc"),
+        Case("assist:identify_out_is_the_vehicle", "assist",
+             lambda f: identify(f)[:-1] + [str(POLO)], "the vehicle file given"),
+        Case("assist:identify_zero_current", "assist",
+             lambda f: identify(f, "--quiet", record=_write(f, "zero.csv", _zero_current_text())),
+             "zero.csv: motor_current_A: the motor current does not follow the torsion-bar torque", ("id.toml",)),
+        Case("assist:identify_without_current", "assist",
+             lambda f: identify(f, record=_write(f, "nocur.csv", no_current)), "column 'motor_current_A': missing",
+             ("id.toml",)),
+        Case("assist:identify_vehicle_without_assist", "assist",
+             lambda f: identify(f)[:4] + [str(VEHICLE)] + identify(f)[5:], "no [assist] section", ("id.toml",)),
+        Case("assist:identify_vehicle_boost_true", "assist",
+             lambda f: identify(f)[:4] + [str(_write(f, "car.toml", BOOST_DEFECTS["true_in_assist"][0]()))]
+             + identify(f)[5:], "car.toml: assist.boost.assist: point 3: true is not a number", ("id.toml",)),
+        Case("assist:size_quiet_unknown_case", "assist",
+             lambda f: ["assist", "size", "--vehicle", str(POLO), "--case", "nocar", "--target-torque", "3",
+                        "--out-dir", str(f / "sizing"), "--quiet"], "--case nocar: not a case of", ("sizing",)),
+        Case("assist:size_out_dir_in_proc", "assist",
+             lambda f: ["assist", "size", "--vehicle", str(POLO), "--target-torque", "3", "--out-dir", "/proc/sizing"],
+             "--out-dir /proc/sizing: cannot write in folder /proc"),
+        Case("assist:size_out_dir_is_a_file", "assist",
+             lambda f: ["assist", "size", "--vehicle", str(POLO), "--target-torque", "3", "--out-dir",
+                        str(_write(f, "sizing", "x"))], "sizing: is a file, not a folder"),
+        Case("assist:size_speeds_beyond_creeping", "assist",
+             lambda f: ["assist", "size", "--vehicle", str(POLO), "--target-torque", "3", "--speeds-kmh", "0,50",
+                        "--out-dir", str(f / "sizing")], "--speeds-kmh 0,50: speeds within", ("sizing",)),
+        Case("assist:size_vehicle_boost_text", "assist",
+             lambda f: ["assist", "size", "--vehicle", str(_write(f, "car.toml", BOOST_DEFECTS["text_in_assist"][0]())),
+                        "--target-torque", "3", "--out-dir", str(f / "sizing")],
+             'car.toml: assist.boost.assist: point 3: "0.9" is not a number', ("sizing",)),
+        Case("assist:size_target_torque_nan", "assist",
+             lambda f: ["assist", "size", "--vehicle", str(POLO), "--target-torque", "nan", "--out-dir",
+                        str(f / "sizing")], "--target-torque nan: must be positive", ("sizing",)),
+        Case("assist:size_gain_half_speed_zero", "assist",
+             lambda f: ["assist", "size", "--vehicle", str(POLO), "--target-torque", "3", "--gain-half-speed-kmh", "0",
+                        "--out-dir", str(f / "sizing")], "--gain-half-speed-kmh 0: must be a positive speed",
+             ("sizing",)),
+        Case("simulate:speed_beyond_creeping", "simulate",
+             lambda f: ["simulate", "--case", "unladen", "--speed-kmh", "50", "--out", str(f / "out.csv")],
+             "--speed-kmh 50: outside 0-10.8 km/h", ("out.csv",)),
+        Case("simulate:with_assist_car_without_one", "simulate",
+             lambda f: ["simulate", "--vehicle", str(VEHICLE), "--with-assist", "--case", "unladen", "--out",
+                        str(f / "out.csv")], "has no [assist] section", ("out.csv",)),
+        Case("vehicle:new_assist_boost_leading_minus", "vehicle", lambda f: _boost_spec(f, "-0.5:0,1:2,3:6"),
+             "--assist-boost -0.5:0,1:2,3:6: torsion_bar_torque: finite values from 0", ("car.toml",)),
+        Case("vehicle:new_assist_boost_word", "vehicle", lambda f: _boost_spec(f, "0:0,one:2"),
+             "--assist-boost 0:0,one:2: expected points T:A", ("car.toml",)),
+        Case("vehicle:new_assist_boost_falls", "vehicle", lambda f: _boost_spec(f, "0:0,1:2,2:1"),
+             "the assist must rise strictly beyond the dead band (2 then 1", ("car.toml",)),
+        Case("vehicle:new_assist_boost", "vehicle", lambda f: _boost_spec(f, "0:0,1:2,3:6"), ACCEPTED),
+        Case("vehicle:new_out_in_proc", "vehicle",
+             lambda f: _spec(f, "--out", "/proc/car.toml"), "/proc/car.toml: cannot write in folder /proc"),
+        Case("simulate:out_in_proc", "simulate",
+             lambda f: ["simulate", "--case", "unladen", "--output-dt", "0.5", "--out", "/proc/out.csv"],
+             "/proc/out.csv: cannot write in folder /proc"),
+        Case("vehicle:new_out_exists", "vehicle",
+             lambda f: (_write(f, "car.toml", "# kept\n"), _spec(f))[1], "exists (--force to overwrite)"),
+    ]
+
+
 def all_cases() -> list[Case]:
     return (record_cases() + odd_record_cases() + parameter_cases() + checksum_cases() + finding_cases()
-            + map_cases() + vehicle_cases() + diagnose_option_cases() + mdf_cases() + bus_cases())
+            + map_cases() + vehicle_cases() + diagnose_option_cases() + mdf_cases() + bus_cases()
+            + effect_file_cases() + suggest_effect_cases() + boost_table_cases() + assist_cases())

@@ -1,6 +1,6 @@
-"""Malformed and odd inputs across the entry points (tests/hardening/corpus.py): each either runs (exit 0) or is
-refused with exit status 2 and one line on stderr holding the expected fragment and the input's name, with no
-traceback and no output written. The class counts must be zero except "clean error" and "accepted"."""
+"""Malformed and odd inputs across the entry points (tests/hardening/corpus.py), a user's effect files, boost tables
+and the assist commands among them: each either runs (exit 0) or is refused with exit status 2 and one line on
+stderr holding the expected fragment and the input's name, with no traceback and no output written. The class counts must be zero except "clean error" and "accepted"."""
 
 from __future__ import annotations
 
@@ -27,6 +27,8 @@ def test_input_gets_its_expected_outcome(case, tmp_path, capsys, monkeypatch):
     holding the expected fragment, and none of the command's outputs written. An exception escaping main() (a
     traceback) fails the test by itself."""
     monkeypatch.chdir(tmp_path)
+    for name, value in case.env:
+        monkeypatch.setenv(name, value.replace("{scratch}", str(tmp_path)))
     argv = case.make(tmp_path)
     try:
         status, out, err = _run(argv, capsys)
@@ -54,6 +56,6 @@ def test_corpus_is_large_and_covers_every_entry_point():
     """At least 60 inputs, every entry point tried, both outcomes present."""
     assert len(CASES) >= 60
     assert {c.entry for c in CASES} == {"compare", "diagnose", "simulate", "check-params", "checksums",
-                                        "vehicle"}
+                                        "vehicle", "assist"}
     assert len({c.name for c in CASES}) == len(CASES)
     assert any(c.expect == ACCEPTED for c in CASES) and any(c.expect != ACCEPTED for c in CASES)

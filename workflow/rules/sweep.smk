@@ -14,7 +14,10 @@ from parksteer.sweep.declaration import DEFAULT_BATCH_SIZE, DEFAULT_SWEEP_FILE
 
 SWEEP_BATCH_SIZE = int(config.get("sweep_batch_size", DEFAULT_BATCH_SIZE))
 SWEEP_FILE = config.get("sweep", DEFAULT_SWEEP_FILE)
-SWEEP_FULL = bool(config.get("sweep_full", False))
+# true from the configuration file, True or "true" from `--config sweep_full=...` (the schema allows those
+# spellings); written back as the boolean, which the batch jobs read
+SWEEP_FULL = config.get("sweep_full", False) in (True, "true")
+config["sweep_full"] = SWEEP_FULL
 SWEEP_INDEX_DIR = ".snakemake/parksteer-sweeps"
 # A bad declaration (empty axis, unknown key or effect, a value out of its bounds, a missing file) is refused
 # here, while the DAG is built, with one line naming the file and the key.

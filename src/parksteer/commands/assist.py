@@ -53,6 +53,7 @@ def register(sub) -> None:
     i.add_argument("--vehicle", required=True, metavar="FILE.toml",
                    help="the vehicle file: its [assist] gives the gear's data (its boost curve is not used)")
     i.add_argument("--out", required=True, metavar="OUT.toml", help="the vehicle file written with what was identified")
+    i.add_argument("--force", action="store_true", help="overwrite an existing --out file")
     i.add_argument("--case", default=None, help="the load case of every record (default: each record's own)")
     i.add_argument("--surface", default=None, help="the surface of records that do not state one")
     add_import_options(i)
@@ -62,29 +63,31 @@ def register(sub) -> None:
 
 
 def _identify(args) -> int:
+    import contextlib
     import json
     import sys
 
     from ..diagnose.assist_identify import identify_boost
-    from ..vehicle import load_vehicle
+    from ..tables import atomic_path
 
     out = Path(args.out)
     if out.resolve() == Path(args.vehicle).resolve():
         raise UsageError(f"--out {args.out}: the vehicle file given; write the identified file beside it")
     if out.is_dir() or not out.resolve().parent.is_dir():
         raise UsageError(f"--out {args.out}: name a file in an existing folder")
-    found = identify_boost(args.files, args.vehicle, args.case, args.surface, channel_map_of(args), quiet=args.quiet)
+    if out.suffix != ".toml":
+        raise UsageError(f"--out {args.out}: a vehicle file is TOML; name it .toml")
+    if out.exists() and not args.force:
+        raise UsageError(f"--out {args.out}: exists (--force to overwrite)")
+    _check_writable("--out", args.out, out.resolve().parent)
+    # what the identification prints while it runs is progress: stderr, so that stdout holds the result alone
+    with contextlib.redirect_stdout(sys.stderr):
+        found = identify_boost(args.files, args.vehicle, args.case, args.surface, channel_map_of(args),
+                               quiet=args.quiet)
     text = found.to_vehicle_toml(Path(args.vehicle).read_text(encoding="utf-8"))
-    # the written file must load as the vehicle it describes, or nothing is written
-    import tempfile
-
-    with tempfile.TemporaryDirectory() as folder:
-        probe = Path(folder) / out.name
-        probe.write_text(text, encoding="utf-8")
-        from ..model.numeric.assist import check_assist
-
-        check_assist(load_vehicle(probe))
-    out.write_text(text, encoding="utf-8")
+    _check_identified(text, out, found, args.files)  # the file must load as the vehicle it describes, or no file
+    with atomic_path(out) as tmp:
+        tmp.write_text(text, encoding="utf-8")
     if args.json:
         json.dump(found.as_dict(), sys.stdout, indent=1)
         sys.stdout.write("\n")
@@ -106,6 +109,59 @@ def _creep(args) -> int:
     return 0
 
 
+def _check_writable(option: str, value: str, folder: Path) -> None:
+    """Refuse a folder nothing can be written in before the work, not after it (a probe file made and removed:
+    permissions alone do not tell, e.g. for root or a read-only mount)."""
+    import tempfile
+
+    try:
+        with tempfile.NamedTemporaryFile(dir=folder, prefix=".parksteer-probe-"):
+            pass
+    except OSError as exc:
+        raise UsageError(f"{option} {value}: cannot write in folder {folder} ({exc.strerror})") from None
+
+
+def _check_out_dir(value: str) -> None:
+    """--out-dir: a folder, or one that can be made, in a place that can be written (checked before the work)."""
+    folder = Path(value).resolve()
+    if folder.exists() and not folder.is_dir():
+        raise UsageError(f"--out-dir {value}: is a file, not a folder")
+    existing = folder
+    while not existing.exists():
+        existing = existing.parent
+    if not existing.is_dir():
+        raise UsageError(f"--out-dir {value}: {existing} is a file, not a folder")
+    _check_writable("--out-dir", value, existing)
+
+
+# A map whose largest current is below this many times the map's own noise has not seen the motor work.
+CURRENT_SEEN_NOISES = 3.0
+
+
+def _check_identified(text: str, out: Path, found, records) -> None:
+    """The identified vehicle file `text` loaded and its assist checked; a value no gear has is told in the
+    records' terms (their motor current), naming the records, never the file that was not written."""
+    from ..model.numeric.assist import check_assist
+    from ..parameters import ParameterError
+    from ..vehicle import vehicle_from_text
+
+    try:
+        check_assist(vehicle_from_text(text, out))
+    except ParameterError as exc:
+        detail = str(exc).removeprefix(f"{out}: ")
+        names = ", ".join(str(r) for r in records)
+        result = found.as_dict()
+        current = [abs(c) for c in result["table"]["current_A"]]
+        noise = result["map_noise_A"]
+        if max(current) <= CURRENT_SEEN_NOISES * noise:
+            raise UsageError(f"{names}: motor_current_A: the motor current does not follow the torsion-bar torque "
+                             f"(at most {max(current):.3g} A at the map's points, its noise {noise:.3g} A), so the "
+                             "assist cannot be read from it: record with the assist working, the current in "
+                             "amperes; nothing written") from None
+        raise UsageError(f"{names}: what these records give is no gear's ({detail}); check the current's channel "
+                         "and unit and the [assist] data; nothing written") from None
+
+
 def _speeds(text: str) -> tuple[float, ...]:
     try:
         speeds = tuple(float(x) for x in text.split(",") if x.strip())
@@ -121,6 +177,7 @@ def _size(args) -> int:
     from ..sweep.assist_sizing import size_assist
     from ..vehicle import vehicle_name
 
+    _check_out_dir(args.out_dir)
     params = parameters_of(args)
     case = args.case or params.case_names[0]
     if case not in params.case_names:

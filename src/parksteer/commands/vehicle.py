@@ -144,12 +144,12 @@ def _new(args) -> int:
         vehicle_from_text(text, out, base)  # checked as a vehicle file before anything is written
     except UsageError as exc:
         raise UsageError(f"the specification gives no valid car, nothing written: {exc}") from None
-    with atomic_path(out) as tmp:
-        tmp.write_text(text, encoding="utf-8")
-    if args.assist is not None:
+    if args.assist is not None:  # the assist's plausibility too, before anything is written
         from ..model.numeric.assist import check_assist
 
         check_assist(vehicle_from_text(text, out, base))
+    with atomic_path(out) as tmp:
+        tmp.write_text(text, encoding="utf-8")
     print(f"{out}: vehicle {vehicle_name(out)}, case {spec.case}" + (f", {args.assist} assist" if args.assist else ""))
     for d in values:
         how = f" = {d.how}" if d.how else ""
