@@ -10,6 +10,10 @@ A worker never forks again (:func:`fork_map` inside a worker runs in line).
 
 Where the platform cannot fork (Windows, or ``workers`` <= 1), everything runs in line.
 
+A worker ignores SIGINT (a terminal's Ctrl-C reaches the whole process group): the diagnosing process alone
+answers it, by ending its workers (:meth:`ServingPool.terminate`, and :func:`fork_map` on any exception), so no
+pool starts new workers in their place and none is waited for.
+
 :class:`Progress` writes one line per step of a diagnosis to stderr (unless quiet), so that a
 long diagnosis says where it is.
 """
@@ -18,6 +22,7 @@ from __future__ import annotations
 
 import multiprocessing
 import os
+import signal
 import time
 from collections.abc import Callable, Sequence
 from typing import Any
@@ -55,6 +60,10 @@ class WorkerProcess:
         self.serve: Callable[[Any], Any] | None = None
 
     def start(self, serve: Callable[[Any], Any]) -> None:
+        # Ctrl-C is the forking process's to answer (module docstring); SIGTERM, which ends a pool's workers,
+        # ends this one at once, even inside a solve, whatever handler it inherited
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+        signal.signal(signal.SIGTERM, signal.SIG_DFL)
         self.serve = serve
 
     @property
@@ -86,6 +95,46 @@ def pool_map(workers_pool, items: Sequence[Any]) -> list:
     return workers_pool.map(_serve, list(items), chunksize=1)
 
 
+class ServingPool:
+    """Up to `workers` worker processes that serve one function made for one key, forked when first asked.
+
+    A worker holds what the forking process held when it was forked (a diagnosis's problem, its files, its
+    replays): asked to serve another key, the pool ends its workers and forks new ones from the process as it is
+    then, so no worker ever answers for a key it was not made for. Keys are compared by identity, and the pool
+    holds the key it serves, so that key's identity cannot pass to another object meanwhile."""
+
+    def __init__(self, workers: int):
+        self.workers = workers
+        self.key: Any = None
+        self.pool = None
+
+    def map(self, key: Any, serve: Callable[[Any], Any], items: Sequence[Any]) -> list | None:
+        """``[serve(item) for item in items]`` on workers forked to serve `serve` for `key` (`serve` is used only
+        when the pool forks: a pool already serving `key` serves the function it was forked with); None where
+        the platform cannot fork, or in a worker."""
+        if self.pool is None or self.key is not key:
+            self.close()
+            self.pool = pool(self.workers, serve)
+            self.key = key if self.pool is not None else None
+        if self.pool is None:
+            return None
+        return pool_map(self.pool, items)
+
+    def close(self) -> None:
+        """Let the workers finish and end them."""
+        if self.pool is not None:
+            self.pool.close()
+            self.pool.join()
+        self.pool, self.key = None, None
+
+    def terminate(self) -> None:
+        """End the workers now, whatever they are doing (on an interrupt or an error), and reap them."""
+        if self.pool is not None:
+            self.pool.terminate()
+            self.pool.join()
+        self.pool, self.key = None, None
+
+
 def fork_map(function: Callable[[Any], Any], items: Sequence[Any], workers: int) -> list:
     """``[function(item) for item in items]``, on up to `workers` forked processes (module docstring).
 
@@ -97,10 +146,14 @@ def fork_map(function: Callable[[Any], Any], items: Sequence[Any], workers: int)
         return [function(item) for item in items]
     workers_pool = pool(min(workers, len(items)), lambda index: function(items[index]))
     try:
-        return pool_map(workers_pool, range(len(items)))
-    finally:
-        workers_pool.close()
+        out = pool_map(workers_pool, range(len(items)))
+    except BaseException:  # an interrupt, or an error in a worker: the others' work is not waited for
+        workers_pool.terminate()
         workers_pool.join()
+        raise
+    workers_pool.close()
+    workers_pool.join()
+    return out
 
 
 class Progress:

@@ -119,6 +119,11 @@ def diagnose(files: list[FileData], params: Parameters, effects=None, registry: 
     engine = ReplayEngine(workers, hosts=replay_models(base, testable, params))
     try:
         state = run_table(state, engine)
+    except BaseException:  # an interrupt or an error: nothing still running is waited for
+        engine.terminate()
+        for builder in builders:
+            builder.terminate()
+        raise
     finally:
         engine.close()
         finish_builds(builders)
