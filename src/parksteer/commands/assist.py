@@ -75,7 +75,10 @@ def _identify(args) -> int:
         from ..model.numeric.assist import check_assist
 
         check_assist(load_vehicle(probe))
-    out.write_text(text, encoding="utf-8")
+    from ..tables import atomic_path
+
+    with atomic_path(out) as tmp:  # complete or absent, whenever the run is stopped
+        tmp.write_text(text, encoding="utf-8")
     if args.json:
         json.dump(found.as_dict(), sys.stdout, indent=1)
         sys.stdout.write("\n")

@@ -60,7 +60,7 @@ from ..model.symbolic.components import Effect, discover_effects, power_assist_o
 from ..parameters import Parameters
 from .candidates import candidate_effects, models_to_build, replay_models
 from .compare import check_torque_sensors
-from .parallel import Progress, by_reference
+from .parallel import Progress, by_reference, signals_held
 from .engine import ReplayEngine
 from .problem import FileData, Problem
 from .settings import DEFAULT_SETTINGS, DiagnosisSettings
@@ -121,8 +121,10 @@ def diagnose(files: list[FileData], params: Parameters, effects=None, registry: 
         state = run_table(state, engine)
     except BaseException:  # an interrupt or an error: nothing still running is waited for
         engine.terminate()
-        for builder in builders:
-            builder.terminate()
+        with signals_held():
+            for builder in builders:
+                builder.terminate()
+            finish_builds(builders)
         raise
     finally:
         engine.close()
