@@ -24,6 +24,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from importlib import metadata
 
+from .diagnose.parallel import STOPPING_SIGNALS
 from .errors import UsageError
 from .progress import quiet_while
 
@@ -77,9 +78,6 @@ def _join_dash_values(argv: list[str]) -> list[str]:
             out.append(argv[i])
             i += 1
     return out
-
-
-STOPPING_SIGNALS = (signal.SIGINT, signal.SIGTERM)
 
 
 class Interrupt:

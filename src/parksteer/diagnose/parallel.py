@@ -170,13 +170,13 @@ def fork_map(function: Callable[[Any], Any], items: Sequence[Any], workers: int)
     items = list(items)
     if not forks(len(items), workers):
         return [function(item) for item in items]
-    workers = ServingPool(min(workers, len(items)))
+    serving = ServingPool(min(workers, len(items)))
     try:
-        out = workers.map(items, lambda index: function(items[index]), range(len(items)))
+        out = serving.map(items, lambda index: function(items[index]), range(len(items)))
     except BaseException:  # an interrupt, or an error in a worker: the others' work is not waited for
-        workers.terminate()
+        serving.terminate()
         raise
-    workers.close()
+    serving.close()
     return out
 
 
