@@ -58,21 +58,21 @@ def test_two_workers_give_the_diagnosis_of_one(written, params, capsys):
 
 
 def test_a_serving_pool_forks_again_for_another_key():
-    """A pool asked to serve another key ends its workers and forks new ones from the process as it is then: the
-    answers for the second key are the second key's, never those of the workers forked for the first (the pool
-    keeps serving the function it was forked with while the key stays the same)."""
+    """A pool keeps serving the function it was forked with while the key stays the same (a function given later
+    for that key is not used), and asked to serve another key it ends its workers and forks new ones: the answers
+    for the second key are the second key's, from processes other than the first key's."""
     first, second = object(), object()
     workers = ServingPool(2)
     try:
-        assert workers.map(first, lambda x: ("first", x, os.getpid()), [1, 2])[0][:2] == ("first", 1)
-        pids = {pid for _, _, pid in workers.map(first, lambda x: ("other", x, os.getpid()), [3, 4])}
-        again = workers.map(first, lambda x: ("other", x, os.getpid()), [3, 4])
-        assert [r[:2] for r in again] == [("first", 3), ("first", 4)]
-        out = workers.map(second, lambda x: ("second", x, os.getpid()), [5, 6])
-        assert [r[:2] for r in out] == [("second", 5), ("second", 6)]
-        assert not pids & {pid for _, _, pid in out}
+        made = workers.map(first, lambda x: ("first", x, os.getpid()), [1, 2])
+        same_key = workers.map(first, lambda x: ("other", x, os.getpid()), [3, 4])
+        other_key = workers.map(second, lambda x: ("second", x, os.getpid()), [5, 6])
     finally:
         workers.close()
+    assert [r[:2] for r in made] == [("first", 1), ("first", 2)]
+    assert [r[:2] for r in same_key] == [("first", 3), ("first", 4)]
+    assert [r[:2] for r in other_key] == [("second", 5), ("second", 6)]
+    assert not {pid for *_, pid in made + same_key} & {pid for *_, pid in other_key}
     assert workers.pool is None
 
 
