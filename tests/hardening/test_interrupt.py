@@ -63,8 +63,9 @@ def handler_in_place(pid: int) -> bool:
 
 
 def interrupted(arguments: list[str], at: str | None, folder: Path, to_group: bool = True,
-                env: dict[str, str] | None = None) -> tuple[int, list[str], float, list[str]]:
-    """Run `parksteer ARGUMENTS` in `folder` in a session of its own, send SIGINT (to its group, or to its main
+                env: dict[str, str] | None = None, signum: int = signal.SIGINT
+                ) -> tuple[int, list[str], float, list[str]]:
+    """Run `parksteer ARGUMENTS` in `folder` in a session of its own, send `signum` (to its group, or to its main
     process) when a line containing `at` comes on stderr (or, with `at` None, when its handler is in place), and
     return (exit status, the stderr lines after the signal, seconds from the signal to the exit, the group's live
     processes left a moment after it)."""
@@ -90,7 +91,7 @@ def interrupted(arguments: list[str], at: str | None, folder: Path, to_group: bo
             if at is not None and at in seen[-1]:
                 break
         sent = time.monotonic()
-        (os.killpg if to_group else os.kill)(process.pid, signal.SIGINT)
+        (os.killpg if to_group else os.kill)(process.pid, signum)
         status = process.wait(timeout=3 * STOP_S)  # a command that hangs fails here, its group killed below
         stopped_s = time.monotonic() - sent
     finally:
@@ -105,12 +106,13 @@ def interrupted(arguments: list[str], at: str | None, folder: Path, to_group: bo
     return status, after, stopped_s, group_members(process.pid)
 
 
-def assert_stopped_cleanly(result, folder: Path, outputs: list[str]) -> None:
-    status, after, stopped_s, left = result
-    assert status == 130, after
+def assert_stopped_cleanly(result, folder: Path, outputs: list[str], status: int = 130,
+                           line: str = ": interrupted") -> None:
+    returned, after, stopped_s, left = result
+    assert returned == status, after
     assert stopped_s < STOP_S
     assert 1 <= len(after) <= MAX_LINES_AFTER, after
-    assert after[-1].endswith(": interrupted"), after
+    assert after[-1].endswith(line), after
     assert not any("Traceback" in line for line in after)
     assert left == []
     assert not [p.name for p in folder.iterdir() if p.name.endswith(".tmp")]  # no writer's temporary file
@@ -145,6 +147,14 @@ def test_ctrl_c_to_the_main_process_alone_ends_its_workers(tmp_path):
     workers: it ends them itself, exits 130 with one line, and leaves no process and no output."""
     result = interrupted(DIAGNOSE, "diagnose: refitting", tmp_path, to_group=False)
     assert_stopped_cleanly(result, tmp_path, OUTPUTS)
+    assert not any((tmp_path / name).exists() for name in OUTPUTS)
+
+
+def test_sigterm_stops_a_diagnosis_as_ctrl_c_does(tmp_path):
+    """SIGTERM (what `kill` and a scheduler send) to the diagnosing process while it ranks on two workers: the same
+    clean stop, with exit status 143 (128 + 15) and the line saying it was terminated."""
+    result = interrupted(DIAGNOSE, "diagnose: ranking", tmp_path, to_group=False, signum=signal.SIGTERM)
+    assert_stopped_cleanly(result, tmp_path, OUTPUTS, status=143, line=": terminated")
     assert not any((tmp_path / name).exists() for name in OUTPUTS)
 
 
