@@ -4,6 +4,12 @@ Each subcommand lives in the module that owns its logic and exposes
 ``register(subparsers)``; this file only lists those modules. A
 :class:`~parksteer.errors.UsageError` (bad argument, bad file, bad value) is printed as
 one line on stderr with exit status 2, and no output file is written.
+
+Ctrl-C (SIGINT, to the process or to its whole group, as a terminal sends it) or SIGTERM ends a subcommand with
+one line on stderr and exit status 128 + the signal's number (130, 143), after what was running has stopped: the
+diagnosis's worker processes end with it (:mod:`parksteer.diagnose.parallel`), and every output is written to a
+temporary file renamed onto its name only when complete (:func:`parksteer.tables.atomic_path`), so none is left
+half-written.
 """
 
 from __future__ import annotations
@@ -11,11 +17,16 @@ from __future__ import annotations
 import argparse
 import importlib
 import os
+import signal
 import sys
+import threading
+from collections.abc import Iterator
+from contextlib import contextmanager
 from importlib import metadata
 
 from .commands import add_quiet_option
 from .commands.effect_files import effect_files_checked
+from .diagnose.parallel import STOPPING_SIGNALS
 from .errors import UsageError
 from .progress import quiet_while
 
@@ -85,9 +96,76 @@ def _join_dash_values(argv: list[str]) -> list[str]:
     return out
 
 
+class Interrupt:
+    """What a stopping signal does while a subcommand runs (module docstring).
+
+    In this process it raises KeyboardInterrupt where the work is, so that every ``finally`` on the way up ends what
+    it started, and again at each signal until the command has said it was interrupted (the interpreter ignores an
+    exception raised in some places, a destructor or a fork hook, so one may be lost; what must not be cut short,
+    ending worker processes, holds the signals back: :func:`parksteer.diagnose.parallel.signals_held`). A process
+    forked from this one that does not ignore the signal (a background model build:
+    :func:`parksteer.model.codegen.cache.start_builds`) ends quietly through SystemExit, which removes its scratch
+    files and kills the compiler it waits for."""
+
+    def __init__(self) -> None:
+        self.pid = os.getpid()
+        self.received: int | None = None
+        self.reported = False
+
+    def __call__(self, signum, frame) -> None:
+        if os.getpid() != self.pid:
+            raise SystemExit(128 + signum)
+        if self.received is None:
+            self.received = signum
+        if not self.reported:
+            raise KeyboardInterrupt
+
+    @property
+    def status(self) -> int:
+        return 128 + int(self.received or signal.SIGINT)
+
+    @property
+    def line(self) -> str:
+        return "interrupted" if self.received in (None, signal.SIGINT) else "terminated"
+
+
+@contextmanager
+def stopped_by_signals() -> Iterator[Interrupt]:
+    """Answer SIGINT and SIGTERM with :class:`Interrupt` inside the block, then restore the handlers (a command run
+    in-process, as the tests run them, leaves the process as it found it). Only the main thread can set a handler;
+    elsewhere the block runs with the handlers as they are."""
+    interrupt = Interrupt()
+    if threading.current_thread() is not threading.main_thread():
+        yield interrupt
+        return
+    before = {number: signal.signal(number, interrupt) for number in STOPPING_SIGNALS}
+    try:
+        yield interrupt
+    finally:
+        for number, handler in before.items():
+            signal.signal(number, handler)
+
+
 def main(argv: list[str] | None = None) -> int:
-    parser = build_parser()
-    args = parser.parse_args(_join_dash_values(sys.argv[1:] if argv is None else list(argv)))
+    with stopped_by_signals() as interrupt:
+        try:  # the subcommands' modules are imported here: a Ctrl-C may come while they load
+            args = build_parser().parse_args(_join_dash_values(sys.argv[1:] if argv is None else list(argv)))
+        except KeyboardInterrupt:
+            return _interrupted(None, interrupt)
+        try:
+            return _run(args, interrupt)
+        except KeyboardInterrupt:  # one that arrived after the command's own handling (while reporting an error)
+            return _interrupted(args, interrupt)
+
+
+def _interrupted(args, interrupt: Interrupt) -> int:
+    interrupt.reported = True
+    name = "parksteer" if args is None else f"parksteer {args.command}"
+    print(f"{name}: {interrupt.line}", file=sys.stderr, flush=True)
+    return interrupt.status
+
+
+def _run(args, interrupt: Interrupt) -> int:
     try:
         with quiet_while(getattr(args, "quiet", False)):  # --quiet means the same in every subcommand that has it
             with effect_files_checked(getattr(args, "effects", None),  # a user's effect files, at the door
@@ -95,15 +173,22 @@ def main(argv: list[str] | None = None) -> int:
                 status = int(args.func(args) or 0)
         sys.stdout.flush()  # a closed pipe shows here, inside the handler, not at interpreter exit
         return status
-    except UsageError as exc:
-        print(f"parksteer {args.command}: error: {exc}", file=sys.stderr)
-        return 2
-    except BrokenPipeError:
-        # The reader went away (`parksteer sweep expand ... | head`). As the Python docs advise for SIGPIPE:
-        # point stdout at devnull so the flush at exit cannot raise again, and end quietly.
-        devnull = os.open(os.devnull, os.O_WRONLY)
-        os.dup2(devnull, sys.stdout.fileno())
-        return 1
+    except KeyboardInterrupt:
+        return _interrupted(args, interrupt)
+    except BaseException as exc:
+        # After a signal, whatever else went wrong is its consequence (a compiler killed by the same Ctrl-C).
+        if interrupt.received is not None and not isinstance(exc, SystemExit):
+            return _interrupted(args, interrupt)
+        if isinstance(exc, UsageError):
+            print(f"parksteer {args.command}: error: {exc}", file=sys.stderr)
+            return 2
+        if isinstance(exc, BrokenPipeError):
+            # The reader went away (`parksteer sweep expand ... | head`). As the Python docs advise for SIGPIPE:
+            # point stdout at devnull so the flush at exit cannot raise again, and end quietly.
+            devnull = os.open(os.devnull, os.O_WRONLY)
+            os.dup2(devnull, sys.stdout.fileno())
+            return 1
+        raise
 
 
 if __name__ == "__main__":

@@ -3,16 +3,22 @@
 from __future__ import annotations
 
 import os
+from dataclasses import replace
+from pathlib import Path
 
+import numpy as np
 import pytest
 
-from parksteer.diagnose.parallel import can_fork, fork_map
-from parksteer.diagnose.problem import load_files
+from parksteer.diagnose.engine import ReplayEngine
+from parksteer.diagnose.parallel import ServingPool, can_fork, fork_map
+from parksteer.diagnose.problem import Problem, load_files
 from parksteer.diagnose.report import diagnosis_dict
 from parksteer.diagnose.select import diagnose
+from parksteer.model.symbolic.components import resolve_effects
 
 pytestmark = pytest.mark.skipif(not can_fork(), reason="the platform cannot fork: everything runs in line")
 
+REPO = Path(__file__).resolve().parents[2]
 TWO_FILES = (("unladen", "ground"), ("part_laden", "ground"))
 
 
@@ -49,3 +55,44 @@ def test_two_workers_give_the_diagnosis_of_one(written, params, capsys):
     lines = capsys.readouterr().err.splitlines()
     assert any("calibrating" in line for line in lines) and any("ranking" in line for line in lines)
     assert lines[-1].startswith(f"diagnose: verdict: {results[0]['verdict']}")
+
+
+def test_a_serving_pool_forks_again_for_another_key():
+    """A pool keeps serving the function it was forked with while the key stays the same (a function given later
+    for that key is not used), and asked to serve another key it ends its workers and forks new ones: the answers
+    for the second key are the second key's, from processes other than the first key's."""
+    first, second = object(), object()
+    workers = ServingPool(2)
+    try:
+        made = workers.map(first, lambda x: ("first", x, os.getpid()), [1, 2])
+        same_key = workers.map(first, lambda x: ("other", x, os.getpid()), [3, 4])
+        other_key = workers.map(second, lambda x: ("second", x, os.getpid()), [5, 6])
+    finally:
+        workers.close()
+    assert [r[:2] for r in made] == [("first", 1), ("first", 2)]
+    assert [r[:2] for r in same_key] == [("first", 3), ("first", 4)]
+    assert [r[:2] for r in other_key] == [("second", 5), ("second", 6)]
+    assert not {pid for *_, pid in made + same_key} & {pid for *_, pid in other_key}
+    assert workers.pool is None
+
+
+def test_predictions_follow_the_problem_they_are_asked_on(params):
+    """Predictions of two records on one problem, then on a problem whose files' torque lags moved (new instants),
+    then on the first again: two workers give the arrays one process gives, bit for bit, and the lagged problem's
+    differ from the first's (the workers answer for the problem asked, not the one they were first forked for)."""
+    paths = [REPO / "data" / "samples" / "car" / f"{case}__ground.csv" for case in ("unladen", "part_laden")]
+    files = load_files(paths, params)
+    first = Problem(files, params)
+    moved = first.with_files([replace(f, torque_lag_s=0.02) for f in files])
+    effects = resolve_effects(None)
+    predictions = {}
+    for workers in (1, 2):
+        engine = ReplayEngine(workers)
+        try:
+            predictions[workers] = [engine.predict(problem, effects, {}) for problem in (first, moved, first)]
+        finally:
+            engine.close()
+    for one, two in zip(predictions[1], predictions[2]):
+        assert all(np.array_equal(a, b) for a, b in zip(one, two))
+    assert not np.allclose(predictions[2][0][0], predictions[2][1][0], atol=1e-3)
+    assert all(np.array_equal(a, b) for a, b in zip(predictions[2][0], predictions[2][2]))

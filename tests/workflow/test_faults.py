@@ -87,6 +87,17 @@ def copy(copy_with_models, tmp_path_factory) -> Path:
     return copy_with_models(tmp_path_factory.mktemp("faults"))
 
 
+def _simulating(logs: Path) -> bool:
+    """Whether a simulation job is running: its log (parksteer.rules.rule_log) has the script's progress line and
+    not yet the line that ends every job's log."""
+    for log in logs.glob("*.log"):
+        lines = log.read_text(encoding="utf-8", errors="replace").splitlines()
+        if any(line.startswith("simulating ") for line in lines) and not any(
+                ": finished after " in line or ": failed after " in line for line in lines):
+            return True
+    return False
+
+
 @pytest.mark.slow
 def test_a_killed_run_is_finished_by_the_next_ordinary_run(copy):
     """SIGKILL to the process group of a running `snakemake` (and its jobs) leaves a lock and incomplete markers;
@@ -97,12 +108,11 @@ def test_a_killed_run_is_finished_by_the_next_ordinary_run(copy):
                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
     incomplete = copy / ".snakemake" / "incomplete"
     deadline = time.monotonic() + 300
-    try:  # kill while a simulation runs (its output is marked incomplete and not yet written)
-        while not any((copy / "logs" / "simulate_model").glob("*.log")) or not any(incomplete.glob("*")):
+    try:  # kill while a simulation runs: its job's log says it is simulating and not yet that it ended
+        while not (_simulating(copy / "logs" / "simulate_model") and any(incomplete.glob("*"))):
             assert run.poll() is None, "the run ended before it could be killed"
             assert time.monotonic() < deadline, "no simulation started within 300 s"
             time.sleep(0.05)
-        time.sleep(1.0)
     finally:
         os.killpg(run.pid, signal.SIGKILL)
         run.wait()

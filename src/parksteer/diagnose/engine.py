@@ -11,9 +11,12 @@ stage (``stage.run(state, engine)``). It is openly mutable and keeps its counts 
   most candidates share the diagnosis model);
 - `direct`: which quantities only enter a compiled model's equations (found once per model and key,
   :meth:`parksteer.diagnose.replay.Replay._is_direct`);
-- `replays`: one :class:`parksteer.diagnose.replay.Replay` per effect set, file and generation of replay instants
-  (:attr:`parksteer.diagnose.problem.Problem.instants`), each counting its own solves;
-- `pool`, `workers`: the worker processes a prediction spreads its files over (:mod:`parksteer.diagnose.parallel`);
+- `replays`: one :class:`parksteer.diagnose.replay.Replay` per effect set, file and torque lag (the file's replay
+  instants, :attr:`parksteer.diagnose.problem.FileData.replay_time_s`), each counting its own solves: a replay is
+  what its key says, whichever process made it and whatever was replayed before;
+- `pool`, `workers`: the worker processes a prediction spreads its files over (:mod:`parksteer.diagnose.parallel`),
+  forked for the problem they serve and forked again when a prediction is asked on another problem (a stage that
+  derives files makes a new one), so that a worker never answers with the files of an earlier problem;
 - `other_replays`: the solves not counted by a kept replay (run in worker processes, or on the replay ensemble's
   racks), so that :attr:`evaluations` counts every solve the diagnosis ran.
 """
@@ -26,7 +29,7 @@ import numpy as np
 
 from ..model.numeric.compiled import CompiledModels
 from ..model.symbolic.components import Effect
-from .parallel import fork_map, forks, pool, pool_map
+from .parallel import ServingPool, fork_map, forks
 from .problem import Problem
 from .replay import Replay
 
@@ -40,7 +43,8 @@ class ReplayEngine:
     """The replays of one diagnosis (module docstring). `workers` > 1 spreads independent replays over forked
     processes (the same numbers as in line); `hosts` maps an effect set's key (:func:`effect_key`) to the effects
     of the compiled model it is replayed on, each host's effects beyond the set absent at their values in the
-    parameters (:func:`parksteer.diagnose.candidates.shares_diagnosis_model`). :meth:`close` ends the pool."""
+    parameters (:func:`parksteer.diagnose.candidates.shares_diagnosis_model`). :meth:`close` ends the pool,
+    :meth:`terminate` at once (on an interrupt or an error)."""
 
     def __init__(self, workers: int = 1, hosts: dict[tuple[str, ...], list[Effect]] | None = None):
         self.workers = max(int(workers), 1)
@@ -49,7 +53,7 @@ class ReplayEngine:
         self.direct: dict[tuple[str, str], bool] = {}
         self.replays: dict[tuple, Replay] = {}
         self.other_replays = 0
-        self.pool = None
+        self.pool = ServingPool(self.workers)
 
     @property
     def evaluations(self) -> int:
@@ -69,10 +73,10 @@ class ReplayEngine:
 
     def replay(self, problem: Problem, effects: list[Effect], index: int) -> Replay:
         """The kept replay of `effects` on file `index` of `problem`, at the file's instants (made when first asked
-        for in the problem's generation of instants)."""
-        key = (effect_key(effects), index, problem.instants)
+        for at the file's torque lag)."""
+        f = problem.files[index]
+        key = (effect_key(effects), index, f.torque_lag_s)
         if key not in self.replays:
-            f = problem.files[index]
             self.replays[key] = self.new_replay(effects, f.case, f.surface, problem.params, f.rack, f.replay_time_s)
         return self.replays[key]
 
@@ -105,14 +109,13 @@ class ReplayEngine:
                 ) -> list[np.ndarray]:
         """The fitted signals replayed at every file's samples (one array per file).
 
-        With several files and workers, on a pool forked once, at the first such prediction: its workers serve
-        the problem and the replays as they were then (a worker's replays are its own copies)."""
+        With several files and workers, on workers forked for `problem` (:class:`parksteer.diagnose.parallel.
+        ServingPool`: forked again when the problem is another); a worker's replays are its own copies, each what
+        its key says (module docstring), so the numbers are those of the files replayed in line."""
         if self.parallel_files(problem):
-            if self.pool is None:
-                self.pool = pool(self.workers, lambda task, problem=problem: self.signals(problem, *task))
-            if self.pool is not None:
-                tasks = [(list(effects), i, overrides) for i in range(len(problem.files))]
-                out = pool_map(self.pool, tasks)
+            tasks = [(list(effects), i, overrides) for i in range(len(problem.files))]
+            out = self.pool.map(problem, lambda task: self.signals(problem, *task), tasks)
+            if out is not None:
                 self.count(len(tasks))
                 return out
         return [self.signals(problem, effects, i, overrides) for i in range(len(problem.files))]
@@ -140,7 +143,9 @@ class ReplayEngine:
     def close(self) -> None:
         """End the worker pool, if one was started; later predictions run in line."""
         self.workers = 1
-        if self.pool is not None:
-            self.pool.close()
-            self.pool.join()
-            self.pool = None
+        self.pool.close()
+
+    def terminate(self) -> None:
+        """End the worker pool now, its work unfinished (an interrupt, an error); later predictions run in line."""
+        self.workers = 1
+        self.pool.terminate()

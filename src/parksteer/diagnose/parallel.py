@@ -10,6 +10,12 @@ A worker never forks again (:func:`fork_map` inside a worker runs in line).
 
 Where the platform cannot fork (Windows, or ``workers`` <= 1), everything runs in line.
 
+A worker ignores SIGINT (a terminal's Ctrl-C reaches the whole process group): the diagnosing process alone
+answers it, by ending its workers (:meth:`ServingPool.terminate`, and :func:`fork_map` on any exception), so no
+pool starts new workers in their place and none is waited for. Forking and ending workers happen with SIGINT and
+SIGTERM held back (:func:`signals_held`): the interpreter ignores an exception raised in its fork hooks, which would
+lose a Ctrl-C, and an interrupt half-way through ending a pool would leave its workers behind.
+
 :class:`Progress` writes one line per step of a diagnosis to stderr (unless quiet), so that a
 long diagnosis says where it is.
 """
@@ -18,8 +24,11 @@ from __future__ import annotations
 
 import multiprocessing
 import os
+import signal
+import threading
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
+from contextlib import contextmanager
 from typing import Any
 from ..progress import note
 
@@ -29,6 +38,23 @@ def available_workers() -> int:
         return max(len(os.sched_getaffinity(0)), 1)
     except AttributeError:  # not on Linux
         return max(os.cpu_count() or 1, 1)
+
+
+STOPPING_SIGNALS = (signal.SIGINT, signal.SIGTERM)
+
+
+@contextmanager
+def signals_held() -> Iterator[None]:
+    """SIGINT and SIGTERM held back inside the block and delivered when it ends (module docstring); where signals
+    cannot be held (no pthread_sigmask, or not the main thread, which alone runs Python's handlers), as they are."""
+    if not hasattr(signal, "pthread_sigmask") or threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    before = signal.pthread_sigmask(signal.SIG_BLOCK, STOPPING_SIGNALS)
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, before)
 
 
 def can_fork() -> bool:
@@ -55,6 +81,11 @@ class WorkerProcess:
         self.serve: Callable[[Any], Any] | None = None
 
     def start(self, serve: Callable[[Any], Any]) -> None:
+        # Ctrl-C is the forking process's to answer (module docstring); SIGTERM, which ends a pool's workers,
+        # ends this one at once, even inside a solve, whatever handler it inherited
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+        signal.signal(signal.SIGTERM, signal.SIG_DFL)
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, STOPPING_SIGNALS)  # held while the pool forked it
         self.serve = serve
 
     @property
@@ -78,12 +109,56 @@ def pool(workers: int, serve: Callable[[Any], Any]):
     where it would not fork. Map items over it with :func:`pool_map`; close it when done."""
     if not forks(workers, workers):
         return None
-    return multiprocessing.get_context("fork").Pool(workers, initializer=WORKER.start, initargs=(serve,))
+    with signals_held():
+        return multiprocessing.get_context("fork").Pool(workers, initializer=WORKER.start, initargs=(serve,))
 
 
 def pool_map(workers_pool, items: Sequence[Any]) -> list:
     """``[serve(item) for item in items]`` on the workers of `workers_pool` (:func:`pool`), in order."""
     return workers_pool.map(_serve, list(items), chunksize=1)
+
+
+class ServingPool:
+    """Up to `workers` worker processes that serve one function made for one key, forked when first asked.
+
+    A worker holds what the forking process held when it was forked (a diagnosis's problem, its files, its
+    replays): asked to serve another key, the pool ends its workers and forks new ones from the process as it is
+    then, so no worker ever answers for a key it was not made for. Keys are compared by identity, and the pool
+    holds the key it serves, so that key's identity cannot pass to another object meanwhile."""
+
+    def __init__(self, workers: int):
+        self.workers = workers
+        self.key: Any = None
+        self.pool = None
+
+    def map(self, key: Any, serve: Callable[[Any], Any], items: Sequence[Any]) -> list | None:
+        """``[serve(item) for item in items]`` on workers forked to serve `serve` for `key` (`serve` is used only
+        when the pool forks: a pool already serving `key` serves the function it was forked with); None where
+        the platform cannot fork, or in a worker."""
+        if self.pool is None or self.key is not key:
+            with signals_held():  # the pool is this object's before an interrupt can arrive
+                self.close()
+                self.pool = pool(self.workers, serve)
+                self.key = key if self.pool is not None else None
+        if self.pool is None:
+            return None
+        return pool_map(self.pool, items)
+
+    def close(self) -> None:
+        """Let the workers finish and end them."""
+        with signals_held():
+            if self.pool is not None:
+                self.pool.close()
+                self.pool.join()
+            self.pool, self.key = None, None
+
+    def terminate(self) -> None:
+        """End the workers now, whatever they are doing (on an interrupt or an error), and reap them."""
+        with signals_held():
+            if self.pool is not None:
+                self.pool.terminate()
+                self.pool.join()
+            self.pool, self.key = None, None
 
 
 def fork_map(function: Callable[[Any], Any], items: Sequence[Any], workers: int) -> list:
@@ -95,12 +170,14 @@ def fork_map(function: Callable[[Any], Any], items: Sequence[Any], workers: int)
     items = list(items)
     if not forks(len(items), workers):
         return [function(item) for item in items]
-    workers_pool = pool(min(workers, len(items)), lambda index: function(items[index]))
+    serving = ServingPool(min(workers, len(items)))
     try:
-        return pool_map(workers_pool, range(len(items)))
-    finally:
-        workers_pool.close()
-        workers_pool.join()
+        out = serving.map(items, lambda index: function(items[index]), range(len(items)))
+    except BaseException:  # an interrupt, or an error in a worker: the others' work is not waited for
+        serving.terminate()
+        raise
+    serving.close()
+    return out
 
 
 class Progress:
@@ -122,23 +199,29 @@ class Progress:
 
 
 def by_reference(effects) -> list:
-    """`effects`, each one's class findable by its module's name. An effect loaded from a file (--effects=+path.py)
-    is of a module kept out of sys.modules (its name carries a hash of the file's text:
-    parksteer.model.symbolic.components.load_effect_module), and a diagnosis's worker pool pickles the effects it
-    sends to its forked workers, which looks a class up by that name: the class is registered under it here, before
-    any pool forks, so the workers inherit it."""
+    """`effects`, each one's class findable by its module's name. A diagnosis's worker pool pickles the effects it
+    sends to its forked workers, which looks a class up by that name, and two kinds of class have none: an effect
+    loaded from a file (--effects=+path.py) is of a module kept out of sys.modules (its name carries a hash of the
+    file's text: parksteer.model.symbolic.components.load_effect_module), and a class a factory makes (an electric
+    assist at its point of action, ``ElectricAssist.at``) is no attribute of its module. Each is registered under
+    its name here, before any pool forks, so the workers inherit it; a name the module gives another object is
+    left alone."""
     import sys
     import types
 
     effects = list(effects)
     for effect in effects:
         cls = type(effect)
-        module = sys.modules.get(cls.__module__)
-        if "." in cls.__qualname__ or (module is not None and not getattr(module, "_parksteer_by_reference", False)):
+        if "." in cls.__qualname__:
             continue
+        module = sys.modules.get(cls.__module__)
         if module is None:  # the file loaded again in one process is a new class of the same name: the latest wins
             module = types.ModuleType(cls.__module__)
             module._parksteer_by_reference = True
             sys.modules[cls.__module__] = module
+        elif getattr(module, cls.__qualname__, None) is cls:
+            continue
+        elif hasattr(module, cls.__qualname__) and not getattr(module, "_parksteer_by_reference", False):
+            continue
         setattr(module, cls.__qualname__, cls)
     return effects

@@ -214,28 +214,21 @@ class Problem:
 
     A problem is not changed once made: :meth:`with_files` makes a new one (the files derived). It replays
     nothing itself: the replays, their counts and the worker processes are the replay engine's
-    (:class:`parksteer.diagnose.engine.ReplayEngine`). `angle_offset_fitted` is the setting the replayed angle
-    reads (:meth:`parksteer.diagnose.engine.ReplayEngine.signals`); `instants` numbers the generation of the files'
-    replay instants (a new one when a torque lag moves), so that the engine's replays are made again at the new
-    instants. The diagnosis's settings are owned by the diagnosis.
+    (:class:`parksteer.diagnose.engine.ReplayEngine`, which keeps one replay per effect set, file and torque lag, so
+    that a file whose lag moved is replayed at its new instants). `angle_offset_fitted` is the setting the replayed
+    angle reads (:meth:`parksteer.diagnose.engine.ReplayEngine.signals`). The diagnosis's settings are owned by the
+    diagnosis.
     """
 
     def __init__(self, files, params: Parameters,
-                 angle_offset_fitted: bool = DEFAULT_SETTINGS.angle_offset_fitted, instants: int = 0):
+                 angle_offset_fitted: bool = DEFAULT_SETTINGS.angle_offset_fitted):
         self.files: tuple[FileData, ...] = tuple(files)
         self.params = params
         self.angle_offset_fitted = angle_offset_fitted
-        self.instants = instants
 
-    def with_files(self, files, new_instants: bool = False) -> Problem:
-        """The same problem on other files (derived from these: the same records, one per index).
-
-        With `new_instants` (a file's torque lag moved), the replays made so far are not this problem's: each is
-        made again at the files' instants when first asked for (the solves already run stay counted). Without,
-        the replays made so far are kept, at the instants they were made for: a lag moved by less than a search
-        step keeps them (parksteer.diagnose.stages.torque_lag)."""
-        return Problem(files, self.params, angle_offset_fitted=self.angle_offset_fitted,
-                       instants=self.instants + 1 if new_instants else self.instants)
+    def with_files(self, files) -> Problem:
+        """The same problem on other files (derived from these: the same records, one per index)."""
+        return Problem(files, self.params, angle_offset_fitted=self.angle_offset_fitted)
 
     @property
     def n(self) -> int:

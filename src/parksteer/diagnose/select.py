@@ -60,7 +60,7 @@ from ..model.symbolic.components import Effect, discover_effects, power_assist_o
 from ..parameters import Parameters
 from .candidates import candidate_effects, models_to_build, replay_models
 from .compare import check_torque_sensors
-from .parallel import Progress, by_reference
+from .parallel import Progress, by_reference, signals_held
 from .engine import ReplayEngine
 from .problem import FileData, Problem
 from .settings import DEFAULT_SETTINGS, DiagnosisSettings
@@ -119,6 +119,13 @@ def diagnose(files: list[FileData], params: Parameters, effects=None, registry: 
     engine = ReplayEngine(workers, hosts=replay_models(base, testable, params))
     try:
         state = run_table(state, engine)
+    except BaseException:  # an interrupt or an error: nothing still running is waited for
+        engine.terminate()
+        with signals_held():
+            for builder in builders:
+                builder.terminate()
+            finish_builds(builders)
+        raise
     finally:
         engine.close()
         finish_builds(builders)

@@ -36,6 +36,7 @@ import numpy as np
 
 from ..errors import UsageError
 from ..model.symbolic.shapes import FORCE_BOUND_N, TORQUE_BOUND_NM, shape_effect
+from ..tables import atomic_path
 from .calibrate import Fit, calibration_parameters, least_squares
 from .engine import ReplayEngine
 from .problem import Problem
@@ -289,7 +290,8 @@ def suggest(problem: Problem, calibration: Fit, signature: Signature, path: str 
     after_ratio = after["weighted_rms_Nm"] / floor
     final = effect_source(signature, {**strengths, "_before": before_ratio, "_after": after_ratio}, speed_90)
     if path is not None:
-        Path(path).write_text(final, encoding="utf-8")
+        with atomic_path(path) as tmp:  # complete or absent, whenever the run is stopped
+            tmp.write_text(final, encoding="utf-8")
     return Suggestion(f"suggested_{signature.effect_class}", signature.effect_class,
                       str(path) if path is not None else None, final, strengths, float(before_ratio),
                       float(after_ratio), float(gain), fit)

@@ -10,8 +10,8 @@ searched on the base model, which lacks the named effect, and an effect at the r
 pulls it off; searched again with the effect, a lag that moves by a step or more is kept and the whole table run
 again on a new state with the lags held (the settings' torque_lag_fitted off), whose result is the diagnosis.
 
-A lag moved by less than a step is kept in the file, without replaying what was replayed already
-(Problem.with_files).
+A lag moved by less than a step is kept in the file without making the replay uncertainty and the calibration
+again; the replays from then on are at the file's new instants (the replay engine keeps one per lag).
 """
 
 from __future__ import annotations
@@ -79,8 +79,8 @@ def estimate_torque_lags(engine: ReplayEngine, problem: Problem, effects: list[E
 def lags_searched(state: DiagnosisState, engine: ReplayEngine, effects: list[Effect], overrides: dict[str, float],
                   why: str) -> tuple[Problem, bool]:
     """(the state's problem on files with the lags searched on `effects` with `overrides`, whether one moved by a
-    search step or more). Where one did, the progress line says so and the new problem's files have neither
-    replays nor replay uncertainty yet (they were made at the old instants)."""
+    search step or more). Where one did, the progress line says so and the new problem's files have no replay
+    uncertainty yet (it was made at the old instants)."""
     problem, settings = state.problem, state.settings
     lags, largest = estimate_torque_lags(engine, problem, effects, overrides, settings)
     files = [replace(f, torque_lag_s=lag) for f, lag in zip(problem.files, lags)]
@@ -89,7 +89,7 @@ def lags_searched(state: DiagnosisState, engine: ReplayEngine, effects: list[Eff
     state.progress(f"torque channel behind the rack's{why}: " + ", ".join(
         f"{f.label} {1000.0 * f.torque_lag_s:.1f} ms" for f in files if f.torque_lag_s))
     files = [replace(f, replay_uncertainty_Nm=None, replay_draws_Nm=None) for f in files]
-    return problem.with_files(files, new_instants=True), True
+    return problem.with_files(files), True
 
 
 class TorqueLag(Stage):
