@@ -21,6 +21,7 @@ from parksteer.diagnose.baseline import Baseline, learn_baseline
 from parksteer.diagnose.problem import load_files
 from parksteer.diagnose.report import diagnosis_dict
 from parksteer.diagnose.select import diagnose
+from parksteer.diagnose.settings import DEFAULT_SETTINGS
 from parksteer.experiments.benchmark import BASE_PERTURBATION
 from parksteer.measure.converter import quantisation_step
 from parksteer.measure.io import write_measurement
@@ -142,7 +143,9 @@ def test_a_healthy_record_of_another_hand_is_as_the_baseline(car):
     assert result["relative_to"]["baseline"] == written.path
     digest = hashlib.sha256((car["folder"] / "car_baseline.toml").read_bytes()).hexdigest()[:16]
     assert result["relative_to"]["content_hash"] == digest
-    assert result["selection"]["thresholds"]["adequate_rms_factor"] == pytest.approx(written.threshold.over_floor)
+    # the threshold of "as the baseline" where it is above the sensor's
+    expected = max(DEFAULT_SETTINGS.adequate_rms_factor, written.threshold.over_floor)
+    assert result["selection"]["thresholds"]["adequate_rms_factor"] == pytest.approx(expected)
 
 
 def test_the_baseline_file_round_trips(car):

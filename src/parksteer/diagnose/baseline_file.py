@@ -73,8 +73,12 @@ def baseline_text(baseline) -> str:
         lines += ["[[threshold.parts]]"] + [f"{_key(k)} = {_value(v)}" for k, v in part.items()
                                             if v is not None] + [""]
     if baseline.identified_vehicle is not None:
+        text = baseline.identified_vehicle
+        # as it reads, where a literal multi-line string can hold it (TOML drops the newline after the quotes)
+        literal = "'''" not in text and "\r" not in text and not text.endswith("'")
+        quoted = "'''\n" + text + "'''" if literal else _string(text)
         lines += ["[identified]", "# the vehicle file as parksteer assist identify writes it from the records above",
-                  f"vehicle = {_string(baseline.identified_vehicle)}", ""]
+                  f"vehicle = {quoted}", ""]
     return "\n".join(lines)
 
 
