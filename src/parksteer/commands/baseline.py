@@ -78,7 +78,7 @@ def baseline_of(args, params, effects, settings, workers: int, records: RecordOp
     given = args.baseline
     if len(given) == 1 and given[0].endswith(".toml"):
         baseline = Baseline.read(given[0])
-        baseline.check_vehicle(params)
+        baseline.check(params, effects)
         return baseline
     if any(b.endswith(".toml") for b in given):
         raise UsageError(f"--baseline {' '.join(given)}: give one baseline file (.toml) or the healthy records, "

@@ -18,11 +18,13 @@ something the model lacks. The question its owner asks after a repair or a thous
 
 A later record is then diagnosed (``diagnose(..., baseline=...)``, :mod:`parksteer.diagnose.select`) on the model
 with the form's strengths HELD at the baseline's values (a change cannot be absorbed by fitting the quirk again),
-starting from the baseline's calibrated values, and with the threshold above in place of the sensor floor's:
+starting from the baseline's calibrated values, and with the threshold above where it is above the sensor's
+(:meth:`Threshold.settings_for`):
 ``adequate`` is "as the baseline", ``missing`` "changed: X", ``unexplained`` "changed, outside the library". The
 uncertainty of the held strengths reaches the verdict through that threshold: a left-out part is judged against
-strengths fitted without it, so their estimation error is inside the spread it measures. Where the records fix
-the form poorly, the spread, and so the threshold, is wide. The diagnosis's JSON names the baseline
+strengths fitted without it, so their estimation error is inside the spread it measures (one record's halves are
+in-sample and do not hold it: a second healthy record does). Where the records fix the form poorly, the spread,
+and so the threshold, is wide. The diagnosis's JSON names the baseline
 (``relative_to``: its file and content hash, the threshold and how it was found).
 
 The file (:meth:`Baseline.write`, :mod:`parksteer.diagnose.baseline_file`) is TOML a person reads: every value with
@@ -91,11 +93,19 @@ class Baseline:
                 "verdict": self.verdict, "form": None if self.form is None else self.form.effect,
                 "threshold": self.threshold.as_dict()}
 
-    def check_vehicle(self, params: Parameters) -> None:
+    def check(self, params: Parameters, effects=None) -> None:
+        """Refuse, in one line naming the file and the key, records of another car (its values' hash) or a model of
+        other effects than the baseline's (`effects`, before the form is added)."""
+        where = self.path or "baseline"
         if vehicle_fingerprint(params) != self.fingerprint:
-            where = self.path or "baseline"
             raise UsageError(f"{where}: key 'vehicle.fingerprint': the baseline is of another car "
                              f"({self.vehicle}); give the vehicle file it was learnt with")
+        if effects is not None:
+            names = tuple(sorted(e.name for e in effects))
+            if names != tuple(sorted(self.effects)):
+                raise UsageError(f"{where}: key 'records.model': the baseline's model is {', '.join(self.effects)}; "
+                                 f"these records are diagnosed with {', '.join(names)} (the same --effects and "
+                                 "--with-assist as the baseline)")
 
     def parameters(self, params: Parameters) -> Parameters:
         """The car's parameters a later record is diagnosed with: the identified vehicle file's where the baseline

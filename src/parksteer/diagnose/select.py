@@ -97,7 +97,7 @@ def diagnose(files: list[FileData], params: Parameters, effects=None, registry: 
         else resolve_effects(effects)
     held = None
     if baseline is not None:
-        baseline.check_vehicle(params)
+        baseline.check(params, base)
         params, base = baseline.parameters(params), baseline.model(base, registry)
         start, held = {**baseline.start, **(start or {})}, baseline.held
     # An assisted car's record: its motor channel fitted beside the torsion-bar torque (settings.use_motor_channel);
