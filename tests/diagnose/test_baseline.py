@@ -164,8 +164,9 @@ def test_the_baseline_file_round_trips(car):
 
 def test_command_line_baseline_then_diagnose(car, tmp_path, capsys):
     """`parksteer baseline` on one healthy record (the threshold from its halves), then `diagnose --baseline` on a
-    later record: exit 0, the file written, the JSON valid and naming the file; `baseline` refuses to overwrite
-    without --force."""
+    later record: exit 0, the file written, the JSON valid and naming the file; the healthy record itself given as
+    the baseline is learnt in memory to the same verdict and fitted values; `baseline` refuses to overwrite without
+    --force."""
     out = tmp_path / "one.toml"
     assert main(["baseline", str(car["paths"]["healthy_a"]), "--out", str(out), "--quiet"]) == 0
     assert "wrote" in capsys.readouterr().out
@@ -175,6 +176,12 @@ def test_command_line_baseline_then_diagnose(car, tmp_path, capsys):
     result = json.loads(capsys.readouterr().out)
     jsonschema.validate(result, json.loads(data_file("diagnosis.schema.json").read_text(encoding="utf-8")))
     assert result["relative_to"]["baseline"] == str(out)
+    assert main(["diagnose", str(car["paths"]["column"]), "--baseline", str(car["paths"]["healthy_a"]), "--json",
+                 "--quiet"]) == 0
+    in_memory = json.loads(capsys.readouterr().out)
+    assert in_memory["relative_to"]["baseline"] is None and in_memory["relative_to"]["records"] == ["healthy_a.csv"]
+    assert (in_memory["verdict"], in_memory["effect"], in_memory["calibrated"]) == \
+        (result["verdict"], result["effect"], result["calibrated"])
     assert main(["baseline", str(car["paths"]["healthy_a"]), "--out", str(out), "--quiet"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "--out" in err[0] and "--force" in err[0]
