@@ -12,10 +12,11 @@ from ..errors import UsageError
 from ..parameters import DEFAULT_PATH
 from ..progress import note
 from . import add_quiet_option
+from .baseline import RecordOptions, baseline_of, register_baseline
 from .vehicle import add_vehicle_option, parameters_of
 
 
-def _common(p) -> None:
+def _common(p, outputs: bool = True) -> None:
     p.add_argument("files", nargs="+", metavar="FILE",
                    help="measurement files: native CSV (data/measurements/README.md), a logger's CSV, ASAM MDF or a raw CAN "
                         "log with --bus/--dbc")
@@ -31,8 +32,9 @@ def _common(p) -> None:
     p.add_argument("--with-assist", action="store_true",
                    help="with --vehicle: the car with its [assist]: the record's torque is the torsion bar's, replayed "
                         "through the boost law, and a motor current or torque channel is fitted beside it")
-    p.add_argument("--json", action="store_true", help="print the result as JSON on stdout")
-    p.add_argument("--plot", default=None, metavar="OUT.svg", help="write a figure")
+    if outputs:
+        p.add_argument("--json", action="store_true", help="print the result as JSON on stdout")
+        p.add_argument("--plot", default=None, metavar="OUT.svg", help="write a figure")
 
 
 def add_import_options(p) -> None:
@@ -90,6 +92,7 @@ def register(sub) -> None:
                         "user-effect file (its strengths fitted with the calibrated parameters; pass it back with "
                         "--effects=+OUT.py); no file when the verdict is adequate or names a candidate")
     p.set_defaults(func=_diagnose)
+    register_baseline(sub, RECORDS, diagnose=p)
 
 
 def _check_outputs(args) -> None:
@@ -308,7 +311,8 @@ def _diagnose(args) -> int:
                              f"({why})")
         note(f"handwheel angle fitted beside the torque in {len(with_angle)} of {len(files)} file(s): "
              + ", ".join(with_angle))
-    diagnosis = diagnose(files, params, effects, workers=workers, quiet=args.quiet, settings=settings)
+    diagnosis = diagnose(files, params, effects, workers=workers, quiet=args.quiet, settings=settings,
+                         baseline=baseline_of(args, params, effects, settings, workers, RECORDS))
     result = _with_suggestion(args, diagnosis_dict(diagnosis), diagnosis, settings)
     user_plot = None
     if args.plot:
@@ -399,3 +403,6 @@ def _write_html(path: str, diagnosis, result: dict, phases: list[dict], ladder) 
         figures = [(name, caption, (Path(tmp) / f"{name}.svg").read_text(encoding="utf-8"))
                    for name, caption in captions.items()]
     write_markdown(path, html_report(result, figures, phases, ladder.as_dict()))
+
+
+RECORDS = RecordOptions(_common, effects_of, _check_writable, channel_map_of, assist_of_effects, with_record_speed)

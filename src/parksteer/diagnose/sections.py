@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 
 from .report import (confound_separates, interval_text, num, separating, shown_unit, signature_lines,
                      strength_text, tie_headline)
+from .relative_text import relative_sentence
 from .user_effect_pages import user_effect_intervals, user_effect_sentence, user_effect_tables
 
 
@@ -304,7 +305,8 @@ def report_sections(result: dict, phases: list[dict] | None = None, ladder: dict
     """The report of the JSON `result` of a diagnosis as sections, in the order both pages show them; the residual
     by phase and the error ladder only where given (`phases`, `ladder`: both pages of one run get the same)."""
     floor, stats = result["noise_floor_Nm"], result["statistics"]
-    out = [Section(None, (_verdict(result),))]
+    relative = relative_sentence(result)
+    out = [Section(None, (_verdict(result),) + ((Paragraph(relative, "Relative to baseline"),) if relative else ()))]
     out.append(Section("Files", (
         Paragraph(f"Model: {', '.join(f'`{e}`' for e in result['model']['effects'])}."),
         table(["file", "case", "surface", "samples", "noise floor (N m)", "replay uncertainty RMS (N m)",

@@ -1,0 +1,151 @@
+"""A car's baseline: what its healthy records fix, and later records judged against it.
+
+No model of a real car reaches a 12-bit sensor's noise floor: every record of it, its healthy ones included, carries
+something the model lacks. The question its owner asks after a repair or a thousand kilometres is what changed.
+:func:`learn_baseline` learns from the healthy records everything they fix:
+
+- the car's calibrated parameters, each with its 95 % interval (:meth:`parksteer.diagnose.calibrate.Fit.intervals`);
+- what the healthy car has that the model lacks (:class:`HeldForm`): the absolute diagnosis's verdict and, where it
+  is not ``adequate``, the car's own form: the named library candidate at its fitted strength, or the form the
+  residual's signature points to (:func:`parksteer.diagnose.suggest.suggest`) with its fitted strengths;
+- how far apart healthy data are (:class:`Threshold`): each healthy record is judged against the form fitted again
+  on the others (leave one out), with the sensor's thresholds; with one record, each half of it (cut between its
+  reversals) under the form and calibration fitted on the whole record (a half replayed alone would start
+  mid-stroke from rest, a start the car never had, so its error is read off the whole record's fit: in-sample, and
+  said so). Of each part, the weighted RMS error in noise floors with the form held and the best candidate's BIC
+  gain per sample; what "as the baseline" allows is the one-sided 95 % prediction bound for one more healthy part
+  (Student's t over the parts: two parts fix it poorly, and the bound is wide; more healthy records tighten it).
+
+A later record is then diagnosed (``diagnose(..., baseline=...)``, :mod:`parksteer.diagnose.select`) on the model
+with the form's strengths HELD at the baseline's values (a change cannot be absorbed by fitting the quirk again),
+starting from the baseline's calibrated values, and with the threshold above where it is above the sensor's
+(:meth:`Threshold.settings_for`):
+``adequate`` is "as the baseline", ``missing`` "changed: X", ``unexplained`` "changed, outside the library". The
+uncertainty of the held strengths reaches the verdict through that threshold: a left-out part is judged against
+strengths fitted without it, so their estimation error is inside the spread it measures (one record's halves are
+in-sample and do not hold it: a second healthy record does). Where the records fix the form poorly, the spread,
+and so the threshold, is wide. The diagnosis's JSON names the baseline
+(``relative_to``: its file and content hash, the threshold and how it was found).
+
+The file (:meth:`Baseline.write`, :mod:`parksteer.diagnose.baseline_file`) is TOML a person reads: every value with
+its interval and source.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+
+from ..errors import UsageError
+from ..model.symbolic.components import Effect, resolve_effects
+from ..parameters import Parameters
+from .baseline_file import baseline_text, content_hash, identified_parameters, parse_baseline, read_bytes
+from .baseline_form import FORMAT, HeldForm, Threshold, vehicle_fingerprint
+from .baseline_learn import learn
+from .settings import DEFAULT_SETTINGS, DiagnosisSettings
+
+__all__ = ["FORMAT", "Baseline", "HeldForm", "Threshold", "learn_baseline", "vehicle_fingerprint"]
+
+
+@dataclass(frozen=True)
+class Baseline:
+    """What a car's healthy records fix (module docstring). `vehicle`: the car's file as given; `fingerprint`: its
+    values' hash (:func:`vehicle_fingerprint`); `effects`: the model's; `calibrated`: key -> {value, ci95,
+    standard_error}; `verdict`, `over_floor`: the absolute diagnosis of the healthy records; `form`: what they have
+    that the model lacks (None when it is adequate); `identified_vehicle`: for an assisted car whose file gave only
+    its gear's data, the vehicle file as ``parksteer assist identify`` writes it from these records."""
+
+    vehicle: str | None
+    fingerprint: str
+    records: tuple[str, ...]
+    effects: tuple[str, ...]
+    calibrated: dict
+    verdict: str
+    over_floor: float
+    form: HeldForm | None
+    threshold: Threshold
+    identified_vehicle: str | None = None
+    path: str | None = None
+    content_hash: str | None = None
+
+    def write(self, path) -> Baseline:
+        """Write the baseline as TOML to `path` (its text read back first: nothing is written that would not read);
+        returns it with its path and content hash."""
+        import tomllib
+        from pathlib import Path
+
+        text = baseline_text(self)
+        Baseline(**parse_baseline(tomllib.loads(text), str(path)))
+        data = text.encode("utf-8")
+        Path(path).write_bytes(data)
+        return dataclasses.replace(self, path=str(path), content_hash=content_hash(data))
+
+    @classmethod
+    def read(cls, path) -> Baseline:
+        """The baseline written to `path`, with its path and content hash (a damaged or foreign file: one line
+        naming it and the key, exit 2)."""
+        data, parsed = read_bytes(path)
+        return cls(**parse_baseline(parsed, str(path)), path=str(path), content_hash=content_hash(data))
+
+    def relative_to(self) -> dict:
+        """What a diagnosis against this baseline names it by (JSON ``relative_to``)."""
+        return {"baseline": self.path, "content_hash": self.content_hash, "records": list(self.records),
+                "verdict": self.verdict, "form": None if self.form is None else self.form.effect,
+                "threshold": self.threshold.as_dict()}
+
+    def check(self, params: Parameters, effects=None) -> None:
+        """Refuse, in one line naming the file and the key, records of another car (its values' hash) or a model of
+        other effects than the baseline's (`effects`, before the form is added)."""
+        where = self.path or "baseline"
+        if vehicle_fingerprint(params) != self.fingerprint:
+            raise UsageError(f"{where}: key 'vehicle.fingerprint': the baseline is of another car "
+                             f"({self.vehicle}); give the vehicle file it was learnt with")
+        if effects is not None:
+            names = tuple(sorted(e.name for e in effects))
+            if names != tuple(sorted(self.effects)):
+                raise UsageError(f"{where}: key 'records.model': the baseline's model is {', '.join(self.effects)}; "
+                                 f"these records are diagnosed with {', '.join(names)} (the same --effects and "
+                                 "--with-assist as the baseline)")
+
+    def parameters(self, params: Parameters) -> Parameters:
+        """The car's parameters a later record is diagnosed with: the identified vehicle file's where the baseline
+        identified the assist, with the held form's values."""
+        if self.identified_vehicle is not None:
+            params = identified_parameters(self.identified_vehicle)
+        if self.form is None:
+            return params
+        self.form.model_effect()  # a signature's form registers its quantities
+        return params.with_overrides(self.form.values)
+
+    def model(self, effects, registry: dict[str, Effect] | None = None) -> list[Effect]:
+        """The model's `effects` with the held form added."""
+        base = effects if isinstance(effects, list) and all(isinstance(e, Effect) for e in effects) \
+            else resolve_effects(effects)
+        if self.form is None or any(e.name == self.form.effect for e in base):
+            return list(base)
+        return sorted([*base, self.form.model_effect(registry)], key=lambda e: e.name)
+
+    @property
+    def held(self) -> dict[str, float]:
+        """The strengths a later diagnosis holds (not fitted)."""
+        return {} if self.form is None else {k: float(v["value"]) for k, v in self.form.strengths.items()}
+
+    @property
+    def start(self) -> dict[str, float]:
+        """The calibrated values, where a later calibration starts."""
+        return {k: float(v["value"]) for k, v in self.calibrated.items()}
+
+
+def learn_baseline(files, params: Parameters, effects=None, settings: DiagnosisSettings = DEFAULT_SETTINGS, *,
+                   vehicle=None, progress=None, registry: dict[str, Effect] | None = None,
+                   workers: int = 1) -> Baseline:
+    """Learn a car's baseline from its healthy records (module docstring).
+
+    `files`, `params`, `effects`, `registry`, `settings`, `workers`: as :func:`parksteer.diagnose.select.diagnose`
+    takes them (the records loaded by :func:`parksteer.diagnose.problem.load_files`). `vehicle`: the vehicle file's
+    path (named in the baseline; for an assisted car whose file gives only its gear's data, its assist is first
+    identified from these records, :mod:`parksteer.diagnose.assist_identify`). `progress`: None (quiet) or a
+    callable given one line at each step."""
+    return learn(Baseline, files, params, effects, settings, vehicle=vehicle, progress=progress, registry=registry,
+                 workers=workers)
+

@@ -1,0 +1,213 @@
+"""Learning a baseline (:func:`parksteer.diagnose.baseline.learn_baseline`): the absolute diagnosis of the healthy
+records, the form they have that the model lacks, and the spread between healthy parts that sets the threshold of
+"as the baseline" (the module docstring of :mod:`parksteer.diagnose.baseline`)."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+from scipy.special import stdtrit  # the t quantile, without importing scipy.stats
+
+from ..model.symbolic.components import Effect, discover_effects, power_assist_of, resolve_effects
+from ..parameters import Parameters
+from .baseline_file import identified_parameters
+from .baseline_form import HeldForm, Threshold, vehicle_fingerprint
+from .calibrate import Fit, calibrate
+from .engine import ReplayEngine
+from .problem import FileData, Problem
+from .settings import DiagnosisSettings
+
+HALVES = ("first half", "second half")
+
+
+def _say(progress):
+    return progress if progress is not None else (lambda text: None)
+
+
+def _estimates(fit: Fit, problem: Problem, settings: DiagnosisSettings, keys, source: str) -> dict:
+    """Value, 95 % interval and standard error of `keys` of `fit` (:meth:`Fit.intervals`), its sandwich's blocks
+    short enough that there are twice as many as the fit's parameters (a form of 15 strengths on an 18 s record
+    needs them under 0.6 s). Where the joint intervals are not finite (a form's strengths summing to a uniform
+    friction trade with the calibrated rack friction: J^T J is singular), each is the interval with the fit's other
+    parameters held at their values, and its source says so."""
+    duration = sum(float(f.time_s[-1] - f.time_s[0]) for f in problem.files)
+    block_s = min(settings.interval_block_s, duration / (2 * len(fit.parameters) + 2))
+    intervals = fit.intervals(problem, block_s)
+    chosen = [k for k in keys if k in intervals]
+    if not all(math.isfinite(intervals[k]["standard_error"]) for k in chosen):
+        index = [i for i, p in enumerate(fit.parameters) if p.key in chosen]
+        alone = dataclasses.replace(fit, parameters=[fit.parameters[i] for i in index], theta=fit.theta[index],
+                                    jacobian=fit.jacobian[:, index])
+        intervals = {**intervals, **alone.intervals(problem, block_s)}
+        source += "; interval with the fit's other parameters held (jointly these data do not fix them apart)"
+    return {k: {"value": float(intervals[k]["value"]), "ci95": [float(c) for c in intervals[k]["ci95"]],
+                "standard_error": float(intervals[k]["standard_error"]), "source": source}
+            for k in chosen}
+
+
+def held_form(diagnosis, settings: DiagnosisSettings, say) -> tuple[HeldForm | None, Fit, Problem]:
+    """What the healthy records have that the model lacks, with the fit it was read from: nothing where the
+    absolute verdict is adequate; the named candidate at its fitted strength; or the form the residual's signature
+    points to with its strengths fitted with the calibrated parameters (:func:`parksteer.diagnose.suggest.suggest`)."""
+    from .signature import COLUMN_CLASSES
+    from .suggest import suggest
+
+    problem, labels = diagnosis.problem, ", ".join(f.label for f in diagnosis.problem.files)
+    if diagnosis.verdict == "missing" and diagnosis.best is not None:
+        best = diagnosis.best
+        key = best.signature.key
+        strengths = _estimates(best.refit, problem, settings, [key],
+                               f"fitted with the calibrated parameters on {labels} (the absolute diagnosis)")
+        return HeldForm("candidate", best.name, strengths), best.refit, problem
+    signature = diagnosis.outputs.get("signature")
+    if diagnosis.verdict != "unexplained" or signature is None or signature.effect_class is None:
+        return None, diagnosis.calibration, problem
+    say(f"baseline: the form the residual's signature points to ({signature.effect_class}), its strengths fitted")
+    found = suggest(problem, diagnosis.calibration, signature, None, settings)
+    shape = next(e for e in found.fit.effects if e.name.startswith("shape_"))
+    free = [q.key for q in shape.quantities if q.free]
+    places = {k: float(v) for k, v in found.fit.fixed.items() if k.startswith(shape.name + ".") and k not in free}
+    strengths = _estimates(found.fit, problem, settings, free,
+                           f"fitted with the calibrated parameters on {labels} (the signature's form)")
+    kind, best = signature.effect_class, signature.best
+    column = kind in COLUMN_CLASSES
+    form = HeldForm("signature", shape.name, strengths, places, kind, 0 if column else len(best.knots),
+                    tuple(best.orders) if column else (), signature.sentence)
+    return form, found.fit, problem
+
+
+def _parts(files) -> tuple[str, list[tuple[list[FileData], FileData]]]:
+    """(method, [(the records the form is fitted on again, the record judged against it)]), for two or more."""
+    return ("leave one out: each healthy record judged against the form fitted again on the others",
+            [([g for j, g in enumerate(files) if j != i], f) for i, f in enumerate(files)])
+
+
+def half_rows(found) -> list[dict]:
+    """One record's two halves (cut between its first and last reversal), each one's weighted RMS error in noise
+    floors under the calibration and form fitted on the whole record. A half is not replayed alone: the replay
+    starts from rest at its first sample, and a half that starts mid-stroke would carry a start the car never had."""
+    f, prediction = found.problem.files[0], found.calibration.predictions[0]
+    weighted = (f.torque_Nm - f.torque_part(prediction)) / f.sigma_Nm
+    t, reversals = f.time_s, np.asarray(f.phases.reversal_times_s, dtype=float)
+    cut = 0.5 * (reversals[0] + reversals[-1]) if reversals.size >= 2 else 0.5 * (t[0] + t[-1])
+    i = int(np.searchsorted(t, cut))
+    return [{"part": f"{f.label} ({name})", "samples": int(part.size),
+             "over_floor": float(np.sqrt(np.mean(part**2))), "verdict": found.verdict}
+            for name, part in zip(HALVES, (weighted[:i], weighted[i:]))]
+
+
+def refit_form(form: HeldForm, train, params: Parameters, model: list[Effect], start: dict,
+               settings: DiagnosisSettings) -> HeldForm:
+    """The form's strengths fitted again, with the calibrated parameters, on the records `train` alone."""
+    problem = Problem(list(train), params.with_overrides(form.places))
+    engine = ReplayEngine()
+    strengths = None
+    if form.source == "candidate":  # a library strength, stepped by a hundredth of its value
+        strengths = {k: max(abs(float(v["value"])) * 1e-2, 1e-9) for k, v in form.strengths.items()}
+    fit = calibrate(engine, problem, model, strengths=strengths, start={**start, **form.values}, settings=settings)
+    values = fit.values
+    return dataclasses.replace(form, strengths={k: {**v, "value": float(values.get(k, v["value"]))}
+                                                for k, v in form.strengths.items()})
+
+
+def _judged(make, judged, params, base, registry, form, train, settings, workers):
+    """The relative diagnosis of the records `judged` against `form` (held) with a threshold of the sensor's."""
+    from .select import diagnose
+
+    part = make(None, vehicle_fingerprint(params), tuple(f.label for f in train), tuple(e.name for e in base),
+                    {}, "", math.nan, form, Threshold(0.0, 0.0, "the sensor's floor"))
+    return diagnose(list(judged), params, base, registry, settings=settings, workers=workers, quiet=True,
+                    baseline=part)
+
+
+def prediction_bound(values) -> float:
+    """The one-sided 95 % prediction bound for one more draw of what `values` are draws of: mean + t(0.95, k-1)
+    s sqrt(1 + 1/k) (Student's t, k values, s their standard deviation). Two healthy parts fix the spread poorly,
+    and the bound says so (t = 6.31 with one degree of freedom); more healthy records tighten it."""
+    values = np.asarray(values, dtype=float)
+    k = values.size
+    if k < 2:
+        return float(values.max())
+    return float(values.mean() + stdtrit(k - 1, 0.95) * values.std(ddof=1) * math.sqrt(1.0 + 1.0 / k))
+
+
+def _threshold(rows: list[dict], method: str) -> Threshold:
+    over = prediction_bound([r["over_floor"] for r in rows])
+    gain = prediction_bound([r["delta_bic"] / r["samples"] for r in rows])
+    return Threshold(over, max(gain, 0.0), method + "; the threshold is the one-sided 95 % prediction bound for "
+                     "one more healthy part (Student's t over the parts)", tuple(rows))
+
+
+def _best_gain(found) -> float:
+    return max([0.0, *(c.delta_bic for c in found.candidates if c.delta_bic is not None)])
+
+
+def spread(make, files, params: Parameters, base: list[Effect], registry, form: HeldForm | None, start: dict,
+           settings: DiagnosisSettings, workers: int, say) -> Threshold:
+    """The threshold of "as the baseline" from the healthy parts (module docstring of
+    :mod:`parksteer.diagnose.baseline`)."""
+    if len(files) == 1:
+        say(f"baseline: the halves of {files[0].label} against the form and calibration of the whole record")
+        found = _judged(make, files, params, base, registry, form, files, settings, workers)
+        rows = half_rows(found)
+        gain = _best_gain(found) / found.problem.n
+        for row in rows:
+            row["delta_bic"] = gain * row["samples"]  # the whole record's, shared by its halves
+        method = ("halves: the weighted RMS error of each half of the one healthy record (cut between its "
+                  "reversals) under the form and calibration fitted on the whole record; the BIC gain per sample "
+                  "of the best candidate there (in-sample: a second healthy record gives the spread of the form's "
+                  "own estimate)")
+        return _threshold(rows, method)
+    method, parts = _parts(files)
+    rows = []
+    for train, judged in parts:
+        say(f"baseline: {judged.label} against the form fitted on {', '.join(f.label for f in train)}")
+        held = form
+        if form is not None:
+            model = sorted([*base, form.model_effect(registry)], key=lambda e: e.name)
+            held = refit_form(form, train, params, model, start, settings)
+        found = _judged(make, [judged], params, base, registry, held, train, settings, workers)
+        n = found.problem.n
+        rows.append({"part": judged.label, "samples": int(n), "over_floor": math.sqrt(found.calibration.rss / n),
+                     "best": found.best.name if found.best is not None else None, "delta_bic": _best_gain(found),
+                     "verdict": found.verdict})
+    return _threshold(rows, method)
+
+
+def learn(make, files, params: Parameters, effects=None, settings: DiagnosisSettings | None = None, *, vehicle=None,
+          progress=None, registry: dict[str, Effect] | None = None, workers: int = 1):
+    """:func:`parksteer.diagnose.baseline.learn_baseline`; `make` is the baseline's class (the parts are judged
+    against baselines of their own)."""
+    from .select import diagnose
+    from .settings import DEFAULT_SETTINGS
+
+    settings = settings or DEFAULT_SETTINGS
+    say = _say(progress)
+    registry = registry if registry is not None else discover_effects()
+    base = effects if isinstance(effects, list) and all(isinstance(e, Effect) for e in effects) \
+        else resolve_effects(effects)
+    fingerprint = vehicle_fingerprint(params)
+    identified = None
+    if power_assist_of(base) is not None:
+        from .baseline_assist import identified_vehicle
+
+        identified = identified_vehicle(files, params, base, vehicle, say)
+        if identified is not None:
+            params = identified_parameters(identified)
+    say(f"baseline: the absolute diagnosis of {len(files)} healthy record(s)")
+    absolute = diagnose(files, params, base, registry, settings=settings, workers=workers, quiet=progress is None)
+    form, fit, problem = held_form(absolute, settings, say)
+    held = set(form.strengths) if form is not None else set()
+    keys = [p.key for p in absolute.calibration.parameters if p.key not in held]
+    labels = ", ".join(f.label for f in files)
+    calibrated = _estimates(fit, problem, settings, keys, f"calibrated on {labels}"
+                            + (f" with {form.effect}" if form is not None else ""))
+    start = {k: v["value"] for k, v in calibrated.items()}
+    threshold = spread(make, files, params, base, registry, form, start, settings, workers, say)
+    say(f"baseline: as the baseline up to {threshold.over_floor:.2f} noise floors and a BIC gain of "
+        f"{threshold.bic_per_sample:.4f} per sample ({threshold.method.split(':')[0]})")
+    return make(None if vehicle is None else str(vehicle), fingerprint, tuple(f.label for f in files),
+                    tuple(e.name for e in base), calibrated, absolute.verdict,
+                    math.sqrt(absolute.calibration.rss / absolute.problem.n), form, threshold, identified)
