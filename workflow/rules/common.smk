@@ -30,6 +30,7 @@ FIGURES = {
     "assist_study": ["figures/assist_study.svg", "figures/assist_study.csv"],
     "diag_assisted": ["figures/diag_assisted.svg", "figures/diag_assisted.csv"],
     "diag_assisted_truth": ["figures/diag_assisted_truth.svg", "figures/diag_assisted_truth.csv"],
+    "diag_baseline": ["figures/diag_baseline.svg", "figures/diag_baseline.csv"],
 }
 
 

@@ -61,13 +61,12 @@ SIDES = ("absolute", "baseline")
 @dataclass(frozen=True)
 class Later:
     """A later record: `what` is ``null``, a hidden library effect or an out-of-class change; its hand (a variation
-    of :data:`~parksteer.synthetic.variations.VARIATIONS`), torque converter bits, size in noise floors, tier."""
+    of :data:`~parksteer.synthetic.variations.VARIATIONS`), torque converter bits, size in noise floors."""
 
     what: str
     hand: str
     bits: int
     floors: float = 0.0
-    tier: str = "rack"
 
     @property
     def kind(self) -> str:
