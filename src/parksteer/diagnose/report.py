@@ -178,6 +178,8 @@ def diagnosis_dict(diagnosis: Diagnosis) -> dict:
         out["assumed"] = diagnosis.outputs["assumed"]
     if diagnosis.outputs.get("baseline") is not None:  # a gain error against an identified table (stages/baseline.py)
         out["baseline"] = diagnosis.outputs["baseline"]
+    if "relative_to" in diagnosis.outputs:  # judged against a car's baseline (parksteer.diagnose.baseline)
+        out["relative_to"] = diagnosis.outputs["relative_to"]
     if "signature" in diagnosis.outputs:  # the residual's signature (stages/signature.py)
         out["signature"] = diagnosis.outputs["signature"].as_dict()
     if "user_effect" in diagnosis.outputs:  # a user's effect with free strengths (stages/user_effect.py)

@@ -74,7 +74,7 @@ __all__ = ["Diagnosis", "diagnose"]
 def diagnose(files: list[FileData], params: Parameters, effects=None, registry: dict[str, Effect] | None = None,
              strengths: dict[str, float] | None = None, start: dict[str, float] | None = None,
              settings: DiagnosisSettings = DEFAULT_SETTINGS, workers: int = 1, quiet: bool = True,
-             stages=STAGES) -> Diagnosis:
+             stages=STAGES, baseline=None) -> Diagnosis:
     """Calibrate, rank every candidate outside the model, refit the best, give the verdict (module docstring).
 
     `settings` are the method's (:mod:`parksteer.diagnose.settings`; by default the documented ones).
@@ -86,11 +86,20 @@ def diagnose(files: list[FileData], params: Parameters, effects=None, registry: 
     result is the same); unless `quiet`, each step says on stderr where it is. `stages` is the table run
     (:data:`parksteer.diagnose.stages.STAGES`).
 
+    `baseline` (a :class:`parksteer.diagnose.baseline.Baseline`): the records are judged against the car's healthy
+    ones (:mod:`parksteer.diagnose.baseline`): the model with the baseline's form, its strengths held, the calibration
+    from the baseline's values, the thresholds of "as the baseline"; the result's ``outputs["relative_to"]`` names it.
+
     Nothing passed in is changed: the files are copied (whether each fits its angle: where it has one beside a
     measured rack, if the settings ask), and what the stages derive for them goes into further copies.
     """
     base = effects if isinstance(effects, list) and all(isinstance(e, Effect) for e in effects) \
         else resolve_effects(effects)
+    held = None
+    if baseline is not None:
+        baseline.check_vehicle(params)
+        params, base = baseline.parameters(params), baseline.model(base, registry)
+        start, held = {**baseline.start, **(start or {})}, baseline.held
     # An assisted car's record: its motor channel fitted beside the torsion-bar torque (settings.use_motor_channel);
     # its handwheel angle is not replayed (parksteer.diagnose.replay).
     assisted = power_assist_of(base) is not None
@@ -103,6 +112,8 @@ def diagnose(files: list[FileData], params: Parameters, effects=None, registry: 
                       uses_motor=assisted and settings.use_motor_channel and f.motor is not None,
                       replay_uncertainty_motor=None, replay_draws_motor=None) for f in files]
     problem = Problem(copies, params, angle_offset_fitted=settings.angle_offset_fitted)
+    if baseline is not None:
+        settings = baseline.threshold.settings_for(settings, problem.n)
     progress = Progress(quiet)
     registry = registry if registry is not None else discover_effects()
     # an effect loaded from a file (the model's, or a candidate named in the environment) replays in the workers
@@ -111,7 +122,10 @@ def diagnose(files: list[FileData], params: Parameters, effects=None, registry: 
     state = DiagnosisState(settings, problem, tuple(base), frozen_mapping(registry),
                            None if strengths is None else frozen_mapping(strengths),
                            None if start is None else frozen_mapping(start), progress,
-                           with_user_effect_stage(tuple(stages), base))
+                           tuple(stages) if baseline is not None else with_user_effect_stage(tuple(stages), base),
+                           held=None if held is None else frozen_mapping(held))
+    if baseline is not None:
+        state = state.with_output("relative_to", baseline.relative_to())
     testable, _ = candidate_effects(base, registry)
     # The models the candidates replay in are built in the background while the base model's stages run (the base
     # model itself is built, if missing, when first replayed).

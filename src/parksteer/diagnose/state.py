@@ -85,7 +85,8 @@ class DiagnosisState:
     Inputs: `settings` (the one owner of the method's settings), `problem` (the caller's files, copied, with
     what the stages derived for them: replay uncertainty, torque lag, whether the angle is fitted), the model's
     `base` effects, the candidate `registry`, the calibrated `strengths` and `start` values, `progress` (prints
-    a line unless quiet) and `table` (the stages this state runs through).
+    a line unless quiet), `table` (the stages this state runs through) and the strengths `held` at a baseline's
+    values (:mod:`parksteer.diagnose.baseline`).
 
     Found: one field per built-in stage; `outputs` holds what a stage added later keeps (by its name, read by
     the report's section for it), so that a new stage needs no field here.
@@ -99,6 +100,7 @@ class DiagnosisState:
     start: Mapping[str, float] | None = None
     progress: Callable[[str], None] = field(default=lambda message: None, repr=False)
     table: tuple = ()
+    held: Mapping[str, float] | None = None  # strengths held at a baseline's values, never fitted
     nominal: tuple[np.ndarray, ...] | None = None
     calibration: Fit | None = None
     candidates: tuple[Candidate, ...] = ()

@@ -13,8 +13,9 @@ from .base import Stage
 
 
 def calibrated(state: DiagnosisState, engine: ReplayEngine, problem: Problem, announce=None) -> Fit:
-    """The base model calibrated on `problem` with the state's strengths, start values and settings."""
-    return calibrate(engine, problem, list(state.base),
+    """The base model calibrated on `problem` with the state's strengths, start values and settings (the strengths
+    held at a baseline's values kept)."""
+    return calibrate(engine, problem, list(state.base), fixed=None if state.held is None else dict(state.held),
                      strengths=None if state.strengths is None else dict(state.strengths),
                      start=None if state.start is None else dict(state.start), settings=state.settings,
                      announce=announce)
