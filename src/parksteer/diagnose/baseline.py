@@ -8,10 +8,13 @@ something the model lacks. The question its owner asks after a repair or a thous
 - what the healthy car has that the model lacks (:class:`HeldForm`): the absolute diagnosis's verdict and, where it
   is not ``adequate``, the car's own form: the named library candidate at its fitted strength, or the form the
   residual's signature points to (:func:`parksteer.diagnose.suggest.suggest`) with its fitted strengths;
-- how far apart healthy data are (:class:`Threshold`): each healthy record is judged against the form fitted on the
-  others (leave one out); with one record, each half of it (split between its reversals) against the form fitted on
-  the other half. The largest weighted RMS error (in noise floors) a left-out part leaves with the form held, and
-  the largest BIC gain per sample any candidate finds in one, are what "as the baseline" allows a later record.
+- how far apart healthy data are (:class:`Threshold`): each healthy record is judged against the form fitted again
+  on the others (leave one out), with the sensor's thresholds; with one record, each half of it (cut between its
+  reversals) under the form and calibration fitted on the whole record (a half replayed alone would start
+  mid-stroke from rest, a start the car never had, so its error is read off the whole record's fit: in-sample, and
+  said so). Of each part, the weighted RMS error in noise floors with the form held and the best candidate's BIC
+  gain per sample; what "as the baseline" allows is the one-sided 95 % prediction bound for one more healthy part
+  (Student's t over the parts: two parts fix it poorly, and the bound is wide; more healthy records tighten it).
 
 A later record is then diagnosed (``diagnose(..., baseline=...)``, :mod:`parksteer.diagnose.select`) on the model
 with the form's strengths HELD at the baseline's values (a change cannot be absorbed by fitting the quirk again),
@@ -82,9 +85,9 @@ class HeldForm:
 
 @dataclass(frozen=True)
 class Threshold:
-    """What "as the baseline" allows: `over_floor`, the largest weighted RMS error in noise floors a healthy part
-    left with the form held; `bic_per_sample`, the largest BIC gain per sample a candidate found in one; `method`
-    says how the parts were made; `parts` lists each."""
+    """What "as the baseline" allows: `over_floor`, the weighted RMS error in noise floors, and `bic_per_sample`, the
+    best candidate's BIC gain per sample, that one more healthy part stays under (95 % prediction bounds over the
+    healthy parts with the form held); `method` says how the parts were made; `parts` lists each."""
 
     over_floor: float
     bic_per_sample: float
@@ -160,7 +163,10 @@ class Baseline:
             from .baseline_file import identified_parameters
 
             params = identified_parameters(self.identified_vehicle)
-        return params if self.form is None else params.with_overrides(self.form.values)
+        if self.form is None:
+            return params
+        self.form.model_effect()  # a signature's form registers its quantities
+        return params.with_overrides(self.form.values)
 
     def model(self, effects, registry: dict[str, Effect] | None = None) -> list[Effect]:
         """The model's `effects` with the held form added."""

@@ -8,13 +8,14 @@ import dataclasses
 import math
 
 import numpy as np
+from scipy.special import stdtrit  # the t quantile, without importing scipy.stats
 
 from ..model.symbolic.components import Effect, discover_effects, power_assist_of, resolve_effects
 from ..parameters import Parameters
 from .baseline import Baseline, HeldForm, Threshold, vehicle_fingerprint
 from .calibrate import Fit, calibrate
 from .engine import ReplayEngine
-from .problem import FileData, Problem, prepare_file
+from .problem import FileData, Problem
 from .settings import DiagnosisSettings
 
 HALVES = ("first half", "second half")
@@ -25,10 +26,24 @@ def _say(progress):
 
 
 def _estimates(fit: Fit, problem: Problem, settings: DiagnosisSettings, keys, source: str) -> dict:
-    intervals = fit.intervals(problem, settings.interval_block_s)
+    """Value, 95 % interval and standard error of `keys` of `fit` (:meth:`Fit.intervals`), its sandwich's blocks
+    short enough that there are twice as many as the fit's parameters (a form of 15 strengths on an 18 s record
+    needs them under 0.6 s). Where the joint intervals are not finite (a form's strengths summing to a uniform
+    friction trade with the calibrated rack friction: J^T J is singular), each is the interval with the fit's other
+    parameters held at their values, and its source says so."""
+    duration = sum(float(f.time_s[-1] - f.time_s[0]) for f in problem.files)
+    block_s = min(settings.interval_block_s, duration / (2 * len(fit.parameters) + 2))
+    intervals = fit.intervals(problem, block_s)
+    chosen = [k for k in keys if k in intervals]
+    if not all(math.isfinite(intervals[k]["standard_error"]) for k in chosen):
+        index = [i for i, p in enumerate(fit.parameters) if p.key in chosen]
+        alone = dataclasses.replace(fit, parameters=[fit.parameters[i] for i in index], theta=fit.theta[index],
+                                    jacobian=fit.jacobian[:, index])
+        intervals = {**intervals, **alone.intervals(problem, block_s)}
+        source += "; interval with the fit's other parameters held (jointly these data do not fix them apart)"
     return {k: {"value": float(intervals[k]["value"]), "ci95": [float(c) for c in intervals[k]["ci95"]],
                 "standard_error": float(intervals[k]["standard_error"]), "source": source}
-            for k in keys if k in intervals}
+            for k in chosen}
 
 
 def held_form(diagnosis, settings: DiagnosisSettings, say) -> tuple[HeldForm | None, Fit, Problem]:
@@ -62,31 +77,24 @@ def held_form(diagnosis, settings: DiagnosisSettings, say) -> tuple[HeldForm | N
     return form, found.fit, problem
 
 
-def halves(f: FileData) -> tuple[FileData, FileData]:
-    """One record cut in two between its first and last reversal (each half keeps a reversal to calibrate the
-    friction on), each prepared as a record of its own."""
-    from ..measure.io import Measurement
+def _parts(files) -> tuple[str, list[tuple[list[FileData], FileData]]]:
+    """(method, [(the records the form is fitted on again, the record judged against it)]), for two or more."""
+    return ("leave one out: each healthy record judged against the form fitted again on the others",
+            [([g for j, g in enumerate(files) if j != i], f) for i, f in enumerate(files)])
 
-    t = f.time_s
-    reversals = np.asarray(f.phases.reversal_times_s, dtype=float)
+
+def half_rows(found) -> list[dict]:
+    """One record's two halves (cut between its first and last reversal), each one's weighted RMS error in noise
+    floors under the calibration and form fitted on the whole record. A half is not replayed alone: the replay
+    starts from rest at its first sample, and a half that starts mid-stroke would carry a start the car never had."""
+    f, prediction = found.problem.files[0], found.calibration.predictions[0]
+    weighted = (f.torque_Nm - f.torque_part(prediction)) / f.sigma_Nm
+    t, reversals = f.time_s, np.asarray(f.phases.reversal_times_s, dtype=float)
     cut = 0.5 * (reversals[0] + reversals[-1]) if reversals.size >= 2 else 0.5 * (t[0] + t[-1])
     i = int(np.searchsorted(t, cut))
-    out = []
-    for name, part in zip(HALVES, (slice(0, i), slice(i, None))):
-        columns = {k: np.asarray(v)[part] for k, v in f.measurement.columns.items()}
-        measurement = Measurement(f.measurement.path, columns, dict(f.measurement.metadata))
-        out.append(prepare_file(measurement, f.case, label=f"{f.label} ({name})"))
-    return out[0], out[1]
-
-
-def _parts(files) -> tuple[str, list[tuple[list[FileData], FileData]]]:
-    """(method, [(the records a form is fitted on, the part judged against it)])."""
-    if len(files) >= 2:
-        return ("leave one out: each healthy record judged against the form fitted on the others",
-                [([g for j, g in enumerate(files) if j != i], f) for i, f in enumerate(files)])
-    first, second = halves(files[0])
-    return ("halves: each half of the one healthy record (cut between its reversals) judged against the form "
-            "fitted on the other half", [([second], first), ([first], second)])
+    return [{"part": f"{f.label} ({name})", "samples": int(part.size),
+             "over_floor": float(np.sqrt(np.mean(part**2))), "verdict": found.verdict}
+            for name, part in zip(HALVES, (weighted[:i], weighted[i:]))]
 
 
 def refit_form(form: HeldForm, train, params: Parameters, model: list[Effect], start: dict,
@@ -103,33 +111,68 @@ def refit_form(form: HeldForm, train, params: Parameters, model: list[Effect], s
                                                 for k, v in form.strengths.items()})
 
 
+def _judged(judged, params, base, registry, form, train, settings, workers):
+    """The relative diagnosis of the records `judged` against `form` (held) with a threshold of the sensor's."""
+    from .select import diagnose
+
+    part = Baseline(None, vehicle_fingerprint(params), tuple(f.label for f in train), tuple(e.name for e in base),
+                    {}, "", math.nan, form, Threshold(0.0, 0.0, "the sensor's floor"))
+    return diagnose(list(judged), params, base, registry, settings=settings, workers=workers, quiet=True,
+                    baseline=part)
+
+
+def prediction_bound(values) -> float:
+    """The one-sided 95 % prediction bound for one more draw of what `values` are draws of: mean + t(0.95, k-1)
+    s sqrt(1 + 1/k) (Student's t, k values, s their standard deviation). Two healthy parts fix the spread poorly,
+    and the bound says so (t = 6.31 with one degree of freedom); more healthy records tighten it."""
+    values = np.asarray(values, dtype=float)
+    k = values.size
+    if k < 2:
+        return float(values.max())
+    return float(values.mean() + stdtrit(k - 1, 0.95) * values.std(ddof=1) * math.sqrt(1.0 + 1.0 / k))
+
+
+def _threshold(rows: list[dict], method: str) -> Threshold:
+    over = prediction_bound([r["over_floor"] for r in rows])
+    gain = prediction_bound([r["delta_bic"] / r["samples"] for r in rows])
+    return Threshold(over, max(gain, 0.0), method + "; the threshold is the one-sided 95 % prediction bound for "
+                     "one more healthy part (Student's t over the parts)", tuple(rows))
+
+
+def _best_gain(found) -> float:
+    return max([0.0, *(c.delta_bic for c in found.candidates if c.delta_bic is not None)])
+
+
 def spread(files, params: Parameters, base: list[Effect], registry, form: HeldForm | None, start: dict,
            settings: DiagnosisSettings, workers: int, say) -> Threshold:
     """The threshold of "as the baseline" from the healthy parts (module docstring of
     :mod:`parksteer.diagnose.baseline`)."""
-    from .select import diagnose
-
+    if len(files) == 1:
+        say(f"baseline: the halves of {files[0].label} against the form and calibration of the whole record")
+        found = _judged(files, params, base, registry, form, files, settings, workers)
+        rows = half_rows(found)
+        gain = _best_gain(found) / found.problem.n
+        for row in rows:
+            row["delta_bic"] = gain * row["samples"]  # the whole record's, shared by its halves
+        method = ("halves: the weighted RMS error of each half of the one healthy record (cut between its "
+                  "reversals) under the form and calibration fitted on the whole record; the BIC gain per sample "
+                  "of the best candidate there (in-sample: a second healthy record gives the spread of the form's "
+                  "own estimate)")
+        return _threshold(rows, method)
     method, parts = _parts(files)
     rows = []
-    open_threshold = Threshold(0.0, 0.0, "none")
     for train, judged in parts:
         say(f"baseline: {judged.label} against the form fitted on {', '.join(f.label for f in train)}")
-        held = None
+        held = form
         if form is not None:
             model = sorted([*base, form.model_effect(registry)], key=lambda e: e.name)
             held = refit_form(form, train, params, model, start, settings)
-        part = Baseline(None, vehicle_fingerprint(params), tuple(f.label for f in train), tuple(e.name for e in base), {}, "",
-                        math.nan, held, open_threshold)
-        found = diagnose([judged], params, base, registry, settings=settings, workers=workers, quiet=True,
-                         baseline=part)
+        found = _judged([judged], params, base, registry, held, train, settings, workers)
         n = found.problem.n
-        gains = [c.delta_bic for c in found.candidates if c.delta_bic is not None]
-        best_gain = max([0.0, *gains])
         rows.append({"part": judged.label, "samples": int(n), "over_floor": math.sqrt(found.calibration.rss / n),
-                     "best": found.best.name if found.best is not None else None, "delta_bic": float(best_gain),
+                     "best": found.best.name if found.best is not None else None, "delta_bic": _best_gain(found),
                      "verdict": found.verdict})
-    return Threshold(max(r["over_floor"] for r in rows), max(r["delta_bic"] / r["samples"] for r in rows),
-                     method, tuple(rows))
+    return _threshold(rows, method)
 
 
 def learn(files, params: Parameters, effects=None, settings: DiagnosisSettings | None = None, *, vehicle=None,

@@ -183,6 +183,33 @@ def _assumed_lines(assumed: dict) -> list[str]:
     return lines
 
 
+def relative_lines(result: dict) -> list[str]:
+    """The records against a car's baseline (``relative_to``): what the verdict means there, in one paragraph (no
+    lines without a baseline)."""
+    rel = result.get("relative_to")
+    if not rel:
+        return []
+    name = rel["baseline"] or "learnt from " + ", ".join(rel["records"])
+    t = rel["threshold"]
+    held = (f"with {rel['form']} held at the baseline's strengths" if rel["form"] else
+            "the healthy records were adequate")
+    verdict = result["verdict"]
+    if verdict == "adequate":
+        said = "As the baseline: nothing changed beyond what healthy records of this car differ by."
+    elif verdict == "missing":
+        best = next((r for r in result["ranking"] if r["effect"] == result["effect"]), {})
+        strength = (best.get("parameters") or {}).get(best.get("strength_parameter"), {})
+        ci = strength.get("ci95")
+        unit = _value_unit(result, best.get("strength_parameter", ""))
+        said = (f"Changed: {result['effect']}" + (f", {num(strength['value'])}{unit}" if "value" in strength else "")
+                + (f" (95 %: {num(ci[0])} to {num(ci[1])}{unit})" if ci else "") + ".")
+    else:
+        said = "Changed, outside the library: see the residual's signature below."
+    return [f"**Relative to baseline {name}** (content hash {rel['content_hash']}; {held}). {said} "
+            f"\"As the baseline\" allows up to {num(t['over_floor'])} noise floors and a BIC gain of "
+            f"{num(t['bic_per_sample'])} per sample, from {t['method']}.", ""]
+
+
 def markdown_report(result: dict, figure: str | None = None, user_figure: str | None = None) -> str:
     """A readable report of the JSON of a diagnosis (`figure`: the diagnosis's figure to link; `user_figure`: that of
     a user's effect in the model)."""
@@ -202,7 +229,7 @@ def markdown_report(result: dict, figure: str | None = None, user_figure: str | 
                      f"{num(stats['calibrated']['weighted_rms_Nm'])} N m against a noise floor of {num(floor)} N m) "
                      "that no candidate removes for the most part. Something outside the candidate library is at "
                      "work (or in the measurement): look at the residual below." + _nearest(result))
-    lines += ["", "## Files", "", "| file | case | surface | samples | noise floor (N m) | replay uncertainty RMS (N m) "
+    lines += ["", *relative_lines(result), "## Files", "", "| file | case | surface | samples | noise floor (N m) | replay uncertainty RMS (N m) "
               "| rack knot spacing (s) |", "|---|---|---|---|---|---|---|"]
     for f in result["files"]:
         lines.append(f"| {f['file']} | {f['case']} | {f['surface']} | {f['samples']} | "
@@ -351,6 +378,7 @@ def html_report(result: dict, figures: list[tuple[str, str]], phases: list[dict]
     out = ["<!DOCTYPE html>", '<html lang="en">', "<head>", '<meta charset="utf-8">',
            f"<title>{html.escape(title)}</title>", f"<style>{_STYLE}</style>", "</head>", "<body>",
            f"<h1>{html.escape(title)}</h1>", f'<p class="verdict">{html.escape(text)}</p>',
+           *(f"<p>{html.escape(line.replace('**', ''))}</p>" for line in relative_lines(result) if line),
            f"<p>Model: {html.escape(', '.join(result['model']['effects']))}.</p>", "<h2>Files</h2>"]
     out += html_table(["file", "case", "surface", "samples", "noise floor (N m)"],
                   [[f["file"], f["case"], f["surface"], f["samples"], num(f["noise_floor"]["total_rms"])]
