@@ -405,6 +405,12 @@ def run_car(params: Parameters, car: Car, vehicle_path=None, progress=None) -> d
                "learn_wall_s": learnt, "rows": []}
         if car.kind == "assisted":
             out["back_efficiency"] = maker.gear.back_efficiency
+        if baseline is not None:
+            named = baseline.relative_to
+            named = named() if callable(named) else named
+            out["learnt"] = {"verdict": named["verdict"], "form": named["form"],
+                             "threshold_over_floor": named["threshold"]["over_floor"],
+                             "threshold_method": named["threshold"]["method"], "records": 1 + len(more)}
         for index, later in enumerate(car.later, start=1):
             truth, record = maker.later(later, index)
             path = folder / f"{later.name}.csv"
@@ -458,7 +464,7 @@ def summarise(cars: list[dict]) -> dict:
         out["cars"][c["car"]] = {"kind": c["kind"], "quirk": c["quirk"], "tier": c["tier"],
                                  "quirk_floors": c["quirk_floors"], "healthy": c["healthy"],
                                  "back_efficiency": c.get("back_efficiency"),
-                                 "baseline_method": c["baseline_method"],
+                                 "baseline_method": c["baseline_method"], "learnt": c.get("learnt"),
                                  **{side: score(c["rows"], side) for side in SIDES}}
     out["all"] = {side: score(rows, side) for side in SIDES}
     out["baseline_method"] = "run" if all(c["baseline_method"] == "run" for c in cars) else "not run"

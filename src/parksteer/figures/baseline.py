@@ -36,7 +36,8 @@ def _label(said: dict | None) -> str:
 def baseline_figure(cars: list[dict], path: str | Path) -> None:
     """Left: one line per later record (grouped by car: its quirk), its answer absolutely and against the healthy
     record, each cell green where right, red where wrong, grey where not run. Right: each record's calibrated
-    weighted error in noise floors on both sides."""
+    weighted error in noise floors on both sides, against the absolute adequate threshold and each car's threshold
+    of "as the baseline" (the larger of it and the absolute one, as the diagnosis applies it)."""
     from ..diagnose.settings import DEFAULT_SETTINGS
 
     rows = [r for c in cars for r in c["rows"]]
@@ -61,7 +62,16 @@ def baseline_figure(cars: list[dict], path: str | Path) -> None:
             ax.plot([v for _, v in values], [i for i, _ in values], marker, color=COLOURS[j], markersize=4,
                     linestyle="none", label=SIDE_LABELS[side].replace("\n", " "))
     adequate = DEFAULT_SETTINGS.adequate_rms_factor
-    ax.axvline(adequate, color="black", linestyle="--", linewidth=1.0, label=f"adequate_rms_factor {adequate:g}")
+    ax.axvline(adequate, color="black", linestyle="--", linewidth=1.0, label=f"adequate, absolute ({adequate:g})")
+    first = True
+    for c in cars:  # "as the baseline": the car's own threshold, from the spread of its healthy data
+        learnt = c.get("learnt")
+        places = [i for i, r in enumerate(rows) if r["car"] == c["car"]]
+        if learnt is None or not places:
+            continue
+        ax.plot([max(adequate, learnt["threshold_over_floor"])] * 2, [min(places) - 0.4, max(places) + 0.4],
+                color=COLOURS[1], linestyle=":", linewidth=1.2, label="as the baseline, the car's" if first else None)
+        first = False
     ax.set_ylim(len(rows) - 0.5, -0.5)
     ax.set_yticks(np.arange(len(rows)), [""] * len(rows))
     ax.set_xscale("log")
@@ -70,7 +80,7 @@ def baseline_figure(cars: list[dict], path: str | Path) -> None:
     ax.set_xticks(ticks, [f"{t:g}" for t in ticks])
     ax.set_xticks([], minor=True)
     ax.set_xlabel("calibrated weighted RMS error / noise floor", fontsize=8)
-    ax.legend(fontsize=6, loc="lower right")
+    ax.legend(fontsize=6, loc="upper center", bbox_to_anchor=(0.5, -0.32), ncol=2)
     fig.tight_layout()
     save_svg(fig, path)
 
