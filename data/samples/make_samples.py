@@ -16,9 +16,10 @@ be tried on a fresh clone before any pipeline has run.
   its base parameters moved off the file's as the benchmarks move them, driven by another hand and logged by a
   50 Hz logger with its quantisation and noise (the variation benchmark's ``rate_8pc_50Hz``): the record of the
   README's loop, where the diagnosis is ``unexplained`` until the user's effect is added.
-- ``polo_baseline.csv`` and ``polo_drag.csv``: the same Polo's kerb cycle as its bus logs it (torsion-bar torque,
-  motor current, rack), its gear as built (torque constant 0.055 N m/A, motor friction 0.03 N m) rather than as the
-  file's data say; then later with a motor that drags (0.09 N m): the baseline-then-diagnose example of
+- ``polo_baseline.csv``, ``polo_drag.csv`` and ``polo_repaired.csv``: the same Polo's kerb cycle as its bus logs it
+  (torsion-bar torque, motor current, rack), its gear as built (torque constant 0.055 N m/A, motor friction
+  0.03 N m) rather than as the file's data say; then later with a motor that drags (0.09 N m); then after its
+  repair (0.03 N m again, another hand): the baseline-then-diagnose example of README.md and
   docs/assist_identify.md.
 
 Made again, byte for byte, by ``python data/samples/make_samples.py`` (a script beside them, not part of the package:
@@ -188,13 +189,14 @@ def write_worn_rack(folder: Path) -> list[Path]:
 # The Polo of the baseline-then-diagnose example (docs/assist_identify.md): its gear as built, not as the vehicle
 # file's data say (torque constant and motor friction), and later with a motor that drags.
 POLO_AS_BUILT = {"electric_assist_column.torque_constant": 0.055}
-POLO_MOTOR_FRICTION = {"polo_baseline.csv": 0.03, "polo_drag.csv": 0.09}
+POLO_MOTOR_FRICTION = {"polo_baseline.csv": 0.03, "polo_drag.csv": 0.09, "polo_repaired.csv": 0.03}
 
 
 def write_polo_records(folder: Path) -> list[Path]:
-    """Two records of the assisted Polo as its bus logs them (torsion-bar torque in 0.01 N m, motor current in 0.1 A
-    steps): a baseline, and a later one with a motor that drags; a hand of the variation benchmark, the assisted
-    replay of its rack (parksteer.synthetic.assisted, as the example record of docs/assist.md)."""
+    """Three records of the assisted Polo as its bus logs them (torsion-bar torque in 0.01 N m, motor current in 0.1 A
+    steps): a baseline, a later one with a motor that drags, and one after the motor's repair (its friction as at
+    the baseline, another hand); a hand of the variation benchmark, the assisted replay of its rack
+    (parksteer.synthetic.assisted, as the example record of docs/assist.md)."""
     from parksteer.measure.io import write_measurement
     from parksteer.model.symbolic.components import discover_effects
     from parksteer.synthetic.assisted import AssistedLogger, assisted_clean, assisted_record

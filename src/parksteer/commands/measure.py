@@ -12,6 +12,7 @@ from ..errors import UsageError
 from ..parameters import DEFAULT_PATH
 from ..progress import note
 from . import add_quiet_option
+from .baseline import add_baseline_options, baseline_of, register_baseline
 from .vehicle import add_vehicle_option, parameters_of
 
 
@@ -397,93 +398,3 @@ def _write_html(path: str, diagnosis, result: dict, files, params, workers: int 
                    for name, caption in captions.items()]
     write_markdown(path, html_report(result, figures, phases, ladder.as_dict()))
 
-
-# ``parksteer baseline`` and ``diagnose --baseline``: a car's healthy records, and later records judged against them
-# (parksteer.diagnose.baseline).
-
-def add_baseline_options(p) -> None:
-    p.add_argument("--baseline", action="append", default=None, metavar="BASE",
-                   help="judge the records against the car's baseline: a file `parksteer baseline` wrote (.toml), or "
-                        "the healthy records themselves (repeat --baseline for each; learnt in memory first, with "
-                        "the same record options)")
-
-
-def register_baseline(sub) -> None:
-    p = sub.add_parser("baseline", help="learn what a car's healthy records fix (calibrated values, what the model "
-                                        "lacks, the spread of healthy data) and write it for diagnose --baseline")
-    _common(p, outputs=False)
-    p.add_argument("--out", required=True, metavar="CAR_baseline.toml", help="the baseline file to write (TOML)")
-    p.add_argument("--force", action="store_true", help="overwrite an existing --out")
-    p.add_argument("--jobs", type=int, default=None, metavar="N",
-                   help="replays run side by side on N processes (default: the CPUs available; same result)")
-    add_quiet_option(p)
-    p.set_defaults(func=_baseline)
-
-
-def _learnt(args, paths, params, effects, settings, workers: int):
-    """The baseline learnt from the records `paths` (loaded with the command's record options)."""
-    from ..diagnose.baseline import learn_baseline
-    from ..diagnose.problem import load_files
-
-    files = load_files(paths, params, args.case, args.surface, channel_map_of(args), assist_of_effects(effects))
-    params, effects = with_record_speed(params, effects, files)
-    for f in files:
-        if len(f.phases.reversal_times_s) == 0:
-            raise UsageError(f"{f.measurement.path}: column 'rack_m': the rack never reverses, so the record holds "
-                             "no reversal to calibrate the friction on; a baseline needs a cycle that turns back")
-    return learn_baseline(files, params, effects, settings, vehicle=args.vehicle,
-                          progress=None if args.quiet else note, workers=workers)
-
-
-def baseline_of(args, params, effects, settings, workers: int):
-    """The baseline of --baseline: read from its file, or learnt from the healthy records given (None without)."""
-    if not getattr(args, "baseline", None):
-        return None
-    from ..diagnose.baseline import Baseline
-
-    given = args.baseline
-    if len(given) == 1 and given[0].endswith(".toml"):
-        baseline = Baseline.read(given[0])
-        baseline.check_vehicle(params)
-        return baseline
-    if any(b.endswith(".toml") for b in given):
-        raise UsageError(f"--baseline {' '.join(given)}: give one baseline file (.toml) or the healthy records, "
-                         "not both")
-    return _learnt(args, given, params, effects, settings, workers)
-
-
-def _baseline(args) -> int:
-    from ..diagnose.parallel import available_workers
-    from ..diagnose.settings import DEFAULT_SETTINGS
-
-    out = Path(args.out)
-    if out.is_dir():
-        raise UsageError(f"--out {args.out}: is a directory; name a file to write")
-    if out.exists() and not args.force:
-        raise UsageError(f"--out {args.out}: exists (--force to overwrite)")
-    if not out.resolve().parent.is_dir():
-        raise UsageError(f"--out {args.out}: folder {out.resolve().parent} does not exist")
-    _check_writable("out", args.out, out.resolve().parent)
-    if args.jobs is not None and args.jobs < 1:
-        raise UsageError(f"--jobs {args.jobs}: give at least 1")
-    workers = args.jobs if args.jobs is not None else available_workers()
-    params = parameters_of(args)
-    effects = effects_of(args, params)
-    baseline = _learnt(args, args.files, params, effects, DEFAULT_SETTINGS, workers).write(out)
-    print("\n".join(baseline_lines(baseline)))
-    return 0
-
-
-def baseline_lines(baseline) -> list[str]:
-    """What a baseline says, in a few lines."""
-    lines = [f"baseline of {', '.join(baseline.records)}: absolute verdict {baseline.verdict} "
-             f"({baseline.over_floor:.2f} noise floors)"]
-    if baseline.form is not None:
-        form = baseline.form
-        lines.append(f"held in later records: {form.effect} ({form.source}, {len(form.strengths)} strength(s))"
-                     + (f": {form.signature}" if form.signature else ""))
-    t = baseline.threshold
-    lines.append(f"as the baseline: up to {t.over_floor:.2f} noise floors, a BIC gain up to {t.bic_per_sample:.4f} "
-                 f"per sample ({t.method})")
-    lines.append(f"wrote {baseline.path} (content hash {baseline.content_hash})")
-    return lines

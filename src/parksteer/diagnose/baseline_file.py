@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import hashlib
 import math
+import re
 import tempfile
 import tomllib
 from pathlib import Path
@@ -23,6 +24,11 @@ def _string(text: str) -> str:
     return '"' + str(text).replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n") + '"'
 
 
+def _key(name: str) -> str:
+    """A bare key where TOML allows one, else quoted (a dotted parameter key stays one key)."""
+    return name if re.fullmatch(r"[A-Za-z0-9_-]+", name) else _string(name)
+
+
 def _value(x) -> str:
     if isinstance(x, bool):
         return "true" if x else "false"
@@ -35,13 +41,13 @@ def _value(x) -> str:
     if isinstance(x, (list, tuple)):
         return "[" + ", ".join(_value(v) for v in x) + "]"
     if isinstance(x, dict):
-        return "{ " + ", ".join(f"{_string(k)} = {_value(v)}" for k, v in x.items() if v is not None) + " }"
+        return "{ " + ", ".join(f"{_key(k)} = {_value(v)}" for k, v in x.items() if v is not None) + " }"
     return _value(float(x))
 
 
 def _table(name: str, entries: dict) -> list[str]:
     lines = [f"[{name}]"]
-    lines += [f"{_string(k)} = {_value(v)}" for k, v in entries.items() if v is not None]
+    lines += [f"{_key(k)} = {_value(v)}" for k, v in entries.items() if v is not None]
     return lines + [""]
 
 
@@ -64,11 +70,15 @@ def baseline_text(baseline) -> str:
     lines += _table("threshold", {"over_floor": float(t.over_floor), "bic_per_sample": float(t.bic_per_sample),
                                   "method": t.method})
     for part in t.parts:
-        lines += ["[[threshold.parts]]"] + [f"{_string(k)} = {_value(v)}" for k, v in part.items()
+        lines += ["[[threshold.parts]]"] + [f"{_key(k)} = {_value(v)}" for k, v in part.items()
                                             if v is not None] + [""]
     if baseline.identified_vehicle is not None:
+        text = baseline.identified_vehicle
+        # as it reads, where a literal multi-line string can hold it (TOML drops the newline after the quotes)
+        literal = "'''" not in text and "\r" not in text and not text.endswith("'")
+        quoted = "'''\n" + text + "'''" if literal else _string(text)
         lines += ["[identified]", "# the vehicle file as parksteer assist identify writes it from the records above",
-                  f"vehicle = {_string(baseline.identified_vehicle)}", ""]
+                  f"vehicle = {quoted}", ""]
     return "\n".join(lines)
 
 
