@@ -181,20 +181,25 @@ def test_command_line_baseline_then_diagnose(car, tmp_path, capsys):
     assert out.read_text(encoding="utf-8") == text
 
 
-def test_a_baseline_of_another_car_is_refused(car, tmp_path, capsys):
-    """The baseline is of the car of the packaged parameter file; a record diagnosed as a car whose rack friction
-    differs (a parameter file with that one value changed) is refused against it in one line naming the baseline
-    file and its vehicle key, exit 2."""
-    other = tmp_path / "other_car.toml"
-    text = DEFAULT_PATH.read_text(encoding="utf-8")
-    assert 'rack_friction_force = { value = 730.0,' in text
-    other.write_text(text.replace('rack_friction_force = { value = 730.0,', 'rack_friction_force = { value = 800.0,'),
-                     encoding="utf-8")
-    assert main(["diagnose", str(car["paths"]["column"]), "--baseline", car["written"].path, "--parameters",
-                 str(other), "--json", "--quiet"]) == 2
+@pytest.mark.parametrize("other", ["car", "model"])
+def test_a_baseline_of_another_car_or_model_is_refused(car, tmp_path, capsys, other):
+    """The baseline is of the car of the packaged parameter file, with the default effects. A record diagnosed as a
+    car whose rack friction differs (a parameter file with that one value changed), or with a column friction in
+    the model, is refused against it in one line naming the baseline file and the key, exit 2."""
+    options = ["--effects=+column_friction"]
+    if other == "car":
+        path = tmp_path / "other_car.toml"
+        text = DEFAULT_PATH.read_text(encoding="utf-8")
+        assert 'rack_friction_force = { value = 730.0,' in text
+        path.write_text(text.replace('rack_friction_force = { value = 730.0,',
+                                     'rack_friction_force = { value = 800.0,'), encoding="utf-8")
+        options = ["--parameters", str(path)]
+    assert main(["diagnose", str(car["paths"]["column"]), "--baseline", car["written"].path, *options, "--json",
+                 "--quiet"]) == 2
     captured = capsys.readouterr()
     err = captured.err.strip().splitlines()
-    assert len(err) == 1 and "car_baseline.toml" in err[0] and "vehicle" in err[0] and captured.out == ""
+    key = "vehicle.fingerprint" if other == "car" else "records.model"
+    assert len(err) == 1 and "car_baseline.toml" in err[0] and key in err[0] and captured.out == ""
 
 
 @pytest.mark.parametrize("damage", ["garbage", "missing_key"])

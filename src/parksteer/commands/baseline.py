@@ -3,11 +3,35 @@ against them (parksteer.diagnose.baseline). The record options are ``diagnose``'
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 
 from ..errors import UsageError
 from ..progress import note
 from . import add_quiet_option
+
+
+@dataclass(frozen=True)
+class RecordOptions:
+    """What ``diagnose`` (:mod:`.measure`) lends these commands, so that they read records exactly as it does (it
+    passes them in: this module does not import it back): `add(parser, outputs=False)`, the record options;
+    `effects(args, params)`, the model's effects; `check_writable(option, value, folder)`; `channel_map(args)`,
+    `assist_of(effects)` and `with_speed(params, effects, files)`, how the records are read and at what speed."""
+
+    add: Callable
+    effects: Callable
+    check_writable: Callable
+    channel_map: Callable
+    assist_of: Callable
+    with_speed: Callable
+
+    def load(self, args, paths, params, effects):
+        """(files, params, effects): the records `paths` read with the command's record options, at their speed."""
+        from ..diagnose.problem import load_files
+
+        files = load_files(paths, params, args.case, args.surface, self.channel_map(args), self.assist_of(effects))
+        return (files, *self.with_speed(params, effects, files))
 
 
 def add_baseline_options(p) -> None:
@@ -18,28 +42,25 @@ def add_baseline_options(p) -> None:
                         "the same record options)")
 
 
-def register_baseline(sub) -> None:
-    from .measure import _common
-
+def register_baseline(sub, records: RecordOptions, diagnose) -> None:
+    """``parksteer baseline``, and ``--baseline`` on the `diagnose` parser."""
+    add_baseline_options(diagnose)
     p = sub.add_parser("baseline", help="learn what a car's healthy records fix (calibrated values, what the model "
                                         "lacks, the spread of healthy data) and write it for diagnose --baseline")
-    _common(p, outputs=False)
+    records.add(p, outputs=False)
     p.add_argument("--out", required=True, metavar="CAR_baseline.toml", help="the baseline file to write (TOML)")
     p.add_argument("--force", action="store_true", help="overwrite an existing --out")
     p.add_argument("--jobs", type=int, default=None, metavar="N",
                    help="replays run side by side on N processes (default: the CPUs available; same result)")
     add_quiet_option(p)
-    p.set_defaults(func=_baseline)
+    p.set_defaults(func=_baseline, records=records)
 
 
-def _learnt(args, paths, params, effects, settings, workers: int):
+def _learnt(args, paths, params, effects, settings, workers: int, records: RecordOptions):
     """The baseline learnt from the records `paths` (loaded with the command's record options)."""
     from ..diagnose.baseline import learn_baseline
-    from ..diagnose.problem import load_files
-    from .measure import assist_of_effects, channel_map_of, with_record_speed
 
-    files = load_files(paths, params, args.case, args.surface, channel_map_of(args), assist_of_effects(effects))
-    params, effects = with_record_speed(params, effects, files)
+    files, params, effects = records.load(args, paths, params, effects)
     for f in files:
         if len(f.phases.reversal_times_s) == 0:
             raise UsageError(f"{f.measurement.path}: column 'rack_m': the rack never reverses, so the record holds "
@@ -48,7 +69,7 @@ def _learnt(args, paths, params, effects, settings, workers: int):
                           progress=None if args.quiet else note, workers=workers)
 
 
-def baseline_of(args, params, effects, settings, workers: int):
+def baseline_of(args, params, effects, settings, workers: int, records: RecordOptions):
     """The baseline of --baseline: read from its file, or learnt from the healthy records given (None without)."""
     if not getattr(args, "baseline", None):
         return None
@@ -57,20 +78,20 @@ def baseline_of(args, params, effects, settings, workers: int):
     given = args.baseline
     if len(given) == 1 and given[0].endswith(".toml"):
         baseline = Baseline.read(given[0])
-        baseline.check_vehicle(params)
+        baseline.check(params, effects)
         return baseline
     if any(b.endswith(".toml") for b in given):
         raise UsageError(f"--baseline {' '.join(given)}: give one baseline file (.toml) or the healthy records, "
                          "not both")
-    return _learnt(args, given, params, effects, settings, workers)
+    return _learnt(args, given, params, effects, settings, workers, records)
 
 
 def _baseline(args) -> int:
     from ..diagnose.parallel import available_workers
     from ..diagnose.settings import DEFAULT_SETTINGS
-    from .measure import _check_writable, effects_of
     from .vehicle import parameters_of
 
+    records = args.records
     out = Path(args.out)
     if out.is_dir():
         raise UsageError(f"--out {args.out}: is a directory; name a file to write")
@@ -78,13 +99,13 @@ def _baseline(args) -> int:
         raise UsageError(f"--out {args.out}: exists (--force to overwrite)")
     if not out.resolve().parent.is_dir():
         raise UsageError(f"--out {args.out}: folder {out.resolve().parent} does not exist")
-    _check_writable("out", args.out, out.resolve().parent)
+    records.check_writable("out", args.out, out.resolve().parent)
     if args.jobs is not None and args.jobs < 1:
         raise UsageError(f"--jobs {args.jobs}: give at least 1")
     workers = args.jobs if args.jobs is not None else available_workers()
     params = parameters_of(args)
-    effects = effects_of(args, params)
-    baseline = _learnt(args, args.files, params, effects, DEFAULT_SETTINGS, workers).write(out)
+    effects = records.effects(args, params)
+    baseline = _learnt(args, args.files, params, effects, DEFAULT_SETTINGS, workers, records).write(out)
     print("\n".join(baseline_lines(baseline)))
     return 0
 

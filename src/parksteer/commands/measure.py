@@ -12,7 +12,7 @@ from ..errors import UsageError
 from ..parameters import DEFAULT_PATH
 from ..progress import note
 from . import add_quiet_option
-from .baseline import add_baseline_options, baseline_of, register_baseline
+from .baseline import RecordOptions, baseline_of, register_baseline
 from .vehicle import add_vehicle_option, parameters_of
 
 
@@ -91,9 +91,8 @@ def register(sub) -> None:
                    help="when the verdict is unexplained, write the effect the residual's signature points to as a "
                         "user-effect file (its strengths fitted with the calibrated parameters; pass it back with "
                         "--effects=+OUT.py); no file when the verdict is adequate or names a candidate")
-    add_baseline_options(p)
     p.set_defaults(func=_diagnose)
-    register_baseline(sub)
+    register_baseline(sub, RECORDS, diagnose=p)
 
 
 def _check_outputs(args) -> None:
@@ -312,9 +311,8 @@ def _diagnose(args) -> int:
                              f"({why})")
         note(f"handwheel angle fitted beside the torque in {len(with_angle)} of {len(files)} file(s): "
              + ", ".join(with_angle))
-    baseline = baseline_of(args, params, effects, settings, workers)
     diagnosis = diagnose(files, params, effects, workers=workers, quiet=args.quiet, settings=settings,
-                         baseline=baseline)
+                         baseline=baseline_of(args, params, effects, settings, workers, RECORDS))
     result = _with_suggestion(args, diagnosis_dict(diagnosis), diagnosis, settings)
     user_plot = None
     if args.plot:
@@ -398,3 +396,5 @@ def _write_html(path: str, diagnosis, result: dict, files, params, workers: int 
                    for name, caption in captions.items()]
     write_markdown(path, html_report(result, figures, phases, ladder.as_dict()))
 
+
+RECORDS = RecordOptions(_common, effects_of, _check_writable, channel_map_of, assist_of_effects, with_record_speed)

@@ -18,11 +18,13 @@ something the model lacks. The question its owner asks after a repair or a thous
 
 A later record is then diagnosed (``diagnose(..., baseline=...)``, :mod:`parksteer.diagnose.select`) on the model
 with the form's strengths HELD at the baseline's values (a change cannot be absorbed by fitting the quirk again),
-starting from the baseline's calibrated values, and with the threshold above in place of the sensor floor's:
+starting from the baseline's calibrated values, and with the threshold above where it is above the sensor's
+(:meth:`Threshold.settings_for`):
 ``adequate`` is "as the baseline", ``missing`` "changed: X", ``unexplained`` "changed, outside the library". The
 uncertainty of the held strengths reaches the verdict through that threshold: a left-out part is judged against
-strengths fitted without it, so their estimation error is inside the spread it measures. Where the records fix
-the form poorly, the spread, and so the threshold, is wide. The diagnosis's JSON names the baseline
+strengths fitted without it, so their estimation error is inside the spread it measures (one record's halves are
+in-sample and do not hold it: a second healthy record does). Where the records fix the form poorly, the spread,
+and so the threshold, is wide. The diagnosis's JSON names the baseline
 (``relative_to``: its file and content hash, the threshold and how it was found).
 
 The file (:meth:`Baseline.write`, :mod:`parksteer.diagnose.baseline_file`) is TOML a person reads: every value with
@@ -32,82 +34,17 @@ its interval and source.
 from __future__ import annotations
 
 import dataclasses
-import hashlib
-import json
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 from ..errors import UsageError
-from ..model.symbolic.components import Effect, discover_effects, resolve_effects
-from ..model.symbolic.shapes import shape_effect
+from ..model.symbolic.components import Effect, resolve_effects
 from ..parameters import Parameters
+from .baseline_file import baseline_text, content_hash, identified_parameters, parse_baseline, read_bytes
+from .baseline_form import FORMAT, HeldForm, Threshold, vehicle_fingerprint
+from .baseline_learn import learn
 from .settings import DEFAULT_SETTINGS, DiagnosisSettings
 
-FORMAT = "parksteer baseline 1"
-
-
-def vehicle_fingerprint(params: Parameters) -> str:
-    """A short hash of the car's values (every section and case of its parameter or vehicle file): a baseline is
-    the car's, and a record of another car is refused against it."""
-    text = json.dumps({"sections": params.sections, "cases": params.cases}, sort_keys=True, default=str)
-    return hashlib.sha256(text.encode("utf-8")).hexdigest()[:16]
-
-
-@dataclass(frozen=True)
-class HeldForm:
-    """What the healthy car has that the model lacks, held at the baseline's values in later diagnoses.
-
-    `source`: ``candidate`` (a library effect the absolute diagnosis named) or ``signature`` (the form its residual's
-    signature points to, :func:`parksteer.model.symbolic.shapes.shape_effect`: `shape_class` with `knots` knots or
-    column `orders`, the knots' places and width in `places`). `strengths`: key -> {value, ci95, standard_error}."""
-
-    source: str
-    effect: str
-    strengths: dict
-    places: dict = field(default_factory=dict)
-    shape_class: str | None = None
-    knots: int = 0
-    orders: tuple[int, ...] = ()
-    signature: str | None = None
-
-    def model_effect(self, registry: dict[str, Effect] | None = None) -> Effect:
-        if self.source == "signature":
-            return shape_effect(self.shape_class, self.knots, tuple(self.orders))
-        registry = registry if registry is not None else discover_effects()
-        if self.effect not in registry:
-            raise UsageError(f"baseline: effect {self.effect!r} is not a registered effect")
-        return registry[self.effect]
-
-    @property
-    def values(self) -> dict[str, float]:
-        """The held values: the strengths and the form's places."""
-        return {**{k: float(v["value"]) for k, v in self.strengths.items()}, **self.places}
-
-
-@dataclass(frozen=True)
-class Threshold:
-    """What "as the baseline" allows: `over_floor`, the weighted RMS error in noise floors, and `bic_per_sample`, the
-    best candidate's BIC gain per sample, that one more healthy part stays under (95 % prediction bounds over the
-    healthy parts with the form held); `method` says how the parts were made; `parts` lists each."""
-
-    over_floor: float
-    bic_per_sample: float
-    method: str
-    parts: tuple[dict, ...] = ()
-
-    def settings_for(self, settings: DiagnosisSettings, samples: int) -> DiagnosisSettings:
-        """`settings` with the thresholds of "as the baseline" for a later record of `samples` samples: the adequate
-        factor at least the healthy spread, the ceiling on a named effect's error raised in proportion, and the BIC
-        gain a candidate needs at least what healthy parts reached at the same length."""
-        adequate = max(settings.adequate_rms_factor, self.over_floor)
-        ceiling = max(settings.missing_rms_ceiling, adequate * settings.missing_rms_ceiling
-                      / settings.adequate_rms_factor)
-        bic = max(settings.bic_missing_threshold, self.bic_per_sample * samples)
-        return dataclasses.replace(settings, adequate_rms_factor=adequate, missing_rms_ceiling=ceiling,
-                                   bic_missing_threshold=bic)
-
-    def as_dict(self) -> dict:
-        return {"over_floor": self.over_floor, "bic_per_sample": self.bic_per_sample, "method": self.method,
-                "parts": [dict(p) for p in self.parts]}
+__all__ = ["FORMAT", "Baseline", "HeldForm", "Threshold", "learn_baseline", "vehicle_fingerprint"]
 
 
 @dataclass(frozen=True)
@@ -132,17 +69,23 @@ class Baseline:
     content_hash: str | None = None
 
     def write(self, path) -> Baseline:
-        """Write the baseline as TOML to `path`; returns it with its path and content hash."""
-        from .baseline_file import write_baseline
+        """Write the baseline as TOML to `path` (its text read back first: nothing is written that would not read);
+        returns it with its path and content hash."""
+        import tomllib
+        from pathlib import Path
 
-        return write_baseline(self, path)
+        text = baseline_text(self)
+        Baseline(**parse_baseline(tomllib.loads(text), str(path)))
+        data = text.encode("utf-8")
+        Path(path).write_bytes(data)
+        return dataclasses.replace(self, path=str(path), content_hash=content_hash(data))
 
     @classmethod
     def read(cls, path) -> Baseline:
-        """The baseline written to `path` (a corrupt or foreign file: one line naming it and the key, exit 2)."""
-        from .baseline_file import read_baseline
-
-        return read_baseline(path)
+        """The baseline written to `path`, with its path and content hash (a damaged or foreign file: one line
+        naming it and the key, exit 2)."""
+        data, parsed = read_bytes(path)
+        return cls(**parse_baseline(parsed, str(path)), path=str(path), content_hash=content_hash(data))
 
     def relative_to(self) -> dict:
         """What a diagnosis against this baseline names it by (JSON ``relative_to``)."""
@@ -150,18 +93,24 @@ class Baseline:
                 "verdict": self.verdict, "form": None if self.form is None else self.form.effect,
                 "threshold": self.threshold.as_dict()}
 
-    def check_vehicle(self, params: Parameters) -> None:
+    def check(self, params: Parameters, effects=None) -> None:
+        """Refuse, in one line naming the file and the key, records of another car (its values' hash) or a model of
+        other effects than the baseline's (`effects`, before the form is added)."""
+        where = self.path or "baseline"
         if vehicle_fingerprint(params) != self.fingerprint:
-            where = self.path or "baseline"
             raise UsageError(f"{where}: key 'vehicle.fingerprint': the baseline is of another car "
                              f"({self.vehicle}); give the vehicle file it was learnt with")
+        if effects is not None:
+            names = tuple(sorted(e.name for e in effects))
+            if names != tuple(sorted(self.effects)):
+                raise UsageError(f"{where}: key 'records.model': the baseline's model is {', '.join(self.effects)}; "
+                                 f"these records are diagnosed with {', '.join(names)} (the same --effects and "
+                                 "--with-assist as the baseline)")
 
     def parameters(self, params: Parameters) -> Parameters:
         """The car's parameters a later record is diagnosed with: the identified vehicle file's where the baseline
         identified the assist, with the held form's values."""
         if self.identified_vehicle is not None:
-            from .baseline_file import identified_parameters
-
             params = identified_parameters(self.identified_vehicle)
         if self.form is None:
             return params
@@ -197,8 +146,6 @@ def learn_baseline(files, params: Parameters, effects=None, settings: DiagnosisS
     path (named in the baseline; for an assisted car whose file gives only its gear's data, its assist is first
     identified from these records, :mod:`parksteer.diagnose.assist_identify`). `progress`: None (quiet) or a
     callable given one line at each step."""
-    from .baseline_learn import learn
-
-    return learn(files, params, effects, settings, vehicle=vehicle, progress=progress, registry=registry,
+    return learn(Baseline, files, params, effects, settings, vehicle=vehicle, progress=progress, registry=registry,
                  workers=workers)
 

@@ -13,7 +13,7 @@ from pathlib import Path
 
 from ..errors import UsageError
 from ..parameters import Parameters
-from .baseline import FORMAT
+from .baseline_form import FORMAT, HeldForm, Threshold
 
 HEADER = ("# A car's baseline: what its healthy records fix (parksteer baseline), read by parksteer diagnose "
           "--baseline.\n# Every value with its 95 % interval and source; the threshold of \"as the baseline\" with "
@@ -86,17 +86,6 @@ def content_hash(data: bytes) -> str:
     return hashlib.sha256(data).hexdigest()[:16]
 
 
-def write_baseline(baseline, path):
-    """Write `baseline` to `path` (its text read back first: nothing is written that would not read)."""
-    import dataclasses
-
-    text = baseline_text(baseline)
-    parse_baseline(tomllib.loads(text), str(path))
-    data = text.encode("utf-8")
-    Path(path).write_bytes(data)
-    return dataclasses.replace(baseline, path=str(path), content_hash=content_hash(data))
-
-
 def _get(table: dict, key: str, kind, where: str, prefix: str = ""):
     name = f"{prefix}{key}"
     if key not in table:
@@ -124,10 +113,8 @@ def _estimate(entry, where: str, name: str) -> dict:
     return out
 
 
-def parse_baseline(data: dict, where: str):
-    """The :class:`~parksteer.diagnose.baseline.Baseline` of parsed TOML `data` (`where`: its file)."""
-    from .baseline import Baseline, HeldForm, Threshold
-
+def parse_baseline(data: dict, where: str) -> dict:
+    """The fields of the :class:`~parksteer.diagnose.baseline.Baseline` of parsed TOML `data` (`where`: its file)."""
     if data.get("format") != FORMAT:
         raise UsageError(f"{where}: key 'format': not a parksteer baseline ({FORMAT!r} expected)")
     vehicle = _get(data, "vehicle", dict, where)
@@ -155,28 +142,25 @@ def parse_baseline(data: dict, where: str):
                           _get(t, "bic_per_sample", float, where, "threshold."),
                           _get(t, "method", str, where, "threshold."), tuple(dict(p) for p in t.get("parts", ())))
     identified = data.get("identified", {}).get("vehicle")
-    return Baseline(vehicle.get("file"), _get(vehicle, "fingerprint", str, where, "vehicle."),
-                    tuple(_get(records, "files", list, where, "records.")),
-                    tuple(_get(records, "model", list, where, "records.")), calibrated,
-                    _get(absolute, "verdict", str, where, "absolute."),
-                    _get(absolute, "over_floor", float, where, "absolute."), form, threshold, identified)
+    return {"vehicle": vehicle.get("file"), "fingerprint": _get(vehicle, "fingerprint", str, where, "vehicle."),
+            "records": tuple(_get(records, "files", list, where, "records.")),
+            "effects": tuple(_get(records, "model", list, where, "records.")), "calibrated": calibrated,
+            "verdict": _get(absolute, "verdict", str, where, "absolute."),
+            "over_floor": _get(absolute, "over_floor", float, where, "absolute."), "form": form,
+            "threshold": threshold, "identified_vehicle": identified}
 
 
-def read_baseline(path):
-    """The baseline in the file `path`, with its path and content hash."""
-    import dataclasses
-
+def read_bytes(path) -> tuple[bytes, dict]:
+    """(the bytes of the file `path`, its TOML parsed); a file that cannot be read or is not TOML: one line."""
     where = str(path)
     try:
         data = Path(path).read_bytes()
     except OSError as exc:
         raise UsageError(f"{where}: cannot read ({exc.strerror})") from None
     try:
-        parsed = tomllib.loads(data.decode("utf-8"))
+        return data, tomllib.loads(data.decode("utf-8"))
     except (UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
         raise UsageError(f"{where}: not a baseline file ({exc})") from None
-    baseline = parse_baseline(parsed, where)
-    return dataclasses.replace(baseline, path=where, content_hash=content_hash(data))
 
 
 def identified_parameters(text: str) -> Parameters:

@@ -12,7 +12,8 @@ from scipy.special import stdtrit  # the t quantile, without importing scipy.sta
 
 from ..model.symbolic.components import Effect, discover_effects, power_assist_of, resolve_effects
 from ..parameters import Parameters
-from .baseline import Baseline, HeldForm, Threshold, vehicle_fingerprint
+from .baseline_file import identified_parameters
+from .baseline_form import HeldForm, Threshold, vehicle_fingerprint
 from .calibrate import Fit, calibrate
 from .engine import ReplayEngine
 from .problem import FileData, Problem
@@ -111,11 +112,11 @@ def refit_form(form: HeldForm, train, params: Parameters, model: list[Effect], s
                                                 for k, v in form.strengths.items()})
 
 
-def _judged(judged, params, base, registry, form, train, settings, workers):
+def _judged(make, judged, params, base, registry, form, train, settings, workers):
     """The relative diagnosis of the records `judged` against `form` (held) with a threshold of the sensor's."""
     from .select import diagnose
 
-    part = Baseline(None, vehicle_fingerprint(params), tuple(f.label for f in train), tuple(e.name for e in base),
+    part = make(None, vehicle_fingerprint(params), tuple(f.label for f in train), tuple(e.name for e in base),
                     {}, "", math.nan, form, Threshold(0.0, 0.0, "the sensor's floor"))
     return diagnose(list(judged), params, base, registry, settings=settings, workers=workers, quiet=True,
                     baseline=part)
@@ -143,13 +144,13 @@ def _best_gain(found) -> float:
     return max([0.0, *(c.delta_bic for c in found.candidates if c.delta_bic is not None)])
 
 
-def spread(files, params: Parameters, base: list[Effect], registry, form: HeldForm | None, start: dict,
+def spread(make, files, params: Parameters, base: list[Effect], registry, form: HeldForm | None, start: dict,
            settings: DiagnosisSettings, workers: int, say) -> Threshold:
     """The threshold of "as the baseline" from the healthy parts (module docstring of
     :mod:`parksteer.diagnose.baseline`)."""
     if len(files) == 1:
         say(f"baseline: the halves of {files[0].label} against the form and calibration of the whole record")
-        found = _judged(files, params, base, registry, form, files, settings, workers)
+        found = _judged(make, files, params, base, registry, form, files, settings, workers)
         rows = half_rows(found)
         gain = _best_gain(found) / found.problem.n
         for row in rows:
@@ -167,7 +168,7 @@ def spread(files, params: Parameters, base: list[Effect], registry, form: HeldFo
         if form is not None:
             model = sorted([*base, form.model_effect(registry)], key=lambda e: e.name)
             held = refit_form(form, train, params, model, start, settings)
-        found = _judged([judged], params, base, registry, held, train, settings, workers)
+        found = _judged(make, [judged], params, base, registry, held, train, settings, workers)
         n = found.problem.n
         rows.append({"part": judged.label, "samples": int(n), "over_floor": math.sqrt(found.calibration.rss / n),
                      "best": found.best.name if found.best is not None else None, "delta_bic": _best_gain(found),
@@ -175,9 +176,10 @@ def spread(files, params: Parameters, base: list[Effect], registry, form: HeldFo
     return _threshold(rows, method)
 
 
-def learn(files, params: Parameters, effects=None, settings: DiagnosisSettings | None = None, *, vehicle=None,
-          progress=None, registry: dict[str, Effect] | None = None, workers: int = 1) -> Baseline:
-    """:func:`parksteer.diagnose.baseline.learn_baseline`."""
+def learn(make, files, params: Parameters, effects=None, settings: DiagnosisSettings | None = None, *, vehicle=None,
+          progress=None, registry: dict[str, Effect] | None = None, workers: int = 1):
+    """:func:`parksteer.diagnose.baseline.learn_baseline`; `make` is the baseline's class (the parts are judged
+    against baselines of their own)."""
     from .select import diagnose
     from .settings import DEFAULT_SETTINGS
 
@@ -193,8 +195,6 @@ def learn(files, params: Parameters, effects=None, settings: DiagnosisSettings |
 
         identified = identified_vehicle(files, params, base, vehicle, say)
         if identified is not None:
-            from .baseline_file import identified_parameters
-
             params = identified_parameters(identified)
     say(f"baseline: the absolute diagnosis of {len(files)} healthy record(s)")
     absolute = diagnose(files, params, base, registry, settings=settings, workers=workers, quiet=progress is None)
@@ -205,9 +205,9 @@ def learn(files, params: Parameters, effects=None, settings: DiagnosisSettings |
     calibrated = _estimates(fit, problem, settings, keys, f"calibrated on {labels}"
                             + (f" with {form.effect}" if form is not None else ""))
     start = {k: v["value"] for k, v in calibrated.items()}
-    threshold = spread(files, params, base, registry, form, start, settings, workers, say)
+    threshold = spread(make, files, params, base, registry, form, start, settings, workers, say)
     say(f"baseline: as the baseline up to {threshold.over_floor:.2f} noise floors and a BIC gain of "
         f"{threshold.bic_per_sample:.4f} per sample ({threshold.method.split(':')[0]})")
-    return Baseline(None if vehicle is None else str(vehicle), fingerprint, tuple(f.label for f in files),
+    return make(None if vehicle is None else str(vehicle), fingerprint, tuple(f.label for f in files),
                     tuple(e.name for e in base), calibrated, absolute.verdict,
                     math.sqrt(absolute.calibration.rss / absolute.problem.n), form, threshold, identified)

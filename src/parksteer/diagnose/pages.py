@@ -205,9 +205,9 @@ def relative_lines(result: dict) -> list[str]:
                 + (f" (95 %: {num(ci[0])} to {num(ci[1])}{unit})" if ci else "") + ".")
     else:
         said = "Changed, outside the library: see the residual's signature below."
-    return [f"**Relative to baseline {name}** (content hash {rel['content_hash']}; {held}). {said} "
+    return ["", f"**Relative to baseline {name}** (content hash {rel['content_hash']}; {held}). {said} "
             f"\"As the baseline\" allows up to {num(t['over_floor'])} noise floors and a BIC gain of "
-            f"{num(t['bic_per_sample'])} per sample, from {t['method']}.", ""]
+            f"{num(t['bic_per_sample'])} per sample, from {t['method']}."]
 
 
 def markdown_report(result: dict, figure: str | None = None, user_figure: str | None = None) -> str:
@@ -229,7 +229,8 @@ def markdown_report(result: dict, figure: str | None = None, user_figure: str | 
                      f"{num(stats['calibrated']['weighted_rms_Nm'])} N m against a noise floor of {num(floor)} N m) "
                      "that no candidate removes for the most part. Something outside the candidate library is at "
                      "work (or in the measurement): look at the residual below." + _nearest(result))
-    lines += ["", *relative_lines(result), "## Files", "", "| file | case | surface | samples | noise floor (N m) | replay uncertainty RMS (N m) "
+    lines += relative_lines(result)
+    lines += ["", "## Files", "", "| file | case | surface | samples | noise floor (N m) | replay uncertainty RMS (N m) "
               "| rack knot spacing (s) |", "|---|---|---|---|---|---|---|"]
     for f in result["files"]:
         lines.append(f"| {f['file']} | {f['case']} | {f['surface']} | {f['samples']} | "

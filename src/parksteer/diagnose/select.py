@@ -97,7 +97,7 @@ def diagnose(files: list[FileData], params: Parameters, effects=None, registry: 
         else resolve_effects(effects)
     held = None
     if baseline is not None:
-        baseline.check_vehicle(params)
+        baseline.check(params, base)
         params, base = baseline.parameters(params), baseline.model(base, registry)
         start, held = {**baseline.start, **(start or {})}, baseline.held
     # An assisted car's record: its motor channel fitted beside the torsion-bar torque (settings.use_motor_channel);
@@ -124,8 +124,6 @@ def diagnose(files: list[FileData], params: Parameters, effects=None, registry: 
                            None if start is None else frozen_mapping(start), progress,
                            tuple(stages) if baseline is not None else with_user_effect_stage(tuple(stages), base),
                            held=None if held is None else frozen_mapping(held))
-    if baseline is not None:
-        state = state.with_output("relative_to", baseline.relative_to())
     testable, _ = candidate_effects(base, registry)
     # The models the candidates replay in are built in the background while the base model's stages run (the base
     # model itself is built, if missing, when first replayed).
@@ -133,6 +131,8 @@ def diagnose(files: list[FileData], params: Parameters, effects=None, registry: 
     engine = ReplayEngine(workers, hosts=replay_models(base, testable, params))
     try:
         state = run_table(state, engine)
+        if baseline is not None:  # after the table: a stage that runs it again starts from nothing found
+            state = state.with_output("relative_to", baseline.relative_to())
     finally:
         engine.close()
         finish_builds(builders)

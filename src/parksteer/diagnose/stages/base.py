@@ -48,5 +48,5 @@ def run_table(state: DiagnosisState, engine: ReplayEngine) -> DiagnosisState:
 def restart(state: DiagnosisState, **changes) -> DiagnosisState:
     """A state with this one's inputs (and `changes`, e.g. other settings or files) and nothing found yet."""
     fresh = DiagnosisState(state.settings, state.problem, state.base, state.registry, state.strengths, state.start,
-                           state.progress, state.table)
+                           state.progress, state.table, state.held)
     return replace(fresh, **changes)
