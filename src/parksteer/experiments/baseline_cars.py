@@ -101,7 +101,8 @@ class ManualCar:
         self.quirk = QUIRKS[car.quirk]
         hand, logger = self._hand_logger(car.healthy_hand, car.healthy_bits, 0)
         road = manual_road(params, hand, car.case, self.base)
-        self.strength, change = quirk_strength(params, road, self.quirk, car.quirk_floors * logger.floor_Nm, car.case)
+        self.strength, change = quirk_strength(params, road, self.quirk, car.quirk_floors * logger.floor_Nm, car.case,
+                                               overrides=self.base)
         self.healthy = quirk_record(road, self.quirk, self.strength, logger, car.case)
         self.quirk_floors = change / logger.floor_Nm
         self.more_healthy = [self.later(Later("null", hand_name, bits), MORE_HEALTHY_INDEX + i)[1]
@@ -140,7 +141,8 @@ class ManualCar:
             truth.update(strength=s, floors=size / logger.floor_Nm)
         elif later.kind == "outclass":  # another quirk on top of the car's own
             other = QUIRKS[later.what]
-            extra, change = quirk_strength(self.params, road, other, later.floors * logger.floor_Nm, self.car.case)
+            extra, change = quirk_strength(self.params, road, other, later.floors * logger.floor_Nm, self.car.case,
+                                           overrides=self.base)
             truth.update(strength=extra, floors=change / logger.floor_Nm)
         record = quirk_record(road, self.quirk, self.strength, logger, self.car.case)
         if later.kind == "outclass":

@@ -58,6 +58,7 @@ class ManualRoad:
     steer_rad: np.ndarray
     tyre_Nm: np.ndarray
     column_per_rack: np.ndarray
+    replayed_Nm: np.ndarray | None = None  # the replay of this rack as a logged rack is replayed (apparent_change)
 
 
 def manual_road(params: Parameters, hand: HandVariant, case: str, overrides: dict[str, float] | None = None,
@@ -180,25 +181,32 @@ def quirk_by_name(name: str) -> Quirk:
 
 
 def apparent_change(params: Parameters, road: ManualRoad, quirk: Quirk, strength: float, case: str,
-                    surface: str = "ground") -> np.ndarray:
+                    surface: str = "ground", overrides: dict[str, float] | None = None) -> np.ndarray:
     """What the quirk changes in the torque against the model's replay of the rack the logger reads: the added
-    torque, and where the logged rack moves (a compliance), the replay of the moved rack less the logged torque."""
+    torque, and where the logged rack moves (a compliance), the replay of the wheels' rack less that of the moved
+    rack, both replayed alike (a spline through the samples), so that the spline's own error cancels."""
     from ..measure.smoothing import interpolate_rack
 
     rack, torque = quirk.logged(road, strength)
     if rack is road.rack_m:
         return torque - road.torque_Nm
-    moved = manual_road(params, HandVariant(), case, surface=surface,
-                        rack_drive=interpolate_rack(road.time_s, rack), dt_s=float(road.time_s[1] - road.time_s[0]))
-    return torque - np.interp(road.time_s, moved.time_s, moved.torque_Nm)
+
+    def replayed(x: np.ndarray) -> np.ndarray:
+        run = manual_road(params, HandVariant(), case, overrides, surface=surface,
+                          rack_drive=interpolate_rack(road.time_s, x), dt_s=float(road.time_s[1] - road.time_s[0]))
+        return np.interp(road.time_s, run.time_s, run.torque_Nm)
+
+    if road.replayed_Nm is None:
+        road.replayed_Nm = replayed(road.rack_m)
+    return road.replayed_Nm - replayed(rack)
 
 
 def quirk_strength(params: Parameters, road: ManualRoad, quirk: Quirk, target_Nm: float, case: str,
-                   surface: str = "ground") -> tuple[float, float]:
-    """(strength, RMS apparent change) of `quirk` whose apparent change (:func:`apparent_change`) on `road` is
-    `target_Nm` RMS: bisection in the log of the strength (the change grows with it)."""
+                   surface: str = "ground", overrides: dict[str, float] | None = None) -> tuple[float, float]:
+    """(strength, RMS apparent change) of `quirk` whose apparent change (:func:`apparent_change`) on `road` (made
+    with `overrides`) is `target_Nm` RMS: bisection in the log of the strength (the change grows with it)."""
     def rms(strength: float) -> float:
-        change = apparent_change(params, road, quirk, strength, case, surface)
+        change = apparent_change(params, road, quirk, strength, case, surface, overrides)
         return math.sqrt(float(np.mean(change * change)))
 
     low, high = quirk.upper * 1e-4, quirk.upper
