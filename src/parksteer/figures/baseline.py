@@ -36,7 +36,7 @@ def _label(said: dict | None) -> str:
 def baseline_figure(cars: list[dict], path: str | Path) -> None:
     """Left: one line per later record (grouped by car: its quirk), its answer absolutely and against the healthy
     record, each cell green where right, red where wrong, grey where not run. Right: each record's calibrated
-    weighted error in noise floors on both sides, against the absolute adequate threshold and each car's threshold
+    weighted RMS error in noise floors on both sides, against the absolute adequate threshold and each car's threshold
     of "as the baseline" (the larger of it and the absolute one, as the diagnosis applies it)."""
     from ..diagnose.settings import DEFAULT_SETTINGS
 
@@ -79,8 +79,8 @@ def baseline_figure(cars: list[dict], path: str | Path) -> None:
     ticks = [t for t in (0.5, 1.0, 1.5, 2.0, 3.0, 5.0, 8.0, 12.0) if t <= max(1.2 * top, 2.0)]
     ax.set_xticks(ticks, [f"{t:g}" for t in ticks])
     ax.set_xticks([], minor=True)
-    ax.set_xlabel("calibrated weighted RMS error / noise floor", fontsize=8)
-    ax.legend(fontsize=6, loc="upper center", bbox_to_anchor=(0.5, -0.32), ncol=2)
+    ax.set_xlabel("calibrated error / noise floor", fontsize=8)
+    ax.legend(fontsize=6, loc="lower center", bbox_to_anchor=(0.5, 1.0), ncol=1, frameon=False)
     fig.tight_layout()
     save_svg(fig, path)
 
