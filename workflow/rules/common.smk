@@ -31,6 +31,7 @@ FIGURES = {
     "assist_creep": ["figures/assist_creep.svg", "figures/assist_creep.csv"],
     "diag_assisted": ["figures/diag_assisted.svg", "figures/diag_assisted.csv"],
     "diag_assisted_truth": ["figures/diag_assisted_truth.svg", "figures/diag_assisted_truth.csv"],
+    "diag_baseline": ["figures/diag_baseline.svg", "figures/diag_baseline.csv"],
 }
 
 
