@@ -132,6 +132,16 @@ class DiagnosisSettings:
     calibration_max_iterations: int = 10
     # A fit has converged when its Gauss-Newton step is below this fraction of every parameter's standard error.
     calibration_tolerance: float = 0.3
+    # The base calibration is then taken on to its optimum (parksteer.diagnose.calibrate.polish): on a Jacobian
+    # taken afresh by finite differences, Gauss-Newton steps until the full step is within this fraction of every
+    # parameter's standard error (what a candidate's refit could then gain from the base parameters moving on is
+    # under 0.03 in the BIC for three parameters); a step that does not lower the sum of squares is halved up to
+    # calibration_polish_halvings times, at most calibration_polish_rounds fresh Jacobians. Off, the calibration
+    # ends where the Broyden iterations do, which can be several standard errors short of the optimum.
+    calibration_polished: bool = True
+    calibration_polish_tolerance: float = 0.1
+    calibration_polish_rounds: int = 4
+    calibration_polish_halvings: int = 2
     # The Jacobian is recomputed by finite differences at the end of a fit when a parameter has moved
     # by more than this (in its fitted variable: 0.15 is 15 % of a log-fitted value) since it was taken.
     jacobian_refresh_theta: float = 0.15
