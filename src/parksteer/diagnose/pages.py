@@ -180,6 +180,11 @@ def _assumed_lines(assumed: dict) -> list[str]:
         lines.append(f"| {r['quantity']} | {num(r['value'], 4)} | {num(r['band'][0], 4)} to {num(r['band'][1], 4)} | "
                      f"{num(ends[0]['calibrated_over_floor'])}, {num(ends[1]['calibrated_over_floor'])} | "
                      f"{ends[0]['verdict']}, {ends[1]['verdict']}{' (decides)' if r['decides'] else ''} |")
+    # why an end is not adequate, by the headline's rule (older results carry no reason)
+    why = [f"- `{r['quantity']}` at {num(e['value'], 4)}: {e['verdict']}: {e['why']}."
+           for r in rows for e in r["ends"] if e["verdict"] != "adequate" and e.get("why")]
+    if why:
+        lines += ["", "Where an end is not adequate, why:", "", *why]
     return lines
 
 
