@@ -58,8 +58,8 @@ def test_the_polished_calibration_is_the_optimum_another_fitter_finds_from_anoth
     upper = np.array([p.theta_bounds()[1] for p in parameters])
 
     def residual(values):  # scipy's variables are the parameters' values themselves, not the fit's log-ratios
-        return _predict(engine, problem, effects, parameters, np.array([p.theta(v) for p, v in zip(parameters, values)]),
-                        fixed)[1]
+        theta = np.array([p.theta(v) for p, v in zip(parameters, values)])
+        return _predict(engine, problem, effects, parameters, theta, fixed)[1]
 
     # from the parameter file's values, with the diagnosis's finite-difference step (3 % of each value): smaller
     # ones see the integrator's noise

@@ -4,22 +4,29 @@ An assisted car's file gives some of its gear's numbers from a data sheet or fro
 and takes the rest from the effect's defaults (the motor's friction and rotor, the gear's efficiencies, the
 corners the boost line and the motor limit are smoothed over...). On an assisted car's bus the torsion-bar torque is
 clean enough that a default harmless on a manual car's records decides the verdict. So for every quantity of the
-assist whose source in the vehicle file is ``assumed`` or ``numerical`` (or that the file leaves to the effect's
-default) and that the model uses, this stage replays the final comparison with it at each end of its band
-(:data:`BANDS`: the range the quantity's own source gives) and gives the verdict those replays would have: the
-calibrated model and the best candidate's refit each replayed with the value moved, their residuals refitted to
-first order (projected off the fit's Jacobian columns: the calibrated parameters take up what they can), and
-:func:`~parksteer.diagnose.stages.verdict.choose_verdict` on the calibrated model's RMS over the floor, the
-candidate's BIC gain and the fraction of the excess it explains, by the headline's rule (a candidate whose strength
-there is 0 or whose interval holds 0 is not named: :func:`~parksteer.diagnose.stages.select.may_headline`); each
-end says why its verdict is what it is (:func:`end_reason`: the figures and the thresholds they were held against). A quantity whose band's end changes the verdict
-*decides* it: the report says it was assumed, and by how much the calibrated fit moves (in noise floors). Where
-``parksteer assist identify`` fixed the product k_t eta_f N, the efficiency and the reduction are moved with the
-products the data fixed held (:func:`moved`).
+assist that the vehicle file declares assumed (``provenance = "assumed"``, or no provenance, or no entry: the
+effect's default; ``Parameters.provenance``) and that the model uses, this stage replays the final comparison with
+it at each end of its band (:data:`BANDS`: the range the quantity's own source gives) and gives the verdict those
+replays would have: the calibrated model and the best candidate's refit each replayed with the value moved, their
+residuals refitted to first order (projected off the fit's Jacobian columns: the calibrated parameters take up what
+they can), and :func:`~parksteer.diagnose.stages.verdict.choose_verdict` on the calibrated model's RMS over the
+floor, the candidate's BIC gain and the fraction of the excess it explains, by the headline's rule (a candidate
+whose strength there is 0 or whose interval holds 0 is not named:
+:func:`~parksteer.diagnose.stages.select.may_headline`); each end says why its verdict is what it is
+(:func:`end_reason`: the figures and the thresholds they were held against). A quantity whose band's end changes the
+verdict *decides* it: the report says it was assumed, and by how much the calibrated fit moves (in noise floors).
+Where ``parksteer assist identify`` fixed the product k_t eta_f N, the efficiency and the reduction are moved with
+the products the data fixed held (:func:`moved`).
 
 Four replays a quantity (two ends, the calibrated model and the best candidate's), none for a car without an
 assist. Quantities the data calibrate (the candidates' strengths, the calibrated parameters) are not here: the
 diagnosis fits them.
+
+With ``assumed_values_calibrated``, an assumed value that decides the verdict and that these data fix is measured
+instead: the deciding values are fitted together with the base model's parameters, each within its band, and those
+whose 95 % interval is at most ``assumed_fixed_fraction_of_band`` of the band wide are added to the calibrated
+parameters and the diagnosis is made again from its calibration (:func:`fixed_by_the_data`,
+:func:`diagnosed_with`); the JSON's ``assumed.calibrated`` lists them with the file's value and the verdict with it.
 """
 
 from __future__ import annotations
@@ -28,11 +35,14 @@ import math
 
 import numpy as np
 
+from dataclasses import replace
+
 from ...model.symbolic.components import power_assist_of
+from ..calibrate import calibration_parameters, least_squares, polish
 from ..engine import ReplayEngine
-from ..state import DiagnosisState
+from ..state import DiagnosisState, frozen_mapping
 from ..statistics import bic_gain
-from .base import Stage
+from .base import Stage, restart, run_table
 from .verdict import choose_verdict, trimmed_rms
 
 # The band of each assumed quantity of an electric assist (low, high), as its own source gives it
@@ -59,15 +69,17 @@ REDUCTION = {"column": (15.0, 22.0), "pinion": (15.0, 25.0), "rack": (1500.0, 35
 LINE_KEYS = ("gain", "dead_band", "dead_band_smoothing")
 
 
-def assumed_source(source: str) -> bool:
-    """Whether a vehicle file's `source` of a value says it is assumed: ``assumed``, ``numerical`` (a smoothing), or
-    no entry at all (the effect's default); anything else is a data sheet's or a measurement's."""
-    return source.startswith(("assumed", "numerical", "the effect's default"))
+def is_assumed(params, dotted: str) -> bool:
+    """Whether the vehicle file takes the value of `dotted` as assumed: its entry declares ``provenance =
+    "assumed"``, or declares none, or there is no entry (the effect's default) (``Parameters.provenance``); a value
+    declared measured or identified is the file's own."""
+    return params.provenance(dotted) == "assumed"
 
 
-def assumed_quantities(params, name: str, effect) -> list[tuple[str, float, str, tuple[float, float]]]:
+def assumed_quantities(params, name: str, effect, calibrated: tuple[str, ...] = ()
+                       ) -> list[tuple[str, float, str, tuple[float, float]]]:
     """(key, value, source, band) of each quantity of the assist `name` the file takes as assumed (module
-    docstring), in the effect's order."""
+    docstring), in the effect's order, but those in `calibrated` (keys the diagnosis fits)."""
     table = any(params.sections.get(name, {}).get(k, 0.0) for k in params.sections.get(name, {})
                 if k.startswith("boost_assist_"))
     out = []
@@ -76,7 +88,7 @@ def assumed_quantities(params, name: str, effect) -> list[tuple[str, float, str,
         if (key not in BANDS and key != "reduction_ratio") or (table and key in LINE_KEYS):
             continue
         source = params.sources.get(f"{name}.{key}", "the effect's default")
-        if not assumed_source(source):
+        if not is_assumed(params, f"{name}.{key}") or f"{name}.{key}" in calibrated:
             continue
         band = BANDS.get(key)
         if key == "reduction_ratio":
@@ -88,13 +100,14 @@ def assumed_quantities(params, name: str, effect) -> list[tuple[str, float, str,
 
 
 def moved(params, name: str, key: str, value: float) -> dict[str, float]:
-    """The overrides that move `key` of the assist `name` to `value`, holding what the data fixed. Where a value
-    was identified (``parksteer assist identify``: its source says so), the column balance fixed a product, not
-    its factors: the product k_t eta_f N (the torque constant), the back-driven delivery N k_t / eta_b per ampere
-    (eta_f eta_b, with the torque constant held), the rotor's reflected inertia N^2 J_m and friction N T_f. Moving
-    the efficiency or the reduction keeps each identified product, its other factor taking up the rest."""
+    """The overrides that move `key` of the assist `name` to `value`, holding what the data fixed. Where a value was
+    identified (``parksteer assist identify``: its entry declares ``provenance = "identified"``), the column balance
+    fixed a product, not its factors: the product k_t eta_f N (the torque constant), the back-driven delivery N k_t
+    / eta_b per ampere (eta_f eta_b, with the torque constant held), the rotor's reflected inertia N^2 J_m and
+    friction N T_f. Moving the efficiency or the reduction keeps each identified product, its other factor taking up
+    the rest."""
     v = lambda k: float(params[f"{name}.{k}"])  # noqa: E731
-    fixed = lambda k: params.sources.get(f"{name}.{k}", "").startswith("identified")  # noqa: E731
+    fixed = lambda k: params.provenance(f"{name}.{k}") == "identified"  # noqa: E731
     out = {f"{name}.{key}": value}
     if key == "efficiency":
         if fixed("torque_constant"):
@@ -200,7 +213,8 @@ class AssumedValues(Stage):
         # the same rule on the fits as they stand: the reference the moved values are held against
         nominal = verdict_of(calibration.rss, None if refit is None else (refit.rss, refit.weighted, refit.theta))
         rows = []
-        for key, value, source, band in assumed_quantities(problem.params, effect.name, effect):
+        for key, value, source, band in assumed_quantities(problem.params, effect.name, effect,
+                                                           settings.calibrated_parameters):
             full = f"{effect.name}.{key}"
             ends = []
             for end in band:
@@ -212,4 +226,88 @@ class AssumedValues(Stage):
                 ends.append({"value": end, **verdict_of(base_rss, with_fit)})
             rows.append({"quantity": full, "value": value, "source": source, "band": list(band), "ends": ends,
                          "decides": any(e["verdict"] != nominal["verdict"] for e in ends)})
-        return state.with_output(self.name, {"verdict": state.verdict, "nominal": nominal, "quantities": rows})
+        out = {"verdict": state.verdict, "nominal": nominal, "quantities": rows,
+               "calibrated": list(state.outputs.get(self.name, {}).get("calibrated", []))}
+        fixed = fixed_by_the_data(state, engine, [r for r in rows if r["decides"]]) \
+            if settings.assumed_values_calibrated else []
+        if not fixed:
+            return state.with_output(self.name, out)
+        return diagnosed_with(state, engine, self, out, fixed)
+
+
+def fixed_by_the_data(state: DiagnosisState, engine: ReplayEngine, deciding: list[dict]) -> list[dict]:
+    """Of the assumed quantities that decide the verdict, those these data fix. They are calibrated together with
+    the base model's parameters (each as a log-ratio to the file's value, within its band), and each is kept where
+    its 95 % interval is at most ``assumed_fixed_fraction_of_band`` of its band wide. Where none is kept so (two
+    factors of one product, the torque constant and the efficiency, are fixed each with the other held, never
+    together), each is calibrated alone, the one that moves the fit most at its band's ends first, and the first
+    fixed is kept: with it calibrated, the diagnosis made again asks whether the others still decide. A quantity
+    the file ties to an identified product (:func:`moved` moves more than itself) is not calibrated alone: only the
+    product is fixed, not the factor."""
+    problem = state.problem
+    effect = power_assist_of(state.base)
+    rows = sorted((r for r in deciding
+                   if len(moved(problem.params, effect.name, r["quantity"].partition(".")[2], r["value"])) == 1),
+                  key=lambda r: -max(e["calibrated_over_floor"] for e in r["ends"]))
+    if not rows:
+        return []
+    together = _fixed(state, engine, rows)
+    if together:
+        return together
+    for row in rows if len(rows) > 1 else []:  # one row alone was just tried
+        alone = _fixed(state, engine, [row])
+        if alone:
+            return alone
+    return []
+
+
+def _fixed(state: DiagnosisState, engine: ReplayEngine, rows: list[dict]) -> list[dict]:
+    """The quantities of `rows` fitted together with the calibrated parameters, those whose interval is narrow
+    enough (:func:`fixed_by_the_data`)."""
+    problem, settings, calibration = state.problem, state.settings, state.calibration
+    bands = {r["quantity"]: r["band"] for r in rows}
+    keys = (*[p.key for p in calibration.parameters if p.transform == "log"], *bands)
+    parameters = [replace(p, lower=max(p.lower, bands[p.key][0]), upper=min(p.upper, bands[p.key][1]))
+                  if p.key in bands else p
+                  for p in calibration_parameters(engine, problem, list(state.base), keys, settings=settings)]
+    theta0 = np.array([p.theta(calibration.values[p.key]) if p.key in calibration.values else 0.0
+                       for p in parameters])
+    fit = polish(engine, problem, least_squares(engine, problem, list(state.base), parameters, theta0,
+                                                calibration.fixed, settings=settings, refresh_at_end=False), settings)
+    intervals = fit.intervals(problem, settings.interval_block_s)
+    out = []
+    for row in rows:
+        if row["quantity"] not in intervals:  # a quantity the model does not use
+            continue
+        interval, (low, high) = intervals[row["quantity"]], row["band"]
+        ci = interval["ci95"]
+        narrow = ci[1] - ci[0] <= settings.assumed_fixed_fraction_of_band * (high - low)
+        if all(math.isfinite(c) for c in ci) and narrow:
+            out.append({"quantity": row["quantity"], "assumed": row["value"], "band": [low, high],
+                        "value": interval["value"], "ci95": list(ci), "verdict_assumed": state.verdict})
+    return out
+
+
+def diagnosed_with(state: DiagnosisState, engine: ReplayEngine, stage: Stage, out: dict, fixed: list[dict]
+                   ) -> DiagnosisState:
+    """The diagnosis made again from its calibration up to this stage, with the quantities in `fixed` calibrated
+    beside the base model's parameters; the files' replay uncertainty is kept as it stands (where a candidate was
+    evidenced, the larger of the base model's and the candidate's: stages/select.py)."""
+    settings = state.settings
+    keys = tuple(f["quantity"] for f in fixed)
+    state.progress("these data fix " + ", ".join(f"{f['quantity']} ({f['value']:.4g}, 95 % {f['ci95'][0]:.4g} to "
+                                                 f"{f['ci95'][1]:.4g}; the file assumed {f['assumed']:g})"
+                                                 for f in fixed)
+                   + ", which decide the verdict: calibrating them, diagnosing again")
+    table = tuple(state.table)
+    # from the calibration on: the base model's replay and its uncertainty are as they were; the calibration starts
+    # where this one ended, the new quantities at their fitted values
+    first = next(i for i, s in enumerate(table) if s.name == "calibration")
+    upto = table[first: table.index(stage) + 1]
+    again = restart(state, table=upto, nominal=state.nominal,
+                    start=frozen_mapping({**state.start_values, **state.calibration.values,
+                                          **{f["quantity"]: f["value"] for f in fixed}}),
+                    settings=replace(settings, calibrated_parameters=(*settings.calibrated_parameters, *keys)))
+    again = again.with_output(stage.name, {"calibrated": [*out["calibrated"], *fixed]})
+    done = run_table(again, engine)
+    return replace(done, table=table)  # its settings calibrate the new quantities: what they fix reports them too
