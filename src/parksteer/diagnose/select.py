@@ -15,9 +15,9 @@ The steps (:func:`diagnose`, each a stage of :data:`parksteer.diagnose.stages.ST
 5. compare by an information criterion over the effective sample size:
    ``BIC = n_eff ln(RSS / n) + k ln(n_eff)``, with ``n_eff = n (1 - rho) / (1 + rho)`` and rho
    the lag-1 autocorrelation of the best model's weighted residuals (neighbouring samples of
-   a smooth misfit are not independent evidence); only a candidate whose fitted strength is above 0 and whose
-   95 % interval is clear of 0 may be the best (:func:`parksteer.diagnose.stages.select.may_headline`), or be
-   named beside it (step 7);
+   a smooth misfit are not independent evidence); only a candidate whose fitted strength is above 0 may be the
+   best (:func:`parksteer.diagnose.stages.select.may_headline`; with ``headline_interval_clear_of_zero``, only one
+   whose 95 % interval is clear of 0), or be named beside it (step 7);
 6. the verdict:
 
    - ``missing``: the best candidate lowers the BIC by more than ``bic_missing_threshold``

@@ -11,7 +11,7 @@ replays would have: the calibrated model and the best candidate's refit each rep
 residuals refitted to first order (projected off the fit's Jacobian columns: the calibrated parameters take up what
 they can), and :func:`~parksteer.diagnose.stages.verdict.choose_verdict` on the calibrated model's RMS over the
 floor, the candidate's BIC gain and the fraction of the excess it explains, by the headline's rule (a candidate
-whose strength there is 0 or whose interval holds 0 is not named:
+whose strength there is 0, or with ``headline_interval_clear_of_zero`` whose interval holds 0, is not named:
 :func:`~parksteer.diagnose.stages.select.may_headline`); each end says why its verdict is what it is
 (:func:`end_reason`: the figures and the thresholds they were held against). A quantity whose band's end changes the
 verdict *decides* it: the report says it was assumed, and by how much the calibrated fit moves (in noise floors).
@@ -197,7 +197,8 @@ class AssumedValues(Stage):
             if with_fit is not None:
                 with_rss, with_weighted, theta = with_fit
                 strength = float(theta[strength_index])
-                clear = bool(strength > 0.0 and strength - halfwidth > 0.0)
+                clear = bool(strength > 0.0 and (strength - halfwidth > 0.0
+                                                 or not settings.headline_interval_clear_of_zero))
                 delta_bic = bic_gain(base_rss, with_rss, state.n_eff or n, 1)
                 after = math.sqrt(with_rss / n)
                 spread = trimmed_rms(with_weighted, settings.missing_ceiling_trim)

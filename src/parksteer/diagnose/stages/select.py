@@ -20,12 +20,15 @@ from .replay_uncertainty import with_replay_uncertainty
 
 def may_headline(problem: Problem, candidate: Candidate,
                  settings: DiagnosisSettings = DEFAULT_SETTINGS) -> bool:
-    """Whether a refitted candidate may be the one a diagnosis names: its fitted strength above 0 and its 95 %
-    interval (:meth:`parksteer.diagnose.calibrate.Fit.intervals`) clear of 0. A candidate is absent at strength 0,
-    so a refit that ends there, or whose interval holds it, says that the data do not need the candidate: whatever
-    it gained in the BIC came from the calibrated parameters moving with it, not from the candidate."""
+    """Whether a refitted candidate may be the one a diagnosis names: its fitted strength above 0 and, with the
+    setting ``headline_interval_clear_of_zero``, its 95 % interval (:meth:`parksteer.diagnose.calibrate.Fit.
+    intervals`) clear of 0. A candidate is absent at strength 0, so a refit that ends there says that the data do
+    not need the candidate: whatever it gained in the BIC came from the calibrated parameters moving with it, not
+    from the candidate."""
     key = candidate.signature.key
     strength = candidate.refit.values[key]
+    if not settings.headline_interval_clear_of_zero:
+        return bool(strength > 0.0)
     low = candidate.refit.intervals(problem, settings.interval_block_s)[key]["ci95"][0]
     return bool(strength > 0.0 and low > 0.0)
 
