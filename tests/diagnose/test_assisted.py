@@ -157,30 +157,6 @@ def test_a_record_of_the_assisted_car_with_nothing_hidden_is_adequate(polo):
                for e in rows["torque_constant"]["ends"])
 
 
-@pytest.mark.slow
-def test_assumed_values_that_decide_and_that_the_data_fix_are_calibrated(polo):
-    """The same null with ``assumed_values_calibrated``: the torque constant, the efficiency and the rotor's inertia
-    each move the fit past the adequate band at an end of theirs, and the current fixes them together with the base
-    parameters (each 95 % interval under half its band); calibrated, each interval holds the record's own value
-    (the file's 0.05 N m/A, 0.85, 2e-4 kg m^2: the record is the file's car), the verdict stays adequate, and none
-    of them is left among the assumed values."""
-    settings = replace(BENCHMARK_SETTINGS, assumed_values_replayed=True, assumed_values_calibrated=True)
-    result = diagnosis_dict(diagnose([prepare_file(record(polo), "kerb", label="polo")], polo,
-                                     resolve_effects(ASSIST), settings=settings))
-    assert result["verdict"] == "adequate"
-    jsonschema.validate(result, json.loads(SCHEMA_PATH.read_text(encoding="utf-8")))
-    name = "electric_assist_column"
-    calibrated = {c["quantity"].split(".")[1]: c for c in result["assumed"]["calibrated"]}
-    assert {"torque_constant", "efficiency", "motor_inertia"} <= set(calibrated)
-    for key, truth in (("torque_constant", 0.05), ("efficiency", 0.85), ("motor_inertia", 2e-4)):
-        low, high = result["calibrated"][f"{name}.{key}"]["ci95"]
-        assert low <= truth <= high, key
-        band = calibrated[key]["band"]
-        assert calibrated[key]["ci95"][1] - calibrated[key]["ci95"][0] <= 0.5 * (band[1] - band[0])
-    left = {r["quantity"].split(".")[1] for r in result["assumed"]["quantities"]}
-    assert not set(calibrated) & left and not any(r["decides"] for r in result["assumed"]["quantities"])
-
-
 def test_moving_a_factor_of_an_identified_product_holds_the_product(polo):
     """Where `assist identify` fixed the product k_t eta N (the torque constant's entry declares it identified), the
     assumed-values stage moves the efficiency with the torque constant taking up the product, and the reduction with

@@ -165,18 +165,10 @@ def _assumed_lines(assumed: dict) -> list[str]:
     there (parksteer.diagnose.stages.assumed)."""
     nominal = assumed["nominal"]
     rows = assumed["quantities"]
-    # assumed values that decided the verdict and that these data fix: calibrated, the diagnosis made again
-    measured = [f"`{c['quantity']}` decided the verdict ({c['verdict_assumed']} at the file's {num(c['assumed'], 4)}) "
-                f"and these data fix it: calibrated, {num(c['value'], 4)} (95 %: {num(c['ci95'][0], 4)} to "
-                f"{num(c['ci95'][1], 4)}, within its band {num(c['band'][0], 4)} to {num(c['band'][1], 4)}), and the "
-                "diagnosis made again with it." for c in assumed.get("calibrated", [])]
-    if measured:
-        measured.append("")
     if not rows:
-        return [*measured, "The vehicle file assumes none of the assist's values the model uses."]
+        return ["The vehicle file assumes none of the assist's values the model uses."]
     deciding = [r["quantity"] for r in rows if r["decides"]]
-    lines = [*measured,
-             f"Each value the vehicle file takes as assumed, replayed at the ends of its band (the calibrated fit "
+    lines = [f"Each value the vehicle file takes as assumed, replayed at the ends of its band (the calibrated fit "
              f"refitted to first order; as it stands {num(nominal['calibrated_over_floor'])} noise floors, verdict "
              f"{nominal['verdict']}). "
              + (f"The verdict depends on {', '.join(f'`{q}`' for q in deciding)}: give its value (a data sheet, "

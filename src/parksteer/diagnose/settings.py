@@ -78,15 +78,6 @@ class DiagnosisSettings:
     # An assisted car: each value of its [assist] the vehicle file takes as assumed replayed at its band's ends, and
     # the verdict there (parksteer.diagnose.stages.assumed: four replays a quantity). Off, the stage adds nothing.
     assumed_values_replayed: bool = True
-    # With assumed_values_calibrated, an assumed value whose band's end changes the verdict is calibrated with the
-    # base model's parameters, within its band, and the diagnosis made again from its calibration with it
-    # calibrated, where these data fix it: its 95 % interval at most assumed_fixed_fraction_of_band of its band wide
-    # (a half: the data then tell its band's two halves apart). Off by default: on the Polo's null record with its
-    # current (tests/diagnose/test_assisted.py) it fixes the torque constant, the efficiency and the rotor's inertia
-    # and costs 475 replays against 88, and the quoted numbers of the assisted examples in README.md and
-    # docs/assist_identify.md are those of the diagnosis without it.
-    assumed_values_calibrated: bool = False
-    assumed_fixed_fraction_of_band: float = 0.5
 
     # --- the torque channel's lag (parksteer.diagnose.stages.torque_lag) ---------------------------------------
     # A logger's torque channel may run behind its rack channel (a sensor's or an amplifier's filter delay,

@@ -21,12 +21,6 @@ the products the data fixed held (:func:`moved`).
 Four replays a quantity (two ends, the calibrated model and the best candidate's), none for a car without an
 assist. Quantities the data calibrate (the candidates' strengths, the calibrated parameters) are not here: the
 diagnosis fits them.
-
-With ``assumed_values_calibrated``, an assumed value that decides the verdict and that these data fix is measured
-instead: the deciding values are fitted together with the base model's parameters, each within its band, and those
-whose 95 % interval is at most ``assumed_fixed_fraction_of_band`` of the band wide are added to the calibrated
-parameters and the diagnosis is made again from its calibration (:func:`fixed_by_the_data`,
-:func:`diagnosed_with`); the JSON's ``assumed.calibrated`` lists them with the file's value and the verdict with it.
 """
 
 from __future__ import annotations
@@ -35,14 +29,11 @@ import math
 
 import numpy as np
 
-from dataclasses import replace
-
 from ...model.symbolic.components import power_assist_of
-from ..calibrate import calibration_parameters, least_squares, polish
 from ..engine import ReplayEngine
-from ..state import DiagnosisState, frozen_mapping
+from ..state import DiagnosisState
 from ..statistics import bic_gain
-from .base import Stage, restart, run_table
+from .base import Stage
 from .verdict import choose_verdict, trimmed_rms
 
 # The band of each assumed quantity of an electric assist (low, high), as its own source gives it
@@ -227,88 +218,4 @@ class AssumedValues(Stage):
                 ends.append({"value": end, **verdict_of(base_rss, with_fit)})
             rows.append({"quantity": full, "value": value, "source": source, "band": list(band), "ends": ends,
                          "decides": any(e["verdict"] != nominal["verdict"] for e in ends)})
-        out = {"verdict": state.verdict, "nominal": nominal, "quantities": rows,
-               "calibrated": list(state.outputs.get(self.name, {}).get("calibrated", []))}
-        fixed = fixed_by_the_data(state, engine, [r for r in rows if r["decides"]]) \
-            if settings.assumed_values_calibrated else []
-        if not fixed:
-            return state.with_output(self.name, out)
-        return diagnosed_with(state, engine, self, out, fixed)
-
-
-def fixed_by_the_data(state: DiagnosisState, engine: ReplayEngine, deciding: list[dict]) -> list[dict]:
-    """Of the assumed quantities that decide the verdict, those these data fix. They are calibrated together with
-    the base model's parameters (each as a log-ratio to the file's value, within its band), and each is kept where
-    its 95 % interval is at most ``assumed_fixed_fraction_of_band`` of its band wide. Where none is kept so (two
-    factors of one product, the torque constant and the efficiency, are fixed each with the other held, never
-    together), each is calibrated alone, the one that moves the fit most at its band's ends first, and the first
-    fixed is kept: with it calibrated, the diagnosis made again asks whether the others still decide. A quantity
-    the file ties to an identified product (:func:`moved` moves more than itself) is not calibrated alone: only the
-    product is fixed, not the factor."""
-    problem = state.problem
-    effect = power_assist_of(state.base)
-    rows = sorted((r for r in deciding
-                   if len(moved(problem.params, effect.name, r["quantity"].partition(".")[2], r["value"])) == 1),
-                  key=lambda r: -max(e["calibrated_over_floor"] for e in r["ends"]))
-    if not rows:
-        return []
-    together = _fixed(state, engine, rows)
-    if together:
-        return together
-    for row in rows if len(rows) > 1 else []:  # one row alone was just tried
-        alone = _fixed(state, engine, [row])
-        if alone:
-            return alone
-    return []
-
-
-def _fixed(state: DiagnosisState, engine: ReplayEngine, rows: list[dict]) -> list[dict]:
-    """The quantities of `rows` fitted together with the calibrated parameters, those whose interval is narrow
-    enough (:func:`fixed_by_the_data`)."""
-    problem, settings, calibration = state.problem, state.settings, state.calibration
-    bands = {r["quantity"]: r["band"] for r in rows}
-    keys = (*[p.key for p in calibration.parameters if p.transform == "log"], *bands)
-    parameters = [replace(p, lower=max(p.lower, bands[p.key][0]), upper=min(p.upper, bands[p.key][1]))
-                  if p.key in bands else p
-                  for p in calibration_parameters(engine, problem, list(state.base), keys, settings=settings)]
-    theta0 = np.array([p.theta(calibration.values[p.key]) if p.key in calibration.values else 0.0
-                       for p in parameters])
-    fit = polish(engine, problem, least_squares(engine, problem, list(state.base), parameters, theta0,
-                                                calibration.fixed, settings=settings, refresh_at_end=False), settings)
-    intervals = fit.intervals(problem, settings.interval_block_s)
-    out = []
-    for row in rows:
-        if row["quantity"] not in intervals:  # a quantity the model does not use
-            continue
-        interval, (low, high) = intervals[row["quantity"]], row["band"]
-        ci = interval["ci95"]
-        narrow = ci[1] - ci[0] <= settings.assumed_fixed_fraction_of_band * (high - low)
-        if all(math.isfinite(c) for c in ci) and narrow:
-            out.append({"quantity": row["quantity"], "assumed": row["value"], "band": [low, high],
-                        "value": interval["value"], "ci95": list(ci), "verdict_assumed": state.verdict})
-    return out
-
-
-def diagnosed_with(state: DiagnosisState, engine: ReplayEngine, stage: Stage, out: dict, fixed: list[dict]
-                   ) -> DiagnosisState:
-    """The diagnosis made again from its calibration up to this stage, with the quantities in `fixed` calibrated
-    beside the base model's parameters; the files' replay uncertainty is kept as it stands (where a candidate was
-    evidenced, the larger of the base model's and the candidate's: stages/select.py)."""
-    settings = state.settings
-    keys = tuple(f["quantity"] for f in fixed)
-    state.progress("these data fix " + ", ".join(f"{f['quantity']} ({f['value']:.4g}, 95 % {f['ci95'][0]:.4g} to "
-                                                 f"{f['ci95'][1]:.4g}; the file assumed {f['assumed']:g})"
-                                                 for f in fixed)
-                   + ", which decide the verdict: calibrating them, diagnosing again")
-    table = tuple(state.table)
-    # from the calibration on: the base model's replay and its uncertainty are as they were; the calibration starts
-    # where this one ended, the new quantities at their fitted values
-    first = next(i for i, s in enumerate(table) if s.name == "calibration")
-    upto = table[first: table.index(stage) + 1]
-    again = restart(state, table=upto, nominal=state.nominal,
-                    start=frozen_mapping({**state.start_values, **state.calibration.values,
-                                          **{f["quantity"]: f["value"] for f in fixed}}),
-                    settings=replace(settings, calibrated_parameters=(*settings.calibrated_parameters, *keys)))
-    again = again.with_output(stage.name, {"calibrated": [*out["calibrated"], *fixed]})
-    done = run_table(again, engine)
-    return replace(done, table=table)  # its settings calibrate the new quantities: what they fix reports them too
+        return state.with_output(self.name, {"verdict": state.verdict, "nominal": nominal, "quantities": rows})
