@@ -369,6 +369,28 @@ VEHICLE_SPEED = declare(Quantity(
     source="input of the run: 0 = standstill (the paper), up to 3 m/s (10.8 km/h) of creeping"))
 
 ENTRY_KEYS = {"value", "unit", "source"}
+# An entry may also declare how its value was obtained (``provenance``): "measured" (a data sheet, a published
+# value, a measurement of this car), "identified" (fitted from this car's records: ``parksteer assist identify``)
+# or "assumed" (a typical value, a numerical choice). Where it declares none, the value counts as assumed
+# (Parameters.provenance); the diagnosis replays an assumed value of the assist at its band's ends
+# (parksteer.diagnose.stages.assumed) and holds an identified one's products.
+PROVENANCE = "provenance"
+PROVENANCES = ("measured", "identified", "assumed")
+
+
+def check_provenance(where: str, entry: dict) -> str | None:
+    """An entry's declared provenance (None when it declares none); anything but :data:`PROVENANCES` is refused."""
+    if PROVENANCE not in entry:
+        return None
+    value = entry[PROVENANCE]
+    if value not in PROVENANCES:
+        raise ParameterError(f"{where}: provenance {value!r}, expected one of {', '.join(PROVENANCES)}")
+    return value
+
+
+def provenance_key(dotted: str) -> str:
+    """Where a quantity's declared provenance is kept beside its source (``Parameters.sources``)."""
+    return f"{dotted}.{PROVENANCE}"
 
 # Tolerances of the statics cross-check, from the printing precision of Table B1: wheel loads are printed to
 # 1 N (so their sum is good to 1 N, two roundings of 0.5 N) and y_cm to 0.1 mm (so the chassis weight's moment
@@ -429,6 +451,11 @@ class Parameters:
             return _DECLARED[dotted].source
         return self.sources[dotted]
 
+    def provenance(self, dotted: str) -> str:
+        """How the value of `dotted` was obtained, as its file declares it (:data:`PROVENANCES`); "assumed" where
+        the file declares none or gives no entry (a quantity at its effect's default)."""
+        return self.sources.get(provenance_key(dotted), "assumed")
+
     @property
     def case_names(self) -> list[str]:
         """Case names in file order (unladen first)."""
@@ -479,13 +506,14 @@ def _check_value(path: Path, key: str, spec: Quantity, entry: Any) -> Any:
     missing = ENTRY_KEYS - entry.keys()
     if missing:
         raise ParameterError(f"{where}: missing {', '.join(sorted(missing))}")
-    extra = entry.keys() - ENTRY_KEYS
+    extra = entry.keys() - ENTRY_KEYS - {PROVENANCE}
     if extra:
         raise ParameterError(f"{where}: unknown field {', '.join(sorted(extra))}")
     if entry["unit"] != spec.unit:
         raise ParameterError(f"{where}: unit {entry['unit']!r} where {spec.unit!r} is required")
     if not isinstance(entry["source"], str) or not entry["source"].strip():
         raise ParameterError(f"{where}: source must be a non-empty string")
+    check_provenance(where, entry)
     raw = entry["value"]
     if spec.is_list:
         if not isinstance(raw, list) or not raw:
@@ -510,6 +538,8 @@ def _check_table(path: Path, prefix: str, table: Any, schema: dict[str, Quantity
     for key, spec in schema.items():
         out[key] = _check_value(path, f"{prefix}.{key}", spec, table[key])
         sources[f"{prefix}.{key}"] = table[key]["source"]
+        if PROVENANCE in table[key]:
+            sources[provenance_key(f"{prefix}.{key}")] = table[key][PROVENANCE]
     return out
 
 

@@ -30,14 +30,18 @@ from .geometry import lock_steer_angle, steer_axis
 from .parameters import (
     CASE_SCHEMA,
     DEFAULT_PATH,
+    PROVENANCE,
+    PROVENANCES,
     SCHEMA,
     VEHICLE_SPEED,
     ParameterError,
     Parameters,
     check_entry,
+    check_provenance,
     check_statics,
     check_table,
     load_parameters,
+    provenance_key,
     quantity,
 )
 
@@ -122,15 +126,19 @@ def _read_assist(path: Path, table: Any, sections: dict, sources: dict) -> None:
         if key.startswith("boost_"):
             raise ParameterError(f"{path}: assist.{key}: a boost table is written as [assist.boost] (torsion_bar_torque, "
                                  "assist, optionally vehicle_speed)")
-        if not isinstance(entry, dict) or set(entry) != {"value", "unit", "source"}:
-            raise ParameterError(f"{path}: assist.{key}: expected {{ value, unit, source }}")
+        if not isinstance(entry, dict) or set(entry) - {PROVENANCE} != {"value", "unit", "source"}:
+            raise ParameterError(f"{path}: assist.{key}: expected {{ value, unit, source }} (and optionally "
+                                 f"provenance, one of {', '.join(PROVENANCES)})")
         _check_text(f"{path}: assist.{key}", entry)
+        provenance = check_provenance(f"{path}: assist.{key}", entry)
         value = entry["value"]
         if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
             raise ParameterError(f"{path}: assist.{key}: value {value!r} is not a finite number")
         values[key] = float(value)
         sources[f"{name}.{key}"] = str(entry["source"])
         sources[f"{name}.{key}.unit"] = str(entry["unit"])
+        if provenance is not None:
+            sources[provenance_key(f"{name}.{key}")] = provenance
     if BOOST_SECTION in table:
         # the table is the boost curve: the gain's (or the valve slope's) straight line is not added to it
         line = "valve_slope" if kind == "hydraulic" else "gain"
@@ -269,6 +277,10 @@ def vehicle_from_text(text: str, path: str | Path, base: str | Path | Parameters
             spec = _file_or_effect_quantity(path, section, name)
             sections.setdefault(section, {})[name] = check_entry(path, f"{section}.{name}", spec, entry)
             sources[f"{section}.{name}"] = entry["source"]
+            if PROVENANCE in entry:
+                sources[provenance_key(f"{section}.{name}")] = entry[PROVENANCE]
+            else:  # the base file's declaration is not this entry's
+                sources.pop(provenance_key(f"{section}.{name}"), None)
 
     cases_doc = doc.get("cases")
     if not isinstance(cases_doc, dict) or not cases_doc:

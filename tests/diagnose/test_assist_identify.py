@@ -173,11 +173,12 @@ def test_a_data_sheets_product_stands_against_a_balance_read_at_the_wrong_tyre_f
     the assist scales with the product k_t eta N: the balance cannot tell the two apart. With the truth's torque
     constant given as a data sheet's (0.055 N m/A) and the file's tyre-ground friction 0.60 (the truth's car has
     0.666), the balance reads another product, the written file keeps the data sheet's, and the friction at which
-    the balance would read the data sheet's is the car's own. Given as assumed instead, the same balance's product
-    is written: only a data sheet is held against it."""
+    the balance would read the data sheet's is the car's own. Declared assumed instead, the same balance's product
+    is written: only a value declared measured is held against it."""
     truth, path, _ = baseline
     text = et.POLO.read_text(encoding="utf-8")
-    sheet = 'torque_constant = { value = 0.055, unit = "N m/A", source = "data sheet of the motor" }'
+    sheet = ('torque_constant = { value = 0.055, unit = "N m/A", source = "data sheet of the motor", '
+             'provenance = "measured" }')
     text = "\n".join(sheet if line.startswith("torque_constant = ") else line for line in text.splitlines())
     friction = 'friction_coefficient = { value = 0.60, unit = "1", source = "assumed: not this car\'s" }'
     text = "\n".join(friction if line.startswith("friction_coefficient = ") else line for line in text.splitlines())
@@ -190,6 +191,5 @@ def test_a_data_sheets_product_stands_against_a_balance_read_at_the_wrong_tyre_f
     agree = found.tyre_friction + (product - found.balance_product) / found.product_per_tyre_friction
     assert agree == pytest.approx(0.666, abs=0.01)  # 0.665 measured: the balance is linear in the friction
     assumed = tmp_path / "assumed.toml"
-    assumed.write_text(text.replace('source = "data sheet of the motor"', 'source = "assumed: a guess"') + "\n",
-                       encoding="utf-8")
+    assumed.write_text(text.replace('provenance = "measured"', 'provenance = "assumed"') + "\n", encoding="utf-8")
     assert "torque_constant" not in identify_boost([path], assumed).kept

@@ -163,7 +163,8 @@ def test_a_record_of_the_assisted_car_with_nothing_hidden_is_adequate(polo):
     file marks assumed is there, the boost line's are not (the file's table gives the curve); the torsion bar's
     stiffness moves the fit by less than 0.1 % (the column is massless: with the rack given, its compliance barely
     reaches the torque); a torque constant of 0.03 or 0.07 N m/A instead of the assumed 0.05 scales the current the
-    replay predicts by 5/3 or 5/7, tens of the current's noise floors, and decides the verdict."""
+    replay predicts by 5/3 or 5/7, tens of the current's noise floors, and decides the verdict: each of its ends says
+    it is not adequate because the calibrated model is above the adequate threshold of 1.15 floors."""
     result = diagnosed(polo, record(polo))
     assert result["verdict"] == "adequate"
     stats = result["statistics"]["calibrated"]
@@ -178,22 +179,25 @@ def test_a_record_of_the_assisted_car_with_nothing_hidden_is_adequate(polo):
                for e in rows["torsion_bar_stiffness"]["ends"])
     assert rows["torque_constant"]["decides"] and not rows["torsion_bar_stiffness"]["decides"]
     assert min(e["calibrated_over_floor"] for e in rows["torque_constant"]["ends"]) > 5.0
+    assert all(e["verdict"] == "unexplained" and "above the 1.15 of adequate" in e["why"]
+               for e in rows["torque_constant"]["ends"])
     # the assumed values' section is on both pages (one structure renders both)
     text, page = assert_same_sections(result)
     assert "<h2>What the verdict owes to the assist&#x27;s assumed values</h2>" in page
 
 
 def test_moving_a_factor_of_an_identified_product_holds_the_product(polo):
-    """Where `assist identify` fixed the product k_t eta N (the torque constant's source says so), the assumed-values
-    stage moves the efficiency with the torque constant taking up the product, and the reduction with the product,
-    the reflected inertia N^2 J and the reflected friction N T_f held; a file's own torque constant moves alone."""
+    """Where `assist identify` fixed the product k_t eta N (the torque constant's entry declares it identified), the
+    assumed-values stage moves the efficiency with the torque constant taking up the product, and the reduction with
+    the product, the reflected inertia N^2 J and the reflected friction N T_f held; a file's own torque constant
+    moves alone."""
     from dataclasses import replace as copy
 
     from parksteer.diagnose.stages.assumed import moved
 
     name = "electric_assist_column"
     assert moved(polo, name, "efficiency", 0.75) == {f"{name}.efficiency": 0.75}
-    sources = {**polo.sources, **{f"{name}.{k}": "identified by parksteer assist identify from run.csv"
+    sources = {**polo.sources, **{f"{name}.{k}.provenance": "identified"
                                   for k in ("torque_constant", "motor_inertia", "motor_friction_torque")}}
     identified = copy(polo, sources=sources)
     v = lambda k: polo[f"{name}.{k}"]  # noqa: E731

@@ -73,7 +73,7 @@ from ..parameters import Parameters
 from .boost_map import BLOCK_S, Z95, _blocks, _estimate, _sandwich, _t95, fit_map
 from .identified_file import Identified
 from .problem import FileData
-from .stages.assumed import assumed_source
+from .stages.assumed import is_assumed
 
 # The mechanics' calibrated parameters (key, finite-difference step) beside the offset and the product: the column
 # torque is linear in the two frictions and the rotor's inertia, so one linear least-squares step is exact.
@@ -264,7 +264,7 @@ def identify_boost(records, vehicle, case: str | None = None, surface: str | Non
         judged["back_efficiency"] = (back_efficiency.value, *back_efficiency.ci95, eta_b)
 
     kept = [key for key, (value, lo, hi, file_value) in judged.items()
-            if not assumed_source(params.sources.get(f"{name}.{key}", "assumed")) or value < 0.0
+            if not is_assumed(params, f"{name}.{key}") or value < 0.0
             or lo <= file_value <= hi]
     # the product the table is written with: the balance's, or the file's where it is kept
     P = product_file if "torque_constant" in kept else p * product_file

@@ -194,11 +194,12 @@ def replace_assist_section(text: str, found) -> str:
     for key, entry in old.items():
         if key in ("type", "boost") or key in LINE_KEYS or key in replaced:
             continue
+        declared = f", provenance = {_toml_string(entry['provenance'])}" if "provenance" in entry else ""
         lines.append(f"{key} = {{ value = {_number(entry['value'])}, unit = {_toml_string(entry['unit'])}, "
-                     f"source = {_toml_string(entry['source'])} }}")
+                     f"source = {_toml_string(entry['source'])}{declared} }}")
     for key, (value, u, source) in replaced.items():
         lines.append(f"{key} = {{ value = {_number(value)}, unit = {_toml_string(u)}, "
-                     f"source = {_toml_string(source)} }}")
+                     f"source = {_toml_string(source)}, provenance = \"identified\" }}")
     torques = ", ".join(_number(t) for t in found.torques)
     assists = ", ".join(_number(max(a, 0.0)) for a in _strictly_rising(found.assist))
     intervals = "; ".join(f"{lo:.3g}-{hi:.3g}" for lo, hi in found.assist_ci95[2:])

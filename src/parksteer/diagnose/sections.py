@@ -228,8 +228,11 @@ def _assumed_parts(assumed: dict) -> list:
              f"{num(r['ends'][0]['calibrated_over_floor'])}, {num(r['ends'][1]['calibrated_over_floor'])}",
              f"{r['ends'][0]['verdict']}, {r['ends'][1]['verdict']}{' (decides)' if r['decides'] else ''}"]
             for r in rows]
+    # why an end is not adequate, by the headline's rule (older results carry no reason)
+    why = tuple(f"`{r['quantity']}` at {num(e['value'], 4)}: {e['verdict']}: {e['why']}."
+                for r in rows for e in r["ends"] if e["verdict"] != "adequate" and e.get("why"))
     return [Paragraph(text), table(["quantity", "value", "band", "over floor at its ends", "verdict at its ends"],
-                                   body)]
+                                   body)] + ([Paragraph("Where an end is not adequate, why:"), Bullets(why)] if why else [])
 
 
 def _verdict(result: dict) -> Paragraph:

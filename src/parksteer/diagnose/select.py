@@ -5,7 +5,9 @@ The steps (:func:`diagnose`, each a stage of :data:`parksteer.diagnose.stages.ST
 
 1. replay the files through the base model at its default parameters, and estimate each
    sample's replay uncertainty (:mod:`parksteer.diagnose.problem`);
-2. calibrate the base model's uncertain parameters (:mod:`parksteer.diagnose.calibrate`);
+2. calibrate the base model's uncertain parameters (:mod:`parksteer.diagnose.calibrate`), on to the optimum
+   of the sum of squares (:func:`parksteer.diagnose.calibrate.polish`: a candidate's refit starts there, so
+   that its BIC gain is its own and not the base parameters' moving on);
 3. for every candidate not in the model, its signature and score test at the calibrated model
    (:mod:`parksteer.diagnose.candidates`);
 4. refit the best-scored few in the full nonlinear model (calibrated parameters and the
@@ -13,7 +15,9 @@ The steps (:func:`diagnose`, each a stage of :data:`parksteer.diagnose.stages.ST
 5. compare by an information criterion over the effective sample size:
    ``BIC = n_eff ln(RSS / n) + k ln(n_eff)``, with ``n_eff = n (1 - rho) / (1 + rho)`` and rho
    the lag-1 autocorrelation of the best model's weighted residuals (neighbouring samples of
-   a smooth misfit are not independent evidence);
+   a smooth misfit are not independent evidence); only a candidate whose fitted strength is above 0 may be the
+   best (:func:`parksteer.diagnose.stages.select.may_headline`; with ``headline_interval_clear_of_zero``, only one
+   whose 95 % interval is clear of 0), or be named beside it (step 7);
 6. the verdict:
 
    - ``missing``: the best candidate lowers the BIC by more than ``bic_missing_threshold``

@@ -4,16 +4,19 @@ An assisted car's file gives some of its gear's numbers from a data sheet or fro
 and takes the rest from the effect's defaults (the motor's friction and rotor, the gear's efficiencies, the
 corners the boost line and the motor limit are smoothed over...). On an assisted car's bus the torsion-bar torque is
 clean enough that a default harmless on a manual car's records decides the verdict. So for every quantity of the
-assist whose source in the vehicle file is ``assumed`` or ``numerical`` (or that the file leaves to the effect's
-default) and that the model uses, this stage replays the final comparison with it at each end of its band
-(:data:`BANDS`: the range the quantity's own source gives) and gives the verdict those replays would have: the
-calibrated model and the best candidate's refit each replayed with the value moved, their residuals refitted to
-first order (projected off the fit's Jacobian columns: the calibrated parameters take up what they can), and
-:func:`~parksteer.diagnose.stages.verdict.choose_verdict` on the calibrated model's RMS over the floor, the
-candidate's BIC gain and the fraction of the excess it explains. A quantity whose band's end changes the verdict
-*decides* it: the report says it was assumed, and by how much the calibrated fit moves (in noise floors). Where
-``parksteer assist identify`` fixed the product k_t eta_f N, the efficiency and the reduction are moved with the
-products the data fixed held (:func:`moved`).
+assist that the vehicle file declares assumed (``provenance = "assumed"``, or no provenance, or no entry: the
+effect's default; ``Parameters.provenance``) and that the model uses, this stage replays the final comparison with
+it at each end of its band (:data:`BANDS`: the range the quantity's own source gives) and gives the verdict those
+replays would have: the calibrated model and the best candidate's refit each replayed with the value moved, their
+residuals refitted to first order (projected off the fit's Jacobian columns: the calibrated parameters take up what
+they can), and :func:`~parksteer.diagnose.stages.verdict.choose_verdict` on the calibrated model's RMS over the
+floor, the candidate's BIC gain and the fraction of the excess it explains, by the headline's rule (a candidate
+whose strength there is 0, or with ``headline_interval_clear_of_zero`` whose interval holds 0, is not named:
+:func:`~parksteer.diagnose.stages.select.may_headline`); each end says why its verdict is what it is
+(:func:`end_reason`: the figures and the thresholds they were held against). A quantity whose band's end changes the
+verdict *decides* it: the report says it was assumed, and by how much the calibrated fit moves (in noise floors).
+Where ``parksteer assist identify`` fixed the product k_t eta_f N, the efficiency and the reduction are moved with
+the products the data fixed held (:func:`moved`).
 
 Four replays a quantity (two ends, the calibrated model and the best candidate's), none for a car without an
 assist. Quantities the data calibrate (the candidates' strengths, the calibrated parameters) are not here: the
@@ -57,15 +60,17 @@ REDUCTION = {"column": (15.0, 22.0), "pinion": (15.0, 25.0), "rack": (1500.0, 35
 LINE_KEYS = ("gain", "dead_band", "dead_band_smoothing")
 
 
-def assumed_source(source: str) -> bool:
-    """Whether a vehicle file's `source` of a value says it is assumed: ``assumed``, ``numerical`` (a smoothing), or
-    no entry at all (the effect's default); anything else is a data sheet's or a measurement's."""
-    return source.startswith(("assumed", "numerical", "the effect's default"))
+def is_assumed(params, dotted: str) -> bool:
+    """Whether the vehicle file takes the value of `dotted` as assumed: its entry declares ``provenance =
+    "assumed"``, or declares none, or there is no entry (the effect's default) (``Parameters.provenance``); a value
+    declared measured or identified is the file's own."""
+    return params.provenance(dotted) == "assumed"
 
 
-def assumed_quantities(params, name: str, effect) -> list[tuple[str, float, str, tuple[float, float]]]:
+def assumed_quantities(params, name: str, effect, calibrated: tuple[str, ...] = ()
+                       ) -> list[tuple[str, float, str, tuple[float, float]]]:
     """(key, value, source, band) of each quantity of the assist `name` the file takes as assumed (module
-    docstring), in the effect's order."""
+    docstring), in the effect's order, but those in `calibrated` (keys the diagnosis fits)."""
     table = any(params.sections.get(name, {}).get(k, 0.0) for k in params.sections.get(name, {})
                 if k.startswith("boost_assist_"))
     out = []
@@ -74,7 +79,7 @@ def assumed_quantities(params, name: str, effect) -> list[tuple[str, float, str,
         if (key not in BANDS and key != "reduction_ratio") or (table and key in LINE_KEYS):
             continue
         source = params.sources.get(f"{name}.{key}", "the effect's default")
-        if not assumed_source(source):
+        if not is_assumed(params, f"{name}.{key}") or f"{name}.{key}" in calibrated:
             continue
         band = BANDS.get(key)
         if key == "reduction_ratio":
@@ -86,13 +91,14 @@ def assumed_quantities(params, name: str, effect) -> list[tuple[str, float, str,
 
 
 def moved(params, name: str, key: str, value: float) -> dict[str, float]:
-    """The overrides that move `key` of the assist `name` to `value`, holding what the data fixed. Where a value
-    was identified (``parksteer assist identify``: its source says so), the column balance fixed a product, not
-    its factors: the product k_t eta_f N (the torque constant), the back-driven delivery N k_t / eta_b per ampere
-    (eta_f eta_b, with the torque constant held), the rotor's reflected inertia N^2 J_m and friction N T_f. Moving
-    the efficiency or the reduction keeps each identified product, its other factor taking up the rest."""
+    """The overrides that move `key` of the assist `name` to `value`, holding what the data fixed. Where a value was
+    identified (``parksteer assist identify``: its entry declares ``provenance = "identified"``), the column balance
+    fixed a product, not its factors: the product k_t eta_f N (the torque constant), the back-driven delivery N k_t
+    / eta_b per ampere (eta_f eta_b, with the torque constant held), the rotor's reflected inertia N^2 J_m and
+    friction N T_f. Moving the efficiency or the reduction keeps each identified product, its other factor taking up
+    the rest."""
     v = lambda k: float(params[f"{name}.{k}"])  # noqa: E731
-    fixed = lambda k: params.sources.get(f"{name}.{k}", "").startswith("identified")  # noqa: E731
+    fixed = lambda k: params.provenance(f"{name}.{k}") == "identified"  # noqa: E731
     out = {f"{name}.{key}": value}
     if key == "efficiency":
         if fixed("torque_constant"):
@@ -110,14 +116,41 @@ def moved(params, name: str, key: str, value: float) -> dict[str, float]:
     return out
 
 
-def _refitted_rss(fit, problem, moved: list[np.ndarray]) -> tuple[float, np.ndarray]:
-    """The weighted RSS of `fit` with its model moved to `moved`, refitted to first order on its Jacobian."""
+def _refitted_rss(fit, problem, moved: list[np.ndarray]) -> tuple[float, np.ndarray, np.ndarray]:
+    """The weighted RSS of `fit` with its model moved to `moved`, refitted to first order on its Jacobian; with the
+    weighted residual and the fitted variables (theta) after that refit."""
     change = problem.scale([m - p for m, p in zip(moved, fit.predictions)])
     weighted = fit.weighted - change
+    theta = np.asarray(fit.theta, dtype=float)
     if fit.jacobian.size:
         step, *_ = np.linalg.lstsq(fit.jacobian, weighted, rcond=None)
         weighted = weighted - fit.jacobian @ step
-    return float(weighted @ weighted), weighted
+        theta = theta + step
+    return float(weighted @ weighted), weighted, theta
+
+
+def end_reason(end: dict, settings) -> str:
+    """Why the rule gives an end's verdict (:func:`~parksteer.diagnose.stages.verdict.choose_verdict`, with the
+    headline's condition that a named candidate's strength is above 0 and its interval clear of 0): the
+    thresholds each figure was held against, so that an end that is not adequate says why."""
+    over, gain, name = end["calibrated_over_floor"], end["delta_bic"], end["candidate"]
+    base = (f"the calibrated model {over:.3g} noise floors, "
+            + ("within" if over <= settings.adequate_rms_factor else "above")
+            + f" the {settings.adequate_rms_factor:g} of adequate")
+    if end["verdict"] == "missing":
+        return (f"{name} evidenced (BIC gain {gain:.3g} > {settings.bic_missing_threshold:g}), "
+                f"{end['after_over_floor']:.3g} floors with it")
+    if name is not None and not end["candidate_clear_of_zero"]:
+        candidate = f"{name}'s strength here holds 0, so it may not be named"
+    elif gain is None or gain <= settings.bic_missing_threshold:
+        candidate = ("no candidate evidenced" if gain is None else
+                     f"{name} not evidenced (BIC gain {gain:.3g}, {settings.bic_missing_threshold:g} needed)")
+    else:
+        candidate = (f"{name} evidenced (BIC gain {gain:.3g}) but leaves {end['after_over_floor']:.3g} floors "
+                     f"({end['spread_over_floor']:.3g} without its largest residuals; a name needs "
+                     f"{settings.adequate_rms_factor:g}, or {settings.explained_fraction_missing:g} of the excess "
+                     f"explained within {settings.missing_rms_ceiling:g})")
+    return f"{base}; {candidate}"
 
 
 class AssumedValues(Stage):
@@ -134,31 +167,51 @@ class AssumedValues(Stage):
                 or not state.settings.assumed_values_replayed):
             return state
         problem, settings, calibration = state.problem, state.settings, state.calibration
-        problem, settings, calibration = state.problem, state.settings, state.calibration
         n = problem.n
         best = state.best_candidate
         refit = best.refit if best is not None else None
 
-        def verdict_of(base_rss: float, with_fit: tuple[float, np.ndarray] | None) -> dict:
+        strength_key = best.signature.key if best is not None else None
+        # the candidate's 95 % half-width as it stands: moving an assumed value shifts its strength, to first order
+        # not its spread
+        halfwidth = None
+        if refit is not None:
+            low, high = refit.intervals(problem, settings.interval_block_s)[strength_key]["ci95"]
+            halfwidth = (high - low) / 2.0
+        strength_index = None if refit is None else [p.key for p in refit.parameters].index(strength_key)
+
+        def verdict_of(base_rss: float, with_fit: tuple[float, np.ndarray, np.ndarray] | None) -> dict:
+            """The verdict by the headline's rule: choose_verdict, with a candidate that may be named only while its
+            strength is above 0 and its interval clear of 0 (stages/select.py, may_headline)."""
             delta_bic = after = spread = explained = None
+            clear = None
             if with_fit is not None:
-                with_rss, with_weighted = with_fit
+                with_rss, with_weighted, theta = with_fit
+                strength = float(theta[strength_index])
+                clear = bool(strength > 0.0 and (strength - halfwidth > 0.0
+                                                 or not settings.headline_interval_clear_of_zero))
                 delta_bic = bic_gain(base_rss, with_rss, state.n_eff or n, 1)
                 after = math.sqrt(with_rss / n)
                 spread = trimmed_rms(with_weighted, settings.missing_ceiling_trim)
                 explained = (base_rss - with_rss) / (base_rss - n) if base_rss > n else None
-            return {"calibrated_over_floor": math.sqrt(base_rss / n), "delta_bic": delta_bic,
-                    "verdict": choose_verdict(math.sqrt(base_rss / n), delta_bic, after, explained, settings, spread)}
+            verdict = choose_verdict(math.sqrt(base_rss / n), delta_bic if clear else None, after if clear else None,
+                                     explained if clear else None, settings, spread if clear else None)
+            end = {"calibrated_over_floor": math.sqrt(base_rss / n), "delta_bic": delta_bic, "verdict": verdict,
+                   "candidate": best.name if best is not None else None, "candidate_clear_of_zero": clear,
+                   "after_over_floor": after, "spread_over_floor": spread}
+            end["why"] = end_reason(end, settings)
+            return end
 
         # the same rule on the fits as they stand: the reference the moved values are held against
-        nominal = verdict_of(calibration.rss, None if refit is None else (refit.rss, refit.weighted))
+        nominal = verdict_of(calibration.rss, None if refit is None else (refit.rss, refit.weighted, refit.theta))
         rows = []
-        for key, value, source, band in assumed_quantities(problem.params, effect.name, effect):
+        for key, value, source, band in assumed_quantities(problem.params, effect.name, effect,
+                                                           settings.calibrated_parameters):
             full = f"{effect.name}.{key}"
             ends = []
             for end in band:
                 change = moved(problem.params, effect.name, key, end)
-                base_rss, _ = _refitted_rss(calibration, problem, engine.predict(
+                base_rss, _, _ = _refitted_rss(calibration, problem, engine.predict(
                     problem, calibration.effects, {**calibration.overrides, **change}))
                 with_fit = None if refit is None else _refitted_rss(refit, problem, engine.predict(
                     problem, refit.effects, {**refit.overrides, **change}))

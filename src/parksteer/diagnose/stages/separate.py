@@ -14,6 +14,7 @@ from ..problem import Problem
 from ..replay import Replay
 from ..state import Candidate, DiagnosisState, Separation
 from .base import Stage
+from .select import may_headline
 
 
 def conditions_not_covered(problem: Problem) -> list[tuple[str, str]]:
@@ -60,5 +61,6 @@ class Separate(Stage):
         best, threshold = state.best_candidate, state.settings.bic_indistinguishable
         separations = tuple(separation(engine, state.problem, best, c) for c in state.candidates
                             if c.refit is not None and c.name != best.name
-                            and c.delta_bic >= best.delta_bic - threshold)
+                            and c.delta_bic >= best.delta_bic - threshold
+                            and may_headline(state.problem, c, state.settings))
         return replace(state, indistinguishable=separations)

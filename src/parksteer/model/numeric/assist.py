@@ -98,9 +98,10 @@ def gear_values(kind: str, given: dict[str, tuple[float, str]]) -> tuple[float, 
 
 
 def assist_template(kind: str, given: dict[str, tuple[float, str]], table: bool = False) -> str:
-    """The ``[assist]`` section of a vehicle file: `given` values ({quantity: (value, source)}) and every other
-    quantity of the assist at its assumed default, marked as assumed with its range and source. With `table` the
-    boost curve is a table that follows ([assist.boost]): the straight line's quantities are left out."""
+    """The ``[assist]`` section of a vehicle file: `given` values ({quantity: (value, source)}, declared measured)
+    and every other quantity of the assist at its assumed default, declared assumed, with its range and source.
+    With `table` the boost curve is a table that follows ([assist.boost]): the straight line's quantities are left
+    out."""
     if kind not in ASSIST_EFFECTS:
         raise UsageError(f"--assist {kind}: one of {', '.join(ASSIST_EFFECTS)}")
     name = ASSIST_EFFECTS[kind]
@@ -113,9 +114,12 @@ def assist_template(kind: str, given: dict[str, tuple[float, str]], table: bool 
         if key in given:
             value, source = given[key]
             q.check(value, where=f"assist.{key}")
+            provenance = "measured"
         else:
             value, source = q.default, q.source
+            provenance = "assumed"
         text = repr(float(value))
         source = source.replace("\\", "\\\\").replace('"', '\\"')
-        lines.append(f'{key} = {{ value = {text}, unit = "{q.unit}", source = "{source}" }}')
+        lines.append(f'{key} = {{ value = {text}, unit = "{q.unit}", source = "{source}", '
+                     f'provenance = "{provenance}" }}')
     return "\n".join(lines) + "\n"
