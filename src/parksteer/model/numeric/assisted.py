@@ -39,13 +39,14 @@ tolerance at the column, the pinion and the rack, and in saturation.
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
-from functools import cached_property
+from functools import cached_property, lru_cache
 
 import numpy as np
 
 from ...boost_table import MAX_POINTS, off_keys, table_keys
 from ...errors import UsageError
 from ...parameters import VEHICLE_SPEED
+from ...reduction_efficiency import min_monotone_back_efficiency
 from ..symbolic.components import power_assist_of
 from ..symbolic.effects.assist_common import (clamp, deadband, directional_efficiency, speed_gain, table_law,
                                               table_points)
@@ -197,6 +198,23 @@ class BoostLaw:
         return 0.5 * (low + high)
 
 
+@lru_cache(maxsize=64)
+def least_back_efficiency(forward: float) -> float:
+    """The least eta_b at which the gear's delivered torque rises with the motor torque at every rotor speed, at
+    eta_f = `forward` (:func:`parksteer.reduction_efficiency.min_monotone_back_efficiency`: 0.147 at 0.85)."""
+    return min_monotone_back_efficiency(forward)
+
+
+def check_back_efficiency(name: str, forward: float, back: float, where: str = "") -> None:
+    """Refuse a back-driven efficiency below :func:`least_back_efficiency` (one line): the delivered torque would
+    fall as the motor torque rises somewhere, and T + A(T) = y would have more than one root."""
+    least = least_back_efficiency(forward)
+    if back < least:
+        raise UsageError(f"{where}{name}.back_efficiency {back:g}: below {least:.3f}, the least at which the gear's "
+                         f"delivered torque rises with the motor torque at every speed (efficiency {forward:g}); the "
+                         "law would not be increasing and the replay could not invert it")
+
+
 def boost_law(run, p: np.ndarray) -> BoostLaw | None:
     """The boost law of `run`'s assist with the values of the parameter vector `p` (None without an assist)."""
     effect = power_assist_of(run.effects)
@@ -219,6 +237,7 @@ def boost_law(run, p: np.ndarray) -> BoostLaw | None:
                        speed=float(p[run.parameter_index(VEHICLE_SPEED.key)]),
                        back_efficiency=v("back_efficiency"), direction_width=v("limit_smoothing"),
                        friction_speed=v("friction_speed"))
+        check_back_efficiency(name, law.efficiency, law.back_efficiency)
     # the law-side effects of the model (a diagnosis's candidates acting in the control unit: Effect.boost_law)
     value = lambda key: float(p[run.parameter_index(key)])  # noqa: E731
     for other in run.effects:
