@@ -13,19 +13,22 @@ zero slope, with no corner. Beyond the last point the law goes on as a straight 
 (the motor's limit bounds it). A table of two points (0, 0), (T_1, A_1) is the straight line A_1 / T_1 T exactly.
 
 The effect reads the table as scalar quantities of fixed count (the generated code's parameter vector has a fixed
-layout): :data:`MAX_POINTS` torques, :data:`MAX_SPEEDS` speeds, an assist and a slope per speed and point. A shorter
-table is padded: torques beyond the last continue in steps of :data:`PAD_STEP_NM` with the straight continuation's
-values and slope (the same law), speeds beyond the last in steps of :data:`PAD_STEP_MPS` with the last row again.
-The law itself (segment choice, Hermite basis, linear interpolation in speed) is in
-:mod:`parksteer.model.symbolic.effects.assist_common`, one definition for the generated C and the replay.
+layout): :data:`MAX_POINTS` torques, :data:`MAX_SPEEDS` speeds, an assist and a slope per speed and point, 552
+scalars, consecutive in the parameter vector in :func:`table_keys` order. A shorter table is padded: torques beyond
+the last continue in steps of :data:`PAD_STEP_NM` with the straight continuation's values and slope (the same law),
+speeds beyond the last in steps of :data:`PAD_STEP_MPS` with the last row again. The law itself (segment choice,
+Hermite basis, linear interpolation in speed) is in :mod:`parksteer.model.symbolic.effects.assist_common`, one
+definition for the generated C and the replay: the model's expressions hold it as one function node, and the
+generated C calls one function printed from that definition (``parksteer.model.codegen.generate``), so a map of
+production size costs the cold build little (``benchmarks/bench_codegen.py``, model ``assist_column``).
 """
 
 from __future__ import annotations
 
 import math
 
-MAX_POINTS = 10
-MAX_SPEEDS = 3
+MAX_POINTS = 32  # torque points of a map
+MAX_SPEEDS = 8  # vehicle-speed rows
 PAD_STEP_NM = 1.0  # spacing of the padded torques beyond a table's last point (the law is a line there)
 PAD_STEP_MPS = 10.0  # spacing of the padded speeds beyond a table's last row (the same row again)
 KMH = 1.0 / 3.6  # m/s per km/h

@@ -78,7 +78,7 @@ from ....reduction_efficiency import (PI, back_efficiency, ball_nut_lead_angle, 
 from ..components import Effect
 from ..system import torque_between
 from .assist_common import (LOCATIONS, clamp, deadband, directional_efficiency, point_of_action,
-                            series_deflection, speed_gain, table_law, table_quantities, torsion_bar_torque)
+                            series_deflection, speed_gain, table_law_node, table_quantities, torsion_bar_torque)
 
 # The reduction's efficiencies from its geometry and friction (parksteer.reduction_efficiency: a thread of lead
 # angle lambda and friction angle rho, eta_f = tan(lambda) / tan(lambda + rho), eta_b = tan(lambda - rho) / tan(lambda)).
@@ -276,7 +276,7 @@ class ElectricAssist(Effect):
         sensor = self.sensor_torque(model)
         demand = self.gain(model) * deadband(sensor, self.q(model, "dead_band"),
                                              self.q(model, "dead_band_smoothing")) * scale
-        demand = demand + table_law(sensor, lambda key: self.q(model, key), model.p(VEHICLE_SPEED.key))
+        demand = demand + table_law_node(sensor, lambda key: self.q(model, key), model.p(VEHICLE_SPEED.key))
         at_motor = demand / (self.q(model, "efficiency") * self.q(model, "reduction_ratio"))
         return clamp(at_motor, self.q(model, "motor_torque_limit"), self.q(model, "limit_smoothing"))
 
