@@ -130,6 +130,28 @@ def entries(torques: list[float], speeds_mps: list[float] | None, rows: list[lis
     return out
 
 
+def table_size(values) -> tuple[int, int]:
+    """(points, rows) of the table as given, from its padded scalars (`values(key)` gives one, as :func:`entries`
+    wrote it): the points before the padding that continues the last point's straight line in steps of
+    :data:`PAD_STEP_NM`, and the rows before the last row's repeats. A table whose own last points lie on that line
+    at those steps reads as the shorter table: the same law."""
+    torques = [values(f"boost_torque_{k}") for k in range(MAX_POINTS)]
+    rows = [[values(f"boost_assist_{r}_{k}") for k in range(MAX_POINTS)] for r in range(MAX_SPEEDS)]
+    slopes_ = [[values(f"boost_slope_{r}_{k}") for k in range(MAX_POINTS)] for r in range(MAX_SPEEDS)]
+
+    def padded_from(n: int) -> bool:
+        last = torques[n - 1]
+        return all(torques[j] == last + PAD_STEP_NM * (j - n + 1) and all(
+            row[j] == row[n - 1] + slope[n - 1] * (torques[j] - last) and slope[j] == slope[n - 1]
+            for row, slope in zip(rows, slopes_)) for j in range(n, MAX_POINTS))
+
+    points = next(n for n in range(2, MAX_POINTS + 1) if padded_from(n))
+    count = MAX_SPEEDS
+    while count > 1 and rows[count - 1] == rows[count - 2] and slopes_[count - 1] == slopes_[count - 2]:
+        count -= 1
+    return points, count
+
+
 def table_keys() -> list[str]:
     """Every scalar key of a table (what :func:`entries` gives), in a fixed order."""
     keys = [f"boost_torque_{k}" for k in range(MAX_POINTS)] + [f"boost_speed_{r}" for r in range(MAX_SPEEDS)]
