@@ -116,9 +116,10 @@ def check_table_units(params: Parameters, name: str) -> None:
         scale = float(params[f"{name}.efficiency"]) * float(params[f"{name}.reduction_ratio"])
         if force < low and low <= force * scale <= high:
             likely = (f"the motor's torque written as the assist at the {kind}? As motor torque through eta N = "
-                      f"{scale:.4g} it is {force * scale:.0f} N: add at = \"motor\" to [assist.boost] assist (parksteer vehicle "
-                      "new: --assist-boost-unit motor)")
-        elif name != ASSIST_EFFECTS["rack"] and low <= force / float(params["steering.handwheel_to_rack_ratio"]) <= high:
+                      f"{scale:.4g} it is {force * scale:.0f} N: add at = \"motor\" to [assist.boost] assist "
+                      "(parksteer vehicle new: --assist-boost-unit motor)")
+        elif name != ASSIST_EFFECTS["rack"] and (
+                low <= force / float(params["steering.handwheel_to_rack_ratio"]) <= high):
             likely = f"a rack force (N) written as a torque at the {kind}? Give the torque at the {kind} (N m)"
         else:
             unit = "N at the rack" if name == ASSIST_EFFECTS["rack"] else f"N m at the {kind}"

@@ -29,7 +29,9 @@ smoothed corners (:mod:`parksteer.model.symbolic.effects.assist_common`); B is t
 demand, or the valve's pressure; zero without a table) and e the gear's efficiency in the direction the power flows (eta_f driving, 1 / eta_b back-driven), read
 from the prescribed rack's speed (the point of action's rate, as the effect reads it) and the law's motor torque. A is increasing (deadband and clamp are,
 strictly for a smoothed clamp: its slope is -(f(a) + f(b))/2 > 0 with f(z) = z / sqrt(z^2 + w^2), a + b = -2 L),
-so y(T_s) rises with slope >= 1 and has one root, found pointwise by bisection in ``[y - B, y + B]`` (B bounds
+and the gear's directional factor keeps the delivered torque rising with the motor torque for eta_b above a
+bound (:func:`least_back_efficiency`, 0.147 at eta_f 0.85; below it the law is refused), so y(T_s) rises with
+slope >= 1 and has one root, found pointwise by bisection in ``[y - B, y + B]`` (B bounds
 |A|). The motor torque T_m and current T_m / k_t (or the pressure) then follow from the law. Nothing in this depends
 on the acceleration: the rotor's inertia is in T_road. The tests (tests/model/test_assisted_replay.py) replay a
 free assisted simulation's rack and recover its torsion-bar torque and motor current to the integrator's

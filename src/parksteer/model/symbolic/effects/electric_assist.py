@@ -49,7 +49,10 @@ action, not eta_f N T_m. Between the two, smoothly through the power's sign
 limit_smoothing of motor torque), so that the gear's loss, T_m N dx/dt (1 - e), is never negative. The control
 unit commands T_m = A_cmd / (eta_f N): while the motor drives, the assist is the demand. The rotor's inertia J_m
 turns at omega = N dx/dt (kinetic energy J_m omega^2 / 2, N^2 J_m reflected to x), its bearings' Coulomb friction
-T_f tanh(omega / w) opposes it. The band w is the assist's own: how sharply the motor's friction and the worm's
+T_f tanh(omega / w) opposes it; both reach the point of action through N alone, without the gear's efficiency
+(a real worm passes them on with it too: at most (1 / eta_b - 1) N T_f of difference). At rest the factor e is 1
+(a stationary gear passes the motor's torque without loss), where a real worm holds by static friction anywhere
+between eta_f and 1 / eta_b; the defaults of eta_f and eta_b are a thread's (:mod:`parksteer.reduction_efficiency`). The band w is the assist's own: how sharply the motor's friction and the worm's
 direction change over at a reversal is a property of the gear, not the car-wide smoothing of the rack's sliding
 contacts, and on a torsion-bar channel of a bus's resolution it decides whether a reversal is read right.
 
@@ -81,7 +84,8 @@ from .assist_common import (LOCATIONS, clamp, deadband, directional_efficiency, 
                             series_deflection, speed_gain, table_law_node, table_quantities, torsion_bar_torque)
 
 # The reduction's efficiencies from its geometry and friction (parksteer.reduction_efficiency: a thread of lead
-# angle lambda and friction angle rho, eta_f = tan(lambda) / tan(lambda + rho), eta_b = tan(lambda - rho) / tan(lambda)).
+# angle lambda and friction angle rho, eta_f = tan(lambda) / tan(lambda + rho),
+# eta_b = tan(lambda - rho) / tan(lambda)).
 # The forward efficiency is the assumption (what a gear's maker states); the friction angle of the worm's sliding
 # flank, or the ball nut's lead and ball circle, is the second; the lead angle (worm) or the effective friction
 # (ball nut, its belt lumped in) follows from the two, and eta_b from the formula.
@@ -98,12 +102,14 @@ BALL_NUT_BACK_EFFICIENCY = back_efficiency(_NUT_LEAD_ANGLE_RAD, _NUT_FRICTION_AN
 _WORM_SOURCE = (
     f"assumed: worm gear eta_f {WORM_FORWARD_EFFICIENCY:g} with a sliding flank of friction angle "
     f"{WORM_FRICTION_ANGLE_RAD * 180.0 / PI:g} deg (mu {pm.tan(WORM_FRICTION_ANGLE_RAD):.3f}); the lead angle at which "
-    f"eta_f = tan(lambda) / tan(lambda + rho) is {WORM_FORWARD_EFFICIENCY:g}, {_WORM_LEAD_ANGLE_RAD * 180.0 / PI:.1f} deg, "
+    f"eta_f = tan(lambda) / tan(lambda + rho) is {WORM_FORWARD_EFFICIENCY:g}, "
+    f"{_WORM_LEAD_ANGLE_RAD * 180.0 / PI:.1f} deg, "
     "gives eta_b = tan(lambda - rho) / tan(lambda)")
 _BALL_NUT_SOURCE = (
     f"assumed: ball nut and belt eta_f {BALL_NUT_FORWARD_EFFICIENCY:g}, a {BALL_NUT_LEAD_M * 1e3:g} mm lead on a "
     f"{BALL_NUT_BALL_CIRCLE_M * 1e3:g} mm ball circle (lead angle {_NUT_LEAD_ANGLE_RAD * 180.0 / PI:.2f} deg); the "
-    f"friction angle at which eta_f = {BALL_NUT_FORWARD_EFFICIENCY:g} there, {_NUT_FRICTION_ANGLE_RAD * 180.0 / PI:.2f} "
+    f"friction angle at which eta_f = {BALL_NUT_FORWARD_EFFICIENCY:g} there, "
+    f"{_NUT_FRICTION_ANGLE_RAD * 180.0 / PI:.2f} "
     f"deg (mu {pm.tan(_NUT_FRICTION_ANGLE_RAD):.4f}, the belt's loss lumped into the nut's), gives "
     "eta_b = tan(lambda - rho) / tan(lambda)")
 
