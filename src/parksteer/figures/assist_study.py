@@ -166,8 +166,10 @@ def _tyre_term(result: SimulationResult, params: Parameters) -> float:
 
 def gear_numbers() -> dict:
     """The assist gears' efficiencies from their thread (parksteer.reduction_efficiency) as the effects' defaults take
-    them, the least eta_b at which the replay's law rises, and the units guard's window of rack forces."""
+    them, the least eta_b at which the replay's law rises, the units guard's window of rack forces and the largest
+    boost map (points, speed rows)."""
     from .. import reduction_efficiency as re_
+    from ..boost_table import MAX_POINTS, MAX_SPEEDS
     from ..model.numeric.assist import rack_force_window_N
     from ..model.symbolic.effects import electric_assist as ea
 
@@ -183,6 +185,7 @@ def gear_numbers() -> dict:
                      "lead_angle_deg": ea._NUT_LEAD_ANGLE_RAD * degrees,
                      "friction_angle_deg": ea._NUT_FRICTION_ANGLE_RAD * degrees},
         "rack_force_window_N": [low, high],
+        "map_size": {"points": MAX_POINTS, "speeds": MAX_SPEEDS},
     }
 
 
