@@ -139,13 +139,16 @@ FRICTION_SPEED_SOURCE = (
     "replays its band's ends (stage assumed)")
 
 _BACK_EFFICIENCY = {
-    "column": (WORM_BACK_EFFICIENCY, f"formula: {WORM_BACK_EFFICIENCY:.3f}; {_WORM_SOURCE} (the worm-gear "
-                                     "efficiencies in the lead angle: novasolver.jp worm gear calculator; "
-                                     "parksteer.reduction_efficiency); an EPS worm is back-drivable (lambda > rho)"),
-    "pinion": (WORM_BACK_EFFICIENCY, f"formula: {WORM_BACK_EFFICIENCY:.3f}, as at the column; {_WORM_SOURCE}"),
-    "rack": (BALL_NUT_BACK_EFFICIENCY, f"formula: {BALL_NUT_BACK_EFFICIENCY:.3f}; {_BALL_NUT_SOURCE} (the ball-screw "
-                                       "catalogue form (1 - mu / tan(lambda)) / (1 + mu tan(lambda)), the same "
-                                       "expression; parksteer.reduction_efficiency)"),
+    "column": (WORM_BACK_EFFICIENCY, f"assumed: the thread formula's {WORM_BACK_EFFICIENCY:.3f} for the "
+                                     f"{_WORM_SOURCE.removeprefix('assumed: ')} (the worm-gear efficiencies in the "
+                                     "lead angle: novasolver.jp worm gear calculator; parksteer.reduction_efficiency); "
+                                     "an EPS worm is back-drivable (lambda > rho)"),
+    "pinion": (WORM_BACK_EFFICIENCY, f"assumed: the thread formula's {WORM_BACK_EFFICIENCY:.3f}, as at the column, for "
+                                     f"the {_WORM_SOURCE.removeprefix('assumed: ')}"),
+    "rack": (BALL_NUT_BACK_EFFICIENCY, f"assumed: the thread formula's {BALL_NUT_BACK_EFFICIENCY:.3f} for the "
+                                       f"{_BALL_NUT_SOURCE.removeprefix('assumed: ')} (the ball-screw catalogue form "
+                                       "(1 - mu / tan(lambda)) / (1 + mu tan(lambda)), the same expression; "
+                                       "parksteer.reduction_efficiency)"),
 }
 _FORWARD_SOURCE = {
     "column": f"{_WORM_SOURCE}; range 0.75-0.9",
