@@ -203,6 +203,33 @@ def test_fir_low_pass_is_linear_phase_with_unit_dc_gain():
     assert np.allclose(h, h[::-1], rtol=0.0, atol=1e-15 * np.max(np.abs(h)))  # symmetric to rounding: linear phase
 
 
+@pytest.mark.parametrize("factor", [2, 3, 5, 10])
+def test_fir_decimation_is_scipys_resample_poly_to_the_bit(factor):
+    """The record importer's anti-alias decimation, written out so that a diagnosis need not import scipy.signal,
+    gives scipy.signal.resample_poly's bits (same taps, same zero-phase delay, same zero padding, same order of sums),
+    at lengths that are and are not multiples of the factor."""
+    from scipy.signal import resample_poly
+
+    rng = np.random.default_rng(factor)
+    fir = pm.hamming_lowpass_fir(20 * factor + 1, 1.0 / factor)
+    for n in (40 * factor, 40 * factor + 1, 4999):
+        x = np.cumsum(rng.normal(size=n)) * 1e-3
+        assert np.array_equal(pm.fir_decimate(x, fir, factor), resample_poly(x, 1, factor, window=fir))
+
+
+def test_running_filters_are_scipy_ndimages_to_the_bit():
+    """The running median and the three-sample maximum are selections, so the numpy forms must give
+    scipy.ndimage's median_filter and maximum_filter1d (mode "nearest") exactly, ties and ends included."""
+    from scipy.ndimage import maximum_filter1d, median_filter
+
+    rng = np.random.default_rng(3)
+    for n in (1, 2, 7, 1000, 70001):
+        x = np.round(rng.normal(size=n), 1)  # rounded: many ties
+        for size in (1, 3, 21):
+            assert np.array_equal(pm.running_median(x, size), median_filter(x, size=size, mode="nearest"))
+        assert np.array_equal(pm.running_max3(x), maximum_filter1d(x, size=3, mode="nearest"))
+
+
 BATTERY = r"""
 import hashlib, numpy as np
 from parksteer import portable as pm
@@ -212,7 +239,8 @@ a = rng.normal(size=(300, 9))
 parts = [pm.sin(x), pm.cos(x), pm.atan(x), pm.exp(x), pm.tanh(x), pm.log(np.abs(x)), pm.power(np.abs(x), 1.7),
          pm.matmul(a.T, a), pm.solve(pm.matmul(a.T, a), pm.matmul(a.T, x[:300])), pm.lstsq(a, x[:300]),
          pm.qr(a)[0], pm.inv(pm.matmul(a.T, a)), pm.norm(a, axis=0),
-         pm.butterworth_lowpass_sos(4, 30.0, 1000.0), pm.hamming_lowpass_fir(41, 0.2)]
+         pm.butterworth_lowpass_sos(4, 30.0, 1000.0), pm.hamming_lowpass_fir(41, 0.2),
+         pm.fir_decimate(x, pm.hamming_lowpass_fir(101, 0.2), 5), pm.running_median(x, 21), pm.running_max3(x)]
 print(hashlib.sha256(b"".join(np.ascontiguousarray(p).tobytes() for p in parts)).hexdigest())
 """
 # OpenBLAS kernels of three generations, numpy without AVX-512 and without AVX2, and two threads.

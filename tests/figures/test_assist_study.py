@@ -12,8 +12,11 @@ from parksteer.model.numeric.simulate import simulate
 
 
 @pytest.fixture(scope="module")
-def study(params):
-    return assist_study(params)
+def study(params, repo_root):
+    import yaml
+
+    config = yaml.safe_load((repo_root / "config" / "config.yaml").read_text(encoding="utf-8"))
+    return assist_study(params, config["assist"]["target_torque"])
 
 
 @pytest.mark.parametrize("kind", ASSISTS)
@@ -73,21 +76,45 @@ def test_the_driver_keeps_the_boost_curves_share(study, params, kind):
 
 def test_the_standstill_rack_force_grows_with_the_tyre_ground_friction(study):
     """The tyre's bore torque at standstill (equation (2)) is proportional to the tyre-ground friction, and it is
-    most of the standstill load: the peak rack force rises at every step of the dry-asphalt band 0.67, 0.8, 1.0,
-    by less than the friction's ratio (rack friction and lifting do not grow with it), and the study says where
-    the band sits against the published standstill rack forces."""
+    most of the standstill load: the peak rack force rises at every step of the band 0.67, 0.8, 1.0, by less than
+    the friction's ratio (rack friction and lifting do not grow with it); the rack's Coulomb friction is fully
+    developed where the rack slides at the peak, so without it the peak is the force less the source's 730 N; and
+    each friction is below, within or above the published class range, exactly once, as its force says."""
     band = study["friction_band"]
     force = band["peak_rack_force_N"]
     assert all(a < b for a, b in zip(force, force[1:]))
     assert force[-1] / force[0] < band["friction"][-1] / band["friction"][0]
-    low = band["published_standstill_rack_force_N"][0]
-    assert band["below_published_at"] == [f for f, x in zip(band["friction"], force) if x < low]
+    assert band["rack_friction_force_N"] == 730.0
+    assert [f - w for f, w in zip(force, band["peak_rack_force_without_rack_friction_N"])] == pytest.approx(
+        [730.0] * 3, abs=1e-6)
+    low, high = band["published_standstill_rack_force_N"]
+    for f, x in zip(band["friction"], force):
+        places = [f in band["below_published_at"], f in band["within_published_at"], f in band["above_published_at"]]
+        assert places == [x < low, low <= x <= high, x > high]
+
+
+def test_the_motor_sized_at_the_class_range_is_linear_in_the_rack_force(study, params):
+    """Quasi-statically the column assist carries the column torque F / c' less the driver's target, through a worm
+    of ratio N and efficiency eta against the rotor's friction T_f: T_m = ((F / c' - T) / N + T_f) / eta, linear in
+    the rack force F. Its three points (the model's own peak and the class range's 3 and 8 kN) lie on one line whose
+    slope, 1 / (c' N eta), gives back a lever c' within the gear's range at the peak (the Hooke joint moves it about
+    the pinion ratio 186.47 rad/m by the joint's speed ratio, cos 0.45 = 0.90 to 1 / 0.90)."""
+    load = study["class_load"]
+    force, motor = np.asarray(load["rack_force_N"]), np.asarray(load["motor_torque_Nm"])
+    slope = (motor[2] - motor[1]) / (force[2] - force[1])
+    assert motor[0] == pytest.approx(motor[1] + slope * (force[0] - force[1]), rel=1e-9)
+    assumed = study["assists"]["column"]["assumed"]
+    lever = 1.0 / (slope * assumed["reduction_ratio"]["value"] * assumed["efficiency"]["value"])
+    ratio = params["steering.handwheel_to_rack_ratio"]
+    assert 0.89 * ratio < lever < ratio / 0.89
+    assert load["rack_force_N"][1:] == study["friction_band"]["published_standstill_rack_force_N"]
 
 
 def test_a_steeper_turn_slip_slope_keeps_more_of_the_tyre_moment(study):
     """The turn-slip factor 1 / sqrt(1 + y^2) has y proportional to 1 / q_Dz8: the larger q_Dz8, the less the
     rolling removes, so at every creeping speed the tyre keeps more of its standstill moment, and the peak rack
-    force is larger, at 0.5 than at 0.12 than at 0.05; the 0.05 runs are the study's own creeping runs."""
+    force is larger, at the band's top than at the passenger-car tyre's 0.296 than at its foot 0.05; the 0.05 runs
+    are the study's own creeping runs (the turn_slip effect's default)."""
     spin = study["spin_slope_band"]
     kept = [spin["tyre_moment_kept"][f"{q:g}"] for q in spin["q_dz8"]]
     force = [spin["peak_rack_force_N"][f"{q:g}"] for q in spin["q_dz8"]]

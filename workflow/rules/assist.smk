@@ -40,6 +40,7 @@ rule vehicle_assist:
 rule assist_study:
     input:
         parameters=PARAMETERS,
+        loads="src/parksteer/data/published_loads.toml",
         models=[CREEPING_MODEL, ASSIST_MODELS["column"], ASSIST_MODELS["hydraulic"]],
     output:
         svg=figure_report("figures/assist_study.svg", "model"),
@@ -47,6 +48,7 @@ rule assist_study:
         json="results/assist_study.json",
     params:
         code=code("assist_study"),
+        target=config["assist"]["target_torque"],
     log:
         "logs/assist_study.log",
     benchmark:
@@ -55,6 +57,31 @@ rule assist_study:
         "../envs/parksteer.yaml"
     script:
         "../scripts/assist_study.py"
+
+
+# Creeping over speed and tyre (parksteer.figures.assist_creep): the paper's car without assist at 1, 3 and 5 km/h
+# over the turn-slip slope q_Dz8, the share of its standstill moment the rolling tyre keeps and the crossover where
+# the tyre's share of the plateau equals the rack friction's; about 130 cycles of 25 ms, bisection included, once
+# the creeping model is compiled. Writes the figure, its table and results/assist_creep.json; part of `all` (FIGURES).
+rule assist_creep:
+    input:
+        parameters=PARAMETERS,
+        loads="src/parksteer/data/published_loads.toml",
+        models=[CREEPING_MODEL],
+    output:
+        svg=figure_report("figures/assist_creep.svg", "model"),
+        csv=figure_report("figures/assist_creep.csv", "model"),
+        json="results/assist_creep.json",
+    params:
+        code=code("assist_creep"),
+    log:
+        "logs/assist_creep.log",
+    benchmark:
+        benchmark_file("assist_creep")
+    conda:
+        "../envs/parksteer.yaml"
+    script:
+        "../scripts/assist_creep.py"
 
 
 # The assisted benchmark (parksteer.experiments.assisted_benchmark, parksteer.figures.assisted): records of the Polo

@@ -28,6 +28,7 @@ FIGURES = {
     "bands": ["figures/bands.svg", "figures/bands.csv"],
     "rivals": ["figures/rivals.svg", "figures/rivals.csv"],
     "assist_study": ["figures/assist_study.svg", "figures/assist_study.csv"],
+    "assist_creep": ["figures/assist_creep.svg", "figures/assist_creep.csv"],
     "diag_assisted": ["figures/diag_assisted.svg", "figures/diag_assisted.csv"],
     "diag_assisted_truth": ["figures/diag_assisted_truth.svg", "figures/diag_assisted_truth.csv"],
 }

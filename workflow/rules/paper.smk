@@ -21,6 +21,7 @@ rule paper:
     input:
         source=paper_sources(),
         parameters=PARAMETERS,
+        loads="src/parksteer/data/published_loads.toml",
         effects="results/effects.json",
         figures=all_figure_files(),
         numbers=all_number_files(),

@@ -5,4 +5,4 @@ from parksteer.rules import rule_log
 
 with rule_log(snakemake):
     make_assist_study(snakemake.input.parameters, snakemake.output.svg, snakemake.output.csv, snakemake.output.json,
-                      progress=note)
+                      snakemake.params.target, progress=note)

@@ -122,7 +122,7 @@ FAMILIES: tuple[Family, ...] = (
 # model's.
 _GEAR_RAD_PER_m = 250.0
 FAMILIES = (*FAMILIES, replace(
-    FAMILIES[1], name="model, rack force", figures=("assist_study",),
+    FAMILIES[1], name="model, rack force", figures=("assist_study", "assist_creep"),
     by_unit={**FAMILIES[1].by_unit,
              "N": Tolerance(_MODEL_RTOL, _MODEL_TORQUE_ATOL_Nm * _GEAR_RAD_PER_m,
                             f"a rack force is a handwheel torque through the gear: the torque tolerance through "

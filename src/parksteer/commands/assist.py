@@ -1,6 +1,8 @@
 """``parksteer assist size``: the rack force a car needs at standstill and creeping, and the assist that keeps the
-driver's torque under a target (parksteer.sweep.assist_sizing). ``parksteer assist identify``: an electric assist's
-boost table and its gear's hidden numbers from the car's own records (parksteer.diagnose.assist_identify)."""
+driver's torque under a target (parksteer.sweep.assist_sizing). ``parksteer assist creep``: how much of the tyre's
+moment a creeping car keeps over the turn-slip slope (parksteer.figures.assist_creep). ``parksteer assist
+identify``: an electric assist's boost table and its gear's hidden numbers from the car's own records
+(parksteer.diagnose.assist_identify)."""
 
 from __future__ import annotations
 
@@ -35,6 +37,13 @@ def register(sub) -> None:
     s.add_argument("--out-dir", required=True, help="folder for sizing.csv and the two figures")
     s.add_argument("--parameters", default=str(DEFAULT_PATH), help="the base parameter file")
     s.set_defaults(func=_size)
+    c = asub.add_parser("creep", help="creeping without assist at 1, 3 and 5 km/h over the tyre's turn-slip slope "
+                                      "q_Dz8: the share of the standstill tyre moment kept, and where the tyre's "
+                                      "share of the parking torque equals the rack friction's")
+    c.add_argument("--vehicle", default=None, metavar="FILE.toml", help="a vehicle file (default: the paper's car)")
+    c.add_argument("--case", default=None, help="its load case (default: its first)")
+    c.add_argument("--parameters", default=str(DEFAULT_PATH), help="the base parameter file")
+    c.set_defaults(func=_creep)
     i = asub.add_parser("identify", help="an electric assist's boost table, motor friction, product k_t eta N and "
                                          "torque-sensor offset from the car's records (torsion-bar torque and motor "
                                          "current), written into the vehicle file")
@@ -85,6 +94,18 @@ def _identify(args) -> int:
     return 0
 
 
+def _creep(args) -> int:
+    from ..figures.assist_creep import creep_study, summary_lines
+
+    params = parameters_of(args)
+    case = args.case or params.case_names[0]
+    if case not in params.case_names:
+        raise UsageError(f"--case {case}: not a case of {args.vehicle or args.parameters} "
+                         f"({', '.join(params.case_names)})")
+    print("\n".join(summary_lines(creep_study(params, case))))
+    return 0
+
+
 def _speeds(text: str) -> tuple[float, ...]:
     try:
         speeds = tuple(float(x) for x in text.split(",") if x.strip())
@@ -130,8 +151,9 @@ def _size(args) -> int:
 
 
 def print_friction_band(study) -> None:
-    """The standstill rack force over the tyre-ground friction band, against the published forces; a warning on
-    stderr when even the band's top is below them."""
+    """The standstill rack force over the tyre-ground friction band, with and without the rack's own friction,
+    against the published class range, and the assist sized at the range's ends; a warning on stderr when a force
+    of the band is below the range."""
     import sys
 
     from ..sweep.assist_sizing import PUBLISHED_STANDSTILL_RACK_FORCE_N
@@ -140,10 +162,16 @@ def print_friction_band(study) -> None:
     hydraulic = study.assist == ASSIST_EFFECTS["hydraulic"]
     print(f"standstill over the tyre-ground friction of dry asphalt (published for small and medium cars: "
           f"{low / 1e3:g}-{high / 1e3:g} kN)")
-    print("friction  peak rack force N" + ("" if hydraulic else "  motor torque N m  motor current A"))
+    print("friction  peak rack force N  without rack friction N" + ("" if hydraulic else
+                                                                    "  motor torque N m  motor current A"))
     for r in study.friction_band:
-        print(f"{r.friction:8.2f}  {r.peak_rack_force_N:17.0f}"
+        print(f"{r.friction:8.2f}  {r.peak_rack_force_N:17.0f}  {r.peak_rack_force_without_rack_friction_N:23.0f}"
               + ("" if hydraulic else f"  {r.motor_torque_Nm:16.2f}  {r.motor_current_A:15.1f}"))
+    print("sized at the class range's ends (quasi-static, through this car's gear at its standstill peak)")
+    print("rack force N  " + ("pressure bar" if hydraulic else "motor torque N m  motor current A"))
+    for r in study.class_load:
+        print(f"{r.rack_force_N:12.0f}  " + (f"{r.pressure_Pa / 1e5:12.1f}" if hydraulic else
+                                            f"{r.motor_torque_Nm:16.2f}  {r.motor_current_A:15.1f}"))
     below = study.below_published()
     if below:
         frictions = ", ".join(f"{r.friction:g}" for r in below)
@@ -151,7 +179,7 @@ def print_friction_band(study) -> None:
         print(f"warning: at tyre-ground friction {frictions} the standstill rack force is below the "
               f"{low / 1e3:g}-{high / 1e3:g} kN published for current small and medium cars ({top:.0f} N at the "
               "band's top): the tyre's bore torque (equation (2)) or the car's loads may be those of an older or "
-              "lighter car; size the motor for the band's top", file=sys.stderr)
+              "lighter car; size the motor for the band's top or the class range's", file=sys.stderr)
 
 
 def with_gain_half_speed(params, args):

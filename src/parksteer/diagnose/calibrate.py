@@ -28,7 +28,6 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.special import stdtrit  # the t quantile, without importing scipy.stats (a second per process)
 
 from .. import portable as pm
 from ..model.symbolic.components import Effect
@@ -137,6 +136,8 @@ class Fit:
             except pm.LinAlgError:
                 covariance, sandwich, blocks = np.full((k, k), np.inf), np.full((k, k), np.inf), 0
                 replay = np.zeros((k, k))
+        from scipy.special import stdtrit  # the t quantile without scipy.stats; imported where used, not with the module
+
         quantile = float(stdtrit(blocks - k, 0.975)) if blocks > k else math.inf
         out = {}
         for i, (p, t) in enumerate(zip(self.parameters, self.theta)):

@@ -30,7 +30,6 @@ from __future__ import annotations
 from dataclasses import replace
 
 import numpy as np
-from scipy.ndimage import maximum_filter1d
 
 from .. import portable as pm
 from ..measure.converter import add_noise, quantise
@@ -91,7 +90,7 @@ def with_replay_uncertainty(engine: ReplayEngine, problem: Problem, effects: lis
             # The replayed torque is itself off by about its attainable error, and the twist that passes it by
             # as much through the column's compliance (in a dead band: the band, where |T| is that small).
             through_torque = engine.replay(problem, effects, i).twist_spread(f.sigma_Nm, overrides)
-            spread = pm.hypot(_spread(angle_runs, None), maximum_filter1d(through_torque, size=3, mode="nearest"))
+            spread = pm.hypot(_spread(angle_runs, None), pm.running_max3(through_torque))
             before = f.replay_uncertainty_rad if keep_larger else None
             f = replace(f, replay_draws_rad=angle_runs - angle_runs.mean(axis=0),
                         replay_uncertainty_rad=spread if before is None else np.maximum(spread, before))
@@ -106,7 +105,7 @@ def with_replay_uncertainty(engine: ReplayEngine, problem: Problem, effects: lis
 
 def _spread(runs: np.ndarray, before: np.ndarray | None) -> np.ndarray:
     """The draws' standard deviation at each sample, widened by one sample either side; at least `before`."""
-    spread = maximum_filter1d(np.std(runs, axis=0, ddof=1), size=3, mode="nearest")
+    spread = pm.running_max3(np.std(runs, axis=0, ddof=1))
     return spread if before is None else np.maximum(spread, before)
 
 

@@ -55,7 +55,6 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.special import chdtrc  # chi2.sf, without importing all of scipy.stats
 
 from .. import portable as pm
 from ..errors import UsageError
@@ -208,6 +207,8 @@ def signature_from_axes(axes: Axes, settings: DiagnosisSettings = DEFAULT_SETTIN
         k = b.columns.shape[1]
         gain = bic_gain(rss0, rss, n_eff, k)
         scores.append(ModelScore(b.family, b.label, k, float(rss), float(gain)))
+    from scipy.special import chdtrc  # chi2.sf without scipy.stats; imported here, where it is used, not with the module
+
     shares = []
     excess = rss0 - n
     for name, columns in groups:

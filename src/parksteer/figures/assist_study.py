@@ -31,9 +31,12 @@ tyre_friction and turn_slip terms). The creeping result hangs on the turn-slip s
 assist runs again at 1, 3, 5 km/h over SPIN_SLOPE_BAND, and the share of its standstill tyre moment the rolling
 tyre keeps on the plateau is reported for each (the figure shades the band of peak rack force).
 
-Loads. The standstill cycle without assist runs again over the tyre-ground friction band of dry asphalt
-(parksteer.sweep.assist_sizing.FRICTION_BAND), its peak rack force set against the published standstill rack
-forces of current small and medium cars (PUBLISHED_STANDSTILL_RACK_FORCE_N there).
+Loads. The standstill cycle without assist runs again over the tyre-ground friction band
+(parksteer.sweep.assist_sizing.FRICTION_BAND), its peak rack force, with and without the rack's own friction, set
+against the published class range of standstill rack forces of small and medium cars
+(PUBLISHED_STANDSTILL_RACK_FORCE_N there): below, within or above it at each friction. The column assist at its
+defaults is sized for the driver's target torque (the pipeline's assist.target_torque) against the model's
+standstill load and against the class range's ends (class_load).
 
 Numbers on this path reach a checksummed figure: elementwise arithmetic, means and extrema only.
 """
@@ -47,7 +50,8 @@ import numpy as np
 from ..model.numeric.simulate import SimulationResult, simulate
 from ..model.symbolic.components import discover_effects
 from ..parameters import Parameters, load_parameters
-from ..sweep.assist_sizing import FRICTION_BAND, PUBLISHED_STANDSTILL_RACK_FORCE_N, SPEEDS_KMH
+from ..sweep.assist_sizing import (FRICTION_BAND, PUBLISHED_STANDSTILL_RACK_FORCE_N, SPEEDS_KMH, published_loads,
+                                   rack_force_without_rack_friction_N, size_for_rack_force)
 from ..tables import write_csv, write_json
 from ..vehicle import ASSIST_EFFECTS, ASSISTED_EFFECTS, CREEPING_EFFECTS, creeping_overrides
 from .model import OFFSET_CASES, _at, _times, plateau_mask, until_hand_stops
@@ -62,11 +66,11 @@ QUOTED = {
 }
 # The rolling tyre's assumed coefficients the paper quotes (MF 6.1 defaults, in the turn_slip effect's file).
 TURN_SLIP_QUOTED = ("spin_slope_coefficient", "camber_reduction")
-# The band of q_Dz8 (turn_slip.spin_slope_coefficient) the creeping result is shown over, car without assist: the
-# MF 6.1 default 0.05 (the effect's source), and 0.12 and 0.5, near the |q_Dz8| of fitted car-tyre sets (0.12 and
-# 0.53 are values quoted for such sets; no published property file was checked here). The larger q_Dz8, the
-# more of its standstill moment the rolling tyre keeps.
-SPIN_SLOPE_BAND = (0.05, 0.12, 0.5)
+# The band of |q_Dz8| (turn_slip.spin_slope_coefficient) the creeping result is shown over, car without assist: the
+# assumed band's ends and the one passenger-car tyre found inside it (published_loads.toml, [spin_slope]). The larger
+# q_Dz8, the more of its standstill moment the rolling tyre keeps.
+_SPIN = published_loads()["spin_slope"]
+SPIN_SLOPE_BAND = (_SPIN["band"][0], _SPIN["passenger_car"], _SPIN["band"][1])
 SPIN_SLOPE_KEY = "turn_slip.spin_slope_coefficient"
 
 
@@ -202,12 +206,31 @@ def back_driven(result: SimulationResult, params: Parameters, least_Nm: float = 
             "forward_factor": float(np.min(factor))}
 
 
+def class_load(standstill: SimulationResult, params: Parameters, target_torque_Nm: float) -> dict:
+    """The column assist at its defaults sized, quasi-statically, to leave the driver `target_torque_Nm` against
+    the model's standstill peak rack force and against the ends of the published class range, through the car's gear
+    at the standstill peak (parksteer.sweep.assist_sizing.size_for_rack_force); with the defaults' motor limit."""
+    name = ASSIST_EFFECTS["column"]
+    c = standstill.columns
+    per_rack = standstill.outputs()["column_angle_per_rack_rad_per_m"]
+    force = c["handwheel_torque_Nm"] * per_rack
+    peak = int(np.argmax(np.abs(force)))
+    at_peak = float(np.abs(per_rack[peak]))
+    rows = [size_for_rack_force(name, params, f, at_peak, target_torque_Nm)
+            for f in (float(np.abs(force[peak])), *PUBLISHED_STANDSTILL_RACK_FORCE_N)]
+    return {"target_torque_Nm": target_torque_Nm, "rack_force_N": [r.rack_force_N for r in rows],
+            "motor_torque_Nm": [r.motor_torque_Nm for r in rows],
+            "motor_current_A": [r.motor_current_A for r in rows],
+            "motor_torque_limit_Nm": assumed_values("column")["motor_torque_limit"]["value"]}
+
+
 def _spread(values: dict) -> float:
     return max(values.values()) - min(values.values())
 
 
-def assist_study(params: Parameters, run=simulate, progress=None) -> dict:
-    """Every run of the study and the numbers the paper quotes (module docstring). `run` is the simulation
+def assist_study(params: Parameters, target_torque_Nm: float, run=simulate, progress=None) -> dict:
+    """Every run of the study and the numbers the paper quotes (module docstring); `target_torque_Nm` is the driver's
+    torque the class-load sizing keeps (the pipeline's config, assist.target_torque). `run` is the simulation
     (simulate's signature); `progress`, if given, is called with a line per run."""
     discover_effects()  # the assists' own quantities, with their assumed defaults
     kinds = (None, *ASSISTS)
@@ -265,10 +288,18 @@ def assist_study(params: Parameters, run=simulate, progress=None) -> dict:
     force = numbers["runs"]["none"]["speeds"]["peak_rack_force_N"]
     numbers["rack_force_fall_at_5_kmh"] = 1.0 - force[-1] / force[0]
     band = [peak_rack_force_N(results[("friction", f)]) for f in FRICTION_BAND]
-    numbers["friction_band"] = {"friction": list(FRICTION_BAND), "peak_rack_force_N": band,
-                                "published_standstill_rack_force_N": list(PUBLISHED_STANDSTILL_RACK_FORCE_N),
-                                "below_published_at": [f for f, force in zip(FRICTION_BAND, band)
-                                                       if force < PUBLISHED_STANDSTILL_RACK_FORCE_N[0]]}
+    low, high = PUBLISHED_STANDSTILL_RACK_FORCE_N
+    numbers["friction_band"] = {
+        "friction": list(FRICTION_BAND), "peak_rack_force_N": band,
+        "peak_rack_force_without_rack_friction_N": [
+            float(np.max(np.abs(rack_force_without_rack_friction_N(results[("friction", f)]))))
+            for f in FRICTION_BAND],
+        "rack_friction_force_N": float(params["steering.rack_friction_force"]),
+        "published_standstill_rack_force_N": [low, high],
+        "below_published_at": [f for f, force in zip(FRICTION_BAND, band) if force < low],
+        "within_published_at": [f for f, force in zip(FRICTION_BAND, band) if low <= force <= high],
+        "above_published_at": [f for f, force in zip(FRICTION_BAND, band) if force > high]}
+    numbers["class_load"] = class_load(results[(None, CASE, 0.0)], params, target_torque_Nm)
     standstill_tyre = _tyre_term(results[(None, CASE, 0.0)], params)
     numbers["spin_slope_band"] = {
         "q_dz8": list(SPIN_SLOPE_BAND),
@@ -346,12 +377,12 @@ def plot_study(numbers: dict, params: Parameters):
 
 
 def make_assist_study(parameters_path: str | Path, svg_path: str | Path, csv_path: str | Path,
-                      json_path: str | Path, progress=None) -> dict:
+                      json_path: str | Path, target_torque_Nm: float, progress=None) -> dict:
     """Write the study's figure (SVG), its table (CSV) and the numbers the paper quotes (JSON)."""
     from ..plotting import save_svg
 
     params = load_parameters(parameters_path)
-    numbers = assist_study(params, progress=progress)
+    numbers = assist_study(params, target_torque_Nm, progress=progress)
     header = {"table": "the paper's car over the lock-to-lock cycle without and with each assist at its assumed "
                        "defaults: the four wheel offsets at standstill, the unladen car at creeping speeds",
               "peak_rack_force_N": "pinion and assist together on the rack; given for the unladen car"}

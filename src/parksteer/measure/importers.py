@@ -603,8 +603,6 @@ def _decimate(path: Path, columns: dict[str, np.ndarray], metadata: dict[str, st
               ) -> dict[str, np.ndarray]:
     """A record sampled faster than METHOD_RATE_HZ, filtered (FIR anti-alias, zero phase) and decimated by the
     largest whole factor that keeps at least that rate; a record with uneven sampling is left as it is."""
-    from scipy.signal import resample_poly
-
     time_s = columns[TIME]
     steps = np.diff(time_s)
     dt = float(np.median(steps))
@@ -616,7 +614,7 @@ def _decimate(path: Path, columns: dict[str, np.ndarray], metadata: dict[str, st
     fir = pm.hamming_lowpass_fir(20 * factor + 1, 1.0 / factor)
     for name, values in columns.items():
         if name != TIME:
-            out[name] = resample_poly(values, 1, factor, window=fir)[: len(out[TIME])]
+            out[name] = pm.fir_decimate(values, fir, factor)[: len(out[TIME])]
     # A converter's levels no longer describe filtered samples, but its rounding stays in them where the signal
     # moves by less than a step (the filter averages rounding errors only across the levels crossed): the step is
     # kept as the column's rounding (Measurement.rounding_step).

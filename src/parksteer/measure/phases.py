@@ -50,8 +50,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.ndimage import median_filter
 
+from .. import portable as pm
 from ..errors import UsageError
 from ..names import SURFACES
 
@@ -88,7 +88,7 @@ def running_median(time_s: np.ndarray, values: np.ndarray, window_s: float) -> n
     dt = float(np.median(np.diff(time_s)))
     size = max(1, int(round(window_s / dt)))
     size += 1 - size % 2
-    return median_filter(np.asarray(values, dtype=float), size=size, mode="nearest")
+    return pm.running_median(np.asarray(values, dtype=float), size)
 
 
 @dataclass(frozen=True)

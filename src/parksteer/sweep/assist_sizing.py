@@ -29,12 +29,22 @@ gives at the row's speed, G(v) = G / (1 + s (v / v_half)^2) (the row's ``gain``)
 1, 3, 5 km/h is then what the falling gain leaves, quasi-statically (T_road + G(v) D) / (1 + G(v)) beyond the
 dead band D. Without it each speed's check sizes its own gain, the assist a speed-independent curve would need there.
 
+Loads. The standstill cycle runs again over the tyre-ground friction band (FRICTION_BAND), its peak rack force
+given with and without the rack's own friction (the rack friction's term taken out of the handwheel torque: the
+linkage's load alone). A vehicle file whose linkage ratio rises toward lock gives the linkage_nonlinearity effect's
+coefficient c (steer = G x (1 + c (G x)^2), G = roadwheel_to_rack_ratio: the ratio rises by 1 + 3 c delta^2); every
+run of the study then carries that effect (with_linkage), the check runs too. The model's load is one car's; the motor is also sized at the ends of the published class
+range of standstill rack forces (PUBLISHED_STANDSTILL_RACK_FORCE_N), quasi-statically through the car's gear at its
+standstill peak (size_for_rack_force). Both ranges, with their sources, are in ``parksteer/data/published_loads.toml``.
+
 The assist's values are the vehicle file's ``[assist]``, else the assumed defaults of a column assist.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import functools
+import tomllib
 
 import numpy as np
 
@@ -43,23 +53,26 @@ from ..model.numeric.assist import check_assist, table_off
 from ..model.numeric.simulate import SimulationResult, simulate
 from ..model.symbolic.components import discover_effects
 from ..parameters import Parameters
+from ..resources import data_file
 from ..vehicle import ASSIST_EFFECTS, ASSISTED_EFFECTS, CREEPING_EFFECTS, creeping_overrides
 
 SPEEDS_KMH = (0.0, 1.0, 3.0, 5.0)
 MARGIN = 1.1  # the sized motor limit or relief pressure over the quasi-static demand
+LINKAGE_EFFECT = "linkage_nonlinearity"  # the linkage ratio rising toward lock, where the vehicle file gives it
 
-# The tyre-ground friction of dry asphalt the standstill rack force is reported over (tyre.friction_coefficient,
-# which scales the bore torque of equation (2)): from the sliding friction of dry asphalt, 0.65-0.8 (Noon,
-# Engineering Analysis of Vehicular Accidents, CRC 1994: 0.65; road-engineering tables: asphalt concrete 0.70-0.80
-# dry), to the peak friction of a current car tyre on a dry road, about 1.0 (Pacejka, Tire and Vehicle Dynamics, 3rd
-# ed. 2012, ch. 4: the Magic Formula's D / F_z near 1 on dry asphalt). The paper's car takes 0.666.
-FRICTION_BAND = (0.67, 0.8, 1.0)
-# Standstill rack forces of current small and medium cars, N: 3-8 kN (Harrer & Pfeffer, Steering Handbook, Springer
-# 2017, ch. 8, as parksteer.model.numeric.assist cites it); rack-type EPS gears are built for up to 18 kN (small
-# utility vehicles: thyssenkrupp Automotive Technology, steering gears, rack EPS). No published standstill rack
-# force of a named small car was found for this project (docs/assist.md, "Loads over the tyre-ground friction", says
-# what was searched and what was found); a rack force below the lower end is reported as such.
-PUBLISHED_STANDSTILL_RACK_FORCE_N = (3.0e3, 8.0e3)
+@functools.cache
+def published_loads() -> dict:
+    """The published loads, tyre coefficients and friction values of ``parksteer/data/published_loads.toml``, each
+    with its source and how it was read (the file's header)."""
+    return tomllib.loads(data_file("published_loads.toml").read_text(encoding="utf-8"))
+
+
+# The tyre-ground friction the standstill rack force is reported over (tyre.friction_coefficient, which scales the
+# bore torque of equation (2)): an assumption, its ends and their regimes in the data file.
+FRICTION_BAND = tuple(published_loads()["tyre_ground_friction"]["band"])
+# The class range of standstill rack forces of small and medium cars (second hand, in the data file): the force is
+# reported against its lower end, and the motor sized at both ends beside the model's own load.
+PUBLISHED_STANDSTILL_RACK_FORCE_N = tuple(published_loads()["class_rack_force"]["value"])
 
 
 @dataclasses.dataclass
@@ -69,8 +82,21 @@ class FrictionRow:
 
     friction: float
     peak_rack_force_N: float
+    peak_rack_force_without_rack_friction_N: float  # the linkage's load alone: the rack's own friction taken out
     motor_torque_Nm: float  # NaN for hydraulic
     motor_current_A: float  # NaN for hydraulic
+
+
+@dataclasses.dataclass
+class ClassLoadRow:
+    """The assist that keeps the driver at the target against a given standstill rack force (the class range's
+    ends), quasi-statically, through the car's gear at its standstill peak (module docstring's demand)."""
+
+    rack_force_N: float
+    demand: float  # at the point of action: N m (column, pinion) or N (rack, hydraulic)
+    motor_torque_Nm: float  # NaN for hydraulic
+    motor_current_A: float  # NaN for hydraulic
+    pressure_Pa: float  # NaN for electric
 
 
 @dataclasses.dataclass
@@ -97,6 +123,7 @@ class SizingStudy:
     standstill_manual: SimulationResult
     standstill_assisted: SimulationResult
     friction_band: list[FrictionRow] = dataclasses.field(default_factory=list)
+    class_load: list[ClassLoadRow] = dataclasses.field(default_factory=list)
 
     def below_published(self) -> list[FrictionRow]:
         """The rows of the friction band whose standstill rack force is below the published forces of current
@@ -157,7 +184,8 @@ def size_assist(params: Parameters, case: str, target_torque_Nm: float, speeds_k
 
     manual_runs, demands, gains, motors = [], [], [], []
     for speed in speeds_kmh:
-        manual = simulate(case, effects=CREEPING_EFFECTS, overrides=creeping_overrides(speed), params=params)
+        manual = simulate(case, effects=with_linkage(CREEPING_EFFECTS, params), overrides=creeping_overrides(speed),
+                          params=params)
         per_rack = manual.outputs()["column_angle_per_rack_rad_per_m"]
         torque = manual.columns["handwheel_torque_Nm"]
         demand = float(np.max(demand_at_action(name, params, torque, per_rack, target_torque_Nm)))
@@ -192,7 +220,7 @@ def size_assist(params: Parameters, case: str, target_torque_Nm: float, speeds_k
             # the sized assist is the straight line of the sized gain: a table of the file is switched off
             sized = one_assist if falloff else {f"{name}.gain": gain, f"{name}.motor_torque_limit": MARGIN * motor,
                                                 **table_off(name)}
-        assisted = simulate(case, effects=ASSISTED_EFFECTS[kind], overrides={**creeping_overrides(speed), **sized},
+        assisted = simulate(case, effects=with_linkage(ASSISTED_EFFECTS[kind], params), overrides={**creeping_overrides(speed), **sized},
                             params=params)
         c = assisted.columns
         rows.append(SizingRow(speed, _peak(torque * per_rack), _peak(torque), demand, motor, current, pressure, gain,
@@ -202,7 +230,43 @@ def size_assist(params: Parameters, case: str, target_torque_Nm: float, speeds_k
         if manual0 is None:
             manual0, assisted0 = manual, assisted
     band_rows = friction_band(params, case, name, target_torque_Nm)
-    return SizingStudy(name, case, target_torque_Nm, rows, manual0, assisted0, band_rows)
+    c0 = manual0.columns
+    per_rack0 = manual0.outputs()["column_angle_per_rack_rad_per_m"]
+    at_peak = float(np.abs(per_rack0[int(np.argmax(np.abs(c0["handwheel_torque_Nm"] * per_rack0)))]))
+    class_rows = [size_for_rack_force(name, params, force, at_peak, target_torque_Nm)
+                  for force in PUBLISHED_STANDSTILL_RACK_FORCE_N]
+    return SizingStudy(name, case, target_torque_Nm, rows, manual0, assisted0, band_rows, class_rows)
+
+
+def size_for_rack_force(name: str, params: Parameters, force_N: float, per_rack: float,
+                        target_torque_Nm: float) -> ClassLoadRow:
+    """The assist that leaves the driver `target_torque_Nm` against a rack force `force_N`, quasi-statically: the
+    column torque F / c' (c' = d(theta_c)/d(rack) = `per_rack`), its excess over the target at the point of action,
+    and the motor torque and current (electric) or the pressure (hydraulic) that give it (module docstring)."""
+    v = lambda key: float(params[f"{name}.{key}"])  # noqa: E731
+    torque = np.array([force_N / per_rack])
+    demand = float(demand_at_action(name, params, torque, np.array([per_rack]), target_torque_Nm)[0])
+    if name == ASSIST_EFFECTS["hydraulic"]:
+        return ClassLoadRow(force_N, demand, float("nan"), float("nan"),
+                            (demand + v("seal_friction_force")) / v("piston_area"))
+    motor = (demand / v("reduction_ratio") + v("motor_friction_torque")) / v("efficiency")
+    return ClassLoadRow(force_N, demand, motor, motor / v("torque_constant"), float("nan"))
+
+
+def with_linkage(effects: str, params: Parameters) -> str:
+    """`effects` with the linkage ratio rising toward lock (the linkage_nonlinearity effect) when the vehicle file
+    gives its coefficient (``[linkage_nonlinearity] cubic_coefficient`` > 0); unchanged for a linear linkage."""
+    if float(params[f"{LINKAGE_EFFECT}.cubic_coefficient"]) > 0.0:
+        return f"{effects},+{LINKAGE_EFFECT}"
+    return effects
+
+
+def rack_force_without_rack_friction_N(result: SimulationResult) -> np.ndarray:
+    """The force on the rack less the rack's own friction, per sample: the handwheel torque less the rack friction's
+    term (its contribution output), through the gear. What the tie rods carry, quasi-statically."""
+    c = result.columns
+    per_rack = result.outputs()["column_angle_per_rack_rad_per_m"]
+    return (c["handwheel_torque_Nm"] - c.get("contrib_rack_friction_Nm", 0.0)) * per_rack
 
 
 def friction_band(params: Parameters, case: str, name: str, target_torque_Nm: float,
@@ -213,9 +277,8 @@ def friction_band(params: Parameters, case: str, name: str, target_torque_Nm: fl
     hydraulic = name == ASSIST_EFFECTS["hydraulic"]
     out = []
     for friction in frictions:
-        manual = simulate(case, effects=CREEPING_EFFECTS, overrides={**creeping_overrides(0.0),
-                                                                     "tyre.friction_coefficient": friction},
-                          params=params)
+        manual = simulate(case, effects=with_linkage(CREEPING_EFFECTS, params), params=params,
+                          overrides={**creeping_overrides(0.0), "tyre.friction_coefficient": friction})
         per_rack = manual.outputs()["column_angle_per_rack_rad_per_m"]
         torque = manual.columns["handwheel_torque_Nm"]
         motor = current = float("nan")
@@ -224,5 +287,6 @@ def friction_band(params: Parameters, case: str, name: str, target_torque_Nm: fl
             v = lambda key: float(params[f"{name}.{key}"])  # noqa: E731
             motor = (demand / v("reduction_ratio") + v("motor_friction_torque")) / v("efficiency")
             current = motor / v("torque_constant")
-        out.append(FrictionRow(friction, _peak(torque * per_rack), motor, current))
+        out.append(FrictionRow(friction, _peak(torque * per_rack), _peak(rack_force_without_rack_friction_N(manual)),
+                               motor, current))
     return out

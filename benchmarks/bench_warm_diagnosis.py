@@ -1,0 +1,96 @@
+"""Benchmark (not a test): what a warm diagnosis costs, and where: imports, replays, wall; as ratios to a reference.
+
+    python benchmarks/bench_warm_diagnosis.py [--reference [NAME=]SRC ...] [--repeats 5] [--jobs N]
+
+For this tree's ``src`` and each ``--reference`` tree's (e.g. ``git archive 53f1b0c`` unpacked; repeatable), in fresh
+interpreters with that ``src`` first on the path, on the model cache the first (unmeasured) run fills:
+
+- **import**: ``import parksteer.cli, parksteer.commands.measure, parksteer.diagnose.select``, timed inside the
+  interpreter (what every ``parksteer diagnose`` pays before it reads a file);
+- **help**: the process ``parksteer diagnose --help``, wall;
+- **manual**: the README's example, ``parksteer diagnose data/measurements/example_unladen.csv --json --quiet``,
+  wall, with the replays and the stage times its JSON reports (``cost``);
+- **assisted**: an assisted record, ``parksteer diagnose data/samples/polo_drag.csv --with-assist --vehicle
+  data/vehicles/polo_vi.toml --json --quiet``.
+
+Each is repeated ``--repeats`` times in turn (tree by tree within a repeat, so a machine's drift touches every tree
+alike) and reported as its median, and as the ratio of this tree's median to each reference's. Replays per second
+is replays / wall of the diagnosis's own stages (``cost.timings_s``), the method without the process around it.
+
+Against the commit before this round's speed work:
+
+    mkdir /tmp/ref && git archive 53f1b0c | tar -x -C /tmp/ref
+    python benchmarks/bench_warm_diagnosis.py --reference before=/tmp/ref/src --repeats 5
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+IMPORT_PROBE = ("import time\nt = time.perf_counter()\nimport parksteer.cli, parksteer.commands.measure, "
+                "parksteer.diagnose.select\nprint(time.perf_counter() - t)")
+DIAGNOSES = {
+    "manual": ["diagnose", "data/measurements/example_unladen.csv", "--json", "--quiet"],
+    "assisted": ["diagnose", "data/samples/polo_drag.csv", "--with-assist", "--vehicle", "data/vehicles/polo_vi.toml",
+                 "--json", "--quiet"],
+}
+
+
+def run(src: Path, args: list[str]) -> tuple[float, str]:
+    """One fresh interpreter on `src`: its wall time and its stdout."""
+    env = {**os.environ, "PYTHONPATH": str(src)}
+    start = time.perf_counter()
+    out = subprocess.run([sys.executable, *args], cwd=ROOT, env=env, capture_output=True, text=True, check=True)
+    return time.perf_counter() - start, out.stdout
+
+
+def measure(src: Path, jobs: int) -> dict[str, float]:
+    out = {"import_s": float(run(src, ["-c", IMPORT_PROBE])[1].strip()),
+           "help_s": run(src, ["-m", "parksteer.cli", "diagnose", "--help"])[0]}
+    for name, args in DIAGNOSES.items():
+        wall, stdout = run(src, ["-m", "parksteer.cli", *args, "--jobs", str(jobs)])
+        cost = json.loads(stdout)["cost"]
+        out[f"{name}_s"] = wall
+        out[f"{name}_replays"] = float(cost["replays"])
+        out[f"{name}_per_replay_ms"] = 1e3 * sum(cost["timings_s"].values()) / max(cost["replays"], 1)
+    return out
+
+
+def main(argv: list[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--reference", action="append", default=[], help="[NAME=]SRC of a tree to compare with")
+    parser.add_argument("--repeats", type=int, default=5)
+    parser.add_argument("--jobs", type=int, default=2)
+    args = parser.parse_args(argv)
+    trees = {"this": ROOT / "src"}
+    for ref in args.reference:
+        name, _, src = ref.rpartition("=")
+        trees[name or "reference"] = Path(src).resolve()
+    for name, src in trees.items():  # the warm-up: fills the model cache for each tree's keys
+        print(f"warm-up {name}", file=sys.stderr, flush=True)
+        measure(src, args.jobs)
+    samples: dict[str, list[dict[str, float]]] = {name: [] for name in trees}
+    for repeat in range(args.repeats):
+        for name, src in trees.items():
+            print(f"repeat {repeat + 1}/{args.repeats}: {name}", file=sys.stderr, flush=True)
+            samples[name].append(measure(src, args.jobs))
+    medians = {name: {k: statistics.median(s[k] for s in runs) for k in runs[0]} for name, runs in samples.items()}
+    keys = list(medians["this"])
+    print(f"{'median':<24}" + "".join(f"{name:>12}" for name in trees)
+          + "".join(f"{'this/' + name:>14}" for name in trees if name != "this"))
+    for k in keys:
+        row = f"{k:<24}" + "".join(f"{medians[name][k]:>12.3f}" for name in trees)
+        row += "".join(f"{medians['this'][k] / medians[name][k]:>14.2f}" for name in trees if name != "this")
+        print(row)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,73 @@
+"""What importing the command line and the diagnosis costs: no heavy package is imported before it is used.
+
+scipy.signal (with scipy.stats, which it imports) is more than a second of every process that imports it, sympy
+seconds; a diagnosis needs neither (its decimation and running filters are written out in parksteer.portable), and
+the command line's help needs no scipy at all. These tests import in a fresh interpreter and read sys.modules.
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+NEVER_AT_IMPORT = ("scipy", "sympy", "matplotlib")
+NEVER_IN_A_DIAGNOSIS = ("scipy.signal", "scipy.stats", "sympy", "matplotlib")
+
+
+def _loaded_after(code: str) -> list[str]:
+    probe = code + "\nimport json, sys\nprint(json.dumps(sorted(sys.modules)))\n"
+    out = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, check=True, cwd=ROOT)
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def _heavy(modules: list[str], packages: tuple[str, ...]) -> list[str]:
+    return sorted({m for m in modules for p in packages if m == p or m.startswith(p + ".")})
+
+
+def test_importing_the_command_line_and_the_diagnosis_imports_no_scipy_sympy_or_matplotlib():
+    """The modules a `parksteer diagnose` process imports before it reads a record pull in none of the heavy
+    packages: each is imported where it is first used."""
+    modules = _loaded_after("import parksteer.cli, parksteer.commands.measure, parksteer.diagnose.select")
+    assert _heavy(modules, NEVER_AT_IMPORT) == []
+
+
+def test_help_of_diagnose_imports_no_scipy():
+    """`parksteer diagnose --help` prints its options without importing scipy, sympy or matplotlib."""
+    modules = _loaded_after("import contextlib, io\nfrom parksteer.cli import main\n"
+                            "with contextlib.redirect_stdout(io.StringIO()), contextlib.suppress(SystemExit):\n"
+                            "    main(['diagnose', '--help'])")
+    assert _heavy(modules, NEVER_AT_IMPORT) == []
+
+
+def _resampled(source: Path, target: Path, factor: int) -> None:
+    """`source` (a measurement CSV) linearly interpolated onto a grid `factor` times finer, header kept."""
+    lines = source.read_text().splitlines()
+    header = [line for line in lines if line.startswith("#")]
+    names = lines[len(header)].split(",")
+    data = np.loadtxt(lines[len(header) + 1:], delimiter=",")
+    time_s = np.linspace(data[0, 0], data[-1, 0], (len(data) - 1) * factor + 1)
+    columns = [time_s] + [np.interp(time_s, data[:, 0], data[:, j]) for j in range(1, data.shape[1])]
+    body = "\n".join(",".join(repr(float(v)) for v in row) for row in np.column_stack(columns))
+    target.write_text("\n".join(header + [",".join(names), body]) + "\n")
+
+
+@pytest.mark.slow
+def test_a_diagnosis_of_a_decimated_record_never_imports_scipy_signal_stats_or_sympy(tmp_path):
+    """The README's example record at five times its rate (so decimated to the method's rate on import), diagnosed
+    from start to verdict, imports neither scipy.signal nor scipy.stats nor sympy nor matplotlib."""
+    from parksteer.measure.importers import load_record
+
+    record = tmp_path / "example_250Hz.csv"
+    _resampled(ROOT / "data" / "measurements" / "example_unladen.csv", record, 5)
+    assert "decimated" in load_record(record).metadata  # the path that used scipy.signal is taken
+    modules = _loaded_after("import contextlib, io\nfrom parksteer.cli import main\n"
+                            "with contextlib.redirect_stdout(io.StringIO()):\n"
+                            f"    main(['diagnose', {str(record)!r}, '--json', '--quiet', '--jobs', '1'])")
+    assert "parksteer.diagnose.select" in modules
+    assert _heavy(modules, NEVER_IN_A_DIAGNOSIS) == []
