@@ -29,9 +29,10 @@ ASSIST_RACK_FORCE_LOW = Quantity(
 ASSIST_RACK_FORCE_HIGH = Quantity(
     "assist_check.rack_force_high", "N", 0.0, 1.0e7, lower_inclusive=True, default=3.0e4,
     description="the largest rack force an assist's limit, or its boost table's largest point, may carry",
-    source="assumed: near ten times those standstill loads (3.0-3.5 kN): no passenger car's rack is asked for "
-           "it, while a unit slip (a pressure in Pa read as bar, a rack force written as a column torque) gives "
-           "10^2-10^5 times the intended force")
+    source="assumed: above the 18 kN a supplier builds its rack EPS gears for (small utility vehicles: "
+           "data/published_loads.toml, gear_rating_rack_eps, read) and near ten times the model's own standstill "
+           "loads (3.0-3.5 kN), while a unit slip (a pressure in Pa read as bar, a rack force written as a column "
+           "torque) gives 10^2-10^5 times the intended force")
 
 
 def rack_force_window_N() -> tuple[float, float]:
