@@ -59,6 +59,7 @@ MODELS = {
     "with_rack_lash": "+rack_lash",
     "with_carcass_hysteresis": "+carcass_hysteresis",
     "assist_hydraulic": "+hydraulic_assist",
+    "assist_column": "+electric_assist_column",
     "with_brush_patch": "+brush_patch",
     "diagnosis": "+ackermann,+braked_wheels,+column_friction,+kingpin_friction,+rack_damping,+rack_lash,+rack_stiction",
 }

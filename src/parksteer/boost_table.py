@@ -13,19 +13,22 @@ zero slope, with no corner. Beyond the last point the law goes on as a straight 
 (the motor's limit bounds it). A table of two points (0, 0), (T_1, A_1) is the straight line A_1 / T_1 T exactly.
 
 The effect reads the table as scalar quantities of fixed count (the generated code's parameter vector has a fixed
-layout): :data:`MAX_POINTS` torques, :data:`MAX_SPEEDS` speeds, an assist and a slope per speed and point. A shorter
-table is padded: torques beyond the last continue in steps of :data:`PAD_STEP_NM` with the straight continuation's
-values and slope (the same law), speeds beyond the last in steps of :data:`PAD_STEP_MPS` with the last row again.
-The law itself (segment choice, Hermite basis, linear interpolation in speed) is in
-:mod:`parksteer.model.symbolic.effects.assist_common`, one definition for the generated C and the replay.
+layout): :data:`MAX_POINTS` torques, :data:`MAX_SPEEDS` speeds, an assist and a slope per speed and point, 552
+scalars, consecutive in the parameter vector in :func:`table_keys` order. A shorter table is padded: torques beyond
+the last continue in steps of :data:`PAD_STEP_NM` with the straight continuation's values and slope (the same law),
+speeds beyond the last in steps of :data:`PAD_STEP_MPS` with the last row again. The law itself (segment choice,
+Hermite basis, linear interpolation in speed) is in :mod:`parksteer.model.symbolic.effects.assist_common`, one
+definition for the generated C and the replay: the model's expressions hold it as one function node, and the
+generated C calls one function printed from that definition (``parksteer.model.codegen.generate``), so a map of
+production size costs the cold build little (``benchmarks/bench_codegen.py``, model ``assist_column``).
 """
 
 from __future__ import annotations
 
 import math
 
-MAX_POINTS = 10
-MAX_SPEEDS = 3
+MAX_POINTS = 32  # torque points of a map
+MAX_SPEEDS = 8  # vehicle-speed rows
 PAD_STEP_NM = 1.0  # spacing of the padded torques beyond a table's last point (the law is a line there)
 PAD_STEP_MPS = 10.0  # spacing of the padded speeds beyond a table's last row (the same row again)
 KMH = 1.0 / 3.6  # m/s per km/h
@@ -125,6 +128,28 @@ def entries(torques: list[float], speeds_mps: list[float] | None, rows: list[lis
             out[f"boost_assist_{r}_{k}"] = float(value)
             out[f"boost_slope_{r}_{k}"] = float(m)
     return out
+
+
+def table_size(values) -> tuple[int, int]:
+    """(points, rows) of the table as given, from its padded scalars (`values(key)` gives one, as :func:`entries`
+    wrote it): the points before the padding that continues the last point's straight line in steps of
+    :data:`PAD_STEP_NM`, and the rows before the last row's repeats. A table whose own last points lie on that line
+    at those steps reads as the shorter table: the same law."""
+    torques = [values(f"boost_torque_{k}") for k in range(MAX_POINTS)]
+    rows = [[values(f"boost_assist_{r}_{k}") for k in range(MAX_POINTS)] for r in range(MAX_SPEEDS)]
+    slopes_ = [[values(f"boost_slope_{r}_{k}") for k in range(MAX_POINTS)] for r in range(MAX_SPEEDS)]
+
+    def padded_from(n: int) -> bool:
+        last = torques[n - 1]
+        return all(torques[j] == last + PAD_STEP_NM * (j - n + 1) and all(
+            row[j] == row[n - 1] + slope[n - 1] * (torques[j] - last) and slope[j] == slope[n - 1]
+            for row, slope in zip(rows, slopes_)) for j in range(n, MAX_POINTS))
+
+    points = next(n for n in range(2, MAX_POINTS + 1) if padded_from(n))
+    count = MAX_SPEEDS
+    while count > 1 and rows[count - 1] == rows[count - 2] and slopes_[count - 1] == slopes_[count - 2]:
+        count -= 1
+    return points, count
 
 
 def table_keys() -> list[str]:

@@ -117,12 +117,7 @@ def _read_assist(path: Path, table: Any, sections: dict, sources: dict) -> None:
         if key == "type":
             continue
         if key == BOOST_SECTION:
-            values.update(_read_boost(path, kind, entry, name, sources))
-            if isinstance(entry, dict) and "gain_uncertainty" in entry:
-                section, _, field_name = BOOST_GAIN_UNCERTAINTY.partition(".")
-                sections[section] = {field_name: _gain_uncertainty(path, entry["gain_uncertainty"])}
-                sources[BOOST_GAIN_UNCERTAINTY] = str(entry["gain_uncertainty"].get("source", ""))
-            continue
+            continue  # read below, once the gear's own values (efficiency, reduction) are known
         if key.startswith("boost_"):
             raise ParameterError(f"{path}: assist.{key}: a boost table is written as [assist.boost] (torsion_bar_torque, "
                                  "assist, optionally vehicle_speed)")
@@ -139,6 +134,13 @@ def _read_assist(path: Path, table: Any, sections: dict, sources: dict) -> None:
         sources[f"{name}.{key}.unit"] = str(entry["unit"])
         if provenance is not None:
             sources[provenance_key(f"{name}.{key}")] = provenance
+    if BOOST_SECTION in table:
+        entry = table[BOOST_SECTION]
+        values.update(_read_boost(path, kind, entry, name, sources, values))
+        if isinstance(entry, dict) and "gain_uncertainty" in entry:
+            section, _, field_name = BOOST_GAIN_UNCERTAINTY.partition(".")
+            sections[section] = {field_name: _gain_uncertainty(path, entry["gain_uncertainty"])}
+            sources[BOOST_GAIN_UNCERTAINTY] = str(entry["gain_uncertainty"].get("source", ""))
     if BOOST_SECTION in table:
         # the table is the boost curve: the gain's (or the valve slope's) straight line is not added to it
         line = "valve_slope" if kind == "hydraulic" else "gain"
@@ -185,9 +187,12 @@ def _gain_uncertainty(path: Path, entry: dict) -> float:
     return float(value)
 
 
-def _read_boost(path: Path, kind: str, table: Any, name: str, sources: dict) -> dict[str, float]:
+def _read_boost(path: Path, kind: str, table: Any, name: str, sources: dict,
+                gear: dict[str, float]) -> dict[str, float]:
     """``[assist.boost]``: the boost table (:mod:`parksteer.boost_table`) as the effect's scalar entries (its
-    ``gain_uncertainty`` is read apart, :func:`_gain_uncertainty`)."""
+    ``gain_uncertainty`` is read apart, :func:`_gain_uncertainty`). An electric assist's ``assist`` may say
+    ``at = "motor"``: its values are the motor's torque (N m), carried to the point of action through eta N (the
+    ``efficiency`` and ``reduction_ratio`` of [assist], `gear`, else the effect's defaults)."""
     where = f"{path}: assist.boost"
     if not isinstance(table, dict) or not {"torsion_bar_torque", "assist"} <= set(table) or not set(table) <= set(
             BOOST_UNITS):
@@ -195,10 +200,18 @@ def _read_boost(path: Path, kind: str, table: Any, name: str, sources: dict) -> 
     read: dict[str, list] = {}
     for key, entry in table.items():
         if not isinstance(entry, dict) or not {"value", "unit"} <= set(entry) or not set(entry) <= {
-                "value", "unit", "source"}:
-            raise ParameterError(f"{where}.{key}: expected {{ value, unit, source }}")
+                "value", "unit", "source", *(("at",) if key == "assist" else ())}:
+            raise ParameterError(f"{where}.{key}: expected {{ value, unit, source }}"
+                                 + (" and optionally at" if key == "assist" else ""))
         units = BOOST_UNITS[key] if key != "assist" else BOOST_ASSIST_UNITS[kind]
         _check_text(f"{where}.{key}", entry)
+        if key == "assist" and "at" in entry:
+            points = ("motor", kind) if kind != "hydraulic" else ()
+            if entry["at"] not in points:
+                raise ParameterError(f"{where}.assist.at: {entry['at']!r}, expected "
+                                     + (" or ".join(map(repr, points)) if points else
+                                        "nothing (a valve's table is its pressure)"))
+            units = ("N m",) if entry["at"] == "motor" else units
         if entry["unit"] not in units:
             raise ParameterError(f"{where}.{key}: unit {entry['unit']!r}, expected {' or '.join(map(repr, units))}")
         if key == "gain_uncertainty":
@@ -218,7 +231,9 @@ def _read_boost(path: Path, kind: str, table: Any, name: str, sources: dict) -> 
         rows = [_numbers(f"{where}.assist", row, f"row {r}, ") for r, row in enumerate(read["assist"], 1)]
     try:
         scale = BAR_PA if table["assist"]["unit"] == "bar" else 1.0
-        rows = [[a * scale for a in row] for row in rows]
+        if table["assist"].get("at") == "motor":
+            scale = motor_to_point_of_action(name, gear)
+        rows = [[float(a) * scale for a in row] for row in rows]
         if speeds is not None:
             scale = KMH if table["vehicle_speed"]["unit"] == "km/h" else 1.0
             speeds = [v * scale for v in speeds]
@@ -226,9 +241,18 @@ def _read_boost(path: Path, kind: str, table: Any, name: str, sources: dict) -> 
     except BoostTableError as exc:
         raise ParameterError(f"{where}: {exc}") from None
     source = f"derived: [assist.boost] ({sources[f'{name}.boost.assist']})"
+    if table["assist"].get("at") == "motor":
+        source += f" (motor torque x eta N = {motor_to_point_of_action(name, gear):g})"
     for key in out:
         sources[f"{name}.{key}"] = source
     return out
+
+
+def motor_to_point_of_action(name: str, gear: dict[str, float]) -> float:
+    """eta N of the electric assist `name`: its ``efficiency`` and ``reduction_ratio`` as the file gives them
+    (`gear`), else as the effect declares them (the registry knows them once parksteer.model is imported)."""
+    value = lambda key: gear[key] if key in gear else quantity(f"{name}.{key}").default  # noqa: E731
+    return value("efficiency") * value("reduction_ratio")
 
 
 def vehicle_name(path: str | Path) -> str:

@@ -257,3 +257,47 @@ def test_over_a_closed_cycle_the_valve_adds_no_net_work_to_a_lossless_car(golf):
     assert np.max(np.abs(c["pressure_Pa"])) > 2e5  # the valve opens into its table
     assert np.max(np.abs(driver + pump - (energy - energy[0]))) < 1e-4 * gross
     assert abs(pump[-1]) < 1e-3 * gross
+
+
+def test_a_production_sized_map_of_17_points_and_5_speeds_drives_the_motor_as_the_map_says(params):
+    """A control unit's map carries more points than a hand-written curve: 17 torsion-bar torques (a 0.4 N m dead
+    band, then a progressive rise to 6.4 N m) and 5 vehicle-speed rows (the assist falling with speed). Simulated on
+    the paper's car at 1.5 m/s, between the rows at 1 and 2 m/s, the commanded motor torque against the torsion-bar
+    torque is the two rows' monotone cubics (SciPy's PCHIP through each row's mirrored points) mixed half and half,
+    over eta N, within 1 % wherever the motor gives more than 0.05 N m; the steer reaches past the tenth point."""
+    from test_assist import series_column
+
+    torques = [0.4 * k for k in range(17)]
+    speeds = [0.0, 0.5, 1.0, 2.0, 3.0]
+    scales = [1.0, 0.95, 0.85, 0.7, 0.6]
+    rows = [[0.0] + [scale * 1.5 * (t - 0.4) ** 1.6 for t in torques[1:]] for scale in scales]
+    gear = {f"{NAME}.motor_torque_limit": 30.0, "run.vehicle_speed": 1.5}
+    result = simulate("unladen", effects=f"+{NAME}",
+                      overrides={**series_column(params, NAME), **gear, **as_overrides(entries(torques, speeds, rows))},
+                      params=params)
+    c = result.columns
+
+    def pchip(row):
+        return PchipInterpolator([-x for x in torques[:0:-1]] + torques, [-y for y in row[:0:-1]] + row)
+
+    sensor = c["torsion_bar_torque_Nm"]
+    expected = 0.5 * (pchip(rows[2])(sensor) + pchip(rows[3])(sensor))
+    scale = params[f"{NAME}.efficiency"] * params[f"{NAME}.reduction_ratio"]
+    used = np.abs(expected / scale) > 0.05
+    assert np.max(np.abs(sensor)) > torques[10]
+    assert np.max(np.abs(c["motor_torque_Nm"][used] * scale / expected[used] - 1.0)) < 0.01
+
+
+def test_the_slope_the_jacobian_takes_is_the_laws_derivative():
+    """The generated C's Jacobian takes the table law's torque derivative from table_slope (the Hermite segment's
+    derivative in closed form): on a 17-point, 5-row map at a speed between rows it is the law's central
+    difference within 1e-5 (the difference's own error) across the dead band, the points and beyond the last."""
+    from parksteer.model.symbolic.effects.assist_common import table_slope
+
+    torques = [0.4 * k for k in range(17)]
+    rows = [[0.0] + [s * 1.5 * (t - 0.4) ** 1.6 for t in torques[1:]] for s in (1.0, 0.95, 0.85, 0.7, 0.6)]
+    values = entries(torques, [0.0, 0.5, 1.0, 2.0, 3.0], rows)
+    t = np.linspace(-8.0, 8.0, 3201) + 1e-3  # off the points, where the cubic's second derivative jumps
+    h = 1e-6
+    difference = (law(values, t + h, 1.5) - law(values, t - h, 1.5)) / (2 * h)
+    assert np.max(np.abs(difference - table_slope(t, values.__getitem__, 1.5))) < 1e-5

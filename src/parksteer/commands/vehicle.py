@@ -141,13 +141,13 @@ def _new(args) -> int:
     values = vehicle_values(spec, base)
     text = template_text(vehicle_name(out), spec, values) + assist_section(args, base)
     try:
-        vehicle_from_text(text, out, base)  # checked as a vehicle file before anything is written
+        params = vehicle_from_text(text, out, base)  # checked as a vehicle file before anything is written
+        if args.assist is not None:
+            from ..model.numeric.assist import check_assist
+
+            check_assist(params)
     except UsageError as exc:
         raise UsageError(f"the specification gives no valid car, nothing written: {exc}") from None
-    if args.assist is not None:  # the assist's plausibility too, before anything is written
-        from ..model.numeric.assist import check_assist
-
-        check_assist(vehicle_from_text(text, out, base))
     with atomic_path(out) as tmp:
         tmp.write_text(text, encoding="utf-8")
     print(f"{out}: vehicle {vehicle_name(out)}, case {spec.case}" + (f", {args.assist} assist" if args.assist else ""))

@@ -42,8 +42,8 @@ from .verdict import choose_verdict, trimmed_rms
 BANDS = {
     "motor_friction_torque": (0.01, 0.05),  # 0.01-0.05 N m for EPS motors (Harrer & Pfeffer, ch. 8.6)
     "motor_inertia": (1.0e-4, 5.0e-4),  # brushless EPS rotors 1-5e-4 kg m^2 (ch. 8.6)
-    "efficiency": (0.75, 0.90),  # worm gears of EPS 0.75-0.9 (Kim, Mech. Sci. 9, 201, 2018)
-    "back_efficiency": (0.75, 0.85),  # a back-driven worm, 0.75-0.85 (Shigley, ch. 13)
+    "efficiency": (0.75, 0.90),  # worm gears of EPS 0.75-0.9 (assumed)
+    "back_efficiency": (0.75, 0.85),  # a worm of eta_f 0.80-0.87, rho 1-4 deg (reduction_efficiency)
     "torsion_bar_stiffness": (85.0, 170.0),  # EPS torsion bars 1.5-3 N m/deg (ch. 8.5)
     "torque_constant": (0.03, 0.07),  # 12 V EPS motors 0.03-0.07 N m/A (ch. 8.6)
     "motor_torque_limit": (3.0, 6.0),  # EPS motors 3-6 N m peak (ch. 8.6)

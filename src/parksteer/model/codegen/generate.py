@@ -62,6 +62,23 @@ class _Printer(C99CodePrinter):
             return f"(1.0/(({b})*sqrt({b})))"
         return f"ps_pow({self._print(base)}, {self._print(exp)})"
 
+    def _print_BoostTableLaw(self, expr):
+        return self._table_call(TABLE_LAW, expr)
+
+    def _print_BoostTableSlope(self, expr):
+        return self._table_call(TABLE_SLOPE, expr)
+
+    def _table_call(self, function: str, expr) -> str:
+        """A boost table's law as a call of its printed function (:func:`_table_functions`): the table's scalars
+        are consecutive in p (an effect's quantities in the order of boost_table.table_keys), so the call passes
+        their start."""
+        torque, speed, *table = expr.args
+        names = [str(t) for t in table]
+        first = int(names[0][2:-1]) if names[0].startswith("p[") else -1
+        if names != [f"p[{first + j}]" for j in range(len(names))]:
+            raise ValueError("a boost table's scalars must be consecutive in the parameter vector")
+        return f"{function}({self._print(torque)}, {self._print(speed)}, p + {first})"
+
 
 def check_portable(source: str) -> None:
     """Refuse generated C that calls a C-library function whose last bit depends on the machine."""
@@ -74,6 +91,29 @@ def check_portable(source: str) -> None:
     bad = sorted(calls & libm)
     if bad:
         raise RuntimeError(f"generated C calls {', '.join(bad)} from the C library; route it through portable_math.c")
+
+
+# The boost table's law and its torque derivative as C functions of (torque, speed, table), printed once from
+# parksteer.model.symbolic.effects.assist_common.table_law (the formula the replay evaluates on numbers).
+TABLE_LAW = "ps_boost_law"
+TABLE_SLOPE = "ps_boost_slope"
+
+
+def _table_functions(printer: _Printer) -> str:
+    """The C of the boost table's law and slope: table_law and table_slope (its derivative in the torque) on symbols
+    x (torque), v (speed) and t[j] (the table's scalars in boost_table.table_keys order), each after
+    common-subexpression elimination."""
+    from ...boost_table import table_keys
+    from ..symbolic.effects.assist_common import table_law, table_points, table_slope
+
+    x, v = sp.Symbol("x", real=True), sp.Symbol("v", real=True)
+    table = {key: sp.Symbol(f"t[{j}]", real=True) for j, key in enumerate(table_keys())}
+    points = table_points(table.__getitem__, v)
+    out = []
+    for name, expr in ((TABLE_LAW, table_law(x, None, v, points)), (TABLE_SLOPE, table_slope(x, None, v, points))):
+        body = ["    double value;", *_c_block([("value", expr)], printer), "    return value;"]
+        out.append(f"static double {name}(double x, double v, const double *t)\n{{\n" + "\n".join(body) + "\n}\n")
+    return "\n".join(out)
 
 
 def _c_block(assignments: list[tuple[str, sp.Expr]], printer: _Printer) -> list[str]:
@@ -226,6 +266,8 @@ def generate(derivation: Derivation) -> tuple[str, dict]:
             _c_block(out_assign, printer),
         ),
     ]
+    if any(f"{TABLE_LAW}(" in part or f"{TABLE_SLOPE}(" in part for part in parts):
+        parts.insert(0, _table_functions(printer))
     timings["cse_derivatives_print_s"] = time.perf_counter() - start
     n_params = len(derivation.parameter_names)
     info = {

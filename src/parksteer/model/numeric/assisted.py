@@ -29,7 +29,9 @@ smoothed corners (:mod:`parksteer.model.symbolic.effects.assist_common`); B is t
 demand, or the valve's pressure; zero without a table) and e the gear's efficiency in the direction the power flows (eta_f driving, 1 / eta_b back-driven), read
 from the prescribed rack's speed (the point of action's rate, as the effect reads it) and the law's motor torque. A is increasing (deadband and clamp are,
 strictly for a smoothed clamp: its slope is -(f(a) + f(b))/2 > 0 with f(z) = z / sqrt(z^2 + w^2), a + b = -2 L),
-so y(T_s) rises with slope >= 1 and has one root, found pointwise by bisection in ``[y - B, y + B]`` (B bounds
+and the gear's directional factor keeps the delivered torque rising with the motor torque for eta_b above a
+bound (:func:`least_back_efficiency`, 0.147 at eta_f 0.85; below it the law is refused), so y(T_s) rises with
+slope >= 1 and has one root, found pointwise by bisection in ``[y - B, y + B]`` (B bounds
 |A|). The motor torque T_m and current T_m / k_t (or the pressure) then follow from the law. Nothing in this depends
 on the acceleration: the rotor's inertia is in T_road. The tests (tests/model/test_assisted_replay.py) replay a
 free assisted simulation's rack and recover its torsion-bar torque and motor current to the integrator's
@@ -39,13 +41,14 @@ tolerance at the column, the pinion and the rack, and in saturation.
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
-from functools import cached_property
+from functools import cached_property, lru_cache
 
 import numpy as np
 
 from ...boost_table import MAX_POINTS, off_keys, table_keys
 from ...errors import UsageError
 from ...parameters import VEHICLE_SPEED
+from ...reduction_efficiency import min_monotone_back_efficiency
 from ..symbolic.components import power_assist_of
 from ..symbolic.effects.assist_common import (clamp, deadband, directional_efficiency, speed_gain, table_law,
                                               table_points)
@@ -197,6 +200,23 @@ class BoostLaw:
         return 0.5 * (low + high)
 
 
+@lru_cache(maxsize=64)
+def least_back_efficiency(forward: float) -> float:
+    """The least eta_b at which the gear's delivered torque rises with the motor torque at every rotor speed, at
+    eta_f = `forward` (:func:`parksteer.reduction_efficiency.min_monotone_back_efficiency`: 0.147 at 0.85)."""
+    return min_monotone_back_efficiency(forward)
+
+
+def check_back_efficiency(name: str, forward: float, back: float, where: str = "") -> None:
+    """Refuse a back-driven efficiency below :func:`least_back_efficiency` (one line): the delivered torque would
+    fall as the motor torque rises somewhere, and T + A(T) = y would have more than one root."""
+    least = least_back_efficiency(forward)
+    if back < least:
+        raise UsageError(f"{where}{name}.back_efficiency {back:g}: below {least:.3f}, the least at which the gear's "
+                         f"delivered torque rises with the motor torque at every speed (efficiency {forward:g}); the "
+                         "law would not be increasing and the replay could not invert it")
+
+
 def boost_law(run, p: np.ndarray) -> BoostLaw | None:
     """The boost law of `run`'s assist with the values of the parameter vector `p` (None without an assist)."""
     effect = power_assist_of(run.effects)
@@ -219,6 +239,7 @@ def boost_law(run, p: np.ndarray) -> BoostLaw | None:
                        speed=float(p[run.parameter_index(VEHICLE_SPEED.key)]),
                        back_efficiency=v("back_efficiency"), direction_width=v("limit_smoothing"),
                        friction_speed=v("friction_speed"))
+        check_back_efficiency(name, law.efficiency, law.back_efficiency)
     # the law-side effects of the model (a diagnosis's candidates acting in the control unit: Effect.boost_law)
     value = lambda key: float(p[run.parameter_index(key)])  # noqa: E731
     for other in run.effects:

@@ -26,7 +26,9 @@ the rows (held beyond the first and last), as a_r + lambda (a_r+1 - a_r) so that
 the cubic Hermite segment the torque falls in, and beyond the last point the straight continuation; odd through
 A(-T) = -A(T). At a point the segment's basis is (1, 0, 0, 0), so the law gives the point's assist exactly; a
 segment between two zero points with zero slopes gives exactly 0 (the dead band). On sympy expressions the choice of
-segment and row is a Piecewise (conditional expressions in the C), on numbers the same branches chosen elementwise. The same three functions evaluate the law on numbers (the assisted replay,
+segment and row is a Piecewise (conditional expressions in the C), on numbers the same branches chosen elementwise.
+The effects put it into the model as one function node (:func:`table_law_node`), whose torque derivative is
+:func:`table_slope`; the generated C evaluates both through two functions printed once from them. The same three functions evaluate the law on numbers (the assisted replay,
 :mod:`parksteer.model.numeric.assisted`): on sympy expressions they build the model's terms, on floats and numpy
 arrays they compute them, with products for squares (no ``pow``) so the numbers are the same on every machine.
 """
@@ -36,7 +38,9 @@ from __future__ import annotations
 import numpy as np
 from ..lazy_sympy import sp
 
-from ....boost_table import MAX_POINTS, MAX_SPEEDS, PAD_STEP_MPS, PAD_STEP_NM
+from functools import cache
+
+from ....boost_table import MAX_POINTS, MAX_SPEEDS, PAD_STEP_MPS, PAD_STEP_NM, table_keys
 from ....parameters import Quantity
 
 LOCATIONS = ("column", "pinion", "rack")
@@ -130,6 +134,14 @@ def _hermite(x, t0, t1, a0, a1, m0, m1):
     return a0 * ((1 + 2 * s) * r * r) + h * m0 * (s * r * r) + a1 * (s * s * (3 - 2 * s)) + h * m1 * (s * s * (s - 1))
 
 
+def _hermite_slope(x, t0, t1, a0, a1, m0, m1):
+    """d/dx of :func:`_hermite`: 6 s r (a1 - a0) / h + m0 r (1 - 3 s) + m1 s (3 s - 2), s = (x - t0) / h, r = 1 - s."""
+    h = t1 - t0
+    s = (x - t0) / h
+    r = 1 - s
+    return 6 * s * r * (a1 - a0) / h + m0 * (r * (1 - 3 * s)) + m1 * (s * (3 * s - 2))
+
+
 def _at_speed(speed, speeds, row_values):
     """One point's value at the vehicle speed, linear between the rows `row_values` at `speeds`, held beyond."""
     branches = [(speed < speeds[0], row_values[0])]
@@ -172,6 +184,53 @@ def table_law(torque, value, speed, points=None):
     else:  # a point read at a speed that varies by sample: every segment, one kept
         magnitude = half(np.abs(torque))
     return np.where(torque >= 0, magnitude, -magnitude)
+
+
+@cache
+def table_functions():
+    """The two sympy functions that stand for :func:`table_law` in a model's expressions, ``BoostTableLaw`` and its
+    torque derivative ``BoostTableSlope``, each of (torque, speed, the table's scalars in
+    :func:`parksteer.boost_table.table_keys` order). A table of 32 points and 8 speeds is a Piecewise of 31
+    segments over 64 values interpolated in speed; written out wherever the law enters (forcing, drive, outputs and
+    the Jacobian's chain rule) it would triple the generated C. As one node, the generated C calls one function
+    for it, whose body is :func:`table_law` itself printed once (``parksteer.model.codegen.generate``), so the C and
+    the replay still evaluate one formula. Made on first use: the replay imports this module without sympy."""
+
+    class BoostTableSlope(sp.Function):
+        """table_slope, d(table_law)/d(torque), at (torque, speed, *table)."""
+
+    class BoostTableLaw(sp.Function):
+        """table_law at (torque, speed, *table)."""
+
+        def fdiff(self, argindex=1):
+            if argindex == 1:
+                return BoostTableSlope(*self.args)
+            return super().fdiff(argindex)
+
+    return BoostTableLaw, BoostTableSlope
+
+
+def table_law_node(torque, value, speed):
+    """:func:`table_law` in a model's expressions: one function node of the torque, the speed and the table's
+    scalars (:func:`table_functions`), evaluated in the generated C by the printed law."""
+    law, _ = table_functions()
+    return law(torque, speed, *(value(key) for key in table_keys()))
+
+
+def table_slope(torque, value, speed, points=None):
+    """d(:func:`table_law`)/d(torque): the derivative of the same segment the law takes (its Hermite segment's, the
+    last point's slope beyond it), even in the torque. The generated C's Jacobian takes it (:func:`table_functions`)."""
+    knots, assist, slope = points if points is not None else table_points(value, speed)
+
+    def half(x):  # x >= 0
+        branches = [(x < knots[k + 1], _hermite_slope(x, knots[k], knots[k + 1], assist[k], assist[k + 1], slope[k],
+                                                        slope[k + 1])) for k in range(MAX_POINTS - 1)]
+        return _select(branches, slope[-1] + 0 * x)
+
+    if isinstance(torque, sp.Basic):
+        return sp.Piecewise((half(torque), torque >= 0), (half(-torque), True))
+    torque = np.asarray(torque, dtype=float)
+    return half(np.abs(torque))
 
 
 def _half_numeric(x, knots, assist, slope):

@@ -49,7 +49,10 @@ action, not eta_f N T_m. Between the two, smoothly through the power's sign
 limit_smoothing of motor torque), so that the gear's loss, T_m N dx/dt (1 - e), is never negative. The control
 unit commands T_m = A_cmd / (eta_f N): while the motor drives, the assist is the demand. The rotor's inertia J_m
 turns at omega = N dx/dt (kinetic energy J_m omega^2 / 2, N^2 J_m reflected to x), its bearings' Coulomb friction
-T_f tanh(omega / w) opposes it. The band w is the assist's own: how sharply the motor's friction and the worm's
+T_f tanh(omega / w) opposes it; both reach the point of action through N alone, without the gear's efficiency
+(a real worm passes them on with it too: at most (1 / eta_b - 1) N T_f of difference). At rest the factor e is 1
+(a stationary gear passes the motor's torque without loss), where a real worm holds by static friction anywhere
+between eta_f and 1 / eta_b; the defaults of eta_f and eta_b are a thread's (:mod:`parksteer.reduction_efficiency`). The band w is the assist's own: how sharply the motor's friction and the worm's
 direction change over at a reversal is a property of the gear, not the car-wide smoothing of the rack's sliding
 contacts, and on a torsion-bar channel of a bus's resolution it decides whether a reversal is read right.
 
@@ -71,32 +74,60 @@ from __future__ import annotations
 
 from ..lazy_sympy import me, sp
 
+from .... import portable as pm
 from ....parameters import VEHICLE_SPEED, Quantity
+from ....reduction_efficiency import (PI, back_efficiency, ball_nut_lead_angle, friction_angle_for_forward,
+                                      lead_angle_for_forward)
 from ..components import Effect
 from ..system import torque_between
 from .assist_common import (LOCATIONS, clamp, deadband, directional_efficiency, point_of_action,
-                            series_deflection, speed_gain, table_law, table_quantities, torsion_bar_torque)
+                            series_deflection, speed_gain, table_law_node, table_quantities, torsion_bar_torque)
+
+# The reduction's efficiencies from its geometry and friction (parksteer.reduction_efficiency: a thread of lead
+# angle lambda and friction angle rho, eta_f = tan(lambda) / tan(lambda + rho),
+# eta_b = tan(lambda - rho) / tan(lambda)).
+# The forward efficiency is the assumption (what a gear's maker states); the friction angle of the worm's sliding
+# flank, or the ball nut's lead and ball circle, is the second; the lead angle (worm) or the effective friction
+# (ball nut, its belt lumped in) follows from the two, and eta_b from the formula.
+WORM_FORWARD_EFFICIENCY = 0.85
+WORM_FRICTION_ANGLE_RAD = 3.0 * PI / 180.0
+BALL_NUT_FORWARD_EFFICIENCY = 0.90
+BALL_NUT_LEAD_M = 0.007
+BALL_NUT_BALL_CIRCLE_M = 0.028
+_WORM_LEAD_ANGLE_RAD = lead_angle_for_forward(WORM_FORWARD_EFFICIENCY, WORM_FRICTION_ANGLE_RAD)
+_NUT_LEAD_ANGLE_RAD = ball_nut_lead_angle(BALL_NUT_LEAD_M, BALL_NUT_BALL_CIRCLE_M)
+_NUT_FRICTION_ANGLE_RAD = friction_angle_for_forward(BALL_NUT_FORWARD_EFFICIENCY, _NUT_LEAD_ANGLE_RAD)
+WORM_BACK_EFFICIENCY = back_efficiency(_WORM_LEAD_ANGLE_RAD, WORM_FRICTION_ANGLE_RAD)
+BALL_NUT_BACK_EFFICIENCY = back_efficiency(_NUT_LEAD_ANGLE_RAD, _NUT_FRICTION_ANGLE_RAD)
+_WORM_SOURCE = (
+    f"assumed: worm gear eta_f {WORM_FORWARD_EFFICIENCY:g} with a sliding flank of friction angle "
+    f"{WORM_FRICTION_ANGLE_RAD * 180.0 / PI:g} deg (mu {pm.tan(WORM_FRICTION_ANGLE_RAD):.3f}); the lead angle at which "
+    f"eta_f = tan(lambda) / tan(lambda + rho) is {WORM_FORWARD_EFFICIENCY:g}, "
+    f"{_WORM_LEAD_ANGLE_RAD * 180.0 / PI:.1f} deg, "
+    "gives eta_b = tan(lambda - rho) / tan(lambda)")
+_BALL_NUT_SOURCE = (
+    f"assumed: ball nut and belt eta_f {BALL_NUT_FORWARD_EFFICIENCY:g}, a {BALL_NUT_LEAD_M * 1e3:g} mm lead on a "
+    f"{BALL_NUT_BALL_CIRCLE_M * 1e3:g} mm ball circle (lead angle {_NUT_LEAD_ANGLE_RAD * 180.0 / PI:.2f} deg); the "
+    f"friction angle at which eta_f = {BALL_NUT_FORWARD_EFFICIENCY:g} there, "
+    f"{_NUT_FRICTION_ANGLE_RAD * 180.0 / PI:.2f} "
+    f"deg (mu {pm.tan(_NUT_FRICTION_ANGLE_RAD):.4f}, the belt's loss lumped into the nut's), gives "
+    "eta_b = tan(lambda - rho) / tan(lambda)")
 
 # Typical values by point of action: (reduction N, its unit, bounds, efficiency, motor torque limit N m,
 # motor inertia kg m^2, source of the reduction). Column and pinion: a worm gear; rack: a ball nut driven through
 # a belt (N = 2 pi / lead x belt ratio).
 _GEARS = {
-    "column": (18.0, "1", (1.0, 100.0), 0.85, 4.0, 2.0e-4,
+    "column": (18.0, "1", (1.0, 100.0), WORM_FORWARD_EFFICIENCY, 4.0, 2.0e-4,
                "assumed: worm gear of column EPS, 15-22:1 (Harrer & Pfeffer, Steering Handbook, Springer 2017, "
                "ch. 8.3; Kim, Mech. Sci. 9, 201, 2018)"),
-    "pinion": (20.0, "1", (1.0, 100.0), 0.85, 4.5, 2.0e-4,
+    "pinion": (20.0, "1", (1.0, 100.0), WORM_FORWARD_EFFICIENCY, 4.5, 2.0e-4,
                "assumed: worm gear of pinion and dual-pinion EPS, 15-25:1 (Harrer & Pfeffer, Steering Handbook, "
                "ch. 8.3)"),
-    "rack": (2400.0, "rad/m", (100.0, 20000.0), 0.90, 5.0, 3.0e-4,
+    "rack": (2400.0, "rad/m", (100.0, 20000.0), BALL_NUT_FORWARD_EFFICIENCY, 5.0, 3.0e-4,
              "assumed: ball nut of 7 mm lead through a 2.7:1 belt, 2 pi / 0.007 x 2.7 = 2420 rad/m; rack EPS "
              "1500-3500 rad/m (Harrer & Pfeffer, Steering Handbook, ch. 8.4)"),
 }
 
-# Back-driven efficiency by point of action (the rack drives the motor), with its source. A worm of lead angle
-# lambda and friction angle rho has eta_f = tan(lambda) / tan(lambda + rho) forward and eta_b = tan(lambda - rho) /
-# tan(lambda) backward (Shigley's Mechanical Engineering Design, ch. 13, worm gearing); an EPS worm is built to be
-# back-driven (the wheels' self-centring returns the handwheel through it). A ball nut's rolling contact gives
-# nearly the same efficiency both ways.
 # How sharply the motor's friction and the gear's direction of power flow change over at a reversal: the rotor speed
 # w of tanh(omega / w) (the assist's own, not the car-wide friction smoothing of the rack's sliding contacts).
 FRICTION_SPEED = 0.5
@@ -108,15 +139,21 @@ FRICTION_SPEED_SOURCE = (
     "replays its band's ends (stage assumed)")
 
 _BACK_EFFICIENCY = {
-    "column": (0.80, "assumed: back-driven worm gear, 0.75-0.85: tan(lambda - rho) / tan(lambda) for the lead angle "
-                     "that gives eta_f = 0.85 (about 25 deg at rho = 3 deg) is 0.86, 0.80 at rho = 4.5 deg "
-                     "(Shigley's Mechanical Engineering Design, ch. 13); EPS worms are made back-drivable "
-                     "(Harrer & Pfeffer, ch. 8.3)"),
-    "pinion": (0.80, "assumed: back-driven worm gear, 0.75-0.85, as at the column (Shigley's Mechanical "
-                     "Engineering Design, ch. 13; Harrer & Pfeffer, ch. 8.3)"),
-    "rack": (0.85, "assumed: back-driven ball nut and belt, 0.8-0.9: ball screws back-drive at 0.8-0.9 of the "
-                   "forward 0.9-0.95 (Harrer & Pfeffer, ch. 8.4; THK and NSK ball screw catalogues, 'reverse "
-                   "efficiency')"),
+    "column": (WORM_BACK_EFFICIENCY, f"assumed: the thread formula's {WORM_BACK_EFFICIENCY:.3f} for the "
+                                     f"{_WORM_SOURCE.removeprefix('assumed: ')} (the worm-gear efficiencies in the "
+                                     "lead angle: novasolver.jp worm gear calculator; parksteer.reduction_efficiency); "
+                                     "an EPS worm is back-drivable (lambda > rho)"),
+    "pinion": (WORM_BACK_EFFICIENCY, f"assumed: the thread formula's {WORM_BACK_EFFICIENCY:.3f}, as at the column, for "
+                                     f"the {_WORM_SOURCE.removeprefix('assumed: ')}"),
+    "rack": (BALL_NUT_BACK_EFFICIENCY, f"assumed: the thread formula's {BALL_NUT_BACK_EFFICIENCY:.3f} for the "
+                                       f"{_BALL_NUT_SOURCE.removeprefix('assumed: ')} (the ball-screw catalogue form "
+                                       "(1 - mu / tan(lambda)) / (1 + mu tan(lambda)), the same expression; "
+                                       "parksteer.reduction_efficiency)"),
+}
+_FORWARD_SOURCE = {
+    "column": f"{_WORM_SOURCE}; range 0.75-0.9",
+    "pinion": f"{_WORM_SOURCE}; range 0.75-0.9",
+    "rack": f"{_BALL_NUT_SOURCE}; range 0.85-0.95",
 }
 
 
@@ -143,7 +180,7 @@ def assist_quantities(name: str, location: str) -> tuple[Quantity, ...]:
                  description="motor angle per unit of the point of action's travel", source=ratio_source),
         Quantity(f"{name}.efficiency", "1", 0.0, 1.0, default=efficiency,
                  description="forward efficiency of the reduction (worm gear or ball nut)",
-                 source="assumed: worm gears of EPS 0.75-0.9 (Kim, Mech. Sci. 9, 201, 2018), ball nuts 0.9-0.95"),
+                 source=_FORWARD_SOURCE[location]),
         Quantity(f"{name}.back_efficiency", "1", 0.0, 1.0, default=back,
                  description="efficiency of the reduction back-driven (power from the point of action into the "
                              "motor): the motor feels eta_b of the power the rack puts in",
@@ -248,7 +285,7 @@ class ElectricAssist(Effect):
         sensor = self.sensor_torque(model)
         demand = self.gain(model) * deadband(sensor, self.q(model, "dead_band"),
                                              self.q(model, "dead_band_smoothing")) * scale
-        demand = demand + table_law(sensor, lambda key: self.q(model, key), model.p(VEHICLE_SPEED.key))
+        demand = demand + table_law_node(sensor, lambda key: self.q(model, key), model.p(VEHICLE_SPEED.key))
         at_motor = demand / (self.q(model, "efficiency") * self.q(model, "reduction_ratio"))
         return clamp(at_motor, self.q(model, "motor_torque_limit"), self.q(model, "limit_smoothing"))
 

@@ -40,7 +40,7 @@ from ..lazy_sympy import sp
 from ....parameters import VEHICLE_SPEED, Quantity
 from ..components import Effect
 from ..system import action_reaction
-from .assist_common import clamp, deadband, series_deflection, table_law, table_quantities, torsion_bar_torque
+from .assist_common import clamp, deadband, series_deflection, table_law_node, table_quantities, torsion_bar_torque
 
 NAME = "hydraulic_assist"
 HANDBOOK = "Harrer & Pfeffer, Steering Handbook, Springer 2017, ch. 7"
@@ -99,7 +99,7 @@ class HydraulicAssist(Effect):
         p = lambda key: model.p(f"{NAME}.{key}")  # noqa: E731
         sensor = torsion_bar_torque(model, "pinion")
         opening = deadband(sensor, p("dead_band"), p("dead_band_smoothing"))
-        demand = p("valve_slope") * opening + table_law(sensor, p, model.p(VEHICLE_SPEED.key))
+        demand = p("valve_slope") * opening + table_law_node(sensor, p, model.p(VEHICLE_SPEED.key))
         return clamp(demand, p("relief_pressure"), p("pressure_smoothing"))
 
     def loads(self, model):
