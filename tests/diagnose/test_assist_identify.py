@@ -152,8 +152,6 @@ def test_a_value_the_balance_confirms_is_kept_and_written_as_measured(baseline, 
     contradict), the identified file keeps 3e-4 and its source names the record and the interval, so a later
     diagnosis no longer replays it as assumed (nor tells the owner to run the identification just run); the band
     of the motor's friction, which a bus's records do not fix, stays the file's, assumed."""
-    from parksteer.diagnose.stages.assumed import assumed_source
-
     truth, path, found = baseline
     text = et.POLO.read_text(encoding="utf-8")
     vehicle = tmp_path / "polo.toml"
@@ -163,9 +161,9 @@ def test_a_value_the_balance_confirms_is_kept_and_written_as_measured(baseline, 
     assert "motor_inertia" in again.kept and "motor_inertia" not in found.kept
     written = tomllib.loads(again.to_vehicle_toml(vehicle.read_text(encoding="utf-8")))["assist"]
     inertia = written["motor_inertia"]
-    assert inertia["value"] == 0.0003 and not assumed_source(inertia["source"])
+    assert inertia["value"] == 0.0003 and inertia["provenance"] == "identified"
     assert "baseline.csv" in inertia["source"] and "holds the file's 0.0003" in inertia["source"]
-    assert "friction_speed" not in written or written["friction_speed"]["source"].startswith("assumed")
+    assert "friction_speed" not in written or written["friction_speed"].get("provenance", "assumed") == "assumed"
 
 
 def test_a_data_sheets_product_stands_against_a_balance_read_at_the_wrong_tyre_friction(baseline, tmp_path):

@@ -222,14 +222,12 @@ def replace_assist_section(text: str, found) -> str:
 def _confirmed(found, old: dict, where: str) -> dict[str, tuple[float, str, str]]:
     """(value, unit, source) of each value of the gear the file assumed and the records measured with an interval
     holding it (kept as the file gives it: :attr:`Identified.kept`): the file's value, its source the estimate."""
-    from .stages.assumed import assumed_source
-
     estimates = {"torque_constant": found.product, "motor_friction_torque": found.motor_friction,
                  "motor_inertia": found.motor_inertia, "back_efficiency": found.back_efficiency}
     out = {}
     for key in found.kept:
         estimate, entry = estimates.get(key), old.get(key)
-        if estimate is None or entry is None or not assumed_source(entry.get("source", "assumed")):
+        if estimate is None or entry is None or entry.get("provenance", "assumed") != "assumed":
             continue
         measured = "the product k_t eta N = " if key == "torque_constant" else ""
         file_value = found.file_values.get("product" if key == "torque_constant" else key, entry["value"])
