@@ -366,12 +366,18 @@ def truth_clean(road: Road, boost: TruthMap, gear: TruthGear, logger: TruthLogge
            "handwheel_torque_Nm": solution.torsion_bar_Nm + hidden.sensor_offset_Nm,
            "motor_current_A": solution.current_A}
     if params is not None:
-        s = params.sections["steering"]
-        k, c = s["column_torsional_stiffness"], s["column_torsional_damping"]
-        series = k * gear.torsion_bar_stiffness / (k + gear.torsion_bar_stiffness)
-        twist, _ = column_twist(road.time_s, solution.torsion_bar_Nm, series, c * series / k)
-        out["handwheel_angle_rad"] = road.column_rad + twist
+        out["handwheel_angle_rad"] = handwheel_angle(road, solution.torsion_bar_Nm, gear, params)
     return out
+
+
+def handwheel_angle(road: Road, torsion_bar_Nm: np.ndarray, gear: TruthGear, params: Parameters) -> np.ndarray:
+    """The handwheel's angle over `road`: the column's plus the twist of the torsion bar and the column in series
+    (the car's column stiffness and damping from `params`) under the torsion-bar torque."""
+    s = params.sections["steering"]
+    k, c = s["column_torsional_stiffness"], s["column_torsional_damping"]
+    series = k * gear.torsion_bar_stiffness / (k + gear.torsion_bar_stiffness)
+    twist, _ = column_twist(road.time_s, torsion_bar_Nm, series, c * series / k)
+    return road.column_rad + twist
 
 
 def truth_record(clean: dict[str, np.ndarray], logger: TruthLogger, case: str, surface: str = "ground",
@@ -412,4 +418,5 @@ def with_hidden(hidden: Hidden, name: str, size: float) -> Hidden:
 
 
 __all__ = ["HIDDEN_TRUTH", "OUT_OF_CLASS_TRUTH", "Hidden", "Road", "TruthGear", "TruthLogger", "TruthMap",
-           "column_of_pinion", "eps_layer", "manual_road", "truth_clean", "truth_record", "with_hidden"]
+           "column_of_pinion", "eps_layer", "handwheel_angle", "manual_road", "truth_clean", "truth_record",
+           "with_hidden"]

@@ -32,7 +32,7 @@ from .. import portable as pm
 from ..geometry import column_twist
 from ..measure.converter import quantisation_step
 from ..parameters import Parameters
-from .assisted_truth import BISECTION_STEPS, Hidden, Road, TruthGear, TruthLogger, TruthMap
+from .assisted_truth import BISECTION_STEPS, Hidden, Road, TruthGear, TruthLogger, TruthMap, handwheel_angle
 
 BACK_EFFICIENCY_BAND = (0.75, 0.85)  # data/vehicles/polo_vi.toml, back_efficiency's source
 
@@ -127,11 +127,7 @@ def quirk_eps_clean(road: Road, boost: TruthMap, gear: TruthGear, quirk: EpsQuir
     out = {"time_s": road.time_s, "rack_m": road.rack_m, "handwheel_torque_Nm": reading,
            "motor_current_A": solution.current_A}
     if params is not None:
-        s = params.sections["steering"]
-        k, c = s["column_torsional_stiffness"], s["column_torsional_damping"]
-        series = k * gear.torsion_bar_stiffness / (k + gear.torsion_bar_stiffness)
-        twist, _ = column_twist(road.time_s, solution.torsion_bar_Nm, series, c * series / k)
-        out["handwheel_angle_rad"] = road.column_rad + twist
+        out["handwheel_angle_rad"] = handwheel_angle(road, solution.torsion_bar_Nm, gear, params)
     return out
 
 
