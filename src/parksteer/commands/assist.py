@@ -13,6 +13,7 @@ from pathlib import Path
 from ..errors import UsageError
 from ..parameters import DEFAULT_PATH
 from ..vehicle import ASSIST_EFFECTS, MAX_CREEPING_SPEED_KMH
+from . import check_writable
 from .measure import add_import_options, channel_map_of
 from .vehicle import parameters_of
 
@@ -79,7 +80,7 @@ def _identify(args) -> int:
         raise UsageError(f"--out {args.out}: a vehicle file is TOML; name it .toml")
     if out.exists() and not args.force:
         raise UsageError(f"--out {args.out}: exists (--force to overwrite)")
-    _check_writable("--out", args.out, out.resolve().parent)
+    check_writable("--out", args.out, out.resolve().parent)
     # what the identification prints while it runs is progress: stderr, so that stdout holds the result alone
     with contextlib.redirect_stdout(sys.stderr):
         found = identify_boost(args.files, args.vehicle, args.case, args.surface, channel_map_of(args),
@@ -109,18 +110,6 @@ def _creep(args) -> int:
     return 0
 
 
-def _check_writable(option: str, value: str, folder: Path) -> None:
-    """Refuse a folder nothing can be written in before the work, not after it (a probe file made and removed:
-    permissions alone do not tell, e.g. for root or a read-only mount)."""
-    import tempfile
-
-    try:
-        with tempfile.NamedTemporaryFile(dir=folder, prefix=".parksteer-probe-"):
-            pass
-    except OSError as exc:
-        raise UsageError(f"{option} {value}: cannot write in folder {folder} ({exc.strerror})") from None
-
-
 def _check_out_dir(value: str) -> None:
     """--out-dir: a folder, or one that can be made, in a place that can be written (checked before the work)."""
     folder = Path(value).resolve()
@@ -131,7 +120,7 @@ def _check_out_dir(value: str) -> None:
         existing = existing.parent
     if not existing.is_dir():
         raise UsageError(f"--out-dir {value}: {existing} is a file, not a folder")
-    _check_writable("--out-dir", value, existing)
+    check_writable("--out-dir", value, existing)
 
 
 # A map whose largest current is below this many times the map's own noise has not seen the motor work.

@@ -11,7 +11,7 @@ from ..names import SURFACES
 from ..errors import UsageError
 from ..parameters import DEFAULT_PATH
 from ..progress import note
-from . import add_quiet_option
+from . import add_quiet_option, check_writable
 from .baseline import RecordOptions, baseline_of, register_baseline
 from .vehicle import add_vehicle_option, parameters_of
 
@@ -115,15 +115,8 @@ def _check_outputs(args) -> None:
 
 
 def _check_writable(option: str, value: str, folder: Path) -> None:
-    """Refuse an output folder nothing can be written in before the work, not after it (a probe file is made and
-    removed: permissions alone do not tell, e.g. for root or a read-only mount)."""
-    import tempfile
-
-    try:
-        with tempfile.NamedTemporaryFile(dir=folder, prefix=".parksteer-probe-"):
-            pass
-    except OSError as exc:
-        raise UsageError(f"--{option} {value}: cannot write in folder {folder} ({exc.strerror})") from None
+    """:func:`parksteer.commands.check_writable` of the option named without its dashes (``out``)."""
+    check_writable(f"--{option}", value, folder)
 
 
 def _print_json(result: dict) -> None:
