@@ -15,6 +15,7 @@ half-written.
 from __future__ import annotations
 
 import argparse
+import atexit
 import importlib
 import os
 import signal
@@ -191,5 +192,19 @@ def _run(args, interrupt: Interrupt) -> int:
         raise
 
 
+def run_as_main() -> None:
+    """``python -m parksteer.cli``: exit with :func:`main`'s status. CPython marks a KeyboardInterrupt that passed
+    through an extension's ``PyRun`` call (as one may while the subcommands' modules load) as unhandled even once
+    caught, and then ends a ``-m`` run by SIGINT whatever its status; an interrupted command therefore runs the exit
+    functions itself and ends with its status through ``os._exit``."""
+    status = main()
+    if status in {128 + int(number) for number in STOPPING_SIGNALS}:
+        atexit._run_exitfuncs()
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(status)
+    sys.exit(status)
+
+
 if __name__ == "__main__":
-    sys.exit(main())
+    run_as_main()
