@@ -58,5 +58,5 @@ def test_a_version_7_3_or_damaged_file_is_refused_in_one_line(tmp_path):
 
 def test_the_reader_is_one_row_of_the_table():
     """Adding the format took one module and one entry of READERS: it sits after MDF, before the text readers."""
-    assert list(READERS) == ["can_log", "mdf", "matlab", "native_csv", "logger_csv"]
+    assert list(READERS) == ["bus_log", "can_log", "mdf", "matlab", "native_csv", "logger_csv"]
     assert READERS["matlab"] is MatlabReader

@@ -60,9 +60,9 @@ def test_a_damaged_file_is_refused_in_one_line(tmp_path):
 
 
 def test_the_table_finds_the_reader_of_each_format(tmp_path):
-    """READERS in order: raw CAN logs by their first lines, MDF by its magic, the native format by its header,
-    anything else the logger reader."""
-    assert list(READERS) == ["can_log", "mdf", "matlab", "native_csv", "logger_csv"]
+    """READERS in order (the bus-log reader only for a file given with its bus): raw CAN logs by their first
+    lines, MDF by its magic, the native format by its header, anything else the logger reader."""
+    assert list(READERS) == ["bus_log", "can_log", "mdf", "matlab", "native_csv", "logger_csv"]
     assert reader_for(b"(1700000000.000000) can0 09F#0011223344556677\n").name == "CAN bus log"
     assert reader_for(b"LOGG\x90\x00\x00\x00").name == "CAN bus log"
     assert reader_for(b"MDF     4.10    ").name == "ASAM MDF"

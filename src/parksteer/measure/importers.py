@@ -43,7 +43,6 @@ from ..parameters import Parameters, load_parameters
 from .io import ALLOWED_COLUMNS, REQUIRED_COLUMNS, UNITS, Measurement, metadata_text, validate_record
 from .readers import Record, Source, reader_for
 from .readers.base import TIME_ALIASES, name_and_unit, normal_name
-from .readers.can_log import read_bus_log
 
 RACK, TORQUE, ANGLE, TIME = "rack_m", "handwheel_torque_Nm", "handwheel_angle_rad", "time_s"
 # An assisted car's torque sensor: a map target of its own, read into the torque column with the metadata
@@ -220,17 +219,12 @@ def channel_map_from_options(map_text: str | None, map_file: str | Path | None) 
 
 # --------------------------------------------------------------------------------------------------- units
 
-_REGISTRY = None
-
-
 def unit_registry():
-    """pint's registry, built once (it takes a few tenths of a second)."""
-    global _REGISTRY
-    if _REGISTRY is None:
-        import pint
+    """pint's application registry (pint's default units, built by pint on first use: it takes a few tenths of a
+    second); the package never defines units in it."""
+    import pint
 
-        _REGISTRY = pint.UnitRegistry()
-    return _REGISTRY
+    return pint.get_application_registry()
 
 
 def conversion(unit: str | None, target: str, where: str):
@@ -485,14 +479,11 @@ def load_record(path: str | Path, channel_map: str | list[Channel] | None = None
         channel_map = parse_channel_map(channel_map)
     raw = read_record_bytes(path)
     # A raw CAN log is decoded with the DBC its channel map carries (--dbc, --bus); sign= and scale= are its own.
-    if getattr(channel_map, "bus", None) is not None:
-        record = read_bus_log(raw, path, channel_map)
-    else:
-        bus_only = next((ch for ch in channel_map or [] if ch.sign or ch.scale), None)
-        if bus_only is not None:
-            raise UsageError(f"{bus_only.origin}: {bus_only.spec()!r}: sign= and scale= apply to a CAN log's "
-                             "signals; give the car's DBC (--dbc or --bus)")
-        record = reader_for(raw).read(raw, path)
+    bus_only = next((ch for ch in channel_map or [] if ch.sign or ch.scale), None)
+    if bus_only is not None and getattr(channel_map, "bus", None) is None:
+        raise UsageError(f"{bus_only.origin}: {bus_only.spec()!r}: sign= and scale= apply to a CAN log's "
+                         "signals; give the car's DBC (--dbc or --bus)")
+    record = reader_for(raw, channel_map).read(raw, path)
     sources, metadata, line_numbers = record.sources, dict(record.metadata), record.line_numbers
     notes: list[str] = list(record.notes)
 
