@@ -13,15 +13,14 @@ one line naming the file and the key.
 
 from __future__ import annotations
 
-from functools import lru_cache
-
 import dataclasses
 import math
 import numbers
 import tomllib
 from dataclasses import dataclass, field
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from pathlib import Path
+from types import MappingProxyType
 from typing import Any
 
 from .errors import UsageError, cannot_read
@@ -278,22 +277,19 @@ RENAMED: dict[str, str] = {
 }
 
 
-@lru_cache(maxsize=1)
-def _file_and_case_keys() -> dict[str, Quantity]:
-    """The parameter file's keys and ``case.*`` (fixed at import; built once, looked up for every value)."""
-    out = {q.key: q for table in SCHEMA.values() for q in table.values()}
-    out.update({q.key: q for q in CASE_SCHEMA.values()})
-    return out
+# The parameter file's keys and ``case.*`` (fixed at import, looked up for every value).
+FILE_AND_CASE_KEYS: Mapping[str, Quantity] = MappingProxyType(
+    {**{q.key: q for table in SCHEMA.values() for q in table.values()}, **{q.key: q for q in CASE_SCHEMA.values()}})
 
 
 def registry() -> dict[str, Quantity]:
     """Every known key: the parameter file's, ``case.*``, and those declared by loaded effects."""
-    return {**_file_and_case_keys(), **_DECLARED}
+    return {**FILE_AND_CASE_KEYS, **_DECLARED}
 
 
 def quantity(key: str) -> Quantity:
     """The quantity of `key`; an unknown or renamed key is a one-line UsageError."""
-    found = _file_and_case_keys().get(key) or _declared(key)
+    found = FILE_AND_CASE_KEYS.get(key) or _declared(key)
     if found is None:
         raise UsageError(unknown_key_message(key))
     return found

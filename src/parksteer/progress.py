@@ -7,33 +7,32 @@ from __future__ import annotations
 import sys
 import time
 from contextlib import contextmanager
+from contextvars import ContextVar
 from typing import Iterator
 
-_quiet = False
+# Whether the progress lines are silenced, held by the running context (a forked worker inherits its parent's).
+QUIET: ContextVar[bool] = ContextVar("parksteer_progress_quiet", default=False)
 
 
 def set_quiet(quiet: bool) -> None:
-    """Silence (True) or restore (False) the progress lines of this process."""
-    global _quiet
-    _quiet = bool(quiet)
+    """Silence (True) or restore (False) the progress lines of the current context."""
+    QUIET.set(bool(quiet))
 
 
 @contextmanager
 def quiet_while(quiet: bool) -> Iterator[None]:
     """Silence the progress lines inside the block when `quiet` (a subcommand's ``--quiet``), then restore what
     was set before it (a command run in-process, as the tests run them, leaves the next one as it found it)."""
-    global _quiet
-    before = _quiet
-    _quiet = before or bool(quiet)
+    token = QUIET.set(QUIET.get() or bool(quiet))
     try:
         yield
     finally:
-        _quiet = before
+        QUIET.reset(token)
 
 
 def note(message: str) -> None:
     """One progress line on the current stderr (looked up at each call: a rule redirects it to its log)."""
-    if not _quiet:
+    if not QUIET.get():
         print(message, file=sys.stderr, flush=True)
 
 

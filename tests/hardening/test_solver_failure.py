@@ -92,11 +92,13 @@ def test_an_absurdly_stiff_tyre_fails_in_one_line_within_the_work_budget(tmp_pat
     simulated second."""
     import dataclasses
     import math
+    from types import MappingProxyType
 
     from parksteer import parameters
 
     unbounded = dataclasses.replace(parameters.quantity("tyre.radial_stiffness"), upper=math.inf)
-    monkeypatch.setitem(parameters._file_and_case_keys(), "tyre.radial_stiffness", unbounded)
+    monkeypatch.setattr(parameters, "FILE_AND_CASE_KEYS",
+                        MappingProxyType({**parameters.FILE_AND_CASE_KEYS, "tyre.radial_stiffness": unbounded}))
     out = tmp_path / "out.csv"
     status = main(["simulate", "--case", "unladen", "--set", "tyre.radial_stiffness=1e16", "--out", str(out)])
     err = capsys.readouterr().err.strip().splitlines()

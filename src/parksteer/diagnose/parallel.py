@@ -63,54 +63,44 @@ def can_fork() -> bool:
 
 def forks(count: int, workers: int) -> bool:
     """Whether :func:`fork_map` of `count` items on `workers` workers runs in worker processes (never in a worker)."""
-    return min(workers, count) > 1 and not WORKER.serving and can_fork()
+    return min(workers, count) > 1 and not in_worker() and can_fork()
 
 
-class WorkerProcess:
-    """What a worker process serves: `serve(argument)` for each task it is sent.
-
-    The one piece of per-process state of the parallel replays, and it is written only in worker processes:
-    :func:`pool` forks its workers with `serve` (a closure over anything in the forking process, inherited, never
-    pickled) and the pool's initializer, :meth:`start`, keeps it on the worker's :data:`WORKER`, where
-    :func:`_serve` finds it for each task (multiprocessing sends a task's function by name, so the function a
-    worker runs needs a module-level home: this object). In the diagnosing process it stays empty, which is how
-    :func:`forks` tells a worker, which never forks again, from the process that forked it.
-    """
-
-    def __init__(self) -> None:
-        self.serve: Callable[[Any], Any] | None = None
-
-    def start(self, serve: Callable[[Any], Any]) -> None:
-        # Ctrl-C is the forking process's to answer (module docstring); SIGTERM, which ends a pool's workers,
-        # ends this one at once, even inside a solve, whatever handler it inherited
-        signal.signal(signal.SIGINT, signal.SIG_IGN)
-        signal.signal(signal.SIGTERM, signal.SIG_DFL)
-        signal.pthread_sigmask(signal.SIG_UNBLOCK, STOPPING_SIGNALS)  # held while the pool forked it
-        self.serve = serve
-
-    @property
-    def serving(self) -> bool:
-        return self.serve is not None
+# The attribute of a worker's process object (multiprocessing.current_process()) holding what it serves.
+SERVE_ATTRIBUTE = "parksteer_serve"
 
 
-WORKER = WorkerProcess()
+def start_worker(serve: Callable[[Any], Any]) -> None:
+    """A pool worker's initializer: keep `serve` on the worker's own process object, where :func:`_serve` finds
+    it for each task (multiprocessing sends a task's function by name, so the function a worker runs is found
+    through an object the worker owns, not a closure). :func:`pool` forks its workers with `serve` (a closure over
+    anything in the forking process, inherited, never pickled). The diagnosing process's own process object holds
+    nothing, which is how :func:`in_worker` tells a worker, which never forks again, from the process that forked
+    it."""
+    # Ctrl-C is the forking process's to answer (module docstring); SIGTERM, which ends a pool's workers,
+    # ends this one at once, even inside a solve, whatever handler it inherited
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, STOPPING_SIGNALS)  # held while the pool forked it
+    setattr(multiprocessing.current_process(), SERVE_ATTRIBUTE, serve)
 
 
 def in_worker() -> bool:
-    return WORKER.serving
+    """Whether this process is a pool worker serving a function (:func:`start_worker`)."""
+    return getattr(multiprocessing.current_process(), SERVE_ATTRIBUTE, None) is not None
 
 
 def _serve(argument):
-    return WORKER.serve(argument)
+    return getattr(multiprocessing.current_process(), SERVE_ATTRIBUTE)(argument)
 
 
 def pool(workers: int, serve: Callable[[Any], Any]):
-    """A pool of `workers` processes forked from this one, each serving `serve` (:class:`WorkerProcess`), or None
+    """A pool of `workers` processes forked from this one, each serving `serve` (:func:`start_worker`), or None
     where it would not fork. Map items over it with :func:`pool_map`; close it when done."""
     if not forks(workers, workers):
         return None
     with signals_held():
-        return multiprocessing.get_context("fork").Pool(workers, initializer=WORKER.start, initargs=(serve,))
+        return multiprocessing.get_context("fork").Pool(workers, initializer=start_worker, initargs=(serve,))
 
 
 def pool_map(workers_pool, items: Sequence[Any]) -> list:

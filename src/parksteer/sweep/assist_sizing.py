@@ -45,6 +45,7 @@ from __future__ import annotations
 import dataclasses
 import functools
 import tomllib
+from types import MappingProxyType
 
 import numpy as np
 
@@ -60,11 +61,20 @@ SPEEDS_KMH = (0.0, 1.0, 3.0, 5.0)
 MARGIN = 1.1  # the sized motor limit or relief pressure over the quasi-static demand
 LINKAGE_EFFECT = "linkage_nonlinearity"  # the linkage ratio rising toward lock, where the vehicle file gives it
 
+def _read_only(value):
+    """`value` (a TOML document) with every table read-only and every array a tuple."""
+    if isinstance(value, dict):
+        return MappingProxyType({key: _read_only(item) for key, item in value.items()})
+    if isinstance(value, list):
+        return tuple(_read_only(item) for item in value)
+    return value
+
+
 @functools.cache
-def published_loads() -> dict:
+def published_loads() -> MappingProxyType:
     """The published loads, tyre coefficients and friction values of ``parksteer/data/published_loads.toml``, each
-    with its source and how it was read (the file's header)."""
-    return tomllib.loads(data_file("published_loads.toml").read_text(encoding="utf-8"))
+    with its source and how it was read (the file's header), read-only (one copy serves every caller)."""
+    return _read_only(tomllib.loads(data_file("published_loads.toml").read_text(encoding="utf-8")))
 
 
 # The tyre-ground friction the standstill rack force is reported over (tyre.friction_coefficient, which scales the

@@ -35,6 +35,7 @@ from dataclasses import dataclass
 from functools import lru_cache
 from importlib.metadata import entry_points
 from pathlib import Path
+from types import MappingProxyType
 from typing import TYPE_CHECKING, Any, ClassVar
 
 from ...errors import UsageError
@@ -106,8 +107,13 @@ class Effect:
     location: ClassVar[str | None] = None
 
     def __init_subclass__(cls, **kwargs: Any) -> None:
+        """A rival is never a candidate: its ``diagnosis_candidate`` is False, and a class that declares both is
+        refused (one line naming it), never corrected silently."""
         super().__init_subclass__(**kwargs)
         if cls.rival is not None:
+            if cls.__dict__.get("diagnosis_candidate") is True:
+                raise UsageError(f"effect {cls.name or cls.__qualname__}: declares both rival and "
+                                 "diagnosis_candidate = True; a rival is never a diagnosis candidate")
             cls.diagnosis_candidate = False
 
     def configure(self, model: ModelSpace) -> None:
@@ -286,8 +292,11 @@ STRENGTH_NAME = "strength"
 
 
 @lru_cache(maxsize=1)
-def _shipped_parameters():
-    return load_parameters(DEFAULT_PATH)
+def _shipped_values() -> MappingProxyType:
+    """The shipped parameter file's scalar values by key, read-only."""
+    params = load_parameters(DEFAULT_PATH)
+    return MappingProxyType({f"{section}.{name}": float(value) for section, table in params.sections.items()
+                             for name, value in table.items() if isinstance(value, (int, float))})
 
 
 def strength_parameter(effect: Effect, params=None) -> Quantity | None:
@@ -296,14 +305,21 @@ def strength_parameter(effect: Effect, params=None) -> Quantity | None:
 
     A candidate effect (off by default) is added to a model at a fitted or chosen size through it.
     """
-    params = params if params is not None else _shipped_parameters()
     declared = {q.key: q for q in effect.quantities}
     table = registry()
     own = [declared.get(k) or table[k] for k in effect.own_keys()]
     named = [q for q in own if q.name == STRENGTH_NAME]
     if named:
         return named[0]
-    zero = [q for q in own if (q.default if q.key in declared else float(params[q.key])) == 0.0 and q.lower == 0.0]
+
+    def is_zero(q: Quantity) -> bool:
+        if q.key in declared:
+            return q.default == 0.0
+        if params is not None:
+            return float(params[q.key]) == 0.0
+        return _shipped_values().get(q.key, q.default) == 0.0
+
+    zero = [q for q in own if is_zero(q) and q.lower == 0.0]
     return zero[0] if len(zero) == 1 else None
 
 

@@ -187,7 +187,7 @@ def table_law(torque, value, speed, points=None):
 
 
 @cache
-def table_functions():
+def table_functions() -> tuple[type, type]:
     """The two sympy functions that stand for :func:`table_law` in a model's expressions, ``BoostTableLaw`` and its
     torque derivative ``BoostTableSlope``, each of (torque, speed, the table's scalars in
     :func:`parksteer.boost_table.table_keys` order). A table of 32 points and 8 speeds is a Piecewise of 31
