@@ -10,6 +10,7 @@ import numpy as np
 from ..plotting import COLOURS, new_figure, save_svg
 from .diagnose import VARIATION_SHADES, _cell
 
+# The hidden candidates' names in the assisted benchmarks' figures (this one and figures/assisted_truth.py).
 LABELS = {"assist_motor_friction": "motor friction", "torsion_bar_offset": "torsion-bar offset",
           "boost_gain_error": "boost gain error", "rack_friction": "rack friction (calibrated)"}
 

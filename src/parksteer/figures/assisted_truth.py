@@ -8,10 +8,9 @@ from pathlib import Path
 import numpy as np
 
 from ..plotting import COLOURS, new_figure, save_svg
+from .assisted import LABELS
 from .diagnose import VARIATION_SHADES, _cell
 
-LABELS = {"assist_motor_friction": "motor friction", "torsion_bar_offset": "torsion-bar offset",
-          "boost_gain_error": "boost gain error", "rack_friction": "rack friction (calibrated)"}
 TIER_LABELS = {"rack": "rack logged", "angle": "angle only"}
 
 
