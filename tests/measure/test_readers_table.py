@@ -35,3 +35,19 @@ def test_the_import_layer_reads_records_only_through_the_table():
     called = {node.func.id for node in ast.walk(tree) if isinstance(node, ast.Call) and isinstance(node.func, ast.Name)}
     reading = {name for name in from_readers & called if name.startswith("read") or name.endswith("Reader")}
     assert reading == {"reader_for"}
+
+
+def test_the_readers_refuse_a_record_through_one_helper():
+    """The fact checked: no reader and not the import layer writes a refusal's ``{where}: `` prefix by hand
+    (``UsageError(f"{where}: ...")``): each goes through ``readers.base.refusal``, which gives the one-line form
+    ``FILE: problem``."""
+    from parksteer.errors import UsageError
+    from parksteer.measure.readers.base import refusal
+
+    modules = [Path(importers.__file__), *sorted(Path(importers.__file__).with_name("readers").glob("*.py"))]
+    by_hand = [f"{path.name}:{number}" for path in modules
+               for number, line in enumerate(path.read_text(encoding="utf-8").splitlines(), 1)
+               if 'UsageError(f"{where}: ' in line and path.name != "base.py"]
+    assert by_hand == []
+    error = refusal(Path("car.csv"), "row 3: not a number")
+    assert isinstance(error, UsageError) and str(error) == "car.csv: row 3: not a number"

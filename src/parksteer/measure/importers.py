@@ -42,7 +42,7 @@ from ..geometry import rack_from_handwheel
 from ..parameters import Parameters, load_parameters
 from .io import ALLOWED_COLUMNS, REQUIRED_COLUMNS, UNITS, Measurement, metadata_text, validate_record
 from .readers import Record, Source, reader_for
-from .readers.base import TIME_ALIASES, name_and_unit, normal_name
+from .readers.base import TIME_ALIASES, name_and_unit, normal_name, refusal
 
 RACK, TORQUE, ANGLE, TIME = "rack_m", "handwheel_torque_Nm", "handwheel_angle_rad", "time_s"
 # An assisted car's torque sensor: a map target of its own, read into the torque column with the metadata
@@ -238,7 +238,7 @@ def conversion(unit: str | None, target: str, where: str):
     try:
         parsed = ureg.parse_units(text)
     except Exception:  # pint raises several types (undefined unit, syntax, tokenizer) for one user mistake
-        raise UsageError(f"{where}: unit {unit!r} is not a unit pint knows") from None
+        raise refusal(where, f"unit {unit!r} is not a unit pint knows") from None
     try:
         factor = float(ureg.Quantity(1.0, parsed).to(si).magnitude)
     except Exception:
@@ -247,9 +247,9 @@ def conversion(unit: str | None, target: str, where: str):
             f"another unit of {UNIT_DIMENSIONS[target]})"
         ) from None
     if target == ANGLE and not any(word in str(parsed) for word in ANGLE_UNIT_WORDS):
-        raise UsageError(f"{where}: unit {unit!r} is not an angle (column {target!r} needs rad, deg or rev)")
+        raise refusal(where, f"unit {unit!r} is not an angle (column {target!r} needs rad, deg or rev)")
     if float(ureg.Quantity(0.0, parsed).to(si).magnitude) != 0.0:
-        raise UsageError(f"{where}: unit {unit!r} has an offset (like degC); give a unit that starts at zero")
+        raise refusal(where, f"unit {unit!r} has an offset (like degC); give a unit that starts at zero")
     divisor = 1.0 / factor
     if factor < 1.0 and divisor == round(divisor):
         # A decimal prefix: divide by the exact integer, so mm -> m is value / 1000 to the last bit.
@@ -287,7 +287,7 @@ def _map_sources(where: Path, sources: list[Source], channel_map: list[Channel] 
         if source is None and len(by_lower.get(ch.source.lower(), [])) == 1:
             source = by_lower[ch.source.lower()][0]
         if source is None:
-            raise UsageError(f"{where}: {ch.origin} names channel {ch.source!r}, which the file does not have "
+            raise refusal(where, f"{ch.origin} names channel {ch.source!r}, which the file does not have "
                              f"(channels: {listing})")
         chosen[ch.target] = (source, ch)
         used.add(source.name)
@@ -315,7 +315,7 @@ def _map_sources(where: Path, sources: list[Source], channel_map: list[Channel] 
     for target, (source, ch) in chosen.items():
         unit = ch.unit or source.unit
         if unit is None and source.name != target and ch.origin == "alias":
-            raise UsageError(f"{where}: channel {source.name!r} has no unit; give it in brackets, a units row or "
+            raise refusal(where, f"channel {source.name!r} has no unit; give it in brackets, a units row or "
                              f"--map '{source.name}[unit]={target}'")
     return chosen
 

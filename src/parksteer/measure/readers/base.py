@@ -81,6 +81,12 @@ class Reader(Protocol):
         `where`. (The caller reads the bytes once, under the size cap of a record.)"""
 
 
+def refusal(where, problem: str) -> UsageError:
+    """The one-line refusal of a record: `where` (its file, with the channel, row or line when known), then what is
+    wrong with it: ``{where}: {problem}``."""
+    return UsageError(f"{where}: {problem}")
+
+
 def normal_name(name: str) -> str:
     """A channel name as aliases are compared: lower case, without spaces, '_', '-' or '.'."""
     return re.sub(r"[\s_.\-]", "", name.lower())
@@ -102,4 +108,4 @@ def decode_text(raw: bytes, where: Path) -> str:
     try:
         return raw.decode("utf-8")
     except UnicodeDecodeError as exc:
-        raise UsageError(f"{where}: not UTF-8 text (byte {exc.start})") from None
+        raise refusal(where, f"not UTF-8 text (byte {exc.start})") from None

@@ -47,7 +47,7 @@ from typing import ClassVar
 import numpy as np
 
 from ...errors import UsageError, cannot_read_as
-from .base import SNIFF_BYTES, Record, Source
+from .base import SNIFF_BYTES, Record, Source, refusal
 
 # A gap in a used message longer than this is refused: the method resolves the phases of a cycle over windows of
 # 0.1 s (parksteer.measure.importers.METHOD_RATE_HZ), so a longer hole takes a part of a phase with it.
@@ -96,7 +96,7 @@ class CanLogReader:
 
     def read(self, raw: bytes, where: Path) -> Record:
         fmt = FORMAT_NAMES[bus_format(raw[:SNIFF_BYTES]) or "candump"]
-        raise UsageError(f"{where}: a raw CAN log ({fmt}); decoding it needs the car's DBC: give --bus NAME "
+        raise refusal(where, f"a raw CAN log ({fmt}); decoding it needs the car's DBC: give --bus NAME "
                          f"(known: {', '.join(known_buses())}) or --dbc CAR.dbc with --map "
                          "'MESSAGE.SIGNAL[unit]=column'")
 
@@ -208,14 +208,14 @@ def read_frames(raw: bytes, where: Path, fmt: str):
         import can  # noqa: F401
         from can.io import asc, blf, canutils, trc
     except ImportError:
-        raise UsageError(f"{where}: a raw CAN log; reading it needs the optional extra: pip install 'parksteer[bus]'") \
+        raise refusal(where, "a raw CAN log; reading it needs the optional extra: pip install 'parksteer[bus]'") \
             from None
     times, ids, data, channels, errors = [], [], [], [], 0
     if fmt == "blf" and len(raw) >= 24:
         # The file header states the file's size (uint64 at byte 16); python-can stops quietly at a cut
         stated = int.from_bytes(raw[16:24], "little")
         if stated > len(raw):
-            raise UsageError(f"{where}: the Vector BLF is cut short: {len(raw)} of the {stated} bytes its header "
+            raise refusal(where, f"the Vector BLF is cut short: {len(raw)} of the {stated} bytes its header "
                              "states; copy the whole file from the logger")
     # asammdf logs a damaged file's tracebacks and its half-built reader's finaliser fails: both silenced here
     quiet = logging.getLogger("asammdf"), sys.unraisablehook
@@ -257,7 +257,7 @@ def read_frames(raw: bytes, where: Path, fmt: str):
         raise UsageError(cannot_read_as(where, f"{FORMAT_NAMES[fmt]}{got}", problem)
                          + "; the file is damaged or cut short")
     if not times:
-        raise UsageError(f"{where}: the {FORMAT_NAMES[fmt]} holds no CAN data frame")
+        raise refusal(where, f"the {FORMAT_NAMES[fmt]} holds no CAN data frame")
     return np.asarray(times, dtype=float), np.asarray(ids, dtype=np.int64), data, np.asarray(channels), errors
 
 
@@ -285,14 +285,14 @@ class _Signal:
 def _split_signal(text: str, where: Path, dbc, dbc_path: Path, what: str) -> tuple[str, str]:
     message, dot, signal = text.partition(".")
     if not dot or not message or not signal:
-        raise UsageError(f"{where}: {what} {text!r} must read 'MESSAGE.SIGNAL' (a message and signal of {dbc_path.name})")
+        raise refusal(where, f"{what} {text!r} must read 'MESSAGE.SIGNAL' (a message and signal of {dbc_path.name})")
     try:
         msg = dbc.get_message_by_name(message)
     except KeyError:
-        raise UsageError(f"{where}: {what} {text!r}: {dbc_path.name} has no message {message!r}") from None
+        raise refusal(where, f"{what} {text!r}: {dbc_path.name} has no message {message!r}") from None
     if signal not in [s.name for s in msg.signals]:
         names = ", ".join(s.name for s in msg.signals)
-        raise UsageError(f"{where}: {what} {text!r}: message {message} has no signal {signal!r} (signals: {names})")
+        raise refusal(where, f"{what} {text!r}: message {message} has no signal {signal!r} (signals: {names})")
     return message, signal
 
 
@@ -332,7 +332,7 @@ def read_bus_log(raw: bytes, where: Path, channels) -> Record:
         if raw[:8] in (b"MDF     ", b"UnFinMF "):
             fmt = "mf4"
         else:
-            raise UsageError(f"{where}: --dbc/--bus given, but the file is not a CAN log this tool reads "
+            raise refusal(where, "--dbc/--bus given, but the file is not a CAN log this tool reads "
                              f"({', '.join(FORMAT_NAMES.values())}); a file of named channels needs neither")
     dbc = load_dbc(bus)
     signals = []
@@ -346,7 +346,7 @@ def read_bus_log(raw: bytes, where: Path, channels) -> Record:
     steps = np.diff(times)
     if np.any(steps < 0.0):
         k = int(np.argmax(steps < 0.0)) + 1
-        raise UsageError(f"{where}: frame {k + 1} (id 0x{ids[k]:03X}) is stamped {times[k] - times[0]:.6f} s, before "
+        raise refusal(where, f"frame {k + 1} (id 0x{ids[k]:03X}) is stamped {times[k] - times[0]:.6f} s, before "
                          f"the frame ahead of it ({times[k - 1] - times[0]:.6f} s): the logger's clock jumped; cut "
                          "the log there or merge its parts in time order")
     # Times from the first frame, to the microsecond: the resolution of candump and ASC, and what undoes the
@@ -368,7 +368,7 @@ def read_bus_log(raw: bytes, where: Path, channels) -> Record:
     for name, msg in messages.items():
         mask = ids == msg.frame_id
         if not mask.any():
-            raise UsageError(f"{where}: no frame of {name} (id {msg.frame_id} = 0x{msg.frame_id:03X}) in the log, "
+            raise refusal(where, f"no frame of {name} (id {msg.frame_id} = 0x{msg.frame_id:03X}) in the log, "
                              f"which holds {_listing(ids)}: a log of another bus, or not this car's DBC")
         # A log of two buses (candump -l any, a logger's two channels) may hold a message on both, as a gateway
         # forwards it: the channel with the most of its frames is read
@@ -389,7 +389,7 @@ def read_bus_log(raw: bytes, where: Path, channels) -> Record:
         keep &= ~dup
         if np.any(np.diff(t[keep]) == 0.0):
             k = int(np.argmax(np.diff(t[keep]) == 0.0)) + 1
-            raise UsageError(f"{where}: two frames of {name} with different data share the time stamp "
+            raise refusal(where, f"two frames of {name} with different data share the time stamp "
                              f"{t[keep][k]:.6f} s: the log's time stamps cannot be trusted there")
         # checksum
         crc = checksum_signal(msg)
@@ -399,7 +399,7 @@ def read_bus_log(raw: bytes, where: Path, channels) -> Record:
             bad = np.array([len(f) < 2 or algorithm(f, bus.data_ids[msg.frame_id]) != f[0] for f in frames])
             bad &= keep
             if bad.sum() > MAX_BAD_SHARE * keep.sum():
-                raise UsageError(f"{where}: {name}: the checksum fails in {int(bad.sum())} of {int(keep.sum())} "
+                raise refusal(where, f"{name}: the checksum fails in {int(bad.sum())} of {int(keep.sum())} "
                                  f"frames (first at {t[bad][0]:.3f} s): not this bus, or not this car's DBC")
             if bad.any():
                 notes.append(f"{name}: {int(bad.sum())} frames failing their checksum dropped (at {_times(t[bad])})")
@@ -422,7 +422,7 @@ def read_bus_log(raw: bytes, where: Path, channels) -> Record:
             for s in msg.signals:
                 values[s.name].append(float(out[s.name]))
         if undecodable.sum() > MAX_BAD_SHARE * keep.sum():
-            raise UsageError(f"{where}: {name}: {int(undecodable.sum())} of {int(keep.sum())} frames do not decode "
+            raise refusal(where, f"{name}: {int(undecodable.sum())} of {int(keep.sum())} frames do not decode "
                              f"(first at {t[undecodable][0]:.3f} s, {len(frames[int(np.argmax(undecodable))])} bytes "
                              f"where the DBC has {msg.length}): not this car's DBC")
         if undecodable.any():
@@ -449,7 +449,7 @@ def read_bus_log(raw: bytes, where: Path, channels) -> Record:
                              f"{_times(t[jumps + 1])})")
             checks.append(f"{name} counter {counter.name}: {len(jumps)} jumps")
         if len(t) < 2:
-            raise UsageError(f"{where}: {name}: fewer than two usable frames")
+            raise refusal(where, f"{name}: fewer than two usable frames")
         period = float(np.median(np.diff(t)))
         periods[name] = period
         gaps = np.nonzero(np.diff(t) > GAP_PERIODS * period)[0]
@@ -460,7 +460,7 @@ def read_bus_log(raw: bytes, where: Path, channels) -> Record:
                 within = [s for s in silences if s[0] >= t[k] - 1e-9 and s[1] <= t[k + 1] + 1e-9]
                 why = ("no frame of any id on the bus then: bus off or a logger pause" if within
                        else "other messages go on: frames of this one lost")
-                raise UsageError(f"{where}: {name}: no frame from {t[k]:.3f} s to {t[k + 1]:.3f} s "
+                raise refusal(where, f"{name}: no frame from {t[k]:.3f} s to {t[k + 1]:.3f} s "
                                  f"({t[k + 1] - t[k]:.3f} s, more than {MAX_GAP_S:g} s; {why}); cut the log to "
                                  "one side of it")
             notes.append(f"{name}: {len(gaps)} gaps of frames lost (at {_times(t[gaps])}, up to "
@@ -477,7 +477,7 @@ def read_bus_log(raw: bytes, where: Path, channels) -> Record:
         if qbit is not None:
             flagged = columns[qbit.name] != 0.0
             if flagged.all():
-                raise UsageError(f"{where}: {sig.name}: every frame has its quality bit {qbit.name} set (a "
+                raise refusal(where, f"{sig.name}: every frame has its quality bit {qbit.name} set (a "
                                  "substitute value, the sensor not ready or failed)")
             if flagged.any():
                 notes.append(f"{sig.name}: {int(flagged.sum())} frames with the quality bit {qbit.name} set dropped "
@@ -489,7 +489,7 @@ def read_bus_log(raw: bytes, where: Path, channels) -> Record:
             top = (2 ** spec.length - 1) * spec.scale + spec.offset
             full = good & (np.abs(values - top) <= 0.5 * abs(spec.scale))
             if full.any():
-                raise UsageError(f"{where}: {sig.name} sits at its largest raw value {2 ** spec.length - 1} "
+                raise refusal(where, f"{sig.name} sits at its largest raw value {2 ** spec.length - 1} "
                                  f"({top:g} {spec.unit or ''}) in {int(full.sum())} frames from {t[full][0]:.3f} s: "
                                  "the signal saturates and what lies beyond it is lost")
         if sig.sign is not None:

@@ -12,7 +12,7 @@ from typing import ClassVar
 import numpy as np
 
 from ...errors import UsageError, cannot_read_as
-from .base import TIME_ALIASES, Record, Source, normal_name
+from .base import TIME_ALIASES, Record, Source, normal_name, refusal
 
 MAGIC = b"MATLAB 5.0 MAT-file"
 HDF5 = b"MATLAB 7.3 MAT-file"
@@ -40,12 +40,12 @@ class MatlabReader:
                    and value.dtype.kind in "iuf" and len(value) >= 2}
         times = [name for name in vectors if normal_name(name) in TIME_ALIASES]
         if not times:
-            raise UsageError(f"{where}: no time vector among the MAT-file's variables (name one "
+            raise refusal(where, "no time vector among the MAT-file's variables (name one "
                              f"{', '.join(TIME_ALIASES)}); its vectors: {', '.join(sorted(vectors)) or 'none'}")
         if len(times) > 1:
-            raise UsageError(f"{where}: {len(times)} time vectors ({', '.join(times)}); keep one")
+            raise refusal(where, f"{len(times)} time vectors ({', '.join(times)}); keep one")
         time = vectors.pop(times[0])
         sources = [Source(name, None, values, time) for name, values in vectors.items() if len(values) == len(time)]
         if not sources:
-            raise UsageError(f"{where}: no numeric vector of the time vector's length ({len(time)} samples)")
+            raise refusal(where, f"no numeric vector of the time vector's length ({len(time)} samples)")
         return Record(self.name, sources, {"format": self.name})

@@ -14,7 +14,7 @@ from typing import ClassVar
 import numpy as np
 
 from ...errors import UsageError, cannot_read_as
-from .base import TIME_ALIASES, Record, Source, normal_name
+from .base import TIME_ALIASES, Record, Source, normal_name, refusal
 
 MAGIC = (b"MDF     ", b"UnFinMF ")
 
@@ -58,7 +58,7 @@ def _sources(raw: bytes, where: Path) -> list[Source]:
             if normal_name(name) in TIME_ALIASES or name.startswith("$"):
                 continue  # master (time) channels and asammdf's own bookkeeping
             if len(places) > 1:
-                raise UsageError(f"{where}: channel {name!r} appears in {len(places)} channel groups; rename one")
+                raise refusal(where, f"channel {name!r} appears in {len(places)} channel groups; rename one")
             group, index = places[0]
             signal = mdf.get(name, group=group, index=index)
             samples = np.asarray(signal.samples)
@@ -69,5 +69,5 @@ def _sources(raw: bytes, where: Path) -> list[Source]:
     finally:
         mdf.close()
     if not sources:
-        raise UsageError(f"{where}: the MDF file holds no numeric channel")
+        raise refusal(where, "the MDF file holds no numeric channel")
     return sources
