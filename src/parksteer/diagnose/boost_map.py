@@ -17,6 +17,7 @@ from ..boost_table import entries
 from ..model.symbolic.effects.assist_common import table_law
 from .calibrate import Z95
 from .problem import FileData
+from ..names import TORQUE
 
 SPAN_POINTS = 7  # table points beyond the dead band (9 with the origin and the dead band; the law allows 10)
 BLOCK_S = 1.0  # s: the blocks of the intervals' sandwich (residuals closer than this are taken as correlated)
@@ -214,7 +215,7 @@ def fit_map(files: list[FileData]) -> _Map:
     # control unit reads the sensor the log reads, so the sensor's own noise moves both together and is no scatter)
     law = _map_law(torques, current)
     slope = (law(S - x[1] + 1e-4) - law(S - x[1] - 1e-4)) / 2e-4
-    step_s = max(f.measurement.quantisation_step("handwheel_torque_Nm") for f in files)
+    step_s = max(f.measurement.quantisation_step(TORQUE) for f in files)
     noise_i, noise_s = step_i / math.sqrt(12.0), step_s / math.sqrt(12.0)
     on = magnitude > x[0] + 0.05 * (top - x[0])
     expected = float(np.sqrt(noise_i ** 2 + np.mean((slope[on] * noise_s) ** 2))) if on.any() else float(noise_i)

@@ -25,6 +25,7 @@ from .engine import ReplayEngine
 from .ensemble import with_replay_uncertainty
 from .problem import FileData, Problem
 from .statistics import fit_statistics
+from ..names import TORQUE
 
 
 @dataclass
@@ -114,7 +115,7 @@ def compare_files(files: list[FileData], params: Parameters, effects=None,
     files = list(problem.files)
     comparisons = [
         compare(f.time_s, f.torque_Nm, f.torque_part(m), phases=f.phases,
-                quantisation_step=f.measurement.quantisation_step("handwheel_torque_Nm"))
+                quantisation_step=f.measurement.quantisation_step(TORQUE))
         for f, m in zip(files, predictions)
     ]
     return CompareResult(chosen, overrides, files, predictions, comparisons, fit_statistics(problem, predictions),

@@ -49,6 +49,7 @@ from ..diagnose.report import diagnosis_dict
 from ..diagnose.select import diagnose
 from .rows import ROW_SUFFIX, read_case_files
 from .variations import NAMED_MIN_STEPS, NAMED_TARGET, NULL_ADEQUATE_TARGET
+from ..names import TORQUE
 
 RACK_FRICTION = "steering.rack_friction_force"
 # The hidden candidates and the quantity each is sized by (the rack friction: added to the base's force).
@@ -141,7 +142,7 @@ def case_truth_and_record(params: Parameters, design: AssistedDesign, case: Assi
 
     def torque(effects: str, overrides: dict, change=None) -> np.ndarray:
         return assisted_clean(params, hand, effects, design.case, overrides=overrides, out_of_class=change,
-                              dt_s=0.01)["handwheel_torque_Nm"]
+                              dt_s=0.01)[TORQUE]
 
     reference = torque(assist, base)
     if case.kind == "hidden":

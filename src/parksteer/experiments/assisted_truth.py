@@ -52,6 +52,7 @@ from .benchmark import BASE_PERTURBATION, BENCHMARK_SETTINGS
 from .assisted_benchmark import RACK_FRICTION, judged
 from .rows import ROW_SUFFIX, read_case_files
 from .variations import NAMED_TARGET, NULL_ADEQUATE_TARGET
+from ..names import TORQUE
 
 # The largest size searched for each hidden quantity (its unit the truth's: N m, 1, N, rad).
 UPPER = {"assist_motor_friction": 0.3, "torsion_bar_offset": 1.0, "boost_gain_error": 1.0, "rack_friction": 1500.0,
@@ -213,7 +214,7 @@ def case_truth_and_record(params: Parameters, design: TruthDesign, case: TruthCa
     road = manual_road(params, hand, design.case, base, rack_friction=case.hidden == "rack_friction")
 
     def reading(hidden: Hidden) -> np.ndarray:
-        return truth_clean(road, design.boost, design.gear, logger, hidden)["handwheel_torque_Nm"]
+        return truth_clean(road, design.boost, design.gear, logger, hidden)[TORQUE]
 
     hidden, strength, size = Hidden(), None, 0.0
     if case.kind != "null":

@@ -22,6 +22,7 @@ from ..synthetic.datasets import SizeSearch, perturbed_base, rms_difference, str
 from ..synthetic.quirks import QUIRKS, ManualLogger, manual_road, quirk_record, quirk_strength
 from ..synthetic.variations import VARIATIONS, variation_by_name
 from .benchmark import BASE_PERTURBATION
+from ..names import TORQUE
 
 MANUAL_HIDDEN = ("column_friction", "rack_stiction", "kingpin_friction", "rack_damping")
 ASSISTED_HIDDEN = ("assist_motor_friction", "torsion_bar_offset", "boost_gain_error")
@@ -232,7 +233,7 @@ class AssistedCar:
         if what is not None:
             def reading(s: float):
                 return quirk_eps_clean(road, self.boost, self.gear, self.eps, logger,
-                                       with_hidden(Hidden(), what, s))["handwheel_torque_Nm"]
+                                       with_hidden(Hidden(), what, s))[TORQUE]
 
             strength = strength_for_rms(reading, floors * floor_Nm(logger), self.UPPER[what] * 1e-2,
                                         self.UPPER[what], SEARCH)

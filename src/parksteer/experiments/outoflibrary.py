@@ -39,6 +39,7 @@ from ..diagnose.problem import load_files
 from ..diagnose.select import diagnose
 from ..diagnose.signature import signature_of
 from ..diagnose.suggest import suggest
+from ..names import TORQUE
 
 CLASS_TARGET = 0.80
 SUGGESTION_TARGET = 0.70
@@ -116,7 +117,7 @@ def make_record(params: Parameters, case: SignatureCase, design: SignatureDesign
 
     def torque(strength: float) -> np.ndarray:
         return np.asarray(simulate("unladen", effects=effects, overrides={**base, key: strength}, rack_drive=drive,
-                                   params=params, output_dt_s=PROBE_DT_S).columns["handwheel_torque_Nm"])
+                                   params=params, output_dt_s=PROBE_DT_S).columns[TORQUE])
 
     target = case.steps * quantisation_step(logger.torque_full_scale_Nm, logger.torque_bits)
     probe = {"N": 100.0, "N s/m": 1000.0, "N s^2/m^2": 10000.0}.get(form.effect.quantities[0].unit, 0.5)

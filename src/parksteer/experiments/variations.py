@@ -42,6 +42,7 @@ from .benchmark import BENCHMARK_SETTINGS, diagnose_written, paired_results
 from ..diagnose.calibrate import calibrated_keys
 from .rows import VariationRow
 from ..diagnose.settings import DEFAULT_SETTINGS, DiagnosisSettings
+from ..names import TORQUE
 
 NAMED_MIN_STEPS = 2.0  # converter steps RMS: hidden effects at least this large count towards the named rate
 NAMED_TARGET = 0.90  # of those, named first or in the reported group
@@ -138,7 +139,7 @@ def _case_files(case: VariationCase, design: VariationDesign):
 
 
 def hidden_strength(params: Parameters, files, base: dict, effect: str, target: float,
-                    signal: str = "handwheel_torque_Nm", settings: DiagnosisSettings = DEFAULT_SETTINGS
+                    signal: str = TORQUE, settings: DiagnosisSettings = DEFAULT_SETTINGS
                     ) -> tuple[str, float, float, float]:
     """(strength key, strength, RMS change of `signal` at it, the part of that change a calibration cannot absorb)
     of `effect` changing the clean `signal` (the torque, or the handwheel angle where the diagnosis fits it) by
@@ -207,7 +208,7 @@ def case_truth(params: Parameters, design: VariationDesign, case: VariationCase)
     # Where the angle is fitted, the hidden effect's size is its change of the angle in the angle converter's
     # steps: with the rack prescribed, what the angle makes observable (a lash) does not change the torque at all.
     signal, size_step = ("handwheel_angle_rad", quantisation_step(logger.angle_full_scale_rad, logger.angle_bits)) \
-        if case.variation.uses_angle else ("handwheel_torque_Nm", torque_step)
+        if case.variation.uses_angle else (TORQUE, torque_step)
     key, strength, steps_actual, steps_observable = None, None, None, None
     if case.hidden is not None:
         key, strength, change, observable = hidden_strength(params, files, base, case.hidden,

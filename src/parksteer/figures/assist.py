@@ -10,6 +10,7 @@ import numpy as np
 from ..plotting import COLOURS, new_figure, save_svg
 from ..sweep.assist_sizing import SizingStudy
 from ..tables import write_csv
+from ..names import TORQUE
 
 TABLE = "sizing.csv"
 TORQUE_FIGURE = "torque_against_rack.svg"
@@ -38,7 +39,7 @@ def write_sizing_files(study: SizingStudy, vehicle: str, table: str | Path, torq
     for label, result, colour in (("without assist", study.standstill_manual, COLOURS[0]),
                                   (f"with {study.assist}", study.standstill_assisted, COLOURS[1])):
         c = result.columns
-        ax.plot(c["rack_m"] * 1000.0, c["handwheel_torque_Nm"], color=colour, label=label)
+        ax.plot(c["rack_m"] * 1000.0, c[TORQUE], color=colour, label=label)
     for sign in (-1, 1):
         ax.axhline(sign * study.target_torque_Nm, color=COLOURS[7], linewidth=0.8, linestyle="--")
     ax.set_xlabel("rack travel (mm)")

@@ -55,6 +55,7 @@ from ..sweep.assist_sizing import (FRICTION_BAND, PUBLISHED_STANDSTILL_RACK_FORC
 from ..tables import write_csv, write_json
 from ..vehicle import ASSIST_EFFECTS, ASSISTED_EFFECTS, CREEPING_EFFECTS, creeping_overrides
 from .model import OFFSET_CASES, _at, _times, plateau_mask, until_hand_stops
+from ..names import TORQUE
 
 CASE = "unladen"
 ASSISTS = ("column", "hydraulic")  # the kinds studied besides the car without assistance
@@ -122,7 +123,7 @@ def shares(columns: dict, params: Parameters) -> dict:
         terms = {k[len("contrib_"):-len("_Nm")]: value(k) for k in mechanisms}
         road = sum(terms.values())
         assist = -sum(value(k) for k in assists)
-        driver = value("handwheel_torque_Nm")
+        driver = value(TORQUE)
         out[where] = {
             "road_torque_Nm": road,
             "driver_torque_Nm": driver,
@@ -143,7 +144,7 @@ def peak_rack_force_N(result: SimulationResult) -> float:
         force = c["rack_force_N"]
     else:
         per_rack = result.outputs()["column_angle_per_rack_rad_per_m"]
-        force = c["handwheel_torque_Nm"] * per_rack
+        force = c[TORQUE] * per_rack
     return float(np.max(np.abs(force)))
 
 
@@ -213,7 +214,7 @@ def class_load(standstill: SimulationResult, params: Parameters, target_torque_N
     name = ASSIST_EFFECTS["column"]
     c = standstill.columns
     per_rack = standstill.outputs()["column_angle_per_rack_rad_per_m"]
-    force = c["handwheel_torque_Nm"] * per_rack
+    force = c[TORQUE] * per_rack
     peak = int(np.argmax(np.abs(force)))
     at_peak = float(np.abs(per_rack[peak]))
     rows = [size_for_rack_force(name, params, f, at_peak, target_torque_Nm)
@@ -266,9 +267,9 @@ def assist_study(params: Parameters, target_torque_Nm: float, run=simulate, prog
                                     "gain": gain, "driver_share_limit": 1.0 / (1.0 + gain)}
     for kind in kinds:
         standstill = results[(kind, CASE, 0.0)].columns
-        plateau = {case: float(np.mean(results[(kind, case, 0.0)].columns["handwheel_torque_Nm"][
+        plateau = {case: float(np.mean(results[(kind, case, 0.0)].columns[TORQUE][
             plateau_mask(results[(kind, case, 0.0)].columns, params)])) for case in OFFSET_CASES}
-        peak = {case: float(np.max(np.abs(results[(kind, case, 0.0)].columns["handwheel_torque_Nm"])))
+        peak = {case: float(np.max(np.abs(results[(kind, case, 0.0)].columns[TORQUE])))
                 for case in OFFSET_CASES}
         numbers["runs"][label(kind)] = {
             "peak_torque_Nm": peak[CASE],
@@ -280,7 +281,7 @@ def assist_study(params: Parameters, target_torque_Nm: float, run=simulate, prog
             "speeds": {
                 "peak_rack_force_N": [peak_rack_force_N(results[(kind, CASE, s)]) for s in SPEEDS_KMH],
                 "peak_handwheel_torque_Nm": [float(np.max(np.abs(results[(kind, CASE, s)].columns[
-                    "handwheel_torque_Nm"]))) for s in SPEEDS_KMH],
+                    TORQUE]))) for s in SPEEDS_KMH],
                 **_plateau_by_speed([shares(results[(kind, CASE, s)].columns, params)["plateau"]
                                      for s in SPEEDS_KMH]),
             },
@@ -350,7 +351,7 @@ def plot_study(numbers: dict, params: Parameters):
     for colour, kind in zip(COLOURS, (None, *ASSISTS)):
         c = numbers["_results"][(kind, CASE, 0.0)].columns
         keep = until_hand_stops(c, params)
-        left.plot(1000 * c["rack_m"][keep], c["handwheel_torque_Nm"][keep], color=colour, linewidth=1.0,
+        left.plot(1000 * c["rack_m"][keep], c[TORQUE][keep], color=colour, linewidth=1.0,
                   linestyle=styles[kind or "none"][0], label=names[kind or "none"])
     left.axhline(0.0, color="0.5", linewidth=0.6)
     left.axvline(0.0, color="0.5", linewidth=0.6)

@@ -48,6 +48,7 @@ from ..plotting import COLOURS, new_figure, save_svg
 from ..sweep.merit import braked_columns
 from ..tables import write_csv, write_json
 from .model import PLATEAU_RACK_M, cycle_summary, plateau_mask
+from ..names import TORQUE
 
 HOOKE_PHASES = 8  # phases evaluated over a full column turn
 
@@ -131,7 +132,7 @@ def a1_deviation(columns: dict, params: Parameters, case: str) -> dict:
     a1 = lifting_torque_a1(params, case, steer)
     through_joint = a1 * hooke_speed_ratio(params, columns["column_angle_rad"])
     lifting = np.asarray(columns["contrib_lifting_Nm"], dtype=float)
-    torque = np.asarray(columns["handwheel_torque_Nm"], dtype=float)
+    torque = np.asarray(columns[TORQUE], dtype=float)
     return {
         "deviation": float(np.mean(lifting[window]) / np.mean(through_joint[window]) - 1.0),
         "torque_above_a1_Nm": float(np.mean(torque[window] - a1[window])),

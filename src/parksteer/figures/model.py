@@ -26,6 +26,7 @@ from ..errors import UsageError
 from ..geometry import steer_axis
 from ..parameters import Parameters, load_parameters
 from ..tables import read_csv, write_csv, write_json
+from ..names import TORQUE
 
 Run = tuple[str, str]  # (case, variant)
 
@@ -142,7 +143,7 @@ def reversal_step(columns: dict, params: Parameters) -> dict:
     start = int(np.flatnonzero((level[:i_lock] >= STEP_LEVEL))[-1])
     t0 = _crossing_time(t, level, STEP_LEVEL, start)
     t1 = _crossing_time(t, level, -STEP_LEVEL, start)
-    torque = np.asarray(columns["handwheel_torque_Nm"], dtype=float)
+    torque = np.asarray(columns[TORQUE], dtype=float)
     out = {"step_Nm": float(np.interp(t0, t, torque) - np.interp(t1, t, torque)), "window_s": [t0, t1]}
     if "contrib_rack_friction_Nm" in columns:
         rack = np.asarray(columns["contrib_rack_friction_Nm"], dtype=float)
@@ -157,19 +158,19 @@ def cycle_summary(columns: dict, params: Parameters) -> dict:
     after_right = t["right_lock"] + t["half_rounding"]
     before_left = t["left_lock"] - t["half_rounding"]
     after_left = t["left_lock"] + t["half_rounding"]
-    torque = columns["handwheel_torque_Nm"]
+    torque = columns[TORQUE]
     plateau = plateau_mask(columns, params)
     out = {
         "plateau_torque_Nm": float(np.mean(torque[plateau])),
         "plateau_rack_range_m": list(PLATEAU_RACK_M),
-        "torque_near_right_lock_Nm": _at(columns, "handwheel_torque_Nm", before_right),
+        "torque_near_right_lock_Nm": _at(columns, TORQUE, before_right),
         "rack_near_right_lock_m": _at(columns, "rack_m", before_right),
-        "torque_near_left_lock_Nm": _at(columns, "handwheel_torque_Nm", before_left),
-        "drop_at_right_lock_reversal_Nm": _at(columns, "handwheel_torque_Nm", before_right)
-        - _at(columns, "handwheel_torque_Nm", after_right),
+        "torque_near_left_lock_Nm": _at(columns, TORQUE, before_left),
+        "drop_at_right_lock_reversal_Nm": _at(columns, TORQUE, before_right)
+        - _at(columns, TORQUE, after_right),
         "reversal_step_at_right_lock_Nm": reversal_step(columns, params)["step_Nm"],
-        "rise_at_left_lock_reversal_Nm": _at(columns, "handwheel_torque_Nm", after_left)
-        - _at(columns, "handwheel_torque_Nm", before_left),
+        "rise_at_left_lock_reversal_Nm": _at(columns, TORQUE, after_left)
+        - _at(columns, TORQUE, before_left),
         "peak_torque_Nm": float(np.max(np.abs(torque))),
         "max_rack_m": float(np.max(columns["rack_m"])),
         "min_rack_m": float(np.min(columns["rack_m"])),
@@ -226,7 +227,7 @@ def _torque_against_rack(params, runs, data, labels, title, ylabel="handwheel to
     for colour, (case, variant) in zip(COLOURS, runs):
         c = data[(case, variant)]
         keep = until_hand_stops(c, params)
-        ax.plot(1000 * c["rack_m"][keep], c["handwheel_torque_Nm"][keep], color=colour,
+        ax.plot(1000 * c["rack_m"][keep], c[TORQUE][keep], color=colour,
                 label=_label(params, case, variant, labels))
     ax.axhline(0.0, color="0.5", linewidth=0.6)
     ax.axvline(0.0, color="0.5", linewidth=0.6)
@@ -279,7 +280,7 @@ def _contributions_over_time(params, c):
         top.fill_between(t, negative, negative + down, color=colour, linewidth=0)
         positive += up
         negative += down
-    top.plot(t, c["handwheel_torque_Nm"], color="k", linewidth=0.9, label="handwheel torque")
+    top.plot(t, c[TORQUE], color="k", linewidth=0.9, label="handwheel torque")
     top.set_ylabel("torque at the handwheel (N m)")
     top.set_title("Contributions of the mechanisms to the handwheel torque (nominal case)", fontsize=9)
     top.legend(loc="lower left", fontsize=7, ncol=2)
@@ -305,12 +306,12 @@ def _figure_columns(name: str, runs: list[Run], data: dict) -> dict:
             cols[f"load_left_{key}_N"] = c["load_left_N"]
             cols[f"load_right_{key}_N"] = c["load_right_N"]
         elif name == "figContrib":
-            cols["handwheel_torque_Nm"] = c["handwheel_torque_Nm"]
+            cols[TORQUE] = c[TORQUE]
             for col in c:
                 if col.startswith("contrib_"):
                     cols[col] = c[col]
         else:
-            cols[f"torque_{key}_Nm"] = c["handwheel_torque_Nm"]
+            cols[f"torque_{key}_Nm"] = c[TORQUE]
     return cols
 
 

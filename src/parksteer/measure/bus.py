@@ -21,6 +21,7 @@ from ..errors import UsageError
 from .importers import Channel, channel_map_from_options, from_si, parse_channel_map
 from .io import Measurement
 from .readers.can_log import BusMap, BusSpec, checksum_signal, counter_signal, dbc_bus, load_bus, load_dbc
+from ..names import TORQUE
 
 WRITERS = {"candump": ".log", "asc": ".asc", "blf": ".blf", "trc": ".trc", "mf4": ".mf4"}
 
@@ -74,7 +75,7 @@ def encode_frames(record: Measurement, channels: BusMap, t0: float = 1_700_000_0
     frames = []
     # The torque's message first: at the record's own instants, so its samples are sent as they are (resampled,
     # a noisy record would have its noise averaged by the interpolation)
-    order = sorted(by_message.items(), key=lambda item: (all(c.target != "handwheel_torque_Nm" for c in item[1]),
+    order = sorted(by_message.items(), key=lambda item: (all(c.target != TORQUE for c in item[1]),
                                                          item[0]))
     for phase, (name, chs) in enumerate(order):
         message = dbc.get_message_by_name(name)

@@ -39,12 +39,13 @@ import numpy as np
 from .. import portable as pm
 from ..errors import UsageError, cannot_read
 from ..geometry import rack_from_handwheel
+from ..names import TORQUE
 from ..parameters import Parameters, load_parameters
 from .io import ALLOWED_COLUMNS, REQUIRED_COLUMNS, UNITS, Measurement, metadata_text, validate_record
 from .readers import Record, Source, reader_for
 from .readers.base import TIME_ALIASES, name_and_unit, normal_name, refusal
 
-RACK, TORQUE, ANGLE, TIME = "rack_m", "handwheel_torque_Nm", "handwheel_angle_rad", "time_s"
+RACK, ANGLE, TIME = "rack_m", "handwheel_angle_rad", "time_s"
 # An assisted car's torque sensor: a map target of its own, read into the torque column with the metadata
 # torque_sensor = torsion_bar (the torque role with a flag: everything downstream of the import reads one torque).
 TORSION_BAR = "torsion_bar_torque_Nm"

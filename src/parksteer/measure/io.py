@@ -48,11 +48,11 @@ import numpy as np
 
 from ..errors import UsageError, cannot_read
 from .converter import quantisation_step
-from ..names import SURFACES
+from ..names import SURFACES, TORQUE
 from ..parameters import Parameters, load_parameters
 from ..tables import atomic_path, format_number
 
-REQUIRED_COLUMNS = ("time_s", "rack_m", "handwheel_torque_Nm")
+REQUIRED_COLUMNS = ("time_s", "rack_m", TORQUE)
 OPTIONAL_COLUMNS = ("handwheel_angle_rad", "load_left_N", "load_right_N")
 # The car's speed (a CAN log's speed signal; 0 in a standstill parking test): a column of measured records only,
 # kept out of OPTIONAL_COLUMNS, which the synthetic records take as the model's recorded channels.
@@ -62,7 +62,7 @@ ALLOWED_COLUMNS = REQUIRED_COLUMNS + OPTIONAL_COLUMNS + MEASURED_ONLY_COLUMNS
 UNITS = {
     "time_s": "s",
     "rack_m": "m",
-    "handwheel_torque_Nm": "N m",
+    TORQUE: "N m",
     "handwheel_angle_rad": "rad",
     "load_left_N": "N",
     "load_right_N": "N",
@@ -120,7 +120,7 @@ class Measurement:
 
     @property
     def handwheel_torque_Nm(self) -> np.ndarray:
-        return self.columns["handwheel_torque_Nm"]
+        return self.columns[TORQUE]
 
     @property
     def torque_sensor(self) -> str:
@@ -297,7 +297,7 @@ def _validate_columns(where: Path | str, columns: Mapping[str, np.ndarray], line
             )
     check_limit("rack_m", RACK_LIMIT_M, "looks like millimetres; convert to metres (a car rack travels about 0.07 m)")
     check_limit(
-        "handwheel_torque_Nm",
+        TORQUE,
         TORQUE_LIMIT_NM,
         "implausible handwheel torque (parking torques are tens of N m); check the column's unit and scale",
     )

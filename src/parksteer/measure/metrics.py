@@ -39,6 +39,7 @@ from .. import portable as pm
 from ..errors import UsageError
 from .io import Measurement
 from .phases import PHASES, CyclePhases, find_phases
+from ..names import TORQUE
 
 CLIP_RMS = 4.0
 
@@ -167,7 +168,7 @@ def compare(
     *,
     phases: CyclePhases | None = None,
     quantisation_step: float = 0.0,
-    channel: str = "handwheel_torque_Nm",
+    channel: str = TORQUE,
 ) -> Comparison:
     """Residual statistics of `model` against `measured`, both on `time_s`, overall and per phase of `phases`."""
     t = np.asarray(time_s, dtype=float)
@@ -215,7 +216,7 @@ def interpolate_onto(time_s: np.ndarray, source_time_s: np.ndarray, source_value
 def compare_measurement(
     measurement: Measurement,
     model_columns: Mapping[str, np.ndarray],
-    channel: str = "handwheel_torque_Nm",
+    channel: str = TORQUE,
     phases: CyclePhases | None = None,
 ) -> Comparison:
     """Compare a model output (columns with ``time_s`` and `channel`) with a measurement's `channel`.

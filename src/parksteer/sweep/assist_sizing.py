@@ -56,6 +56,7 @@ from ..model.symbolic.components import discover_effects
 from ..parameters import Parameters
 from ..resources import data_file
 from ..vehicle import ASSIST_EFFECTS, ASSISTED_EFFECTS, CREEPING_EFFECTS, creeping_overrides
+from ..names import TORQUE
 
 SPEEDS_KMH = (0.0, 1.0, 3.0, 5.0)
 MARGIN = 1.1  # the sized motor limit or relief pressure over the quasi-static demand
@@ -197,7 +198,7 @@ def size_assist(params: Parameters, case: str, target_torque_Nm: float, speeds_k
         manual = simulate(case, effects=with_linkage(CREEPING_EFFECTS, params), overrides=creeping_overrides(speed),
                           params=params)
         per_rack = manual.outputs()["column_angle_per_rack_rad_per_m"]
-        torque = manual.columns["handwheel_torque_Nm"]
+        torque = manual.columns[TORQUE]
         demand = float(np.max(demand_at_action(name, params, torque, per_rack, target_torque_Nm)))
         manual_runs.append((manual, torque, per_rack))
         demands.append(demand)
@@ -234,7 +235,7 @@ def size_assist(params: Parameters, case: str, target_torque_Nm: float, speeds_k
                             params=params)
         c = assisted.columns
         rows.append(SizingRow(speed, _peak(torque * per_rack), _peak(torque), demand, motor, current, pressure, gain,
-                              _peak(c["handwheel_torque_Nm"]),
+                              _peak(c[TORQUE]),
                               float("nan") if hydraulic else _peak(c["motor_torque_Nm"]),
                               _peak(c["pressure_Pa"]) if hydraulic else float("nan")))
         if manual0 is None:
@@ -242,7 +243,7 @@ def size_assist(params: Parameters, case: str, target_torque_Nm: float, speeds_k
     band_rows = friction_band(params, case, name, target_torque_Nm)
     c0 = manual0.columns
     per_rack0 = manual0.outputs()["column_angle_per_rack_rad_per_m"]
-    at_peak = float(np.abs(per_rack0[int(np.argmax(np.abs(c0["handwheel_torque_Nm"] * per_rack0)))]))
+    at_peak = float(np.abs(per_rack0[int(np.argmax(np.abs(c0[TORQUE] * per_rack0)))]))
     class_rows = [size_for_rack_force(name, params, force, at_peak, target_torque_Nm)
                   for force in PUBLISHED_STANDSTILL_RACK_FORCE_N]
     return SizingStudy(name, case, target_torque_Nm, rows, manual0, assisted0, band_rows, class_rows)
@@ -276,7 +277,7 @@ def rack_force_without_rack_friction_N(result: SimulationResult) -> np.ndarray:
     term (its contribution output), through the gear. What the tie rods carry, quasi-statically."""
     c = result.columns
     per_rack = result.outputs()["column_angle_per_rack_rad_per_m"]
-    return (c["handwheel_torque_Nm"] - c.get("contrib_rack_friction_Nm", 0.0)) * per_rack
+    return (c[TORQUE] - c.get("contrib_rack_friction_Nm", 0.0)) * per_rack
 
 
 def friction_band(params: Parameters, case: str, name: str, target_torque_Nm: float,
@@ -290,7 +291,7 @@ def friction_band(params: Parameters, case: str, name: str, target_torque_Nm: fl
         manual = simulate(case, effects=with_linkage(CREEPING_EFFECTS, params), params=params,
                           overrides={**creeping_overrides(0.0), "tyre.friction_coefficient": friction})
         per_rack = manual.outputs()["column_angle_per_rack_rad_per_m"]
-        torque = manual.columns["handwheel_torque_Nm"]
+        torque = manual.columns[TORQUE]
         motor = current = float("nan")
         if not hydraulic:
             demand = float(np.max(demand_at_action(name, params, torque, per_rack, target_torque_Nm)))

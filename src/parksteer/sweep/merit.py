@@ -32,13 +32,13 @@ import numpy as np
 
 from .. import portable as pm
 from ..geometry import steer_axis
-from ..names import SIDES
+from ..names import SIDES, TORQUE
 from ..rig import disc_distance_integral_m3, patch_radius_m, pressure_correction
 
 MOVING_FRACTION = 0.5  # of the reference speed, for "moving", "arriving at lock" and "returning"
 SLIDING_FRACTION = 0.5  # tread turning at least this fraction of the wheel's steer rate
 RIPPLE_PERIOD_RAD = math.pi  # Hooke joint: two torque cycles per column revolution
-REQUIRED = ("time_s", "rack_m", "handwheel_torque_Nm", "column_angle_rad", "steer_left_rad", "steer_right_rad")
+REQUIRED = ("time_s", "rack_m", TORQUE, "column_angle_rad", "steer_left_rad", "steer_right_rad")
 
 
 class TraceError(ValueError):
@@ -49,7 +49,7 @@ def _nan_merits(contributions: list[str]) -> dict:
     return {"plateau_torque_Nm": math.nan, **{f"share_{c}": math.nan for c in contributions}}
 
 
-def figures_of_merit(columns: Mapping[str, np.ndarray], torque_column: str = "handwheel_torque_Nm") -> dict:
+def figures_of_merit(columns: Mapping[str, np.ndarray], torque_column: str = TORQUE) -> dict:
     """The figures of merit of one cycle (see the module docstring); NaN where a quantity does not exist."""
     missing = [c for c in REQUIRED if c not in columns]
     if missing:
@@ -151,5 +151,5 @@ def braked_columns(columns: Mapping[str, np.ndarray], factor: float) -> dict[str
     out = dict(columns)
     tyre = np.asarray(columns["contrib_tyre_friction_Nm"], dtype=float)
     out["contrib_tyre_friction_Nm"] = tyre * factor
-    out["handwheel_torque_Nm"] = np.asarray(columns["handwheel_torque_Nm"], dtype=float) + (factor - 1.0) * tyre
+    out[TORQUE] = np.asarray(columns[TORQUE], dtype=float) + (factor - 1.0) * tyre
     return out

@@ -22,6 +22,7 @@ from ..parameters import Parameters
 from ..measure.converter import add_noise, quantise
 from .logger import resample
 from .variations import CLEAN_DT_S, HandVariant, VariationLogger, variation_rack
+from ..names import TORQUE
 
 
 @dataclass(frozen=True)
@@ -84,7 +85,7 @@ def assisted_clean(params: Parameters, hand: HandVariant, effects: str, case: st
         else:
             raise ValueError(f"unknown out-of-class change {kind!r} (known: {', '.join(OUT_OF_CLASS)})")
     solution = solve_assisted(run, run.p, rack, t, law=law, delivered=delivered)
-    return {"time_s": t, "rack_m": rack_m, "handwheel_torque_Nm": solution.torque_Nm,
+    return {"time_s": t, "rack_m": rack_m, TORQUE: solution.torque_Nm,
             "motor_current_A": solution.motor_current_A}
 
 
@@ -105,7 +106,7 @@ def assisted_record(clean: dict[str, np.ndarray], logger: AssistedLogger, case: 
         "time_s": time_s,
         "rack_m": quantise(add_noise(sampled["rack_m"], logger.rack_noise_m, rng), logger.rack_full_scale_m,
                            logger.rack_bits),
-        "handwheel_torque_Nm": quantise(add_noise(sampled["handwheel_torque_Nm"], logger.torque_noise_Nm, rng),
+        TORQUE: quantise(add_noise(sampled[TORQUE], logger.torque_noise_Nm, rng),
                                         logger.torque_full_scale_Nm, logger.torque_bits),
     }
     metadata = {"case": case, "surface": surface, "source": "synthetic: parksteer.synthetic.assisted",

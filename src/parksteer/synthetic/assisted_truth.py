@@ -52,6 +52,7 @@ from ..measure.io import Measurement, metadata_text
 from ..parameters import Parameters
 from .logger import resample
 from .variations import CLEAN_DT_S, HandVariant, variation_rack
+from ..names import TORQUE
 
 RACK_FRICTION = "steering.rack_friction_force"
 # The rack friction's direction in the column torque is found from a replay with this much more (N).
@@ -214,11 +215,11 @@ def manual_road(params: Parameters, hand: HandVariant, case: str, overrides: dic
     theta_c = column_of_pinion(s["handwheel_to_rack_ratio"] * x, s["hooke_joint_angle"], s["hooke_joint_phase"])
     rate = np.gradient(theta_c, t)
     accel = np.gradient(rate, t)
-    torque = np.asarray(columns["handwheel_torque_Nm"], dtype=float)
+    torque = np.asarray(columns[TORQUE], dtype=float)
     road = Road(t, x, theta_c, rate, accel, torque)
     if rack_friction:
         base = overrides.get(RACK_FRICTION, float(params[RACK_FRICTION]))
-        more = np.asarray(replay({RACK_FRICTION: base + RACK_FRICTION_PROBE_N})["handwheel_torque_Nm"], dtype=float)
+        more = np.asarray(replay({RACK_FRICTION: base + RACK_FRICTION_PROBE_N})[TORQUE], dtype=float)
         road.per_rack_friction = (more - torque) / RACK_FRICTION_PROBE_N
     return road
 
@@ -363,7 +364,7 @@ def truth_clean(road: Road, boost: TruthMap, gear: TruthGear, logger: TruthLogge
     with `params` (its column), the handwheel angle."""
     solution = eps_layer(road, boost, gear, logger.torque_step, logger.torque_full_scale_Nm, hidden)
     out = {"time_s": road.time_s, "rack_m": road.rack_m,
-           "handwheel_torque_Nm": solution.torsion_bar_Nm + hidden.sensor_offset_Nm,
+           TORQUE: solution.torsion_bar_Nm + hidden.sensor_offset_Nm,
            "motor_current_A": solution.current_A}
     if params is not None:
         out["handwheel_angle_rad"] = handwheel_angle(road, solution.torsion_bar_Nm, gear, params)
@@ -397,7 +398,7 @@ def truth_record(clean: dict[str, np.ndarray], logger: TruthLogger, case: str, s
                                      logger.rack_full_scale_m, logger.rack_bits)
         metadata["bits_rack_m"] = logger.rack_bits
         metadata["full_scale_rack_m"] = logger.rack_full_scale_m
-    columns["handwheel_torque_Nm"] = quantise(add_noise(sampled["handwheel_torque_Nm"], logger.torque_noise_Nm, rng),
+    columns[TORQUE] = quantise(add_noise(sampled[TORQUE], logger.torque_noise_Nm, rng),
                                               logger.torque_full_scale_Nm, logger.torque_bits)
     columns["motor_current_A"] = quantise(add_noise(sampled["motor_current_A"], logger.current_noise_A, rng),
                                           logger.current_full_scale_A, logger.current_bits)

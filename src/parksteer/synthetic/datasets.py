@@ -53,6 +53,7 @@ from ..model.numeric.simulate import simulate
 from ..parameters import Parameters
 from ..resources import example_effect
 from ..model.symbolic.components import strength_parameter
+from ..names import TORQUE
 
 RECORDED = [name for name in REQUIRED_COLUMNS + OPTIONAL_COLUMNS if name != "time_s"]
 CLEAN_OUTPUT_DT_S = 0.005
@@ -65,7 +66,7 @@ RANGE_STEP_FRACTION = 0.2  # ranges go up in steps of this fraction of the param
 def torque_step_Nm(params: Parameters) -> float:
     """The torque channel's converter step of the synthetic logger."""
     logger = example_logger(params)
-    return quantisation_step(logger.full_scale["handwheel_torque_Nm"], logger.bits)
+    return quantisation_step(logger.full_scale[TORQUE], logger.bits)
 
 
 def hand(params: Parameters, seed: int) -> HandProfile:
@@ -116,16 +117,16 @@ class Disturbance:
 
     def apply(self, params: Parameters, columns: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
         out = dict(columns)
-        t, torque = columns["time_s"], columns["handwheel_torque_Nm"]
+        t, torque = columns["time_s"], columns[TORQUE]
         if self.kind == "torque_drift":
-            out["handwheel_torque_Nm"] = torque + self.size * (t - t[0]) / (t[-1] - t[0])
+            out[TORQUE] = torque + self.size * (t - t[0]) / (t[-1] - t[0])
         elif self.kind == "gear_tooth":
             ratio = params["steering.handwheel_to_rack_ratio"]
             angle = ratio * columns["rack_m"] + self.phase
             out["rack_m"] = columns["rack_m"] + self.size * pm.sin(angle)
-            out["handwheel_torque_Nm"] = torque * (1.0 + self.size * ratio * pm.cos(angle))
+            out[TORQUE] = torque * (1.0 + self.size * ratio * pm.cos(angle))
         elif self.kind == "channel_lag":
-            out["handwheel_torque_Nm"] = np.interp(t - self.size, t, torque)
+            out[TORQUE] = np.interp(t - self.size, t, torque)
         return out
 
     def with_size(self, size: float) -> Disturbance:
@@ -319,7 +320,7 @@ def make_dataset(params: Parameters, spec: DatasetSpec) -> Dataset:
             columns = clean_run(params, case, surface, hand_profile, effects, overrides)
             if disturbance is not None:
                 columns = disturbance.apply(params, columns)
-            out.append(columns["handwheel_torque_Nm"])
+            out.append(columns[TORQUE])
         return np.concatenate(out)
 
     effects, overrides, disturbance, strength_key, strength = None, dict(base), None, None, None
@@ -544,12 +545,12 @@ def chain_logged(params: Parameters, columns: dict[str, np.ndarray], chain: Chai
     s = params.sections["synthetic"]
     rng = np.random.default_rng(seed)
     rack_scale, torque_scale = float(s["full_scale_rack"]), float(s["full_scale_torque"])
-    peak = float(np.max(np.abs(sampled["handwheel_torque_Nm"])))
+    peak = float(np.max(np.abs(sampled[TORQUE])))
     if peak > (1.0 - RANGE_HEADROOM) * torque_scale:  # the engineer's next range up, as _logged does
         unit = RANGE_STEP_FRACTION * torque_scale
         torque_scale = unit * math.ceil(peak / (1.0 - RANGE_HEADROOM) / unit)
     rack = quantise(add_noise(sampled["rack_m"], float(s["noise_rack"]), rng), rack_scale, chain.rack_bits)
-    torque = quantise(add_noise(sampled["handwheel_torque_Nm"], float(s["noise_torque"]), rng), torque_scale,
+    torque = quantise(add_noise(sampled[TORQUE], float(s["noise_torque"]), rng), torque_scale,
                       chain.torque_bits)
     # a file states one converter (the torque's); the rack's noise is estimated from the data
     metadata = {"case": case, "surface": surface, "source": "synthetic: parksteer.synthetic.datasets (out of class)",
@@ -557,7 +558,7 @@ def chain_logged(params: Parameters, columns: dict[str, np.ndarray], chain: Chai
                 "full_scale_handwheel_torque_Nm": torque_scale, "rack_bits": chain.rack_bits,
                 "anti_alias_hz": chain.anti_alias_hz, "torque_lag_s": chain.torque_lag_s, "noise_seed": int(seed)}
     metadata.update(hand_profile.metadata)
-    return Measurement(path=None, columns={"time_s": time_s, "rack_m": rack, "handwheel_torque_Nm": torque},
+    return Measurement(path=None, columns={"time_s": time_s, "rack_m": rack, TORQUE: torque},
                        metadata={k: metadata_text(v) for k, v in metadata.items()})
 
 
@@ -572,11 +573,11 @@ def anti_alias_and_lag(time_s: np.ndarray, columns: dict[str, np.ndarray], anti_
     filtered = {}
     if anti_alias_hz > 0.0:
         sos = pm.butterworth_lowpass_sos(order, anti_alias_hz, 1.0 / float(t[1] - t[0]))
-    for name in ("rack_m", "handwheel_torque_Nm"):
+    for name in ("rack_m", TORQUE):
         x = np.asarray(columns[name], dtype=float)
         filtered[name] = sosfilt(sos, x, zi=pm.sos_steady_state(sos) * x[0])[0] if anti_alias_hz > 0.0 else x.copy()
     if torque_lag_s:
-        filtered["handwheel_torque_Nm"] = np.interp(t - torque_lag_s, t, filtered["handwheel_torque_Nm"])
+        filtered[TORQUE] = np.interp(t - torque_lag_s, t, filtered[TORQUE])
     return filtered
 
 
@@ -600,7 +601,7 @@ def make_outclass_dataset(params: Parameters, spec: DatasetSpec, design: Outclas
                 for (case, surface), h in zip(spec.files, hands)]
 
     def torque(effects, overrides):
-        return np.concatenate([r["handwheel_torque_Nm"] for r in runs(effects, overrides)])
+        return np.concatenate([r[TORQUE] for r in runs(effects, overrides)])
 
     effects, overrides, strength_key, strength, steps = None, dict(base), None, None, None
     if spec.kind == "rival":
@@ -612,7 +613,7 @@ def make_outclass_dataset(params: Parameters, spec: DatasetSpec, design: Outclas
         overrides[strength_key] = strength
     clean = runs(effects, overrides)
     if spec.kind == "rival":
-        steps = rms_difference(np.concatenate([r["handwheel_torque_Nm"] for r in clean]), torque(None, base)) / step
+        steps = rms_difference(np.concatenate([r[TORQUE] for r in clean]), torque(None, base)) / step
     measurements = [chain_logged(params, columns, design.logger, case, surface, spec.seed * 100 + 50 + i, h)
                     for i, (columns, (case, surface), h) in enumerate(zip(clean, spec.files, hands))]
     rival = outclass_rivals().get(spec.hidden, {})
@@ -630,7 +631,7 @@ def make_outclass_dataset(params: Parameters, spec: DatasetSpec, design: Outclas
 def _fine_run(params, case, surface, hand_profile, effects, overrides, rtol) -> dict[str, np.ndarray]:
     result = simulate(case, effects=effects, overrides=overrides, surface=surface, params=params,
                       handwheel=hand_profile.handwheel_profile(), output_dt_s=OUTCLASS_CLEAN_DT_S, rtol=rtol)
-    return {name: np.asarray(result.columns[name]) for name in ("time_s", "rack_m", "handwheel_torque_Nm")}
+    return {name: np.asarray(result.columns[name]) for name in ("time_s", "rack_m", TORQUE)}
 
 
 OUTCLASS_CLEAN_DT_S = 0.001  # the truth's output spacing: the anti-alias filter runs on a signal this fine

@@ -27,6 +27,7 @@ from .logger import LoggerSettings, synthetic_measurement
 from ..measure.io import OPTIONAL_COLUMNS, REQUIRED_COLUMNS, Measurement, write_measurement
 from ..measure.smoothing import interpolate_rack
 from .standin import rack_of_hand
+from ..names import TORQUE
 
 
 
@@ -36,14 +37,14 @@ def example_logger(params: Parameters) -> LoggerSettings:
     full_scale = {
         "handwheel_angle_rad": s["full_scale_handwheel_angle"],
         "rack_m": s["full_scale_rack"],
-        "handwheel_torque_Nm": s["full_scale_torque"],
+        TORQUE: s["full_scale_torque"],
         "load_left_N": s["full_scale_load"],
         "load_right_N": s["full_scale_load"],
     }
     noise_rms = {
         "handwheel_angle_rad": s["noise_handwheel_angle"],
         "rack_m": s["noise_rack"],
-        "handwheel_torque_Nm": s["noise_torque"],
+        TORQUE: s["noise_torque"],
         "load_left_N": s["noise_load"],
         "load_right_N": s["noise_load"],
     }

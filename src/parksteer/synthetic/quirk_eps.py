@@ -33,6 +33,7 @@ from ..geometry import column_twist
 from ..measure.converter import quantisation_step
 from ..parameters import Parameters
 from .assisted_truth import BISECTION_STEPS, Hidden, Road, TruthGear, TruthLogger, TruthMap, handwheel_angle
+from ..names import TORQUE
 
 BACK_EFFICIENCY_BAND = (0.75, 0.85)  # data/vehicles/polo_vi.toml, back_efficiency's source
 
@@ -124,7 +125,7 @@ def quirk_eps_clean(road: Road, boost: TruthMap, gear: TruthGear, quirk: EpsQuir
     solution = quirk_layer(road, boost, gear, quirk, logger.torque_step, logger.torque_full_scale_Nm, hidden)
     reading = sensor_filtered(road.time_s, solution.torsion_bar_Nm + hidden.sensor_offset_Nm,
                               quirk.sensor_time_constant_s)
-    out = {"time_s": road.time_s, "rack_m": road.rack_m, "handwheel_torque_Nm": reading,
+    out = {"time_s": road.time_s, "rack_m": road.rack_m, TORQUE: reading,
            "motor_current_A": solution.current_A}
     if params is not None:
         out["handwheel_angle_rad"] = handwheel_angle(road, solution.torsion_bar_Nm, gear, params)

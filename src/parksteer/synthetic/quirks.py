@@ -41,6 +41,7 @@ from ..parameters import Parameters
 from .assisted_truth import column_of_pinion
 from .logger import LoggerSettings, synthetic_measurement
 from .variations import CLEAN_DT_S, HandVariant, variation_rack
+from ..names import TORQUE
 
 JOINT_STEP_RAD = 1e-6  # the central difference of the Hooke joint's map that gives its speed ratio
 
@@ -78,7 +79,7 @@ def manual_road(params: Parameters, hand: HandVariant, case: str, overrides: dic
     speed_ratio = (column_of_pinion(ratio * x + h, angle, phase) - column_of_pinion(ratio * x - h, angle, phase)) \
         / (2.0 * h)
     steer = 0.5 * (np.asarray(c["steer_left_rad"], dtype=float) + np.asarray(c["steer_right_rad"], dtype=float))
-    return ManualRoad(np.asarray(c["time_s"], dtype=float), x, np.asarray(c["handwheel_torque_Nm"], dtype=float),
+    return ManualRoad(np.asarray(c["time_s"], dtype=float), x, np.asarray(c[TORQUE], dtype=float),
                       np.asarray(c["column_angle_rad"], dtype=float), np.asarray(c["rack_speed_m_s"], dtype=float),
                       steer, np.asarray(c["contrib_tyre_friction_Nm"], dtype=float), ratio * speed_ratio)
 
@@ -248,11 +249,11 @@ def quirk_record(road: ManualRoad, quirk: Quirk, strength: float, logger: Manual
     converter: :func:`parksteer.synthetic.logger.synthetic_measurement`)."""
     rack, torque = quirk.logged(road, strength)
     settings = LoggerSettings(logger.sample_rate_hz,
-                              {"rack_m": logger.rack_full_scale_m, "handwheel_torque_Nm": logger.torque_full_scale_Nm},
-                              {"rack_m": logger.rack_noise_m, "handwheel_torque_Nm": logger.torque_noise_Nm},
+                              {"rack_m": logger.rack_full_scale_m, TORQUE: logger.torque_full_scale_Nm},
+                              {"rack_m": logger.rack_noise_m, TORQUE: logger.torque_noise_Nm},
                               logger.seed, bits=logger.torque_bits, column_bits={"rack_m": logger.rack_bits})
     meta = {"quirk": quirk.name, "quirk_strength": strength, **(extra_metadata or {})}
-    return synthetic_measurement(road.time_s, {"rack_m": rack, "handwheel_torque_Nm": torque}, settings, case=case,
+    return synthetic_measurement(road.time_s, {"rack_m": rack, TORQUE: torque}, settings, case=case,
                                  surface=surface, source="synthetic: parksteer.synthetic.quirks",
                                  extra_metadata=meta)
 

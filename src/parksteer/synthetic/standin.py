@@ -24,7 +24,7 @@ import numpy as np
 
 from .. import portable as pm
 from ..geometry import lifting_torque_a1, steering_ratio
-from ..names import SURFACES
+from ..names import SURFACES, TORQUE
 from ..parameters import Parameters
 from ..rig import limiting_torque_Nm
 from .hand import HandProfile
@@ -92,7 +92,7 @@ def quasi_static_cycle(
         "time_s": hand.time_s.copy(),
         "handwheel_angle_rad": hand.angle_rad.copy(),
         "rack_m": rack_m,
-        "handwheel_torque_Nm": pinion_torque * ratio,
+        TORQUE: pinion_torque * ratio,
         "load_left_N": np.full(len(rack_m), c["load_left"]),
         "load_right_N": np.full(len(rack_m), c["load_right"]),
     }

@@ -37,6 +37,7 @@ from ..parameters import Parameters
 from ..measure.converter import add_noise, quantise
 from .logger import resample
 from .standin import rack_of_hand
+from ..names import TORQUE
 
 # The hand's motion is sampled this finely before the rack is splined through it (s).
 HAND_DT_S = 0.002
@@ -184,7 +185,7 @@ def variation_record(params: Parameters, hand: HandVariant, logger: VariationLog
     time_s, sampled = resample(t, clean, logger.sample_rate_hz)
     rng = np.random.default_rng(logger.seed)
     rack = quantise(add_noise(sampled["rack_m"], logger.rack_noise_m, rng), logger.rack_full_scale_m, logger.rack_bits)
-    torque = quantise(add_noise(sampled["handwheel_torque_Nm"], logger.torque_noise_Nm, rng),
+    torque = quantise(add_noise(sampled[TORQUE], logger.torque_noise_Nm, rng),
                       logger.torque_full_scale_Nm, logger.torque_bits)
     metadata = {
         "case": case, "surface": surface, "source": "synthetic: parksteer.synthetic.variations",
@@ -201,7 +202,7 @@ def variation_record(params: Parameters, hand: HandVariant, logger: VariationLog
         metadata["anti_alias_hz"] = logger.anti_alias_hz
     if logger.torque_lag_s:
         metadata["torque_lag_s"] = logger.torque_lag_s
-    columns = {"time_s": time_s, "rack_m": rack, "handwheel_torque_Nm": torque}
+    columns = {"time_s": time_s, "rack_m": rack, TORQUE: torque}
     if logger.angle_bits:  # its noise drawn after the others', so that the other channels are those without it
         columns["handwheel_angle_rad"] = quantise(add_noise(sampled["handwheel_angle_rad"], logger.angle_noise_rad, rng),
                                                   logger.angle_full_scale_rad, logger.angle_bits)

@@ -48,6 +48,7 @@ import numpy as np
 
 from ...errors import UsageError, cannot_read_as
 from .base import SNIFF_BYTES, Record, Source, refusal
+from ...names import TORQUE
 
 # A gap in a used message longer than this is refused: the method resolves the phases of a cycle over windows of
 # 0.1 s (parksteer.measure.importers.METHOD_RATE_HZ), so a longer hole takes a part of a phase with it.
@@ -511,7 +512,7 @@ def read_bus_log(raw: bytes, where: Path, channels) -> Record:
         sources.append(Source(sig.name, unit, values[good], t[good], step=step,
                               full_scale=abs(counts * spec.scale * sig.scale) if spec.offset == 0 else None))
 
-    base = next((s for s, ch in zip(signals, channels) if ch.target == "handwheel_torque_Nm"), signals[0])
+    base = next((s for s, ch in zip(signals, channels) if ch.target == TORQUE), signals[0])
     others = sorted({s.message for s in signals} - {base.message})
     text = f"the frames of {base.message} ({1.0 / periods[base.message]:.4g} Hz)"
     if others:

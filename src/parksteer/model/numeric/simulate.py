@@ -27,6 +27,7 @@ from .inputs import HandwheelProfile, sawtooth_profile
 from .statics import static_state
 from .tolerances import PRESCRIBED_RTOL, RTOL, absolute_tolerances, integrator_failure, max_steps
 from .values import RunValues, parameter_vector, resolve_values
+from ...names import TORQUE
 
 if TYPE_CHECKING:
     from .prescribed import RackMotion
@@ -140,7 +141,7 @@ def _columns(run: PreparedRun, t: np.ndarray, states: np.ndarray, outputs: dict,
         "time_s": t,
         "handwheel_angle_rad": handwheel[:, 0],
         "rack_m": states[:, model.index("rack")],
-        "handwheel_torque_Nm": outputs["column_torque_Nm"],
+        TORQUE: outputs["column_torque_Nm"],
         "load_left_N": outputs["load_left_N"],
         "load_right_N": outputs["load_right_N"],
     }
@@ -161,7 +162,7 @@ def _columns(run: PreparedRun, t: np.ndarray, states: np.ndarray, outputs: dict,
         # The force the pinion and the assist together put on the rack: every load on the rack but theirs, i.e.
         # the handwheel-torque contributions of all but the assist, through d(column angle)/d(rack).
         assists = [f"contrib_{e.name}_Nm" for e in run.effects if e.power_assist]
-        road = cols["handwheel_torque_Nm"] - sum((cols[name] for name in assists), np.zeros(len(t)))
+        road = cols[TORQUE] - sum((cols[name] for name in assists), np.zeros(len(t)))
         cols["rack_force_N"] = road * outputs["column_angle_per_rack_rad_per_m"]
         for name in extra:
             cols[name] = outputs[name]
