@@ -1,5 +1,5 @@
 """The reference pages of docs/ (the effect library, the command line, the vehicle file) are what the code gives
-(parksteer.commands.reference): a new option, effect or vehicle key changes the page, so the page cannot drift."""
+(parksteer.reference): a new option, effect or vehicle key changes the page, so the page cannot drift."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from parksteer.commands import reference
+from parksteer import reference
 
 DOCS = Path(__file__).resolve().parents[1] / "docs"
 
@@ -16,10 +16,10 @@ DOCS = Path(__file__).resolve().parents[1] / "docs"
 @pytest.mark.parametrize("name", sorted(reference.PAGES))
 def test_reference_page_is_the_code_s(name):
     """docs/<name> is byte for byte the page its generator writes from the code now; after a change to an option,
-    an effect or a vehicle-file key, `python -m parksteer.commands.reference docs` writes it again."""
+    an effect or a vehicle-file key, `python -m parksteer.reference docs` writes it again."""
     page = (DOCS / name).read_text(encoding="utf-8")
     assert page == reference.PAGES[name](), (
-        f"docs/{name} differs from the code: run `python -m parksteer.commands.reference docs` and commit it")
+        f"docs/{name} differs from the code: run `python -m parksteer.reference docs` and commit it")
 
 
 def test_cli_page_follows_the_parser(monkeypatch):

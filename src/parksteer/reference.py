@@ -2,7 +2,7 @@
 
 Each page is a function of the code alone (the effect registry, the argument parser, the parameter registry), so
 it cannot drift from what the program does: ``tests/test_docs_reference.py`` compares the pages in docs/ with what
-these functions give, and ``python -m parksteer.commands.reference docs`` writes them after a change.
+these functions give, and ``python -m parksteer.reference docs`` writes them after a change.
 """
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ import sys
 from collections.abc import Callable
 from pathlib import Path
 
-GENERATED = ("<!-- Generated from the code by `python -m parksteer.commands.reference docs`; "
+GENERATED = ("<!-- Generated from the code by `python -m parksteer.reference docs`; "
              "tests/test_docs_reference.py fails when this page differs from what the code gives. -->")
 
 # Quantities numbered per table point (an assist's boost table: boost_torque_0 ... boost_torque_31) are one row.
@@ -33,7 +33,7 @@ def _row(*cells: object) -> str:
 
 def _library_effects() -> dict:
     """The package's own effects by name (not a user's: entry points and PARKSTEER_EFFECT_MODULES are left out)."""
-    from ..model.symbolic.components import discover_effects
+    from .model.symbolic.components import discover_effects
 
     package = "parksteer.model.symbolic.effects."
     return {name: effect for name, effect in sorted(discover_effects().items())
@@ -132,7 +132,7 @@ def _help(action: argparse.Action) -> str:
 
 def cli_page() -> str:
     """Every subcommand of ``parksteer`` and its arguments, as the parser defines them."""
-    from ..cli import build_parser
+    from .cli import build_parser
 
     lines = [
         "# Reference: the command line",
@@ -159,8 +159,8 @@ def cli_page() -> str:
 
 def vehicle_file_page() -> str:
     """The sections and keys of a vehicle file: required keys, load cases, the assist and its boost table."""
-    from ..parameters import CASE_SCHEMA, PROVENANCES, SCHEMA, load_parameters
-    from ..vehicle import ASSIST_EFFECTS, BOOST_ASSIST_UNITS, BOOST_UNITS, REQUIRED
+    from .parameters import CASE_SCHEMA, PROVENANCES, SCHEMA, load_parameters
+    from .vehicle import ASSIST_EFFECTS, BOOST_ASSIST_UNITS, BOOST_UNITS, REQUIRED
 
     paper = load_parameters()
     effects = _library_effects()
