@@ -25,7 +25,7 @@ floors (the bar of the owner's routes: `--rungs as_is --routes map,identified --
     PYTHONPATH=src python benchmarks/bench_assisted_truth_ladder.py [--tiers rack] [--routes map] [out.json]
 
 Other cars of the truth: `--seed`, with `--hands`, `--floors`, `--replicates` and `--bits` for the cases, e.g. the
-two quoted in docs/assist.md:
+two quoted in docs/assist_diagnosis.md:
 
     PYTHONPATH=src python benchmarks/bench_assisted_truth_ladder.py --rungs as_is --routes map,identified --outclass \
         --seed 777 --hands mid_stroke_end,rate_8pc_50Hz,lock_overshoot --outclass-hand pauses --floors 3 \

@@ -1,6 +1,6 @@
 """Every relative link of README.md and docs/*.md reaches a file of the repository, and every `#anchor` a heading of
 that file (as GitHub makes a heading's anchor), so a reader following the front page into the book never lands on
-nothing."""
+nothing; the table of contents (docs/README.md) lists every page, and docs/targets.md every figure target."""
 
 from __future__ import annotations
 
@@ -57,3 +57,28 @@ def test_the_front_page_links_the_page_that_draws_the_house():
     readme = (REPO / "README.md").read_text(encoding="utf-8")
     assert "(docs/house.md)" in readme
     assert len([t for _, t in links(REPO / "README.md") if t.startswith("docs/")]) >= 10  # the links are read
+
+
+def test_every_page_is_in_the_table_of_contents():
+    """docs/README.md, the table of contents, links every page of docs/ once, so that no page is out of the book."""
+    contents = (REPO / "docs" / "README.md").read_text(encoding="utf-8")
+    listed = re.findall(r"^\d+\. \[[^\]]+\]\(([\w.-]+\.md)\)", contents, re.M)
+    pages = sorted(p.name for p in (REPO / "docs").glob("*.md") if p.name != "README.md")
+    assert sorted(listed) == pages
+    assert len(listed) == len(set(listed))
+
+
+def test_every_figure_target_is_in_the_targets_page():
+    """Each figure or table target of the workflow (FIGURES in workflow/rules/common.smk, the one list) has its row
+    in docs/targets.md naming its files, so a new target cannot be left out of the page."""
+    import ast
+
+    text = (REPO / "workflow" / "rules" / "common.smk").read_text(encoding="utf-8")
+    start = text.index("FIGURES = {") + len("FIGURES = ")
+    figures = ast.literal_eval(text[start:text.index("\n}\n", start) + 2])
+    page = (REPO / "docs" / "targets.md").read_text(encoding="utf-8")
+    rows = {m.group(1): m.group(0) for m in re.finditer(r"^\| `(\w+)` \|.*$", page, re.M)}
+    missing = [target for target in figures if target not in rows]
+    assert not missing, f"targets without a row in docs/targets.md: {', '.join(missing)}"
+    for target, files in figures.items():
+        assert f"`{files[0]}`" in rows[target], f"docs/targets.md: the row of {target} does not name {files[0]}"

@@ -2,8 +2,8 @@
 command's output is the one the command prints.
 
 Each ```sh block is run by bash (`set -e -o pipefail`: the first failing command fails the block) in one scratch
-copy of the repository (its tracked and new files: no results, no model cache), the documents in README order
-(README.md, then the order of its "More" list), each document's blocks in order, as one reader following them all
+copy of the repository (its tracked and new files: no results, no model cache), the documents in reading order
+(README.md, then docs/README.md and the pages of its table of contents in its order), each document's blocks in order, as one reader following them all
 would: two pages writing one file, or one needing what another has not yet written, fail; `parksteer`, `snakemake` and `python` are this
 environment's, the package is the copy's (PYTHONPATH), and the model cache is one for the session, seeded with the
 worktree's compiled models (a model a document's commands need and no earlier run built is derived there once).
@@ -291,23 +291,28 @@ def run_block(block: Block, work: Path, env: dict) -> tuple[int, str, float]:
     return done.returncode, done.stdout + done.stderr, time.perf_counter() - start
 
 
+CONTENTS = "docs/README.md"  # the table of contents: the pages in reading order
+
+
 def readme_order() -> list[str]:
-    """README.md, then docs/*.md in the order README.md's "More" list links them (a reader's order)."""
-    text = (REPO / "README.md").read_text(encoding="utf-8")
-    more = text[text.index("\n## More"):]
-    linked = list(dict.fromkeys(re.findall(r"\]\((docs/[\w.-]+\.md)\)", more)))
-    return ["README.md", *linked]
+    """README.md, then the table of contents (docs/README.md) and the pages it links, in its order (a reader's)."""
+    text = (REPO / CONTENTS).read_text(encoding="utf-8")
+    linked = list(dict.fromkeys(re.findall(r"^\d+\. \[[^]]+\]\(([\w.-]+\.md)\)", text, re.M)))
+    return ["README.md", CONTENTS, *(f"docs/{name}" for name in linked)]
 
 
 def test_every_document_in_readme_order():
-    """A new document is run: each of README.md and docs/*.md is linked once from README.md's "More" list, whose
-    order the documents run in."""
-    assert sorted(readme_order()) == sorted(DOCUMENTS)
+    """A new document is run: each of README.md and docs/*.md is README.md, the table of contents or one of its
+    numbered entries, whose order the documents run in."""
+    order = readme_order()
+    assert len(order) == len(set(order)), "a page is listed twice in the table of contents"
+    assert sorted(order) == sorted(DOCUMENTS), "pages missing from docs/README.md's table of contents: " + ", ".join(
+        sorted(set(DOCUMENTS) - set(order)))
 
 
 @pytest.mark.slow
 def test_documents_run_in_readme_order(tmp_path, copy_repository, model_cache):
-    """Every document's blocks run in one scratch copy, the documents in README order, as one reader following
+    """Every document's blocks run in one scratch copy, the documents in reading order (the table of contents), as one reader following
     them all would: a file one page writes is there for the next, so two pages that write one file (or one that
     needs what another has not yet written) fail here."""
     work = copy_repository(tmp_path / "repo")

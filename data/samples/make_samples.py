@@ -196,7 +196,7 @@ def write_polo_records(folder: Path) -> list[Path]:
     """Three records of the assisted Polo as its bus logs them (torsion-bar torque in 0.01 N m, motor current in 0.1 A
     steps): a baseline, a later one with a motor that drags, and one after the motor's repair (its friction as at
     the baseline, another hand); a hand of the variation benchmark, the assisted replay of its rack
-    (parksteer.synthetic.assisted, as the example record of docs/assist.md)."""
+    (parksteer.synthetic.assisted, as the example record of docs/assist_diagnosis.md)."""
     from parksteer.measure.io import write_measurement
     from parksteer.model.symbolic.components import discover_effects
     from parksteer.synthetic.assisted import AssistedLogger, assisted_clean, assisted_record

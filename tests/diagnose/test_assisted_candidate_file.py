@@ -11,7 +11,7 @@ noise). Its motor is sized for the parking duty: the 26 A limit is reached near 
 moment. The owner's file is the gear's data sheet and the map at its points
 (parksteer.experiments.assisted_truth.owner_file): the motor's limit 26 A x k_t. The truth's rotor friction and the
 band over which its friction and worm pass through rest are those the owner's file and the model's smoothing
-describe (docs/assist.md, the truth ladder), so what the file does not hold is the map between its points and the
+describe (docs/assist_diagnosis.md, the truth ladder), so what the file does not hold is the map between its points and the
 control unit's steps, and, in the derated record, the lower current limit.
 
 The diagnoses offer the file's effect alone as candidate (the registry given to diagnose): what is tested is that a
