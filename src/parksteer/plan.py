@@ -120,10 +120,10 @@ def sweep(path: str, parameters_path: str, full: bool, batch_size: int, index_di
     """The sweep declared in `path`, read, checked and expanded (parksteer.sweep.load_sweep; its braked-wheel
     check resolves effects): its name, effect sets by variant, what every point spec shares, and its batch ids;
     each batch's points go to the sweep's batch index under `index_dir`
-    (parksteer.sweep.declaration.write_batch_index), where its job reads them."""
+    (parksteer.sweep.batch_index.write_batch_index), where its job reads them."""
     from .parameters import load_parameters
     from .sweep import load_sweep
-    from .sweep.declaration import write_batch_index
+    from .sweep.batch_index import write_batch_index
 
     declared = load_sweep(path, load_parameters(parameters_path), full=full)
     write_batch_index(declared, batch_size, index_dir)

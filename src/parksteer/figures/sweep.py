@@ -27,7 +27,8 @@ from ..sweep.aggregate import (
     point_quantity,
     summarise,
 )
-from ..sweep.declaration import Sweep, load_sweep, parameter_bounds
+from ..sweep.declaration import Sweep, load_sweep
+from ..sweep.keys import parameter_bounds
 from ..tables import write_json
 
 # How each SI unit is shown on an axis: (factor, label).

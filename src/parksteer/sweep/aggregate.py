@@ -25,7 +25,9 @@ import numpy as np
 
 from ..parameters import Parameters
 from ..tables import StreamedList, format_number, write_csv_rows
-from .declaration import Sweep, SweepError, parameter_bounds
+from .declaration import Sweep
+from .design import SweepError
+from .keys import parameter_bounds
 from .design import base_value
 
 # Relative tolerance for "this grid value is the base car's value".
