@@ -302,7 +302,9 @@ def test_the_streamed_gathering_writes_what_all_records_in_memory_give(tmp_path,
     memory, and the summary (points above the threshold streamed from a scratch file) that summarise gives from
     every record, byte for byte; a missing point is named, a record of another sweep or one gathered twice
     refused."""
-    from parksteer.sweep.aggregate import gather_points, read_points, summarise, sweep_table
+    from parksteer.sweep.aggregate import summarise
+    from parksteer.sweep.gathering import gather_points
+    from parksteer.sweep.records import read_points, sweep_table
     from parksteer.tables import write_csv, write_json
 
     text = GRID + ("map: {x: tyre.tyre_pressure, y: design.front_axle_load, panels: steering.rack_friction_force,\n"

@@ -45,7 +45,8 @@ def diagnosis(config: dict, parameters_path: str, user_effect: str) -> dict:
     from .experiments.variations import VariationDesign, case_names as variation_case_names
     from .figures.signature import case_names as signature_case_names, design_from_config as signature_design
     from .parameters import load_parameters
-    from .synthetic.datasets import BenchmarkDesign, CarDesign, OutclassDesign, file_name
+    from .synthetic.datasets import BenchmarkDesign, CarDesign, file_name
+    from .synthetic.outclass import OutclassDesign
 
     params = load_parameters(parameters_path)
     car = CarDesign.from_config(config["car"], config["benchmark"]["perturbation"])
@@ -66,7 +67,8 @@ def diagnosis(config: dict, parameters_path: str, user_effect: str) -> dict:
 def assisted_truth_cases(section: dict | None = None) -> list[str]:
     """The case names of the assisted benchmark on an independent truth (parksteer.experiments.assisted_truth), in
     its order, of the design config["assisted_truth"] gives (each case keeps its own seed and converter)."""
-    from .experiments.assisted_truth import case_names, design_from_config
+    from .experiments.assisted_truth import design_from_config
+    from .experiments.assisted_truth_design import case_names
 
     return case_names(design_from_config(section))
 

@@ -7,7 +7,9 @@
 - :mod:`.design`: a point's values as `simulate` overrides (design variables kept consistent);
 - :mod:`.merit`: figures of merit of one cycle (peak, plateau, lock, reversal drop, shares);
 - :mod:`.run`: one point job (never derives the model);
-- :mod:`.aggregate`: the table of all points and the summary a study quotes.
+- :mod:`.records`, :mod:`.totals`, :mod:`.gathering`: the points' records, what is counted over all of them,
+  and the table of all points written streamed;
+- :mod:`.aggregate`: the summary a study quotes.
 
 Only the declaration and its readers are imported here, so that reading a sweep (as the Snakefile does at
 every start) does not import the model or sympy.
