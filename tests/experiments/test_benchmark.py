@@ -99,7 +99,7 @@ def test_benchmark_figure_data_is_the_same_whatever_the_timings(tmp_path):
 def test_benchmark_figure_shows_both_curves_when_they_coincide(scored, tmp_path, monkeypatch):
     """Where every hidden candidate named was named first, the two accuracy curves carry the same numbers; the one
     drawn underneath must stay visible beside the one on top (wider line and marks, lower in the drawing order)."""
-    import parksteer.figures.diagnose as diagnose_figures
+    import parksteer.figures.diagnosis_benchmarks as diagnose_figures
 
     figures = []
     monkeypatch.setattr(diagnose_figures, "save_svg", lambda fig, path: figures.append(fig))
