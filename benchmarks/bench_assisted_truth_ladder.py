@@ -44,7 +44,8 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "src"))
-from parksteer.experiments.assisted_truth import TruthDesign, run  # noqa: E402
+from parksteer.experiments.assisted_truth import run  # noqa: E402
+from parksteer.experiments.assisted_truth_design import TruthDesign  # noqa: E402
 
 
 def rungs(gear):
@@ -117,7 +118,8 @@ def model_nulls(params, design) -> dict:
     from parksteer.diagnose.problem import load_files
     from parksteer.diagnose.report import diagnosis_dict
     from parksteer.diagnose.select import diagnose
-    from parksteer.experiments.assisted_truth import _logger, _write, cases
+    from parksteer.experiments.assisted_truth import _logger, _write
+    from parksteer.experiments.assisted_truth_design import cases
     from parksteer.experiments.benchmark import BASE_PERTURBATION, BENCHMARK_SETTINGS
     from parksteer.geometry import column_twist
     from parksteer.model.numeric.assist import effects_with_assist

@@ -21,7 +21,9 @@ ROOT = Path(__file__).resolve().parents[1]
 
 def main(argv=None) -> int:
     from parksteer.diagnose.assist_identify import identify_boost
-    from parksteer.experiments.assisted_truth import TruthDesign, _seed, _write, baseline_record, owner_file
+    from parksteer.experiments.assisted_truth import _write, baseline_record
+    from parksteer.experiments.assisted_truth_design import TruthDesign, case_seed
+    from parksteer.experiments.assisted_truth_owner import owner_file
     from parksteer.experiments.benchmark import BASE_PERTURBATION
     from parksteer.synthetic.datasets import perturbed_base
     from parksteer.vehicle import load_vehicle
@@ -39,7 +41,7 @@ def main(argv=None) -> int:
             record = Path(folder) / "baseline.csv"
             _write(record, baseline_record(params, design, "rack"), owner.params)
             found = identify_boost([record], Path(folder) / "owner.toml", case=None, quiet=True)
-        own = perturbed_base(params, _seed(design, design.baseline_variation) + 77,
+        own = perturbed_base(params, case_seed(design, design.baseline_variation) + 77,
                              BASE_PERTURBATION)["tyre.friction_coefficient"]
         sheet = found.file_values["product"]
         agree = found.tyre_friction + (sheet - found.balance_product) / found.product_per_tyre_friction

@@ -85,7 +85,8 @@ def main(argv: list[str] | None = None) -> int:
     sys.path.insert(0, str(ROOT / "src"))
     import yaml
 
-    from parksteer.experiments.peers import compare, peers_file_name, read_cases
+    from parksteer.experiments.peer_scoring import compare, read_cases
+    from parksteer.experiments.peers import peers_file_name
     from parksteer.experiments.variations import VariationDesign
 
     config = yaml.safe_load((ROOT / "config" / "config.yaml").read_text(encoding="utf-8"))

@@ -4,7 +4,7 @@
 
 For each case (a library candidate hidden at a number of converter steps of torque RMS, in the
 benchmark's first file, unladen on the ground), the size is found twice on the same simulations:
-by :func:`parksteer.synthetic.datasets.strength_for_rms` (a linearised estimate from a probe, then
+by :func:`parksteer.synthetic.size_search.strength_for_rms` (a linearised estimate from a probe, then
 secant steps in log-log) and by the bisection it replaced (the bracket grown by factors of 4, then
 bisection in the logarithm; kept below as the reference). Each evaluation is a full handwheel-driven
 simulation, so the wall time is in proportion to the evaluations; both are reported per case, with
@@ -52,8 +52,8 @@ def main(argv: list[str] | None = None) -> int:
 
     from parksteer.model.symbolic.components import discover_effects, strength_parameter
     from parksteer.parameters import load_parameters
-    from parksteer.synthetic.datasets import (BenchmarkDesign, clean_run, hand, perturbed_base, rms_difference,
-                                              strength_for_rms, torque_step_Nm)
+    from parksteer.synthetic.datasets import BenchmarkDesign, clean_run, hand, perturbed_base, torque_step_Nm
+    from parksteer.synthetic.size_search import rms_difference, strength_for_rms
     from parksteer.tables import write_json
 
     params = load_parameters()

@@ -110,7 +110,10 @@ BATCHING = """
 import json, sys, tempfile, time
 from parksteer.parameters import load_parameters
 from parksteer.sweep import load_sweep
-import parksteer.sweep.declaration as declaration
+try:
+    import parksteer.sweep.batch_index as index_module
+except ImportError:  # before the batch index had a module of its own
+    import parksteer.sweep.declaration as index_module
 params = load_parameters(sys.argv[2])
 start = time.perf_counter()
 sweep = load_sweep(sys.argv[1], params)
@@ -118,9 +121,9 @@ loaded = time.perf_counter()
 batches = sweep.batches(int(sys.argv[3]))
 batched = time.perf_counter()
 out = {"load_sweep_s": loaded - start, "batches_s": batched - loaded, "n_batches": len(batches)}
-if hasattr(declaration, "write_batch_index"):
+if hasattr(index_module, "write_batch_index"):
     with tempfile.TemporaryDirectory() as folder:
-        declaration.write_batch_index(sweep, int(sys.argv[3]), folder)
+        index_module.write_batch_index(sweep, int(sys.argv[3]), folder)
     out["batch_index_s"] = time.perf_counter() - batched
 else:  # the plan formed each batch's spec
     begun = time.perf_counter()

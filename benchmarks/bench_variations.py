@@ -44,7 +44,8 @@ def main(argv: list[str] | None = None) -> int:
     from parksteer.experiments.benchmark import BENCHMARK_SETTINGS
     from parksteer.diagnose.settings import DEFAULT_SETTINGS
     from parksteer.experiments.rows import as_dict
-    from parksteer.experiments.variations import VariationDesign, case_names, outcome, run_case, summarise
+    from parksteer.experiments.variation_summary import outcome, summarise
+    from parksteer.experiments.variations import VariationDesign, case_names, run_case
     from parksteer.parameters import DEFAULT_PATH
     from parksteer.tables import write_json
 
@@ -92,7 +93,8 @@ def main(argv: list[str] | None = None) -> int:
 
 def _sizes(design, out: str) -> int:
     """Each hidden case's whole and observable change (case_truth), and per hidden effect the observable share."""
-    from parksteer.experiments.variations import case_truth, spread, variation_cases
+    from parksteer.experiments.variation_summary import spread
+    from parksteer.experiments.variations import case_truth, variation_cases
     from parksteer.parameters import load_parameters
     from parksteer.tables import write_json
 

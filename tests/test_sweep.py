@@ -198,7 +198,7 @@ def test_batches_partition_the_points_and_a_new_point_reruns_only_its_batch(tmp_
     changed_old, changed_new = set(batches) - set(grown), set(grown) - set(batches)
     assert len(changed_old) == 1 and len(changed_new) == 1
     assert set(grown[changed_new.pop()]) == set(batches[changed_old.pop()]) | {new_id}
-    from parksteer.sweep.declaration import point_id
+    from parksteer.sweep.expansion import point_id
 
     boundary = next(q for q in range(123001, 124000, 2)
                     if int(point_id("unladen", None, "ground", {"tyre.tyre_pressure": float(q)}), 16) % 8 == 0)
@@ -211,7 +211,7 @@ def test_batches_partition_the_points_and_a_new_point_reruns_only_its_batch(tmp_
     assert len(set(batches) - set(shrunk)) == 1 and len(set(shrunk) - set(batches)) <= 1
     assert all(len(points) == 1 for points in sweep.batches(1).values()) and len(sweep.batches(1)) == 200
     ids = [hashlib.sha256(str(k).encode()).hexdigest()[:10] for k in range(2000)]  # uniform, as point ids are
-    from parksteer.sweep.declaration import batch_points
+    from parksteer.sweep.expansion import batch_points
 
     sizes = [len(points) for points in batch_points(ids, 25).values()]
     assert sum(sizes) == 2000 and max(sizes) <= 75 and 15 <= 2000 / len(sizes) <= 40
@@ -222,18 +222,18 @@ def test_a_large_sweep_is_cut_into_a_bounded_number_of_batches_and_a_small_one_a
     batch size doubles until the points fit in about MAX_BATCHES batches; a sweep up to that size is cut exactly as
     at the plain batch size (same batches, same ids: its results stay valid), and the grown size is a power-of-two
     multiple of the asked one (its natural boundaries a subset of the plain size's)."""
-    from parksteer.sweep import declaration
-    from parksteer.sweep.declaration import batch_points, effective_batch_size
+    from parksteer.sweep import expansion
+    from parksteer.sweep.expansion import batch_points, effective_batch_size
 
     ids = [hashlib.sha256(str(k).encode()).hexdigest()[:10] for k in range(2000)]  # uniform, as point ids are
     plain = batch_points(ids, 25)  # 2,000 points <= 4,096 x 25: the plain size
     assert effective_batch_size(2000, 25) == 25 and effective_batch_size(4096 * 50, 50) == 50
     assert effective_batch_size(4096 * 50 + 1, 50) == 100 and effective_batch_size(10**6, 50) == 400
-    monkeypatch.setattr(declaration, "MAX_BATCHES", 80)  # 2,000 points = 80 x 25: still the plain size
+    monkeypatch.setattr(expansion, "MAX_BATCHES", 80)  # 2,000 points = 80 x 25: still the plain size
     assert batch_points(ids, 25) == plain
-    monkeypatch.setattr(declaration, "MAX_BATCHES", 20)  # 2,000 > 20 x 25 x 2: cut at 100 points a batch
+    monkeypatch.setattr(expansion, "MAX_BATCHES", 20)  # 2,000 > 20 x 25 x 2: cut at 100 points a batch
     grown = batch_points(ids, 25)
-    monkeypatch.setattr(declaration, "MAX_BATCHES", 10**6)
+    monkeypatch.setattr(expansion, "MAX_BATCHES", 10**6)
     assert grown == batch_points(ids, 100)
     assert sorted(p for points in grown.values() for p in points) == sorted(ids)
     assert 10 <= len(grown) <= 1.25 * 20 and len(plain) > 60  # about n / size: fewer only where a batch is capped
@@ -258,7 +258,7 @@ def test_a_batch_writes_the_records_its_points_give_alone(tmp_path, params):
 def test_point_ids_in_bulk_are_point_id_of_each_point():
     """The bulk hashing (pieces kept per key and value) gives each point the id point_id gives it alone, signed
     zeros, mixed key sets and keys out of order included."""
-    from parksteer.sweep.declaration import point_id, point_ids
+    from parksteer.sweep.expansion import point_id, point_ids
 
     values = [{"tyre.tyre_pressure": 122500.0, "design.front_axle_load": 5576.0},
               {"design.front_axle_load": 5576.0, "tyre.tyre_pressure": 122500.0},
@@ -275,7 +275,7 @@ def test_point_ids_in_bulk_are_point_id_of_each_point():
 def test_a_batch_job_reads_from_the_batch_index_the_spec_the_sweep_gives(tmp_path, params, declaration):
     """Each batch's spec read from the batch index (what the batch job runs) equals Sweep.batch_spec; a job that
     finds no index writes it; an index that no longer matches its batch is refused, not run."""
-    from parksteer.sweep.declaration import batch_index_path, batch_spec_from_index, write_batch_index
+    from parksteer.sweep.batch_index import batch_index_path, batch_spec_from_index, write_batch_index
 
     path = _write(tmp_path, GRID) if declaration == "grid" else _listed(tmp_path, range(100000, 300000, 7000), "l.yaml")
     sweep = load_sweep(path, params)
@@ -302,7 +302,9 @@ def test_the_streamed_gathering_writes_what_all_records_in_memory_give(tmp_path,
     memory, and the summary (points above the threshold streamed from a scratch file) that summarise gives from
     every record, byte for byte; a missing point is named, a record of another sweep or one gathered twice
     refused."""
-    from parksteer.sweep.aggregate import gather_points, read_points, summarise, sweep_table
+    from parksteer.sweep.aggregate import summarise
+    from parksteer.sweep.gathering import gather_points
+    from parksteer.sweep.records import read_points, sweep_table
     from parksteer.tables import write_csv, write_json
 
     text = GRID + ("map: {x: tyre.tyre_pressure, y: design.front_axle_load, panels: steering.rack_friction_force,\n"

@@ -45,7 +45,8 @@ def diagnosis(config: dict, parameters_path: str, user_effect: str) -> dict:
     from .experiments.variations import VariationDesign, case_names as variation_case_names
     from .figures.signature import case_names as signature_case_names, design_from_config as signature_design
     from .parameters import load_parameters
-    from .synthetic.datasets import BenchmarkDesign, CarDesign, OutclassDesign, file_name
+    from .synthetic.datasets import BenchmarkDesign, CarDesign, file_name
+    from .synthetic.outclass import OutclassDesign
 
     params = load_parameters(parameters_path)
     car = CarDesign.from_config(config["car"], config["benchmark"]["perturbation"])
@@ -66,7 +67,8 @@ def diagnosis(config: dict, parameters_path: str, user_effect: str) -> dict:
 def assisted_truth_cases(section: dict | None = None) -> list[str]:
     """The case names of the assisted benchmark on an independent truth (parksteer.experiments.assisted_truth), in
     its order, of the design config["assisted_truth"] gives (each case keeps its own seed and converter)."""
-    from .experiments.assisted_truth import case_names, design_from_config
+    from .experiments.assisted_truth import design_from_config
+    from .experiments.assisted_truth_design import case_names
 
     return case_names(design_from_config(section))
 
@@ -120,10 +122,10 @@ def sweep(path: str, parameters_path: str, full: bool, batch_size: int, index_di
     """The sweep declared in `path`, read, checked and expanded (parksteer.sweep.load_sweep; its braked-wheel
     check resolves effects): its name, effect sets by variant, what every point spec shares, and its batch ids;
     each batch's points go to the sweep's batch index under `index_dir`
-    (parksteer.sweep.declaration.write_batch_index), where its job reads them."""
+    (parksteer.sweep.batch_index.write_batch_index), where its job reads them."""
     from .parameters import load_parameters
     from .sweep import load_sweep
-    from .sweep.declaration import write_batch_index
+    from .sweep.batch_index import write_batch_index
 
     declared = load_sweep(path, load_parameters(parameters_path), full=full)
     write_batch_index(declared, batch_size, index_dir)

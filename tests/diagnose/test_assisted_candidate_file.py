@@ -30,10 +30,12 @@ from parksteer.diagnose.candidates import candidate_effects
 from parksteer.diagnose.problem import prepare_file
 from parksteer.diagnose.report import diagnosis_dict
 from parksteer.diagnose.select import diagnose
-from parksteer.experiments.assisted_truth import TruthDesign, owner_file
+from parksteer.experiments.assisted_truth_owner import owner_file
+from parksteer.experiments.assisted_truth_design import TruthDesign
 from parksteer.experiments.benchmark import BENCHMARK_SETTINGS
 from parksteer.model.symbolic.components import MODULES_ENV, discover_effects, load_effect_module, resolve_effects
-from parksteer.synthetic.assisted_truth import TruthGear, TruthLogger, TruthMap, manual_road, truth_clean, truth_record
+from parksteer.synthetic.assisted_truth import TruthGear, TruthLogger, TruthMap, manual_road, truth_record
+from parksteer.synthetic.column_eps_layer import truth_clean
 from parksteer.synthetic.variations import HandVariant
 
 pytestmark = pytest.mark.slow  # derives the model with the user's effect once per cache

@@ -29,7 +29,8 @@ from parksteer.model.numeric.simulate import simulate
 from parksteer.model.symbolic.components import discover_effects, resolve_effects, strength_parameter
 from parksteer.parameters import DEFAULT_PATH, load_parameters
 from parksteer.resources import data_file
-from parksteer.synthetic.datasets import perturbed_base, rms_difference
+from parksteer.synthetic.datasets import perturbed_base
+from parksteer.synthetic.size_search import rms_difference
 from parksteer.synthetic.outoflibrary import form_by_name
 from parksteer.synthetic.variations import VARIATIONS, variation_rack, variation_record
 

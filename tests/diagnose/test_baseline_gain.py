@@ -19,8 +19,9 @@ from parksteer.diagnose.problem import load_files
 from parksteer.diagnose.report import diagnosis_dict
 from parksteer.diagnose.select import diagnose
 from parksteer.errors import UsageError
-from parksteer.experiments.assisted_truth import (TruthDesign, _write, baseline_record, case_truth_and_record, cases,
-                                                  identified_route, owner_file)
+from parksteer.experiments.assisted_truth import _write, baseline_record, case_truth_and_record
+from parksteer.experiments.assisted_truth_design import TruthDesign, cases
+from parksteer.experiments.assisted_truth_owner import identified_route, owner_file
 from parksteer.experiments.benchmark import BENCHMARK_SETTINGS
 from parksteer.parameters import ParameterError
 from parksteer.vehicle import load_vehicle, vehicle_from_text

@@ -20,9 +20,12 @@ from parksteer.diagnose.engine import ReplayEngine
 from parksteer.diagnose.ensemble import with_replay_uncertainty
 from parksteer.diagnose.problem import Problem, load_files
 from parksteer.diagnose.replay import Replay
-from parksteer.experiments.assisted_truth import TruthDesign, case_truth_and_record, cases, owner_file
+from parksteer.experiments.assisted_truth import case_truth_and_record
+from parksteer.experiments.assisted_truth_owner import owner_file
+from parksteer.experiments.assisted_truth_design import TruthDesign, cases
 from parksteer.measure.io import format_measurement
-from parksteer.measure.smoothing import RackSpline, interpolate_rack, rounding_draw, smooth_rack
+from parksteer.measure.smoothing import rounding_draw, smooth_rack
+from parksteer.measure.rack_spline import RackSpline, interpolate_rack
 from parksteer.synthetic.variations import variation_by_name, variation_rack
 from parksteer.vehicle import load_vehicle
 

@@ -9,8 +9,9 @@ import pytest
 import yaml
 
 from parksteer.errors import UsageError
-from parksteer.experiments.assisted_truth import (TruthDesign, case_names, cases, design_from_config,
-                                                  owner_vehicle_text)
+from parksteer.experiments.assisted_truth import design_from_config
+from parksteer.experiments.assisted_truth_design import TruthDesign, case_names, cases
+from parksteer.experiments.assisted_truth_owner import owner_vehicle_text
 from parksteer.model.symbolic.components import discover_effects
 from parksteer.vehicle import vehicle_from_text
 

@@ -77,7 +77,7 @@ def test_benchmark_figure_data_is_the_same_whatever_the_timings(tmp_path):
     """Figure data and key numbers are checksummed and reproduced by a rebuild, so they must not change from run to
     run: two benchmarks that differ only in the wall-clock and stage times of each diagnosis give byte-identical
     figure data and key-number file, and neither holds a machine time."""
-    from parksteer.figures.diagnose import make_benchmark_figure
+    from parksteer.figures.diagnosis_benchmarks import make_benchmark_figure
 
     csv_bytes = []
     for run, wall_s in enumerate((5.0, 9.5)):
@@ -99,7 +99,7 @@ def test_benchmark_figure_data_is_the_same_whatever_the_timings(tmp_path):
 def test_benchmark_figure_shows_both_curves_when_they_coincide(scored, tmp_path, monkeypatch):
     """Where every hidden candidate named was named first, the two accuracy curves carry the same numbers; the one
     drawn underneath must stay visible beside the one on top (wider line and marks, lower in the drawing order)."""
-    import parksteer.figures.diagnose as diagnose_figures
+    import parksteer.figures.diagnosis_benchmarks as diagnose_figures
 
     figures = []
     monkeypatch.setattr(diagnose_figures, "save_svg", lambda fig, path: figures.append(fig))

@@ -11,8 +11,16 @@ from parksteer.experiments.outclass import outcome, run_case
 from parksteer.errors import UsageError
 from parksteer.model.symbolic.components import discover_effects, resolve_effects
 from parksteer.parameters import DEFAULT_PATH, load_parameters
-from parksteer.synthetic.datasets import (ChainLogger, OutclassDesign, SizeSearch, chain_logged,
-                                          chain_torque_step_Nm, hand, outclass_rivals, outclass_specs)
+from parksteer.synthetic.datasets import hand
+from parksteer.synthetic.outclass import (
+    ChainLogger,
+    OutclassDesign,
+    chain_logged,
+    chain_torque_step_Nm,
+    outclass_rivals,
+    outclass_specs,
+)
+from parksteer.synthetic.size_search import SizeSearch
 
 CHAIN = ChainLogger(sample_rate_hz=50.0, anti_alias_hz=10.0, anti_alias_order=2, torque_lag_s=0.01, torque_bits=8,
                     rack_bits=12)

@@ -6,9 +6,22 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from parksteer.experiments.peers import (FROLS_SETTINGS, STLSQ_RIDGES, STLSQ_SETTINGS, STLSQ_THRESHOLDS, frols, frols_ranking, generic_terms,
-                                      library_from, peer_answers, portable_stlsq, score_method, setting_label, stlsq, tune,
-                                      verdict_of)
+from parksteer.experiments.peer_methods import (
+    FROLS_SETTINGS,
+    STLSQ_RIDGES,
+    STLSQ_SETTINGS,
+    STLSQ_THRESHOLDS,
+    frols,
+    frols_ranking,
+    generic_terms,
+    library_from,
+    peer_answers,
+    portable_stlsq,
+    setting_label,
+    stlsq,
+    verdict_of,
+)
+from parksteer.experiments.peer_scoring import score_method, tune
 
 SAMPLES = 4000
 RATIO = 186.47  # rad/m, the parameter file's handwheel-to-rack ratio
@@ -161,7 +174,7 @@ def test_an_out_of_class_rival_answered_with_an_unrelated_candidate_is_a_peers_c
 
 @pytest.mark.slow
 def test_the_library_of_a_real_diagnosis_holds_its_residual_and_its_candidates_signatures(written, params):
-    from parksteer.experiments.peers import record_library
+    from parksteer.experiments.peer_methods import record_library
     from parksteer.diagnose.problem import load_files
     from parksteer.diagnose.select import diagnose
 
@@ -184,7 +197,7 @@ def test_the_library_of_a_real_diagnosis_holds_its_residual_and_its_candidates_s
 
 
 def test_the_comparison_tunes_on_the_tuning_split_and_scores_on_the_evaluation_records():
-    from parksteer.experiments.peers import compare
+    from parksteer.experiments.peer_scoring import compare
 
     k = len(STLSQ_THRESHOLDS)
     frols_quiet = {setting_label("frols", s): {"verdict": "adequate", "effect": None} for s in FROLS_SETTINGS}

@@ -12,8 +12,16 @@ import pytest
 from parksteer.experiments.benchmark import BASE_PERTURBATION
 from parksteer.experiments.rows import VariationRow
 from parksteer.diagnose.settings import DEFAULT_SETTINGS
-from parksteer.experiments.variations import (COVERAGE_TARGET, NAMED_MIN_STEPS, NAMED_TARGET, NULL_ADEQUATE_TARGET,
-                                           VariationDesign, outcome, run_case, summarise, variation_cases)
+from parksteer.experiments.variation_summary import outcome, summarise
+from parksteer.experiments.variations import (
+    COVERAGE_TARGET,
+    NAMED_MIN_STEPS,
+    NAMED_TARGET,
+    NULL_ADEQUATE_TARGET,
+    VariationDesign,
+    run_case,
+    variation_cases,
+)
 from parksteer.errors import UsageError
 from parksteer.measure.io import read_measurement
 from parksteer.parameters import DEFAULT_PATH, load_parameters

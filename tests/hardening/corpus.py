@@ -616,7 +616,7 @@ def _reframe(frame, data: bytes | None = None, timestamp: float | None = None, a
 
 
 def _with_crc(data: bytearray, frame_id: int) -> bytes:
-    from parksteer.measure.readers.can_log import e2e_p2_checksum, load_bus
+    from parksteer.measure.readers.bus_files import e2e_p2_checksum, load_bus
 
     data[0] = e2e_p2_checksum(bytes(data), load_bus("vw_mqb").data_ids[frame_id])
     return bytes(data)

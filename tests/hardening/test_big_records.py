@@ -3,11 +3,13 @@ on reading, and one beyond the caps is refused in one line before it is parsed."
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
 from parksteer.errors import UsageError
-from parksteer.measure import importers, io
+from parksteer.measure import importers, text_table
 from parksteer.measure.importers import METHOD_RATE_HZ, load_record
 
 from .corpus import base_record
@@ -51,7 +53,7 @@ def test_fast_record_is_decimated_and_a_tone_above_the_new_nyquist_is_filtered_n
 
 def test_slow_record_is_kept_sample_for_sample(tmp_path, params):
     """The 50 Hz example needs no decimation: every sample is kept and nothing is noted."""
-    m = load_record(io.Path(__file__).resolve().parents[2] / "data/measurements/example_unladen.csv", params=params)
+    m = load_record(Path(__file__).resolve().parents[2] / "data/measurements/example_unladen.csv", params=params)
     assert m.n_samples == 901
     assert "decimated" not in m.metadata
 
@@ -60,7 +62,7 @@ def test_record_beyond_the_row_cap_is_refused_before_parsing(tmp_path, params, m
     """More data rows than MAX_SAMPLES: one line naming the file and the cap (the cap lowered to keep it small)."""
     path = tmp_path / "long.csv"
     _fast_record(path, 200.0, 1.0, 0.0)
-    monkeypatch.setattr(io, "MAX_SAMPLES", 1000)
+    monkeypatch.setattr(text_table, "MAX_SAMPLES", 1000)
     with pytest.raises(UsageError, match=r"long\.csv: \d+ data rows, beyond the 1000"):
         load_record(path, params=params)
 

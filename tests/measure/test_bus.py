@@ -16,7 +16,8 @@ from parksteer.cli import main  # noqa: E402
 from parksteer.measure.bus import WRITERS, bus_channel_map, encode_frames, write_log  # noqa: E402
 from parksteer.measure.importers import load_record  # noqa: E402
 from parksteer.measure.io import Measurement, format_measurement  # noqa: E402
-from parksteer.measure.readers.can_log import e2e_p2_checksum, load_bus, load_dbc, read_bus_log  # noqa: E402
+from parksteer.measure.readers.bus_files import e2e_p2_checksum, load_bus, load_dbc  # noqa: E402
+from parksteer.measure.readers.can_log import read_bus_log  # noqa: E402
 
 # Frames logged on real MQB cars, published with opendbc 0.3.1 (opendbc/can/tests/test_checksums.py), byte 0 the
 # checksum the car's own control unit computed.

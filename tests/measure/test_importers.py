@@ -16,7 +16,7 @@ from hypothesis import strategies as st
 from parksteer.cli import main
 from parksteer.errors import UsageError
 from parksteer.measure.importers import from_si, load_rack_drive, load_record, to_si
-from parksteer.measure.io import read_table
+from parksteer.measure.text_table import read_table
 
 CORPUS = Path(__file__).parent / "corpus"
 DAQ_MAP = "RackPos[mm]=rack_m,SteerTorque[N*m]=handwheel_torque_Nm,SWA[deg]=handwheel_angle_rad"

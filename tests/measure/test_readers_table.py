@@ -9,7 +9,8 @@ from pathlib import Path
 from parksteer.measure import importers
 from parksteer.measure.readers import READERS, reader_for
 from parksteer.measure.readers.bus_log import BusLogReader
-from parksteer.measure.readers.can_log import BusMap, CanLogReader, load_bus
+from parksteer.measure.readers.bus_files import BusMap, load_bus
+from parksteer.measure.readers.can_log import CanLogReader
 
 SAMPLES = Path(__file__).resolve().parents[2] / "data" / "samples"
 

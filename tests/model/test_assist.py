@@ -125,7 +125,7 @@ def test_a_prescribed_rack_cannot_drive_an_assisted_car(params):
     """The rack-driven solve takes the column torque as its unknown, linear in the equations; an assist feeds that
     torque back through its boost curve, so the solve is refused in one line instead of solving the wrong
     equations (an assisted car is driven by its handwheel angle)."""
-    from parksteer.measure.smoothing import interpolate_rack
+    from parksteer.measure.rack_spline import interpolate_rack
 
     t = np.linspace(0.0, 2.0, 21)
     with pytest.raises(UsageError, match="a prescribed rack cannot drive the effects .*electric_assist_column"):

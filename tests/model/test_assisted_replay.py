@@ -8,7 +8,7 @@ import pytest
 from scipy.interpolate import BPoly, PPoly
 
 from parksteer.boost_table import entries
-from parksteer.measure.smoothing import RackSpline
+from parksteer.measure.rack_spline import RackSpline
 from parksteer.model.numeric.assisted import BoostLaw, solve_assisted
 from parksteer.model.numeric.simulate import prepare, simulate
 from parksteer.model.symbolic.components import discover_effects
@@ -116,7 +116,7 @@ def test_boost_law_inverse_balances_the_column_at_the_corners_of_the_law(params)
 def _sweep(params, effects: str, overrides: dict):
     """The assisted replay of a smooth steer to the right and back (no free run needed: the candidates act in the
     replay), at rtol 1e-8."""
-    from parksteer.measure.smoothing import interpolate_rack
+    from parksteer.measure.rack_spline import interpolate_rack
 
     t = np.linspace(0.0, 6.0, 601)
     rack = interpolate_rack(t, 0.03 * np.sin(np.pi * t / 6.0))

@@ -17,7 +17,7 @@ from scipy.integrate import cumulative_trapezoid
 
 from parksteer.cli import main
 from parksteer.geometry import steer_axis
-from parksteer.measure.smoothing import interpolate_rack
+from parksteer.measure.rack_spline import interpolate_rack
 from parksteer.model.numeric.simulate import simulate
 from parksteer.rig import braked_pin_torque_Nm, free_rolling_pin_torque_Nm
 

@@ -9,7 +9,7 @@ from scipy.interpolate import BPoly, CubicSpline, PPoly
 from parksteer.cli import main
 from parksteer.errors import UsageError
 from parksteer.measure.io import read_measurement
-from parksteer.measure.smoothing import RackSpline, interpolate_rack
+from parksteer.measure.rack_spline import RackSpline, interpolate_rack
 from parksteer.geometry import column_twist
 from parksteer.model.numeric.prescribed import solve
 from parksteer.model.numeric.simulate import prepare, simulate, static_state

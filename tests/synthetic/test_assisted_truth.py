@@ -7,8 +7,8 @@ import pytest
 from scipy.optimize import brentq
 
 from parksteer.geometry import pinion_angle_from_column
-from parksteer.synthetic.assisted_truth import (Hidden, Road, TruthGear, TruthMap, _delivered, column_of_pinion,
-                                                eps_layer)
+from parksteer.synthetic.assisted_truth import Hidden, Road, TruthGear, TruthMap, column_of_pinion
+from parksteer.synthetic.column_eps_layer import _delivered, eps_layer
 
 
 def _road(torque, rate=None, accel=None) -> Road:

@@ -1,4 +1,4 @@
-"""The size search of the benchmark's hidden effects (parksteer.synthetic.datasets.strength_for_rms).
+"""The size search of the benchmark's hidden effects (parksteer.synthetic.size_search.strength_for_rms).
 
 Checked against closed forms: a torque change c s^p (a power of the size, as a small effect's change
 is) reaches a target RMS T at s = (T / c)^(1/p).
@@ -7,7 +7,7 @@ is) reaches a target RMS T at s = (T / c)^(1/p).
 import numpy as np
 import pytest
 
-from parksteer.synthetic.datasets import SizeSearch, strength_for_rms
+from parksteer.synthetic.size_search import SizeSearch, strength_for_rms
 
 SHAPE = np.sin(np.linspace(0.0, 20.0, 400))
 SEARCH = SizeSearch(iterations=12, tolerance=0.05, max_lag_s=0.3)

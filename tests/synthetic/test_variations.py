@@ -16,7 +16,8 @@ from parksteer.diagnose.engine import ReplayEngine
 from parksteer.diagnose.ensemble import with_replay_uncertainty
 from parksteer.diagnose.problem import Problem, prepare_file
 from parksteer.diagnose.statistics import fit_statistics
-from parksteer.measure.smoothing import rest_intervals, smooth_rack
+from parksteer.measure.smoothing import smooth_rack
+from parksteer.measure.rack_fit import rest_intervals
 from parksteer.model.symbolic.components import resolve_effects
 from parksteer.parameters import load_parameters
 from parksteer.synthetic.example import example_measurement

@@ -68,7 +68,7 @@ def test_the_rivals_are_a_selection_of_the_effects_that_declare_one(config):
     the entry."""
     from parksteer.model.symbolic.components import rival_effects
     from parksteer.plan import rival_names
-    from parksteer.synthetic.datasets import OutclassDesign
+    from parksteer.synthetic.outclass import OutclassDesign
 
     assert rival_names(config["rivals"]) == config["rivals"]
     assert rival_names(None) == sorted(rival_effects())

@@ -1,16 +1,17 @@
 # Design exploration: the sweep declared in config["sweep"] (default config/sweeps/design.yaml; its large
 # version with config["sweep_full"]), expanded into points and the points into batches of about
-# config["sweep_batch_size"] (parksteer.sweep.declaration.batch_points; doubled until a sweep makes at most about
+# config["sweep_batch_size"] (parksteer.sweep.expansion.batch_points; doubled until a sweep makes at most about
 # 4,096 batches, so that a million points make some 2,600 jobs rather than 21,000), one sweep_batch job per batch,
 # so that a point costs its physics rather than a process start, and the batches run in parallel with --cores N and
 # unchanged on a cluster (workflow/profiles/slurm). Each batch job reads the compiled model of its effect sets
 # ("free", and "braked" when the sweep simulates braked wheels) from the cache, where rule derive puts it, and
 # never derives; sweep_<name> gathers the table, the key numbers and the torque maps.
 # The plan holds the batch ids only: each batch's points are in the sweep's batch index (SWEEP_INDEX_DIR, written
-# once per declaration while the DAG is built; parksteer.sweep.declaration.write_batch_index), where its job reads
+# once per declaration while the DAG is built; parksteer.sweep.batch_index.write_batch_index), where its job reads
 # them, so that the DAG of a million points costs the scheduler a name per batch and no spec.
 from parksteer.errors import UsageError
-from parksteer.sweep.declaration import DEFAULT_BATCH_SIZE, DEFAULT_SWEEP_FILE
+from parksteer.sweep.declaration import DEFAULT_SWEEP_FILE
+from parksteer.sweep.expansion import DEFAULT_BATCH_SIZE
 
 SWEEP_BATCH_SIZE = int(config.get("sweep_batch_size", DEFAULT_BATCH_SIZE))
 SWEEP_FILE = config.get("sweep", DEFAULT_SWEEP_FILE)

@@ -1,5 +1,5 @@
-# Thin rule script: the logic is parksteer.figures.diagnose.make_benchmark_figure.
-from parksteer.figures.diagnose import make_benchmark_figure
+# Thin rule script: the logic is parksteer.figures.diagnosis_benchmarks.make_benchmark_figure.
+from parksteer.figures.diagnosis_benchmarks import make_benchmark_figure
 from parksteer.rules import rule_log
 from parksteer.synthetic.datasets import BenchmarkDesign
 

@@ -4,7 +4,7 @@ from parksteer.experiments.benchmark import run_batch
 from parksteer.experiments.outclass import run_case
 from parksteer.experiments.peers import peers_beside
 from parksteer.rules import rule_log
-from parksteer.synthetic.datasets import OutclassDesign
+from parksteer.synthetic.outclass import OutclassDesign
 
 with rule_log(snakemake):
     run_batch(run_case, snakemake.input.parameters,

@@ -1,6 +1,6 @@
-# Thin rule script: the logic is parksteer.figures.diagnose.make_variations_figure.
+# Thin rule script: the logic is parksteer.figures.diagnosis_benchmarks.make_variations_figure.
 from parksteer.experiments.variations import VariationDesign
-from parksteer.figures.diagnose import make_variations_figure
+from parksteer.figures.diagnosis_benchmarks import make_variations_figure
 from parksteer.rules import rule_log
 
 with rule_log(snakemake):

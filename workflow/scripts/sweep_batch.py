@@ -1,7 +1,8 @@
 # Thin rule script: the logic is parksteer.sweep.run.run_batch; the batch's points come from the sweep's batch
-# index (parksteer.sweep.declaration.batch_spec_from_index), at the batch size and sweep_full of workflow/rules/sweep.smk.
+# index (parksteer.sweep.batch_index.batch_spec_from_index), at the batch size and sweep_full of workflow/rules/sweep.smk.
 from parksteer.rules import rule_log
-from parksteer.sweep.declaration import DEFAULT_BATCH_SIZE, batch_spec_from_index
+from parksteer.sweep.batch_index import batch_spec_from_index
+from parksteer.sweep.expansion import DEFAULT_BATCH_SIZE
 from parksteer.sweep.run import run_batch
 
 with rule_log(snakemake):

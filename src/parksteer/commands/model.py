@@ -176,7 +176,8 @@ def with_speed(effects: str | None, overrides: dict, speed_kmh: float) -> tuple[
 def _measured_rack(path: str, params, raw: bool, channel_map=None, case=None, surface=None):
     """(case, surface, rack motion, description) of a measurement file's rack: smoothed as compare does, or raw."""
     from ..measure.importers import load_rack_drive
-    from ..measure.smoothing import interpolate_rack, smooth_rack
+    from ..measure.smoothing import smooth_rack
+    from ..measure.rack_spline import interpolate_rack
 
     measurement = load_rack_drive(path, channel_map, case=case, surface=surface, params=params)
     with naming(path):

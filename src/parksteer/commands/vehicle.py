@@ -87,7 +87,7 @@ def tyre_radius_m(size: str) -> float:
 
 def specification(args, gravity: float):
     """The :class:`parksteer.vehicle.Specification` of the command line, in SI units."""
-    from ..vehicle import Specification
+    from ..vehicle.specification import Specification
 
     load_N = args.front_axle_load_N if args.front_axle_load_N is not None else args.front_axle_mass_kg * gravity
     load_option = "--front-axle-load-N" if args.front_axle_load_N is not None else "--front-axle-mass-kg"
@@ -127,7 +127,8 @@ def specification(args, gravity: float):
 
 def _new(args) -> int:
     from ..tables import atomic_path
-    from ..vehicle import template_text, vehicle_from_text, vehicle_name, vehicle_values
+    from ..vehicle import vehicle_from_text, vehicle_name
+    from ..vehicle.specification import template_text, vehicle_values
 
     out = Path(args.out)
     if out.suffix != ".toml":

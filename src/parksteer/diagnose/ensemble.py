@@ -60,7 +60,7 @@ def with_replay_uncertainty(engine: ReplayEngine, problem: Problem, effects: lis
         base.parameter_vector(overrides)  # any run the overrides need is prepared once, here
         logger = rack_logger(f.measurement, problem.params)
         # An end held at rest may be a hand still slowing there, and a pause's edges are not sharp
-        # (smoothing.RACK_REST_TEST_CHI2, RACK_REST_MIN_S): every other draw smooths with the ends and the
+        # (rack_fit.RACK_REST_TEST_CHI2, RACK_REST_MIN_S): every other draw smooths with the ends and the
         # pauses free, so the samples there carry that doubt.
         released = any(f.rack.held_at_rest) or bool(f.rack.rest_intervals_s)
         sources = ensemble_sources(f, draws, released)

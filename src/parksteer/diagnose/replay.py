@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..measure.smoothing import RackSpline
+from ..measure.rack_spline import RackSpline
 from ..errors import UsageError
 from ..model.numeric.assisted import solve_assisted
 from ..model.numeric.compiled import CompiledModels

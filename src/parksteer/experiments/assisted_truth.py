@@ -10,13 +10,13 @@ design's converters (10 bits on +-10 N m to 0.005 N m steps; the control unit re
 in 0.05 A steps, and one of two tiers: the rack logged, or the handwheel angle only (a bus log: the diagnosis
 derives the rack through the column and the torsion bar, :func:`parksteer.measure.column.rack_from_angle`).
 
-The file the diagnosis is given is the owner's (:func:`owner_vehicle_text`): the Polo file with an ``[assist]``
-from the gear's data sheet (reduction, both efficiencies, torque constant, current limit as motor torque, rotor
-inertia, torsion-bar stiffness) and the map written point by point in ``[assist.boost]`` (the control unit's
-calibration read at the design's torques); what no data sheet gives (the motor's friction, the band of rotor speed
-over which it and the worm's direction change over at a reversal) stays at the template's assumed default. A
-second route, the file written from a baseline null record by the identification of the assist (``parksteer assist
-identify``), is the entry ``identified`` of :data:`ROUTES`.
+The file the diagnosis is given is the owner's (:func:`~.assisted_truth_owner.owner_vehicle_text`): the Polo file
+with an ``[assist]`` from the gear's data sheet (reduction, both efficiencies, torque constant, current limit as
+motor torque, rotor inertia, torsion-bar stiffness) and the map written point by point in ``[assist.boost]`` (the
+control unit's calibration read at the design's torques); what no data sheet gives (the motor's friction, the band
+of rotor speed over which it and the worm's direction change over at a reversal) stays at the template's assumed
+default. A second route, the file written from a baseline null record by the identification of the assist
+(``parksteer assist identify``), is the entry ``identified`` of :data:`~.assisted_truth_owner.ROUTES`.
 
 Cases and what counts, as in :mod:`.assisted_benchmark`: nulls (``adequate`` right), hidden effects of the truth
 standing for the assisted candidates (the motor's extra friction, the sensor's offset, the map's gain error; the
@@ -29,11 +29,9 @@ from __future__ import annotations
 
 import json
 import math
-import re
 import tempfile
 import time
-import zlib
-from dataclasses import dataclass, field, replace
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -44,153 +42,36 @@ from ..diagnose.select import diagnose
 from ..errors import UsageError
 from ..measure.io import format_measurement, write_measurement
 from ..parameters import Parameters, load_parameters
-from ..synthetic.assisted_truth import (HIDDEN_TRUTH, OUT_OF_CLASS_TRUTH, Hidden, TruthGear, TruthLogger, TruthMap,
-                                        manual_road, truth_clean, truth_record, with_hidden)
-from ..synthetic.datasets import SizeSearch, perturbed_base, rms_difference, strength_for_rms
+from ..synthetic.assisted_truth import (
+    HIDDEN_TRUTH,
+    OUT_OF_CLASS_TRUTH,
+    Hidden,
+    TruthLogger,
+    manual_road,
+    truth_record,
+    with_hidden,
+)
+from ..synthetic.column_eps_layer import truth_clean
+from ..synthetic.datasets import perturbed_base
+from ..synthetic.size_search import rms_difference, strength_for_rms
 from ..synthetic.variations import variation_by_name
 from .benchmark import BASE_PERTURBATION, BENCHMARK_SETTINGS
 from .assisted_benchmark import RACK_FRICTION, judged
+from .assisted_truth_design import (
+    NAMED_MIN_FLOORS,
+    SEARCH,
+    TIERS,
+    UPPER,
+    TruthCase,
+    TruthDesign,
+    case_names,
+    case_seed,
+    cases,
+)
+from .assisted_truth_owner import BASELINE_ROUTES, ROUTES, Owner, owner_file, template_default
 from .rows import ROW_SUFFIX, read_case_files
 from .variations import NAMED_TARGET, NULL_ADEQUATE_TARGET
 from ..names import TORQUE
-
-# The largest size searched for each hidden quantity (its unit the truth's: N m, 1, N, rad).
-UPPER = {"assist_motor_friction": 0.3, "torsion_bar_offset": 1.0, "boost_gain_error": 1.0, "rack_friction": 1500.0,
-         "cogging": 0.5, "boost_hysteresis": 1.0, "gear_backlash": 3.0, "current_friction": 0.8}
-SEARCH = SizeSearch(iterations=4, tolerance=0.05, max_lag_s=0.0)
-# Hidden effects at least this many noise floors RMS count towards the named rate (module docstring).
-NAMED_MIN_FLOORS = 2.0
-TIERS = ("rack", "angle")
-
-
-@dataclass(frozen=True)
-class TruthDesign:
-    """The truth's car (map, gear), the owner's file (the map's points), the loggers' torque converters
-    (bits, full scale), the cases (hands, sizes in noise floors, out-of-class forms), the tiers and the seed."""
-
-    case: str = "kerb"
-    boost: TruthMap = TruthMap()
-    gear: TruthGear = TruthGear()
-    map_points_Nm: tuple[float, ...] = (0.0, 0.4, 0.8, 1.2, 1.6, 2.0, 2.5, 3.0, 4.0)
-    torque_converters: tuple[tuple[int, float], ...] = ((10, 10.0), (11, 10.24), (12, 10.24))
-    # the channels' noise, the assisted benchmark's (parksteer.experiments.assisted_benchmark: relative to the
-    # parking range as the variation benchmark's)
-    torque_noise_Nm: float = 0.03
-    current_noise_A: float = 0.25
-    tiers: tuple[str, ...] = TIERS
-    null_variations: tuple[str, ...] = ("rest_after_stop", "mid_stroke_end", "pauses", "rate_8pc_50Hz",
-                                        "rate_3pc_200Hz", "uneven_strokes", "lock_overshoot",
-                                        "rack_16bit_torque_10bit")
-    null_replicates: int = 1
-    hidden_variations: tuple[str, ...] = ("pauses", "uneven_strokes")
-    hidden: tuple[str, ...] = tuple(HIDDEN_TRUTH)
-    floors: tuple[float, ...] = (2.0, 4.0)
-    out_of_class: tuple[tuple[str, float], ...] = (("cogging", 3.0), ("boost_hysteresis", 3.0),
-                                                    ("gear_backlash", 3.0), ("current_friction", 3.0))
-    out_of_class_variations: tuple[str, ...] = ("uneven_strokes",)
-    routes: tuple[str, ...] = ("map",)
-    baseline_variation: str = "rest_after_stop"
-    seed: int = 4242
-
-
-@dataclass(frozen=True)
-class TruthCase:
-    name: str
-    tier: str
-    kind: str  # null, hidden, outclass
-    variation: str
-    hidden: str | None
-    floors: float | None
-    converter: tuple[int, float]
-    seed: int
-
-
-def cases(design: TruthDesign) -> list[TruthCase]:
-    """Every case of `design`, in a fixed order. A case's seed follows its hand's place in
-    :data:`~parksteer.synthetic.variations.VARIATIONS`, its replicate and its tier, and its torque converter is one
-    of the design's picked by its name: a case kept by a smaller design is the full design's case of that name."""
-    out: list[TruthCase] = []
-    for tier in design.tiers:
-        made: list[tuple] = []
-        for replicate in range(design.null_replicates):
-            for v in design.null_variations:
-                made.append((f"{v}__r{replicate}__null", "null", v, None, None, _seed(design, v, replicate)))
-        for v in design.hidden_variations:
-            for effect in design.hidden:
-                for size in design.floors:
-                    made.append((f"{v}__{effect}_{size:g}", "hidden", v, effect, size, _seed(design, v)))
-        for v in design.out_of_class_variations:
-            for form, size in design.out_of_class:
-                made.append((f"{v}__{form}_{size:g}", "outclass", v, form, size, _seed(design, v)))
-        for name, kind, v, hidden, size, seed in made:
-            converter = design.torque_converters[zlib.crc32(f"{tier}__{name}".encode()) % len(design.torque_converters)]
-            out.append(TruthCase(f"{tier}__{name}__t{converter[0]}", tier, kind, v, hidden, size, converter,
-                                 seed + (500 if tier == "angle" else 0)))
-    return out
-
-
-def _seed(design: TruthDesign, variation: str, replicate: int = 0) -> int:
-    from ..synthetic.variations import VARIATIONS
-
-    names = [v.name for v in VARIATIONS]
-    if variation not in names:
-        raise UsageError(f"assisted truth: no hand {variation!r} (the hands: {', '.join(names)})")
-    return design.seed + 1000 * replicate + 10 * names.index(variation)
-
-
-def case_names(design: TruthDesign = TruthDesign()) -> list[str]:
-    return [c.name for c in cases(design)]
-
-
-def owner_vehicle_text(base_text: str, design: TruthDesign) -> str:
-    """The owner's vehicle file: `base_text` (a column-assisted car's file) with its ``[assist]`` and
-    ``[assist.boost]`` replaced by the gear's data sheet and the map written at ``design.map_points_Nm``; the
-    motor's friction, which no data sheet gives, at the assumed default of the assist template."""
-    from ..model.numeric.assist import assist_template
-
-    g = design.gear
-    sheet = "data sheet of the truth's gear (parksteer.synthetic.assisted_truth.TruthGear)"
-    given = {"torsion_bar_stiffness": (g.torsion_bar_stiffness, sheet), "reduction_ratio": (g.reduction, sheet),
-             "efficiency": (g.efficiency, sheet), "back_efficiency": (g.back_efficiency, sheet),
-             "torque_constant": (g.torque_constant_Nm_per_A, sheet),
-             "motor_torque_limit": (g.torque_constant_Nm_per_A * g.current_limit_A, sheet + ": current limit x k_t"),
-             "motor_inertia": (g.motor_inertia_kg_m2, sheet)}
-    section = assist_template("column", given, table=True)
-    torques = list(design.map_points_Nm)
-    assists = [float(a) for a in design.boost(np.array(torques))]
-    fmt = lambda xs: "[" + ", ".join(repr(round(x, 6)) for x in xs) + "]"  # noqa: E731
-    section += ("\n[assist.boost]\n"
-                f'torsion_bar_torque = {{ value = {fmt(torques)}, unit = "N m", source = "the control unit\'s map, '
-                'read point by point" }\n'
-                f'assist = {{ value = {fmt(assists)}, unit = "N m", source = "the control unit\'s map, read point by '
-                'point" }\n')
-    cut = re.search(r"^(# Power assistance.*\n)?\[assist\]", base_text, flags=re.M)
-    if cut is None:
-        raise UsageError("owner's file: the base vehicle file has no [assist] section")
-    return base_text[:cut.start()] + section
-
-
-@dataclass
-class Owner:
-    """The owner's file read as parameters, its assist effect's name and the effects a diagnosis uses."""
-
-    params: Parameters
-    assist: str
-    effects: list = field(default_factory=list)
-
-
-def owner_file(base_path: str | Path, design: TruthDesign, folder: str | Path) -> Owner:
-    from ..model.numeric.assist import effects_with_assist
-    from ..model.symbolic.components import discover_effects, resolve_effects
-    from ..vehicle import vehicle_from_text
-
-    discover_effects()
-    path = Path(folder) / "owner.toml"
-    text = owner_vehicle_text(Path(base_path).read_text(encoding="utf-8"), design)
-    path.write_text(text, encoding="utf-8")
-    params = vehicle_from_text(text, path)
-    spec = effects_with_assist(None, params)
-    return Owner(params, spec.lstrip("+"), resolve_effects(spec))
 
 
 def _logger(design: TruthDesign, case: TruthCase) -> TruthLogger:
@@ -294,51 +175,16 @@ def describe(design: TruthDesign) -> dict:
             "torque_steps_Nm": [TruthLogger(torque_bits=b_, torque_full_scale_Nm=f).torque_step
                                 for b_, f in design.torque_converters],
             "torque_noise_Nm": design.torque_noise_Nm, "current_noise_A": design.current_noise_A,
-            "owner_file": {"motor_friction_Nm": _template_default("motor_friction_torque"),
-                           "friction_speed_rad_s": _template_default("friction_speed"),
+            "owner_file": {"motor_friction_Nm": template_default("motor_friction_torque"),
+                           "friction_speed_rad_s": template_default("friction_speed"),
                            "friction_smoothing_s_per_m": float(load_parameters()["steering.friction_smoothing"])}}
-
-
-def _template_default(key: str) -> float:
-    """The assumed default of the column assist's quantity `key` (what the owner's file keeps)."""
-    from ..model.symbolic.components import discover_effects
-
-    effect = discover_effects()["electric_assist_column"]
-    return float(next(q.default for q in effect.quantities if q.name == key))
-
-
-# The files a diagnosis can be given, by route: route -> (owner, baseline, folder) -> Owner, with `owner` the
-# owner's file (:func:`owner_file`), `baseline` the path of the tier's baseline record (a null of the truth's car
-# on ``TruthDesign.baseline_variation``, made apart from the cases) and `folder` a scratch folder. "map": the
-# owner's file as it is; "identified": the file `parksteer assist identify` writes from the baseline, read as an
-# Owner. The baseline is made only when a route of the design is in BASELINE_ROUTES.
-def identified_route(owner: Owner, baseline: Path, folder: str | Path) -> Owner:
-    """The file `parksteer assist identify` writes from the tier's baseline record and the owner's file (its
-    gear's data; its map is not used): the identified table, the product k_t eta_f N, the motor friction."""
-    from ..diagnose.assist_identify import identify_boost
-    from ..model.numeric.assist import effects_with_assist
-    from ..model.symbolic.components import resolve_effects
-    from ..vehicle import vehicle_from_text
-
-    source = Path(folder) / "owner.toml"
-    found = identify_boost([baseline], source, case=None)
-    path = Path(folder) / f"identified_{Path(baseline).stem}.toml"
-    text = found.to_vehicle_toml(source.read_text(encoding="utf-8"))
-    path.write_text(text, encoding="utf-8")
-    params = vehicle_from_text(text, path)
-    spec = effects_with_assist(None, params)
-    return Owner(params, spec.lstrip("+"), resolve_effects(spec))
-
-
-ROUTES = {"map": lambda owner, baseline, folder: owner, "identified": identified_route}
-BASELINE_ROUTES = {"identified"}
 
 
 def baseline_record(params: Parameters, design: TruthDesign, tier: str):
     """The tier's baseline record: a null of the truth's car on ``design.baseline_variation`` (the record an
     owner logs first, from which a route may identify the assist), its seed apart from every case's."""
     case = TruthCase(f"{tier}__baseline", tier, "null", design.baseline_variation, None, None,
-                     design.torque_converters[-1], _seed(design, design.baseline_variation) + 77)
+                     design.torque_converters[-1], case_seed(design, design.baseline_variation) + 77)
     return case_truth_and_record(params, design, case)[1]
 
 
@@ -396,8 +242,6 @@ def _write(path: Path, record, params: Parameters) -> None:
         path.write_text(format_measurement(record), encoding="utf-8")
 
 
-
-
 def run_batch(params: Parameters, base_path, names: list[str], folder, design: TruthDesign = TruthDesign()) -> None:
     """Run the cases `names` (one job of the rule diag_assisted_truth_batch); each case's rows (one a route) to
     <folder>/<name>.row.json. A case is made from its own seed: the same rows whichever job runs it."""
@@ -445,10 +289,9 @@ def design_from_config(section: dict | None) -> TruthDesign:
         if bad:
             raise UsageError(f"config assisted_truth.{key}: {bad[0]!r} is not one of {', '.join(known)}")
     for v in (*design.null_variations, *design.hidden_variations, *design.out_of_class_variations):
-        _seed(design, v)
+        case_seed(design, v)
     return design
 
 
-__all__ = ["BASELINE_ROUTES", "ROUTES", "TruthCase", "TruthDesign", "baseline_record", "case_names",
-           "case_truth_and_record", "cases", "design_from_config", "outcome", "owner_vehicle_text", "read_rows", "run",
+__all__ = ["baseline_record", "case_truth_and_record", "design_from_config", "outcome", "read_rows", "run",
            "run_batch", "summarise"]

@@ -144,7 +144,7 @@ def run_car(params: Parameters, car: Car, vehicle_path=None, progress=None) -> d
         if car.kind == "manual":
             absolute_params, absolute_effects = params, None
         else:
-            from .assisted_truth import Owner, identified_route
+            from .assisted_truth_owner import Owner, identified_route
 
             (folder / "owner.toml").write_text(maker.owner_path.read_text(encoding="utf-8"), encoding="utf-8")
             found = identified_route(Owner(maker.owner, maker.assist, maker.effects), healthy, folder)

@@ -18,7 +18,8 @@ from ..diagnose.problem import load_files
 from ..errors import UsageError
 from ..measure.io import write_measurement
 from ..parameters import Parameters
-from ..synthetic.datasets import SizeSearch, perturbed_base, rms_difference, strength_for_rms
+from ..synthetic.datasets import perturbed_base
+from ..synthetic.size_search import SizeSearch, rms_difference, strength_for_rms
 from ..synthetic.quirks import QUIRKS, ManualLogger, manual_road, quirk_record, quirk_strength
 from ..synthetic.variations import VARIATIONS, variation_by_name
 from .benchmark import BASE_PERTURBATION

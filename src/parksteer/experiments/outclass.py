@@ -1,12 +1,12 @@
 """The out-of-class benchmark: diagnose records whose hidden effect is none of the candidates' forms.
 
 The in-class benchmark (:mod:`parksteer.experiments.benchmark`) hides candidates in records made by the model the
-diagnosis fits. Here the truth comes from elsewhere (:func:`parksteer.synthetic.datasets.make_outclass_dataset`):
+diagnosis fits. Here the truth comes from elsewhere (:func:`parksteer.synthetic.outclass.make_outclass_dataset`):
 a rival effect that is not a diagnosis candidate (gear efficiency, a tyre breakaway peak, a Maxwell carcass
 branch, top-mount wind-up, a nonlinear linkage, rolling resistance), integrated handwheel-driven at a tighter
 tolerance than the diagnosis's rack replay, and logged through a whole logger chain (anti-alias filter, channel
 lag, 8-bit torque, quantised rack). The honest answers are the physically closest candidate (or one sharing its
-physics, :func:`parksteer.synthetic.datasets.outclass_rivals`) or ``unexplained``. Each case is scored against
+physics, :func:`parksteer.synthetic.outclass.outclass_rivals`) or ``unexplained``. Each case is scored against
 two targets: never ``adequate`` when the hidden effect is at least ADEQUATE_LIMIT_STEPS converter steps RMS,
 and never a physically unrelated candidate named with a BIC margin over the runner-up beyond the
 indistinguishable band (the diagnosis's own ``bic_indistinguishable``).
@@ -20,7 +20,7 @@ import numpy as np
 
 from ..errors import UsageError
 from ..parameters import load_parameters
-from ..synthetic.datasets import OutclassDesign, make_outclass_dataset, outclass_rivals, outclass_specs
+from ..synthetic.outclass import OutclassDesign, make_outclass_dataset, outclass_rivals, outclass_specs
 from .benchmark import diagnose_written, paired_results
 from .rows import OutclassRow
 

@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from ..plotting import COLOURS, new_figure, save_svg
-from .diagnose import VARIATION_SHADES, _cell
+from .diagnosis_benchmarks import VARIATION_SHADES, grid_cell
 
 # The hidden candidates' names in the assisted benchmarks' figures (this one and figures/assisted_truth.py).
 LABELS = {"assist_motor_friction": "motor friction", "torsion_bar_offset": "torsion-bar offset",
@@ -32,7 +32,7 @@ def assisted_figure(rows: list[dict], summary: dict, path: str | Path) -> None:
     fig, axes = new_figure(7.4, 0.34 * len(cells) + 1.4, ncols=2, gridspec_kw={"width_ratios": [0.8, 1.8]})
     ax = axes[0]
     for i, (_label, k, n, target) in enumerate(cells):
-        ax.add_patch(_cell(0, i, VARIATION_SHADES[None if n == 0 else k / n >= target]))
+        ax.add_patch(grid_cell(0, i, VARIATION_SHADES[None if n == 0 else k / n >= target]))
         ax.text(0, i, f"{k}/{n}" if n else "-", ha="center", va="center", fontsize=7)
     ax.set_xlim(-0.5, 0.5)
     ax.set_ylim(len(cells) - 0.5, -0.5)

@@ -9,7 +9,7 @@ import numpy as np
 
 from ..plotting import COLOURS, new_figure, save_svg
 from .assisted import LABELS
-from .diagnose import VARIATION_SHADES, _cell
+from .diagnosis_benchmarks import VARIATION_SHADES, grid_cell
 
 TIER_LABELS = {"rack": "rack logged", "angle": "angle only"}
 
@@ -48,7 +48,7 @@ def assisted_truth_figure(rows: list[dict], summary: dict, path: str | Path) -> 
             if label not in by_label:
                 continue
             _, k, n, target = by_label[label]
-            ax.add_patch(_cell(j, i, VARIATION_SHADES[None if n == 0 else k / n >= target]))
+            ax.add_patch(grid_cell(j, i, VARIATION_SHADES[None if n == 0 else k / n >= target]))
             ax.text(j, i, f"{k}/{n}" if n else "-", ha="center", va="center", fontsize=7)
     ax.set_xlim(-0.5, len(columns) - 0.5)
     ax.set_ylim(len(labels) - 0.5, -0.5)

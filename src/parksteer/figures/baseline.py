@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from ..plotting import COLOURS, new_figure, save_svg
-from .diagnose import VARIATION_SHADES, _cell
+from .diagnosis_benchmarks import VARIATION_SHADES, grid_cell
 
 SIDE_LABELS = {"absolute": "absolute", "baseline": "against the\nhealthy record"}
 SHORT = {"adequate": "adequate", "unexplained": "unexplained", "missing": "missing"}
@@ -45,7 +45,7 @@ def baseline_figure(cars: list[dict], path: str | Path) -> None:
     ax = axes[0]
     for i, row in enumerate(rows):
         for j, side in enumerate(("absolute", "baseline")):
-            ax.add_patch(_cell(j, i, VARIATION_SHADES[right(row, side)]))
+            ax.add_patch(grid_cell(j, i, VARIATION_SHADES[right(row, side)]))
             ax.text(j, i, _label(row[side]), ha="center", va="center", fontsize=6)
     labels = [f"{r['car']}: {r['hidden'] if r['kind'] != 'null' else 'nothing'}"
               + (f" {r['floors']:.1f}" if r["kind"] != "null" else "") for r in rows]

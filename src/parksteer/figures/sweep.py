@@ -16,18 +16,12 @@ import numpy as np
 
 from ..parameters import Parameters, load_parameters
 from ..plotting import COLOURS, new_figure, save_svg
-from ..sweep.aggregate import (
-    MapSlice,
-    Totals,
-    axis_values,
-    design_values,
-    gather_points,
-    map_held,
-    matching,
-    point_quantity,
-    summarise,
-)
-from ..sweep.declaration import Sweep, load_sweep, parameter_bounds
+from ..sweep.aggregate import MapSlice, axis_values, design_values, map_held, matching, summarise
+from ..sweep.gathering import gather_points
+from ..sweep.records import point_quantity
+from ..sweep.totals import Totals
+from ..sweep.declaration import Sweep, load_sweep
+from ..sweep.keys import parameter_bounds
 from ..tables import write_json
 
 # How each SI unit is shown on an axis: (factor, label).

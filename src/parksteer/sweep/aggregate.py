@@ -1,4 +1,6 @@
-"""Gather a sweep's point records into one table and the numbers a design study quotes.
+"""The numbers a design study quotes from a sweep's point records (results/sweep_<name>.json), and its map slice.
+
+The records are read by :mod:`.records` (all in memory) or :mod:`.gathering` (streamed, with the table).
 
 The summary answers, for whatever axes the sweep has:
 
@@ -11,87 +13,23 @@ The summary answers, for whatever axes the sweep has:
 
 from __future__ import annotations
 
-import json
 import math
-import tempfile
 from array import array
-from collections.abc import Iterable, Iterator
-from contextlib import contextmanager
-from dataclasses import dataclass, field
-from pathlib import Path
+from collections.abc import Iterable
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from ..parameters import Parameters
-from ..tables import StreamedList, format_number, write_csv_rows
-from .declaration import Sweep, SweepError, parameter_bounds
+from .declaration import Sweep
 from .design import base_value
+from .keys import parameter_bounds
+from .records import as_float, column_name, merits_of, point_quantity
+from .totals import Totals
 
 # Relative tolerance for "this grid value is the base car's value".
 ON_DESIGN_RTOL = 1e-3
-SUMMARY_MERITS = ("peak_torque_Nm", "plateau_torque_Nm", "lock_torque_Nm", "reversal_drop_Nm")
-
-
-def _batch_records(path) -> list[dict[str, Any]]:
-    doc = json.loads(Path(path).read_text(encoding="utf-8"))
-    return doc["records"] if "records" in doc else [doc]  # a batch file holds its points' records
-
-
-def read_points(paths, sweep: Sweep) -> list[dict[str, Any]]:
-    """Point records (JSON files written by run_point, or batch files written by run_batch) in the sweep's order,
-    each given its index there, all in memory (gather_points streams them)."""
-    records = [record for path in paths for record in _batch_records(path)]
-    for record in records:
-        point = sweep.find(record["point"])
-        record["index"] = point.index if point is not None else -1
-    return sorted(records, key=lambda r: r["index"])
-
-
-def _nan(x) -> float:
-    return math.nan if x is None else float(x)
-
-
-def column_name(key: str) -> str:
-    unit = parameter_bounds(key)[3]
-    return key if unit == "1" else f"{key}_{unit.replace(' ', '').replace('/', '_per_')}"
-
-
-def point_quantity(record: dict, quantity: str) -> float:
-    """A figure of merit of a record; the braked ones are named <quantity>_braked_Nm."""
-    if quantity.endswith("_braked_Nm"):
-        return _nan(record["braked"][quantity.replace("_braked_Nm", "_Nm")])
-    return _nan(record["merits"][quantity])
-
-
-def share_names(records: list[dict]) -> list[str]:
-    names: dict[str, None] = {}
-    for r in records:
-        names.update(dict.fromkeys(k for k in r["merits"] if k.startswith("share_contrib_")))
-    return list(names)
-
-
-def sweep_table(sweep: Sweep, records: list[dict], threshold_Nm: float | None) -> dict[str, Any]:
-    """Columns of figures/sweep_<name>.csv: one row per point."""
-    keys = sweep.keys
-    cols: dict[str, Any] = {"point": np.array([r["point"] for r in records]),
-                            "index": np.array([r["index"] for r in records])}
-    for key in keys:
-        cols[column_name(key)] = np.array([_nan(r["values"].get(key)) for r in records])
-    for q in SUMMARY_MERITS:
-        cols[q] = np.array([point_quantity(r, q) for r in records])
-    for name in share_names(records):
-        short = name.replace("share_contrib_", "share_").removesuffix("_Nm")
-        cols[short] = np.array([_nan(r["merits"].get(name)) for r in records])
-    cols["sliding_start_rack_m"] = np.array([_nan(r["merits"]["sliding_start_rack_m"]) for r in records])
-    cols["plateau_torque_braked_Nm"] = np.array([point_quantity(r, "plateau_torque_braked_Nm") for r in records])
-    cols["peak_torque_braked_Nm"] = np.array([point_quantity(r, "peak_torque_braked_Nm") for r in records])
-    cols["braked_factor"] = np.array([_nan(r["braked"]["factor"]) for r in records])
-    cols["ground_offset_m"] = np.array([_nan(r["braked"]["ground_offset_m"]) for r in records])
-    if threshold_Nm is not None:
-        cols["needs_assistance"] = (cols["peak_torque_Nm"] > threshold_Nm).astype(int)
-        cols["needs_assistance_braked"] = (cols["peak_torque_braked_Nm"] > threshold_Nm).astype(int)
-    return cols
 
 
 def axis_values(sweep: Sweep, key: str) -> list[float]:
@@ -117,18 +55,6 @@ def matching(records: list[dict], fixed: dict[str, float]) -> list[dict]:
     return [r for r in records if all(r["values"].get(k) == v for k, v in fixed.items())]
 
 
-def _merits_of(record: dict) -> dict[str, float]:
-    out = {q: point_quantity(record, q) for q in SUMMARY_MERITS}
-    out["plateau_torque_braked_Nm"] = point_quantity(record, "plateau_torque_braked_Nm")
-    out["peak_torque_braked_Nm"] = point_quantity(record, "peak_torque_braked_Nm")
-    out["tyre_share_Nm"] = out["plateau_torque_Nm"] * _nan(record["merits"].get("share_contrib_tyre_friction_Nm"))
-    out["braked_factor"] = _nan(record["braked"]["factor"])
-    out["rig_theory_plateau_torque_braked_Nm"] = _nan(record["braked"].get("rig_theory_plateau_torque_Nm"))
-    out["rig_theory_braked_factor"] = _nan(record["braked"].get("rig_theory_factor"))
-    out["ground_offset_m"] = _nan(record["braked"]["ground_offset_m"])
-    return out
-
-
 def sensitivities(sweep: Sweep, records: list[dict], design: dict) -> dict[str, Any]:
     out = {}
     for key in sweep.keys:
@@ -138,9 +64,9 @@ def sensitivities(sweep: Sweep, records: list[dict], design: dict) -> dict[str, 
             continue
         low, high = line[0], line[-1]
         entry = {"held": held, "values": [r["values"][key] for r in line],
-                 "low": {"value": low["values"][key], "point": low["point"], **_merits_of(low)},
-                 "high": {"value": high["values"][key], "point": high["point"], **_merits_of(high)},
-                 "points": [{"value": r["values"][key], **_merits_of(r)} for r in line]}
+                 "low": {"value": low["values"][key], "point": low["point"], **merits_of(low)},
+                 "high": {"value": high["values"][key], "point": high["point"], **merits_of(high)},
+                 "points": [{"value": r["values"][key], **merits_of(r)} for r in line]}
         for q in ("plateau_torque_Nm", "peak_torque_Nm", "plateau_torque_braked_Nm", "tyre_share_Nm"):
             lo, hi = entry["low"][q], entry["high"][q]
             entry[f"change_{q}"] = hi - lo
@@ -169,13 +95,13 @@ class MapSlice:
     @classmethod
     def of(cls, sweep: Sweep, records: Iterable[dict], held: dict[str, float], quantities) -> MapSlice:
         """The slice of `records`, all of them or the points gathered, each with its index, in any order."""
-        collector = _SliceCollector(sweep, held, quantities)
+        collector = SliceCollector(sweep, held, quantities)
         for position, record in enumerate(records):
             collector.add(record, record.get("index", position))
         return collector.finish()
 
 
-class _SliceCollector:
+class SliceCollector:
     """MapSlice.of one record at a time: the held points' numbers in flat arrays, sorted by index at the end."""
 
     def __init__(self, sweep: Sweep, held: dict[str, float], quantities):
@@ -189,9 +115,9 @@ class _SliceCollector:
             return
         spec, columns = self.spec, self.columns
         self.index.append(index)
-        columns["panel"].append(_nan(values.get(spec.panels)) if spec.panels else math.nan)
-        columns["x"].append(_nan(values.get(spec.x)))
-        columns["y"].append(_nan(values.get(spec.y)))
+        columns["panel"].append(as_float(values.get(spec.panels)) if spec.panels else math.nan)
+        columns["x"].append(as_float(values.get(spec.x)))
+        columns["y"].append(as_float(values.get(spec.y)))
         for name in self.names:
             columns[name].append(point_quantity(record, name))
 
@@ -247,7 +173,7 @@ def summarise(sweep: Sweep, params: Parameters, records: list[dict], totals: Tot
     design_point = {"values": design_fixed, "on_design": all(d["on_design"] for d in design.values()),
                     "base": {k: d["base"] for k, d in design.items()}}
     if found:
-        design_point.update(point=found[0]["point"], **_merits_of(found[0]),
+        design_point.update(point=found[0]["point"], **merits_of(found[0]),
                             shares={k.replace("share_contrib_", "").removesuffix("_Nm"): v
                                     for k, v in found[0]["merits"].items() if k.startswith("share_contrib_")})
     summary: dict[str, Any] = {
@@ -289,167 +215,3 @@ def summarise(sweep: Sweep, params: Parameters, records: list[dict], totals: Tot
                                    if k not in (sweep.map.x, sweep.map.y, sweep.map.panels)},
                           "quantity": sweep.map.quantity}
     return summary
-
-
-# ---------------------------------------------------------------------------- gathering, streamed
-
-
-@dataclass
-class Totals:
-    """What the summary and the maps take from every record of a sweep, counted one record at a time."""
-
-    threshold_Nm: float | None
-    n_points: int = 0
-    first_index: int = -1
-    effects: list = field(default_factory=list)
-    braked_method: str = ""
-    peak_range_Nm: tuple = ()
-    map_range: dict = field(default_factory=dict)  # map quantity -> (nanmin, nanmax) over every record
-    keep_above: bool = True  # False: the points above the threshold are counted only (gather_points spills them)
-    points_above: list = field(default_factory=list)  # (index, entry) of each point above the threshold
-    above: Iterable | None = None  # or their entries in the sweep's order, read once (from gather_points' spill)
-    n_above: int = 0
-    n_above_braked: int = 0
-
-    def add(self, record: dict) -> None:
-        self.n_points += 1
-        if self.first_index < 0 or record["index"] < self.first_index:
-            self.first_index = record["index"]
-            self.effects, self.braked_method = record["effects"], record["braked"]["method"]
-        peak = point_quantity(record, "peak_torque_Nm")
-        self.peak_range_Nm = (min(self.peak_range_Nm[0], peak), max(self.peak_range_Nm[1], peak)) \
-            if self.peak_range_Nm else (peak, peak)
-        for quantity, (low, high) in list(self.map_range.items()):
-            value = point_quantity(record, quantity)
-            if not math.isnan(value):
-                self.map_range[quantity] = (min(low, value), max(high, value))
-        if self.threshold_Nm is not None:
-            if peak > self.threshold_Nm:
-                self.n_above += 1
-                if self.keep_above:
-                    self.points_above.append((record["index"], above_entry(record, peak)))
-            if point_quantity(record, "peak_torque_braked_Nm") > self.threshold_Nm:
-                self.n_above_braked += 1
-
-    def points_above_in_order(self) -> list | StreamedList:
-        """The summary's entries of the points above the threshold, in the sweep's order."""
-        if self.above is not None:
-            return StreamedList(self.above)
-        return [entry for _, entry in sorted(self.points_above, key=lambda item: item[0])]
-
-    @classmethod
-    def of(cls, records: list[dict], threshold_Nm: float | None, map_quantity: str | None = None) -> Totals:
-        totals = cls(threshold_Nm, map_range={map_quantity: (math.inf, -math.inf)} if map_quantity else {})
-        for record in records:
-            totals.add(record)
-        return totals
-
-
-def above_entry(record: dict, peak_Nm: float) -> dict[str, Any]:
-    """A point's entry in the summary's list of the points above the assistance threshold."""
-    return {"point": record["point"], "values": record["values"], "peak_torque_Nm": peak_Nm}
-
-
-def _row(keys: list[str], record: dict, threshold_Nm: float | None) -> tuple[str, dict[str, str], str]:
-    """A record's row of the sweep table (as sweep_table and write_csv give it), in three parts: the cells before
-    the share columns, the share cells by merit name, the cells after them."""
-    head = [record["point"], format_number(record["index"])]
-    head += [format_number(_nan(record["values"].get(key))) for key in keys]
-    head += [format_number(point_quantity(record, q)) for q in SUMMARY_MERITS]
-    shares = {k: format_number(_nan(v)) for k, v in record["merits"].items() if k.startswith("share_contrib_")}
-    peak, peak_braked = point_quantity(record, "peak_torque_Nm"), point_quantity(record, "peak_torque_braked_Nm")
-    tail = [format_number(_nan(record["merits"]["sliding_start_rack_m"])),
-            format_number(point_quantity(record, "plateau_torque_braked_Nm")), format_number(peak_braked),
-            format_number(_nan(record["braked"]["factor"])), format_number(_nan(record["braked"]["ground_offset_m"]))]
-    if threshold_Nm is not None:
-        tail += [format_number(int(peak > threshold_Nm)), format_number(int(peak_braked > threshold_Nm))]
-    return ",".join(head), shares, ",".join(tail)
-
-
-@dataclass
-class Gathered:
-    """What gather_points keeps of a sweep's records: those on a line through the design point along one key
-    (the design point, the sensitivities; full records, in the sweep's order), the map's slice and the totals."""
-
-    records: list[dict[str, Any]]
-    map_slice: MapSlice | None
-    totals: Totals
-
-
-@contextmanager
-def gather_points(paths, sweep: Sweep, params: Parameters, out_csv: str | Path, header, threshold_Nm: float | None
-                  ) -> Iterator[Gathered]:
-    """Read the point or batch files `paths` one at a time and write the sweep's table (the file sweep_table and
-    write_csv give) to `out_csv`: each record's row goes to a scratch file as it is read, the rows are then
-    copied in the sweep's order under the lines header(totals) gives. Yield what the summary and the maps read
-    (:class:`Gathered`); the totals' list of the points above the threshold comes from a second scratch file,
-    written in the sweep's order as the rows are copied, and can be read (written: tables.write_json) only
-    within this context.
-
-    A record's index in the sweep is found from its values and checked against its id (Sweep.locate), so the
-    sweep may be loaded without its expansion (load_sweep(expand=False)): no point is regenerated unless one is
-    missing (to name it). Memory: an 8-byte offset per point, the lines' records (a few per axis value), the map
-    slice (7 numbers a point of it) and the batch file being read, whatever the number of points."""
-    design = design_values(sweep, params)
-    keys = sweep.keys
-    design_fixed = {k: d["nearest"] for k, d in design.items()}
-    spec = sweep.map
-    collector = _SliceCollector(sweep, map_held(sweep, design), [spec.quantity, "peak_torque_Nm"]) if spec else None
-    totals = Totals(threshold_Nm, map_range={spec.quantity: (math.inf, -math.inf)} if spec else {}, keep_above=False)
-    n = sweep.n_points
-    offsets = np.full(n, -1, dtype=np.int64)
-    first_share: dict[str, tuple[int, int]] = {}  # merit name -> (index, position) where it first shows
-    kept, unknown = [], []
-    folder = Path(out_csv).parent or None
-    end = 0  # of the spill, in bytes (a binary file: no text-mode tell() per record)
-    with tempfile.TemporaryFile("w+b", dir=folder) as spill, \
-            tempfile.TemporaryFile("w+", encoding="utf-8", dir=folder) as above:
-        for path in paths:
-            for record in _batch_records(path):
-                index = sweep.locate(record["point"], record["values"])
-                if index < 0:
-                    unknown.append(record["point"])
-                    continue
-                if offsets[index] >= 0:
-                    raise SweepError(f"{path}: point {record['point']} was gathered from another file already")
-                record["index"] = index
-                head, shares, tail = _row(keys, record, threshold_Nm)
-                for position, name in enumerate(shares):
-                    if name not in first_share or first_share[name] > (index, position):
-                        first_share[name] = (index, position)
-                # the row's parts, and after a tab (never in JSON text) the point's entry if above the threshold
-                peak = point_quantity(record, "peak_torque_Nm")
-                entry = "\t" + json.dumps(above_entry(record, peak)) \
-                    if threshold_Nm is not None and peak > threshold_Nm else ""
-                offsets[index] = end
-                end += spill.write((json.dumps([head, shares, tail]) + entry + "\n").encode())
-                totals.add(record)
-                if sum(record["values"].get(k) != v for k, v in design_fixed.items()) <= 1:
-                    kept.append(record)
-                if collector is not None:
-                    collector.add(record, index)
-        missing = np.flatnonzero(offsets < 0)
-        if len(missing) or unknown:
-            first = sorted(sweep.id_at(int(i)) for i in missing) or sorted(unknown)
-            raise SweepError(f"{sweep.path}: point files do not match the sweep (first difference: {first[0]})")
-        shares = sorted(first_share, key=first_share.get)
-        names = ["point", "index", *(column_name(k) for k in keys), *SUMMARY_MERITS,
-                 *(name.replace("share_contrib_", "share_").removesuffix("_Nm") for name in shares),
-                 "sliding_start_rack_m", "plateau_torque_braked_Nm", "peak_torque_braked_Nm", "braked_factor",
-                 "ground_offset_m", *(("needs_assistance", "needs_assistance_braked") if threshold_Nm is not None
-                                      else ())]
-        nan = format_number(math.nan)
-
-        def rows():
-            for offset in offsets:
-                spill.seek(int(offset))
-                row, _, entry = spill.readline().decode().rstrip("\n").partition("\t")
-                if entry:
-                    above.write(entry + "\n")
-                head, cells, tail = json.loads(row)
-                yield ",".join([head, *(cells.get(name, nan) for name in shares), tail])
-
-        write_csv_rows(out_csv, names, rows(), n, header(totals))
-        above.seek(0)
-        totals.above = (json.loads(line) for line in above)
-        yield Gathered(sorted(kept, key=lambda r: r["index"]), collector.finish() if collector else None, totals)

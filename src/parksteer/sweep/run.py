@@ -21,7 +21,8 @@ from ..errors import UsageError
 from ..geometry import steer_axis
 from ..parameters import Parameters, load_parameters, quantity
 from ..tables import write_json
-from .declaration import BRAKE_PARAMETER, BRAKED_NONE, BRAKED_RIG_THEORY, SweepError
+from .design import SweepError
+from .fields import BRAKE_PARAMETER, BRAKED_NONE, BRAKED_RIG_THEORY
 from .design import point_overrides
 from .merit import braked_columns, braked_factor, figures_of_merit, ground_offset_m
 

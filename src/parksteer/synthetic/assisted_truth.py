@@ -4,27 +4,7 @@ The model's assisted replay (:mod:`parksteer.model.numeric.assisted`) inverts th
 diagnoses with. Records made by it share that law, its corners and its gear with the diagnosis. Here nothing of
 the model's assist is called: the road part is the manual replay (the prescribed-rack solve of the car without
 an assist, :func:`parksteer.model.numeric.simulate.simulate`), and over it sits a quasi-static column-EPS layer
-written for this module alone:
-
-- the column: the pinion follows the rack (theta_p = G_hr x), the column angle is the Hooke joint's inverse of
-  it (:func:`column_of_pinion`), its rate and acceleration by differences on the fine grid;
-- the torsion bar carries T_s; its sensor reads S = T_s + o (o: a zero offset) on the logger's converter (the bus
-  carries the sensor's own value: the control unit reads the same steps);
-- the control unit: the assist the map asks for at the column, A_map(S) (:class:`TruthMap`: a progressive power
-  law c (|S| - d)^p beyond a dead band d, or an exponential family c (exp((|S| - d)/w) - 1), odd in S; neither is
-  the model's monotone cubic table), times 1 + e (a gain error), turned into the motor's current through the
-  data sheet's numbers, I = A_map / (eta_f N k_t), clipped at the current limit;
-- the motor and the worm: the motor's electromagnetic torque k_t I less its loads (the rotor's inertia J_m N
-  theta_c'', a Coulomb friction saturated linearly below ``friction_speed_rad_s`` of the rotor) is the torque o the
-  worm transmits; the column receives eta_f N o when the motor drives it (o and the column's rate of one sign)
-  and N o / eta_b when the column drives the motor (back-driven), the factor passing linearly through 1 as the
-  rotor slows to rest (a worm at rest loses no power);
-- the balance T_s + D(o(T_s)) = T_road, with T_road the manual replay's column torque. The left side rises with
-  T_s (a staircase, the sensor's steps, plus T_s itself): the torsion-bar torque is where it first reaches
-  T_road; where T_road falls inside a step's jump, T_s sits at the step's edge and the control unit dithers
-  between the two levels, the delivered torque their mean (T_road - T_s) and the current the mean that delivers
-  it. The control unit filters its reading's noise (out of the mechanics' band): the logged channel carries the
-  noise, the loop does not.
+written for it alone (:mod:`parksteer.synthetic.column_eps_layer`, which says how it works).
 
 Hidden, in the truth's own terms (:data:`HIDDEN_TRUTH`): the motor's friction above the car's, the sensor's
 offset, the map's gain error, a rack friction above the file's (the manual replay's own parameter, affine in the
@@ -32,21 +12,15 @@ torque: one extra replay gives its direction). Out of class (:data:`OUT_OF_CLASS
 (n periods a revolution), a hysteresis of the control unit's map (a play of half-width h on its reading), backlash
 of the worm (after every reversal of the worm's torque the motor crosses the lash unloaded: no assist for
 sqrt(2 J_m b / |o|)), a friction of the gear growing with the motor's torque (mu |k_t I| beside the Coulomb part).
-
-The handwheel angle (the angle-only tier: a bus log has no rack) is the column's plus the twist that passes T_s
-through the torsion bar in series with the column shaft, with the column's own damping time constant (the file's
-column law; :func:`parksteer.geometry.column_twist`).
 """
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from .. import portable as pm
-from ..geometry import column_twist
 from ..measure.converter import add_noise, quantisation_step, quantise
 from ..measure.io import Measurement, metadata_text
 from ..parameters import Parameters
@@ -224,163 +198,6 @@ def manual_road(params: Parameters, hand: HandVariant, case: str, overrides: dic
     return road
 
 
-def _factor(o, rate, gear: TruthGear):
-    """What the worm delivers to the column per rotor-side torque, over N: eta_f when the motor drives (o with the
-    column's rate), 1 / eta_b back-driven (o against it), moving linearly from 1 at rest to these as the rotor's
-    speed reaches ``direction_speed_rad_s`` (the worm's friction passing through its static band at a reversal).
-    Driving it is at most 1 and back-driven at least 1: the gear never gives more power than it takes."""
-    along = np.where(o * rate > 0.0, gear.efficiency, 1.0 / gear.back_efficiency)
-    if gear.direction_speed_rad_s <= 0.0:
-        reached = np.where(rate != 0.0, 1.0, 0.0)
-    else:
-        reached = np.minimum(np.abs(gear.reduction * rate) / gear.direction_speed_rad_s, 1.0)
-    return 1.0 + (along - 1.0) * reached
-
-
-def _delivered(o, rate, gear: TruthGear):
-    """The torque the worm gives the column for the rotor-side torque o (:func:`_factor`); it rises with o."""
-    return gear.reduction * o * _factor(o, rate, gear)
-
-
-def _undelivered(delivered, rate, gear: TruthGear):
-    """The rotor-side torque o that delivers `delivered` (the inverse of :func:`_delivered`: o has the sign of
-    what it delivers, so the factor is read from that sign)."""
-    return delivered / (gear.reduction * _factor(delivered, rate, gear))
-
-
-@dataclass
-class TruthSolution:
-    torsion_bar_Nm: np.ndarray
-    current_A: np.ndarray
-    delivered_Nm: np.ndarray
-
-
-def eps_layer(road: Road, boost: TruthMap, gear: TruthGear, step_Nm: float, full_scale_Nm: float,
-              hidden: Hidden = Hidden()) -> TruthSolution:
-    """The torsion-bar torque, the motor current and the delivered assist over `road` (module docstring), the
-    control unit reading its sensor in steps of `step_Nm` (the converter of ``full_scale_Nm`` with that step)."""
-    y = road.torque_Nm + hidden.rack_friction_N * (road.per_rack_friction if hidden.rack_friction_N else 0.0)
-    n = gear.reduction
-    rotor_rate = n * road.column_rate
-    speed = np.clip(rotor_rate / gear.friction_speed_rad_s, -1.0, 1.0)
-    coulomb = (gear.motor_friction_Nm + hidden.motor_friction_Nm) * speed
-    load = gear.motor_inertia_kg_m2 * n * road.column_accel + coulomb
-    if hidden.cogging_Nm:
-        load = load + hidden.cogging_Nm * pm.sin(hidden.cogging_periods * n * road.column_rad)
-    bits = max(1, round(math.log2(2.0 * full_scale_Nm / step_Nm + 1.0)))
-    gain = (1.0 + hidden.gain_error) / (gear.efficiency * n * gear.torque_constant_Nm_per_A)
-
-    # the control unit's current at each level of its reading (it reads nothing between the levels)
-    step = quantisation_step(full_scale_Nm, bits)
-    levels = -full_scale_Nm + step * np.arange(2**bits)
-    table = np.clip(gain * boost(levels), -gear.current_limit_A, gear.current_limit_A)
-
-    def current(reading):
-        level = np.clip(np.rint((np.asarray(reading, dtype=float) + full_scale_Nm) / step), 0, 2**bits - 1)
-        return table[level.astype(int)]
-
-    def rotor(i):
-        em = gear.torque_constant_Nm_per_A * i
-        return em - hidden.current_friction * np.abs(em) * speed - load
-
-    def solve(readings_of, y_, rate_):
-        """T_s with T_s + D(o) first reaching y_ (bisection; readings_of(T_s) the control unit's input)."""
-        width = n * gear.torque_constant_Nm_per_A * gear.current_limit_A / gear.back_efficiency + 10.0
-        low, high = y_ - width, y_ + width
-        for _ in range(BISECTION_STEPS):
-            mid = 0.5 * (low + high)
-            above = mid + _delivered(rotor_current(readings_of(mid)), rate_, gear) >= y_
-            high, low = np.where(above, mid, high), np.where(above, low, mid)
-        return high
-
-    def rotor_current(reading):
-        return rotor(current(reading))
-
-    if hidden.hysteresis_Nm:
-        ts = _solve_play(y, road.column_rate, hidden.sensor_offset_Nm, hidden.hysteresis_Nm,
-                         lambda readings_of: solve(readings_of, y, road.column_rate), current, gear, load, speed,
-                         hidden.current_friction)
-    else:
-        ts = solve(lambda t_s: t_s + hidden.sensor_offset_Nm, y, road.column_rate)
-    delivered = y - ts
-    o = _undelivered(delivered, road.column_rate, gear)
-    # the mean current that delivers it (o = k_t I - mu |k_t I| sign - load, I of the sign of o + load)
-    em = o + load
-    em = em / (1.0 - hidden.current_friction * np.sign(em) * speed) if hidden.current_friction else em
-    amps = em / gear.torque_constant_Nm_per_A
-    if hidden.backlash_rad:
-        ts, amps, delivered = _backlash(road, y, ts, amps, o, hidden, gear, current, rotor)
-    return TruthSolution(ts, amps, delivered)
-
-
-def _solve_play(y, rate, offset, half_width, solve, current, gear, load, speed, current_friction):
-    """The torsion-bar torque when the control unit reads its sensor through a play of `half_width` (the map's
-    hysteresis): the play's output r = clip(r_prev, S - h, S + h) feeds the map. At each sample either r holds
-    (the map's input fixed: T_s = T_road less what r's current delivers, if its reading stays within r +- h), or
-    r is pushed by the reading (r = S -+ h, the balance monotone in T_s: solved for every sample at once by
-    `solve` beforehand)."""
-    rising = solve(lambda t_s: t_s + offset - half_width)
-    falling = solve(lambda t_s: t_s + offset + half_width)
-    ts = np.empty(len(y))
-    r = 0.0
-    k_t = gear.torque_constant_Nm_per_A
-    for k in range(len(y)):
-        em = k_t * float(current(r))
-        o = em - current_friction * abs(em) * speed[k] - load[k]
-        delivered = gear.reduction * (o / gear.back_efficiency if o * rate[k] < 0.0 else gear.efficiency * o)
-        held = y[k] - delivered
-        s = held + offset
-        if s > r + half_width:
-            ts[k] = rising[k]
-            r = rising[k] + offset - half_width
-        elif s < r - half_width:
-            ts[k] = falling[k]
-            r = falling[k] + offset + half_width
-        else:
-            ts[k] = held
-    return ts
-
-
-def _backlash(road, y, ts, amps, o, hidden, gear, current, rotor):
-    """Gaps of the assist where the worm's torque o reverses: the rotor crosses the lash b unloaded, for
-    sqrt(2 J_m b / |o_free|) with o_free its torque with the column carrying all (T_s = T_road), during which
-    the column gets no assist."""
-    ts, amps = ts.copy(), amps.copy()
-    t = road.time_s
-    flips = np.nonzero(np.sign(o[1:]) * np.sign(o[:-1]) < 0)[0] + 1
-    free = gear.torque_constant_Nm_per_A * current(y + hidden.sensor_offset_Nm)
-    for k in flips:
-        o_free = max(abs(float(free[k])), 1e-6)
-        gap = math.sqrt(2.0 * gear.motor_inertia_kg_m2 * hidden.backlash_rad / o_free)
-        inside = (t >= t[k]) & (t < t[k] + gap)
-        ts[inside] = y[inside]
-        amps[inside] = current(y[inside] + hidden.sensor_offset_Nm)
-    return ts, amps, y - ts
-
-
-def truth_clean(road: Road, boost: TruthMap, gear: TruthGear, logger: TruthLogger, hidden: Hidden = Hidden(),
-                params: Parameters | None = None) -> dict[str, np.ndarray]:
-    """The clean channels of the truth over `road`: time, rack, the sensor's reading (T_s + offset), current and,
-    with `params` (its column), the handwheel angle."""
-    solution = eps_layer(road, boost, gear, logger.torque_step, logger.torque_full_scale_Nm, hidden)
-    out = {"time_s": road.time_s, "rack_m": road.rack_m,
-           TORQUE: solution.torsion_bar_Nm + hidden.sensor_offset_Nm,
-           "motor_current_A": solution.current_A}
-    if params is not None:
-        out["handwheel_angle_rad"] = handwheel_angle(road, solution.torsion_bar_Nm, gear, params)
-    return out
-
-
-def handwheel_angle(road: Road, torsion_bar_Nm: np.ndarray, gear: TruthGear, params: Parameters) -> np.ndarray:
-    """The handwheel's angle over `road`: the column's plus the twist of the torsion bar and the column in series
-    (the car's column stiffness and damping from `params`) under the torsion-bar torque."""
-    s = params.sections["steering"]
-    k, c = s["column_torsional_stiffness"], s["column_torsional_damping"]
-    series = k * gear.torsion_bar_stiffness / (k + gear.torsion_bar_stiffness)
-    twist, _ = column_twist(road.time_s, torsion_bar_Nm, series, c * series / k)
-    return road.column_rad + twist
-
-
 def truth_record(clean: dict[str, np.ndarray], logger: TruthLogger, case: str, surface: str = "ground",
                  source: str = "synthetic: parksteer.synthetic.assisted_truth") -> Measurement:
     """`clean` logged on `logger`: sampled, noise added, each channel on its converter; no rack when
@@ -419,5 +236,4 @@ def with_hidden(hidden: Hidden, name: str, size: float) -> Hidden:
 
 
 __all__ = ["HIDDEN_TRUTH", "OUT_OF_CLASS_TRUTH", "Hidden", "Road", "TruthGear", "TruthLogger", "TruthMap",
-           "column_of_pinion", "eps_layer", "handwheel_angle", "manual_road", "truth_clean", "truth_record",
-           "with_hidden"]
+           "column_of_pinion", "manual_road", "truth_record", "with_hidden"]

@@ -23,13 +23,6 @@ logger's and the hand's settings.
 The experiment design (what is hidden in the car data set, the benchmark's strengths, files,
 perturbations and seeds) is the pipeline's configuration (``config/config.yaml``, sections
 ``car`` and ``benchmark``), given here as :class:`CarDesign` and :class:`BenchmarkDesign`.
-
-The out-of-class benchmark's records (:func:`make_outclass_dataset`, design :class:`OutclassDesign`, section
-``outclass``) are made otherwise: a rival effect that is no diagnosis candidate is hidden, the model runs at a
-tighter tolerance, and the clean columns pass a whole logger chain (:func:`chain_logged`: anti-alias filter,
-channel lag, sampling, noise, an 8-bit torque and a finer rack converter). The hand is the irregular hand above:
-the smooth hand of :mod:`parksteer.synthetic.variations` is sampled too finely to be a handwheel input of the
-compiled model (24 pieces at most), and driving the rack instead would be the diagnosis's own drive.
 """
 
 from __future__ import annotations
@@ -48,11 +41,12 @@ from ..measure.converter import quantisation_step
 from .logger import synthetic_measurement
 from .example import example_hand, example_logger
 from ..measure.io import OPTIONAL_COLUMNS, REQUIRED_COLUMNS, Measurement
-from ..model.symbolic.components import chosen_rivals, discover_effects, load_effect_module, rival_effects
+from ..model.symbolic.components import discover_effects, load_effect_module
 from ..model.numeric.simulate import simulate
 from ..parameters import Parameters
 from ..resources import example_effect
 from ..model.symbolic.components import strength_parameter
+from .size_search import SizeSearch, rms_difference, strength_for_rms
 from ..names import TORQUE
 
 RECORDED = [name for name in REQUIRED_COLUMNS + OPTIONAL_COLUMNS if name != "time_s"]
@@ -133,73 +127,6 @@ class Disturbance:
         return dataclasses.replace(self, size=float(size))
 
 
-def rms_difference(a: np.ndarray, b: np.ndarray) -> float:
-    return float(np.sqrt(np.mean((np.asarray(a) - np.asarray(b)) ** 2)))
-
-
-@dataclass(frozen=True)
-class SizeSearch:
-    """How the size of a hidden thing is found: evaluations of the search beyond its probe (the setting keeps its
-    historical name, bisection_iterations, in the configuration), accepted relative error of the RMS change, and
-    the largest lag of the torque channel searched (s)."""
-
-    iterations: int
-    tolerance: float
-    max_lag_s: float
-
-
-def strength_for_rms(torque_of, target_Nm: float, start: float, upper: float, search: SizeSearch) -> float:
-    """The size s (from 0 up) at which RMS(torque_of(s) - torque_of(0)) = target: secant steps in log-log.
-
-    The RMS change of a small effect grows as a power of its size (linearly for most; faster for
-    one with a threshold), so a straight line through two points in log(size), log(change) lands
-    close to the target at once: from the probe `start`, a linearised estimate (change
-    proportional to size), then secant steps through the last two points, each kept inside the
-    bracket known so far (a step outside it, or a change that does not grow with the size, falls
-    back to halving the bracket in the logarithm). Stops when the RMS change is within
-    ``search.tolerance`` of the target, after at most ``search.iterations`` evaluations beyond the probe.
-    If even `upper` changes the torque by less than the target, `upper` is returned (the caller
-    records the change it actually makes).
-    """
-    reference = torque_of(0.0)
-
-    def change(s: float) -> float:
-        return rms_difference(torque_of(s), reference)
-
-    def close(value: float) -> bool:
-        return abs(value - target_Nm) <= search.tolerance * target_Nm
-
-    low, high = 0.0, float(upper)  # sizes known to give less / more than the target
-    bounded = False  # whether `high` has been evaluated (or upper tried)
-    points = [(float(min(start, upper)), change(float(min(start, upper))))]
-    for _ in range(search.iterations):
-        s, value = points[-1]
-        if close(value):
-            return s
-        if value < target_Nm:
-            low = max(low, s)
-            if s >= upper:
-                return upper
-        else:
-            high = min(high, s)
-        if len(points) == 1 or value <= 0.0:
-            guess = s * target_Nm / value if value > 0.0 else s * 4.0  # linearised: change proportional to size
-        else:
-            (s0, v0), (s1, v1) = points[-2], points[-1]
-            slope = pm.log(v1 / v0) / pm.log(s1 / s0) if v0 > 0.0 and s0 != s1 and v1 != v0 else 0.0
-            guess = s1 * pm.power(target_Nm / v1, 1.0 / slope) if slope > 0.0 else -1.0
-        if not low < guess < high:  # outside the bracket
-            if guess >= high and not bounded:
-                guess = upper  # nothing above has reached the target yet: try the largest size itself
-            elif low > 0.0:
-                guess = math.sqrt(low * high)  # halve the bracket in the logarithm
-            else:
-                guess = high / 4.0
-        bounded = bounded or guess >= upper or value >= target_Nm
-        points.append((guess, change(guess)))
-    return points[-1][0]
-
-
 @dataclass
 class DatasetSpec:
     """One synthetic data set: its files, what is hidden, at what size, and the base perturbation."""
@@ -232,7 +159,7 @@ class BenchmarkDesign:
 
     @classmethod
     def from_config(cls, section: dict) -> BenchmarkDesign:
-        return cls(tuple(float(s) for s in section["steps"]), _files(section["files"]),
+        return cls(tuple(float(s) for s in section["steps"]), file_pairs(section["files"]),
                    {str(k): float(v) for k, v in section["perturbation"].items()}, int(section["nulls"]),
                    int(section["seed"]), tuple(float(s) for s in section["disturbance_steps"]),
                    SizeSearch(int(section["bisection_iterations"]), float(section["bisection_tolerance"]),
@@ -252,11 +179,11 @@ class CarDesign:
 
     @classmethod
     def from_config(cls, section: dict, perturbation: dict) -> CarDesign:
-        return cls(str(section["hidden_effect"]), float(section["hidden_strength"]), _files(section["files"]),
+        return cls(str(section["hidden_effect"]), float(section["hidden_strength"]), file_pairs(section["files"]),
                    int(section["seed"]), {str(k): float(v) for k, v in perturbation.items()})
 
 
-def _files(pairs) -> tuple[tuple[str, str], ...]:
+def file_pairs(pairs) -> tuple[tuple[str, str], ...]:
     return tuple((str(case), str(surface)) for case, surface in pairs)
 
 
@@ -444,194 +371,3 @@ def write_car_dataset(parameters_path: str | Path, design: CarDesign, paths: lis
     for path, measurement in zip(paths, dataset.measurements):
         write_measurement(path, measurement, params)
     write_json(truth_path, dataset.truth)
-
-
-# ------------------------------------------------------------------------------ the out-of-class benchmark
-def outclass_rivals(registry=None) -> dict[str, dict]:
-    """Each rival effect's closest library candidate (or None), the others that share its physics ("related") and
-    why, as each rival declares them (:class:`parksteer.model.symbolic.components.Rival`). A diagnosis that names
-    the closest or a related candidate, or says `unexplained`, has answered honestly; one that names any other
-    candidate beyond the indistinguishable band has given a confident wrong answer."""
-    return {name: {"closest": e.rival.closest, "related": tuple(e.rival.related), "reason": e.rival.why}
-            for name, e in rival_effects(registry).items()}
-
-
-@dataclass(frozen=True)
-class ChainLogger:
-    """The whole logger chain of the out-of-class records, in the order a signal passes it.
-
-    A causal Butterworth low-pass of ``anti_alias_order`` at ``anti_alias_hz`` on every channel (the analogue
-    anti-alias filter, run from rest on the fine clean signal), a delay of the torque channel behind the rack of
-    ``torque_lag_s`` (a multiplexed converter), sampling at ``sample_rate_hz``, analog noise (the parameter
-    file's ``[synthetic]`` RMS values), and a converter per channel: the torque on ``torque_bits`` over the
-    parameter file's full scale, the rack on ``rack_bits``.
-    """
-
-    sample_rate_hz: float
-    anti_alias_hz: float
-    anti_alias_order: int
-    torque_lag_s: float
-    torque_bits: int
-    rack_bits: int
-
-    @classmethod
-    def from_config(cls, section: dict) -> ChainLogger:
-        return cls(float(section["sample_rate_hz"]), float(section["anti_alias_hz"]), int(section["anti_alias_order"]),
-                   float(section["torque_lag_s"]), int(section["torque_bits"]), int(section["rack_bits"]))
-
-
-@dataclass(frozen=True)
-class OutclassDesign:
-    """The out-of-class benchmark's design (config/config.yaml, section ``outclass``, where each value's reason
-    is): rival effects (a selection of the effects that declare ``rival``, in the order of the data sets; every
-    one in name order when the section names none), their sizes in converter steps (the small grid, or the full one when ``full_grid``), the
-    nulls, the files, the truth integrator's relative tolerance, the logger chain and the seed. The base
-    perturbation and the size search are the in-class benchmark's."""
-
-    rivals: tuple[str, ...]
-    steps: tuple[float, ...]
-    nulls: int
-    files: tuple[tuple[str, str], ...]
-    rtol: float
-    logger: ChainLogger
-    seed: int
-    perturbation: dict[str, float]
-    search: SizeSearch
-
-    @classmethod
-    def from_config(cls, section: dict, benchmark: dict) -> OutclassDesign:
-        grid = section["full"] if section["full_grid"] else section["small"]
-        bench = BenchmarkDesign.from_config(benchmark)
-        rivals = chosen_rivals(section.get("rivals"), "config outclass.rivals")
-        return cls(rivals, tuple(float(s) for s in grid["steps"]), int(grid["nulls"]), _files(section["files"]),
-                   float(section["rtol"]), ChainLogger.from_config(section["logger"]), int(section["seed"]), bench.perturbation, bench.search)
-
-
-def outclass_specs(params: Parameters, design: OutclassDesign, registry=None) -> list[DatasetSpec]:
-    """Every data set of the out-of-class benchmark: each rival at each size, then the nulls.
-
-    A rival must be an effect that declares itself one (``rival``: never a diagnosis candidate, so the truth is
-    never one of the forms the diagnosis fits, and with its closest candidate, so its answer can be judged).
-    """
-    registry = registry if registry is not None else discover_effects()
-    chosen_rivals(design.rivals, "config outclass.rivals", registry)
-    specs: list[DatasetSpec] = []
-
-    def add(kind, hidden, steps):
-        index = len(specs)
-        seed = design.seed + index
-        label = "null" if kind == "null" else f"{hidden}_{steps:g}".replace(".", "p")
-        specs.append(DatasetSpec(f"o{index:02d}_{label}", seed, design.files, kind, hidden, steps,
-                                 perturbed_base(params, seed, design.perturbation), search=design.search))
-
-    for rival in design.rivals:
-        for steps in design.steps:
-            add("rival", rival, steps)
-    for _ in range(design.nulls):
-        add("null", None, None)
-    return specs
-
-
-def chain_logged(params: Parameters, columns: dict[str, np.ndarray], chain: ChainLogger, case: str, surface: str,
-                 seed: int, hand_profile: HandProfile) -> Measurement:
-    """Pass clean columns (time_s, rack_m, handwheel_torque_Nm on a fine even grid) through the logger chain."""
-    from ..measure.io import metadata_text
-    from ..measure.converter import add_noise, quantise
-    from .logger import resample
-
-    t = np.asarray(columns["time_s"], dtype=float)
-    filtered = anti_alias_and_lag(t, columns, chain.anti_alias_hz, chain.anti_alias_order, chain.torque_lag_s)
-    time_s, sampled = resample(t, filtered, chain.sample_rate_hz)
-    s = params.sections["synthetic"]
-    rng = np.random.default_rng(seed)
-    rack_scale, torque_scale = float(s["full_scale_rack"]), float(s["full_scale_torque"])
-    peak = float(np.max(np.abs(sampled[TORQUE])))
-    if peak > (1.0 - RANGE_HEADROOM) * torque_scale:  # the engineer's next range up, as _logged does
-        unit = RANGE_STEP_FRACTION * torque_scale
-        torque_scale = unit * math.ceil(peak / (1.0 - RANGE_HEADROOM) / unit)
-    rack = quantise(add_noise(sampled["rack_m"], float(s["noise_rack"]), rng), rack_scale, chain.rack_bits)
-    torque = quantise(add_noise(sampled[TORQUE], float(s["noise_torque"]), rng), torque_scale,
-                      chain.torque_bits)
-    # a file states one converter (the torque's); the rack's noise is estimated from the data
-    metadata = {"case": case, "surface": surface, "source": "synthetic: parksteer.synthetic.datasets (out of class)",
-                "synthetic": True, "bits": chain.torque_bits, "sample_rate_hz": chain.sample_rate_hz,
-                "full_scale_handwheel_torque_Nm": torque_scale, "rack_bits": chain.rack_bits,
-                "anti_alias_hz": chain.anti_alias_hz, "torque_lag_s": chain.torque_lag_s, "noise_seed": int(seed)}
-    metadata.update(hand_profile.metadata)
-    return Measurement(path=None, columns={"time_s": time_s, "rack_m": rack, TORQUE: torque},
-                       metadata={k: metadata_text(v) for k, v in metadata.items()})
-
-
-def anti_alias_and_lag(time_s: np.ndarray, columns: dict[str, np.ndarray], anti_alias_hz: float, order: int,
-                       torque_lag_s: float) -> dict[str, np.ndarray]:
-    """The analogue front of a logger on clean columns sampled on a fine even grid `time_s`: a causal Butterworth
-    low-pass of `order` at `anti_alias_hz` on the rack and the torque (run from rest at the first value; none when
-    `anti_alias_hz` is 0), then the torque channel delayed `torque_lag_s` behind the rack (linear interpolation)."""
-    from scipy.signal import sosfilt
-
-    t = np.asarray(time_s, dtype=float)
-    filtered = {}
-    if anti_alias_hz > 0.0:
-        sos = pm.butterworth_lowpass_sos(order, anti_alias_hz, 1.0 / float(t[1] - t[0]))
-    for name in ("rack_m", TORQUE):
-        x = np.asarray(columns[name], dtype=float)
-        filtered[name] = sosfilt(sos, x, zi=pm.sos_steady_state(sos) * x[0])[0] if anti_alias_hz > 0.0 else x.copy()
-    if torque_lag_s:
-        filtered[TORQUE] = np.interp(t - torque_lag_s, t, filtered[TORQUE])
-    return filtered
-
-
-def chain_torque_step_Nm(params: Parameters, chain: ChainLogger) -> float:
-    """The converter step of the chain's torque channel at the parameter file's full scale."""
-    return quantisation_step(float(params.sections["synthetic"]["full_scale_torque"]), chain.torque_bits)
-
-
-def make_outclass_dataset(params: Parameters, spec: DatasetSpec, design: OutclassDesign) -> Dataset:
-    """Simulate a rival hidden in the base model, handwheel-driven at ``design.rtol``, and log it through the chain.
-
-    The rival's strength makes the clean torque change by ``spec.steps`` converter steps RMS over all files (the
-    chain's torque step; its largest strength if that falls short, the truth records the steps it makes).
-    """
-    step = chain_torque_step_Nm(params, design.logger)
-    hands = [hand(params, spec.seed * 100 + i) for i in range(len(spec.files))]
-    base = dict(spec.base_overrides)
-
-    def runs(effects, overrides):
-        return [_fine_run(params, case, surface, h, effects, overrides, design.rtol)
-                for (case, surface), h in zip(spec.files, hands)]
-
-    def torque(effects, overrides):
-        return np.concatenate([r[TORQUE] for r in runs(effects, overrides)])
-
-    effects, overrides, strength_key, strength, steps = None, dict(base), None, None, None
-    if spec.kind == "rival":
-        effect = discover_effects()[spec.hidden]
-        quantity = strength_parameter(effect, params)
-        strength_key, effects = quantity.key, f"+{effect.name}"
-        strength = strength_for_rms(lambda s: torque(effects, {**base, strength_key: s}), spec.steps * step,
-                                    quantity.upper * 1e-3, quantity.upper, spec.search)
-        overrides[strength_key] = strength
-    clean = runs(effects, overrides)
-    if spec.kind == "rival":
-        steps = rms_difference(np.concatenate([r[TORQUE] for r in clean]), torque(None, base)) / step
-    measurements = [chain_logged(params, columns, design.logger, case, surface, spec.seed * 100 + 50 + i, h)
-                    for i, (columns, (case, surface), h) in enumerate(zip(clean, spec.files, hands))]
-    rival = outclass_rivals().get(spec.hidden, {})
-    truth = {
-        "name": spec.name, "kind": spec.kind, "hidden": spec.hidden, "steps_requested": spec.steps, "steps": steps,
-        "torque_step_Nm": step, "strength_key": strength_key, "strength": strength,
-        "closest": rival.get("closest"), "related": list(rival.get("related", ())), "reason": rival.get("reason"),
-        "rtol": design.rtol, "logger": dataclasses.asdict(design.logger),
-        "base_overrides": spec.base_overrides, "files": [{"case": c, "surface": s} for c, s in spec.files],
-        "seed": spec.seed,
-    }
-    return Dataset(spec, measurements, truth)
-
-
-def _fine_run(params, case, surface, hand_profile, effects, overrides, rtol) -> dict[str, np.ndarray]:
-    result = simulate(case, effects=effects, overrides=overrides, surface=surface, params=params,
-                      handwheel=hand_profile.handwheel_profile(), output_dt_s=OUTCLASS_CLEAN_DT_S, rtol=rtol)
-    return {name: np.asarray(result.columns[name]) for name in ("time_s", "rack_m", TORQUE)}
-
-
-OUTCLASS_CLEAN_DT_S = 0.001  # the truth's output spacing: the anti-alias filter runs on a signal this fine

@@ -25,7 +25,7 @@ from ..parameters import Parameters
 from .hand import HandVariation, irregular_hand_profile
 from .logger import LoggerSettings, synthetic_measurement
 from ..measure.io import OPTIONAL_COLUMNS, REQUIRED_COLUMNS, Measurement, write_measurement
-from ..measure.smoothing import interpolate_rack
+from ..measure.rack_spline import interpolate_rack
 from .standin import rack_of_hand
 from ..names import TORQUE
 

@@ -32,7 +32,8 @@ from .. import portable as pm
 from ..geometry import column_twist
 from ..measure.converter import quantisation_step
 from ..parameters import Parameters
-from .assisted_truth import BISECTION_STEPS, Hidden, Road, TruthGear, TruthLogger, TruthMap, handwheel_angle
+from .assisted_truth import BISECTION_STEPS, Hidden, Road, TruthGear, TruthLogger, TruthMap
+from .column_eps_layer import handwheel_angle
 from ..names import TORQUE
 
 BACK_EFFICIENCY_BAND = (0.75, 0.85)  # data/vehicles/polo_vi.toml, back_efficiency's source
@@ -119,7 +120,7 @@ def quirk_layer(road: Road, boost: TruthMap, gear: TruthGear, quirk: EpsQuirk, s
 
 def quirk_eps_clean(road: Road, boost: TruthMap, gear: TruthGear, quirk: EpsQuirk, logger: TruthLogger,
                     hidden: Hidden = Hidden(), params: Parameters | None = None) -> dict[str, np.ndarray]:
-    """The clean channels over `road` (as :func:`parksteer.synthetic.assisted_truth.truth_clean` gives them, for
+    """The clean channels over `road` (as :func:`parksteer.synthetic.column_eps_layer.truth_clean` gives them, for
     :func:`~parksteer.synthetic.assisted_truth.truth_record`): the torsion-bar channel through the sensor's filter,
     and with `params` the handwheel angle (the column's plus the twist of the torsion bar and the column)."""
     solution = quirk_layer(road, boost, gear, quirk, logger.torque_step, logger.torque_full_scale_Nm, hidden)

@@ -186,7 +186,7 @@ def apparent_change(params: Parameters, road: ManualRoad, quirk: Quirk, strength
     """What the quirk changes in the torque against the model's replay of the rack the logger reads: the added
     torque, and where the logged rack moves (a compliance), the replay of the wheels' rack less that of the moved
     rack, both replayed alike (a spline through the samples), so that the spline's own error cancels."""
-    from ..measure.smoothing import interpolate_rack
+    from ..measure.rack_spline import interpolate_rack
 
     rack, torque = quirk.logged(road, strength)
     if rack is road.rack_m:

@@ -32,7 +32,7 @@ import numpy as np
 from .. import portable as pm
 from ..errors import UsageError
 from ..measure.io import Measurement, metadata_text
-from ..measure.smoothing import interpolate_rack
+from ..measure.rack_spline import interpolate_rack
 from ..parameters import Parameters
 from ..measure.converter import add_noise, quantise
 from .logger import resample
@@ -142,7 +142,7 @@ class VariationLogger:
     """A logger with its own sample rate and a converter per channel: rack and torque bits, full scales, noise.
 
     ``anti_alias_hz`` (0: none) and ``torque_lag_s`` put the out-of-class logger chain's analogue front before the
-    sampling (:func:`parksteer.synthetic.datasets.anti_alias_and_lag`: a causal Butterworth of
+    sampling (:func:`parksteer.synthetic.outclass.anti_alias_and_lag`: a causal Butterworth of
     ``anti_alias_order`` on both channels, the torque channel delayed behind the rack).
     ``angle_bits`` (0: no angle channel) logs the handwheel angle too, as an encoder would: sampled without the
     analogue filter, with ``angle_noise_rad`` RMS noise on +-``angle_full_scale_rad``.
@@ -172,7 +172,7 @@ def variation_record(params: Parameters, hand: HandVariant, logger: VariationLog
     by default nothing is (a null).
     """
     from ..model.numeric.simulate import simulate
-    from .datasets import anti_alias_and_lag
+    from .outclass import anti_alias_and_lag
 
     drive = variation_rack(params, hand)
     # at least two clean samples per logged one, so that a 1 kHz logger samples a signal finer than itself

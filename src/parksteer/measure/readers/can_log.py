@@ -33,12 +33,6 @@ What a bus does to data is checked frame by frame, each finding a note on stderr
 
 from __future__ import annotations
 
-import gc
-import io
-import logging
-import re
-import sys
-import tomllib
 from collections import Counter
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -46,8 +40,10 @@ from typing import ClassVar
 
 import numpy as np
 
-from ...errors import UsageError, cannot_read_as
+from ...errors import UsageError
 from .base import SNIFF_BYTES, Record, Source, refusal
+from .bus_files import BusSpec, checksum_signal, counter_signal, known_buses, load_dbc, quality_bit
+from .can_frames import FORMAT_NAMES, bus_format, read_frames
 from ...names import TORQUE
 
 # A gap in a used message longer than this is refused: the method resolves the phases of a cycle over windows of
@@ -59,30 +55,6 @@ GAP_PERIODS = 1.5
 MAX_BAD_SHARE = 0.1
 # How many findings of one kind a note names with their times.
 NAMED_FINDINGS = 3
-# Quality bits: VW names them '<stem>_QBit' or '<prefix>_QBit_<stem>'; set (1) means a substitute value.
-QBIT = "qbit"
-
-FORMAT_NAMES = {"candump": "candump log", "asc": "Vector ASC", "blf": "Vector BLF", "trc": "PCAN TRC",
-                "mf4": "ASAM MDF4 bus logging"}
-_CANDUMP_LINE = re.compile(r"^\(\s*\d+(\.\d+)?\)\s+\S+\s+[0-9A-Fa-f]{1,8}#")
-
-
-def bus_format(head: bytes) -> str | None:
-    """Which bus log a file beginning with `head` is (a key of FORMAT_NAMES), or None. An MDF file is 'mf4' only
-    when read with a DBC: whether it holds frames or channels shows in its channels, not its first bytes."""
-    if head[:4] == b"LOGG":
-        return "blf"
-    text = head.decode("utf-8", errors="replace").lstrip("\ufeff")
-    lines = [line.strip() for line in text.splitlines() if line.strip()]
-    if not lines:
-        return None
-    if _CANDUMP_LINE.match(lines[0]):
-        return "candump"
-    if lines[0].startswith(";$FILEVERSION") or (lines[0].startswith(";") and "PCAN" in text[:1000]):
-        return "trc"
-    if lines[0].lower().startswith("date ") and any(line.lower().startswith("base ") for line in lines[:4]):
-        return "asc"
-    return None
 
 
 class CanLogReader:
@@ -100,166 +72,6 @@ class CanLogReader:
         raise refusal(where, f"a raw CAN log ({fmt}); decoding it needs the car's DBC: give --bus NAME "
                          f"(known: {', '.join(known_buses())}) or --dbc CAR.dbc with --map "
                          "'MESSAGE.SIGNAL[unit]=column'")
-
-
-# ------------------------------------------------------------------------------------------------ bus files
-
-BUSES_DIR = Path(__file__).resolve().parents[2] / "data" / "buses"
-
-
-@dataclass(frozen=True)
-class BusSpec:
-    """A DBC and what the project knows of its bus: the ready channel map (--map entries), the messages' send
-    rates, the checksum algorithm and its data IDs (message id -> one byte per counter value)."""
-
-    name: str
-    dbc: Path
-    map_entries: tuple[str, ...] = ()
-    rates_hz: dict[str, float] = field(default_factory=dict)
-    checksum: str | None = None
-    data_ids: dict[int, tuple[int, ...]] = field(default_factory=dict)
-    source: str = ""
-
-    @property
-    def checksum_algorithm(self):
-        """The function computing a frame's checksum (a value of CHECKSUMS), or None when none is named."""
-        return CHECKSUMS.get(self.checksum) if self.checksum else None
-
-
-def known_buses() -> list[str]:
-    return sorted(p.stem for p in BUSES_DIR.glob("*.toml"))
-
-
-def load_bus(name: str) -> BusSpec:
-    """The bus file ``parksteer/data/buses/NAME.toml``; refused in one line when there is none."""
-    path = BUSES_DIR / f"{name}.toml"
-    if not path.is_file():
-        raise UsageError(f"--bus {name}: no such bus (known: {', '.join(known_buses())})")
-    with path.open("rb") as f:
-        spec = tomllib.load(f)
-    checksum = spec.get("checksum", {})
-    return BusSpec(spec["name"], path.parent / spec["dbc"], tuple(spec.get("map", ())),
-                   {k: float(v) for k, v in spec.get("rates_hz", {}).items()}, checksum.get("algorithm"),
-                   {int(k): tuple(v) for k, v in checksum.get("data_ids", {}).items()}, spec.get("source", ""))
-
-
-def dbc_bus(path: str | Path) -> BusSpec:
-    """A DBC given alone (--dbc): no ready map, no known checksum."""
-    path = Path(path)
-    if not path.is_file():
-        raise UsageError(f"--dbc {path}: no such file")
-    return BusSpec(path.stem, path)
-
-
-class BusMap(list):
-    """A channel map (a list of parksteer.measure.importers.Channel) that carries the bus its signals are on."""
-
-    def __init__(self, channels, bus: BusSpec):
-        super().__init__(channels)
-        self.bus = bus
-
-
-def load_dbc(bus: BusSpec):
-    """The cantools database of `bus`; refused in one line when it does not parse."""
-    try:
-        import cantools
-    except ImportError:
-        raise UsageError(f"{bus.dbc}: decoding a CAN log needs the optional extra: pip install 'parksteer[bus]'") \
-            from None
-    try:
-        return cantools.database.load_file(str(bus.dbc), database_format="dbc", strict=False)
-    except Exception as exc:  # cantools raises parser errors of several types
-        raise UsageError(f"{bus.dbc}: not a DBC cantools can read ({str(exc).splitlines()[0][:160]})") from None
-
-
-# ------------------------------------------------------------------------------------------------ checksums
-
-def _crc8_h2f_table() -> list[int]:
-    """CRC-8 with polynomial 0x2F (AUTOSAR CRC8H2F), most significant bit first."""
-    table = []
-    for byte in range(256):
-        crc = byte
-        for _ in range(8):
-            crc = ((crc << 1) ^ 0x2F) & 0xFF if crc & 0x80 else (crc << 1) & 0xFF
-        table.append(crc)
-    return table
-
-
-_H2F = _crc8_h2f_table()
-
-
-def e2e_p2_checksum(data: bytes, data_ids: tuple[int, ...]) -> int:
-    """AUTOSAR E2E profile 2 checksum of a frame whose byte 0 is the checksum and whose low nibble of byte 1 is
-    the counter: CRC8H2F from 0xFF over bytes 1.., then the data ID of that counter value, final XOR 0xFF."""
-    crc = 0xFF
-    for byte in data[1:]:
-        crc = _H2F[crc ^ byte]
-    crc = _H2F[crc ^ data_ids[data[1] & 0x0F]]
-    return crc ^ 0xFF
-
-
-CHECKSUMS = {"autosar_e2e_p2": e2e_p2_checksum}
-
-
-# ------------------------------------------------------------------------------------------------ frames
-
-def read_frames(raw: bytes, where: Path, fmt: str):
-    """(time stamps, ids, data, channels, error frame count) of every data frame of the log, in file order."""
-    try:
-        import can  # noqa: F401
-        from can.io import asc, blf, canutils, trc
-    except ImportError:
-        raise refusal(where, "a raw CAN log; reading it needs the optional extra: pip install 'parksteer[bus]'") \
-            from None
-    times, ids, data, channels, errors = [], [], [], [], 0
-    if fmt == "blf" and len(raw) >= 24:
-        # The file header states the file's size (uint64 at byte 16); python-can stops quietly at a cut
-        stated = int.from_bytes(raw[16:24], "little")
-        if stated > len(raw):
-            raise refusal(where, f"the Vector BLF is cut short: {len(raw)} of the {stated} bytes its header "
-                             "states; copy the whole file from the logger")
-    # asammdf logs a damaged file's tracebacks and its half-built reader's finaliser fails: both silenced here
-    quiet = logging.getLogger("asammdf"), sys.unraisablehook
-    quiet[0].disabled, sys.unraisablehook = True, (lambda report: None)
-    problem = None
-    try:
-        if fmt == "blf":
-            reader = blf.BLFReader(io.BytesIO(raw))
-        elif fmt == "mf4":
-            from can.io import mf4
-
-            reader = mf4.MF4Reader(io.BytesIO(raw))
-        else:
-            text = io.StringIO(raw.decode("utf-8", errors="replace"))
-            reader = {"candump": canutils.CanutilsLogReader, "asc": asc.ASCReader, "trc": trc.TRCReader}[fmt](text)
-        for message in reader:
-            if message.is_error_frame:
-                errors += 1
-                continue
-            if message.is_remote_frame:
-                continue
-            times.append(message.timestamp)
-            ids.append(message.arbitration_id)
-            data.append(bytes(message.data))
-            channels.append(str(message.channel))
-    except UsageError:
-        raise
-    except Exception as exc:  # the readers raise many types for a damaged file; the user needs the gist
-        problem = re.sub(r"<_io\.\w+ object at 0x[0-9a-f]+>", "it", f"{type(exc).__name__}: {exc}").splitlines()
-        problem = problem[0][:160] if problem else type(exc).__name__
-    finally:
-        reader = None
-    try:
-        gc.collect()  # the exception and its traceback are gone: a half-built reader is collected now, quietly
-    finally:
-        quiet[0].disabled, sys.unraisablehook = False, quiet[1]
-    if problem is not None:
-        got = f" after {len(times)} frames" if times else ""
-        raise UsageError(cannot_read_as(where, f"{FORMAT_NAMES[fmt]}{got}", problem)
-                         + "; the file is damaged or cut short")
-    if not times:
-        raise refusal(where, f"the {FORMAT_NAMES[fmt]} holds no CAN data frame")
-    return np.asarray(times, dtype=float), np.asarray(ids, dtype=np.int64), data, np.asarray(channels), errors
 
 
 def _listing(ids: np.ndarray, count: int = 5) -> str:
@@ -297,44 +109,33 @@ def _split_signal(text: str, where: Path, dbc, dbc_path: Path, what: str) -> tup
     return message, signal
 
 
-def _role(msg, pattern: str):
-    """The signal of a message whose name matches `pattern`, or None."""
-    for s in msg.signals:
-        if re.fullmatch(pattern, s.name):
-            return s
-    return None
+@dataclass
+class _Findings:
+    """What the checks of a bus log found, in the order found: notes (stderr and the metadata ``bus_findings``)
+    and the checks made (``bus_checks``)."""
+
+    notes: list[str] = field(default_factory=list)
+    checks: list[str] = field(default_factory=list)
 
 
-def counter_signal(msg):
-    """The message counter of a message (COUNTER, or VW's ..._BZ), or None."""
-    return _role(msg, r"COUNTER|\w+_BZ")
+@dataclass(frozen=True)
+class _Frames:
+    """Every data frame of a log: time stamps (s, from the first frame, to the microsecond), ids, data, the
+    channel each came in on, and the first frame's time stamp as logged."""
 
-
-def checksum_signal(msg):
-    """The checksum of a message (CHECKSUM, or VW's ..._CRC), or None."""
-    return _role(msg, r"CHECKSUM|\w+_CRC")
-
-
-def _quality_bit(msg, signal: str):
-    """The quality bit of `signal` in its message: a QBit signal whose name holds the signal's stem."""
-    stem = signal.split("_", 1)[1] if "_" in signal else signal
-    for s in msg.signals:
-        if QBIT in s.name.lower() and stem.lower() in s.name.lower() and s.length == 1:
-            return s
-    return None
+    times: np.ndarray
+    ids: np.ndarray
+    data: list[bytes]
+    buses: np.ndarray
+    t0: float
 
 
 def read_bus_log(raw: bytes, where: Path, channels) -> Record:
     """The mapped signals of the bus log `raw` (file `where`), decoded with the DBC that `channels` (a
-    :class:`BusMap`) carries, each with the time stamps of its message's frames, checked as the module says."""
+    :class:`~parksteer.measure.readers.bus_files.BusMap`) carries, each with the time stamps of its message's
+    frames, checked as the module says."""
     bus: BusSpec = channels.bus
-    fmt = bus_format(raw[:SNIFF_BYTES])
-    if fmt is None:
-        if raw[:8] in (b"MDF     ", b"UnFinMF "):
-            fmt = "mf4"
-        else:
-            raise refusal(where, "--dbc/--bus given, but the file is not a CAN log this tool reads "
-                             f"({', '.join(FORMAT_NAMES.values())}); a file of named channels needs neither")
+    fmt = _log_format(raw, where)
     dbc = load_dbc(bus)
     signals = []
     for ch in channels:
@@ -342,8 +143,7 @@ def read_bus_log(raw: bytes, where: Path, channels) -> Record:
         sign = _split_signal(ch.sign, where, dbc, bus.dbc, "sign") if ch.sign else None
         signals.append(_Signal(message, signal, sign, ch.scale if ch.scale is not None else 1.0, ch.source))
     times, ids, data, buses, error_frames = read_frames(raw, where, fmt)
-    notes: list[str] = []
-    checks: list[str] = []
+    found = _Findings()
     steps = np.diff(times)
     if np.any(steps < 0.0):
         k = int(np.argmax(steps < 0.0)) + 1
@@ -355,10 +155,11 @@ def read_bus_log(raw: bytes, where: Path, channels) -> Record:
     t0 = times[0]
     times = t0 + np.round(times - t0, 6)
     if error_frames:
-        notes.append(f"{error_frames} error frames on the bus")
+        found.notes.append(f"{error_frames} error frames on the bus")
     # Silences of the whole bus: longer than MAX_GAP_S with no frame of any id.
     silent = np.nonzero(steps > MAX_GAP_S)[0]
     silences = [(times[k] - t0, times[k + 1] - t0) for k in silent]
+    frames = _Frames(times, ids, data, buses, t0)
 
     messages = {}
     for sig in signals:
@@ -367,161 +168,211 @@ def read_bus_log(raw: bytes, where: Path, channels) -> Record:
     decoded: dict[str, tuple[np.ndarray, dict[str, np.ndarray]]] = {}
     periods: dict[str, float] = {}
     for name, msg in messages.items():
-        mask = ids == msg.frame_id
-        if not mask.any():
-            raise refusal(where, f"no frame of {name} (id {msg.frame_id} = 0x{msg.frame_id:03X}) in the log, "
-                             f"which holds {_listing(ids)}: a log of another bus, or not this car's DBC")
-        # A log of two buses (candump -l any, a logger's two channels) may hold a message on both, as a gateway
-        # forwards it: the channel with the most of its frames is read
-        on = Counter(buses[mask].tolist())
-        if len(on) > 1:
-            chosen, count = on.most_common(1)[0]
-            notes.append(f"{name} is on channels {', '.join(f'{c} ({n} frames)' for c, n in on.most_common())}: "
-                         f"read from {chosen}")
-            mask &= buses == chosen
-        t = np.round(times[mask] - t0, 6)
-        frames = [data[k] for k in np.nonzero(mask)[0]]
-        keep = np.ones(len(t), dtype=bool)
-        # exact duplicates: the same time stamp and data as the frame before
-        dup = np.zeros(len(t), dtype=bool)
-        dup[1:] = (np.diff(t) == 0.0) & np.array([frames[k] == frames[k - 1] for k in range(1, len(t))])
-        if dup.any():
-            notes.append(f"{name}: {int(dup.sum())} duplicated frames dropped (at {_times(t[dup])})")
-        keep &= ~dup
-        if np.any(np.diff(t[keep]) == 0.0):
-            k = int(np.argmax(np.diff(t[keep]) == 0.0)) + 1
-            raise refusal(where, f"two frames of {name} with different data share the time stamp "
-                             f"{t[keep][k]:.6f} s: the log's time stamps cannot be trusted there")
-        # checksum
-        crc = checksum_signal(msg)
-        algorithm = bus.checksum_algorithm
-        if crc is not None and algorithm is not None and msg.frame_id in bus.data_ids and crc.start == 0 \
-                and crc.length == 8:
-            bad = np.array([len(f) < 2 or algorithm(f, bus.data_ids[msg.frame_id]) != f[0] for f in frames])
-            bad &= keep
-            if bad.sum() > MAX_BAD_SHARE * keep.sum():
-                raise refusal(where, f"{name}: the checksum fails in {int(bad.sum())} of {int(keep.sum())} "
-                                 f"frames (first at {t[bad][0]:.3f} s): not this bus, or not this car's DBC")
-            if bad.any():
-                notes.append(f"{name}: {int(bad.sum())} frames failing their checksum dropped (at {_times(t[bad])})")
-            keep &= ~bad
-            checks.append(f"{name} checksum {bus.checksum} checked")
-        else:
-            checks.append(f"{name} checksum not checked (no algorithm known for it)")
-            if crc is not None:
-                notes.append(f"{name}: checksum {crc.name} not checked (no algorithm known for {bus.dbc.name}; "
-                             "a bus file of parksteer/data/buses names one)")
-        # decoding
-        values: dict[str, list] = {s.name: [] for s in msg.signals}
-        undecodable = np.zeros(len(t), dtype=bool)
-        for k in np.nonzero(keep)[0]:
-            try:
-                out = msg.decode(frames[k], decode_choices=False)
-            except Exception:  # a frame shorter than its message (cantools DecodeError and others)
-                undecodable[k] = True
-                continue
-            for s in msg.signals:
-                values[s.name].append(float(out[s.name]))
-        if undecodable.sum() > MAX_BAD_SHARE * keep.sum():
-            raise refusal(where, f"{name}: {int(undecodable.sum())} of {int(keep.sum())} frames do not decode "
-                             f"(first at {t[undecodable][0]:.3f} s, {len(frames[int(np.argmax(undecodable))])} bytes "
-                             f"where the DBC has {msg.length}): not this car's DBC")
-        if undecodable.any():
-            notes.append(f"{name}: {int(undecodable.sum())} frames that do not decode dropped")
-        keep &= ~undecodable
-        t = t[keep]
-        columns = {s: np.asarray(v, dtype=float) for s, v in values.items()}
-        # counter
-        counter = counter_signal(msg)
-        if counter is not None and len(t) > 1:
-            modulus = 2 ** counter.length
-            step = np.mod(np.diff(columns[counter.name]), modulus)
-            repeated = np.concatenate([[False], step == 0])
-            if repeated.any():
-                notes.append(f"{name}: {int(repeated.sum())} frames repeating their counter dropped (at "
-                             f"{_times(t[repeated])})")
-                t = t[~repeated]
-                columns = {s: v[~repeated] for s, v in columns.items()}
-                step = np.mod(np.diff(columns[counter.name]), modulus)
-            jumps = np.nonzero(step > 1)[0]
-            if len(jumps):
-                lost = int(np.sum(step[jumps] - 1))
-                notes.append(f"{name}: counter {counter.name} jumps {len(jumps)} times, {lost} frames lost (at "
-                             f"{_times(t[jumps + 1])})")
-            checks.append(f"{name} counter {counter.name}: {len(jumps)} jumps")
-        if len(t) < 2:
-            raise refusal(where, f"{name}: fewer than two usable frames")
-        period = float(np.median(np.diff(t)))
-        periods[name] = period
-        gaps = np.nonzero(np.diff(t) > GAP_PERIODS * period)[0]
-        if len(gaps):
-            long = [k for k in gaps if t[k + 1] - t[k] > MAX_GAP_S]
-            if long:
-                k = long[0]
-                within = [s for s in silences if s[0] >= t[k] - 1e-9 and s[1] <= t[k + 1] + 1e-9]
-                why = ("no frame of any id on the bus then: bus off or a logger pause" if within
-                       else "other messages go on: frames of this one lost")
-                raise refusal(where, f"{name}: no frame from {t[k]:.3f} s to {t[k + 1]:.3f} s "
-                                 f"({t[k + 1] - t[k]:.3f} s, more than {MAX_GAP_S:g} s; {why}); cut the log to "
-                                 "one side of it")
-            notes.append(f"{name}: {len(gaps)} gaps of frames lost (at {_times(t[gaps])}, up to "
-                         f"{max(t[k + 1] - t[k] for k in gaps) * 1000:.0f} ms)")
+        t, columns = _message_columns(name, msg, frames, bus, where, found)
+        periods[name] = _check_gaps(name, t, silences, where, found)
         decoded[name] = (t, columns)
-
-    sources = []
-    for sig, ch in zip(signals, channels):
-        msg = messages[sig.message]
-        t, columns = decoded[sig.message]
-        values = columns[sig.signal].copy()
-        good = np.ones(len(t), dtype=bool)
-        qbit = _quality_bit(msg, sig.signal)
-        if qbit is not None:
-            flagged = columns[qbit.name] != 0.0
-            if flagged.all():
-                raise refusal(where, f"{sig.name}: every frame has its quality bit {qbit.name} set (a "
-                                 "substitute value, the sensor not ready or failed)")
-            if flagged.any():
-                notes.append(f"{sig.name}: {int(flagged.sum())} frames with the quality bit {qbit.name} set dropped "
-                             f"(at {_times(t[flagged])})")
-            good &= ~flagged
-            checks.append(f"{sig.name} quality bit {qbit.name}")
-        spec = msg.get_signal_by_name(sig.signal)
-        if not spec.is_signed and not spec.is_float and spec.length > 1:
-            top = (2 ** spec.length - 1) * spec.scale + spec.offset
-            full = good & (np.abs(values - top) <= 0.5 * abs(spec.scale))
-            if full.any():
-                raise refusal(where, f"{sig.name} sits at its largest raw value {2 ** spec.length - 1} "
-                                 f"({top:g} {spec.unit or ''}) in {int(full.sum())} frames from {t[full][0]:.3f} s: "
-                                 "the signal saturates and what lies beyond it is lost")
-        if sig.sign is not None:
-            st, scolumns = decoded[sig.sign[0]]
-            flag = scolumns[sig.sign[1]]
-            if sig.sign[0] == sig.message:
-                negative = flag != 0.0
-            else:  # another message: its last frame at or before each sample
-                index = np.clip(np.searchsorted(st, t, side="right") - 1, 0, len(st) - 1)
-                negative = flag[index] != 0.0
-            values = np.where(negative, -values, values)
-        values = values * sig.scale
-        unit = spec.unit.strip() if spec.unit else None
-        if unit is not None and (unit.startswith("Unit_") or not unit):
-            unit = None  # VW's unit names (Unit_centiNewtoMeter) are not units pint reads: the map gives one
-        # The resolution: one raw count; the full scale: the largest raw magnitude (the sign flag doubles the levels)
-        step = abs(spec.scale * sig.scale)
-        counts = 2 ** (spec.length - 1) if spec.is_signed else 2 ** spec.length - 1
-        sources.append(Source(sig.name, unit, values[good], t[good], step=step,
-                              full_scale=abs(counts * spec.scale * sig.scale) if spec.offset == 0 else None))
+    sources = [_signal_source(sig, messages[sig.message], decoded, where, found) for sig in signals]
 
     base = next((s for s, ch in zip(signals, channels) if ch.target == TORQUE), signals[0])
-    others = sorted({s.message for s in signals} - {base.message})
-    text = f"the frames of {base.message} ({1.0 / periods[base.message]:.4g} Hz)"
+    metadata = {"format": FORMAT_NAMES[fmt], "bus": bus.name, "dbc": bus.dbc.name,
+                "bus_time_base": _time_base(base.message, sorted({s.message for s in signals} - {base.message}),
+                                            periods),
+                "bus_checks": "; ".join(found.checks)}
+    if found.notes:
+        metadata["bus_findings"] = "; ".join(found.notes)
+    return Record(f"{FORMAT_NAMES[fmt]} ({bus.name})", sources, metadata,
+                  notes=[f"{where}: note: {n}" for n in found.notes])
+
+
+def _log_format(raw: bytes, where: Path) -> str:
+    """The bus log format of `raw` (a key of FORMAT_NAMES): sniffed, or 'mf4' for an MDF file read with a DBC."""
+    fmt = bus_format(raw[:SNIFF_BYTES])
+    if fmt is None:
+        if raw[:8] in (b"MDF     ", b"UnFinMF "):
+            fmt = "mf4"
+        else:
+            raise refusal(where, f"--dbc/--bus given, but the file is not a CAN log this tool reads "
+                             f"({', '.join(FORMAT_NAMES.values())}); a file of named channels needs neither")
+    return fmt
+
+
+def _message_columns(name: str, msg, frames: _Frames, bus: BusSpec, where: Path, found: _Findings
+                     ) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+    """The frames of message `name` that pass the checks (duplicates, checksum, decoding, counter), as its time
+    stamps and each of its signals' values."""
+    mask = frames.ids == msg.frame_id
+    if not mask.any():
+        raise refusal(where, f"no frame of {name} (id {msg.frame_id} = 0x{msg.frame_id:03X}) in the log, "
+                         f"which holds {_listing(frames.ids)}: a log of another bus, or not this car's DBC")
+    # A log of two buses (candump -l any, a logger's two channels) may hold a message on both, as a gateway
+    # forwards it: the channel with the most of its frames is read
+    on = Counter(frames.buses[mask].tolist())
+    if len(on) > 1:
+        chosen, count = on.most_common(1)[0]
+        found.notes.append(f"{name} is on channels {', '.join(f'{c} ({n} frames)' for c, n in on.most_common())}: "
+                           f"read from {chosen}")
+        mask &= frames.buses == chosen
+    t = np.round(frames.times[mask] - frames.t0, 6)
+    data = [frames.data[k] for k in np.nonzero(mask)[0]]
+    keep = np.ones(len(t), dtype=bool)
+    # exact duplicates: the same time stamp and data as the frame before
+    dup = np.zeros(len(t), dtype=bool)
+    dup[1:] = (np.diff(t) == 0.0) & np.array([data[k] == data[k - 1] for k in range(1, len(t))])
+    if dup.any():
+        found.notes.append(f"{name}: {int(dup.sum())} duplicated frames dropped (at {_times(t[dup])})")
+    keep &= ~dup
+    if np.any(np.diff(t[keep]) == 0.0):
+        k = int(np.argmax(np.diff(t[keep]) == 0.0)) + 1
+        raise refusal(where, f"two frames of {name} with different data share the time stamp "
+                         f"{t[keep][k]:.6f} s: the log's time stamps cannot be trusted there")
+    keep &= ~_failing_checksum(name, msg, bus, t, data, keep, where, found)
+    t, columns = _decoded(name, msg, t, data, keep, where, found)
+    return _counted(name, msg, t, columns, found)
+
+
+def _failing_checksum(name: str, msg, bus: BusSpec, t: np.ndarray, data: list[bytes], keep: np.ndarray,
+                      where: Path, found: _Findings) -> np.ndarray:
+    """Which of the kept frames of `msg` fail their checksum, where the bus names its algorithm (none where it
+    does not); too many refuse the log."""
+    crc = checksum_signal(msg)
+    algorithm = bus.checksum_algorithm
+    if crc is not None and algorithm is not None and msg.frame_id in bus.data_ids and crc.start == 0 \
+            and crc.length == 8:
+        bad = np.array([len(f) < 2 or algorithm(f, bus.data_ids[msg.frame_id]) != f[0] for f in data])
+        bad &= keep
+        if bad.sum() > MAX_BAD_SHARE * keep.sum():
+            raise refusal(where, f"{name}: the checksum fails in {int(bad.sum())} of {int(keep.sum())} "
+                             f"frames (first at {t[bad][0]:.3f} s): not this bus, or not this car's DBC")
+        if bad.any():
+            found.notes.append(f"{name}: {int(bad.sum())} frames failing their checksum dropped (at {_times(t[bad])})")
+        found.checks.append(f"{name} checksum {bus.checksum} checked")
+        return bad
+    found.checks.append(f"{name} checksum not checked (no algorithm known for it)")
+    if crc is not None:
+        found.notes.append(f"{name}: checksum {crc.name} not checked (no algorithm known for {bus.dbc.name}; "
+                           "a bus file of parksteer/data/buses names one)")
+    return np.zeros(len(t), dtype=bool)
+
+
+def _decoded(name: str, msg, t: np.ndarray, data: list[bytes], keep: np.ndarray, where: Path, found: _Findings
+             ) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+    """The kept frames of `msg` decoded: their time stamps and each signal's values; a frame that does not decode
+    is dropped, too many refuse the log."""
+    values: dict[str, list] = {s.name: [] for s in msg.signals}
+    undecodable = np.zeros(len(t), dtype=bool)
+    for k in np.nonzero(keep)[0]:
+        try:
+            out = msg.decode(data[k], decode_choices=False)
+        except Exception:  # a frame shorter than its message (cantools DecodeError and others)
+            undecodable[k] = True
+            continue
+        for s in msg.signals:
+            values[s.name].append(float(out[s.name]))
+    if undecodable.sum() > MAX_BAD_SHARE * keep.sum():
+        raise refusal(where, f"{name}: {int(undecodable.sum())} of {int(keep.sum())} frames do not decode "
+                         f"(first at {t[undecodable][0]:.3f} s, {len(data[int(np.argmax(undecodable))])} bytes "
+                         f"where the DBC has {msg.length}): not this car's DBC")
+    if undecodable.any():
+        found.notes.append(f"{name}: {int(undecodable.sum())} frames that do not decode dropped")
+    keep = keep & ~undecodable
+    return t[keep], {s: np.asarray(v, dtype=float) for s, v in values.items()}
+
+
+def _counted(name: str, msg, t: np.ndarray, columns: dict[str, np.ndarray], found: _Findings
+             ) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+    """The frames of `msg` after its message counter's check: a repeated counter dropped, jumps noted."""
+    counter = counter_signal(msg)
+    if counter is not None and len(t) > 1:
+        modulus = 2 ** counter.length
+        step = np.mod(np.diff(columns[counter.name]), modulus)
+        repeated = np.concatenate([[False], step == 0])
+        if repeated.any():
+            found.notes.append(f"{name}: {int(repeated.sum())} frames repeating their counter dropped (at "
+                               f"{_times(t[repeated])})")
+            t = t[~repeated]
+            columns = {s: v[~repeated] for s, v in columns.items()}
+            step = np.mod(np.diff(columns[counter.name]), modulus)
+        jumps = np.nonzero(step > 1)[0]
+        if len(jumps):
+            lost = int(np.sum(step[jumps] - 1))
+            found.notes.append(f"{name}: counter {counter.name} jumps {len(jumps)} times, {lost} frames lost (at "
+                               f"{_times(t[jumps + 1])})")
+        found.checks.append(f"{name} counter {counter.name}: {len(jumps)} jumps")
+    return t, columns
+
+
+def _check_gaps(name: str, t: np.ndarray, silences: list[tuple[float, float]], where: Path, found: _Findings
+                ) -> float:
+    """The period of message `name` (the median spacing of its frames); its gaps noted, a long one refused."""
+    if len(t) < 2:
+        raise refusal(where, f"{name}: fewer than two usable frames")
+    period = float(np.median(np.diff(t)))
+    gaps = np.nonzero(np.diff(t) > GAP_PERIODS * period)[0]
+    if len(gaps):
+        long = [k for k in gaps if t[k + 1] - t[k] > MAX_GAP_S]
+        if long:
+            k = long[0]
+            within = [s for s in silences if s[0] >= t[k] - 1e-9 and s[1] <= t[k + 1] + 1e-9]
+            why = ("no frame of any id on the bus then: bus off or a logger pause" if within
+                   else "other messages go on: frames of this one lost")
+            raise refusal(where, f"{name}: no frame from {t[k]:.3f} s to {t[k + 1]:.3f} s "
+                             f"({t[k + 1] - t[k]:.3f} s, more than {MAX_GAP_S:g} s; {why}); cut the log to "
+                             "one side of it")
+        found.notes.append(f"{name}: {len(gaps)} gaps of frames lost (at {_times(t[gaps])}, up to "
+                           f"{max(t[k + 1] - t[k] for k in gaps) * 1000:.0f} ms)")
+    return period
+
+
+def _signal_source(sig: _Signal, msg, decoded: dict[str, tuple[np.ndarray, dict[str, np.ndarray]]], where: Path,
+                   found: _Findings) -> Source:
+    """A mapped signal's values on its message's frames: quality bit, saturation and sign applied, scaled."""
+    t, columns = decoded[sig.message]
+    values = columns[sig.signal].copy()
+    good = np.ones(len(t), dtype=bool)
+    qbit = quality_bit(msg, sig.signal)
+    if qbit is not None:
+        flagged = columns[qbit.name] != 0.0
+        if flagged.all():
+            raise refusal(where, f"{sig.name}: every frame has its quality bit {qbit.name} set (a "
+                             "substitute value, the sensor not ready or failed)")
+        if flagged.any():
+            found.notes.append(f"{sig.name}: {int(flagged.sum())} frames with the quality bit {qbit.name} set "
+                               f"dropped (at {_times(t[flagged])})")
+        good &= ~flagged
+        found.checks.append(f"{sig.name} quality bit {qbit.name}")
+    spec = msg.get_signal_by_name(sig.signal)
+    if not spec.is_signed and not spec.is_float and spec.length > 1:
+        top = (2 ** spec.length - 1) * spec.scale + spec.offset
+        full = good & (np.abs(values - top) <= 0.5 * abs(spec.scale))
+        if full.any():
+            raise refusal(where, f"{sig.name} sits at its largest raw value {2 ** spec.length - 1} "
+                             f"({top:g} {spec.unit or ''}) in {int(full.sum())} frames from {t[full][0]:.3f} s: "
+                             "the signal saturates and what lies beyond it is lost")
+    if sig.sign is not None:
+        st, scolumns = decoded[sig.sign[0]]
+        flag = scolumns[sig.sign[1]]
+        if sig.sign[0] == sig.message:
+            negative = flag != 0.0
+        else:  # another message: its last frame at or before each sample
+            index = np.clip(np.searchsorted(st, t, side="right") - 1, 0, len(st) - 1)
+            negative = flag[index] != 0.0
+        values = np.where(negative, -values, values)
+    values = values * sig.scale
+    unit = spec.unit.strip() if spec.unit else None
+    if unit is not None and (unit.startswith("Unit_") or not unit):
+        unit = None  # VW's unit names (Unit_centiNewtoMeter) are not units pint reads: the map gives one
+    # The resolution: one raw count; the full scale: the largest raw magnitude (the sign flag doubles the levels)
+    step = abs(spec.scale * sig.scale)
+    counts = 2 ** (spec.length - 1) if spec.is_signed else 2 ** spec.length - 1
+    return Source(sig.name, unit, values[good], t[good], step=step,
+                  full_scale=abs(counts * spec.scale * sig.scale) if spec.offset == 0 else None)
+
+
+def _time_base(base: str, others: list[str], periods: dict[str, float]) -> str:
+    """The metadata ``bus_time_base``: the message whose frames are the time base, the others interpolated."""
+    text = f"the frames of {base} ({1.0 / periods[base]:.4g} Hz)"
     if others:
         text += "; " + ", ".join(f"{m} ({1.0 / periods[m]:.4g} Hz)" for m in others) + (
             " interpolated linearly onto them, each value from frames at most half its period away, the most lag "
             "this adds (" + ", ".join(f"{0.5 * periods[m] * 1000:.3g} ms" for m in others) + ")")
-    metadata = {"format": FORMAT_NAMES[fmt], "bus": bus.name, "dbc": bus.dbc.name, "bus_time_base": text,
-                "bus_checks": "; ".join(checks)}
-    if notes:
-        metadata["bus_findings"] = "; ".join(notes)
-    return Record(f"{FORMAT_NAMES[fmt]} ({bus.name})", sources, metadata,
-                  notes=[f"{where}: note: {n}" for n in notes])
+    return text

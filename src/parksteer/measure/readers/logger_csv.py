@@ -1,5 +1,5 @@
 """A logger's or spreadsheet's text export: its own channel names, units in brackets after a name
-(``RackPos [mm]``) or in a units row under the header, any dialect :func:`parksteer.measure.io.read_table`
+(``RackPos [mm]``) or in a units row under the header, any dialect :func:`parksteer.measure.text_table.read_table`
 accepts (semicolons or tabs, a decimal comma, quoted cells). Every text file that is not the native format."""
 
 from __future__ import annotations
@@ -8,7 +8,7 @@ from pathlib import Path
 from typing import ClassVar
 
 from ...errors import UsageError
-from ..io import Table, read_table
+from ..text_table import Table, read_table
 from .base import Record, Source, decode_text, name_and_unit
 
 

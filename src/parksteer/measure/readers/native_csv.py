@@ -1,5 +1,5 @@
 """The native format (data/measurements/README.md): a text table whose header names only native columns, SI units
-in the names, no units row. Any dialect :func:`parksteer.measure.io.read_table` accepts (delimiter, line ends,
+in the names, no units row. Any dialect :func:`parksteer.measure.text_table.read_table` accepts (delimiter, line ends,
 byte-order mark, blank lines)."""
 
 from __future__ import annotations
@@ -7,7 +7,8 @@ from __future__ import annotations
 from pathlib import Path
 from typing import ClassVar
 
-from ..io import ALLOWED_COLUMNS, header_cells, is_number, read_table
+from ..io import ALLOWED_COLUMNS
+from ..text_table import header_cells, is_number, read_table
 from .base import Record, Source, decode_text
 
 

@@ -194,7 +194,7 @@ def simulate(case: str, effects=None, overrides: dict | None = None, surface: st
     or a list of names/Effect instances. overrides: {key: value} (quantity keys, as --set). surface: "ground"
     or "air_bearing" (no tyre-to-ground friction, vertical support kept). rack_drive: a rack
     motion (:class:`parksteer.model.numeric.prescribed.RackMotion`, e.g. a
-    :class:`parksteer.measure.smoothing.RackSpline`); then the rack is prescribed from its start to
+    :class:`parksteer.measure.rack_spline.RackSpline`); then the rack is prescribed from its start to
     its end (or t_end_s) and the handwheel torque is solved for. handwheel: a HandwheelProfile to
     drive instead of the paper's saw tooth (the run ends with the profile unless t_end_s is given).
     rtol: the integrator's relative tolerance (default: RTOL, or PRESCRIBED_RTOL with a rack drive;

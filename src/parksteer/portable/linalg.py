@@ -1,0 +1,257 @@
+"""Linear algebra for the small systems of the model and the diagnosis, with sums in a fixed order: Gaussian
+elimination with partial pivoting and Householder QR with column pivoting, the algorithms LAPACK uses, written
+out (:mod:`parksteer.portable` says why)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+LinAlgError = np.linalg.LinAlgError
+
+_CHUNK_ELEMENTS = 1 << 21  # temporaries of matmul stay under 16 MB
+
+
+def _f64(a) -> np.ndarray:
+    return np.asarray(a, dtype=float)
+
+
+def dot(a, b) -> float:
+    """sum(a * b) of two vectors, pairwise in a fixed order."""
+    return float(np.sum(np.multiply(_f64(a), _f64(b))))
+
+
+def matmul(a, b) -> np.ndarray:
+    """a @ b for 1-D and 2-D operands, each entry a pairwise sum of products in a fixed order."""
+    a, b = _f64(a), _f64(b)
+    if a.ndim == 1 and b.ndim == 1:
+        return np.asarray(dot(a, b))
+    a2 = a[None, :] if a.ndim == 1 else a
+    b2 = b[:, None] if b.ndim == 1 else b
+    if a2.ndim != 2 or b2.ndim != 2 or a2.shape[1] != b2.shape[0]:
+        raise ValueError(f"matmul: shapes {a.shape} and {b.shape} do not align")
+    m, n = a2.shape
+    p = b2.shape[1]
+    bt = np.ascontiguousarray(b2.T)
+    out = np.empty((m, p))
+    rows = max(1, _CHUNK_ELEMENTS // max(1, p * n))
+    for start in range(0, m, rows):
+        block = np.ascontiguousarray(a2[start:start + rows])
+        # (rows, p, n), reduced over its last, contiguous axis: one pairwise sum per entry
+        out[start:start + rows] = np.sum(block[:, None, :] * bt[None, :, :], axis=-1)
+    if a.ndim == 1:
+        out = out[0]
+    if b.ndim == 1:
+        out = out[..., 0]
+    return out
+
+
+def norm(a, axis: int | None = None):
+    """Euclidean norm of a vector (or of a matrix's columns with ``axis=0``, rows with ``axis=1``)."""
+    a = _f64(a)
+    if axis is None:
+        return float(np.sqrt(np.sum(np.square(a.ravel()))))
+    lines = np.ascontiguousarray(np.moveaxis(a, axis, -1))
+    return np.sqrt(np.sum(np.square(lines), axis=-1))
+
+
+def solve(a, b) -> np.ndarray:
+    """x with a x = b (a square); Gaussian elimination with partial pivoting. Raises LinAlgError if singular."""
+    lu = np.array(a, dtype=float)
+    x = np.array(b, dtype=float)
+    n = lu.shape[0]
+    if lu.shape != (n, n) or x.shape[0] != n:
+        raise ValueError(f"solve: shapes {lu.shape} and {x.shape} do not align")
+    vector = x.ndim == 1
+    if vector:
+        x = x[:, None]
+    for k in range(n):
+        p = k + int(np.argmax(np.abs(lu[k:, k])))
+        if lu[p, k] == 0.0:
+            raise LinAlgError("Singular matrix")
+        if p != k:
+            lu[[k, p]] = lu[[p, k]]
+            x[[k, p]] = x[[p, k]]
+        if k + 1 < n:
+            factor = lu[k + 1:, k] / lu[k, k]
+            lu[k + 1:, k:] -= np.multiply.outer(factor, lu[k, k:])
+            x[k + 1:] -= np.multiply.outer(factor, x[k])
+    for k in range(n - 1, -1, -1):
+        tail = np.sum(lu[k, k + 1:, None] * x[k + 1:], axis=0) if k + 1 < n else 0.0
+        x[k] = (x[k] - tail) / lu[k, k]
+    return x[:, 0] if vector else x
+
+
+def inv(a) -> np.ndarray:
+    """The inverse of a square matrix (:func:`solve` against the identity)."""
+    a = _f64(a)
+    return solve(a, np.eye(a.shape[0]))
+
+
+def cholesky(a) -> np.ndarray:
+    """Lower-triangular L with L L^T = a; raises LinAlgError unless a is positive definite."""
+    a = _f64(a)
+    n = a.shape[0]
+    low = np.zeros((n, n))
+    for j in range(n):
+        d = a[j, j] - float(np.sum(np.square(low[j, :j])))
+        if not d > 0.0:
+            raise LinAlgError("Matrix is not positive definite")
+        low[j, j] = np.sqrt(d)
+        if j + 1 < n:
+            low[j + 1:, j] = (a[j + 1:, j] - np.sum(low[j + 1:, :j] * low[j, :j], axis=1)) / low[j, j]
+    return low
+
+
+def _householder(r: np.ndarray, k: int, b: np.ndarray | None) -> np.ndarray | None:
+    """Zero r[k+1:, k] by a reflection applied to r[k:, k:] (and b[k:]); returns the reflector's vector."""
+    x = r[k:, k]
+    length = norm(x)
+    if length == 0.0:
+        return None
+    alpha = -length if x[0] >= 0.0 else length
+    v = x.copy()
+    v[0] -= alpha
+    scale = 2.0 / float(np.sum(np.square(v)))
+    r[k:, k:] -= np.multiply.outer(v, np.sum(v[:, None] * r[k:, k:], axis=0) * scale)
+    if b is not None:
+        b[k:] -= np.multiply.outer(v, np.sum(v[:, None] * b[k:], axis=0) * scale)
+    return v
+
+
+def lstsq(a, b, rcond: float | None = None) -> np.ndarray:
+    """Least-squares solution of a x = b by Householder QR with column pivoting.
+
+    Columns whose pivot falls below ``rcond`` times the largest (default: machine epsilon times max(m, n), as
+    numpy's) are left out and their unknowns set to zero: the basic solution, which for a column of zeros (an
+    unknown nothing depends on) is also the minimum-norm one.
+    """
+    r = np.array(a, dtype=float)
+    rhs = np.array(b, dtype=float)
+    m, n = r.shape
+    vector = rhs.ndim == 1
+    if vector:
+        rhs = rhs[:, None]
+    if rcond is None:
+        rcond = np.finfo(float).eps * max(m, n)
+    order = np.arange(n)
+    rank = 0
+    largest = 0.0
+    for k in range(min(m, n)):
+        lengths = np.sum(np.square(r[k:, k:]), axis=0)
+        j = k + int(np.argmax(lengths))
+        if k == 0:
+            largest = float(np.sqrt(lengths[j - k]))
+        if not np.sqrt(lengths[j - k]) > rcond * largest:
+            break
+        if j != k:
+            r[:, [k, j]] = r[:, [j, k]]
+            order[[k, j]] = order[[j, k]]
+        _householder(r, k, rhs)
+        rank = k + 1
+    z = np.zeros((n, rhs.shape[1]))
+    for k in range(rank - 1, -1, -1):
+        tail = np.sum(r[k, k + 1:rank, None] * z[k + 1:rank], axis=0) if k + 1 < rank else 0.0
+        z[k] = (rhs[k] - tail) / r[k, k]
+    x = np.zeros_like(z)
+    x[order] = z
+    return x[:, 0] if vector else x
+
+
+def inv_spd_batched(a) -> np.ndarray:
+    """Inverses of a stack of small symmetric positive definite matrices (w x n x n), Gauss-Jordan without
+    pivoting (stable for such matrices), every matrix in one pass."""
+    work = np.array(a, dtype=float)
+    w, n, _ = work.shape
+    out = np.broadcast_to(np.eye(n), (w, n, n)).copy()
+    for k in range(n):
+        pivot = work[:, k, k].copy()
+        work[:, k, :] /= pivot[:, None]
+        out[:, k, :] /= pivot[:, None]
+        for i in range(n):
+            if i != k:
+                factor = work[:, i, k].copy()
+                work[:, i, :] -= factor[:, None] * work[:, k, :]
+                out[:, i, :] -= factor[:, None] * out[:, k, :]
+    return out
+
+
+def generalized_inverse(a) -> np.ndarray:
+    """A generalised inverse G of a square matrix (a G a = a), from :func:`lstsq` against the identity: for a
+    singular ``a`` it inverts a maximal independent set of columns, which serves wherever any generalised inverse
+    gives the same answer (a projection onto constraints, some of which repeat others)."""
+    a = _f64(a)
+    return lstsq(a, np.eye(a.shape[0]))
+
+
+def psd_factor(a, rcond: float = 1e-12) -> np.ndarray:
+    """F (n x r) with F F^T = a for a symmetric positive semi-definite ``a`` of rank r: Cholesky with diagonal
+    pivoting, stopped where the largest remaining pivot falls below ``rcond`` times the largest diagonal entry."""
+    work = np.array(a, dtype=float)
+    n = work.shape[0]
+    factor = np.zeros((n, n))
+    remaining = np.diagonal(work).copy()
+    scale = float(np.max(remaining)) if n else 0.0
+    used = np.zeros(n, dtype=bool)
+    rank = 0
+    for k in range(n):
+        candidates = np.where(used, -np.inf, remaining)
+        p = int(np.argmax(candidates))
+        if not candidates[p] > rcond * scale:
+            break
+        used[p] = True
+        column = (work[:, p] - np.sum(factor[:, :k] * factor[p, :k], axis=1)) / np.sqrt(candidates[p])
+        column[used & (np.arange(n) != p)] = 0.0
+        column[p] = np.sqrt(candidates[p])
+        factor[:, k] = column
+        remaining = remaining - column * column
+        rank = k + 1
+    return factor[:, :rank]
+
+
+def solve_tridiagonal(lower, diagonal, upper, rhs) -> np.ndarray:
+    """x with A x = rhs for tridiagonal A (``lower[i]`` = A[i+1, i], ``upper[i]`` = A[i, i+1]): Gaussian
+    elimination with partial pivoting, as LAPACK's dgtsv (a row swap makes a second superdiagonal)."""
+    d = np.array(diagonal, dtype=float).tolist()
+    dl = np.array(lower, dtype=float).tolist()
+    du = np.array(upper, dtype=float).tolist() + [0.0]
+    b = np.array(rhs, dtype=float).tolist()
+    n = len(d)
+    du2 = [0.0] * n
+    for i in range(n - 1):
+        if abs(d[i]) >= abs(dl[i]):
+            if d[i] == 0.0:
+                raise LinAlgError("Singular matrix")
+            f = dl[i] / d[i]
+            d[i + 1] = d[i + 1] - f * du[i]
+            b[i + 1] = b[i + 1] - f * b[i]
+        else:
+            f = d[i] / dl[i]
+            d[i], dl[i] = dl[i], d[i]
+            temp = d[i + 1]
+            d[i + 1] = du[i] - f * temp
+            du2[i] = du[i + 1]
+            du[i + 1] = -f * du[i + 1]
+            du[i] = temp
+            b[i], b[i + 1] = b[i + 1], b[i] - f * b[i + 1]
+    if d[n - 1] == 0.0:
+        raise LinAlgError("Singular matrix")
+    x = [0.0] * n
+    x[n - 1] = b[n - 1] / d[n - 1]
+    if n > 1:
+        x[n - 2] = (b[n - 2] - du[n - 2] * x[n - 1]) / d[n - 2]
+    for i in range(n - 3, -1, -1):
+        x[i] = (b[i] - du[i] * x[i + 1] - du2[i] * x[i + 2]) / d[i]
+    return np.array(x)
+
+
+def qr(a) -> tuple[np.ndarray, np.ndarray]:
+    """Reduced QR of an m x n matrix (m >= n) by Householder reflections: Q (m x n), R (n x n)."""
+    r = np.array(a, dtype=float)
+    m, n = r.shape
+    reflectors = [_householder(r, k, None) for k in range(min(m, n))]
+    q = np.eye(m, n)
+    for k in range(min(m, n) - 1, -1, -1):
+        v = reflectors[k]
+        if v is not None:
+            q[k:] -= np.multiply.outer(v, np.sum(v[:, None] * q[k:], axis=0) * (2.0 / float(np.sum(np.square(v)))))
+    return q, np.triu(r[:n])
