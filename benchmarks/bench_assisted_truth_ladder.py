@@ -115,7 +115,7 @@ def model_nulls(params, design) -> dict:
     import tempfile
 
     from parksteer.diagnose.problem import load_files
-    from parksteer.diagnose.report import diagnosis_dict
+    from parksteer.reporting.report import diagnosis_dict
     from parksteer.diagnose.select import diagnose
     from parksteer.experiments.assisted_truth import _logger, _write, cases
     from parksteer.experiments.benchmark import BASE_PERTURBATION, BENCHMARK_SETTINGS

@@ -20,7 +20,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def main(argv=None) -> int:
-    from parksteer.diagnose.assist_identify import identify_boost
+    from parksteer.diagnose.identify.assist_identify import identify_boost
     from parksteer.experiments.assisted_truth import TruthDesign, _seed, _write, baseline_record, owner_file
     from parksteer.experiments.benchmark import BASE_PERTURBATION
     from parksteer.synthetic.datasets import perturbed_base

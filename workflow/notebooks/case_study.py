@@ -36,9 +36,9 @@ import numpy as np
 from IPython.display import SVG, Markdown, display
 
 from parksteer.diagnose.compare import compare_files
-from parksteer.diagnose.ladder import error_ladder
+from parksteer.reporting.ladder import error_ladder
 from parksteer.diagnose.problem import load_files
-from parksteer.diagnose.report import diagnosis_dict, signature_lines, without_machine_times
+from parksteer.reporting.report import diagnosis_dict, signature_lines, without_machine_times
 from parksteer.diagnose.select import diagnose
 from parksteer.figures.diagnose import compare_figure, diagnosis_figure, ladder_figure, shown_files
 from parksteer.measure.phases import PHASES

@@ -263,8 +263,8 @@ def _compare(args) -> int:
 
 def _diagnose(args) -> int:
     from ..diagnose.problem import load_files
-    from ..diagnose.report import diagnosis_dict
-    from ..diagnose.pages import markdown_report, write_markdown
+    from ..reporting.report import diagnosis_dict
+    from ..reporting.pages import markdown_report, write_markdown
     from ..measure.importers import ANGLE
     from ..diagnose.select import diagnose
     from ..diagnose.settings import DEFAULT_SETTINGS
@@ -322,11 +322,11 @@ def _diagnose(args) -> int:
     # each effect it names) where the HTML page asks for it, and then in both
     phases = ladder = None
     if args.report or args.html:
-        from ..diagnose.report import phase_residuals
+        from ..reporting.report import phase_residuals
 
         phases = phase_residuals(diagnosis)
     if args.html:
-        from ..diagnose.ladder import error_ladder
+        from ..reporting.ladder import error_ladder
 
         ladder = error_ladder(files, params, list(diagnosis.base_effects), first=diagnosis, workers=workers)
     if args.report:
@@ -358,7 +358,7 @@ def _with_suggestion(args, result: dict, diagnosis, settings) -> dict:
              + (", no structure in the residual" if signature is not None and signature.effect_class is None
                 else "") + ")")
         return result
-    from ..diagnose.report import with_suggestion
+    from ..reporting.report import with_suggestion
     from ..diagnose.suggest import suggest
 
     suggestion = suggest(diagnosis.problem, diagnosis.calibration, signature, args.suggest_effect, settings)
@@ -368,10 +368,10 @@ def _with_suggestion(args, result: dict, diagnosis, settings) -> dict:
 
 
 def _write_html(path: str, diagnosis, result: dict, phases: list[dict], ladder) -> None:
-    """The diagnosis and its error ladder as one self-contained HTML page (parksteer.diagnose.pages.html_report)."""
+    """The diagnosis and its error ladder as one self-contained HTML page (parksteer.reporting.pages.html_report)."""
     import tempfile
 
-    from ..diagnose.pages import html_report, write_markdown
+    from ..reporting.pages import html_report, write_markdown
     from ..figures.diagnose import diagnosis_figure, ladder_figure, phase_residual_figure
 
     captions = {

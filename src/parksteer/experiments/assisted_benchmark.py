@@ -45,7 +45,7 @@ from ..synthetic.variations import variation_by_name
 from .benchmark import BASE_PERTURBATION, BENCHMARK_SETTINGS
 from .outclass import bic_margin
 from ..diagnose.problem import load_files
-from ..diagnose.report import diagnosis_dict
+from ..reporting.report import diagnosis_dict
 from ..diagnose.select import diagnose
 from .rows import ROW_SUFFIX, read_case_files
 from .variations import NAMED_MIN_STEPS, NAMED_TARGET, NULL_ADEQUATE_TARGET

@@ -39,7 +39,7 @@ from pathlib import Path
 import numpy as np
 
 from ..diagnose.problem import load_files
-from ..diagnose.report import diagnosis_dict
+from ..reporting.report import diagnosis_dict
 from ..diagnose.select import diagnose
 from ..errors import UsageError
 from ..measure.io import format_measurement, write_measurement
@@ -314,7 +314,7 @@ def _template_default(key: str) -> float:
 def identified_route(owner: Owner, baseline: Path, folder: str | Path) -> Owner:
     """The file `parksteer assist identify` writes from the tier's baseline record and the owner's file (its
     gear's data; its map is not used): the identified table, the product k_t eta_f N, the motor friction."""
-    from ..diagnose.assist_identify import identify_boost
+    from ..diagnose.identify.assist_identify import identify_boost
     from ..model.numeric.assist import effects_with_assist
     from ..model.symbolic.components import resolve_effects
     from ..vehicle import vehicle_from_text

@@ -33,7 +33,7 @@ from ..parameters import Parameters, load_parameters
 from ..synthetic.datasets import BenchmarkDesign, benchmark_specs, file_name, make_dataset
 from ..tables import write_json
 from ..diagnose.problem import load_files
-from ..diagnose.report import diagnosis_dict
+from ..reporting.report import diagnosis_dict
 from .rows import BenchmarkRow
 from ..diagnose.select import diagnose
 from ..diagnose.settings import DEFAULT_SETTINGS, DiagnosisSettings

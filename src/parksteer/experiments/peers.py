@@ -339,7 +339,7 @@ def diagnose_case(params, folder, truth: dict, benchmark: str, split: str) -> di
     from ..synthetic.variations import variation_by_name
     from .benchmark import BENCHMARK_SETTINGS
     from ..diagnose.problem import load_files
-    from ..diagnose.report import diagnosis_dict
+    from ..reporting.report import diagnosis_dict
     from ..diagnose.select import diagnose
 
     settings = BENCHMARK_SETTINGS
