@@ -23,9 +23,10 @@ def measurement_files(items):
 with rule_log(snakemake):
     options = snakemake.params.options
     vehicle = snakemake.input.vehicle
-    taken = intake(Request(measurement_files(snakemake.input.files), car_parameters(snakemake.input.parameters, vehicle),
-                           vehicle=vehicle, case=options["case"], surface=options["surface"],
-                           channel_map=channel_map_from_options(None, options["map_file"]), command="compare"))
+    car = car_parameters(snakemake.input.parameters, vehicle)
+    taken = intake(Request(measurement_files(snakemake.input.files), car, vehicle=vehicle, case=options["case"],
+                           surface=options["surface"], channel_map=channel_map_from_options(None, options["map_file"]),
+                           command="compare"))
     result = compare_files(taken.files, taken.params, taken.effects)
     compare_figure(result, snakemake.output.svg)
     with open(snakemake.output.json, "w", encoding="utf-8") as out:

@@ -23,9 +23,10 @@ def measurement_files(items):
 with rule_log(snakemake):
     options = snakemake.params.options
     vehicle = snakemake.input.vehicle
-    taken = intake(Request(measurement_files(snakemake.input.files), car_parameters(snakemake.input.parameters, vehicle),
-                           vehicle=vehicle, case=options["case"], surface=options["surface"],
-                           channel_map=channel_map_from_options(None, options["map_file"]), jobs=None))
+    car = car_parameters(snakemake.input.parameters, vehicle)
+    taken = intake(Request(measurement_files(snakemake.input.files), car, vehicle=vehicle, case=options["case"],
+                           surface=options["surface"], channel_map=channel_map_from_options(None, options["map_file"]),
+                           jobs=None))
     diagnosis = taken.diagnose(quiet=False)
     result = write_diagnosis(diagnosis, taken, plot=snakemake.output.svg, report=snakemake.output.md,
                              html=snakemake.output.html)

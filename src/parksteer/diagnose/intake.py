@@ -7,8 +7,8 @@ warned about; the run's one speed read from the records' speed channel, and the 
 a creeping car (:func:`with_record_speed`); the refusal of a record whose rack never reverses (no reversal to
 calibrate the friction on); the torque-lag search only on a measured rack; the handwheel angle fitted only where a
 file has one beside a measured rack; the settings from the options. The command line (``parksteer compare``,
-``diagnose``, ``baseline``), the workflow, experiments/ and the case study all call :func:`intake` before they
-diagnose, so that one record gives one diagnosis whichever door it came in by.
+``diagnose``, ``baseline``), the workflow's rule scripts, the benchmarks of experiments/ and the case study call
+:func:`intake` before they diagnose, so that one record gives one diagnosis whichever door it came in by.
 
 Bad input raises :class:`parksteer.errors.UsageError` in one line naming the file, the column and where it can, the
 row (the command line prints it and exits with status 2).
@@ -41,13 +41,14 @@ NEEDS_REVERSAL = {"diagnose": "diagnose needs a cycle that turns back",
 @dataclass(frozen=True)
 class Request:
     """What a caller asks. `files`: the records' paths (any format :func:`parksteer.measure.importers.load_record`
-    reads); `params`: the car (:func:`car_parameters`); `effects`: the model's effects as a spec (``"+column_friction"``,
-    None for the paper's five) or as a list of effects; `vehicle`: the vehicle file `params` were read from (its
-    ``[assist]`` for `with_assist`, and named in messages); `case`, `surface`, `channel_map`: how the files are read
-    (:func:`parksteer.diagnose.problem.load_files`); `settings`: the method's, with `angle` (fit the handwheel angle
-    beside the torque) and `torque_lag` (search the torque channel's lag behind the rack) turned on over them;
-    `jobs`: worker processes (None: the CPUs available); `command`: what the request serves (``compare``,
-    ``diagnose``, ``baseline``), which says what is checked and names the command in a warning."""
+    reads); `params`: the car (:func:`car_parameters`); `effects`: the model's effects as a spec
+    (``"+column_friction"``, None for the paper's five) or as a list of effects; `vehicle`: the vehicle file
+    `params` were read from (its ``[assist]`` for `with_assist`, and named in messages); `case`, `surface`,
+    `channel_map`: how the files are read (:func:`parksteer.diagnose.problem.load_files`); `settings`: the method's,
+    with `angle` (fit the handwheel angle beside the torque) and `torque_lag` (search the torque channel's lag
+    behind the rack) turned on over them; `jobs`: worker processes (None: the CPUs available); `command`: what the
+    request serves (``compare``, ``diagnose``, ``baseline``), which says what is checked and names the command in a
+    warning."""
 
     files: Sequence[str | Path]
     params: Parameters
@@ -66,8 +67,9 @@ class Request:
 
 @dataclass(frozen=True)
 class Intake:
-    """What :func:`intake` made of a :class:`Request`: the prepared files (:class:`parksteer.diagnose.problem.FileData`),
-    the parameters at the records' speed, the effects, the settings and the worker count a diagnosis takes."""
+    """What :func:`intake` made of a :class:`Request`: the prepared files
+    (:class:`parksteer.diagnose.problem.FileData`), the parameters at the records' speed, the effects, the settings
+    and the worker count a diagnosis takes."""
 
     files: list = field(repr=False)
     params: Parameters = field(repr=False)
