@@ -161,3 +161,25 @@ def test_the_contracts_keep_the_method_from_reporting_and_from_the_identificatio
     assert done.returncode != 0, done.stdout[-2000:]
     assert "parksteer.diagnose.calibrate -> parksteer.reporting.report" in done.stdout, done.stdout[-4000:]
     assert "parksteer.diagnose.engine -> parksteer.diagnose.identify.boost_map" in done.stdout, done.stdout[-4000:]
+
+
+def test_no_rule_script_drives_the_command_line():
+    """The workflow calls the package's functions, the command line's front door included (the diagnosis's intake),
+    never the command line itself: no rule script or notebook imports parksteer.cli. The scan is checked on a
+    planted line first, so that it can fail."""
+
+    def drives_cli(source: str) -> bool:
+        for node in ast.walk(ast.parse(source)):
+            names = [a.name for a in node.names] if isinstance(node, ast.Import) else []
+            if isinstance(node, ast.ImportFrom) and node.module:
+                names = [node.module] + [f"{node.module}.{a.name}" for a in node.names]
+            if any(n == "parksteer.cli" or n.startswith("parksteer.cli.") for n in names):
+                return True
+        return False
+
+    assert drives_cli("from parksteer.cli import main\n") and drives_cli("import parksteer.cli\n")
+    assert not drives_cli("from parksteer.diagnose.intake import intake\n")
+    workflow = REPO_ROOT / "workflow"
+    scripts = sorted(workflow.glob("scripts/*.py")) + sorted(workflow.glob("notebooks/*.py"))
+    assert len(scripts) > 10
+    assert [s.name for s in scripts if drives_cli(s.read_text(encoding="utf-8"))] == []
