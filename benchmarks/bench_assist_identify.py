@@ -31,7 +31,7 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
 
     import eps_truth as et
-    from parksteer.diagnose.assist_identify import identify_boost
+    from parksteer.diagnose.identify.assist_identify import identify_boost
     from parksteer.errors import UsageError
     from parksteer.model.symbolic.components import discover_effects
 

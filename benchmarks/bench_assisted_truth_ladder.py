@@ -116,7 +116,7 @@ def model_nulls(params, design) -> dict:
     import tempfile
 
     from parksteer.diagnose.problem import load_files
-    from parksteer.diagnose.report import diagnosis_dict
+    from parksteer.reporting.report import diagnosis_dict
     from parksteer.diagnose.select import diagnose
     from parksteer.experiments.assisted_truth import _logger, _write
     from parksteer.experiments.assisted_truth_design import cases

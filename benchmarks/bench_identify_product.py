@@ -20,7 +20,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def main(argv=None) -> int:
-    from parksteer.diagnose.assist_identify import identify_boost
+    from parksteer.diagnose.identify.assist_identify import identify_boost
     from parksteer.experiments.assisted_truth import _write, baseline_record
     from parksteer.experiments.assisted_truth_design import TruthDesign, case_seed
     from parksteer.experiments.assisted_truth_owner import owner_file

@@ -144,3 +144,42 @@ def test_the_contract_catches_an_upward_import(tmp_path):
     done = lint_imports(tmp_path, tmp_path / "src")
     assert done.returncode != 0, done.stdout[-2000:]
     assert "parksteer.measure.io -> parksteer.model.numeric.simulate" in done.stdout, done.stdout[-4000:]
+
+
+def test_the_contracts_keep_the_method_from_reporting_and_from_the_identification_tool(tmp_path):
+    """The contracts can fail on the method's rooms: in a copy of the package, the calibration importing the
+    reporting (which sits above the method) breaks the layers, and the replay engine importing the assist's
+    identification (which uses the engine) breaks identify-apart."""
+    shutil.copytree(SRC / "parksteer", tmp_path / "src" / "parksteer", ignore=shutil.ignore_patterns("__pycache__"))
+    shutil.copy2(REPO_ROOT / "pyproject.toml", tmp_path / "pyproject.toml")
+    diagnose = tmp_path / "src" / "parksteer" / "diagnose"
+    for module, planted in (("calibrate.py", "from ..reporting import report"),
+                            ("engine.py", "from .identify import boost_map")):
+        path = diagnose / module
+        path.write_text(path.read_text() + f"\n\ndef _upward():\n    {planted}  # noqa: F401\n")
+    done = lint_imports(tmp_path, tmp_path / "src")
+    assert done.returncode != 0, done.stdout[-2000:]
+    assert "parksteer.diagnose.calibrate -> parksteer.reporting.report" in done.stdout, done.stdout[-4000:]
+    assert "parksteer.diagnose.engine -> parksteer.diagnose.identify.boost_map" in done.stdout, done.stdout[-4000:]
+
+
+def test_no_rule_script_drives_the_command_line():
+    """The workflow calls the package's functions, the command line's front door included (the diagnosis's intake),
+    never the command line itself: no rule script or notebook imports parksteer.cli. The scan is checked on a
+    planted line first, so that it can fail."""
+
+    def drives_cli(source: str) -> bool:
+        for node in ast.walk(ast.parse(source)):
+            names = [a.name for a in node.names] if isinstance(node, ast.Import) else []
+            if isinstance(node, ast.ImportFrom) and node.module:
+                names = [node.module] + [f"{node.module}.{a.name}" for a in node.names]
+            if any(n == "parksteer.cli" or n.startswith("parksteer.cli.") for n in names):
+                return True
+        return False
+
+    assert drives_cli("from parksteer.cli import main\n") and drives_cli("import parksteer.cli\n")
+    assert not drives_cli("from parksteer.diagnose.intake import intake\n")
+    workflow = REPO_ROOT / "workflow"
+    scripts = sorted(workflow.glob("scripts/*.py")) + sorted(workflow.glob("notebooks/*.py"))
+    assert len(scripts) > 10
+    assert [s.name for s in scripts if drives_cli(s.read_text(encoding="utf-8"))] == []

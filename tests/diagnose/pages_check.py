@@ -5,7 +5,7 @@ from __future__ import annotations
 import html
 import re
 
-from parksteer.diagnose.pages import html_report, markdown_report
+from parksteer.reporting.pages import html_report, markdown_report
 
 
 def markdown_sections(text: str) -> list[str]:

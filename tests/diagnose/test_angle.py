@@ -22,8 +22,8 @@ import pytest
 
 from parksteer.cli import main
 from parksteer.diagnose.problem import prepare_file
-from parksteer.diagnose.report import SCHEMA_PATH, diagnosis_dict
-from parksteer.diagnose.pages import html_report, markdown_report
+from parksteer.reporting.report import SCHEMA_PATH, diagnosis_dict
+from parksteer.reporting.pages import html_report, markdown_report
 from parksteer.diagnose.select import diagnose
 from parksteer.diagnose.settings import DEFAULT_SETTINGS
 from parksteer.measure.io import write_measurement

@@ -1,4 +1,4 @@
-"""An electric assist identified from its car's log (parksteer.diagnose.assist_identify, ``parksteer assist identify``).
+"""An electric assist identified from its car's log (parksteer.diagnose.identify, ``parksteer assist identify``).
 
 The records are not made by the assisted model the identified file feeds: a quasi-static column EPS written in the
 test (eps_truth.py: the torsion bar and a worm-gear motor sharing the column torque sample by sample over the manual
@@ -19,7 +19,7 @@ import pytest
 
 import eps_truth as et
 from parksteer.cli import main
-from parksteer.diagnose.assist_identify import identify_boost
+from parksteer.diagnose.identify.assist_identify import identify_boost
 from parksteer.model.symbolic.components import discover_effects
 from parksteer.vehicle import load_vehicle
 

@@ -22,7 +22,7 @@ from pages_check import assert_same_sections
 from parksteer.cli import main
 from parksteer.experiments.benchmark import BENCHMARK_SETTINGS
 from parksteer.diagnose.problem import prepare_file
-from parksteer.diagnose.report import SCHEMA_PATH, diagnosis_dict
+from parksteer.reporting.report import SCHEMA_PATH, diagnosis_dict
 from parksteer.diagnose.select import diagnose
 from parksteer.measure.io import write_measurement
 from parksteer.model.symbolic.components import discover_effects, resolve_effects
@@ -78,7 +78,7 @@ def test_a_tie_is_the_headline_and_no_test_is_offered_below_the_noise_floor(moto
     data lack would move the two fitted models apart by far less than the noise floor, so no such measurement is
     offered as separating them; the motor current is shown beside the torque, as a table and as the figure's
     measured, fitted and residual panels."""
-    from parksteer.diagnose.pages import html_report, markdown_report
+    from parksteer.reporting.pages import html_report, markdown_report
     from parksteer.figures.diagnose import diagnosis_figure
 
     diagnosis, result = motor_friction

@@ -28,7 +28,7 @@ import pytest
 
 from parksteer.diagnose.candidates import candidate_effects
 from parksteer.diagnose.problem import prepare_file
-from parksteer.diagnose.report import diagnosis_dict
+from parksteer.reporting.report import diagnosis_dict
 from parksteer.diagnose.select import diagnose
 from parksteer.experiments.assisted_truth_owner import owner_file
 from parksteer.experiments.assisted_truth_design import TruthDesign

@@ -19,7 +19,7 @@ import pytest
 from parksteer.cli import main
 from parksteer.diagnose.baseline import Baseline, learn_baseline
 from parksteer.diagnose.problem import load_files
-from parksteer.diagnose.report import diagnosis_dict
+from parksteer.reporting.report import diagnosis_dict
 from parksteer.diagnose.select import diagnose
 from parksteer.diagnose.settings import DEFAULT_SETTINGS
 from parksteer.experiments.benchmark import BASE_PERTURBATION

@@ -14,9 +14,9 @@ import tomllib
 
 import pytest
 
-from parksteer.diagnose.pages import markdown_report
+from parksteer.reporting.pages import markdown_report
 from parksteer.diagnose.problem import load_files
-from parksteer.diagnose.report import diagnosis_dict
+from parksteer.reporting.report import diagnosis_dict
 from parksteer.diagnose.select import diagnose
 from parksteer.errors import UsageError
 from parksteer.experiments.assisted_truth import _write, baseline_record, case_truth_and_record

@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 
 from parksteer.cli import main
-from parksteer.diagnose.ladder import error_ladder
+from parksteer.reporting.ladder import error_ladder
 from parksteer.diagnose.problem import load_files
-from parksteer.diagnose.report import SCHEMA_PATH, diagnosis_dict
+from parksteer.reporting.report import SCHEMA_PATH, diagnosis_dict
 from parksteer.diagnose.select import diagnose
 from parksteer.synthetic.datasets import USER_EFFECT_PATH
 from parksteer.model.symbolic.components import MODULES_ENV, discover_effects, load_effect_module

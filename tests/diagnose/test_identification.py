@@ -8,8 +8,8 @@ import json
 import jsonschema
 
 from parksteer.diagnose.problem import load_files
-from parksteer.diagnose.report import SCHEMA_PATH, diagnosis_dict
-from parksteer.diagnose.pages import markdown_report
+from parksteer.reporting.report import SCHEMA_PATH, diagnosis_dict
+from parksteer.reporting.pages import markdown_report
 from parksteer.diagnose.select import diagnose
 
 OFF_NOMINAL = {"tyre.friction_coefficient": 0.70, "steering.rack_friction_force": 650.0,

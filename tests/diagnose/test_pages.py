@@ -1,9 +1,9 @@
 """The reports advise only what the tool accepts: which of an assisted car's assumed values `parksteer assist
-identify` can fix (parksteer.diagnose.sections)."""
+identify` can fix (parksteer.reporting.sections)."""
 
 from __future__ import annotations
 
-from parksteer.diagnose.sections import _assumed_parts, _identify_measures
+from parksteer.reporting.sections import _assumed_parts, _identify_measures
 
 NAME = "electric_assist_column"
 

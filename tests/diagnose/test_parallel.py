@@ -12,7 +12,7 @@ import pytest
 from parksteer.diagnose.engine import ReplayEngine
 from parksteer.diagnose.parallel import ServingPool, can_fork, fork_map
 from parksteer.diagnose.problem import Problem, load_files
-from parksteer.diagnose.report import diagnosis_dict
+from parksteer.reporting.report import diagnosis_dict
 from parksteer.diagnose.select import diagnose
 from parksteer.model.symbolic.components import resolve_effects
 

@@ -18,8 +18,8 @@ from parksteer.cli import main
 from parksteer.experiments.benchmark import BENCHMARK_SETTINGS
 from parksteer.experiments.outoflibrary import SignatureCase, SignatureDesign, make_record, summarise
 from parksteer.diagnose.problem import load_files
-from parksteer.diagnose.report import diagnosis_dict, with_suggestion
-from parksteer.diagnose.pages import markdown_report
+from parksteer.reporting.report import diagnosis_dict, with_suggestion
+from parksteer.reporting.pages import markdown_report
 from parksteer.diagnose.select import diagnose
 from parksteer.diagnose.signature import signature_from_axes
 from parksteer.diagnose.signature_axes import Axes, column_angle

@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 
 from parksteer.diagnose.problem import load_files
-from parksteer.diagnose.report import diagnosis_dict
+from parksteer.reporting.report import diagnosis_dict
 from parksteer.diagnose.select import diagnose
 from parksteer.diagnose.settings import DEFAULT_SETTINGS
 from parksteer.measure.io import write_measurement

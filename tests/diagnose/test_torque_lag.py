@@ -17,7 +17,7 @@ import json
 
 from parksteer.cli import main
 from parksteer.diagnose.problem import load_files
-from parksteer.diagnose.report import diagnosis_dict
+from parksteer.reporting.report import diagnosis_dict
 from parksteer.diagnose.select import diagnose
 from parksteer.diagnose.settings import DEFAULT_SETTINGS
 from parksteer.measure.io import write_measurement

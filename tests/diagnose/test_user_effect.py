@@ -19,7 +19,7 @@ from pages_check import assert_same_sections
 
 from parksteer.diagnose.calibrate import free_strengths
 from parksteer.diagnose.problem import load_files
-from parksteer.diagnose.report import diagnosis_dict
+from parksteer.reporting.report import diagnosis_dict
 from parksteer.diagnose.select import diagnose
 from parksteer.diagnose.stages import STAGES
 from parksteer.diagnose.stages.user_effect import with_user_effect_stage

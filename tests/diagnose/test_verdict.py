@@ -42,7 +42,7 @@ def test_the_ceiling_sits_above_every_null_and_every_correctly_named_record_of_t
 
 
 def test_the_report_names_the_nearest_candidate_of_an_unexplained_verdict():
-    from parksteer.diagnose.sections import _nearest
+    from parksteer.reporting.sections import _nearest
 
     thresholds = {"bic_missing": S.bic_missing_threshold, "missing_rms_ceiling": S.missing_rms_ceiling}
     result = {"noise_floor_Nm": 0.2, "selection": {"thresholds": thresholds},

@@ -1,4 +1,4 @@
-"""A record's vehicle-speed channel sets the run's speed in compare (parksteer.commands.measure.with_record_speed)."""
+"""A record's vehicle-speed channel sets the run's speed in compare (parksteer.diagnose.intake.with_record_speed)."""
 
 from __future__ import annotations
 

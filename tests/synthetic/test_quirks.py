@@ -117,7 +117,7 @@ def test_the_model_cannot_fit_a_quirk_record_to_its_noise_floor(tmp_path):
     rack friction: calibrated, the model stays above the adequate threshold on a record carrying it at 5 noise
     floors, where the same record without it fits (adequate)."""
     from parksteer.diagnose.problem import load_files
-    from parksteer.diagnose.report import diagnosis_dict
+    from parksteer.reporting.report import diagnosis_dict
     from parksteer.diagnose.select import diagnose
     from parksteer.diagnose.settings import DEFAULT_SETTINGS
     from parksteer.experiments.benchmark import BENCHMARK_SETTINGS

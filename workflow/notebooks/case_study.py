@@ -36,10 +36,9 @@ import numpy as np
 from IPython.display import SVG, Markdown, display
 
 from parksteer.diagnose.compare import compare_files
-from parksteer.diagnose.ladder import error_ladder
-from parksteer.diagnose.problem import load_files
-from parksteer.diagnose.report import diagnosis_dict, signature_lines, without_machine_times
-from parksteer.diagnose.select import diagnose
+from parksteer.reporting.ladder import error_ladder
+from parksteer.diagnose.intake import Request, intake
+from parksteer.reporting.report import diagnosis_dict, signature_lines, without_machine_times
 from parksteer.figures.diagnose import compare_figure, diagnosis_figure, ladder_figure, shown_files
 from parksteer.measure.phases import PHASES
 from parksteer.parameters import DEFAULT_PATH, load_parameters
@@ -70,7 +69,8 @@ def table(header, rows):
 
 params = load_parameters(PARAMETERS)
 paths = sorted(DATA.glob("*.csv"))
-files = load_files(paths, params)
+taken = intake(Request(paths, params))  # the records as `parksteer diagnose` takes them in
+files = taken.files
 table(["file", "case", "surface", "samples", "noise floor (N m)", "rack spline knots every (s)"],
       [[f.label, f.case, f.surface, f.n, f"{f.noise.total_rms:.3f}", f"{f.rack.knot_spacing_s:.2f}"] for f in files])
 
@@ -87,7 +87,7 @@ table(["file", "case", "surface", "samples", "noise floor (N m)", "rack spline k
 # parameter file's values), which returns the handwheel torque that motion needs.
 
 # %%
-compared = compare_files(files, params)
+compared = compare_files(files, taken.params, taken.effects)
 summary = compared.as_dict()
 table(["file", "RMS (N m)", "weighted RMS / noise floor"] + [p.replace("_", " ") for p in PHASES],
       [[f["file"], f"{f['overall']['rms']:.3f}", f"{f['over_floor']:.2f}"]
@@ -127,7 +127,7 @@ print(f"mean weighted RMS / noise floor: ground {np.mean([f['over_floor'] for f 
 # information criterion over the effective number of samples chooses.
 
 # %%
-diagnosis = diagnose(files, params)
+diagnosis = taken.diagnose()
 result = diagnosis_dict(diagnosis)
 display(Markdown(f"**Verdict: {result['verdict']}**" + (f", effect `{result['effect']}`" if result["effect"] else "")))
 table(["candidate", "score", "ΔBIC", "fitted strength (95 % interval)", "weighted RMS after (N m)"],
@@ -166,7 +166,7 @@ print("\n".join(signature_lines(result)) if result.get("signature") else "no sig
 # the rack data cannot say exactly when the rack friction turns over.
 
 # %%
-ladder = error_ladder(files, params, first=diagnosis)
+ladder = error_ladder(files, taken.params, taken.effects, first=diagnosis)
 table(["model", "RMS (N m)", "weighted RMS (N m)", "weighted RMS / noise floor"],
       [[r["label"], f"{r['rms_Nm']:.3f}", f"{r['weighted_rms_Nm']:.3f}", f"{r['over_floor']:.2f}"]
        for r in ladder.rungs])
@@ -238,17 +238,14 @@ table(["parameter", "true", "calibrated without the effect", "fitted with the ef
 # is fitted beside the torque.
 
 # %%
-from parksteer.commands.measure import assist_of_effects
-from parksteer.model.numeric.assist import effects_with_assist
-from parksteer.model.symbolic.components import resolve_effects
-from parksteer.vehicle import load_vehicle
+from parksteer.diagnose.intake import car_parameters
 
-assisted_params = load_vehicle(ASSISTED_VEHICLE)
-assisted_effects = resolve_effects(effects_with_assist(None, assisted_params))
-assisted_files = load_files([ASSISTED_RECORD], assisted_params, assist=assist_of_effects(assisted_effects))
-assisted_compare = compare_files(assisted_files, assisted_params, assisted_effects)
+assisted_car = car_parameters(DEFAULT_PATH, ASSISTED_VEHICLE)  # the vehicle file over the packaged parameters
+assisted_taken = intake(Request([ASSISTED_RECORD], assisted_car, vehicle=ASSISTED_VEHICLE, with_assist=True))
+assisted_files = assisted_taken.files
+assisted_compare = compare_files(assisted_files, assisted_taken.params, assisted_taken.effects)
 show(compare_figure, assisted_compare)
-assisted = diagnose(assisted_files, assisted_params, assisted_effects, quiet=True)
+assisted = assisted_taken.diagnose(quiet=True)
 assisted_result = diagnosis_dict(assisted)
 top = assisted_result["ranking"][0]
 strength = next(v for k, v in top["parameters"].items() if k.startswith(f"{top['effect']}."))  # its own strength

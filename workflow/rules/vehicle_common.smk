@@ -59,12 +59,9 @@ def check_vehicle_data():
 
 
 def vehicle_options():
-    """Import options for every file of the study: --map-file, --case, --surface from the configuration."""
-    options = []
-    for key, option in (("vehicle_map", "--map-file"), ("vehicle_case", "--case"), ("vehicle_surface", "--surface")):
-        if config.get(key) is not None:
-            options += [option, str(config[key])]
-    return options
+    """How every file of the study is read, from the configuration: its channel map file, case and surface."""
+    return {"map_file": config.get("vehicle_map"), "case": config.get("vehicle_case"),
+            "surface": config.get("vehicle_surface")}
 
 
 def vehicle_study_files(wildcards):

@@ -1,7 +1,7 @@
-# Thin rule script: the logic is parksteer.diagnose.notebook.execute_notebook (the notebook does the work).
+# Thin rule script: the logic is parksteer.reporting.notebook.execute_notebook (the notebook does the work).
 from pathlib import Path
 
-from parksteer.diagnose.notebook import execute_notebook
+from parksteer.reporting.notebook import execute_notebook
 from parksteer.rules import rule_log
 
 with rule_log(snakemake):

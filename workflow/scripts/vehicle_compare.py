@@ -1,10 +1,12 @@
-# Thin rule script: `parksteer compare --vehicle` (parksteer.commands.measure) with its JSON kept as the output.
-import contextlib
-import sys
+# Thin rule script: the vehicle study's comparison (parksteer.diagnose.compare.compare_files), its records taken in
+# as `parksteer compare --vehicle` takes them (parksteer.diagnose.intake), its JSON and figure kept as the outputs.
+import json
 from pathlib import Path
 
-import parksteer.commands.measure  # noqa: F401 (the command this rule runs; its imports are the rule's inputs)
-from parksteer.cli import main
+from parksteer.diagnose.compare import compare_files
+from parksteer.diagnose.intake import Request, car_parameters, intake
+from parksteer.figures.diagnose import compare_figure
+from parksteer.measure.importers import channel_map_from_options
 from parksteer.rules import rule_log
 
 
@@ -18,9 +20,15 @@ def measurement_files(items):
     return out
 
 
-with rule_log(snakemake), open(snakemake.output.json, "w", encoding="utf-8") as out, \
-        contextlib.redirect_stdout(out):
-    status = main(["compare", *measurement_files(snakemake.input.files), "--parameters", snakemake.input.parameters,
-                   "--vehicle", snakemake.input.vehicle, *snakemake.params.options,
-                   "--json", "--plot", snakemake.output.svg])
-sys.exit(status)
+with rule_log(snakemake):
+    options = snakemake.params.options
+    vehicle = snakemake.input.vehicle
+    car = car_parameters(snakemake.input.parameters, vehicle)
+    taken = intake(Request(measurement_files(snakemake.input.files), car, vehicle=vehicle, case=options["case"],
+                           surface=options["surface"], channel_map=channel_map_from_options(None, options["map_file"]),
+                           command="compare"))
+    result = compare_files(taken.files, taken.params, taken.effects)
+    compare_figure(result, snakemake.output.svg)
+    with open(snakemake.output.json, "w", encoding="utf-8") as out:
+        json.dump(result.as_dict(), out, indent=1, allow_nan=False)
+        out.write("\n")

@@ -1,10 +1,12 @@
-# Thin rule script: `parksteer diagnose --vehicle` (parksteer.commands.measure) with its JSON kept as the output.
-import contextlib
-import sys
+# Thin rule script: the vehicle study's diagnosis, its records taken in as `parksteer diagnose --vehicle` takes them
+# (parksteer.diagnose.intake), its JSON, figure, report and HTML page written as the command writes them
+# (parksteer.commands.diagnosis_files).
+import json
 from pathlib import Path
 
-import parksteer.commands.measure  # noqa: F401 (the command this rule runs; its imports are the rule's inputs)
-from parksteer.cli import main
+from parksteer.commands.diagnosis_files import write_diagnosis
+from parksteer.diagnose.intake import Request, car_parameters, intake
+from parksteer.measure.importers import channel_map_from_options
 from parksteer.rules import rule_log
 
 
@@ -18,10 +20,16 @@ def measurement_files(items):
     return out
 
 
-with rule_log(snakemake), open(snakemake.output.json, "w", encoding="utf-8") as out, \
-        contextlib.redirect_stdout(out):
-    status = main(["diagnose", *measurement_files(snakemake.input.files), "--parameters", snakemake.input.parameters,
-                   "--vehicle", snakemake.input.vehicle, *snakemake.params.options,
-                   "--json", "--plot", snakemake.output.svg, "--report", snakemake.output.md,
-                   "--html", snakemake.output.html])
-sys.exit(status)
+with rule_log(snakemake):
+    options = snakemake.params.options
+    vehicle = snakemake.input.vehicle
+    car = car_parameters(snakemake.input.parameters, vehicle)
+    taken = intake(Request(measurement_files(snakemake.input.files), car, vehicle=vehicle, case=options["case"],
+                           surface=options["surface"], channel_map=channel_map_from_options(None, options["map_file"]),
+                           jobs=None))
+    diagnosis = taken.diagnose(quiet=False)
+    result = write_diagnosis(diagnosis, taken, plot=snakemake.output.svg, report=snakemake.output.md,
+                             html=snakemake.output.html)
+    with open(snakemake.output.json, "w", encoding="utf-8") as out:
+        json.dump(result, out, indent=1, allow_nan=False)
+        out.write("\n")

@@ -2,7 +2,7 @@
 driver's torque under a target (parksteer.sweep.assist_sizing). ``parksteer assist creep``: how much of the tyre's
 moment a creeping car keeps over the turn-slip slope (parksteer.figures.assist_creep). ``parksteer assist
 identify``: an electric assist's boost table and its gear's hidden numbers from the car's own records
-(parksteer.diagnose.assist_identify)."""
+(parksteer.diagnose.identify.assist_identify)."""
 
 from __future__ import annotations
 
@@ -68,7 +68,7 @@ def _identify(args) -> int:
     import json
     import sys
 
-    from ..diagnose.assist_identify import identify_boost
+    from ..diagnose.identify.assist_identify import identify_boost
     from ..tables import atomic_path
 
     out = Path(args.out)

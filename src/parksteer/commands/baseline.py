@@ -4,7 +4,7 @@ against them (parksteer.diagnose.baseline). The record options are ``diagnose``'
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 from ..errors import UsageError
@@ -16,22 +16,23 @@ from . import add_quiet_option
 class RecordOptions:
     """What ``diagnose`` (:mod:`.measure`) lends these commands, so that they read records exactly as it does (it
     passes them in: this module does not import it back): `add(parser, outputs=False)`, the record options;
-    `effects(args, params)`, the model's effects; `check_writable(option, value, folder)`; `channel_map(args)`,
-    `assist_of(effects)` and `with_speed(params, effects, files)`, how the records are read and at what speed."""
+    `effects(args, params)`, the model's effects; `check_writable(option, value, folder)`; `channel_map(args)`;
+    `request(args, params)`, the intake's request (:class:`parksteer.diagnose.intake.Request`) of the options."""
 
     add: Callable
     effects: Callable
     check_writable: Callable
     channel_map: Callable
-    assist_of: Callable
-    with_speed: Callable
+    request: Callable
 
     def load(self, args, paths, params, effects):
-        """(files, params, effects): the records `paths` read with the command's record options, at their speed."""
-        from ..diagnose.problem import load_files
+        """(files, params, effects): the records `paths` read with the command's record options, at their speed,
+        through the intake (:func:`parksteer.diagnose.intake.intake`; a rack that never reverses is refused)."""
+        from ..diagnose.intake import intake
 
-        files = load_files(paths, params, args.case, args.surface, self.channel_map(args), self.assist_of(effects))
-        return (files, *self.with_speed(params, effects, files))
+        taken = intake(replace(self.request(args, params), files=paths, effects=effects, vehicle=None,
+                               with_assist=False, command="baseline"))
+        return taken.files, taken.params, taken.effects
 
 
 def add_baseline_options(p) -> None:
@@ -61,10 +62,6 @@ def _learnt(args, paths, params, effects, settings, workers: int, records: Recor
     from ..diagnose.baseline import learn_baseline
 
     files, params, effects = records.load(args, paths, params, effects)
-    for f in files:
-        if len(f.phases.reversal_times_s) == 0:
-            raise UsageError(f"{f.measurement.path}: column 'rack_m': the rack never reverses, so the record holds "
-                             "no reversal to calibrate the friction on; a baseline needs a cycle that turns back")
     return learn_baseline(files, params, effects, settings, vehicle=args.vehicle,
                           progress=None if args.quiet else note, workers=workers)
 

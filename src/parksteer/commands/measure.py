@@ -1,8 +1,9 @@
-"""``parksteer compare`` and ``parksteer diagnose``: the model against measurement files."""
+"""``parksteer compare`` and ``parksteer diagnose``: the model against measurement files. The command parses its
+options and prints; what the options mean to the method is the intake's (:mod:`parksteer.diagnose.intake`), what
+it writes beside its JSON :mod:`.diagnosis_files`'s."""
 
 from __future__ import annotations
 
-import dataclasses
 import json
 import sys
 from pathlib import Path
@@ -10,7 +11,6 @@ from pathlib import Path
 from ..names import SURFACES
 from ..errors import UsageError
 from ..parameters import DEFAULT_PATH
-from ..progress import note
 from . import add_quiet_option, check_writable
 from .baseline import RecordOptions, baseline_of, register_baseline
 from .vehicle import add_vehicle_option, parameters_of
@@ -124,118 +124,34 @@ def _print_json(result: dict) -> None:
     sys.stdout.write("\n")
 
 
+def request_of(args, params, **options):
+    """The intake's request (:class:`parksteer.diagnose.intake.Request`) of the record options in `args`, for the
+    car `params`; `options`: the request's further fields (the diagnosis's options)."""
+    from ..diagnose.intake import Request
+
+    return Request(args.files, params, args.effects, vehicle=getattr(args, "vehicle", None),
+                   with_assist=getattr(args, "with_assist", False), case=args.case, surface=args.surface,
+                   channel_map=channel_map_of(args), command=args.command, **options)
+
+
 def effects_of(args, params) -> list:
-    """The model's effects: --effects, with the vehicle file's [assist] added under --with-assist."""
-    from ..model.symbolic.components import resolve_effects
+    """The model's effects: --effects, with the vehicle file's [assist] added under --with-assist
+    (:func:`parksteer.diagnose.intake.model_effects`)."""
+    from ..diagnose.intake import Request, model_effects
 
-    if not getattr(args, "with_assist", False):
-        effects = resolve_effects(args.effects)
-        _warn_unused_assist(args, params, effects)
-        return _by_reference(effects)
-    if args.vehicle is None:
-        raise UsageError("--with-assist needs --vehicle FILE (the assist is the vehicle file's [assist])")
-    from ..model.numeric.assist import check_assist, effects_with_assist
-
-    if check_assist(params) is None:
-        raise UsageError(f"--with-assist: {args.vehicle} has no [assist] section")
-    return _by_reference(resolve_effects(effects_with_assist(args.effects, params)))
-
-
-def _by_reference(effects: list) -> list:
-    """`effects`, each one's class findable by its module's name before any worker process forks
-    (:func:`parksteer.diagnose.parallel.by_reference`)."""
-    from ..diagnose.parallel import by_reference
-
-    return by_reference(effects)
-
-
-def _warn_unused_assist(args, params, effects) -> None:
-    """One line on stderr when the vehicle file has an [assist] the run leaves out: the record is then fitted as
-    the car without assistance, its torque as the whole steering torque, which a record of the car with its
-    assist working (a bus log's torsion-bar torque, say) is not."""
-    if getattr(args, "vehicle", None) is None or assist_of_effects(effects) is not None:
-        return
-    from ..vehicle import assist_of
-
-    if assist_of(params) is not None:
-        print(f"parksteer {args.command}: warning: {args.vehicle} has an [assist] section, left out: the records "
-              "are fitted as the car without assistance; if they were logged with the assist working, add "
-              "--with-assist", file=sys.stderr)
-
-
-# A record's speed channel gives the run's one constant speed (the model has no time-varying speed): its middle 90 %
-# must lie within this band (km/h), every file's median within it of the others', and a median below the standstill
-# limit is standstill (the model as it was, bit for bit).
-SPEED_BAND_KMH = 1.0
-STANDSTILL_KMH = 0.1
-
-
-def with_record_speed(params, effects, files):
-    """(params, effects) of a run at the records' vehicle speed, from their speed channel (``vehicle_speed_mps``):
-    unchanged at standstill or without the channel, else the rolling tyre's turn slip added at the median speed
-    (as ``simulate --speed-kmh``); a speed that varies, or differs between files, is refused in one line."""
-    import numpy as np
-
-    from ..measure.importers import SPEED
-    from ..model.symbolic.components import discover_effects
-    from ..vehicle import MAX_CREEPING_SPEED_KMH, creeping_overrides
-
-    logged = [f for f in files if SPEED in f.measurement.columns]
-    if not logged:
-        return params, effects
-    if len(logged) != len(files):
-        missing = next(f for f in files if SPEED not in f.measurement.columns)
-        raise UsageError(f"{missing.measurement.path or missing.label}: no column {SPEED!r} while "
-                         f"{logged[0].measurement.path or logged[0].label} has one; a run has one speed, give it in "
-                         "every file or in none")
-    medians = []
-    for f in logged:
-        kmh = np.abs(np.asarray(f.measurement.columns[SPEED], dtype=float)) * 3.6
-        low, middle, high = np.percentile(kmh, [5.0, 50.0, 95.0])
-        where = f"{f.measurement.path or f.label}: column {SPEED!r}"
-        if high - low > SPEED_BAND_KMH:
-            raise UsageError(f"{where}: the speed varies from {low:.2f} to {high:.2f} km/h (middle 90 %); the model "
-                             f"takes one constant speed a run (within {SPEED_BAND_KMH:g} km/h): cut the record where "
-                             "the car creeps steadily")
-        if middle > MAX_CREEPING_SPEED_KMH:
-            raise UsageError(f"{where}: {middle:.1f} km/h is beyond parking and creeping (0-"
-                             f"{MAX_CREEPING_SPEED_KMH:g} km/h)")
-        medians.append((middle, f))
-    (slow, f_slow), (fast, f_fast) = min(medians, key=lambda m: m[0]), max(medians, key=lambda m: m[0])
-    if fast - slow > SPEED_BAND_KMH:
-        raise UsageError(f"{f_fast.measurement.path or f_fast.label}: column {SPEED!r}: {fast:.2f} km/h against "
-                         f"{slow:.2f} km/h in {f_slow.measurement.path or f_slow.label}; diagnose files of one speed "
-                         "together")
-    speed_kmh = float(np.median([m for m, _ in medians]))
-    if speed_kmh < STANDSTILL_KMH:
-        return params, effects
-    if all(e.name != "turn_slip" for e in effects):
-        effects = sorted([*effects, discover_effects()["turn_slip"]], key=lambda e: e.name)
-    note(f"vehicle speed from the records' {SPEED}: {speed_kmh:.2f} km/h, constant over the run (the rolling tyre's "
-         "turn slip added)")
-    return params.with_overrides(creeping_overrides(speed_kmh)), effects
-
-
-def assist_of_effects(effects) -> str | None:
-    """The name of the power assist among `effects`, if any."""
-    from ..model.symbolic.components import power_assist_of
-
-    assist = power_assist_of(effects)
-    return None if assist is None else assist.name
+    return model_effects(Request((), params, args.effects, vehicle=getattr(args, "vehicle", None),
+                                 with_assist=getattr(args, "with_assist", False), command=args.command))
 
 
 def _compare(args) -> int:
     from ..diagnose.compare import compare_files
-    from ..diagnose.problem import load_files
+    from ..diagnose.intake import intake
     from ..model.numeric.values import parse_overrides
 
     _check_outputs(args)
     overrides = parse_overrides(args.overrides)
-    params = parameters_of(args)
-    effects = effects_of(args, params)
-    files = load_files(args.files, params, args.case, args.surface, channel_map_of(args), assist_of_effects(effects))
-    params, effects = with_record_speed(params, effects, files)
-    result = compare_files(files, params, effects, overrides)
+    taken = intake(request_of(args, parameters_of(args)))
+    result = compare_files(taken.files, taken.params, taken.effects, overrides)
     summary = result.as_dict()
     if args.plot:
         from ..figures.diagnose import compare_figure
@@ -262,140 +178,22 @@ def _compare(args) -> int:
 
 
 def _diagnose(args) -> int:
-    from ..diagnose.problem import load_files
-    from ..diagnose.report import diagnosis_dict
-    from ..diagnose.pages import markdown_report, write_markdown
-    from ..measure.importers import ANGLE
-    from ..diagnose.select import diagnose
-    from ..diagnose.settings import DEFAULT_SETTINGS
+    from ..diagnose.intake import intake
+    from .diagnosis_files import write_diagnosis
 
     _check_outputs(args)
     if not (args.json or args.report or args.plot or args.html or args.suggest_effect):
         raise UsageError("say where the result goes: --json, --report OUT.md, --html OUT.html, --plot OUT.svg and/or "
                          "--suggest-effect OUT.py")
-    params = parameters_of(args)
-    effects = effects_of(args, params)
-    files = load_files(args.files, params, args.case, args.surface, channel_map_of(args), assist_of_effects(effects))
-    params, effects = with_record_speed(params, effects, files)
-    for f in files:
-        if len(f.phases.reversal_times_s) == 0:
-            raise UsageError(f"{f.measurement.path}: column 'rack_m': the rack never reverses, so the record holds "
-                             "no reversal to calibrate the friction on; diagnose needs a cycle that turns back")
-    from ..diagnose.parallel import available_workers
-
-    if args.jobs is not None and args.jobs < 1:
-        raise UsageError(f"--jobs {args.jobs}: give at least 1")
-    workers = args.jobs if args.jobs is not None else available_workers()
-    settings = DEFAULT_SETTINGS
-    if args.torque_lag:
-        derived = next((f for f in files if "rack_derived" in f.measurement.metadata), None)
-        if derived is not None:
-            raise UsageError(f"{derived.measurement.path or derived.label}: --torque-lag needs a measured rack channel "
-                             "(this file's rack is derived from the angle and the torque itself, so it has no lag "
-                             "behind the torque to find)")
-        settings = dataclasses.replace(settings, torque_lag_fitted=True)
-    if args.angle:
-        settings = dataclasses.replace(settings, use_handwheel_angle=True)
-        with_angle = [f.label for f in files if f.angle_rad is not None]
-        if not with_angle:
-            f = files[0]
-            why = "its rack is derived from the angle" if ANGLE in f.measurement.columns else f"no column {ANGLE!r}"
-            raise UsageError(f"{f.measurement.path or f.label}: --angle needs a handwheel angle beside a measured rack "
-                             f"({why})")
-        note(f"handwheel angle fitted beside the torque in {len(with_angle)} of {len(files)} file(s): "
-             + ", ".join(with_angle))
-    diagnosis = diagnose(files, params, effects, workers=workers, quiet=args.quiet, settings=settings,
-                         baseline=baseline_of(args, params, effects, settings, workers, RECORDS))
-    result = _with_suggestion(args, diagnosis_dict(diagnosis), diagnosis, settings)
-    user_plot = None
-    if args.plot:
-        from ..figures.diagnose import diagnosis_figure
-
-        diagnosis_figure(diagnosis, args.plot)
-        if "user_effect" in diagnosis.outputs:  # a user's effect in the model: its own figure beside
-            from ..figures.user_effect import user_effect_figure, user_effect_path
-
-            user_plot = user_effect_path(args.plot)
-            user_effect_figure(diagnosis, user_plot)
-            note(f"the figure of {', '.join(diagnosis.outputs['user_effect'].effects)}: {user_plot}")
-    # both pages render the same sections: the residual by phase for both, the error ladder (a diagnosis more for
-    # each effect it names) where the HTML page asks for it, and then in both
-    phases = ladder = None
-    if args.report or args.html:
-        from ..diagnose.report import phase_residuals
-
-        phases = phase_residuals(diagnosis)
-    if args.html:
-        from ..diagnose.ladder import error_ladder
-
-        ladder = error_ladder(files, params, list(diagnosis.base_effects), first=diagnosis, workers=workers)
-    if args.report:
-        figure = _linked(args.plot, args.report) if args.plot else None
-        write_markdown(args.report, markdown_report(result, figure,
-                                                    _linked(user_plot, args.report) if user_plot else None,
-                                                    phases, ladder.as_dict() if ladder is not None else None))
-    if args.html:
-        _write_html(args.html, diagnosis, result, phases, ladder)
+    taken = intake(request_of(args, parameters_of(args), angle=args.angle, torque_lag=args.torque_lag,
+                              jobs=args.jobs))
+    diagnosis = taken.diagnose(quiet=args.quiet, baseline=baseline_of(args, taken.params, taken.effects,
+                                                                       taken.settings, taken.workers, RECORDS))
+    result = write_diagnosis(diagnosis, taken, plot=args.plot, report=args.report, html=args.html,
+                             suggest_effect=args.suggest_effect)
     if args.json:
         _print_json(result)
     return 0
 
 
-def _linked(figure, report) -> str:
-    """`figure` as the markdown `report` links it: relative to the report's folder when it lies under it."""
-    resolved, folder = Path(figure).resolve(), Path(report).resolve().parent
-    return str(resolved.relative_to(folder)) if resolved.is_relative_to(folder) else str(figure)
-
-
-def _with_suggestion(args, result: dict, diagnosis, settings) -> dict:
-    """With --suggest-effect and an unexplained verdict, the effect the residual's signature points to, written
-    and fitted (parksteer.diagnose.suggest)."""
-    if not args.suggest_effect:
-        return result
-    signature = diagnosis.outputs.get("signature")
-    if diagnosis.verdict != "unexplained" or signature is None or signature.effect_class is None:
-        note(f"no effect suggested (verdict {diagnosis.verdict}"
-             + (", no structure in the residual" if signature is not None and signature.effect_class is None
-                else "") + ")")
-        return result
-    from ..diagnose.report import with_suggestion
-    from ..diagnose.suggest import suggest
-
-    suggestion = suggest(diagnosis.problem, diagnosis.calibration, signature, args.suggest_effect, settings)
-    note(f"suggested effect {suggestion.effect_name} written to {args.suggest_effect}: weighted RMS "
-         f"{suggestion.before_over_floor:.2f} -> {suggestion.after_over_floor:.2f} noise floors")
-    return with_suggestion(result, suggestion)
-
-
-def _write_html(path: str, diagnosis, result: dict, phases: list[dict], ladder) -> None:
-    """The diagnosis and its error ladder as one self-contained HTML page (parksteer.diagnose.pages.html_report)."""
-    import tempfile
-
-    from ..diagnose.pages import html_report, write_markdown
-    from ..figures.diagnose import diagnosis_figure, ladder_figure, phase_residual_figure
-
-    captions = {
-        "diagnosis": "Measured handwheel torque and the calibrated model (with the best candidate) against rack, "
-                     "their residual, and the weighted RMS error with each candidate (first file).",
-        "phases": "RMS residual by phase of the cycle over all files, against the noise floor.",
-        "ladder": "The error ladder: the paper's model, calibrated, then with each effect the diagnoses name, down "
-                  "to the noise floor.",
-    }
-    if "user_effect" in diagnosis.outputs:
-        captions["user_effect"] = ("Your effect: the error ladder without it and with it, the record (first file) "
-                                   "with both models and their residuals over the phases of the cycle, the residual "
-                                   "by phase, and the error as its strengths grow from 0 to their fitted values.")
-    with tempfile.TemporaryDirectory() as tmp:
-        if "user_effect" in diagnosis.outputs:
-            from ..figures.user_effect import user_effect_figure
-
-            user_effect_figure(diagnosis, Path(tmp) / "user_effect.svg")
-        diagnosis_figure(diagnosis, Path(tmp) / "diagnosis.svg")
-        phase_residual_figure(phases, Path(tmp) / "phases.svg")
-        ladder_figure(ladder.rungs, ladder.noise_floor_Nm, ladder.attainable_floor_Nm, Path(tmp) / "ladder.svg")
-        figures = [(name, caption, (Path(tmp) / f"{name}.svg").read_text(encoding="utf-8"))
-                   for name, caption in captions.items()]
-    write_markdown(path, html_report(result, figures, phases, ladder.as_dict()))
-
-
-RECORDS = RecordOptions(_common, effects_of, _check_writable, channel_map_of, assist_of_effects, with_record_speed)
+RECORDS = RecordOptions(_common, effects_of, _check_writable, channel_map_of, request_of)

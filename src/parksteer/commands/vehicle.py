@@ -263,14 +263,8 @@ def add_vehicle_option(p) -> None:
 
 
 def parameters_of(args):
-    """The parameters of a command: --parameters, with the car of --vehicle over it when given."""
-    params = load_parameters(args.parameters)
-    if getattr(args, "vehicle", None) is None:
-        return params
-    from ..vehicle import load_vehicle
+    """The parameters of a command: --parameters, with the car of --vehicle over it when given
+    (:func:`parksteer.diagnose.intake.car_parameters`)."""
+    from ..diagnose.intake import car_parameters
 
-    from ..model.numeric.assist import check_assist
-
-    params = load_vehicle(args.vehicle, params)
-    check_assist(params)
-    return params
+    return car_parameters(args.parameters, getattr(args, "vehicle", None))

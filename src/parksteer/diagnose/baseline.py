@@ -144,7 +144,7 @@ def learn_baseline(files, params: Parameters, effects=None, settings: DiagnosisS
     `files`, `params`, `effects`, `registry`, `settings`, `workers`: as :func:`parksteer.diagnose.select.diagnose`
     takes them (the records loaded by :func:`parksteer.diagnose.problem.load_files`). `vehicle`: the vehicle file's
     path (named in the baseline; for an assisted car whose file gives only its gear's data, its assist is first
-    identified from these records, :mod:`parksteer.diagnose.assist_identify`). `progress`: None (quiet) or a
+    identified from these records, :mod:`parksteer.diagnose.identify.assist_identify`). `progress`: None (quiet) or a
     callable given one line at each step."""
     return learn(Baseline, files, params, effects, settings, vehicle=vehicle, progress=progress, registry=registry,
                  workers=workers)

@@ -1,6 +1,6 @@
 """An assisted car's baseline: where its vehicle file gives only the gear's data (its boost map assumed, or a line),
 the map and the gear's hidden numbers are identified from the healthy records first, as ``parksteer assist
-identify`` does (:func:`parksteer.diagnose.assist_identify.identify_boost`), and the vehicle file it writes is the
+identify`` does (:func:`.identify.assist_identify.identify_boost`), and the vehicle file it writes is the
 one the baseline and every later record are diagnosed with."""
 
 from __future__ import annotations
@@ -29,7 +29,7 @@ def identified_vehicle(files, params: Parameters, effects, vehicle, say) -> str 
     file's path is not known)."""
     if vehicle is None or not needs_identification(files, params, effects):
         return None
-    from .assist_identify import identify_boost
+    from .identify.assist_identify import identify_boost
 
     say("baseline: the assist's map and gear identified from the healthy records (as parksteer assist identify)")
     found = identify_boost([f.measurement for f in files], params)

@@ -205,7 +205,7 @@ class DiagnosisSettings:
     confounded_fraction: float = 0.3
     # A measurement is offered as separating two candidates (or as fixing a calibrated parameter) only where it
     # predicts a difference of at least this many noise floors RMS: below the floor the record of that measurement
-    # would not tell them apart either (parksteer.diagnose.report.separating).
+    # would not tell them apart either (parksteer.reporting.report.separating).
     separating_over_floor: float = 1.0
 
     # --- what the data fix (parksteer.diagnose.stages.identify) ------------------------------------------------

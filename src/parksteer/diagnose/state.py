@@ -152,7 +152,7 @@ class DiagnosisState:
 
 @dataclass(frozen=True)
 class Diagnosis:
-    """Everything :func:`parksteer.diagnose.select.diagnose` found (its JSON form, :mod:`parksteer.diagnose.report`,
+    """Everything :func:`parksteer.diagnose.select.diagnose` found (its JSON form, :mod:`parksteer.reporting.report`,
     is documented by the schema ``parksteer/data/diagnosis.schema.json``)."""
 
     problem: Problem

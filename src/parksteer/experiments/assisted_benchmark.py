@@ -45,9 +45,8 @@ from ..measure.converter import quantisation_step
 from ..synthetic.variations import variation_by_name
 from .benchmark import BASE_PERTURBATION, BENCHMARK_SETTINGS
 from .outclass import bic_margin
-from ..diagnose.problem import load_files
-from ..diagnose.report import diagnosis_dict
-from ..diagnose.select import diagnose
+from ..diagnose.intake import Request, intake
+from ..reporting.report import diagnosis_dict
 from .rows import ROW_SUFFIX, read_case_files
 from .variations import NAMED_MIN_STEPS, NAMED_TARGET, NULL_ADEQUATE_TARGET
 from ..names import TORQUE
@@ -266,7 +265,7 @@ def run(params: Parameters, design: AssistedDesign = AssistedDesign(), only=None
             path = Path(folder) / f"{case.name}.csv"
             write_measurement(path, record, params)
             made = time.perf_counter()
-            result = diagnosis_dict(diagnose(load_files([path], params), params, effects, settings=settings))
+            result = diagnosis_dict(intake(Request([path], params, effects, settings=settings)).diagnose())
             result["cost"]["wall_s"] = time.perf_counter() - made
             row = outcome(truth, result)
             row["generation_s"] = made - start

@@ -36,9 +36,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..diagnose.problem import load_files
-from ..diagnose.report import diagnosis_dict
-from ..diagnose.select import diagnose
+from ..diagnose.intake import Request, intake
+from ..reporting.report import diagnosis_dict
 from ..errors import UsageError
 from ..measure.io import format_measurement, write_measurement
 from ..parameters import Parameters, load_parameters
@@ -221,8 +220,8 @@ def run(params: Parameters, base_path: str | Path, design: TruthDesign = TruthDe
             for route in design.routes:
                 file = file_for(route, case.tier)
                 began = time.perf_counter()
-                files = load_files([path], file.params, assist=file.assist)
-                result = diagnosis_dict(diagnose(files, file.params, file.effects, settings=BENCHMARK_SETTINGS))
+                taken = intake(Request([path], file.params, file.effects, settings=BENCHMARK_SETTINGS))
+                result = diagnosis_dict(taken.diagnose())
                 result["cost"]["wall_s"] = time.perf_counter() - began
                 row = outcome(truth, result)
                 row["route"] = route

@@ -82,7 +82,7 @@ def template_default(key: str) -> float:
 def identified_route(owner: Owner, baseline: Path, folder: str | Path) -> Owner:
     """The file `parksteer assist identify` writes from the tier's baseline record and the owner's file (its
     gear's data; its map is not used): the identified table, the product k_t eta_f N, the motor friction."""
-    from ..diagnose.assist_identify import identify_boost
+    from ..diagnose.identify.assist_identify import identify_boost
     from ..model.numeric.assist import effects_with_assist
     from ..model.symbolic.components import resolve_effects
     from ..vehicle import vehicle_from_text

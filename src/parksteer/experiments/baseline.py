@@ -31,7 +31,7 @@ import time
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
-from ..diagnose.report import diagnosis_dict
+from ..reporting.report import diagnosis_dict
 from ..diagnose.select import diagnose
 from ..errors import UsageError
 from ..parameters import Parameters

@@ -32,10 +32,9 @@ from ..measure.io import write_measurement
 from ..parameters import Parameters, load_parameters
 from ..synthetic.datasets import BenchmarkDesign, benchmark_specs, file_name, make_dataset
 from ..tables import write_json
-from ..diagnose.problem import load_files
-from ..diagnose.report import diagnosis_dict
+from ..diagnose.intake import Request, intake
+from ..reporting.report import diagnosis_dict
 from .rows import BenchmarkRow
-from ..diagnose.select import diagnose
 from ..diagnose.settings import DEFAULT_SETTINGS, DiagnosisSettings
 
 # The benchmarks' diagnoses: a user's, without the stages that only inform a report (the confound tests, the
@@ -72,7 +71,7 @@ def diagnose_written(params: Parameters, records, folder: str | Path, truth: dic
         write_measurement(path, measurement, params)
         paths.append(path)
     generated = time.perf_counter()
-    diagnosis = diagnose(load_files(paths, params), params, settings=settings)
+    diagnosis = intake(Request(paths, params, settings=settings)).diagnose()
     result = diagnosis_dict(diagnosis)
     result["cost"]["wall_s"] = time.perf_counter() - generated
     result["cost"]["generation_s"] = generated - started_s

@@ -36,8 +36,7 @@ from ..measure.converter import quantisation_step
 from ..synthetic.outoflibrary import COMBINED_FORMS, FORMS, TruthForm, form_by_name
 from ..synthetic.variations import VARIATIONS, variation_rack, variation_record
 from .benchmark import BASE_PERTURBATION, BENCHMARK_SETTINGS
-from ..diagnose.problem import load_files
-from ..diagnose.select import diagnose
+from ..diagnose.intake import Request, intake
 from ..diagnose.signature import signature_of
 from ..diagnose.suggest import suggest
 from ..names import TORQUE
@@ -138,7 +137,7 @@ def run_case(params: Parameters, case: SignatureCase, design: SignatureDesign, f
     # as a user would: the torque lag searched for where the logger is known to delay its torque channel
     logger = next(v for v in VARIATIONS if v.name == case.variation).logger
     settings = replace(BENCHMARK_SETTINGS, torque_lag_fitted=logger.torque_lag_s > 0.0)
-    diagnosis = diagnose(load_files([path], params), params, settings=settings)
+    diagnosis = intake(Request([path], params, settings=settings)).diagnose()
     diagnosed = time.perf_counter()
     sig = signature_of(diagnosis.problem.files, diagnosis.calibration.predictions, params,
                        diagnosis.calibration.overrides, diagnosis.calibration.jacobian)

@@ -91,9 +91,8 @@ def diagnose_case(params, folder, truth: dict, benchmark: str, split: str) -> di
     from ..synthetic.datasets import file_name
     from ..synthetic.variations import variation_by_name
     from .benchmark import BENCHMARK_SETTINGS
-    from ..diagnose.problem import load_files
-    from ..diagnose.report import diagnosis_dict
-    from ..diagnose.select import diagnose
+    from ..diagnose.intake import Request, intake
+    from ..reporting.report import diagnosis_dict
 
     settings = BENCHMARK_SETTINGS
     if benchmark == "variations":  # as variations.run_case diagnoses it
@@ -102,7 +101,7 @@ def diagnose_case(params, folder, truth: dict, benchmark: str, split: str) -> di
                            torque_lag_fitted=variation.logger.torque_lag_s > 0.0)
     paths = [Path(folder) / file_name(f["case"], f["surface"]) for f in truth["files"]]
     start = time.perf_counter()
-    diagnosis = diagnose(load_files(paths, params), params, settings=settings)
+    diagnosis = intake(Request(paths, params, settings=settings)).diagnose()
     wall = time.perf_counter() - start
     return case_result(truth, diagnosis, diagnosis_dict(diagnosis), wall, split, benchmark)
 

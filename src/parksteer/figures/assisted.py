@@ -101,7 +101,7 @@ def gather_assisted_figure(batches, names: list[str], vehicle: str | Path, svg: 
 
 def _write_outputs(rows: list[dict], summary: dict, vehicle: str | Path, svg: str | Path, csv: str | Path,
                    json_path: str | Path) -> dict:
-    from ..diagnose.report import MACHINE_TIME_KEYS, without_machine_times
+    from ..reporting.report import MACHINE_TIME_KEYS, without_machine_times
     from ..tables import write_csv, write_json
 
     assisted_figure(rows, summary, svg)

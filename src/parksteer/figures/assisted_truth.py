@@ -109,7 +109,7 @@ def gather_assisted_truth_figure(batches, names: list[str], section: dict | None
     """figures/diag_assisted_truth.svg, its CSV (one row per record and route) and results/diag_assisted_truth.json
     (the targets per route and tier, the misses, the truth's description; no machine times) from the rows the jobs
     of rule diag_assisted_truth_batch wrote into the folders `batches`, the cases `names` in the design's order."""
-    from ..diagnose.report import MACHINE_TIME_KEYS, without_machine_times
+    from ..reporting.report import MACHINE_TIME_KEYS, without_machine_times
     from ..experiments.assisted_truth import design_from_config, read_rows, summarise
     from ..tables import write_csv, write_json
 

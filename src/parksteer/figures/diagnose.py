@@ -103,7 +103,7 @@ def diagnosis_figure(diagnosis, path: str | Path) -> None:
     """First file: torque and residual against rack for the calibrated model and with the best candidate; for an
     assisted car whose motor channel is fitted, that channel measured and fitted, and its residual, beside the
     torque's; ranking."""
-    from ..diagnose.report import candidate_predictions, candidate_statistics
+    from ..reporting.report import candidate_predictions, candidate_statistics
 
     f = diagnosis.problem.files[0]
     fig, axes = new_figure(7.0, 12.0 if f.uses_motor else 8.0, nrows=5 if f.uses_motor else 3)
@@ -145,7 +145,7 @@ def diagnosis_figure(diagnosis, path: str | Path) -> None:
 def _motor_panels(diagnosis, channel_ax, residual_ax) -> None:
     """The first file's motor channel (an assisted car's current or motor torque): measured, the calibrated model
     and with the best candidate against rack; and the residual of each."""
-    from ..diagnose.report import candidate_predictions
+    from ..reporting.report import candidate_predictions
 
     f = diagnosis.problem.files[0]
     rack_mm = f.rack_m * 1000
@@ -211,7 +211,7 @@ def make_ladder_figure(case_study_json: str | Path, residuals_csv: str | Path, s
     """figures/diag_ladder from the case study's numbers (results/case_study.json) and residuals."""
     import json
 
-    from ..diagnose.report import without_machine_times
+    from ..reporting.report import without_machine_times
     from ..tables import read_csv, write_csv, write_json
 
     study = json.loads(Path(case_study_json).read_text(encoding="utf-8"))
@@ -233,7 +233,7 @@ def make_ladder_figure(case_study_json: str | Path, residuals_csv: str | Path, s
 
 
 def phase_residual_figure(rows: list[dict], path: str | Path) -> None:
-    """RMS residual by phase over all files (from :func:`parksteer.diagnose.report.phase_residuals`): the calibrated
+    """RMS residual by phase over all files (from :func:`parksteer.reporting.report.phase_residuals`): the calibrated
     model and, when the verdict names one, with the missing effect; the dotted line is the median noise floor."""
     fig, ax = new_figure(7.0, 3.0)
     present = [p for p in PHASES if any(r["phase"] == p for r in rows)]

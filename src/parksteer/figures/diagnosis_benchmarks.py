@@ -64,7 +64,7 @@ def make_benchmark_figure(truth_paths, diagnosis_paths, svg: str | Path, csv: st
                           design=None) -> dict:
     """figures/diag_benchmark.svg (confusion matrix, accuracy against strength), its CSV, results JSON."""
     from ..experiments.benchmark import aggregate
-    from ..diagnose.report import MACHINE_TIME_KEYS, without_machine_times
+    from ..reporting.report import MACHINE_TIME_KEYS, without_machine_times
     from ..experiments.rows import csv_columns
     from ..tables import write_csv, write_json
 
@@ -132,7 +132,7 @@ def make_outclass_figure(truth_paths, diagnosis_paths, svg: str | Path, csv: str
                          design=None) -> dict:
     """figures/diag_outclass.svg (the out-of-class confusion table), its CSV (one row per data set), results JSON."""
     from ..experiments.outclass import aggregate
-    from ..diagnose.report import MACHINE_TIME_KEYS, without_machine_times
+    from ..reporting.report import MACHINE_TIME_KEYS, without_machine_times
     from ..experiments.rows import csv_columns
     from ..tables import write_csv, write_json
 
@@ -209,7 +209,7 @@ def make_variations_figure(truth_paths, diagnosis_paths, svg: str | Path, csv: s
                            design=None) -> dict:
     """figures/diag_variations.svg (targets per variation, errors against the thresholds), its CSV (one row per
     record) and results/diag_variations.json (the per-variation table and the targets)."""
-    from ..diagnose.report import MACHINE_TIME_KEYS, without_machine_times
+    from ..reporting.report import MACHINE_TIME_KEYS, without_machine_times
     from ..experiments.rows import csv_columns
     from ..experiments.variation_summary import aggregate
     from ..tables import write_csv, write_json

@@ -52,7 +52,7 @@ def peers_figure(comparison: dict, svg: str | Path) -> None:
 def make_peers_figure(peer_paths, svg: str | Path, csv: str | Path, json_path: str | Path) -> dict:
     """figures/diag_peers.svg and .csv (one row per method) and results/diag_peers.json (the comparison)."""
     from ..experiments.peer_scoring import compare, read_cases
-    from ..diagnose.report import without_machine_times
+    from ..reporting.report import without_machine_times
     from ..tables import write_csv, write_json
 
     comparison = compare(read_cases(peer_paths))

@@ -272,7 +272,7 @@ def make_signature_figure(row_paths, svg: str | Path, csv: str | Path, json_path
                           design: SignatureDesign | None = None) -> dict:
     """figures/diag_signature.svg and .csv, results/diag_signature.json from the rows the jobs wrote (in any
     order; sorted by record name)."""
-    from ..diagnose.report import without_machine_times
+    from ..reporting.report import without_machine_times
     from ..tables import write_csv, write_json
 
     rows = []

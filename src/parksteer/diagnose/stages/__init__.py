@@ -17,7 +17,7 @@ To add a stage:
    it keeps its result with ``state.with_output(name, value)`` (or, for a per-file result, in copies of the
    files: ``state.problem.with_files([dataclasses.replace(f, ...) ...])``);
 2. put it in :data:`STAGES` below, after the stages whose results it reads;
-3. give it its section in the report (:func:`parksteer.diagnose.report.diagnosis_dict`, reading
+3. give it its section in the report (:func:`parksteer.reporting.report.diagnosis_dict`, reading
    ``diagnosis.outputs[name]``) and in the JSON schema (``parksteer/data/diagnosis.schema.json``).
 
 The torque lag search (:mod:`.torque_lag`) is such a stage; its result is per file (``files[].torque_lag_s`` in

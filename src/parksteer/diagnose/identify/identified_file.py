@@ -1,4 +1,4 @@
-"""What ``parksteer assist identify`` found (:class:`Identified`, :func:`parksteer.diagnose.assist_identify.identify_boost`)
+"""What ``parksteer assist identify`` found (:class:`Identified`, :func:`.assist_identify.identify_boost`)
 and the vehicle file it writes again: its ``[assist]`` section replaced by what was identified, every other line
 kept as the owner wrote it."""
 
@@ -24,7 +24,7 @@ def _number(x: float) -> str:
 
 @dataclass(frozen=True)
 class Identified:
-    """What :func:`parksteer.diagnose.assist_identify.identify_boost` found (that module's docstring). ``torques`` (N m) and ``assist`` (at the point of
+    """What :func:`.assist_identify.identify_boost` found (that module's docstring). ``torques`` (N m) and ``assist`` (at the point of
     action, N m at the column or pinion, N at the rack) are the table with ``assist_ci95`` per point; ``current_A``
     the same map in motor current. ``beyond_map`` lists what the map cannot hold (empty: scatter and hysteresis
     within the noise)."""
@@ -84,7 +84,7 @@ class Identified:
     @property
     def assist_unit(self) -> str:
         """The unit of the assist at its point of action: N at the rack, N m at the column or pinion."""
-        from ..model.symbolic.components import discover_effects
+        from ...model.symbolic.components import discover_effects
 
         return "N" if discover_effects()[self.assist_name].location == "rack" else "N m"
 
@@ -137,7 +137,7 @@ def replace_assist_section(text: str, found) -> str:
     """`text` (a vehicle file) with its ``[assist]`` and ``[assist.*]`` tables written again from `found`."""
     import tomllib
 
-    from ..model.numeric.assist import LINE_KEYS  # the boost line's quantities, which a table replaces
+    from ...model.numeric.assist import LINE_KEYS  # the boost line's quantities, which a table replaces
 
     doc = tomllib.loads(text)
     old = doc.get("assist", {})

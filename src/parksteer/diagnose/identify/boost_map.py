@@ -1,4 +1,4 @@
-"""Step 1 of ``parksteer assist identify`` (:mod:`parksteer.diagnose.assist_identify`): the motor current's map of
+"""Step 1 of ``parksteer assist identify`` (:mod:`.assist_identify`): the motor current's map of
 the logged torsion-bar torque, fitted as a boost table (the law of
 :func:`parksteer.model.symbolic.effects.assist_common.table_law`) by a bounded Levenberg-Marquardt on portable
 arithmetic, with the intervals of a block sandwich and what a map cannot hold (scatter, hysteresis); and the
@@ -12,12 +12,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import portable as pm
-from ..boost_table import entries
-from ..model.symbolic.effects.assist_common import table_law
-from .calibrate import Z95
-from .problem import FileData
-from ..names import TORQUE
+from ... import portable as pm
+from ...boost_table import entries
+from ...model.symbolic.effects.assist_common import table_law
+from ..calibrate import Z95
+from ..problem import FileData
+from ...names import TORQUE
 
 SPAN_POINTS = 7  # table points beyond the dead band (9 with the origin and the dead band; the law allows 10)
 BLOCK_S = 1.0  # s: the blocks of the intervals' sandwich (residuals closer than this are taken as correlated)
@@ -181,7 +181,7 @@ def bounded_least_squares(residual, x0: np.ndarray, lower: np.ndarray, upper: np
 
 def fit_map(files: list[FileData]) -> _Map:
     """Step 1 of the module docstring: the current's map of the logged torsion-bar torque."""
-    from ..model.numeric.assisted import rack_speed_mps
+    from ...model.numeric.assisted import rack_speed_mps
 
     S = np.concatenate([f.torque_Nm for f in files])
     i = np.concatenate([f.motor for f in files])

@@ -1,6 +1,6 @@
-"""A diagnosis's JSON (:func:`parksteer.diagnose.report.diagnosis_dict`) as markdown, and as one self-contained
+"""A diagnosis's JSON (:func:`parksteer.reporting.report.diagnosis_dict`) as markdown, and as one self-contained
 HTML page (figures inlined as SVG, no external reference): both render the same sections
-(:func:`parksteer.diagnose.sections.report_sections`), so a section cannot be in one and not the other."""
+(:func:`parksteer.reporting.sections.report_sections`), so a section cannot be in one and not the other."""
 
 from __future__ import annotations
 
@@ -75,7 +75,7 @@ def html_report(result: dict, figures: list[tuple[str, str, str]], phases: list[
                 ladder: dict | None = None, title: str | None = None) -> str:
     """One self-contained page of the same sections as :func:`markdown_report`, each figure inlined where its
     section places it (`figures`: ``(name, caption, svg text)``, the names of
-    :class:`parksteer.diagnose.sections.FigurePlace`)."""
+    :class:`parksteer.reporting.sections.FigurePlace`)."""
     title = title or "Diagnosis: model against measurement"
     inlined = {name: (k, caption, svg) for k, (name, caption, svg) in enumerate(figures)}
     out = ["<!DOCTYPE html>", '<html lang="en">', "<head>", '<meta charset="utf-8">',

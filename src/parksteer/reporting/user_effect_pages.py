@@ -1,6 +1,6 @@
 """The report's section on a user's own effect (:mod:`parksteer.diagnose.stages.user_effect`): the ladder without it
 and with it, its fitted strengths with their intervals, the residual by phase before and after, and the sweep of its
-strengths from 0 (the section itself: :func:`parksteer.diagnose.sections.report_sections`)."""
+strengths from 0 (the section itself: :func:`parksteer.reporting.sections.report_sections`)."""
 
 from __future__ import annotations
 

@@ -14,9 +14,9 @@ from dataclasses import dataclass
 
 from ..model.symbolic.components import Effect, resolve_effects
 from ..parameters import Parameters
-from .settings import DEFAULT_SETTINGS, DiagnosisSettings
-from .problem import FileData
-from .select import Diagnosis, diagnose
+from ..diagnose.settings import DEFAULT_SETTINGS, DiagnosisSettings
+from ..diagnose.problem import FileData
+from ..diagnose.select import Diagnosis, diagnose
 
 
 @dataclass

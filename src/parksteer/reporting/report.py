@@ -1,5 +1,5 @@
 """A diagnosis as JSON (documented by parksteer/data/diagnosis.schema.json), and the rows and lines other views
-read from it; the pages (markdown and HTML) are :mod:`parksteer.diagnose.pages`."""
+read from it; the pages (markdown and HTML) are :mod:`parksteer.reporting.pages`."""
 
 from __future__ import annotations
 
@@ -11,9 +11,9 @@ import numpy as np
 
 from ..measure.phases import PHASES
 from ..resources import data_file
-from .calibrate import free_strengths
-from .stages.user_effect import conditioned_on_strengths
-from .state import Candidate, Diagnosis
+from ..diagnose.calibrate import free_strengths
+from ..diagnose.stages.user_effect import conditioned_on_strengths
+from ..diagnose.state import Candidate, Diagnosis
 
 SCHEMA_ID = "parksteer.diagnosis/1"
 SCHEMA_PATH = data_file("diagnosis.schema.json")

@@ -66,14 +66,14 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import portable as pm
-from ..errors import UsageError
-from ..model.symbolic.effects.assist_common import directional_efficiency
-from ..parameters import Parameters
+from ... import portable as pm
+from ...errors import UsageError
+from ...model.symbolic.effects.assist_common import directional_efficiency
+from ...parameters import Parameters
 from .boost_map import BLOCK_S, Z95, _blocks, _estimate, _sandwich, _t95, fit_map
 from .identified_file import Identified
-from .problem import FileData
-from .stages.assumed import is_assumed
+from ..problem import FileData
+from ..stages.assumed import is_assumed
 
 # The mechanics' calibrated parameters (key, finite-difference step) beside the offset and the product: the column
 # torque is linear in the two frictions and the rotor's inertia, so one linear least-squares step is exact.
@@ -99,9 +99,9 @@ def _files(records, params, case, surface, channel_map, name) -> list[FileData]:
     """The records ready to replay, in their order: paths read as ``parksteer diagnose`` reads them, and records
     already in memory (:class:`parksteer.measure.io.Measurement`, e.g. a benchmark's) prepared the same way (an
     angle-only one's rack derived through the column and the torsion bar)."""
-    from ..measure.column import with_derived_rack
-    from ..measure.io import Measurement
-    from .problem import load_files, prepare_file, torsion_bar
+    from ...measure.column import with_derived_rack
+    from ...measure.io import Measurement
+    from ..problem import load_files, prepare_file, torsion_bar
 
     out = []
     for k, record in enumerate(records):
@@ -115,7 +115,7 @@ def _files(records, params, case, surface, channel_map, name) -> list[FileData]:
 
 
 def _assist_name(effects) -> str:
-    from ..model.symbolic.components import power_assist_of
+    from ...model.symbolic.components import power_assist_of
 
     effect = power_assist_of(effects)
     if effect is None or effect.power_assist != "electric":
@@ -135,12 +135,12 @@ def identify_boost(records, vehicle, case: str | None = None, surface: str | Non
     its loaded :class:`~parksteer.parameters.Parameters` (its ``[assist]`` gives the gear; its boost curve, table or
     line, is not used). `case`, `surface`: as for
     ``parksteer diagnose``. Returns an :class:`Identified`; :meth:`Identified.to_vehicle_toml` writes the file."""
-    from ..model.numeric.assist import check_assist, effects_with_assist
-    from ..model.numeric.assisted import boost_keys, rack_speed_mps
-    from ..model.symbolic.components import discover_effects, resolve_effects
-    from ..vehicle import load_vehicle
-    from .engine import ReplayEngine
-    from .problem import Problem
+    from ...model.numeric.assist import check_assist, effects_with_assist
+    from ...model.numeric.assisted import boost_keys, rack_speed_mps
+    from ...model.symbolic.components import discover_effects, resolve_effects
+    from ...vehicle import load_vehicle
+    from ..engine import ReplayEngine
+    from ..problem import Problem
 
     discover_effects()  # a vehicle file's [assist] entries are the assist effect's quantities
     if isinstance(vehicle, Parameters):

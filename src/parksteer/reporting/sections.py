@@ -1,8 +1,8 @@
-"""The sections of a diagnosis's report, one structure that both pages render (:mod:`parksteer.diagnose.pages`: the
+"""The sections of a diagnosis's report, one structure that both pages render (:mod:`parksteer.reporting.pages`: the
 markdown report and the HTML page): each section a title and its parts, a paragraph, a list, a table or a figure's
-place, from the diagnosis's JSON (:func:`parksteer.diagnose.report.diagnosis_dict`) and, where the caller computed
-them, the residual by phase (:func:`parksteer.diagnose.report.phase_residuals`) and the error ladder
-(:meth:`parksteer.diagnose.ladder.Ladder.as_dict`). Text is written once, with markdown's backticks around names;
+place, from the diagnosis's JSON (:func:`parksteer.reporting.report.diagnosis_dict`) and, where the caller computed
+them, the residual by phase (:func:`parksteer.reporting.report.phase_residuals`) and the error ladder
+(:meth:`parksteer.reporting.ladder.Ladder.as_dict`). Text is written once, with markdown's backticks around names;
 the HTML page drops them."""
 
 from __future__ import annotations
@@ -66,7 +66,7 @@ def _value_unit(result: dict, key: str) -> str:
 
 def _missing_headline(result: dict) -> tuple[str, str]:
     """The verdict's sentence for a named effect, (head, body): the tie first where candidates lie within the
-    information criterion's threshold of it (:func:`parksteer.diagnose.report.tie_headline`)."""
+    information criterion's threshold of it (:func:`parksteer.reporting.report.tie_headline`)."""
     stats, floor = result["statistics"], result["noise_floor_Nm"]
     tied = tie_headline(result)
     if tied is not None:
@@ -188,7 +188,7 @@ def _identification_lines(result: dict) -> list[str]:
     return lines
 
 
-# What `parksteer assist identify` measures (parksteer.diagnose.assist_identify): the product k_t eta N (written as
+# What `parksteer assist identify` measures (diagnose.identify.assist_identify): the product k_t eta N (written as
 # the torque constant, so it also fixes the efficiency and the reduction as a product), the motor's friction and
 # inertia, the back-driven efficiency.
 _IDENTIFIED = ("torque_constant", "motor_friction_torque", "motor_inertia", "back_efficiency")
