@@ -185,10 +185,11 @@ def _folds(make, f: FileData, params: Parameters, base: list[Effect], registry, 
             say(f"baseline: the {FOLDS} folds of {f.label}, nothing held")
             found = _judged(make, [f], params, base, registry, None, [f], settings, workers)
         rows.append(fold_row(found, label, fold == k))
+    held = ("with the form fitted on the other folds held (out of sample)" if form is not None
+            else "with nothing held (the healthy record is adequate: one diagnosis of it)")
     method = (f"folds: the one healthy record's samples dealt in blocks of {settings.interval_block_s:g} s to "
               f"{FOLDS} folds in turn; each fold's weighted RMS error and share of the best candidate's BIC gain "
-              "with the form fitted on the other folds held (out of sample) and the whole record calibrated, as a "
-              "later record is")
+              f"{held} and the whole record calibrated, as a later record is")
     return _threshold(rows, method)
 
 
