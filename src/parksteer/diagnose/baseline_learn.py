@@ -114,7 +114,12 @@ def fold_row(found, label: str, mask: np.ndarray) -> dict:
         fall_here = float(np.sum(weighted[index]**2 - after[index]**2))
         gain = best.delta_bic * min(max(fall_here / fall_all, 0.0), 1.0) if fall_all > 0.0 else 0.0
     return {"part": label, "samples": samples, "over_floor": float(np.sqrt(np.mean(weighted[index]**2))),
-            "best": best.name if best is not None else None, "delta_bic": gain, "verdict": found.verdict}
+            **_best_of(best), "delta_bic": gain, "verdict": found.verdict}
+
+
+def _best_of(candidate) -> dict:
+    """A part's best candidate as its row names it: none is left out, as the baseline file (TOML) leaves it."""
+    return {} if candidate is None else {"best": candidate.name}
 
 
 def refit_form(form: HeldForm, train, params: Parameters, model: list[Effect], start: dict,
@@ -210,7 +215,7 @@ def spread(make, files, params: Parameters, base: list[Effect], registry, form: 
         found = _judged(make, [judged], params, base, registry, held, train, settings, workers)
         n = found.problem.n
         rows.append({"part": judged.label, "samples": int(n), "over_floor": math.sqrt(found.calibration.rss / n),
-                     "best": found.best.name if found.best is not None else None, "delta_bic": _best_gain(found),
+                     **_best_of(found.best), "delta_bic": _best_gain(found),
                      "verdict": found.verdict})
     return _threshold(rows, method)
 
