@@ -164,15 +164,17 @@ def test_the_baseline_file_round_trips(car):
 
 
 def test_command_line_baseline_then_diagnose(car, tmp_path, capsys):
-    """`parksteer baseline` on one healthy record (the threshold from its halves), then `diagnose --baseline` on a
-    later record: exit 0, the file written, the JSON valid and naming the file; the healthy record itself given as
-    the baseline is learnt in memory to the same verdict and fitted values; `baseline` refuses to overwrite without
-    --force."""
+    """`parksteer baseline` on one healthy record (the threshold from its three folds, each out of sample), then
+    `diagnose --baseline` on a later record: exit 0, the file written, the JSON valid and naming the file; the
+    healthy record itself given as the baseline is learnt in memory to the same verdict and fitted values;
+    `baseline` refuses to overwrite without --force."""
     out = tmp_path / "one.toml"
     assert main(["baseline", str(car["paths"]["healthy_a"]), "--out", str(out), "--quiet"]) == 0
     assert "wrote" in capsys.readouterr().out
     text = out.read_text(encoding="utf-8")
-    assert tomllib.loads(text)["threshold"]["method"].startswith("halves")
+    threshold = tomllib.loads(text)["threshold"]
+    assert threshold["method"].startswith("folds")
+    assert [p["part"] for p in threshold["parts"]] == [f"healthy_a.csv (fold {k} of 3)" for k in (1, 2, 3)]
     assert main(["diagnose", str(car["paths"]["column"]), "--baseline", str(out), "--json", "--quiet"]) == 0
     result = json.loads(capsys.readouterr().out)
     jsonschema.validate(result, json.loads(data_file("diagnosis.schema.json").read_text(encoding="utf-8")))

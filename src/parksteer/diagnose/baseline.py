@@ -8,23 +8,24 @@ something the model lacks. The question its owner asks after a repair or a thous
 - what the healthy car has that the model lacks (:class:`HeldForm`): the absolute diagnosis's verdict and, where it
   is not ``adequate``, the car's own form: the named library candidate at its fitted strength, or the form the
   residual's signature points to (:func:`parksteer.diagnose.suggest.suggest`) with its fitted strengths;
-- how far apart healthy data are (:class:`Threshold`): each healthy record is judged against the form fitted again
-  on the others (leave one out), with the sensor's thresholds; with one record, each half of it (cut between its
-  reversals) under the form and calibration fitted on the whole record (a half replayed alone would start
-  mid-stroke from rest, a start the car never had, so its error is read off the whole record's fit: in-sample, and
-  said so). Of each part, the weighted RMS error in noise floors with the form held and the best candidate's BIC
-  gain per sample; what "as the baseline" allows is the one-sided 95 % prediction bound for one more healthy part
-  (Student's t over the parts: two parts fix it poorly, and the bound is wide; more healthy records tighten it).
+- how far apart healthy data are (:class:`Threshold`), always out of sample: with two or more healthy records, each
+  is judged against the form fitted again on the others (leave one out); with one, its samples are dealt in blocks
+  of 2 s to three folds in turn, and each fold is judged with the form fitted on the other two held (the record is
+  replayed whole, the fold weighted out of the fit: a part replayed alone would start mid-stroke from rest, a start
+  the car never had) and the whole record calibrated, as a later record is. Of each part, the weighted RMS error
+  in noise floors with the form held and the best candidate's BIC gain per sample (a fold: its share of the
+  record's); what "as the baseline" allows is the one-sided 95 % prediction bound for one more healthy part
+  (Student's t over the parts: few parts fix it poorly, and the bound is wide; more healthy records tighten it).
 
 A later record is then diagnosed (``diagnose(..., baseline=...)``, :mod:`parksteer.diagnose.select`) on the model
 with the form's strengths HELD at the baseline's values (a change cannot be absorbed by fitting the quirk again),
 starting from the baseline's calibrated values, and with the threshold above where it is above the sensor's
 (:meth:`Threshold.settings_for`):
 ``adequate`` is "as the baseline", ``missing`` "changed: X", ``unexplained`` "changed, outside the library". The
-uncertainty of the held strengths reaches the verdict through that threshold: a left-out part is judged against
-strengths fitted without it, so their estimation error is inside the spread it measures (one record's halves are
-in-sample and do not hold it: a second healthy record does). Where the records fix the form poorly, the spread,
-and so the threshold, is wide. The diagnosis's JSON names the baseline
+uncertainty of the held strengths reaches the verdict through that threshold (every part is judged against
+strengths fitted without it, so their estimation error is inside the spread it measures) and through the headline
+rule: against a baseline no candidate whose 95 % interval holds 0 is named. Where the records fix the form poorly,
+the spread, and so the threshold, is wide. The diagnosis's JSON names the baseline
 (``relative_to``: its file and content hash, the threshold and how it was found).
 
 The file (:meth:`Baseline.write`, :mod:`parksteer.diagnose.baseline_file`) is TOML a person reads: every value with
@@ -40,7 +41,7 @@ from ..errors import UsageError
 from ..model.symbolic.components import Effect, resolve_effects
 from ..parameters import Parameters
 from .baseline_file import baseline_text, content_hash, identified_parameters, parse_baseline, read_bytes
-from .baseline_form import FORMAT, HeldForm, Threshold, vehicle_fingerprint
+from .baseline_form import FORMAT, HEADLINE, HeldForm, Threshold, vehicle_fingerprint
 from .baseline_learn import learn
 from .settings import DEFAULT_SETTINGS, DiagnosisSettings
 
@@ -91,7 +92,7 @@ class Baseline:
         """What a diagnosis against this baseline names it by (JSON ``relative_to``)."""
         return {"baseline": self.path, "content_hash": self.content_hash, "records": list(self.records),
                 "verdict": self.verdict, "form": None if self.form is None else self.form.effect,
-                "threshold": self.threshold.as_dict()}
+                "threshold": self.threshold.as_dict(), "headline": HEADLINE}
 
     def check(self, params: Parameters, effects=None) -> None:
         """Refuse, in one line naming the file and the key, records of another car (its values' hash) or a model of

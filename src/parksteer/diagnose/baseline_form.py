@@ -15,6 +15,9 @@ from ..parameters import Parameters
 from .settings import DiagnosisSettings
 
 FORMAT = "parksteer baseline 1"
+# The headline rule against a baseline (Threshold.settings_for): the held strengths are uncertain, and a change the
+# data do not hold apart from 0 is within what the healthy car already does.
+HEADLINE = "no candidate named whose fitted strength is 0 or whose 95 % interval holds 0"
 
 
 def vehicle_fingerprint(params: Parameters) -> str:
@@ -69,13 +72,15 @@ class Threshold:
     def settings_for(self, settings: DiagnosisSettings, samples: int) -> DiagnosisSettings:
         """`settings` with the thresholds of "as the baseline" for a later record of `samples` samples: the adequate
         factor at least the healthy spread, the ceiling on a named effect's error raised in proportion, and the BIC
-        gain a candidate needs at least what healthy parts reached at the same length."""
+        gain a candidate needs at least what healthy parts reached at the same length; and no candidate named whose
+        95 % interval holds 0 (``headline_interval_clear_of_zero``): against a baseline the held strengths are
+        uncertain, and a strength the data do not hold apart from 0 is within what the healthy car already does."""
         adequate = max(settings.adequate_rms_factor, self.over_floor)
         ceiling = max(settings.missing_rms_ceiling, adequate * settings.missing_rms_ceiling
                       / settings.adequate_rms_factor)
         bic = max(settings.bic_missing_threshold, self.bic_per_sample * samples)
         return dataclasses.replace(settings, adequate_rms_factor=adequate, missing_rms_ceiling=ceiling,
-                                   bic_missing_threshold=bic)
+                                   bic_missing_threshold=bic, headline_interval_clear_of_zero=True)
 
     def as_dict(self) -> dict:
         return {"over_floor": self.over_floor, "bic_per_sample": self.bic_per_sample, "method": self.method,

@@ -19,9 +19,6 @@ from .engine import ReplayEngine
 from .problem import FileData, Problem
 from .settings import DiagnosisSettings
 
-HALVES = ("first half", "second half")
-
-
 def _say(progress):
     return progress if progress is not None else (lambda text: None)
 
@@ -84,23 +81,51 @@ def _parts(files) -> tuple[str, list[tuple[list[FileData], FileData]]]:
             [([g for j, g in enumerate(files) if j != i], f) for i, f in enumerate(files)])
 
 
-def half_rows(found) -> list[dict]:
-    """One record's two halves (cut between its first and last reversal), each one's weighted RMS error in noise
-    floors under the calibration and form fitted on the whole record. A half is not replayed alone: the replay
-    starts from rest at its first sample, and a half that starts mid-stroke would carry a start the car never had."""
+def fold_of(f: FileData, folds: int, block_s: float) -> np.ndarray:
+    """Each sample's fold: the record cut into blocks of `block_s` from its start (residuals within a block are
+    dependent, blocks nearly independent: :attr:`DiagnosisSettings.interval_block_s`), the blocks dealt to `folds`
+    folds in turn, so that every fold has blocks along the whole record (both strokes, every place of the rack)."""
+    t = f.time_s
+    return (np.floor((t - t[0]) / block_s).astype(int) % folds)
+
+
+def left_out(f: FileData, held_out: np.ndarray) -> FileData:
+    """`f` with the samples `held_out` weighted out of a fit (their attainable error a million noise floors): the
+    replay still runs through them from the record's start, so the samples kept are replayed as in the whole
+    record, and a fit of `f` is a fit to the others alone."""
+    out = np.where(held_out, 1e6 * f.noise.total_rms, 0.0)
+    return dataclasses.replace(f, replay_uncertainty_Nm=out)
+
+
+def fold_row(found, label: str, mask: np.ndarray) -> dict:
+    """One fold's row: its weighted RMS error in noise floors under the whole record's calibration with the form
+    fitted without it held, and its share of the best candidate's BIC gain (the gain times the fraction of the
+    refit's fall of the weighted sum of squares that falls on the fold's samples)."""
     f, prediction = found.problem.files[0], found.calibration.predictions[0]
-    weighted = (f.torque_Nm - f.torque_part(prediction)) / f.sigma_Nm
-    t, reversals = f.time_s, np.asarray(f.phases.reversal_times_s, dtype=float)
-    cut = 0.5 * (reversals[0] + reversals[-1]) if reversals.size >= 2 else 0.5 * (t[0] + t[-1])
-    i = int(np.searchsorted(t, cut))
-    return [{"part": f"{f.label} ({name})", "samples": int(part.size),
-             "over_floor": float(np.sqrt(np.mean(part**2))), "verdict": found.verdict}
-            for name, part in zip(HALVES, (weighted[:i], weighted[i:]))]
+    index = np.tile(mask, f.signals)
+    weighted = (f.measured - prediction) / f.sigma
+    samples = int(index.sum())
+    best = max((c for c in found.candidates if c.delta_bic is not None and c.refit is not None),
+               key=lambda c: c.delta_bic, default=None)
+    gain = 0.0
+    if best is not None and best.delta_bic > 0.0:
+        after = (f.measured - best.refit.predictions[0]) / f.sigma
+        fall_all = float(np.sum(weighted**2 - after**2))
+        fall_here = float(np.sum(weighted[index]**2 - after[index]**2))
+        gain = best.delta_bic * min(max(fall_here / fall_all, 0.0), 1.0) if fall_all > 0.0 else 0.0
+    return {"part": label, "samples": samples, "over_floor": float(np.sqrt(np.mean(weighted[index]**2))),
+            **_best_of(best), "delta_bic": gain, "verdict": found.verdict}
+
+
+def _best_of(candidate) -> dict:
+    """A part's best candidate as its row names it: none is left out, as the baseline file (TOML) leaves it."""
+    return {} if candidate is None else {"best": candidate.name}
 
 
 def refit_form(form: HeldForm, train, params: Parameters, model: list[Effect], start: dict,
                settings: DiagnosisSettings) -> HeldForm:
-    """The form's strengths fitted again, with the calibrated parameters, on the records `train` alone."""
+    """The form's strengths fitted again, with the calibrated parameters, on the records `train` alone (samples
+    weighted out of them, :func:`left_out`, take no part)."""
     problem = Problem(list(train), params.with_overrides(form.places))
     engine = ReplayEngine()
     strengths = None
@@ -144,22 +169,41 @@ def _best_gain(found) -> float:
     return max([0.0, *(c.delta_bic for c in found.candidates if c.delta_bic is not None)])
 
 
+FOLDS = 3  # a single record's parts: t(0.95, 2) = 2.92 over three, against 6.31 over two
+
+
+def _folds(make, f: FileData, params: Parameters, base: list[Effect], registry, form: HeldForm | None, start: dict,
+           settings: DiagnosisSettings, workers: int, say) -> Threshold:
+    """One healthy record's threshold, out of sample: its samples dealt to :data:`FOLDS` folds (:func:`fold_of`),
+    each fold judged with the form fitted on the others (the record replayed whole, the fold weighted out of the
+    fit: :func:`left_out`) held, and the calibration of the whole record, as a later record is judged."""
+    fold = fold_of(f, FOLDS, settings.interval_block_s)
+    model = None if form is None else sorted([*base, form.model_effect(registry)], key=lambda e: e.name)
+    rows, found = [], None
+    for k in range(FOLDS):
+        label = f"{f.label} (fold {k + 1} of {FOLDS})"
+        if form is not None:  # nothing held: every fold is read off the one diagnosis of the record
+            say(f"baseline: {label} against the form fitted on the other folds")
+            held = refit_form(form, [left_out(f, fold == k)], params, model, start, settings)
+            found = _judged(make, [f], params, base, registry, held, [f], settings, workers)
+        elif found is None:
+            say(f"baseline: the {FOLDS} folds of {f.label}, nothing held")
+            found = _judged(make, [f], params, base, registry, None, [f], settings, workers)
+        rows.append(fold_row(found, label, fold == k))
+    held = ("with the form fitted on the other folds held (out of sample)" if form is not None
+            else "with nothing held (the healthy record is adequate: one diagnosis of it)")
+    method = (f"folds: the one healthy record's samples dealt in blocks of {settings.interval_block_s:g} s to "
+              f"{FOLDS} folds in turn; each fold's weighted RMS error and share of the best candidate's BIC gain "
+              f"{held} and the whole record calibrated, as a later record is")
+    return _threshold(rows, method)
+
+
 def spread(make, files, params: Parameters, base: list[Effect], registry, form: HeldForm | None, start: dict,
            settings: DiagnosisSettings, workers: int, say) -> Threshold:
     """The threshold of "as the baseline" from the healthy parts (module docstring of
     :mod:`parksteer.diagnose.baseline`)."""
     if len(files) == 1:
-        say(f"baseline: the halves of {files[0].label} against the form and calibration of the whole record")
-        found = _judged(make, files, params, base, registry, form, files, settings, workers)
-        rows = half_rows(found)
-        gain = _best_gain(found) / found.problem.n
-        for row in rows:
-            row["delta_bic"] = gain * row["samples"]  # the whole record's, shared by its halves
-        method = ("halves: the weighted RMS error of each half of the one healthy record (cut between its "
-                  "reversals) under the form and calibration fitted on the whole record; the BIC gain per sample "
-                  "of the best candidate there (in-sample: a second healthy record gives the spread of the form's "
-                  "own estimate)")
-        return _threshold(rows, method)
+        return _folds(make, files[0], params, base, registry, form, start, settings, workers, say)
     method, parts = _parts(files)
     rows = []
     for train, judged in parts:
@@ -171,7 +215,7 @@ def spread(make, files, params: Parameters, base: list[Effect], registry, form: 
         found = _judged(make, [judged], params, base, registry, held, train, settings, workers)
         n = found.problem.n
         rows.append({"part": judged.label, "samples": int(n), "over_floor": math.sqrt(found.calibration.rss / n),
-                     "best": found.best.name if found.best is not None else None, "delta_bic": _best_gain(found),
+                     **_best_of(found.best), "delta_bic": _best_gain(found),
                      "verdict": found.verdict})
     return _threshold(rows, method)
 
