@@ -126,6 +126,21 @@ def intake(request: Request) -> Intake:
     return Intake(files, params, effects, settings, workers)
 
 
+def vehicle_study(items, parameters: str | Path, vehicle: str | Path, options: dict, **request) -> Intake:
+    """The vehicle study's records taken in as ``parksteer compare/diagnose --vehicle`` takes them: `items` files, or
+    a folder whose .csv files are the records (the synthetic set), read with the workflow's import options
+    (``case``, ``surface``, ``map_file``); `request` the rest of the :class:`Request`."""
+    from ..measure.importers import channel_map_from_options
+
+    files = []
+    for item in [items] if isinstance(items, str | Path) else list(items):
+        path = Path(item)
+        files += sorted(str(p) for p in path.iterdir() if p.suffix == ".csv") if path.is_dir() else [str(item)]
+    return intake(Request(files, car_parameters(parameters, vehicle), vehicle=vehicle, case=options["case"],
+                          surface=options["surface"], channel_map=channel_map_from_options(None, options["map_file"]),
+                          **request))
+
+
 def load_records(request: Request, params: Parameters, effects) -> list:
     """The request's files read and prepared for the model of `effects` (its torsion bar, if assisted)."""
     from .problem import load_files
