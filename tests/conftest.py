@@ -22,8 +22,8 @@ REPO_ROOT = Path(__file__).resolve().parents[1]
 
 
 # Modules whose tests share no module fixture and are each long (the document chains, the diagnosis routes at several
-# job counts): each test is a work unit of its own for the test run's workers, not the module (pytest_collection_
-# modifyitems).
+# job counts): each test is a work unit of its own for the test run's workers, not the module; their slow tests
+# start in this order, the longest first (pytest_collection_modifyitems).
 INDEPENDENT_MODULES = ("tests/test_docs.py", "tests/diagnose/test_job_counts.py")
 
 
@@ -53,10 +53,11 @@ def pytest_collection_modifyitems(config, items):
     to fill the other worker, and the workers finish together (longest first)."""
     def rank(item):
         if item.get_closest_marker("slurm"):
-            return 0
+            return (0, 0)
         if item.get_closest_marker("slow"):
-            return 1 if _module(item.nodeid) in INDEPENDENT_MODULES else 2
-        return 3
+            module = _module(item.nodeid)
+            return (1, INDEPENDENT_MODULES.index(module)) if module in INDEPENDENT_MODULES else (2, 0)
+        return (3, 0)
 
     items.sort(key=rank)  # stable: the order within each rank is the collection order
 
