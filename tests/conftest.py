@@ -31,6 +31,7 @@ def _module(nodeid: str) -> str:
     return nodeid.split("::")[0]
 
 
+@pytest.hookimpl(optionalhook=True)  # pytest-xdist's hook
 def pytest_xdist_make_scheduler(config, log):
     """xdist's loadscope (pyproject.toml), but each test of :data:`INDEPENDENT_MODULES` a scope of its own."""
     from xdist.scheduler import LoadScopeScheduling
