@@ -21,15 +21,44 @@ from parksteer.parameters import DEFAULT_PATH, Parameters, load_parameters  # no
 REPO_ROOT = Path(__file__).resolve().parents[1]
 
 
+# Modules whose tests share no module fixture and are each long (the document chains, the diagnosis routes at several
+# job counts): each test is a work unit of its own for the test run's workers, not the module; their slow tests
+# start in this order, the longest first (pytest_collection_modifyitems).
+INDEPENDENT_MODULES = ("tests/test_docs.py", "tests/diagnose/test_job_counts.py")
+
+
+def _module(nodeid: str) -> str:
+    return nodeid.split("::")[0]
+
+
+@pytest.hookimpl(optionalhook=True)  # pytest-xdist's hook
+def pytest_xdist_make_scheduler(config, log):
+    """xdist's loadscope (pyproject.toml), but each test of :data:`INDEPENDENT_MODULES` a scope of its own."""
+    from xdist.scheduler import LoadScopeScheduling
+
+    class Scheduling(LoadScopeScheduling):
+        def _split_scope(self, nodeid: str) -> str:
+            return nodeid if _module(nodeid) in INDEPENDENT_MODULES else super()._split_scope(nodeid)
+
+    return Scheduling(config, log)
+
+
 def pytest_collection_modifyitems(config, items):
-    """The modules marked slow first, and the real SLURM run first of all (it mostly waits on the cluster's
-    polling): the test run's workers take modules in this order (xdist's loadscope with --no-loadscope-reorder,
-    pyproject.toml; by default loadscope would order modules by their number of tests), so the long ones start
-    while short ones remain to fill the other worker, and the workers finish together (longest first)."""
+    """Work units and their order for the test run's workers (xdist's loadscope with --no-loadscope-reorder,
+    pyproject.toml: each unit goes whole to one worker, the units in the order given here).
+
+    A module is one unit, so its tests share one worker and its fixtures; in :data:`INDEPENDENT_MODULES` each test
+    is a unit (pytest_xdist_make_scheduler), so that no one module's long tests run end to end on one worker while
+    the other idles. The real SLURM run starts first (it mostly waits on the cluster's polling), then the slow
+    tests of those modules (each long), then the modules marked slow: the long ones start while short ones remain
+    to fill the other worker, and the workers finish together (longest first)."""
     def rank(item):
         if item.get_closest_marker("slurm"):
-            return 0
-        return 1 if item.get_closest_marker("slow") else 2
+            return (0, 0)
+        if item.get_closest_marker("slow"):
+            module = _module(item.nodeid)
+            return (1, INDEPENDENT_MODULES.index(module)) if module in INDEPENDENT_MODULES else (2, 0)
+        return (3, 0)
 
     items.sort(key=rank)  # stable: the order within each rank is the collection order
 

@@ -1,12 +1,16 @@
 """Every command block of README.md and docs/*.md runs as written, and every number a document quotes from a
 command's output is the one the command prints.
 
-Each ```sh block is run by bash (`set -e -o pipefail`: the first failing command fails the block) in one scratch
-copy of the repository (its tracked and new files: no results, no model cache), the documents in reading order
-(README.md, then docs/README.md and the pages of its table of contents in its order), each document's blocks in order, as one reader following them all
-would: two pages writing one file, or one needing what another has not yet written, fail; `parksteer`, `snakemake` and `python` are this
-environment's, the package is the copy's (PYTHONPATH), and the model cache is one for the session, seeded with the
-worktree's compiled models (a model a document's commands need and no earlier run built is derived there once).
+Each ```sh block is run by bash (`set -e -o pipefail`: the first failing command fails the block) in a scratch copy
+of the repository (its tracked and new files: no results, no model cache), as a reader following the documents
+would. The documents are run as a few chains (:data:`CHAINS`), each a test of its own in a copy of its own, so that
+the test run's workers take them side by side: a chain is a list of documents, or of a document's sections (the
+blocks under one heading), in reading order (README.md, then the table of contents, docs/README.md), each document's blocks
+in order. A page that runs a command on what another page wrote is in that page's chain, after it; a page that
+needs what its chain has not yet written fails, as one that needs another chain's output does (its copy has none
+of it). `parksteer`, `snakemake` and `python` are this environment's, the package is the copy's (PYTHONPATH),
+and the model cache is one for the test process, seeded with the worktree's compiled models (a model a
+document's commands need and no earlier run in the process built is derived there once).
 
 What a document may say about a block, in HTML comments the rendered page does not show, each on a line of its own:
 
@@ -31,8 +35,8 @@ must be tied by a quotes or appear marker, declared given, or be in the block's 
 (:func:`untied_numbers`). A quotes or appear marker whose source only a heavy line writes is checked in the full
 run.
 
-The marker checks are quick; running the blocks (one test, one copy) and regenerating data/samples/ are marked
-slow.
+The marker checks are quick; running the blocks (one test a chain, one copy each) and regenerating data/samples/ are
+marked slow.
 """
 
 from __future__ import annotations
@@ -301,6 +305,75 @@ def readme_order() -> list[str]:
     return ["README.md", CONTENTS, *(f"docs/{name}" for name in linked)]
 
 
+# The chains the documents run as (module docstring), each in reading order; an entry is a document (all its blocks)
+# or "DOCUMENT#HEADING" (the blocks whose nearest heading above starts with HEADING). The blocks of one chain do not
+# read what another chain's write: each section of README.md under "Use it" is a reader's errand of its own, and the
+# pages each build on their own commands' outputs; a page goes in the chain of the page whose outputs or derived
+# models it uses again (docs/targets.md's fig3 is README.md's). Split so that no chain alone takes longer than the others together take on a second worker, and
+# listed longest first (the order the test run's workers start them in: tests/conftest.py).
+CHAINS: dict[str, list[str]] = {
+    "figures_and_models": ["README.md#What it builds", "docs/targets.md", "docs/model.md", "docs/reproducibility.md",
+                           "docs/workflow.md", "docs/sweeps.md", "docs/scaling.md", "docs/measurement.md",
+                           "docs/diagnosis.md", "docs/peers.md", "docs/house.md", "docs/development.md"],
+    "buses_and_vehicles": ["docs/bus.md", "docs/vehicles.md", "docs/assist.md", "docs/assist_sizing.md"],
+    "assist_identify": ["docs/assist_identify.md"],
+    "assisted_car": ["docs/assist_diagnosis.md"],
+    "missing_effect": ["docs/signature.md"],
+    "use_it": ["README.md#Quick start", "README.md#Use it", "README.md#A worked example"],
+}
+
+
+def headings(text: str) -> list[tuple[int, str]]:
+    """(line, heading text) of each Markdown heading of `text`, those inside fenced blocks left out."""
+    out, fenced = [], False
+    for number, line in enumerate(text.splitlines(), start=1):
+        if line.startswith("```"):
+            fenced = not fenced
+        elif not fenced and (m := re.match(r"#+\s+(.*)", line)):
+            out.append((number, m.group(1).strip()))
+    return out
+
+
+def section_of(block: Block, marks: list[tuple[int, str]]) -> str:
+    """The text of the nearest heading above `block` ("" before the first)."""
+    above = [title for line, title in marks if line < block.line]
+    return above[-1] if above else ""
+
+
+def chain_blocks(chain: list[str]) -> list[tuple[str, list[Block]]]:
+    """(document, its blocks the chain runs) for each entry of `chain`, in the chain's order."""
+    out = []
+    for entry in chain:
+        document, _, heading = entry.partition("#")
+        text = (REPO / document).read_text(encoding="utf-8")
+        blocks, marks = parse(document, text), headings(text)
+        out.append((document, [b for b in blocks if not heading or section_of(b, marks).startswith(heading)]))
+    return out
+
+
+def test_chains_run_every_block_once_in_readme_order():
+    """Every block of every document is in exactly one chain (a section entry names a heading that is there), and
+    each chain keeps README order: its documents in reading order (the table of contents), each document's blocks
+    in the document's order. A block left out of the chains, or run twice, fails."""
+    order = readme_order()
+    seen: dict[tuple[str, int], str] = {}
+    for name, chain in CHAINS.items():
+        position = []
+        for (document, blocks), entry in zip(chain_blocks(chain), chain):
+            if "#" in entry:
+                heading = entry.partition("#")[2]
+                assert any(title.startswith(heading) for _, title in headings((REPO / document).read_text(
+                    encoding="utf-8"))), f"{name}: {entry}: no such heading"
+            for block in blocks:
+                key = (document, block.line)
+                assert key not in seen, f"{document}:{block.line} is in chains {seen[key]} and {name}"
+                seen[key] = name
+                position.append((order.index(document), block.line))
+        assert position == sorted(position), f"chain {name} is not in README order"
+    every = {(name, b.line) for name, text in documents().items() for b in parse(name, text)}
+    assert every - set(seen) == set(), f"blocks in no chain: {sorted(every - set(seen))}"
+
+
 def test_every_document_in_readme_order():
     """A new document is run: each of README.md and docs/*.md is README.md, the table of contents or one of its
     numbered entries, whose order the documents run in."""
@@ -311,14 +384,15 @@ def test_every_document_in_readme_order():
 
 
 @pytest.mark.slow
-def test_documents_run_in_readme_order(tmp_path, copy_repository, model_cache):
-    """Every document's blocks run in one scratch copy, the documents in reading order (the table of contents), as one reader following
-    them all would: a file one page writes is there for the next, so two pages that write one file (or one that
-    needs what another has not yet written) fail here."""
+@pytest.mark.parametrize("chain", list(CHAINS))
+def test_documents_run_in_readme_order(chain, tmp_path, copy_repository, model_cache):
+    """Every block of the chain's documents runs in one scratch copy, the documents in README order, as one reader
+    following them would: a file one page writes is there for the next page of its chain, so a page that needs what
+    its chain has not yet written (or what only another chain writes) fails here."""
     work = copy_repository(tmp_path / "repo")
     failures, report = [], []
-    for document in readme_order():
-        found, lines = run_document(document, work, model_cache)
+    for document, blocks in chain_blocks(CHAINS[chain]):
+        found, lines = run_document(document, work, model_cache, blocks)
         failures += found
         report += lines
     print("\n".join(report))
@@ -341,12 +415,14 @@ def test_samples_are_their_generator_s(tmp_path):
         assert (tmp_path / name).read_bytes() == (REPO / "data" / "samples" / name).read_bytes(), name
 
 
-def run_document(document: str, work: Path, model_cache: Path) -> tuple[list[str], list[str]]:
-    """Each sh block of `document` runs in the scratch copy `work`, in order, and ends with status 0 (or the status
-    its exits marker states); each quote marker's value is what the block printed or wrote. Returns the failures
-    and the lines of what ran (skipped blocks and lines with their reasons)."""
+def run_document(document: str, work: Path, model_cache: Path, blocks: list[Block] | None = None
+                 ) -> tuple[list[str], list[str]]:
+    """Each sh block of `document` (or those of `blocks`, its blocks a chain runs) runs in the scratch copy `work`,
+    in order, and ends with status 0 (or the status its exits marker states); each quote marker's value is what the
+    block printed or wrote. Returns the failures and the lines of what ran (skipped blocks and lines with their
+    reasons)."""
     text = (REPO / document).read_text(encoding="utf-8")
-    blocks = parse(document, text)
+    blocks = parse(document, text) if blocks is None else blocks
     bin_dir = str(Path(sys.executable).parent)
     env = dict(os.environ, PYTHONPATH=str(work / "src"), PARKSTEER_MODEL_CACHE=str(model_cache),
                PATH=bin_dir + os.pathsep + os.environ.get("PATH", ""))

@@ -73,7 +73,8 @@ def diagnosed(arguments: list[str], jobs: int, capsys) -> dict[str, object]:
     return {k: v for k, v in result.items() if not k.startswith(("/cost/timings_s/", "/cost/wall_s"))}
 
 
-@pytest.mark.parametrize("route", ["several_records", "torque_lag", "angle", "user_effect", "assisted"])
+# the longest first (the test run's workers take each route alone: tests/conftest.py)
+@pytest.mark.parametrize("route", ["angle", "assisted", "user_effect", "torque_lag", "several_records"])
 def test_every_route_gives_the_same_json_at_one_two_and_three_jobs(route, tmp_path, capsys):
     """The diagnosis at 2 and 3 processes reports, field by field, what it reports in one (verdict, lags, fitted
     values and intervals, ranking, statistics, replay counts): the workers compute exactly what the process would,

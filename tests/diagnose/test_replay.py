@@ -5,12 +5,14 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from parksteer.diagnose.engine import ReplayEngine, effect_key
 from parksteer.diagnose.ensemble import relogged_rack
 from parksteer.diagnose.replay import Replay
 from parksteer.measure.smoothing import smooth_rack
+from parksteer.model.codegen.cache import entry_path as compiled_entry_path
 from parksteer.model.numeric.prescribed import solve
 from parksteer.model.numeric.simulate import prepare
-from parksteer.model.symbolic.components import resolve_effects
+from parksteer.model.symbolic.components import discover_effects, resolve_effects
 from parksteer.measure.converter import add_noise, quantise, quantisation_step
 
 FULL_SCALE_M = 0.1
@@ -119,6 +121,43 @@ def test_a_rack_friction_override_changes_the_torque_by_its_physical_share(param
     expected = 100.0 / params["steering.handwheel_to_rack_ratio"]
     assert np.all(share > 0.85 * expected) and np.all(share < 1.16 * expected)
     assert np.mean(share) == pytest.approx(expected, rel=0.05)
+
+
+def test_replays_on_one_host_model_share_its_prepared_runs_and_replay_as_alone(params):
+    """ReplayEngine.new_replay: the replays of two effect sets on one host model (a candidate and the set without
+    it, as a diagnosis replays them) prepare its base run once, and each gives exactly the torque of a replay made
+    alone on that model, with an override set in the vector and one that prepares the run again (a case value):
+    a prepared run does not depend on which replay made it."""
+    t, logged, _ = _logged_rack(13, True)
+    rack = smooth_rack(t, logged)
+    base = resolve_effects(None)
+    host = resolve_effects([*base, discover_effects()["column_friction"]])
+    engine = ReplayEngine(hosts={effect_key(base): host, effect_key(host): host})
+    first = engine.new_replay(base, "unladen", "ground", params, rack, t)
+    second = engine.new_replay(host, "unladen", "ground", params, rack, t)
+    assert first._base is second._base
+    moves = ({}, {"steering.rack_friction_force": params["steering.rack_friction_force"] + 80.0},
+             {"case.load_left": 1.05 * params["cases.unladen.load_left"]})
+    for effects, shared in ((base, first), (host, second)):
+        alone = Replay(effects, "unladen", "ground", params, rack, t, model_effects=host)
+        for overrides in moves:
+            assert np.array_equal(shared.torque(overrides), alone.torque(overrides))
+
+
+def test_the_engine_finds_an_effect_sets_model_once(monkeypatch):
+    """LoadedModels (the replay engine's models): an effect set's cache key, a hash of its source, is computed once
+    however many runs are prepared on it, and the model found is the cache entry of that key, the one a fresh
+    CompiledModels loads."""
+    import parksteer.model.numeric.compiled as compiled
+
+    effects = resolve_effects(None)
+    expected = compiled.CompiledModels().of(effects).directory
+    keyed = []
+    monkeypatch.setattr(compiled, "entry_path", lambda e: keyed.append(1) or compiled_entry_path(e))
+    engine = ReplayEngine()
+    found = [engine.models.of(effects) for _ in range(3)]
+    assert len(keyed) == 1 and all(model is found[0] for model in found)
+    assert found[0].directory == expected
 
 
 def test_a_replay_on_another_rack_shares_the_preparation_not_the_result(params):

@@ -6,11 +6,15 @@ are counted. :func:`parksteer.diagnose.select.diagnose` makes one :class:`Replay
 stage (``stage.run(state, engine)``). It is openly mutable and keeps its counts on itself, as scipy's
 ``OdeSolver`` keeps ``nfev`` on the solver that spends them. It owns:
 
-- `models`: the compiled models loaded (:class:`parksteer.model.numeric.compiled.CompiledModels`);
+- `models`: the compiled models loaded (:class:`parksteer.model.numeric.compiled.CompiledModels`), each found
+  again by its effects without hashing their source for the cache key again (:class:`LoadedModels`);
 - `hosts`: which compiled model each effect set is replayed on (:func:`parksteer.diagnose.candidates.replay_models`:
   most candidates share the diagnosis model);
 - `direct`: which quantities only enter a compiled model's equations (found once per model and key,
   :meth:`parksteer.diagnose.replay.Replay._is_direct`);
+- `prepared`: the prepared runs (compiled model, parameter vector, static balance: what does not depend on the
+  rack) by host model, case, surface and parameters, shared by every replay on them, so that the candidates
+  replayed on one host model prepare its base run once, not once each;
 - `replays`: one :class:`parksteer.diagnose.replay.Replay` per effect set, file and torque lag (the file's replay
   instants, :attr:`parksteer.diagnose.problem.FileData.replay_time_s`), each counting its own solves: a replay is
   what its key says, whichever process made it and whatever was replayed before;
@@ -27,11 +31,28 @@ from collections.abc import Callable
 
 import numpy as np
 
-from ..model.numeric.compiled import CompiledModels
+from ..model.numeric.compiled import CompiledModel, CompiledModels
 from ..model.symbolic.components import Effect
 from .parallel import ServingPool, fork_map, forks
 from .problem import Problem
 from .replay import Replay
+
+
+class LoadedModels(CompiledModels):
+    """The compiled models of one diagnosis, each effect set's found once: the cache key hashes the symbolic
+    half's and the effects' source (:func:`parksteer.model.codegen.cache.model_key`), which a diagnosis does not
+    change, and every prepared run of the set would hash it again."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        # the effects' ids -> (the effects, kept so that their ids stay theirs; the compiled model)
+        self.by_effects: dict[tuple[int, ...], tuple[list[Effect], CompiledModel]] = {}
+
+    def of(self, effects: list[Effect]) -> CompiledModel:
+        key = tuple(map(id, effects))
+        if key not in self.by_effects:
+            self.by_effects[key] = (list(effects), super().of(effects))
+        return self.by_effects[key][1]
 
 
 def effect_key(effects: list[Effect]) -> tuple[str, ...]:
@@ -48,9 +69,11 @@ class ReplayEngine:
 
     def __init__(self, workers: int = 1, hosts: dict[tuple[str, ...], list[Effect]] | None = None):
         self.workers = max(int(workers), 1)
-        self.models = CompiledModels()
+        self.models = LoadedModels()
         self.hosts: dict[tuple[str, ...], list[Effect]] = dict(hosts or {})
         self.direct: dict[tuple[str, str], bool] = {}
+        # (host key, case, surface, id(parameters)) -> (the parameters, kept so that their id stays theirs; runs)
+        self.prepared: dict[tuple, tuple[object, dict]] = {}
         self.replays: dict[tuple, Replay] = {}
         self.other_replays = 0
         self.pool = ServingPool(self.workers)
@@ -65,11 +88,14 @@ class ReplayEngine:
         self.other_replays += evaluations
 
     def new_replay(self, effects: list[Effect], case: str, surface: str, params, rack, time_s) -> Replay:
-        """A replay of `effects` on its host's compiled model, sharing what the engine knows of that model; not kept
-        (its solves are not counted)."""
-        return Replay(list(effects), case, surface, params, rack, time_s,
-                      model_effects=self.hosts.get(effect_key(effects), list(effects)), direct=self.direct,
-                      models=self.models)
+        """A replay of `effects` on its host's compiled model, sharing what the engine knows of that model and the
+        runs prepared on it; not kept (its solves are not counted)."""
+        model_effects = self.hosts.get(effect_key(effects), list(effects))
+        key = (effect_key(model_effects), case, surface, id(params))
+        if key not in self.prepared:
+            self.prepared[key] = (params, {})
+        return Replay(list(effects), case, surface, params, rack, time_s, model_effects=model_effects,
+                      direct=self.direct, models=self.models, shared_runs=self.prepared[key][1])
 
     def replay(self, problem: Problem, effects: list[Effect], index: int) -> Replay:
         """The kept replay of `effects` on file `index` of `problem`, at the file's instants (made when first asked

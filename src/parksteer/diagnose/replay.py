@@ -55,6 +55,9 @@ class Replay:
     evaluations: int = 0
     # prepared runs to start from (another replay's of the same model, case and surface: :meth:`on_rack`)
     runs: dict[tuple, PreparedRun] | None = field(default=None, repr=False, compare=False)
+    # prepared runs shared with the other replays of the same compiled model, case, surface and parameters, kept
+    # in this dict itself (ReplayEngine.new_replay): a run is what its overrides make it, whichever replay made it
+    shared_runs: dict[tuple, PreparedRun] | None = field(default=None, repr=False, compare=False)
     # the effects of the compiled model it runs on: by default the set's own (a host's: ReplayEngine.new_replay)
     model_effects: list[Effect] | None = field(default=None, repr=False, compare=False)
     # (compiled model, quantity key) -> whether the quantity only enters the equations (_is_direct), shared by the
@@ -66,8 +69,11 @@ class Replay:
 
     def __post_init__(self):
         self.time_s = np.asarray(self.time_s, dtype=float)
-        self._runs: dict[tuple, PreparedRun] = dict(self.runs) if self.runs is not None else {}
-        self.runs = None
+        if self.shared_runs is not None:
+            self._runs = self.shared_runs
+        else:
+            self._runs: dict[tuple, PreparedRun] = dict(self.runs) if self.runs is not None else {}
+        self.runs = self.shared_runs = None
         if self.model_effects is None:
             self.model_effects = self.effects
         if self.direct is None:
@@ -95,7 +101,8 @@ class Replay:
         key = tuple(sorted(overrides.items()))
         if key not in self._runs:
             if len(self._runs) >= KEPT_RUNS:  # a fit moving a prepared quantity makes a new run at every step
-                del self._runs[next(k for k in self._runs if self._runs[k] is not self._base)]
+                # (the oldest run but this replay's base; a shared dict's other bases stay with their replays)
+                del self._runs[next(k for k in self._runs if self._runs[k] is not getattr(self, "_base", None))]
             self._runs[key] = prepare(self.case, self.model_effects, overrides, self.surface, self.params,
                                      models=self.models)
         return self._runs[key]
