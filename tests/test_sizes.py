@@ -38,7 +38,6 @@ EXCEPTIONS: dict[str, tuple[int, str]] = {
     "parksteer/figures/assist_study.py:assist_study": (88, f"the assistance study's figure; {NOT_YET_CUT}"),
     "parksteer/diagnose/identified_file.py:replace_assist_section": (84, f"the identified file's text; {NOT_YET_CUT}"),
     "parksteer/figures/rivals.py:compare_rivals": (82, f"the rivals' comparison; {NOT_YET_CUT}"),
-    "parksteer/figures/user_effect.py:user_effect_figure": (81, f"the user effect's figure; {NOT_YET_CUT}"),
 }
 
 
