@@ -37,7 +37,6 @@ EXCEPTIONS: dict[str, tuple[int, str]] = {
     "parksteer/diagnose/sections.py:report_sections": (95, f"the report's sections; {NOT_YET_CUT}"),
     "parksteer/figures/assist_study.py:assist_study": (88, f"the assistance study's figure; {NOT_YET_CUT}"),
     "parksteer/diagnose/identified_file.py:replace_assist_section": (84, f"the identified file's text; {NOT_YET_CUT}"),
-    "parksteer/figures/rivals.py:compare_rivals": (82, f"the rivals' comparison; {NOT_YET_CUT}"),
 }
 
 
