@@ -25,7 +25,6 @@ EXCEPTIONS: dict[str, tuple[int, str]] = {
     "parksteer/model/codegen/cache.py": (487, STALES_PRE_DERIVED),
     "parksteer/model/symbolic/system.py": (464, STALES_PRE_DERIVED),
     "parksteer/model/codegen/generate.py:generate": (118, STALES_PRE_DERIVED),
-    "parksteer/parameters.py": (610, f"the registry of quantities and the parameter file's loader; {NOT_YET_SPLIT}"),
     "parksteer/diagnose/calibrate.py": (440, f"the calibration of the base model; {NOT_YET_SPLIT}"),
     "parksteer/commands/measure.py": (401, f"the measurement commands and the diagnosis's intake; {NOT_YET_SPLIT}"),
     "parksteer/diagnose/sections.py": (401, f"the diagnosis report's sections; {NOT_YET_SPLIT}"),
