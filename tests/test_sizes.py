@@ -32,7 +32,6 @@ EXCEPTIONS: dict[str, tuple[int, str]] = {
     "parksteer/diagnose/suggest.py:effect_source": (113, f"the suggested effect's source text; {NOT_YET_CUT}"),
     "parksteer/diagnose/report.py:diagnosis_dict": (110, f"the diagnosis's JSON; {NOT_YET_CUT}"),
     "parksteer/diagnose/sections.py:report_sections": (95, f"the report's sections; {NOT_YET_CUT}"),
-    "parksteer/figures/assist_study.py:assist_study": (88, f"the assistance study's figure; {NOT_YET_CUT}"),
     "parksteer/diagnose/identified_file.py:replace_assist_section": (84, f"the identified file's text; {NOT_YET_CUT}"),
 }
 
