@@ -25,20 +25,13 @@ EXCEPTIONS: dict[str, tuple[int, str]] = {
     "parksteer/model/codegen/cache.py": (487, STALES_PRE_DERIVED),
     "parksteer/model/symbolic/system.py": (464, STALES_PRE_DERIVED),
     "parksteer/model/codegen/generate.py:generate": (118, STALES_PRE_DERIVED),
-    "parksteer/measure/importers.py": (637, f"record import: readers, channel maps, load_record; {NOT_YET_SPLIT}"),
-    "parksteer/parameters.py": (610, f"the registry of quantities and the parameter file's loader; {NOT_YET_SPLIT}"),
     "parksteer/diagnose/calibrate.py": (440, f"the calibration of the base model; {NOT_YET_SPLIT}"),
     "parksteer/reporting/sections.py": (401, f"the diagnosis report's sections; {NOT_YET_SPLIT}"),
     "parksteer/diagnose/identify/assist_identify.py:identify_boost": (194, f"the assist's identification; {NOT_YET_CUT}"),
     "parksteer/diagnose/suggest.py:effect_source": (113, f"the suggested effect's source text; {NOT_YET_CUT}"),
     "parksteer/reporting/report.py:diagnosis_dict": (110, f"the diagnosis's JSON; {NOT_YET_CUT}"),
-    "parksteer/measure/importers.py:load_record": (105, f"record import; {NOT_YET_CUT}"),
     "parksteer/reporting/sections.py:report_sections": (95, f"the report's sections; {NOT_YET_CUT}"),
-    "parksteer/measure/phases.py:find_phases": (93, f"the cycle's phases; {NOT_YET_CUT}"),
-    "parksteer/figures/assist_study.py:assist_study": (88, f"the assistance study's figure; {NOT_YET_CUT}"),
     "parksteer/diagnose/identify/identified_file.py:replace_assist_section": (84, f"the identified file's text; {NOT_YET_CUT}"),
-    "parksteer/figures/rivals.py:compare_rivals": (82, f"the rivals' comparison; {NOT_YET_CUT}"),
-    "parksteer/figures/user_effect.py:user_effect_figure": (81, f"the user effect's figure; {NOT_YET_CUT}"),
 }
 
 

@@ -159,7 +159,8 @@ def cli_page() -> str:
 
 def vehicle_file_page() -> str:
     """The sections and keys of a vehicle file: required keys, load cases, the assist and its boost table."""
-    from .parameters import CASE_SCHEMA, PROVENANCES, SCHEMA, load_parameters
+    from .parameter_entries import PROVENANCES
+    from .parameters import CASE_SCHEMA, SCHEMA, load_parameters
     from .vehicle import ASSIST_EFFECTS, BOOST_ASSIST_UNITS, BOOST_UNITS, REQUIRED
 
     paper = load_parameters()

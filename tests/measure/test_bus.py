@@ -199,7 +199,7 @@ def test_map_options_parse_and_print_back():
     """';sign=' and ';scale=' after a bus signal's target: parsed, printed back by spec() as given, and a wrong
     option or a zero scale refused in one line naming the entry."""
     from parksteer.errors import UsageError
-    from parksteer.measure.importers import parse_channel_map
+    from parksteer.measure.channel_map import parse_channel_map
 
     (ch,) = parse_channel_map("LH_EPS_03.EPS_Lenkmoment[cN*m]=-handwheel_torque_Nm;sign=LH_EPS_03.EPS_VZ_Lenkmoment")
     assert (ch.source, ch.unit, ch.negate, ch.sign, ch.scale) == (

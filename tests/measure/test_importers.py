@@ -15,7 +15,8 @@ from hypothesis import strategies as st
 
 from parksteer.cli import main
 from parksteer.errors import UsageError
-from parksteer.measure.importers import from_si, load_rack_drive, load_record, to_si
+from parksteer.measure.importers import load_rack_drive, load_record
+from parksteer.measure.units import from_si, to_si
 from parksteer.measure.text_table import read_table
 
 CORPUS = Path(__file__).parent / "corpus"

@@ -39,13 +39,16 @@ def test_the_import_layer_reads_records_only_through_the_table():
 
 
 def test_the_readers_refuse_a_record_through_one_helper():
-    """The fact checked: no reader and not the import layer writes a refusal's ``{where}: `` prefix by hand
+    """The fact checked: no reader and no module of the import layer (importers.py and the channel map, units and
+    plausibility checks it runs) writes a refusal's ``{where}: `` prefix by hand
     (``UsageError(f"{where}: ...")``): each goes through ``readers.base.refusal``, which gives the one-line form
     ``FILE: problem``."""
     from parksteer.errors import UsageError
     from parksteer.measure.readers.base import refusal
 
-    modules = [Path(importers.__file__), *sorted(Path(importers.__file__).with_name("readers").glob("*.py"))]
+    layer = [Path(importers.__file__).with_name(f"{name}.py")
+             for name in ("importers", "channel_map", "units", "plausibility")]
+    modules = [*layer, *sorted(Path(importers.__file__).with_name("readers").glob("*.py"))]
     by_hand = [f"{path.name}:{number}" for path in modules
                for number, line in enumerate(path.read_text(encoding="utf-8").splitlines(), 1)
                if 'UsageError(f"{where}: ' in line and path.name != "base.py"]

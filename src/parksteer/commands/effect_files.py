@@ -108,7 +108,7 @@ def _load(ref: str) -> UserEffect:
 
 def unit_problem(unit: str) -> str | None:
     """Why `unit` cannot be a model quantity's unit (pint does not know it, or it is not SI), or None."""
-    from ..measure.importers import unit_registry
+    from ..measure.units import unit_registry
 
     ureg = unit_registry()
     try:

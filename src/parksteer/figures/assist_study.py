@@ -54,6 +54,7 @@ from ..sweep.assist_sizing import (FRICTION_BAND, PUBLISHED_STANDSTILL_RACK_FORC
                                    rack_force_without_rack_friction_N, size_for_rack_force)
 from ..tables import write_csv, write_json
 from ..vehicle import ASSIST_EFFECTS, ASSISTED_EFFECTS, CREEPING_EFFECTS, creeping_overrides
+from .assist_gear import back_driven, gear_numbers
 from .model import OFFSET_CASES, _at, _times, plateau_mask, until_hand_stops
 from ..names import TORQUE
 
@@ -169,44 +170,6 @@ def _tyre_term(result: SimulationResult, params: Parameters) -> float:
     return terms["tyre_friction"] + terms.get("turn_slip", 0.0)
 
 
-def gear_numbers() -> dict:
-    """The assist gears' efficiencies from their thread (parksteer.reduction_efficiency) as the effects' defaults take
-    them, the least eta_b at which the replay's law rises, the units guard's window of rack forces and the largest
-    boost map (points, speed rows)."""
-    from .. import reduction_efficiency as re_
-    from ..boost_table import MAX_POINTS, MAX_SPEEDS
-    from ..model.numeric.assist import rack_force_window_N
-    from ..model.symbolic.effects import electric_assist as ea
-
-    degrees = 180.0 / re_.PI
-    low, high = rack_force_window_N()
-    return {
-        "worm": {"efficiency": ea.WORM_FORWARD_EFFICIENCY, "back_efficiency": ea.WORM_BACK_EFFICIENCY,
-                 "friction_angle_deg": ea.WORM_FRICTION_ANGLE_RAD * degrees,
-                 "lead_angle_deg": ea._WORM_LEAD_ANGLE_RAD * degrees,
-                 "least_back_efficiency": re_.min_monotone_back_efficiency(ea.WORM_FORWARD_EFFICIENCY)},
-        "ball_nut": {"efficiency": ea.BALL_NUT_FORWARD_EFFICIENCY, "back_efficiency": ea.BALL_NUT_BACK_EFFICIENCY,
-                     "lead_mm": ea.BALL_NUT_LEAD_M * 1e3, "ball_circle_mm": ea.BALL_NUT_BALL_CIRCLE_M * 1e3,
-                     "lead_angle_deg": ea._NUT_LEAD_ANGLE_RAD * degrees,
-                     "friction_angle_deg": ea._NUT_FRICTION_ANGLE_RAD * degrees},
-        "rack_force_window_N": [low, high],
-        "map_size": {"points": MAX_POINTS, "speeds": MAX_SPEEDS},
-    }
-
-
-def back_driven(result: SimulationResult, params: Parameters, least_Nm: float = 1.0) -> dict:
-    """How much of the standstill cycle the column assist's gear is back-driven: the share of the samples with more
-    than `least_Nm` of assist at the column where it delivers more than N T_m (the rack driving the motor), and the
-    largest delivered factor, assist / (N T_m), over those samples."""
-    c = result.columns
-    name = ASSIST_EFFECTS["column"]
-    n = result.values.value(f"{name}.reduction_ratio")
-    strong = np.abs(c["assist_torque_Nm"]) > least_Nm
-    factor = c["assist_torque_Nm"][strong] / (n * c["motor_torque_Nm"][strong])
-    return {"least_assist_Nm": least_Nm, "share": float(np.mean(factor > 1.0)), "largest_factor": float(np.max(factor)),
-            "forward_factor": float(np.min(factor))}
-
-
 def class_load(standstill: SimulationResult, params: Parameters, target_torque_Nm: float) -> dict:
     """The column assist at its defaults sized, quasi-statically, to leave the driver `target_torque_Nm` against
     the model's standstill peak rack force and against the ends of the published class range, through the car's gear
@@ -234,63 +197,74 @@ def assist_study(params: Parameters, target_torque_Nm: float, run=simulate, prog
     torque the class-load sizing keeps (the pipeline's config, assist.target_torque). `run` is the simulation
     (simulate's signature); `progress`, if given, is called with a line per run."""
     discover_effects()  # the assists' own quantities, with their assumed defaults
-    kinds = (None, *ASSISTS)
-    label = lambda kind: kind or "none"  # noqa: E731
-    results: dict = {}
-    for kind in kinds:
-        for case in OFFSET_CASES:
-            if progress:
-                progress(f"assist {label(kind)}, {case}, 0 km/h")
-            results[(kind, case, 0.0)] = run(case, effects=_effects(kind), overrides=creeping_overrides(0.0), params=params)
-        for speed in SPEEDS_KMH[1:]:
-            if progress:
-                progress(f"assist {label(kind)}, {CASE}, {speed:g} km/h")
-            results[(kind, CASE, speed)] = run(CASE, effects=_effects(kind), overrides=creeping_overrides(speed), params=params)
-
-    for friction in FRICTION_BAND:
-        if progress:
-            progress(f"assist none, {CASE}, 0 km/h, tyre friction {friction:g}")
-        results[("friction", friction)] = run(CASE, effects=_effects(None), params=params, overrides={
-            **creeping_overrides(0.0), "tyre.friction_coefficient": friction})
-    for q in SPIN_SLOPE_BAND:
-        for speed in SPEEDS_KMH[1:]:
-            if progress:
-                progress(f"assist none, {CASE}, {speed:g} km/h, q_Dz8 {q:g}")
-            results[("spin_slope", q, speed)] = run(CASE, effects=_effects(None), params=params, overrides={
-                **creeping_overrides(speed), SPIN_SLOPE_KEY: q})
-
+    results = _study_runs(params, run, progress or (lambda line: None))
     numbers: dict = {"case": CASE, "surface": "ground", "speeds_kmh": list(SPEEDS_KMH), "offset_cases": list(OFFSET_CASES),
                      "turn_slip": turn_slip_values(), "assists": {}, "runs": {}}
     for kind in ASSISTS:
         gain = equivalent_gain(kind, params)
         numbers["assists"][kind] = {"effect": ASSIST_EFFECTS[kind], "assumed": assumed_values(kind),
                                     "gain": gain, "driver_share_limit": 1.0 / (1.0 + gain)}
-    for kind in kinds:
-        standstill = results[(kind, CASE, 0.0)].columns
-        plateau = {case: float(np.mean(results[(kind, case, 0.0)].columns[TORQUE][
-            plateau_mask(results[(kind, case, 0.0)].columns, params)])) for case in OFFSET_CASES}
-        peak = {case: float(np.max(np.abs(results[(kind, case, 0.0)].columns[TORQUE])))
-                for case in OFFSET_CASES}
-        numbers["runs"][label(kind)] = {
-            "peak_torque_Nm": peak[CASE],
-            "shares": shares(standstill, params),
-            "offsets": {"plateau_torque_Nm": plateau, "peak_torque_Nm": peak,
-                        "plateau_spread_Nm": _spread(plateau), "peak_spread_Nm": _spread(peak),
-                        "plateau_spread_relative": _spread(plateau) / plateau[CASE],
-                        "peak_spread_relative": _spread(peak) / peak[CASE]},
-            "speeds": {
-                "peak_rack_force_N": [peak_rack_force_N(results[(kind, CASE, s)]) for s in SPEEDS_KMH],
-                "peak_handwheel_torque_Nm": [float(np.max(np.abs(results[(kind, CASE, s)].columns[
-                    TORQUE]))) for s in SPEEDS_KMH],
-                **_plateau_by_speed([shares(results[(kind, CASE, s)].columns, params)["plateau"]
-                                     for s in SPEEDS_KMH]),
-            },
-        }
+    for kind in (None, *ASSISTS):
+        numbers["runs"][kind or "none"] = _assist_numbers(kind, results, params)
     force = numbers["runs"]["none"]["speeds"]["peak_rack_force_N"]
     numbers["rack_force_fall_at_5_kmh"] = 1.0 - force[-1] / force[0]
+    numbers["friction_band"] = _friction_band(results, params)
+    numbers["class_load"] = class_load(results[(None, CASE, 0.0)], params, target_torque_Nm)
+    numbers["spin_slope_band"] = _spin_slope_band(results, params, force[0])
+    numbers["back_driven"] = back_driven(results[("column", CASE, 0.0)], params)
+    numbers["gear"] = gear_numbers()
+    numbers["_results"] = results
+    return numbers
+
+
+def _study_runs(params: Parameters, run, progress) -> dict:
+    """The study's simulations by key: (assist kind or None, case, speed in km/h) for each assist's offsets and
+    speeds, ("friction", coefficient) over the friction band, ("spin_slope", q_Dz8, speed) over the spin-slope band."""
+    results: dict = {}
+    for kind in (None, *ASSISTS):
+        for case, speed in [(case, 0.0) for case in OFFSET_CASES] + [(CASE, speed) for speed in SPEEDS_KMH[1:]]:
+            progress(f"assist {kind or 'none'}, {case}, {speed:g} km/h")
+            results[(kind, case, speed)] = run(case, effects=_effects(kind), overrides=creeping_overrides(speed),
+                                               params=params)
+    for friction in FRICTION_BAND:
+        progress(f"assist none, {CASE}, 0 km/h, tyre friction {friction:g}")
+        results[("friction", friction)] = run(CASE, effects=_effects(None), params=params, overrides={
+            **creeping_overrides(0.0), "tyre.friction_coefficient": friction})
+    for q in SPIN_SLOPE_BAND:
+        for speed in SPEEDS_KMH[1:]:
+            progress(f"assist none, {CASE}, {speed:g} km/h, q_Dz8 {q:g}")
+            results[("spin_slope", q, speed)] = run(CASE, effects=_effects(None), params=params, overrides={
+                **creeping_overrides(speed), SPIN_SLOPE_KEY: q})
+    return results
+
+
+def _assist_numbers(kind: str | None, results: dict, params: Parameters) -> dict:
+    """One assist's (None: without) peak torque, shares, spread over the offsets and numbers at each speed."""
+    standstill = {case: results[(kind, case, 0.0)].columns for case in OFFSET_CASES}
+    plateau = {case: float(np.mean(c[TORQUE][plateau_mask(c, params)])) for case, c in standstill.items()}
+    peak = {case: float(np.max(np.abs(c[TORQUE]))) for case, c in standstill.items()}
+    return {
+        "peak_torque_Nm": peak[CASE],
+        "shares": shares(standstill[CASE], params),
+        "offsets": {"plateau_torque_Nm": plateau, "peak_torque_Nm": peak,
+                    "plateau_spread_Nm": _spread(plateau), "peak_spread_Nm": _spread(peak),
+                    "plateau_spread_relative": _spread(plateau) / plateau[CASE],
+                    "peak_spread_relative": _spread(peak) / peak[CASE]},
+        "speeds": {
+            "peak_rack_force_N": [peak_rack_force_N(results[(kind, CASE, s)]) for s in SPEEDS_KMH],
+            "peak_handwheel_torque_Nm": [float(np.max(np.abs(results[(kind, CASE, s)].columns[TORQUE])))
+                                         for s in SPEEDS_KMH],
+            **_plateau_by_speed([shares(results[(kind, CASE, s)].columns, params)["plateau"] for s in SPEEDS_KMH]),
+        },
+    }
+
+
+def _friction_band(results: dict, params: Parameters) -> dict:
+    """The standstill peak rack force (with and without the rack's friction) over the friction band, against the
+    published class range."""
     band = [peak_rack_force_N(results[("friction", f)]) for f in FRICTION_BAND]
     low, high = PUBLISHED_STANDSTILL_RACK_FORCE_N
-    numbers["friction_band"] = {
+    return {
         "friction": list(FRICTION_BAND), "peak_rack_force_N": band,
         "peak_rack_force_without_rack_friction_N": [
             float(np.max(np.abs(rack_force_without_rack_friction_N(results[("friction", f)]))))
@@ -300,12 +274,16 @@ def assist_study(params: Parameters, target_torque_Nm: float, run=simulate, prog
         "below_published_at": [f for f, force in zip(FRICTION_BAND, band) if force < low],
         "within_published_at": [f for f, force in zip(FRICTION_BAND, band) if low <= force <= high],
         "above_published_at": [f for f, force in zip(FRICTION_BAND, band) if force > high]}
-    numbers["class_load"] = class_load(results[(None, CASE, 0.0)], params, target_torque_Nm)
+
+
+def _spin_slope_band(results: dict, params: Parameters, standstill_force_N: float) -> dict:
+    """The car without assist at each speed over the spin-slope band: peak rack force, the share of its standstill
+    tyre moment the rolling tyre keeps, the plateau's shares."""
     standstill_tyre = _tyre_term(results[(None, CASE, 0.0)], params)
-    numbers["spin_slope_band"] = {
+    return {
         "q_dz8": list(SPIN_SLOPE_BAND),
-        "peak_rack_force_N": {f"{q:g}": [force[0], *(peak_rack_force_N(results[("spin_slope", q, s)])
-                                                     for s in SPEEDS_KMH[1:])] for q in SPIN_SLOPE_BAND},
+        "peak_rack_force_N": {f"{q:g}": [standstill_force_N, *(peak_rack_force_N(results[("spin_slope", q, s)])
+                                                               for s in SPEEDS_KMH[1:])] for q in SPIN_SLOPE_BAND},
         "tyre_moment_kept": {f"{q:g}": [1.0, *(_tyre_term(results[("spin_slope", q, s)], params) / standstill_tyre
                                                for s in SPEEDS_KMH[1:])] for q in SPIN_SLOPE_BAND},
         "plateau_shares": {f"{q:g}": _plateau_by_speed(
@@ -313,10 +291,6 @@ def assist_study(params: Parameters, target_torque_Nm: float, run=simulate, prog
              *(shares(results[("spin_slope", q, s)].columns, params)["plateau"] for s in SPEEDS_KMH[1:])]
         )["plateau_shares"] for q in SPIN_SLOPE_BAND},
     }
-    numbers["back_driven"] = back_driven(results[("column", CASE, 0.0)], params)
-    numbers["gear"] = gear_numbers()
-    numbers["_results"] = results
-    return numbers
 
 
 def study_table(numbers: dict) -> dict[str, list]:

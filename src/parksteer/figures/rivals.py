@@ -77,11 +77,7 @@ def compare_rivals(params: Parameters, simulate=None, rivals=None, progress=None
     rivals = chosen_rivals(rivals, "rivals", registry)
     base = {key: simulate(case, params=params, surface=surface).columns for key, case, surface, _ in TESTS}
     base_numbers = {key: _near_and_plateau(c, params) for key, c in base.items()}
-
-    def entry(near: float, plateau: float) -> dict:
-        return {"near_lock_Nm": near, "plateau_Nm": plateau, "rise_Nm": near - plateau}
-
-    lifting = {key: entry(*_near_and_plateau(c, params, "lifting")) for key, c in base.items()}
+    lifting = {key: _rise_entry(*_near_and_plateau(c, params, "lifting")) for key, c in base.items()}
     target = lifting["unladen_ground"]["rise_Nm"]
     step = converter_step_Nm(params)
 
@@ -95,7 +91,7 @@ def compare_rivals(params: Parameters, simulate=None, rivals=None, progress=None
         columns = simulate(case, effects=f"+{rival}", overrides={quantity.key: strength}, params=params,
                            surface=surface).columns
         near, plateau = _near_and_plateau(columns, params)
-        cycles[rival, key, strength] = entry(near - base_numbers[key][0], plateau - base_numbers[key][1])
+        cycles[rival, key, strength] = _rise_entry(near - base_numbers[key][0], plateau - base_numbers[key][1])
         return cycles[rival, key, strength]
 
     out = {}
@@ -103,36 +99,10 @@ def compare_rivals(params: Parameters, simulate=None, rivals=None, progress=None
         if progress is not None:
             progress(f"rival {rival}: matching lifting's rise toward lock, {target:.3f} N m")
         quantity = strength_parameter(registry[rival], params)
-        upper = quantity.upper if math.isfinite(quantity.upper) else math.inf
-        # Secant on the strength for the added rise toward lock (zero at zero strength), kept in the bounds.
-        s0, f0 = 0.0, -target
-        s1 = registry[rival].rival.probe_strength
-        first = added(rival, "unladen_ground", s1)
-        f1 = first["rise_Nm"] - target
-        if first["rise_Nm"] * math.copysign(1.0, target) < NO_RISE_FRACTION * abs(target):
-            status = "no rise"  # its torque does not grow toward lock: it cannot stand in for lifting
-        else:
-            for _ in range(MATCH_STEPS):
-                if abs(f1) <= MATCH_RELATIVE * abs(target) or f1 == f0:
-                    break
-                s_next = min(max(s1 - f1 * (s1 - s0) / (f1 - f0), 0.0), upper)
-                if s_next == s1 or s_next == 0.0:
-                    break  # held at a bound
-                s0, f0, s1 = s1, f1, s_next
-                f1 = added(rival, "unladen_ground", s1)["rise_Nm"] - target
-            status = "matched" if abs(f1) <= MATCH_RELATIVE * abs(target) else "at bound"
-        tests = {key: added(rival, key, s1) for key, *_ in TESTS}
-        differences = {key: tests[key]["rise_Nm"] - lifting[key]["rise_Nm"] for key, *_ in TESTS[1:]}
-        separating = max(differences, key=lambda k: abs(differences[k]))
-        out[rival] = {
-            "strength_key": quantity.key, "strength": s1, "unit": quantity.unit, "status": status,
-            "tests": tests,
-            "difference_from_lifting_Nm": differences,
-            "separating_test": separating,
-            "separating_difference_Nm": differences[separating],
-            "told_apart": status == "matched" and abs(differences[separating]) > step,
-            "told_apart_by": [k for k in differences if status == "matched" and abs(differences[k]) > step],
-        }
+        strength, status = _matched_strength(lambda s: added(rival, "unladen_ground", s)["rise_Nm"], target,
+                                             registry[rival].rival.probe_strength, quantity.upper)
+        tests = {key: added(rival, key, strength) for key, *_ in TESTS}
+        out[rival] = _rival_numbers(quantity, strength, status, tests, lifting, step)
     matched = [r for r in rivals if out[r]["status"] == "matched"]
     return {
         "tests": [{"key": k, "case": c, "surface": s, "label": label} for k, c, s, label in TESTS],
@@ -148,6 +118,48 @@ def compare_rivals(params: Parameters, simulate=None, rivals=None, progress=None
         "at_bound": [r for r in rivals if out[r]["status"] == "at bound"],
         "told_apart": [r for r in matched if out[r]["told_apart"]],
         "not_told_apart": [r for r in matched if not out[r]["told_apart"]],
+    }
+
+
+def _rise_entry(near: float, plateau: float) -> dict:
+    return {"near_lock_Nm": near, "plateau_Nm": plateau, "rise_Nm": near - plateau}
+
+
+def _matched_strength(rise, target: float, probe: float, upper_bound: float) -> tuple[float, str]:
+    """The strength whose added rise toward lock (`rise(strength)`, zero at zero strength) is `target`, by a secant
+    search from `probe` kept within [0, upper_bound], and its status: "matched", "at bound", or "no rise" (the
+    rise at the probe is below NO_RISE_FRACTION of the target's)."""
+    upper = upper_bound if math.isfinite(upper_bound) else math.inf
+    s0, f0 = 0.0, -target
+    s1 = probe
+    first = rise(s1)
+    f1 = first - target
+    if first * math.copysign(1.0, target) < NO_RISE_FRACTION * abs(target):
+        return s1, "no rise"  # its torque does not grow toward lock: it cannot stand in for lifting
+    for _ in range(MATCH_STEPS):
+        if abs(f1) <= MATCH_RELATIVE * abs(target) or f1 == f0:
+            break
+        s_next = min(max(s1 - f1 * (s1 - s0) / (f1 - f0), 0.0), upper)
+        if s_next == s1 or s_next == 0.0:
+            break  # held at a bound
+        s0, f0, s1 = s1, f1, s_next
+        f1 = rise(s1) - target
+    return s1, "matched" if abs(f1) <= MATCH_RELATIVE * abs(target) else "at bound"
+
+
+def _rival_numbers(quantity, strength: float, status: str, tests: dict, lifting: dict, step: float) -> dict:
+    """A rival's strength and added rise in each test, against lifting's: the separating test and whether it tells
+    them apart by more than one converter step `step`."""
+    differences = {key: tests[key]["rise_Nm"] - lifting[key]["rise_Nm"] for key, *_ in TESTS[1:]}
+    separating = max(differences, key=lambda k: abs(differences[k]))
+    return {
+        "strength_key": quantity.key, "strength": strength, "unit": quantity.unit, "status": status,
+        "tests": tests,
+        "difference_from_lifting_Nm": differences,
+        "separating_test": separating,
+        "separating_difference_Nm": differences[separating],
+        "told_apart": status == "matched" and abs(differences[separating]) > step,
+        "told_apart_by": [k for k in differences if status == "matched" and abs(differences[k]) > step],
     }
 
 

@@ -20,9 +20,21 @@ def user_effect_figure(diagnosis, path: str | Path) -> None:
     found = diagnosis.outputs["user_effect"]
     names = ", ".join(found.effects)
     fig, axes = new_figure(7.0, 13.0, nrows=5, gridspec_kw={"height_ratios": [1.0, 1.3, 1.0, 1.0, 1.1]})
-    floor = found.noise_floor_Nm
+    _ladder(axes[0], found)
+    f = diagnosis.problem.files[0]
+    t = f.time_s - f.time_s[0]
+    before = f.torque_part(found.without.predictions[0])
+    after = f.torque_part(diagnosis.calibration.predictions[0])
+    _record(axes[1], f, t, before, after, names)
+    _residuals(axes[2], f, t, before, after)
+    _residual_by_phase(axes[3], found)
+    _strength_sweep(axes[4], found, names)
+    fig.tight_layout()
+    save_svg(fig, path)
 
-    ax = axes[0]
+
+def _ladder(ax, found) -> None:
+    """The error ladder: measured floor, the calibrated model without the effect, with it."""
     x = np.arange(len(found.rungs))
     ax.bar(x, [r["over_floor"] for r in found.rungs], color=[MEASURED, BEFORE, AFTER][: len(found.rungs)])
     ax.axhline(1.0, color="black", linestyle=":", linewidth=1.0, label="noise floor")
@@ -32,11 +44,9 @@ def user_effect_figure(diagnosis, path: str | Path) -> None:
     ax.set_title("the error ladder: the paper's model, calibrated, with your effect", fontsize=9)
     ax.legend(fontsize=7)
 
-    f = diagnosis.problem.files[0]
-    t = f.time_s - f.time_s[0]
-    before = f.torque_part(found.without.predictions[0])
-    after = f.torque_part(diagnosis.calibration.predictions[0])
-    ax = axes[1]
+
+def _record(ax, f, t, before, after, names: str) -> None:
+    """The record's torque with both models', its rack on a second axis."""
     ax.plot(t, f.torque_Nm, ".", color=MEASURED, markersize=1.5, label=f"measured ({f.label})")
     ax.plot(t, before, color=BEFORE, linewidth=1.0, label="calibrated, without it")
     ax.plot(t, after, color=AFTER, linewidth=1.0, label=f"with {names}")
@@ -46,7 +56,9 @@ def user_effect_figure(diagnosis, path: str | Path) -> None:
     twin.plot(t, f.rack_m * 1000, color=COLOURS[2], linewidth=0.6, alpha=0.5)
     twin.set_ylabel("rack (mm)", color=COLOURS[2])
 
-    ax = axes[2]
+
+def _residuals(ax, f, t, before, after) -> None:
+    """Both models' residuals over the record, its phases shaded."""
     for k, phase in enumerate(PHASES):
         mask = f.phases.mask(phase)
         if mask.any():
@@ -61,7 +73,9 @@ def user_effect_figure(diagnosis, path: str | Path) -> None:
     ax.set_xlabel("time (s)")
     ax.legend(fontsize=6, ncol=4)
 
-    ax = axes[3]
+
+def _residual_by_phase(ax, found) -> None:
+    """The RMS residual of each phase, pooled over the files, without and with the effect."""
     present = [p for p in PHASES if any(r["phase"] == p for r in found.phases)]
     xp = np.arange(len(present))
     for k, (label, key, colour) in enumerate((("without it", "without_rms_Nm", BEFORE),
@@ -79,7 +93,9 @@ def user_effect_figure(diagnosis, path: str | Path) -> None:
     ax.set_title("the residual by phase of the cycle, all files", fontsize=9)
     ax.legend(fontsize=7)
 
-    ax = axes[4]
+
+def _strength_sweep(ax, found, names: str) -> None:
+    """The error as the fitted strengths grow from 0 to their values (one strength, or their common fraction)."""
     sweep = found.sweep
     keys = sweep["keys"]
     if len(keys) == 1:
@@ -92,10 +108,9 @@ def user_effect_figure(diagnosis, path: str | Path) -> None:
     ax.set_yscale("log")
     ax.set_xlabel(label)
     ax.set_ylabel("weighted RMS / floor")
-    ax.set_title(f"the error as the strength grows from 0 to its fitted value (floor {floor:.3g} N m)", fontsize=9)
+    ax.set_title(f"the error as the strength grows from 0 to its fitted value (floor {found.noise_floor_Nm:.3g} N m)",
+                 fontsize=9)
     ax.legend(fontsize=7)
-    fig.tight_layout()
-    save_svg(fig, path)
 
 
 def user_effect_path(plot: str | Path) -> Path:

@@ -2,7 +2,8 @@
 
 - :mod:`.io`: read, validate and write measurement files (format: data/measurements/README.md);
 - :mod:`.importers`: the one way in for every measurement, rack drive or angle record (logger exports mapped to the
-  format), a thin dispatcher over the readers;
+  format), a thin dispatcher over the readers, running the channel map (:mod:`.channel_map`), the units'
+  conversion (:mod:`.units`) and the plausibility checks against the car (:mod:`.plausibility`);
 - :mod:`.readers`: one reader per file format (native CSV, logger CSV, ASAM MDF) in a table, ``READERS``;
 - :mod:`.phases`: split a steering cycle into initial rise, wind-up, plateau, reversal, return;
 - :mod:`.smoothing`: a measured rack as a motion the model can follow (least-squares spline);

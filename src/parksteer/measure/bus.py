@@ -18,9 +18,10 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import UsageError
-from .importers import Channel, channel_map_from_options, from_si, parse_channel_map
+from .channel_map import Channel, channel_map_from_options, parse_channel_map
 from .io import Measurement
 from .readers.bus_files import BusMap, BusSpec, checksum_signal, counter_signal, dbc_bus, load_bus, load_dbc
+from .units import from_si
 from ..names import TORQUE
 
 WRITERS = {"candump": ".log", "asc": ".asc", "blf": ".blf", "trc": ".trc", "mf4": ".mf4"}

@@ -15,7 +15,9 @@ from pathlib import Path
 from ..errors import UsageError
 from ..geometry import column_twist, pinion_angle_from_column
 from ..parameters import Parameters
-from .importers import ANGLE, TORQUE, load_record
+from ..names import TORQUE
+from .channel_map import ANGLE
+from .importers import load_record
 from .io import Measurement
 from .metrics import noise_floor
 

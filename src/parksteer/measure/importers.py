@@ -9,29 +9,17 @@ header, and automotive loggers write ASAM MDF. :func:`load_record` reads any of 
 native names (a channel map, or known aliases when that is unambiguous), converts units with pint, fills the case
 and surface the file does not state, derives the rack from the handwheel angle when there is no rack channel, and
 then runs the native format's own checks (:func:`parksteer.measure.io.validate_record`) and the plausibility checks
-below. Every refusal is one :class:`~parksteer.errors.UsageError` line naming the file and the channel, row or key.
+(:mod:`.plausibility`). Every refusal is one :class:`~parksteer.errors.UsageError` line naming the file and the
+channel, row or key.
 
-Channel map syntax (``--map`` or one entry per line in a map file)::
-
-    RackPos[mm]=rack_m,SteerTorque[N*m]=handwheel_torque_Nm,SWA[deg]=-handwheel_angle_rad
-
-A unit in brackets is the source channel's unit; a leading minus on the target negates the channel (a logger with
-the opposite sign convention). A target without a source unit is taken in its own SI unit (``rack_m``: metres).
-
-A signal of a raw CAN log (``--dbc CAR.dbc`` or ``--bus NAME``, :mod:`parksteer.measure.readers.can_log`) is
-named ``MESSAGE.SIGNAL``, and its entry may end in options after semicolons: ``sign=MESSAGE.SIGNAL`` (the value
-is a magnitude whose sign is that flag signal: set means negative) and ``scale=FACTOR`` (the decoded value, a raw
-count where the DBC gives no factor, times FACTOR, before the unit)::
-
-    LH_EPS_03.EPS_Lenkmoment[cN*m]=-handwheel_torque_Nm;sign=LH_EPS_03.EPS_VZ_Lenkmoment
+The channel map's syntax and parsing are :mod:`.channel_map`'s, the units' conversion :mod:`.units`'; this module
+runs them, in order, on what the reader gives.
 """
 
 from __future__ import annotations
 
 import errno
-import math
 import sys
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -41,28 +29,18 @@ from ..errors import UsageError, cannot_read
 from ..geometry import rack_from_handwheel
 from ..names import TORQUE
 from ..parameters import Parameters, load_parameters
-from .io import ALLOWED_COLUMNS, REQUIRED_COLUMNS, UNITS, Measurement, metadata_text, validate_record
+from .channel_map import (ANGLE, CURRENT, MAP_TARGETS, MOTOR_TORQUE, RACK, SPEED, TIME, TORSION_BAR, Channel,
+                          parse_channel_map)
+from .io import ALLOWED_COLUMNS, REQUIRED_COLUMNS, Measurement, metadata_text, validate_record
+from .plausibility import check_against_lock, check_signs
 from .readers import Record, Source, reader_for
-from .readers.base import TIME_ALIASES, name_and_unit, normal_name, refusal
+from .readers.base import TIME_ALIASES, normal_name, refusal
+from .units import SI_UNITS, to_si
 
-RACK, ANGLE, TIME = "rack_m", "handwheel_angle_rad", "time_s"
-# An assisted car's torque sensor: a map target of its own, read into the torque column with the metadata
-# torque_sensor = torsion_bar (the torque role with a flag: everything downstream of the import reads one torque).
-TORSION_BAR = "torsion_bar_torque_Nm"
-CURRENT, MOTOR_TORQUE, SPEED = "motor_current_A", "motor_torque_Nm", "vehicle_speed_mps"
-MAP_TARGETS = ALLOWED_COLUMNS + (TORSION_BAR,)
+# parksteer.measure.importers stays the import path of the channel map's options that the command line reads
+from .channel_map import channel_map_from_options  # noqa: F401
+
 RACK_DRIVE_COLUMNS = (TIME, RACK)
-
-# The pint unit each native column is converted to.
-SI_UNITS = {TIME: "s", RACK: "m", TORQUE: "N*m", ANGLE: "rad", "load_left_N": "N", "load_right_N": "N",
-            SPEED: "m/s", TORSION_BAR: "N*m", CURRENT: "A", MOTOR_TORQUE: "N*m"}
-UNIT_DIMENSIONS = {TIME: "time", RACK: "length", TORQUE: "torque", ANGLE: "angle", "load_left_N": "force",
-                   "load_right_N": "force", SPEED: "speed", TORSION_BAR: "torque", CURRENT: "current",
-                   MOTOR_TORQUE: "torque"}
-
-# Logger spellings pint reads as something else: "Nm" is pint's number-metre, never a torque on a logger.
-UNIT_SPELLINGS = {"Nm": "N*m", "rev": "revolution", "Nmm": "N*mm", "kNm": "kN*m", "deg.": "deg", "sec": "s", "kph": "km/h"}
-ANGLE_UNIT_WORDS = ("radian", "degree", "revolution", "turn", "grade", "arcminute", "arcsecond")
 
 # Channel names loggers use for the native columns, compared lower-case without spaces, '_', '-' or '.'.
 ALIASES = {
@@ -80,22 +58,6 @@ ALIASES = {
     MOTOR_TORQUE: ("motortorque", "epsmotortorque", "motormoment"),
 }
 
-# Plausibility against the car (the parameter file's lock and ratio). Refused, not warned: each of these makes a
-# comparison with the model meaningless, and a warning scrolls past while the report is believed.
-# - The rack cannot pass the lock. Beyond the handwheel lock the rack moves by at most the column twist (30 N m
-#   on a 1000 N m/rad column: 0.03 rad at the handwheel) and the Hooke joint's largest lead of the pinion over the
-#   column (0.05 rad at 0.45 rad joint angle); 10 % more covers a zero offset of the rack sensor.
-LOCK_MARGIN = 1.10
-LOCK_TWIST_TORQUE_NM = 30.0
-# - A rack or angle tens to thousands of times the lock is a unit error, and the ratio names the unit.
-UNIT_SUSPECTS = {RACK: (("centimetres", "cm", 100.0), ("millimetres", "mm", 1000.0)),
-                 ANGLE: (("degrees", "deg", 180.0 / np.pi),)}
-# - Torque against rack speed: the driver pushes the rack the way it moves (friction opposes the motion), so over a
-#   cycle they correlate strongly positively (about +0.8 for the paper's car). A clearly negative correlation is a
-#   flipped sign convention on one channel; noise alone stays near zero.
-SIGN_CORRELATION_LIMIT = -0.3
-SPEED_WINDOW_S = 0.25  # rack speed from a moving average over this window (converter steps are not motion)
-
 # Big and fast records. The method resolves a steering cycle's phases over windows of 0.1 s and more, and it is
 # shown to work on 50 Hz loggers (data/measurements/example_unladen.csv); 100 samples a second, twice that, carry
 # all it uses. A faster record is low-pass filtered (an FIR anti-alias filter, zero phase) and decimated to at
@@ -103,173 +65,6 @@ SPEED_WINDOW_S = 0.25  # rack speed from a moving average over this window (conv
 # Beyond the caps a record is refused, not read for minutes.
 METHOD_RATE_HZ = 100.0
 MAX_RECORD_BYTES = 256 * 2**20
-
-
-@dataclass(frozen=True)
-class Channel:
-    """One entry of a channel map: source channel (with its unit, if stated) to a native column."""
-
-    source: str
-    unit: str | None
-    target: str
-    negate: bool = False
-    origin: str = "--map"
-    sign: str | None = None  # a bus log's flag signal holding the sign of this magnitude (set: negative)
-    scale: float | None = None  # a bus log's signal times this factor before the unit (a raw count's scale)
-
-    def spec(self, negate: bool | None = None) -> str:
-        negate = self.negate if negate is None else negate
-        unit = f"[{self.unit}]" if self.unit else ""
-        options = (f";sign={self.sign}" if self.sign else "") + (f";scale={self.scale:g}" if self.scale else "")
-        return f"{self.source}{unit}={'-' if negate else ''}{self.target}{options}"
-
-
-def _split_entries(text: str) -> list[str]:
-    """Split a map on commas outside brackets (a unit may not contain one, but a stray one gets a clear error)."""
-    entries, depth, current = [], 0, ""
-    for ch in text:
-        depth += ch in "[(" and 1 or 0
-        depth -= ch in "])" and 1 or 0
-        if ch == "," and depth <= 0:
-            entries.append(current)
-            current = ""
-        else:
-            current += ch
-    entries.append(current)
-    return [e.strip() for e in entries if e.strip()]
-
-
-def parse_channel_map(text: str, origin: str = "--map") -> list[Channel]:
-    """Parse ``Source[unit]=[-]target`` entries separated by commas; `origin` names the map in errors."""
-    channels: list[Channel] = []
-    for entry in _split_entries(text):
-        source_text, eq, target = entry.partition("=")
-        target, *options = [part.strip() for part in target.split(";")]
-        sign, scale = _bus_options(options, entry, origin)
-        negate = target.startswith("-")
-        target = target.lstrip("-").strip()
-        source, unit = name_and_unit(source_text)
-        if not eq or not source:
-            raise UsageError(f"{origin}: entry {entry!r} must read 'Source[unit]=target', e.g. 'RackPos[mm]=rack_m'")
-        if target not in MAP_TARGETS:
-            raise UsageError(f"{origin}: entry {entry!r}: unknown target {target!r} (known: {', '.join(MAP_TARGETS)})")
-        for other in channels:
-            if other.target == target:
-                raise UsageError(f"{origin}: entries {other.spec()!r} and {entry!r} both map to {target!r}")
-            if other.source == source:
-                raise UsageError(f"{origin}: channel {source!r} is mapped twice")
-        channels.append(Channel(source, unit or None, target, negate, origin, sign, scale))
-    if not channels:
-        raise UsageError(f"{origin}: empty channel map")
-    return channels
-
-
-def _bus_options(options: list[str], entry: str, origin: str) -> tuple[str | None, float | None]:
-    """The ';sign=MESSAGE.SIGNAL' and ';scale=FACTOR' options of a bus signal's map entry."""
-    sign = scale = None
-    for option in options:
-        key, eq, value = (part.strip() for part in option.partition("="))
-        if key == "sign" and eq and value:
-            sign = value
-        elif key == "scale" and eq:
-            try:
-                scale = float(value)
-            except ValueError:
-                scale = math.nan
-            if not math.isfinite(scale) or scale == 0.0:
-                raise UsageError(f"{origin}: entry {entry!r}: scale={value} is not a finite non-zero number")
-        else:
-            raise UsageError(f"{origin}: entry {entry!r}: option {option!r} is neither 'sign=MESSAGE.SIGNAL' nor "
-                             "'scale=FACTOR'")
-    return sign, scale
-
-
-def read_channel_map(path: str | Path) -> list[Channel]:
-    """A map file: one ``Source[unit]=[-]target`` entry per line (or several, comma separated); '#' comments."""
-    path = Path(path)
-    try:
-        text = path.read_bytes().decode("utf-8-sig")
-    except OSError as exc:
-        raise UsageError(cannot_read(path, exc)) from None
-    except UnicodeDecodeError as exc:
-        raise UsageError(f"{path}: not UTF-8 text (byte {exc.start})") from None
-    channels: list[Channel] = []
-    for line_no, line in enumerate(text.splitlines(), start=1):
-        line = line.split("#", 1)[0].strip()
-        if line:
-            for channel in parse_channel_map(line, f"{path}: line {line_no}"):
-                for other in channels:
-                    if other.target == channel.target or other.source == channel.source:
-                        raise UsageError(f"{path}: line {line_no}: {channel.spec()!r} repeats a channel or target "
-                                         f"of {other.spec()!r}")
-                channels.append(channel)
-    if not channels:
-        raise UsageError(f"{path}: empty channel map")
-    return channels
-
-
-def channel_map_from_options(map_text: str | None, map_file: str | Path | None) -> list[Channel] | None:
-    """The channel map of ``--map`` and ``--map-file`` together (None when neither is given)."""
-    channels = (read_channel_map(map_file) if map_file else []) + (parse_channel_map(map_text) if map_text else [])
-    for i, a in enumerate(channels):
-        for b in channels[i + 1:]:
-            if a.target == b.target or a.source == b.source:
-                raise UsageError(f"{b.origin}: {b.spec()!r} repeats a channel or target of {a.spec()!r} ({a.origin})")
-    return channels or None
-
-
-# --------------------------------------------------------------------------------------------------- units
-
-def unit_registry():
-    """pint's application registry (pint's default units, built by pint on first use: it takes a few tenths of a
-    second); the package never defines units in it."""
-    import pint
-
-    return pint.get_application_registry()
-
-
-def conversion(unit: str | None, target: str, where: str):
-    """A function taking values in `unit` to the SI unit of native column `target`; refused in one line when
-    pint does not know the unit or its dimension is not the target's."""
-    si = SI_UNITS[target]
-    if unit is None or unit.strip() == "" or unit.strip() == si:
-        return lambda values: np.asarray(values, dtype=float)
-    text = UNIT_SPELLINGS.get(unit.strip(), unit.strip())
-    ureg = unit_registry()
-    try:
-        parsed = ureg.parse_units(text)
-    except Exception:  # pint raises several types (undefined unit, syntax, tokenizer) for one user mistake
-        raise refusal(where, f"unit {unit!r} is not a unit pint knows") from None
-    try:
-        factor = float(ureg.Quantity(1.0, parsed).to(si).magnitude)
-    except Exception:
-        raise UsageError(
-            f"{where}: unit {unit!r} is not a unit of {UNIT_DIMENSIONS[target]} (column {target!r} needs {si} or "
-            f"another unit of {UNIT_DIMENSIONS[target]})"
-        ) from None
-    if target == ANGLE and not any(word in str(parsed) for word in ANGLE_UNIT_WORDS):
-        raise refusal(where, f"unit {unit!r} is not an angle (column {target!r} needs rad, deg or rev)")
-    if float(ureg.Quantity(0.0, parsed).to(si).magnitude) != 0.0:
-        raise refusal(where, f"unit {unit!r} has an offset (like degC); give a unit that starts at zero")
-    divisor = 1.0 / factor
-    if factor < 1.0 and divisor == round(divisor):
-        # A decimal prefix: divide by the exact integer, so mm -> m is value / 1000 to the last bit.
-        return lambda values: np.asarray(values, dtype=float) / round(divisor)
-    return lambda values: np.asarray(values, dtype=float) * factor
-
-
-def to_si(values, unit: str | None, target: str, where: str = "value") -> np.ndarray:
-    """Values in `unit` converted to the SI unit of native column `target`."""
-    return conversion(unit, target, where)(values)
-
-
-def from_si(values, unit: str | None, target: str, where: str = "value") -> np.ndarray:
-    """The inverse of :func:`to_si`: SI values of `target` in `unit`."""
-    one = float(to_si(np.array([1.0]), unit, target, where)[0])
-    divisor = 1.0 / one
-    if one < 1.0 and divisor == round(divisor):
-        return np.asarray(values, dtype=float) * round(divisor)
-    return np.asarray(values, dtype=float) / one
 
 
 # ---------------------------------------------------------------------------------------------- mapping
@@ -319,97 +114,6 @@ def _map_sources(where: Path, sources: list[Source], channel_map: list[Channel] 
             raise refusal(where, f"channel {source.name!r} has no unit; give it in brackets, a units row or "
                              f"--map '{source.name}[unit]={target}'")
     return chosen
-
-
-def _lock_rack_m(params: Parameters) -> float:
-    s = params.sections["steering"]
-    return params["input.handwheel_lock_angle"] / s["handwheel_to_rack_ratio"]
-
-
-def _lock_limits(params: Parameters) -> dict[str, float]:
-    """The largest plausible |rack| and |handwheel angle| of the car, margins included (see LOCK_MARGIN)."""
-    s = params.sections["steering"]
-    cos_a = pm.cos(s["hooke_joint_angle"])
-    hooke_lead = pm.atan((1.0 - cos_a) / (2.0 * math.sqrt(cos_a)))
-    twist = LOCK_TWIST_TORQUE_NM / s["column_torsional_stiffness"]
-    angle = (params["input.handwheel_lock_angle"] + hooke_lead + twist) * LOCK_MARGIN
-    return {ANGLE: angle, RACK: angle / s["handwheel_to_rack_ratio"]}
-
-
-def _source_text(source: Source, ch: Channel) -> str:
-    return f"column {source.name!r}" if source.name == ch.target else f"column {source.name!r} ({ch.target})"
-
-
-def _fix_unit_hint(source: Source, ch: Channel, unit: str) -> str:
-    return f"--map '{Channel(source.name, unit, ch.target, ch.negate).spec()}'"
-
-
-def _check_against_lock(where: Path, columns: dict, chosen: dict, params: Parameters,
-                        line_numbers: list[int] | None) -> None:
-    limits = _lock_limits(params)
-    for target in (ANGLE, RACK):
-        if target not in columns or target not in chosen:
-            continue
-        values = columns[target]
-        magnitude = np.abs(values)
-        peak = float(magnitude.max())
-        if peak <= limits[target]:
-            continue
-        row = int(np.argmax(magnitude > limits[target])) + 1
-        line = f" (line {line_numbers[row - 1]})" if line_numbers is not None else ""
-        source, ch = chosen[target]
-        at = f"{where}: {_source_text(source, ch)}, row {row}{line}"
-        unit = UNITS[target]
-        lock = _lock_rack_m(params) if target == RACK else params["input.handwheel_lock_angle"]
-        ratio = peak / lock
-        for words, symbol, scale in UNIT_SUSPECTS[target]:
-            if scale / 3.0 < ratio < scale * 3.0:
-                raise UsageError(
-                    f"{at}: peak {peak:g} {unit} is {ratio:.0f} times the car's lock ({lock:.4g} {unit}); looks like "
-                    f"{words} given as {unit}: give the unit, e.g. {_fix_unit_hint(source, ch, symbol)}"
-                )
-        raise UsageError(
-            f"{at}: {values[row - 1]:g} {unit} is beyond the car's lock ({lock:.4g} {unit} from "
-            f"input.handwheel_lock_angle and steering.handwheel_to_rack_ratio, {limits[target]:.4g} {unit} with "
-            "margin); check the channel's unit and zero, or use the parameter file of this car"
-        )
-
-
-def _rack_speed(time_s: np.ndarray, rack_m: np.ndarray) -> np.ndarray:
-    dt = float(np.median(np.diff(time_s)))
-    width = max(1, int(round(SPEED_WINDOW_S / dt)))
-    padded = np.pad(rack_m, (width // 2, width - 1 - width // 2), mode="edge")
-    smooth = np.sum(np.lib.stride_tricks.sliding_window_view(padded, width), axis=-1) / width  # a moving mean
-    return np.gradient(smooth, time_s)
-
-
-def _correlation(a: np.ndarray, b: np.ndarray) -> float | None:
-    if np.std(a) == 0.0 or np.std(b) == 0.0:
-        return None
-    return float(np.corrcoef(a, b)[0, 1])
-
-
-def _check_signs(where: Path, columns: dict, chosen: dict, derived_rack: bool) -> None:
-    """Torque with rack speed, and measured angle with measured rack, correlate positively on a cycle."""
-    time_s = columns[TIME]
-    if ANGLE in columns and RACK in columns and not derived_rack:
-        r = _correlation(columns[ANGLE], columns[RACK])
-        if r is not None and r < SIGN_CORRELATION_LIMIT:
-            source, ch = chosen[ANGLE]
-            raise UsageError(
-                f"{where}: handwheel angle and rack move against each other (correlation {r:.2f}); both are "
-                f"positive to the right: negate one, e.g. --map '{ch.spec(negate=not ch.negate)}'"
-            )
-    if TORQUE in columns and RACK in columns:
-        r = _correlation(columns[TORQUE], _rack_speed(time_s, columns[RACK]))
-        if r is not None and r < SIGN_CORRELATION_LIMIT:
-            source, ch = chosen[TORQUE]
-            moving = "handwheel angle" if derived_rack else "rack"
-            raise UsageError(
-                f"{where}: torque opposes the {moving}'s motion through the cycle (correlation {r:.2f} with its speed); "
-                f"torque and {moving} are positive turning right: negate one, e.g. --map "
-                f"'{ch.spec(negate=not ch.negate)}'"
-            )
 
 
 # ------------------------------------------------------------------------------------------------ reader
@@ -478,13 +182,7 @@ def load_record(path: str | Path, channel_map: str | list[Channel] | None = None
         params = load_parameters()
     if isinstance(channel_map, str):
         channel_map = parse_channel_map(channel_map)
-    raw = read_record_bytes(path)
-    # A raw CAN log is decoded with the DBC its channel map carries (--dbc, --bus); sign= and scale= are its own.
-    bus_only = next((ch for ch in channel_map or [] if ch.sign or ch.scale), None)
-    if bus_only is not None and getattr(channel_map, "bus", None) is None:
-        raise UsageError(f"{bus_only.origin}: {bus_only.spec()!r}: sign= and scale= apply to a CAN log's "
-                         "signals; give the car's DBC (--dbc or --bus)")
-    record = reader_for(raw, channel_map).read(raw, path)
+    record = _read(path, channel_map)
     sources, metadata, line_numbers = record.sources, dict(record.metadata), record.line_numbers
     notes: list[str] = list(record.notes)
 
@@ -497,7 +195,45 @@ def load_record(path: str | Path, channel_map: str | list[Channel] | None = None
         notes.append(f"{path}: note: ignored channel{'s' if len(ignored) > 1 else ''} {', '.join(ignored)} "
                      f"(not mapped to {', '.join(MAP_TARGETS)})")
     _on_one_time_base(path, record, chosen, listing)
+    columns = _si_columns(path, chosen, metadata)
+    _torsion_bar_as_torque(path, columns, chosen, metadata)
+    if CURRENT in columns and MOTOR_TORQUE in columns:
+        raise UsageError(f"{path}: channels {chosen[CURRENT][0].name!r} ({CURRENT}) and {chosen[MOTOR_TORQUE][0].name!r} "
+                         f"({MOTOR_TORQUE}) are both the motor's; map one (the current, if the car's torque constant "
+                         "is the file's)")
 
+    check_against_lock(path, columns, chosen, params, line_numbers)
+    derived = RACK not in columns and RACK in required
+    if derived:
+        _derive_rack(path, columns, metadata, params, f"(channels: {listing}){_unmapped(ignored)}")
+    missing = [t for t in required if t not in columns]
+    if missing:
+        raise UsageError(f"{path}: no channel for {missing[0]!r} (channels: {listing}){_unmapped(ignored)}; map one, "
+                         f"e.g. --map 'NAME[{SI_UNITS[missing[0]]}]={missing[0]}'")
+    _case_and_surface(path, metadata, case, surface, record.is_text, params)
+    ordered = {name: columns[name] for name in ALLOWED_COLUMNS if name in columns}
+    validate_record(path, ordered, metadata, params, line_numbers, required)
+    check_signs(path, ordered, chosen, derived)
+    ordered = _decimate(path, ordered, metadata, notes)
+    for note in notes:
+        sys.stderr.write(note + "\n")
+    return Measurement(path=path, columns=ordered, metadata=metadata)
+
+
+def _read(path: Path, channel_map: list[Channel] | None) -> Record:
+    """The record as the readers' table reads it: a raw CAN log is decoded with the DBC its channel map carries
+    (--dbc, --bus); sign= and scale= are its own."""
+    raw = read_record_bytes(path)
+    bus_only = next((ch for ch in channel_map or [] if ch.sign or ch.scale), None)
+    if bus_only is not None and getattr(channel_map, "bus", None) is None:
+        raise UsageError(f"{bus_only.origin}: {bus_only.spec()!r}: sign= and scale= apply to a CAN log's "
+                         "signals; give the car's DBC (--dbc or --bus)")
+    return reader_for(raw, channel_map).read(raw, path)
+
+
+def _si_columns(path: Path, chosen: dict, metadata: dict[str, str]) -> dict[str, np.ndarray]:
+    """Each chosen source in its column's SI unit, negated where the map says; a unit the map and the file state
+    differently is refused; a bus signal's resolution goes into the metadata (full scale and bits)."""
     columns: dict[str, np.ndarray] = {}
     for target, (src, ch) in chosen.items():
         unit = ch.unit or src.unit
@@ -522,47 +258,35 @@ def load_record(path: str | Path, channel_map: str | list[Channel] | None = None
                if (src.name != ch.target or ch.negate) and ch.origin != "master"]
     if renamed:
         metadata["channel_map"] = ", ".join(renamed)
-    _torsion_bar_as_torque(path, columns, chosen, metadata)
-    if CURRENT in columns and MOTOR_TORQUE in columns:
-        raise UsageError(f"{path}: channels {chosen[CURRENT][0].name!r} ({CURRENT}) and {chosen[MOTOR_TORQUE][0].name!r} "
-                         f"({MOTOR_TORQUE}) are both the motor's; map one (the current, if the car's torque constant "
-                         "is the file's)")
+    return columns
 
-    _check_against_lock(path, columns, chosen, params, line_numbers)
-    derived = False
-    if RACK not in columns and RACK in required:
-        if ANGLE in columns and TORQUE in columns:
-            columns[RACK] = rack_from_handwheel(columns[ANGLE], columns[TORQUE], params)
-            s = params.sections["steering"]
-            metadata["rack_derived"] = (
-                f"from {ANGLE} and {TORQUE} by the column law (parksteer.geometry.rack_from_handwheel): column twist "
-                f"T / {s['column_torsional_stiffness']:g} N m/rad, Hooke joint angle {s['hooke_joint_angle']:g} rad "
-                f"and phase {s['hooke_joint_phase']:g} rad, ratio {s['handwheel_to_rack_ratio']:g} rad/m"
-            )
-            derived = True
-        else:
-            raise UsageError(f"{path}: no rack channel, and no handwheel angle and torque to derive it from "
-                             f"(channels: {listing}){_unmapped(ignored)}; map one, e.g. --map 'RackPos[mm]=rack_m'")
-    missing = [t for t in required if t not in columns]
-    if missing:
-        raise UsageError(f"{path}: no channel for {missing[0]!r} (channels: {listing}){_unmapped(ignored)}; map one, "
-                         f"e.g. --map 'NAME[{SI_UNITS[missing[0]]}]={missing[0]}'")
 
+def _derive_rack(path: Path, columns: dict, metadata: dict[str, str], params: Parameters, channels: str) -> None:
+    """The rack from the handwheel angle and torque by the column law, said in the metadata; refused without them
+    (`channels`: the file's channels, for the refusal)."""
+    if ANGLE not in columns or TORQUE not in columns:
+        raise UsageError(f"{path}: no rack channel, and no handwheel angle and torque to derive it from "
+                         f"{channels}; map one, e.g. --map 'RackPos[mm]=rack_m'")
+    columns[RACK] = rack_from_handwheel(columns[ANGLE], columns[TORQUE], params)
+    s = params.sections["steering"]
+    metadata["rack_derived"] = (
+        f"from {ANGLE} and {TORQUE} by the column law (parksteer.geometry.rack_from_handwheel): column twist "
+        f"T / {s['column_torsional_stiffness']:g} N m/rad, Hooke joint angle {s['hooke_joint_angle']:g} rad "
+        f"and phase {s['hooke_joint_phase']:g} rad, ratio {s['handwheel_to_rack_ratio']:g} rad/m"
+    )
+
+
+def _case_and_surface(path: Path, metadata: dict[str, str], case: str | None, surface: str | None, is_text: bool,
+                      params: Parameters) -> None:
+    """The case and surface the caller gives fill what the file does not state; refused when neither says."""
     if "case" not in metadata and case is None:
-        add = "add '# case: NAME' above the header or " if record.is_text else ""
+        add = "add '# case: NAME' above the header or " if is_text else ""
         raise UsageError(f"{path}: the file names no case; {add}give --case (known: {', '.join(params.case_names)})")
     if "surface" not in metadata and surface is None:
-        add = "add '# surface: ground' above the header or " if record.is_text else ""
+        add = "add '# surface: ground' above the header or " if is_text else ""
         raise UsageError(f"{path}: the file names no surface; {add}give --surface ground|air_bearing")
     _fill(metadata, "case", case)
     _fill(metadata, "surface", surface)
-    ordered = {name: columns[name] for name in ALLOWED_COLUMNS if name in columns}
-    validate_record(path, ordered, metadata, params, line_numbers, required)
-    _check_signs(path, ordered, chosen, derived)
-    ordered = _decimate(path, ordered, metadata, notes)
-    for note in notes:
-        sys.stderr.write(note + "\n")
-    return Measurement(path=path, columns=ordered, metadata=metadata)
 
 
 def _torsion_bar_as_torque(path: Path, columns: dict, chosen: dict, metadata: dict[str, str]) -> None:

@@ -185,6 +185,30 @@ def find_phases(
 
     rack_s, velocity = local_linear_fit(t, x, smoothing_s)
     torque_s = running_median(t, torque, torque_smoothing_s)
+    motions = _steady_motions(t, velocity, moving_fraction, min_stroke_s)
+    bounds, reversal_windows, reversal_times = _reversals(t, rack_s, motions, reversal_half_width_s)
+
+    labels = np.empty(len(t), dtype="<U12")
+    labels[: bounds[0][0]] = "initial_rise"
+    for w_start, w_stop in reversal_windows:
+        labels[w_start:w_stop] = "reversal"
+    strokes = _label_strokes(labels, rack_s, torque_s, motions, bounds, surface == "ground", windup_fraction,
+                             plateau_travel_fraction)
+    return CyclePhases(
+        time_s=t,
+        labels=labels,
+        strokes=tuple(strokes),
+        reversal_times_s=np.array(reversal_times),
+        rack_smoothed_m=rack_s,
+        rack_velocity_m_s=velocity,
+        torque_smoothed_Nm=torque_s,
+    )
+
+
+def _steady_motions(t: np.ndarray, velocity: np.ndarray, moving_fraction: float, min_stroke_s: float
+                    ) -> list[list[int]]:
+    """[sign, start, stop] of each stroke: the runs of steady rack motion of at least `min_stroke_s`, runs in one
+    direction joined (a pause of the hand, not a reversal)."""
     typical_speed = float(np.percentile(np.abs(velocity), 90))
     if typical_speed == 0.0:
         raise UsageError("phases: the rack never moves, so the record holds no steering cycle")
@@ -200,54 +224,52 @@ def find_phases(
             merged[-1][2] = b  # a pause of the hand, not a reversal
         else:
             merged.append([sign, a, b])
+    return merged
 
-    # Reversal windows between strokes of opposite direction; the strokes are trimmed to them.
-    bounds = [[a, b] for _, a, b in merged]
+
+def _reversals(t: np.ndarray, rack_s: np.ndarray, motions: list[list[int]], half_width_s: float
+               ) -> tuple[list[list[int]], list[tuple[int, int]], list[float]]:
+    """The strokes' [start, stop] trimmed to the reversal windows between strokes of opposite direction, the
+    windows (start, stop) and the turning points' times; any rest after the last stroke belongs to it."""
+    bounds = [[a, b] for _, a, b in motions]
     reversal_windows: list[tuple[int, int]] = []
     reversal_times: list[float] = []
-    for k in range(len(merged) - 1):
-        sign = merged[k][0]
+    for k in range(len(motions) - 1):
+        sign = motions[k][0]
         end, next_start = bounds[k][1], bounds[k + 1][0]  # end: first sample after stroke k's motion
         between = slice(end - 1, next_start + 1)
         turn = end - 1 + int(np.argmax(sign * rack_s[between]))
         t_turn = float(t[turn])
-        w_start = min(end, int(np.searchsorted(t, t_turn - reversal_half_width_s, side="left")))
-        w_stop = max(next_start, int(np.searchsorted(t, t_turn + reversal_half_width_s, side="right")))
+        w_start = min(end, int(np.searchsorted(t, t_turn - half_width_s, side="left")))
+        w_stop = max(next_start, int(np.searchsorted(t, t_turn + half_width_s, side="right")))
         w_start = max(w_start, bounds[k][0] + 1)  # never swallow a whole stroke
         w_stop = min(w_stop, bounds[k + 1][1] - 1)
         bounds[k][1], bounds[k + 1][0] = w_start, w_stop
         reversal_windows.append((w_start, w_stop))
         reversal_times.append(t_turn)
-    bounds[-1][1] = len(t)  # any rest after the last stroke belongs to it
+    bounds[-1][1] = len(t)
+    return bounds, reversal_windows, reversal_times
 
-    labels = np.empty(len(t), dtype="<U12")
-    labels[: bounds[0][0]] = "initial_rise"
-    for w_start, w_stop in reversal_windows:
-        labels[w_start:w_stop] = "reversal"
 
+def _label_strokes(labels: np.ndarray, rack_s: np.ndarray, torque_s: np.ndarray, motions: list[list[int]],
+                   bounds: list[list[int]], winds_up: bool, windup_fraction: float, plateau_travel_fraction: float
+                   ) -> list[Stroke]:
+    """Each stroke's wind-up (on the ground only: `winds_up`) and plateau, or return for a last stroke heading back
+    to straight ahead, written into `labels`; the strokes."""
     strokes = []
-    for k, ((sign, _, _), (a, b)) in enumerate(zip(merged, bounds)):
+    for k, ((sign, _, _), (a, b)) in enumerate(zip(motions, bounds)):
         travel = np.abs(rack_s[a:b] - rack_s[a])
         late = travel >= (1.0 - plateau_travel_fraction) * travel.max()
         start_torque = float(torque_s[a])
         plateau_torque = float(np.median(torque_s[a:b][late]))
         change = plateau_torque - start_torque
         windup_stop = a
-        if surface == "ground" and change != 0.0:
+        if winds_up and change != 0.0:
             progress = (torque_s[a:b] - start_torque) / change
             reached = np.flatnonzero(progress >= windup_fraction)
             windup_stop = a + int(reached[0]) if reached.size else b
-        returns = k == len(merged) - 1 and sign * rack_s[a] < 0.0
+        returns = k == len(motions) - 1 and sign * rack_s[a] < 0.0
         labels[a:windup_stop] = "wind_up"
         labels[windup_stop:b] = "return" if returns else "plateau"
         strokes.append(Stroke(sign, a, b, windup_stop, start_torque, plateau_torque, returns))
-
-    return CyclePhases(
-        time_s=t,
-        labels=labels,
-        strokes=tuple(strokes),
-        reversal_times_s=np.array(reversal_times),
-        rack_smoothed_m=rack_s,
-        rack_velocity_m_s=velocity,
-        torque_smoothed_Nm=torque_s,
-    )
+    return strokes

@@ -9,7 +9,7 @@ bounds of :mod:`parksteer.parameters`. What the paper's tyre rig, spacers, synth
 file, and the file may still override any key of it (a candidate effect's friction guess, for instance).
 
 At load time the car is checked as a car, each refusal one line naming the file and the key: the wheel loads
-against the masses (:func:`parksteer.parameters.check_statics`), the unsprung mass against the parts the model
+against the masses (:func:`parksteer.parameter_entries.check_statics`), the unsprung mass against the parts the model
 moves, the heights in order (king-pin top above the wheel centre above the ground), the king-pin top inboard of
 the wheel centre and meeting the ground on its own side, and the road-wheel lock within :data:`MAX_LOCK_STEER_RAD`.
 """
@@ -25,23 +25,10 @@ from typing import Any
 from ..boost_table import KMH, BoostTableError, entries
 from ..errors import UsageError, cannot_read
 from ..geometry import lock_steer_angle, steer_axis
-from ..parameters import (
-    CASE_SCHEMA,
-    DEFAULT_PATH,
-    PROVENANCE,
-    PROVENANCES,
-    SCHEMA,
-    VEHICLE_SPEED,
-    ParameterError,
-    Parameters,
-    check_entry,
-    check_provenance,
-    check_statics,
-    check_table,
-    load_parameters,
-    provenance_key,
-    quantity,
-)
+from ..parameter_entries import (PROVENANCE, PROVENANCES, check_entry, check_provenance, check_statics, check_table,
+                                 provenance_key)
+from ..parameters import (CASE_SCHEMA, DEFAULT_PATH, SCHEMA, VEHICLE_SPEED, ParameterError, Parameters, load_parameters,
+                          quantity)
 
 # Keys every vehicle file must give: everything the model takes from the car itself.
 REQUIRED: tuple[str, ...] = (

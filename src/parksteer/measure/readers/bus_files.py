@@ -60,7 +60,7 @@ def dbc_bus(path: str | Path) -> BusSpec:
 
 
 class BusMap(list):
-    """A channel map (a list of parksteer.measure.importers.Channel) that carries the bus its signals are on."""
+    """A channel map (a list of parksteer.measure.channel_map.Channel) that carries the bus its signals are on."""
 
     def __init__(self, channels, bus: BusSpec):
         super().__init__(channels)
