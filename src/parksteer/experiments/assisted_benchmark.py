@@ -39,11 +39,11 @@ from ..measure.io import write_measurement
 from ..model.symbolic.components import discover_effects, resolve_effects
 from ..parameters import Parameters
 from ..synthetic.assisted import OUT_OF_CLASS, AssistedLogger, assisted_clean, assisted_record
-from ..synthetic.datasets import perturbed_base
+from ..synthetic.datasets import BASE_PERTURBATION, perturbed_base
 from ..synthetic.size_search import SizeSearch, rms_difference, strength_for_rms
 from ..measure.converter import quantisation_step
 from ..synthetic.variations import variation_by_name
-from .benchmark import BASE_PERTURBATION, BENCHMARK_SETTINGS
+from .benchmark import BENCHMARK_SETTINGS
 from .outclass import bic_margin
 from ..diagnose.problem import load_files
 from ..diagnose.report import diagnosis_dict

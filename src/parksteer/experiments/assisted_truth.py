@@ -52,10 +52,10 @@ from ..synthetic.assisted_truth import (
     with_hidden,
 )
 from ..synthetic.column_eps_layer import truth_clean
-from ..synthetic.datasets import perturbed_base
+from ..synthetic.datasets import BASE_PERTURBATION, perturbed_base
 from ..synthetic.size_search import rms_difference, strength_for_rms
 from ..synthetic.variations import variation_by_name
-from .benchmark import BASE_PERTURBATION, BENCHMARK_SETTINGS
+from .benchmark import BENCHMARK_SETTINGS
 from .assisted_benchmark import RACK_FRICTION, judged
 from .assisted_truth_design import (
     NAMED_MIN_FLOORS,
