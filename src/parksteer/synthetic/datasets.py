@@ -187,9 +187,9 @@ class CarDesign:
 
 # The base perturbation of every synthetic benchmark record (the in-class, out-of-class, variation, assisted and
 # baseline benchmarks, the synthetic car data sets and the docs' samples): each key's value is its parameter file's
-# times 1 + U(-p, p), drawn by :func:`perturbed_base`. An experiment-design choice, not a measured spread: the three
-# parameters the diagnosis calibrates are moved so that no record starts the calibration at its truth, the least
-# well known (the carcass's torsional stiffness, fitted to the paper's rig curves) the furthest.
+# times 1 + U(-p, p), drawn by :func:`perturbed_base` in key order. An experiment-design choice, not a measured
+# spread: the three parameters the diagnosis calibrates are moved so that no record starts the calibration at its
+# truth. The paper quotes them from the benchmark's results (settings.perturbation).
 BASE_PERTURBATION = MappingProxyType({"tyre.friction_coefficient": 0.10, "steering.rack_friction_force": 0.15,
                                       "tyre.carcass_torsional_stiffness": 0.20})
 
