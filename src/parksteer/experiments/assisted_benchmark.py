@@ -74,11 +74,11 @@ SEARCH = SizeSearch(iterations=4, tolerance=0.05, max_lag_s=0.0)
 def hidden_candidates(registry: dict[str, Effect] | None = None) -> dict[str, tuple[str, float]]:
     """What the assisted benchmarks hide, by name: (the quantity set, the largest size searched, in its unit).
 
-    The names and their order are the independent truth's rows (:data:`parksteer.synthetic.assisted_truth.HIDDEN_TRUTH`:
-    each candidate's one row there); each but the rack friction is an assist candidate of `registry` (the library
-    by default) and is sized by its strength quantity up to that quantity's upper bound. A row that names no assist
-    candidate, or an assist candidate the package ships without a row, is refused in one line (a user's effect
-    module without a row is diagnosed, not benchmarked)."""
+    The names and their order are the independent truth's rows
+    (:data:`parksteer.synthetic.assisted_truth.HIDDEN_TRUTH`: each candidate's one row there); each but the rack
+    friction is an assist candidate of `registry` (the library by default) and is sized by its strength quantity up
+    to that quantity's upper bound. A row that names no assist candidate, or an assist candidate the package ships
+    without a row, is refused in one line (a user's effect module without a row is diagnosed, not benchmarked)."""
     registry = discover_effects() if registry is None else registry
     table = {}
     for name in HIDDEN_TRUTH:
@@ -86,7 +86,8 @@ def hidden_candidates(registry: dict[str, Effect] | None = None) -> dict[str, tu
             table[name] = (RACK_FRICTION, RACK_FRICTION_LARGEST_N)
             continue
         if name not in registry or not registry[name].assist_candidate:
-            raise UsageError(f"assisted benchmark: HIDDEN_TRUTH row {name!r} is not an assist candidate of the library")
+            raise UsageError(f"assisted benchmark: HIDDEN_TRUTH row {name!r} is not an assist candidate of the "
+                             "library")
         strength = strength_parameter(registry[name])
         table[name] = (strength.key, strength.upper)
     rowless = [name for name, effect in registry.items() if effect.assist_candidate and name not in table
@@ -338,4 +339,5 @@ def read_rows(folders, names: list[str]) -> list[dict]:
     return read_case_files(folders, names, "assisted benchmark")
 
 
-__all__ = ["AssistedDesign", "case_names", "cases", "hidden_candidates", "outcome", "read_rows", "run", "run_batch", "summarise"]
+__all__ = ["AssistedDesign", "case_names", "cases", "hidden_candidates", "outcome", "read_rows", "run", "run_batch",
+           "summarise"]

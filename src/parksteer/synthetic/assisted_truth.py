@@ -246,5 +246,5 @@ def with_hidden(hidden: Hidden, name: str, size: float) -> Hidden:
     return replace(hidden, **{key: size})
 
 
-__all__ = ["HIDDEN_TRUTH", "OUT_OF_CLASS_TRUTH", "Hidden", "Road", "TruthHidden", "TruthGear", "TruthLogger", "TruthMap",
-           "column_of_pinion", "manual_road", "truth_record", "with_hidden"]
+__all__ = ["HIDDEN_TRUTH", "OUT_OF_CLASS_TRUTH", "Hidden", "Road", "TruthHidden", "TruthGear", "TruthLogger",
+           "TruthMap", "column_of_pinion", "manual_road", "truth_record", "with_hidden"]

@@ -149,7 +149,8 @@ class DatasetSpec:
 class BenchmarkDesign:
     """The hidden-effect benchmark's design (config/config.yaml, section ``benchmark``, where each value's reason
     is): strengths in converter steps, the files of each data set, the base perturbation (fractions by key:
-    :data:`BASE_PERTURBATION`), the number of nulls, the seed of data set 0, the disturbances' sizes, and the size search."""
+    :data:`BASE_PERTURBATION`), the number of nulls, the seed of data set 0, the disturbances' sizes, and the size
+    search."""
 
     steps: tuple[float, ...]
     files: tuple[tuple[str, str], ...]
