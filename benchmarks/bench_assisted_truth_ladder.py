@@ -120,13 +120,13 @@ def model_nulls(params, design) -> dict:
     from parksteer.diagnose.select import diagnose
     from parksteer.experiments.assisted_truth import _logger, _write
     from parksteer.experiments.assisted_truth_design import cases
-    from parksteer.experiments.benchmark import BASE_PERTURBATION, BENCHMARK_SETTINGS
+    from parksteer.experiments.benchmark import BENCHMARK_SETTINGS
     from parksteer.geometry import column_twist
     from parksteer.model.numeric.assist import effects_with_assist
     from parksteer.model.symbolic.components import resolve_effects
     from parksteer.synthetic.assisted import assisted_clean
     from parksteer.synthetic.assisted_truth import column_of_pinion, truth_record
-    from parksteer.synthetic.datasets import perturbed_base
+    from parksteer.synthetic.datasets import BASE_PERTURBATION, perturbed_base
     from parksteer.synthetic.variations import variation_by_name
 
     spec = effects_with_assist(None, params)

@@ -43,7 +43,7 @@ def _run(item) -> str:
     from parksteer.parameters import DEFAULT_PATH
 
     config = yaml.safe_load((ROOT / "config" / "config.yaml").read_text(encoding="utf-8"))
-    design = VariationDesign.from_config(config["variations"], config["benchmark"])
+    design = VariationDesign.from_config(config["variations"])
     run_peer_batch(DEFAULT_PATH, [job], out, tuning_design(design, tuning_seed))
     return job
 
@@ -90,7 +90,7 @@ def main(argv: list[str] | None = None) -> int:
     from parksteer.experiments.variations import VariationDesign
 
     config = yaml.safe_load((ROOT / "config" / "config.yaml").read_text(encoding="utf-8"))
-    design = VariationDesign.from_config(config["variations"], config["benchmark"])
+    design = VariationDesign.from_config(config["variations"])
     out = Path(args.out)
     todo = []
     for split, job in _jobs(Path(args.records), design):

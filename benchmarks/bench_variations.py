@@ -57,7 +57,7 @@ def main(argv: list[str] | None = None) -> int:
         grid["variations"] = args.only.split(",")
     if args.hidden:
         grid["hidden"] = grid["hidden_with_angle"] = args.hidden.split(",")
-    design = VariationDesign.from_config(section, config["benchmark"])
+    design = VariationDesign.from_config(section)
     if args.sizes:
         return _sizes(design, args.out)
     rows = []

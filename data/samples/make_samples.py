@@ -75,7 +75,7 @@ def write_car(folder: Path) -> list[Path]:
     root = Path(__file__).resolve().parents[2]
     config = yaml.safe_load((root / "config" / "config.yaml").read_text(encoding="utf-8"))
     car = dict(config["car"], files=[list(c) for c in CAR_CONDITIONS])
-    design = CarDesign.from_config(car, config["benchmark"]["perturbation"])
+    design = CarDesign.from_config(car)
     folder.mkdir(parents=True, exist_ok=True)
     files = [folder / f"{case}__{surface}.csv" for case, surface in CAR_CONDITIONS]
     with tempfile.TemporaryDirectory() as scratch:
@@ -167,11 +167,10 @@ def _worn_centre():
 
 def write_worn_rack(folder: Path) -> list[Path]:
     """A record with a centre friction no candidate has, another hand and a 50 Hz logger's noise."""
-    from parksteer.experiments.benchmark import BASE_PERTURBATION
     from parksteer.measure.io import write_measurement
     from parksteer.model.symbolic.components import resolve_effects
     from parksteer.parameters import load_parameters
-    from parksteer.synthetic.datasets import perturbed_base
+    from parksteer.synthetic.datasets import BASE_PERTURBATION, perturbed_base
     from parksteer.synthetic.variations import VARIATIONS, variation_record
 
     params = load_parameters()

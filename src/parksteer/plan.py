@@ -49,10 +49,10 @@ def diagnosis(config: dict, parameters_path: str, user_effect: str) -> dict:
     from .synthetic.outclass import OutclassDesign
 
     params = load_parameters(parameters_path)
-    car = CarDesign.from_config(config["car"], config["benchmark"]["perturbation"])
+    car = CarDesign.from_config(config["car"])
     bench = BenchmarkDesign.from_config(config["benchmark"])
     outclass = OutclassDesign.from_config(config["outclass"], config["benchmark"])
-    variations = VariationDesign.from_config(config["variations"], config["benchmark"])
+    variations = VariationDesign.from_config(config["variations"])
     return {
         "candidates": dict(candidate_models(None, (user_effect,))),
         "car_files": [file_name(case, surface) for case, surface in car.files],

@@ -22,7 +22,7 @@ from parksteer.diagnose.problem import load_files
 from parksteer.reporting.report import diagnosis_dict
 from parksteer.diagnose.select import diagnose
 from parksteer.diagnose.settings import DEFAULT_SETTINGS
-from parksteer.experiments.benchmark import BASE_PERTURBATION
+from parksteer.synthetic.datasets import BASE_PERTURBATION
 from parksteer.measure.converter import quantisation_step
 from parksteer.measure.io import write_measurement
 from parksteer.model.numeric.simulate import simulate

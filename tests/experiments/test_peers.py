@@ -234,7 +234,8 @@ def test_the_peers_run_beside_a_benchmark_batch_are_those_of_diagnosing_its_file
     records and settings give the same diagnosis, so both records agree in everything but the machine's times."""
     import json
 
-    from parksteer.experiments.benchmark import BASE_PERTURBATION, run_batch
+    from parksteer.experiments.benchmark import run_batch
+    from parksteer.synthetic.datasets import BASE_PERTURBATION
     from parksteer.experiments.peers import peers_beside, peers_file_name, run_peer_batch
     from parksteer.experiments.variations import VariationDesign, run_case, variation_cases
     from parksteer.parameters import DEFAULT_PATH

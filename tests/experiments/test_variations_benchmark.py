@@ -9,7 +9,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from parksteer.experiments.benchmark import BASE_PERTURBATION
+from parksteer.synthetic.datasets import BASE_PERTURBATION
 from parksteer.experiments.rows import VariationRow
 from parksteer.diagnose.settings import DEFAULT_SETTINGS
 from parksteer.experiments.variation_summary import outcome, summarise
@@ -183,11 +183,11 @@ def test_an_unknown_variation_or_too_many_files_is_refused_in_one_line():
                "small": {"variations": ["no_such"], "replicates": 1, "hidden": [], "steps": [1.0]},
                "full": {"variations": ["pauses"], "replicates": 1, "hidden": [], "steps": [1.0]}}
     with pytest.raises(UsageError, match="no_such") as info:
-        VariationDesign.from_config(section, {"perturbation": BASE_PERTURBATION})
+        VariationDesign.from_config(section)
     assert "\n" not in str(info.value)
     section["small"]["variations"] = ["three_files"]
     with pytest.raises(UsageError, match="three_files needs 3 files"):
-        VariationDesign.from_config(section, {"perturbation": BASE_PERTURBATION})
+        VariationDesign.from_config(section)
 
 
 @pytest.mark.parametrize("effect, confounded", [("kingpin_friction", True), ("rack_stiction", False)])

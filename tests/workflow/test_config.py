@@ -80,3 +80,49 @@ def test_the_rivals_are_a_selection_of_the_effects_that_declare_one(config):
         with pytest.raises(UsageError, match=entry) as info:
             call()
         assert "\n" not in str(info.value) and "'rack_lash' is not a rival" in str(info.value)
+
+
+def test_the_base_perturbation_has_one_definition(config, schema, repo_root):
+    """The base perturbation is declared once (parksteer.synthetic.datasets.BASE_PERTURBATION): every benchmark's
+    design built from the configuration carries its values, the configuration has no copy (its schema refuses a
+    ``benchmark.perturbation``), and no other source file writes one of its fractions beside its key."""
+    import ast
+
+    from parksteer.experiments.variations import VariationDesign
+    from parksteer.synthetic.datasets import BASE_PERTURBATION, BenchmarkDesign, CarDesign
+    from parksteer.synthetic.outclass import OutclassDesign
+
+    designs = (BenchmarkDesign.from_config(config["benchmark"]), CarDesign.from_config(config["car"]),
+               OutclassDesign.from_config(config["outclass"], config["benchmark"]),
+               VariationDesign.from_config(config["variations"]))
+    assert all(d.perturbation == dict(BASE_PERTURBATION) for d in designs)
+    with_copy = copy.deepcopy(config)
+    with_copy["benchmark"]["perturbation"] = dict(BASE_PERTURBATION)
+    with pytest.raises(WorkflowError):
+        validate(with_copy, schema)
+    # a second declaration: a mapping (a Python dict literal, a YAML mapping) whose keys are the perturbation's
+    keys = set(BASE_PERTURBATION)
+
+    def mappings(node):
+        if isinstance(node, dict):
+            yield node
+            node = list(node.values())
+        if isinstance(node, list):
+            for item in node:
+                yield from mappings(item)
+
+    declaring = []
+    for folder in ("src", "config", "workflow", "benchmarks", "data/samples"):
+        for path in sorted((repo_root / folder).rglob("*")):
+            if path.suffix == ".py":
+                found = any(isinstance(n, ast.Dict) and {getattr(k, "value", None) for k in n.keys} == keys
+                            for n in ast.walk(ast.parse(path.read_text(encoding="utf-8"))))
+            elif path.suffix == ".yaml":
+                found = any(set(m) == keys for m in mappings(yaml.safe_load(path.read_text(encoding="utf-8"))))
+            elif path.suffix == ".smk":
+                found = all(k in path.read_text(encoding="utf-8") for k in keys)
+            else:
+                continue
+            if found:
+                declaring.append(str(path.relative_to(repo_root)))
+    assert declaring == ["src/parksteer/synthetic/datasets.py"]

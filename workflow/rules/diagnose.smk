@@ -47,7 +47,6 @@ rule diag_car_data:
     params:
         code=code("diag_car_data"),
         car=config["car"],
-        perturbation=config["benchmark"]["perturbation"],
     log:
         "logs/diag_car_data.log",
     benchmark:
@@ -224,7 +223,6 @@ rule diag_variation_batch:
     params:
         code=code("diag_variation_batch"),
         design=config["variations"],
-        benchmark=config["benchmark"],
         cases=lambda wildcards: DIAG_VARIATION_BATCHES[wildcards.batch],
     wildcard_constraints:
         batch="|".join(DIAG_VARIATION_BATCHES) if DIAG_VARIATION_BATCHES else "none",
@@ -248,7 +246,6 @@ rule diag_variations:
     params:
         code=code("diag_variations"),
         design=config["variations"],
-        benchmark=config["benchmark"],
         truths=case_outputs("results/diagnose/variations", DIAG_VARIATION_CASES, DIAG_VARIATION_BATCHES, "truth"),
         diagnoses=case_outputs("results/diagnose/variations", DIAG_VARIATION_CASES, DIAG_VARIATION_BATCHES, "diagnosis"),
     log:

@@ -17,7 +17,6 @@ rule diag_peers_batch:
     params:
         code=code("diag_peers_batch"),
         design=config["variations"],
-        benchmark=config["benchmark"],
         tuning_seed=config["peers"]["tuning_seed"],
         jobs=lambda wildcards: PEER_BATCHES[wildcards.batch],
     wildcard_constraints:

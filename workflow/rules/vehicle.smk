@@ -23,7 +23,6 @@ rule vehicle_synthetic_data:
         code=code("vehicle_data"),
         runs=lambda w: vehicle_runs(w.vehicle),
         car=config["car"],
-        perturbation=config["benchmark"]["perturbation"],
     log:
         "logs/vehicles/{vehicle}/synthetic_data.log",
     benchmark:

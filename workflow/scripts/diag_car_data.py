@@ -3,5 +3,5 @@ from parksteer.rules import rule_log
 from parksteer.synthetic.datasets import CarDesign, write_car_dataset
 
 with rule_log(snakemake):
-    design = CarDesign.from_config(snakemake.params.car, snakemake.params.perturbation)
+    design = CarDesign.from_config(snakemake.params.car)
     write_car_dataset(snakemake.input.parameters, design, list(snakemake.output.files), snakemake.output.truth)

@@ -7,5 +7,5 @@ from parksteer.rules import rule_log
 
 with rule_log(snakemake):
     run_batch(run_case, snakemake.input.parameters,
-              VariationDesign.from_config(snakemake.params.design, snakemake.params.benchmark),
+              VariationDesign.from_config(snakemake.params.design),
               snakemake.params.cases, snakemake.output[0], on_diagnosis=peers_beside("variations"))

@@ -6,4 +6,4 @@ from parksteer.rules import rule_log
 with rule_log(snakemake):
     make_variations_figure(list(snakemake.params.truths), list(snakemake.params.diagnoses), snakemake.output.svg,
                            snakemake.output.csv, snakemake.output.json,
-                           VariationDesign.from_config(snakemake.params.design, snakemake.params.benchmark))
+                           VariationDesign.from_config(snakemake.params.design))

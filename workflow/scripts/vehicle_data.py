@@ -10,7 +10,7 @@ from parksteer.vehicle import load_vehicle
 with rule_log(snakemake):
     params = load_vehicle(snakemake.input.vehicle, snakemake.input.parameters)
     runs = tuple((str(c), str(s)) for c, s in snakemake.params.runs)
-    design = dataclasses.replace(CarDesign.from_config(snakemake.params.car, snakemake.params.perturbation),
+    design = dataclasses.replace(CarDesign.from_config(snakemake.params.car),
                                  files=runs)
     dataset = car_dataset(params, design)
     out = Path(snakemake.output.files)

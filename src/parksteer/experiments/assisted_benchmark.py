@@ -36,14 +36,15 @@ import numpy as np
 
 from ..errors import UsageError
 from ..measure.io import write_measurement
-from ..model.symbolic.components import discover_effects, resolve_effects
+from ..model.symbolic.components import Effect, discover_effects, resolve_effects, strength_parameter
 from ..parameters import Parameters
 from ..synthetic.assisted import OUT_OF_CLASS, AssistedLogger, assisted_clean, assisted_record
-from ..synthetic.datasets import perturbed_base
+from ..synthetic.assisted_truth import HIDDEN_TRUTH
+from ..synthetic.datasets import BASE_PERTURBATION, perturbed_base
 from ..synthetic.size_search import SizeSearch, rms_difference, strength_for_rms
 from ..measure.converter import quantisation_step
 from ..synthetic.variations import variation_by_name
-from .benchmark import BASE_PERTURBATION, BENCHMARK_SETTINGS
+from .benchmark import BENCHMARK_SETTINGS
 from .outclass import bic_margin
 from ..diagnose.intake import Request, intake
 from ..reporting.report import diagnosis_dict
@@ -52,15 +53,13 @@ from .variations import NAMED_MIN_STEPS, NAMED_TARGET, NULL_ADEQUATE_TARGET
 from ..names import TORQUE
 
 RACK_FRICTION = "steering.rack_friction_force"
-# The hidden candidates and the quantity each is sized by (the rack friction: added to the base's force).
-HIDDEN = {
-    "assist_motor_friction": "assist_motor_friction.friction_torque",
-    "torsion_bar_offset": "torsion_bar_offset.strength",
-    "boost_gain_error": "boost_gain_error.strength",
-    "rack_friction": RACK_FRICTION,
-}
-UPPER = {"assist_motor_friction": 0.5, "torsion_bar_offset": 2.0, "boost_gain_error": 2.0, "rack_friction": 2000.0,
-         "motor_ripple": 0.5, "dead_band_change": 5.0}
+# The rack friction is hidden as a force added to the base's, up to this (N); the out-of-class changes up to these
+# (parksteer.synthetic.assisted.OUT_OF_CLASS, each its unit). An assist candidate's largest size is its strength
+# quantity's upper bound (hidden_candidates).
+RACK_FRICTION_LARGEST_N = 2000.0
+OUT_OF_CLASS_LARGEST = {"motor_ripple": 0.5, "dead_band_change": 5.0}
+# The package's effect modules: each assist candidate among them is hidden by the assisted benchmarks.
+SHIPPED_EFFECTS = "parksteer.model.symbolic.effects."
 # The channels' noise, relative to their parking range as the variation benchmark's (0.1 N m on a 12 N m peak: 0.8 %):
 # 0.03 N m on a torsion bar's 3.5 N m, 0.25 A on a current's 27 A. With channels twice as clean (0.02 N m, 0.1 A)
 # the nulls are adequate too (20 of 20), now that the replay ensemble smooths at every knot spacing the rack data
@@ -69,6 +68,39 @@ UPPER = {"assist_motor_friction": 0.5, "torsion_bar_offset": 2.0, "boost_gain_er
 TORQUE_NOISE_NM = 0.03
 CURRENT_NOISE_A = 0.25
 SEARCH = SizeSearch(iterations=4, tolerance=0.05, max_lag_s=0.0)
+
+
+def hidden_candidates(registry: dict[str, Effect] | None = None) -> dict[str, tuple[str, float]]:
+    """What the assisted benchmarks hide, by name: (the quantity set, the largest size searched, in its unit).
+
+    The names and their order are the independent truth's rows
+    (:data:`parksteer.synthetic.assisted_truth.HIDDEN_TRUTH`: each candidate's one row there); each but the rack
+    friction is an assist candidate of `registry` (the library by default) and is sized by its strength quantity up
+    to that quantity's upper bound. A row that names no assist candidate, or an assist candidate the package ships
+    without a row, is refused in one line (a user's effect module without a row is diagnosed, not benchmarked)."""
+    registry = discover_effects() if registry is None else registry
+    table = {}
+    for name in HIDDEN_TRUTH:
+        if name == "rack_friction":
+            table[name] = (RACK_FRICTION, RACK_FRICTION_LARGEST_N)
+            continue
+        if name not in registry or not registry[name].assist_candidate:
+            raise UsageError(f"assisted benchmark: HIDDEN_TRUTH row {name!r} is not an assist candidate of the "
+                             "library")
+        strength = strength_parameter(registry[name])
+        table[name] = (strength.key, strength.upper)
+    rowless = [name for name, effect in registry.items() if effect.assist_candidate and name not in table
+               and type(effect).__module__.startswith(SHIPPED_EFFECTS)]
+    if rowless:
+        raise UsageError(f"assisted benchmark: the shipped assist candidate {rowless[0]!r} has no row in HIDDEN_TRUTH "
+                         "(parksteer.synthetic.assisted_truth: how the independent truth shows it)")
+    return table
+
+
+def largest_size(name: str, hidden: dict[str, tuple[str, float]]) -> float:
+    """The largest size the size search tries for `name`: a hidden candidate's (`hidden`, :func:`hidden_candidates`)
+    or an out-of-class change's."""
+    return hidden[name][1] if name in hidden else OUT_OF_CLASS_LARGEST[name]
 
 
 @dataclass(frozen=True)
@@ -107,7 +139,7 @@ def cases(design: AssistedDesign) -> list[AssistedCase]:
             out.append(AssistedCase(f"{v}__r{replicate}__null", "null", v, None, None,
                                     design.seed + 1000 * replicate + 10 * i))
     for i, v in enumerate(design.hidden_variations):
-        for effect in HIDDEN:
+        for effect in hidden_candidates():
             for steps in design.steps:
                 out.append(AssistedCase(f"{v}__{effect}_{steps:g}", "hidden", v, effect, steps,
                                         design.seed + 10 * design.null_variations.index(v)))
@@ -145,21 +177,24 @@ def case_truth_and_record(params: Parameters, design: AssistedDesign, case: Assi
                               dt_s=0.01)[TORQUE]
 
     reference = torque(assist, base)
+    hidden = hidden_candidates()
     if case.kind == "hidden":
-        key = HIDDEN[case.hidden]
+        key = hidden[case.hidden][0]
         if case.hidden == "rack_friction":
             of = lambda s: torque(assist, {**base, key: base[key] + s})  # noqa: E731
         else:
             spec = f"{assist},+{case.hidden}"
             of = lambda s: torque(spec, {**base, key: s})  # noqa: E731
-        strength = strength_for_rms(of, case.steps * step, UPPER[case.hidden] * 1e-2, UPPER[case.hidden], SEARCH)
+        largest = largest_size(case.hidden, hidden)
+        strength = strength_for_rms(of, case.steps * step, largest * 1e-2, largest, SEARCH)
         size = rms_difference(of(strength), reference) / step
     elif case.kind == "outclass":
         if case.hidden == "torsion_bar_stiffness":
             strength = case.steps
         else:
             of = lambda s: torque(assist, base, (case.hidden, s) if s > 0 else None)  # noqa: E731
-            strength = strength_for_rms(of, case.steps * step, UPPER[case.hidden] * 1e-2, UPPER[case.hidden], SEARCH)
+            largest = largest_size(case.hidden, hidden)
+            strength = strength_for_rms(of, case.steps * step, largest * 1e-2, largest, SEARCH)
         out_of_class = (case.hidden, strength)
         size = rms_difference(torque(assist, base, out_of_class), reference) / step
     else:
@@ -303,4 +338,5 @@ def read_rows(folders, names: list[str]) -> list[dict]:
     return read_case_files(folders, names, "assisted benchmark")
 
 
-__all__ = ["AssistedDesign", "case_names", "cases", "outcome", "read_rows", "run", "run_batch", "summarise"]
+__all__ = ["AssistedDesign", "case_names", "cases", "hidden_candidates", "outcome", "read_rows", "run", "run_batch",
+           "summarise"]

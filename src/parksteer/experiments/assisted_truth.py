@@ -51,16 +51,16 @@ from ..synthetic.assisted_truth import (
     with_hidden,
 )
 from ..synthetic.column_eps_layer import truth_clean
-from ..synthetic.datasets import perturbed_base
+from ..synthetic.datasets import BASE_PERTURBATION, perturbed_base
 from ..synthetic.size_search import rms_difference, strength_for_rms
 from ..synthetic.variations import variation_by_name
-from .benchmark import BASE_PERTURBATION, BENCHMARK_SETTINGS
+from .benchmark import BENCHMARK_SETTINGS
 from .assisted_benchmark import RACK_FRICTION, judged
 from .assisted_truth_design import (
     NAMED_MIN_FLOORS,
     SEARCH,
     TIERS,
-    UPPER,
+    largest_size,
     TruthCase,
     TruthDesign,
     case_names,
@@ -101,7 +101,8 @@ def case_truth_and_record(params: Parameters, design: TruthDesign, case: TruthCa
         reference = reading(Hidden())
         of = lambda s: reading(with_hidden(Hidden(), case.hidden, s))  # noqa: E731
         target = case.floors * floor_Nm(logger)
-        strength = strength_for_rms(of, target, UPPER[case.hidden] * 1e-2, UPPER[case.hidden], SEARCH)
+        largest = largest_size(case.hidden)
+        strength = strength_for_rms(of, target, largest * 1e-2, largest, SEARCH)
         hidden = with_hidden(Hidden(), case.hidden, strength)
         size = rms_difference(of(strength), reference) / floor_Nm(logger)
     clean = truth_clean(road, design.boost, design.gear, logger, hidden, params)

@@ -1,20 +1,25 @@
-"""The assisted truth benchmark's design: its hidden sizes' upper bounds, the design's fields (config/config.yaml,
+"""The assisted truth benchmark's design: its out-of-class sizes' upper bounds, the design's fields (config/config.yaml,
 section ``assisted_truth``), its cases and their seeds (:mod:`parksteer.experiments.assisted_truth` says what the
 benchmark is)."""
 
 from __future__ import annotations
 
 import zlib
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from ..errors import UsageError
 from ..synthetic.assisted_truth import HIDDEN_TRUTH, TruthGear, TruthMap
 from ..synthetic.size_search import SizeSearch
 
 
-# The largest size searched for each hidden quantity (its unit the truth's: N m, 1, N, rad).
-UPPER = {"assist_motor_friction": 0.3, "torsion_bar_offset": 1.0, "boost_gain_error": 1.0, "rack_friction": 1500.0,
-         "cogging": 0.5, "boost_hysteresis": 1.0, "gear_backlash": 3.0, "current_friction": 0.8}
+# The largest size searched for each out-of-class form (its unit the truth's: N m, N m, rad, 1); a hidden
+# candidate's is its row of HIDDEN_TRUTH.
+OUT_OF_CLASS_LARGEST = {"cogging": 0.5, "boost_hysteresis": 1.0, "gear_backlash": 3.0, "current_friction": 0.8}
+
+
+def largest_size(name: str) -> float:
+    """The largest size the size search tries for hidden candidate or out-of-class form `name` (the truth's unit)."""
+    return HIDDEN_TRUTH[name].largest if name in HIDDEN_TRUTH else OUT_OF_CLASS_LARGEST[name]
 
 
 SEARCH = SizeSearch(iterations=4, tolerance=0.05, max_lag_s=0.0)
@@ -47,7 +52,7 @@ class TruthDesign:
                                         "rack_16bit_torque_10bit")
     null_replicates: int = 1
     hidden_variations: tuple[str, ...] = ("pauses", "uneven_strokes")
-    hidden: tuple[str, ...] = tuple(HIDDEN_TRUTH)
+    hidden: tuple[str, ...] = field(default_factory=lambda: tuple(HIDDEN_TRUTH))
     floors: tuple[float, ...] = (2.0, 4.0)
     out_of_class: tuple[tuple[str, float], ...] = (("cogging", 3.0), ("boost_hysteresis", 3.0),
                                                     ("gear_backlash", 3.0), ("current_friction", 3.0))

@@ -22,7 +22,7 @@ from ..synthetic.datasets import perturbed_base
 from ..synthetic.size_search import SizeSearch, rms_difference, strength_for_rms
 from ..synthetic.quirks import QUIRKS, ManualLogger, manual_road, quirk_record, quirk_strength
 from ..synthetic.variations import VARIATIONS, variation_by_name
-from .benchmark import BASE_PERTURBATION
+from ..synthetic.datasets import BASE_PERTURBATION
 from ..names import TORQUE
 
 MANUAL_HIDDEN = ("column_friction", "rack_stiction", "kingpin_friction", "rack_damping")

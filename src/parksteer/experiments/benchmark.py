@@ -43,12 +43,6 @@ from ..diagnose.settings import DEFAULT_SETTINGS, DiagnosisSettings
 BENCHMARK_SETTINGS = replace(DEFAULT_SETTINGS, confound_tests=False, residual_signature=False,
                              assumed_values_replayed=False)
 
-# The base parameters of a benchmark record are perturbed by these relative 1-sigma fractions (in this order, which
-# sets the random draws); the pipeline's in-class benchmark reads the same from config/config.yaml
-# (benchmark.perturbation), the out-of-library and assisted benchmarks use these.
-BASE_PERTURBATION = {"tyre.friction_coefficient": 0.10, "steering.rack_friction_force": 0.15,
-                     "tyre.carcass_torsional_stiffness": 0.20}
-
 TARGETS = {"named_or_group_at_2_steps": 0.90, "false_alarm_rate": 0.05, "outside_unexplained": 0.80,
            "after_over_floor": 1.2}
 

@@ -30,12 +30,12 @@ import numpy as np
 from ..measure.io import write_measurement
 from ..model.symbolic.components import resolve_effects
 from ..parameters import Parameters
-from ..synthetic.datasets import perturbed_base
+from ..synthetic.datasets import BASE_PERTURBATION, perturbed_base
 from ..synthetic.size_search import rms_difference
 from ..measure.converter import quantisation_step
 from ..synthetic.outoflibrary import COMBINED_FORMS, FORMS, TruthForm, form_by_name
 from ..synthetic.variations import VARIATIONS, variation_rack, variation_record
-from .benchmark import BASE_PERTURBATION, BENCHMARK_SETTINGS
+from .benchmark import BENCHMARK_SETTINGS
 from ..diagnose.intake import Request, intake
 from ..diagnose.signature import signature_of
 from ..diagnose.suggest import suggest

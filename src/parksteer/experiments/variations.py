@@ -35,7 +35,7 @@ import numpy as np
 from .. import portable as pm
 from ..errors import UsageError
 from ..parameters import Parameters, load_parameters
-from ..synthetic.datasets import perturbed_base
+from ..synthetic.datasets import BASE_PERTURBATION, perturbed_base
 from ..synthetic.size_search import SizeSearch, rms_difference, strength_for_rms
 from ..measure.converter import quantisation_step
 from ..synthetic.variations import VARIATIONS, Variation, variation_by_name, variation_rack, variation_record
@@ -57,7 +57,7 @@ SEARCH_TOLERANCE = 0.02  # accepted relative error of the hidden RMS change
 class VariationDesign:
     """The variation benchmark's design (config/config.yaml, section ``variations``): which variations, how many
     replicates of each (other seeds), the hidden library effects and their sizes in converter steps, the files a
-    case draws from, the seed. The base perturbation is the in-class benchmark's."""
+    case draws from, the seed. The base perturbation is :data:`parksteer.synthetic.datasets.BASE_PERTURBATION`."""
 
     variations: tuple[str, ...]
     replicates: int
@@ -76,7 +76,7 @@ class VariationDesign:
         return self.hidden
 
     @classmethod
-    def from_config(cls, section: dict, benchmark: dict) -> VariationDesign:
+    def from_config(cls, section: dict) -> VariationDesign:
         grid = section["full"] if section["full_grid"] else section["small"]
         names = tuple(str(v) for v in grid["variations"])
         for name in names:
@@ -85,7 +85,7 @@ class VariationDesign:
         design = cls(names, int(grid["replicates"]), tuple(str(h) for h in grid["hidden"]),
                      tuple(float(s) for s in grid["steps"]),
                      tuple((str(c), str(s)) for c, s in section["files"]), int(section["seed"]),
-                     {str(k): float(v) for k, v in benchmark["perturbation"].items()},
+                     dict(BASE_PERTURBATION),
                      None if with_angle is None else tuple(str(h) for h in with_angle))
         too_many = [v for v in names if variation_by_name(v).files > len(design.files)]
         if too_many:

@@ -98,12 +98,23 @@ class Hidden:
     current_friction: float = 0.0
 
 
-# The hidden quantities of the truth by the diagnosis candidate each stands for (rack friction: calibrated).
+@dataclass(frozen=True)
+class TruthHidden:
+    """How the truth shows one hidden candidate: the field of :class:`Hidden` it sets, and the largest size the
+    benchmark's size search tries (that field's unit; the search starts at a hundredth of it)."""
+
+    hidden_field: str
+    largest: float
+
+
+# The truth's row of each diagnosis candidate it hides (rack friction: the base's, calibrated), in the benchmarks'
+# order. The truth is written apart from the model, so how it shows a candidate is declared here, not read from the
+# candidate's effect: each candidate of the assisted benchmarks has this one row besides its effect file.
 HIDDEN_TRUTH = {
-    "assist_motor_friction": "motor_friction_Nm",
-    "torsion_bar_offset": "sensor_offset_Nm",
-    "boost_gain_error": "gain_error",
-    "rack_friction": "rack_friction_N",
+    "assist_motor_friction": TruthHidden("motor_friction_Nm", 0.3),
+    "torsion_bar_offset": TruthHidden("sensor_offset_Nm", 1.0),
+    "boost_gain_error": TruthHidden("gain_error", 1.0),
+    "rack_friction": TruthHidden("rack_friction_N", 1500.0),
 }
 # Out-of-class forms: name -> (the Hidden field, what it is, candidates a diagnosis may honestly name for it). A
 # friction that grows with the motor's torque acts as a loss of the forward gain and as a friction of the gear:
@@ -231,9 +242,9 @@ def truth_record(clean: dict[str, np.ndarray], logger: TruthLogger, case: str, s
 
 def with_hidden(hidden: Hidden, name: str, size: float) -> Hidden:
     """`hidden` with the truth's quantity of candidate or out-of-class form `name` set to `size`."""
-    key = HIDDEN_TRUTH.get(name) or OUT_OF_CLASS_TRUTH[name][0]
+    key = HIDDEN_TRUTH[name].hidden_field if name in HIDDEN_TRUTH else OUT_OF_CLASS_TRUTH[name][0]
     return replace(hidden, **{key: size})
 
 
-__all__ = ["HIDDEN_TRUTH", "OUT_OF_CLASS_TRUTH", "Hidden", "Road", "TruthGear", "TruthLogger", "TruthMap",
-           "column_of_pinion", "manual_road", "truth_record", "with_hidden"]
+__all__ = ["HIDDEN_TRUTH", "OUT_OF_CLASS_TRUTH", "Hidden", "Road", "TruthHidden", "TruthGear", "TruthLogger",
+           "TruthMap", "column_of_pinion", "manual_road", "truth_record", "with_hidden"]
