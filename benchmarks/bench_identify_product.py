@@ -24,7 +24,7 @@ def main(argv=None) -> int:
     from parksteer.experiments.assisted_truth import _write, baseline_record
     from parksteer.experiments.assisted_truth_design import TruthDesign, case_seed
     from parksteer.experiments.assisted_truth_owner import owner_file
-    from parksteer.experiments.benchmark import BASE_PERTURBATION
+    from parksteer.synthetic.datasets import BASE_PERTURBATION
     from parksteer.synthetic.datasets import perturbed_base
     from parksteer.vehicle import load_vehicle
 

@@ -42,7 +42,7 @@ from parksteer.measure.io import write_measurement
 from parksteer.model.symbolic.components import Effect, resolve_effects
 from parksteer.model.symbolic.system import action_reaction, torque_between
 from parksteer.parameters import Quantity, load_parameters
-from parksteer.experiments.benchmark import BASE_PERTURBATION
+from parksteer.synthetic.datasets import BASE_PERTURBATION
 from parksteer.synthetic.datasets import perturbed_base
 from parksteer.synthetic.size_search import rms_difference
 from parksteer.synthetic.variations import VARIATIONS, variation_rack, variation_record
