@@ -119,12 +119,12 @@ def ensemble_sources(f: FileData, draws: int, released: bool) -> list[tuple[Smoo
     noise for a tenth of a second or more, and how the spline eases into and out of the turn (which sets when
     the speed passes the millimetre per second over which the rack friction turns over) is set by its knots, not
     by the data. Redrawing the noise about one spline (the chosen one) measures that spline's variance but not
-    this choice: on a sound car's record at 50 Hz (the Polo, rate_8pc_50Hz) the chosen spline's replay was
-    1.3 N m off at the reversals where the draws spread by 0.08 N m, while replays of the other passing
+    this choice: on a sound car's record at 50 Hz (the Polo, rate_8pc_50Hz) the chosen spline's replay is
+    1.3 N m off at the reversals where draws about it spread by 0.08 N m, while replays of the other passing
     spacings bracket the truth. So the draws are spread over the passing spacings, the chosen one first and the
     finest last (evenly by index); with `released`, the draws come in pairs, the first of each pair held at rest
     as the chosen spline is, the second with the ends and pauses free. A record whose chosen spacing is the
-    only one to pass draws as before.
+    only one to pass draws every time about that spline.
     """
     spacings = f.rack.passing_spacings_s
     pair = 2 if released else 1

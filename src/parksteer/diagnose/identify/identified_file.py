@@ -188,8 +188,8 @@ def replace_assist_section(text: str, found) -> str:
                                        f"{where}: {found.back_efficiency.text()} (the column balance on the "
                                        f"back-driven samples; the file gave {found.file_values['back_efficiency']:g})")
     replaced = {k: e for k, e in replaced.items() if k not in found.kept}
-    # A value the records measured and whose interval holds the file's assumed value: the file's value stays, now
-    # measured, so its source says so (a diagnosis replays only what is still assumed: stages/assumed.py)
+    # A value the records measured and whose interval holds the file's assumed value: the file's value stays, as a
+    # measured one, so its source says so (a diagnosis replays only what is still assumed: stages/assumed.py)
     replaced.update(confirmed)
     for key, entry in old.items():
         if key in ("type", "boost") or key in LINE_KEYS or key in replaced:

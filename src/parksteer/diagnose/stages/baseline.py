@@ -9,7 +9,7 @@ one to two per cent, with a BIC gain of tens. That is no effect of the car. Wher
 error and its 95 % interval lies within the file's half-width, the verdict is ``adequate`` and the report says
 by how much the record's gain differs from the table's; a gain error reaching beyond the half-width stands (a
 change of the map since the baseline, or a table read on too short a baseline). A file that states its map (no
-``gain_uncertainty``) is taken as exact, as before.
+``gain_uncertainty``) is taken as exact.
 """
 
 from __future__ import annotations
