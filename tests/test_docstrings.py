@@ -26,13 +26,7 @@ STALES_PRE_DERIVED = "the symbolic half's source keys the pre-derived models; cu
 NOT_YET_CUT = "derivation and measurements not yet moved to the docs page that owns them"
 EXCEPTIONS: dict[str, tuple[int, str]] = {
     "parksteer/model/symbolic/effects/electric_assist.py": (991, STALES_PRE_DERIVED),
-    "parksteer/diagnose/identify/assist_identify.py": (908, NOT_YET_CUT),
-    "parksteer/diagnose/signature.py": (684, NOT_YET_CUT),
-    "parksteer/sweep/assist_sizing.py": (585, NOT_YET_CUT),
-    "parksteer/model/numeric/assisted.py": (575, NOT_YET_CUT),
-    "parksteer/diagnose/select.py": (574, NOT_YET_CUT),
     "parksteer/model/symbolic/effects/rack_presliding.py": (564, STALES_PRE_DERIVED),
-    "parksteer/figures/assist_study.py": (556, NOT_YET_CUT),
     "parksteer/model/symbolic/effects/brush_patch.py": (522, STALES_PRE_DERIVED),
     "parksteer/model/symbolic/effects/assist_common.py": (484, STALES_PRE_DERIVED),
     "parksteer/model/symbolic/effects/braked_wheels.py": (480, STALES_PRE_DERIVED),

@@ -1,57 +1,17 @@
 """Diagnose: calibrate, rank the candidates, refit the best, choose, and say what would separate them.
 
-The steps (:func:`diagnose`, each a stage of :data:`parksteer.diagnose.stages.STAGES`, run in order on a frozen
-:class:`parksteer.diagnose.state.DiagnosisState`):
-
-1. replay the files through the base model at its default parameters, and estimate each
-   sample's replay uncertainty (:mod:`parksteer.diagnose.problem`);
-2. calibrate the base model's uncertain parameters (:mod:`parksteer.diagnose.calibrate`), on to the optimum
-   of the sum of squares (:func:`parksteer.diagnose.calibrate.polish`: a candidate's refit starts there, so
-   that its BIC gain is its own and not the base parameters' moving on);
-3. for every candidate not in the model, its signature and score test at the calibrated model
-   (:mod:`parksteer.diagnose.candidates`);
-4. refit the best-scored few in the full nonlinear model (calibrated parameters and the
-   candidate's strength together);
-5. compare by an information criterion over the effective sample size:
-   ``BIC = n_eff ln(RSS / n) + k ln(n_eff)``, with ``n_eff = n (1 - rho) / (1 + rho)`` and rho
-   the lag-1 autocorrelation of the best model's weighted residuals (neighbouring samples of
-   a smooth misfit are not independent evidence); only a candidate whose fitted strength is above 0 may be the
-   best (:func:`parksteer.diagnose.stages.select.may_headline`; with ``headline_interval_clear_of_zero``, only one
-   whose 95 % interval is clear of 0), or be named beside it (step 7);
-6. the verdict:
-
-   - ``missing``: the best candidate lowers the BIC by more than ``bic_missing_threshold``
-     and, with it, the error is at the floor (weighted RMS within ``adequate_rms_factor`` of
-     the noise floor) or it removes at least ``explained_fraction_missing`` of the weighted
-     sum of squares above the floor (a perfect model leaves a weighted sum of squares equal
-     to the number of samples); either way the error with it must come within
-     ``missing_rms_ceiling`` floors (without its largest ``missing_ceiling_trim`` of residuals),
-     since a named effect that leaves the residual above what records with nothing hidden reach
-     along the strokes is not the whole story. This is tested first: a small
-     effect that the calibration has mostly absorbed can leave the error near the floor and
-     still be strongly evidenced by its shape;
-   - ``adequate``: otherwise, when no candidate is strongly evidenced and the calibrated base
-     model's weighted error is at the floor;
-   - ``unexplained``: the residual is structured (or a candidate is evidenced but leaves most
-     of it), and no candidate removes most of it.
-
-   When a candidate is strongly evidenced, the replay uncertainty is estimated again with its
-   fitted model, each sample keeps the larger of the two, and the comparison is repeated with
-   these weights: a candidate can sharpen the torque exactly where the rack data are least
-   certain (a breakaway peak at a reversal), and a comparison weighted by the base model's
-   uncertainty alone would count the replay's timing errors there against it.
-
-7. candidates within ``BIC_INDISTINGUISHABLE`` of the best are ``indistinguishable`` by these
-   data; for each, both fitted models are replayed (on the first file's rack) under every
-   condition the data do not cover (the other load cases and spacers, on the ground and on
-   air bearings), and the condition where they differ most, relative to the noise floor, is
-   named as the measurement that would separate them;
-8. a candidate ``confounded`` with the calibrated parameters (these data cannot tell it from a
-   change of them) gets the same: the measurement where it would show although the calibrated
-   parameters take it up here (:func:`parksteer.diagnose.stages.confound.confound_tests`).
-
-With ``torque_lag_fitted``, each file's torque lag behind its rack is searched after the calibration and again
-with the named effect (:mod:`parksteer.diagnose.stages.torque_lag`).
+:func:`diagnose` runs the stages of :data:`parksteer.diagnose.stages.STAGES` in order on a frozen
+:class:`parksteer.diagnose.state.DiagnosisState`: the files replayed through the base model with each sample's
+replay uncertainty (:mod:`parksteer.diagnose.problem`); the base model's uncertain parameters calibrated to the
+optimum (:mod:`parksteer.diagnose.calibrate`, :func:`parksteer.diagnose.calibrate.polish`); every candidate not in
+the model scored at the calibrated model (:mod:`parksteer.diagnose.candidates`); the best-scored few refitted in the
+full nonlinear model; the comparison by the BIC over the effective sample size, only a candidate whose fitted
+strength is above 0 heading it (:func:`parksteer.diagnose.stages.select.may_headline`); the verdict ``missing``,
+``adequate`` or ``unexplained``; for candidates within ``BIC_INDISTINGUISHABLE`` of the best, and for one
+``confounded`` with the calibrated parameters, the uncovered condition that would separate them
+(:func:`parksteer.diagnose.stages.confound.confound_tests`). With ``torque_lag_fitted``, each file's torque lag is
+searched after the calibration and again with the named effect (:mod:`parksteer.diagnose.stages.torque_lag`). The
+stages' table and the verdict's rules: docs/diagnosis.md.
 """
 
 from __future__ import annotations

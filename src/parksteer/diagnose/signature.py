@@ -1,53 +1,16 @@
 """The residual's signature: what kind of effect the calibrated model lacks, read off the residual's shape.
 
-When no candidate explains the residual, the residual itself still says much about the mechanism behind it.
-A force that opposes the motion reverses with the rack speed (it is *odd* in the speed: dissipative); one that
-depends on where the rack is and not on where it is going is *even* in the speed (elastic); one that acts while
-the rack moves but points the same way whichever way it moves does not reverse (direction-dependent, the even
-part of a moving force). Along the stroke it may be the same everywhere, grow toward lock or sit in one place;
-it may repeat with the column angle (once per turn: an out-of-balance or an eccentric part; twice: a joint; a
-tooth-mesh order); it may grow with the speed (viscous) or fall with it (Stribeck-like).
-
-The axes and the bases on them are :mod:`parksteer.diagnose.signature_axes`'s. The decomposition
-(:func:`signature_from_axes`) regresses the calibrated model's weighted torque residual
-``w_i = (measured_i - model_i) / sigma_i`` on nested bases along these axes, each basis column weighted the
-same way (weighted least squares, :func:`parksteer.portable.lstsq`). With ``s = tanh(beta v)`` the smoothed
-sign of the rack speed (beta the model's friction smoothing), ``x`` the rack position, ``theta`` the column
-angle and radial basis functions ``phi_k(z) = exp(-((z - c_k) / h)^2)`` on knots ``c_k`` spaced ``h``:
-
-- dissipative: ``s``, ``s phi_k(x)`` (K knots over the stroke);
-- elastic: ``phi_k(x)``;
-- direction-dependent: ``s^2``, ``s^2 phi_k(x)`` (zero at rest, the same sign both ways);
-- speed: ``s phi_k(|v| / v_90)`` (v_90 the 90th percentile of |v|): viscous when the shape grows with the
-  speed, Stribeck-like when it falls;
-- column: ``sin(m theta), cos(m theta)`` for the orders m of the settings (once, twice per turn, a mesh
-  order);
-- dissipative x column (``dissipative_column``), a product of two classes: ``s sin(m theta), s cos(m theta)``
-  for the combined orders of the settings (once, twice per turn, both, two and four, one to four): a friction on the column shaft that rises and falls with the
-  column angle (a bearing pinched once per turn, a joint's friction that grows twice per turn with its angle).
-  Its uniform part is the dissipative class's; a product counts where the information criterion prefers it to
-  the classes apart (a friction periodic in the column angle also reads, with more columns, as a dissipative
-  force along the stroke).
-
-Each family member is one model; they compete with the null (no structure) by the information criterion of the
-diagnosis, ``BIC = n_eff ln(RSS / n) + k ln(n_eff)`` with ``n_eff = n (1 - rho) / (1 + rho)`` and rho the lag-1
-autocorrelation of the weighted residual left by all bases together (neighbouring samples of a smooth misfit are
-not independent evidence, :func:`parksteer.diagnose.statistics.effective_samples`). The member with the lowest BIC
-names the class; none, when no member beats the null by the diagnosis's ``bic_missing_threshold``.
-
-Beside the class, every *axis* (the richest basis of each family, and the cycle phase and the record where
-records differ in load or surface) gets its share of the residual's weighted sum of squares and its
-significance against the noise floor: a perfect model leaves weighted residuals of unit variance, so the sum of
-squares an axis of k columns removes is, without any structure, chi-square with k degrees of freedom -- for
-independent samples. Autocorrelated noise inflates that sum by about n / n_eff (the variance of a slowly varying
-projection of an AR(1) sequence), so the likelihood-ratio statistic is ``LR = Delta RSS n_eff / n`` against
-chi-square(k) (its survival function :func:`scipy.special.chdtrc`, what ``scipy.stats.chi2.sf`` calls).
-
-A torque residual at the handwheel is turned into a force on the rack by the handwheel-to-rack ratio (a rack
-force F gives a handwheel torque F / G through the rigid column; the Hooke joint's ripple of a few per cent is
-left out of this reading, and in the suggested effect the model has it back).
-
-:func:`signature_of` reads the axes off a diagnosis's files and calibrated predictions; the result is frozen.
+:func:`signature_from_axes` regresses the calibrated model's weighted torque residual
+``w_i = (measured_i - model_i) / sigma_i`` on nested bases along the axes of
+:mod:`parksteer.diagnose.signature_axes` (dissipative, elastic, direction-dependent, speed, column, dissipative x
+column), by weighted least squares (:func:`parksteer.portable.lstsq`). Each basis competes with the null by the
+diagnosis's information criterion, ``BIC = n_eff ln(RSS / n) + k ln(n_eff)`` with ``n_eff`` from the lag-1
+autocorrelation (:func:`parksteer.diagnose.statistics.effective_samples`); the lowest names the class, none when no
+basis gains ``bic_missing_threshold``. Every axis gets its share of the weighted sum of squares and its
+likelihood-ratio significance ``LR = Delta RSS n_eff / n`` against chi-square(k) (:func:`scipy.special.chdtrc`).
+A handwheel torque residual is read as a rack force through the handwheel-to-rack ratio (the Hooke joint's ripple
+left out of this reading). :func:`signature_of` reads the axes off a diagnosis's files and calibrated predictions;
+the result is frozen. The bases, the classes and what each means: docs/signature.md.
 """
 
 from __future__ import annotations

@@ -1,42 +1,16 @@
 """Today's steering on the paper's car: what power assistance and creeping change in the source's conclusions.
 
 The paper's car (the pipeline's parameter file) runs the source's lock-to-lock cycle, unladen on the ground, with
-the tyre rolling (the turn_slip effect: exactly the paper's model at 0 km/h), three ways: without assistance,
-with the column electric assist at its assumed defaults, with the hydraulic assist at its assumed defaults
-(each default with its range and source in the effect's file, copied into the JSON).
-
-Shares. The model's contribution outputs split the handwheel torque into one term per mechanism, the generalized
-force of each on the rack referred to the handwheel through d(column angle)/d(rack) (as the figContrib figure
-does). With an assist one term is the assist's own, negative: the motor (or piston) pushes the rack. What the
-column must carry is the road torque
-
-    T_road = sum of the mechanisms' terms (all but the assist's, inertia included) = T_driver + T_assist,
-
-so each mechanism's share is its term over T_road (the shares add up to one, with and without assist), and the
-driver and the motor split T_road between them. Quasi-statically, beyond the dead band D of a boost curve of gain
-G below its limit, T_driver = (T_road + G D) / (1 + G): the driver's share tends to 1 / (1 + G) as T_road grows.
-For the hydraulic gear the equivalent gain is A k_v / G_hr (piston area A, valve slope k_v in Pa per N m of
-torsion-bar torque, G_hr the handwheel-to-rack ratio). Shares are taken over the plateau (the mean over the rack
-window of the figContrib figure, before right lock) and at the sample before the right-lock reversal.
-
-Offsets. The source found the king-pin offset hardly matters on the ground: the cycle is run for the paper's four
-wheel offsets (the standard car and its three spacers) with and without each assist, and the spread (largest
-less smallest) of the plateau torque and of the peak torque over the four is reported, in N m and relative to the
-standard car's.
-
-Creeping. The peak rack force over the cycle (handwheel torque through the gear, F = T d(theta_c)/d(rack), for the
-car without assist; the force the pinion and the assist together put on the rack, with it) at 0, 1, 3 and 5 km/h,
-and the plateau's shares at each speed (the tyre's: its friction moment times the turn-slip factor, the sum of the
-tyre_friction and turn_slip terms). The creeping result hangs on the turn-slip slope q_Dz8: the car without
-assist runs again at 1, 3, 5 km/h over SPIN_SLOPE_BAND, and the share of its standstill tyre moment the rolling
-tyre keeps on the plateau is reported for each (the figure shades the band of peak rack force).
-
-Loads. The standstill cycle without assist runs again over the tyre-ground friction band
-(parksteer.sweep.assist_sizing.FRICTION_BAND), its peak rack force, with and without the rack's own friction, set
-against the published class range of standstill rack forces of small and medium cars
-(PUBLISHED_STANDSTILL_RACK_FORCE_N there): below, within or above it at each friction. The column assist at its
-defaults is sized for the driver's target torque (the pipeline's assist.target_torque) against the model's
-standstill load and against the class range's ends (class_load).
+the tyre rolling (the turn_slip effect), without assistance and with the column electric and the hydraulic assist at
+their assumed defaults (each default with its range and source in the effect's file, copied into the JSON). It
+gives each mechanism's share of the road torque over the plateau and before the right-lock reversal, the driver's
+share against 1 / (1 + G); the spread (N m and relative) of the plateau and peak torque over the paper's four wheel
+offsets; the peak rack force (N) and the plateau's shares at 0, 1, 3 and 5 km/h, and over the turn-slip slope band
+SPIN_SLOPE_BAND; the standstill peak rack force over the tyre-ground friction band
+(parksteer.sweep.assist_sizing.FRICTION_BAND) against the published class range
+(PUBLISHED_STANDSTILL_RACK_FORCE_N there); and the column assist sized for the pipeline's assist.target_torque
+against the model's load and the range's ends (class_load). The shares' definition and what the study finds:
+docs/assist.md, "The paper's car: what assistance and creeping change".
 
 Numbers on this path reach a checksummed figure: elementwise arithmetic, means and extrema only.
 """

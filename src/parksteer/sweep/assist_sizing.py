@@ -1,43 +1,18 @@
 """Assist sizing: the rack force a car needs at standstill and creeping, and the motor (or pressure) that keeps
 the driver's torque under a target over the lock-to-lock cycle.
 
-For each speed the car runs the cycle without assistance, the tyre rolling at that speed (the turn_slip effect,
-exactly today's model at 0 km/h). The rack force is the handwheel torque through the gear,
-F = T d(theta_c)/d(rack): quasi-statically the force the pinion must put on the rack. To leave the driver at most
-T_target, the assist must carry the excess E = max(|T| - T_target, 0) of the column torque; at its point of action
-
-    column: E (N m),   pinion: E d(theta_c)/d(rack) / G_hr (N m),   rack: E d(theta_c)/d(rack) (N),
-
-and its motor, through the reduction N of efficiency eta and against its own friction T_f, must give
-T_m = (A / N + T_f) / eta with A the peak of that demand; the current is T_m / k_t. A hydraulic gear needs the
-pressure (A + F_s) / A_piston, against its seals' friction F_s too. This is the quasi-static demand; the check
-runs the cycle again with the assist sized so and gives the driver's peak torque that results: the motor limit
-or relief pressure 10 % above the demand, and the boost gain that meets the target at the peak beyond the file's
-dead band D,
-
-    G = (T_peak + T_f,col - T_target) / (T_target - D),
-
-where T_f,col is the assist's own friction as a column torque, which the gear must overcome as well (the motor's
-bearings N T_f at the column, N T_f G_hr / c' at the pinion, N T_f / c' at the rack; the piston's seals F_s / c';
-c' = d(theta_c)/d(rack) at the peak).
-
-A speed-dependent boost curve (an electric assist with ``speed_dependence`` > 0, from the vehicle file or
-``parksteer assist size --gain-half-speed-kmh``) is one assist for every speed, as on the car: its parking gain G is
-sized at the study's lowest speed v_0 to meet the target there (G = G(v_0) (1 + s (v_0 / v_half)^2)), its motor
-limit 10 % above the largest motor demand over the speeds, and each check runs the cycle with the gain that curve
-gives at the row's speed, G(v) = G / (1 + s (v / v_half)^2) (the row's ``gain``): the driver's peak torque at
-1, 3, 5 km/h is then what the falling gain leaves, quasi-statically (T_road + G(v) D) / (1 + G(v)) beyond the
-dead band D. Without it each speed's check sizes its own gain, the assist a speed-independent curve would need there.
-
-Loads. The standstill cycle runs again over the tyre-ground friction band (FRICTION_BAND), its peak rack force
-given with and without the rack's own friction (the rack friction's term taken out of the handwheel torque: the
-linkage's load alone). A vehicle file whose linkage ratio rises toward lock gives the linkage_nonlinearity effect's
-coefficient c (steer = G x (1 + c (G x)^2), G = roadwheel_to_rack_ratio: the ratio rises by 1 + 3 c delta^2); every
-run of the study then carries that effect (with_linkage), the check runs too. The model's load is one car's; the motor is also sized at the ends of the published class
-range of standstill rack forces (PUBLISHED_STANDSTILL_RACK_FORCE_N), quasi-statically through the car's gear at its
-standstill peak (size_for_rack_force). Both ranges, with their sources, are in ``parksteer/data/published_loads.toml``.
-
-The assist's values are the vehicle file's ``[assist]``, else the assumed defaults of a column assist.
+For each speed the car runs the cycle without assistance, the tyre rolling at that speed (the turn_slip effect).
+The rack force (N) is the handwheel torque through the gear; the assist carries the excess of the column torque
+over the target, and its motor torque (N m) and current (A), or the hydraulic pressure (Pa), follow quasi-statically
+through the gear and against the assist's own friction. The check runs the cycle again with the assist so sized
+(limit or relief pressure 10 % above the demand, the gain that meets the target at the peak beyond the dead band)
+and gives the driver's peak torque. A speed-dependent boost curve is one assist for every speed, its parking gain
+sized at the study's lowest speed. The standstill cycle runs again over the tyre-ground friction band
+(FRICTION_BAND), with and without the rack's own friction; a vehicle file whose linkage ratio rises toward lock
+adds the linkage_nonlinearity effect to every run (with_linkage); the motor is also sized for the ends of the
+published class range (PUBLISHED_STANDSTILL_RACK_FORCE_N, size_for_rack_force), whose sources are in
+``parksteer/data/published_loads.toml``. The assist's values are the vehicle file's ``[assist]``, else the assumed
+defaults of a column assist. The formulas: docs/assist_sizing.md, "The demand and the gain".
 """
 
 from __future__ import annotations

@@ -5,58 +5,15 @@ torque S as the car's bus logs it, the motor current i, the rack or the handwhee
 (its gear's data: reduction N, efficiencies, torque constant, rotor inertia, motor limit) and gives an
 :class:`Identified`, which writes the vehicle file again with what the records fix (:meth:`Identified.to_vehicle_toml`).
 
-Two steps, each a least-squares fit with its 95 % intervals:
-
-1. **The map** (model-free: S and i alone). The control unit commands the current its map gives the reading it
-   takes, so the samples (S, i) lie on one curve, i = K(S - c): a boost table in ampere
-   (:mod:`parksteer.boost_table`'s law: monotone cubic Hermite, odd, exactly zero in its dead band |T| <= D), with
-   c the map's zero in the logged torque (0 when the log and the control unit read one sensor). Its points are the
-   origin, the dead band D and :data:`SPAN_POINTS` points evenly spaced from D to the largest |S|; the
-   fitted values are D, c and the rises between points (positive, so the table is a boost curve). What the map
-   cannot hold is reported: the residual's RMS against what the two channels' noise floors allow (scatter), and
-   the mean residual on loading (|S| rising) less that on unloading at equal torque (hysteresis: a current that
-   depends on the way the torque goes, which a map of S cannot give).
-
-2. **The gear** (the mechanics: the car's manual model replayed on the record's rack). The torques on the massless
-   column balance at every sample (:mod:`parksteer.model.numeric.assisted`):
-
-       (S - o) + p D(t) = y(t; theta),   D(t) = e(t) (P_file / eta_f) K(S - c),
-
-   S - o the torque the bar carries (o the sensor's zero offset, read by the control unit and the log alike), D(t)
-   what the file's gear would deliver for the identified current (P_file = k_t eta_f N, e(t) the gear's efficiency
-   in the direction the power flows), p the factor on the product k_t eta_f N that the data fix, and y the column
-   torque the car without boost needs on this rack (the assisted model replayed with its boost off: the rotor's
-   inertia in it), which depends on the calibrated parameters theta (:data:`MECHANICS`: the motor's Coulomb
-   friction and rotor inertia, the rack friction), all linearly, so the fit is one linear least-squares step on
-   finite-difference sensitivities, o and p with them. Where enough samples are back-driven
-   (:data:`BACK_DRIVEN_SHARE`), D is split into the samples the motor drives and those it is driven back, with
-   factors p and p eta_b,file / eta_b: the back-driven efficiency is fitted too. The tyre-ground friction is not
-   fitted: it scales the road torque as p scales the assist, and S, their small difference, cannot tell them
-   apart; the product's change per step of it is reported.
-
-The band of rotor speed over which the motor's friction and the worm's direction change over at a reversal (the
-assist's ``friction_speed``) is the file's: the balance read across the reversals does not fix it from the
-records of a bus (the smoothed rack places a reversal no finer than about 1 mm/s of the rack, and a narrower band
-reads wider than it is); the diagnosis replays it at its band's ends (stage ``assumed``).
-
-Intervals are the least squares' with the residuals' correlation in time left in (a sandwich over blocks of
-:data:`BLOCK_S`, with Student's t for its blocks): a record of a few cycles fixes less than its sample count says.
-The map's points carry two errors the samples do not average: the table's own (the change from a table of two
-points fewer, halved) and the current's rounding (one current per reading of the sensor); the dead band and the
-map's centre the torque's rounding (the map between two readings is never seen); the product the map's error,
-relative, since it is read through the map. The identified table is the map
-times the identified product, P K(S - c), at the point of action; the written file carries it in ``[assist.boost]``
-and the product as the torque constant k_t = P / (eta_f N) (only the product is fixed: eta_f and N stay the file's),
-and the motor friction; each entry's ``source`` names the records. A number of the gear is written only where it is
-physical and its interval excludes the file's value; otherwise the file's stays (:attr:`Identified.kept`). A value
-the file gives from a data sheet always stays: the balance reads the gear through what it cannot check. The product
-moves by about a tenth per 0.05 of the tyre-ground friction, which an owner's file takes from elsewhere (the Polo's
-from the paper's loading plate), and the back-driven efficiency through the few samples after each reversal, whose
-timing a rack derived from a bus's angle does not fix; a data sheet's value overturned on either leaves every later
-record of the car unexplained. The report gives the balance's reading beside it, and for the product the friction at
-which the balance would agree with the data sheet. The sensor offset and the map's centre have no
-place in a vehicle file (the model's law is odd about the reading's zero): they are reported, and a later
-diagnosis that names an offset of the same size names the baseline's.
+Two least-squares steps, each with 95 % intervals that keep the residuals' correlation in time (a sandwich over
+blocks of :data:`BLOCK_S`): the map i = K(S - c), a :mod:`parksteer.boost_table` law in ampere on the origin, the
+dead band and :data:`SPAN_POINTS` points, with its scatter and hysteresis reported; then the gear, the column
+balance of :mod:`parksteer.model.numeric.assisted` replayed on the record's rack, which fixes the product
+k_t eta_f N (N m/A), the sensor's zero offset (N m), the :data:`MECHANICS` parameters and, where enough samples
+are back-driven (:data:`BACK_DRIVEN_SHARE`), the back-driven efficiency. The assist's ``friction_speed`` stays the
+file's. A gear number is written only where it is physical and its interval excludes the file's value, and a value
+the file gives from a data sheet always stays (:attr:`Identified.kept`); each written entry's ``source`` names the
+records. The method, its intervals and its accuracy on known cars: docs/assist_identify.md.
 """
 
 from __future__ import annotations

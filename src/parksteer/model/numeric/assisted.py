@@ -1,41 +1,14 @@
 """The prescribed-rack solve of an assisted car: the torsion-bar torque and the motor's output from a rack motion.
 
-Why the plain solve does not do it. The prescribed-rack solve (:mod:`.prescribed`) takes the column torque T as
-its unknown: ``M a = F + b T`` with the rack's acceleration given. An assist's force depends on the torsion-bar
-torque, i.e. on T itself, so F would hold the unknown (the generated drive refuses it: ``rack_drive`` false).
-
-Derivation. The model's column is massless and every assist acts on the steering's one kinematic chain: the
-column angle, the pinion angle (G_hr x, G_hr the handwheel-to-rack ratio) and the rack x are functions of x
-alone, so a torque on any of them has the generalized-force direction of the rack's, scaled by its lever
-dtheta/dx: ``c_col = dtheta_col/dx`` (the output ``column_angle_per_rack``, the Hooke joint's ratio in it),
-``G_hr`` at the pinion, 1 at the rack. With the rack prescribed, the rest of the model (wheels, tyres, the
-rotor's inertia N^2 J_m and friction, both fixed by the rack's motion) feels only the sum of the column torque and
-the assist, reduced to the rack:
-
-    R = T c_col + A_x lever_x,    lever_x = c_col (column), G_hr (pinion), 1 (rack; A_x a force),
-
-where A_x is the assist the reduction delivers at its point of action, eta N T_m. So solving the model once with
-the boost switched off (gain 0, or a valve of zero slope: the motor's inertia and friction, which depend on the
-kinematics alone, stay in) gives T_road(t), the column torque that alone would carry R: ``R = T_road c_col``.
-The torsion bar's torque is T_s = T (column assist) or T c_col / G_hr (pinion, rack, hydraulic: the bar on the
-pinion, the column torque through the joint). Dividing R by c_col (column) or G_hr (the others):
-
-    y = T_s + A(T_s),   y = T_road (column), T_road c_col / G_hr (pinion, rack, hydraulic),
-    A(T_s) = e N clamp((G deadband(T_s) s + B(T_s)) / (eta N), T_max) / s,   s = 1 (column, pinion), G_hr (rack),
-    A(T_s) = a_p clamp(k_v deadband(T_s) + B(T_s), p_relief) / G_hr          (hydraulic),
-
-the boost laws of :mod:`parksteer.model.symbolic.effects.electric_assist` and ``hydraulic_assist`` with the same
-smoothed corners (:mod:`parksteer.model.symbolic.effects.assist_common`); B is the boost table's law (the motor's
-demand, or the valve's pressure; zero without a table) and e the gear's efficiency in the direction the power flows (eta_f driving, 1 / eta_b back-driven), read
-from the prescribed rack's speed (the point of action's rate, as the effect reads it) and the law's motor torque. A is increasing (deadband and clamp are,
-strictly for a smoothed clamp: its slope is -(f(a) + f(b))/2 > 0 with f(z) = z / sqrt(z^2 + w^2), a + b = -2 L),
-and the gear's directional factor keeps the delivered torque rising with the motor torque for eta_b above a
-bound (:func:`least_back_efficiency`, 0.147 at eta_f 0.85; below it the law is refused), so y(T_s) rises with
-slope >= 1 and has one root, found pointwise by bisection in ``[y - B, y + B]`` (B bounds
-|A|). The motor torque T_m and current T_m / k_t (or the pressure) then follow from the law. Nothing in this depends
-on the acceleration: the rotor's inertia is in T_road. The tests (tests/model/test_assisted_replay.py) replay a
-free assisted simulation's rack and recover its torsion-bar torque and motor current to the integrator's
-tolerance at the column, the pinion and the rack, and in saturation.
+The plain prescribed-rack solve (:mod:`.prescribed`) cannot take an assist, whose force depends on its own unknown
+column torque. Here the model is solved once with the boost switched off (the motor's inertia and friction kept),
+which gives the road torque T_road (N m); the torsion-bar torque T_s (N m) is then the one root of
+``T_s + A(T_s) = y``, y the road torque referred to the bar, A the boost law of
+:mod:`parksteer.model.symbolic.effects.electric_assist` or ``hydraulic_assist`` with the same smoothed corners
+(:mod:`parksteer.model.symbolic.effects.assist_common`) and the gear's efficiency in the direction the power flows,
+found pointwise by bisection; the motor torque (N m) and current (A), or the pressure (Pa), follow from the law. A is
+increasing, so the root is unique, for a back-driven efficiency above :func:`least_back_efficiency` (0.147 at
+eta_f 0.85); below it the law is refused. The derivation: docs/assist.md, "Replaying an assisted car's rack".
 """
 
 from __future__ import annotations
