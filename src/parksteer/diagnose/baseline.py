@@ -1,35 +1,17 @@
 """A car's baseline: what its healthy records fix, and later records judged against it.
 
-No model of a real car reaches a 12-bit sensor's noise floor: every record of it, its healthy ones included, carries
-something the model lacks. The question its owner asks after a repair or a thousand kilometres is what changed.
-:func:`learn_baseline` learns from the healthy records everything they fix:
-
-- the car's calibrated parameters, each with its 95 % interval (:meth:`parksteer.diagnose.calibrate.Fit.intervals`);
-- what the healthy car has that the model lacks (:class:`HeldForm`): the absolute diagnosis's verdict and, where it
-  is not ``adequate``, the car's own form: the named library candidate at its fitted strength, or the form the
-  residual's signature points to (:func:`parksteer.diagnose.suggest.suggest`) with its fitted strengths;
-- how far apart healthy data are (:class:`Threshold`), always out of sample: with two or more healthy records, each
-  is judged against the form fitted again on the others (leave one out); with one, its samples are dealt in blocks
-  of 2 s to three folds in turn, and each fold is judged with the form fitted on the other two held (the record is
-  replayed whole, the fold weighted out of the fit: a part replayed alone would start mid-stroke from rest, a start
-  the car never had) and the whole record calibrated, as a later record is. Of each part, the weighted RMS error
-  in noise floors with the form held and the best candidate's BIC gain per sample (a fold: its share of the
-  record's); what "as the baseline" allows is the one-sided 95 % prediction bound for one more healthy part
-  (Student's t over the parts: few parts fix it poorly, and the bound is wide; more healthy records tighten it).
-
-A later record is then diagnosed (``diagnose(..., baseline=...)``, :mod:`parksteer.diagnose.select`) on the model
-with the form's strengths HELD at the baseline's values (a change cannot be absorbed by fitting the quirk again),
-starting from the baseline's calibrated values, and with the threshold above where it is above the sensor's
-(:meth:`Threshold.settings_for`):
-``adequate`` is "as the baseline", ``missing`` "changed: X", ``unexplained`` "changed, outside the library". The
-uncertainty of the held strengths reaches the verdict through that threshold (every part is judged against
-strengths fitted without it, so their estimation error is inside the spread it measures) and through the headline
-rule: against a baseline no candidate whose 95 % interval holds 0 is named. Where the records fix the form poorly,
-the spread, and so the threshold, is wide. The diagnosis's JSON names the baseline
-(``relative_to``: its file and content hash, the threshold and how it was found).
-
-The file (:meth:`Baseline.write`, :mod:`parksteer.diagnose.baseline_file`) is TOML a person reads: every value with
-its interval and source.
+:func:`learn_baseline` learns from a car's healthy records its calibrated parameters with their 95 % intervals
+(:meth:`parksteer.diagnose.calibrate.Fit.intervals`), what the healthy car has that the model lacks
+(:class:`HeldForm`: the named library candidate at its fitted strength, or the form the residual's signature
+points to, :func:`parksteer.diagnose.suggest.suggest`), and how far apart healthy data are (:class:`Threshold`,
+out of sample: leave one record out, or with one record three folds of 2 s blocks; the one-sided 95 % prediction
+bound, in noise floors, for one more healthy part). A later record is diagnosed (``diagnose(..., baseline=...)``)
+with the form's strengths held at the baseline's values, from its calibrated values, and with that threshold where
+it is above the sensor's (:meth:`Threshold.settings_for`): ``adequate`` reads "as the baseline", ``missing``
+"changed: X", ``unexplained`` "changed, outside the library"; against a baseline no candidate whose 95 % interval
+holds 0 is named. The diagnosis's JSON names the baseline (``relative_to``). The file (:meth:`Baseline.write`,
+:mod:`parksteer.diagnose.baseline_file`) is TOML a person reads, every value with its interval and source. Why and
+how: docs/diagnosis.md, "Against a car's baseline".
 """
 
 from __future__ import annotations

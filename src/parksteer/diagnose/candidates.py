@@ -1,37 +1,15 @@
 """Candidate effects: which ones can be tested, their signatures, and the score test that ranks them.
 
-A candidate is any registered effect (:mod:`parksteer.model.symbolic.components`: the package's
-modules, entry points, configured files) that is not in the model, and that has a strength:
-the parameter whose default value means the effect is absent. It is the parameter named
-``strength`` if there is one, else the only parameter whose default is zero and whose range
-starts at zero. An effect without one (e.g. the paper's own mechanisms, when left out of the
-model) cannot be added at a fitted size, so it is listed as not testable.
-
-Signature: the change of the replayed torque per unit strength, taken from the model with
-the candidate at strength zero to the model at a probe strength. The probe is scaled (one or
-two extra replays) so that it changes the torque by a few noise floors RMS: well above the
-integrator's noise and still in the nearly linear range. In the weighted units of the
-residuals it is the column ``w`` of a Jacobian. A candidate that even at its largest
-strength moves the replayed torque by less than a tenth of a noise floor is unobservable in
-these data as replayed (a lash between pinion and rack is: with the rack's motion given, the
-torque the rack needs does not depend on the play the hand turned through before it moved;
-the play shows against the handwheel angle instead, which a diagnosis with the angle fits as a
-second signal, :attr:`parksteer.diagnose.settings.DiagnosisSettings.use_handwheel_angle`). It scores
-zero and is listed as such. With the angle, a signature and its probe's change are in both signals,
-an angle change counted in torque floors per angle floor (:meth:`parksteer.diagnose.problem.Problem.
-in_torque_floors`).
-
-Score test (Rao): at the calibrated base model, with weighted residual ``r`` and the
-calibrated parameters' sensitivities ``J``, the part of ``w`` that a change of those
-parameters could also produce is projected out, ``w~ = (I - J (J^T J)^-1 J^T) w``. Then
-``u = w~ . r`` is the score; the linear estimate of the strength is ``u / |w~|^2`` and the
-weighted sum of squares it removes is ``u^2 / |w~|^2``. The statistic
-``u^2 / (|w~|^2 s^2)``, with s^2 the residual variance per sample, is chi-square with one
-degree of freedom when the candidate is absent. Strengths are physical sizes that cannot be
-negative: a candidate whose score asks for a negative strength scores zero.
-``|w~| / |w|`` is how much of the signature survives the projection: near zero, the
-candidate is confounded with the calibrated parameters (these data cannot tell it from a
-change of them), and it is reported so.
+A candidate is any registered effect (:mod:`parksteer.model.symbolic.components`) that is not in the model and has
+a strength: the parameter named ``strength``, else the only one whose default is zero and whose range starts at
+zero; one without it is listed as not testable. Its signature is the change of the replayed torque (and, with
+:attr:`parksteer.diagnose.settings.DiagnosisSettings.use_handwheel_angle`, of the angle, counted in torque floors
+per angle floor: :meth:`parksteer.diagnose.problem.Problem.in_torque_floors`) per unit strength, from a probe
+scaled to a few noise floors RMS; one that moves the torque by less than a tenth of a floor at its largest strength
+is unobservable and scores zero. The score test (Rao) projects the calibrated parameters' sensitivities out of the
+signature and gives the linear strength, the weighted sum of squares it removes and a chi-square statistic of one
+degree of freedom; a negative strength scores zero, and a signature that barely survives the projection is reported
+confounded with the calibrated parameters. The test's formulas: docs/diagnosis.md, "Candidates and the score test".
 """
 
 from __future__ import annotations

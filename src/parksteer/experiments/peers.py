@@ -1,41 +1,19 @@
 """The diagnosis against its peers: sparse regression of the calibrated residual, on the same records.
 
-A user who has a calibrated model and its residual might not run :func:`parksteer.diagnose.select.diagnose`'s
-score test, refits and BIC at all, and reach instead for one of two common tools:
-
-- **STLSQ** (sequentially thresholded least squares, PySINDy's ``STLSQ`` optimizer): regress the residual on a
-  library of terms, drop every term whose coefficient is below a threshold, regress again on what is left, until
-  nothing changes;
-- **FROLS** (forward regression with orthogonal least squares, SysIdentPy's method): rank the terms by their error
-  reduction ratio (ERR, the share of the residual's sum of squares each explains once orthogonalised against the
-  terms already taken), and stop at the minimum of an information criterion (AIC or BIC). SysIdentPy 0.9.0 requires
-  ``numpy<=2.3.5`` and does not install beside the project's numpy 2.4.6 (requirements/pipeline.lock), so
-  :func:`~.peer_methods.frols` is this project's own implementation of the same algorithm (its ERR and its criteria
-  as SysIdentPy computes them), not SysIdentPy.
-
-Both get what the diagnosis has (:func:`~.peer_methods.record_library`, from one
-:class:`~parksteer.diagnose.select.Diagnosis`): the calibrated base model's weighted residual ((measured - model) /
-sigma, sigma the attainable error the diagnosis weights by, so a model at the noise floor leaves RMS 1), and a
-library of weighted terms, each scaled to RMS 1 so that a coefficient is the term's RMS contribution in noise
-floors:
-
-- generic terms built from the record (each file's smoothed rack at the replay's instants): a constant, the
-  smoothed sign of the rack speed (``tanh`` with the model's own friction smoothing), the rack speed, the speed
-  magnitude, the rack position x, x^2, x^3, |x| x, and sin and cos of one and two times the column angle (rack
-  position times the handwheel-to-rack ratio); where the diagnosis fits the handwheel angle too, each generic term
-  again on the angle's rows (named ``angle:...``);
-- each observable candidate's own signature, the weighted sensitivity the diagnosis scores
-  (:attr:`parksteer.diagnose.candidates.Signature.weighted`), named by its effect.
-
-Their answers map onto the diagnosis's verdicts (:func:`~.peer_methods.verdict_of`): nothing selected is
-``adequate``; a selected candidate signature is ``missing`` that candidate (the one with the largest contribution:
-coefficient for STLSQ, ERR for FROLS); only generic terms selected is ``unexplained``. The peers regress the
-residual as it is: unlike the score test they do not project the calibrated parameters' sensitivities out of the
-terms, and they say nothing about a candidate's sign (a strength that would be negative is still a selected term).
-Each peer's setting is tuned over its grid, :data:`~.peer_methods.STLSQ_SETTINGS` (threshold and ridge) and
-:data:`~.peer_methods.FROLS_SETTINGS` (criterion and ERR tolerance), on records of another seed
-(:func:`~.peer_scoring.tune`), and scored with the best setting on the benchmarks' records
-(:func:`~.peer_scoring.score_method`)."""
+Two common tools a user with a calibrated model and its residual might reach for instead of
+:func:`parksteer.diagnose.select.diagnose`: **STLSQ** (sequentially thresholded least squares, PySINDy's
+optimizer) and **FROLS** (forward regression with orthogonal least squares, SysIdentPy's method;
+:func:`~.peer_methods.frols` is this project's own implementation, since SysIdentPy 0.9.0 does not install beside
+the project's numpy, requirements/pipeline.lock). Both regress the calibrated base model's weighted residual (noise
+floors) on a library (:func:`~.peer_methods.record_library`) of generic terms of the record, each scaled to RMS 1,
+and of each observable candidate's weighted signature
+(:attr:`parksteer.diagnose.candidates.Signature.weighted`). Their answers map onto the diagnosis's verdicts
+(:func:`~.peer_methods.verdict_of`): nothing selected is ``adequate``, a selected candidate is ``missing`` that one,
+generic terms alone ``unexplained``. Each peer's setting is tuned over :data:`~.peer_methods.STLSQ_SETTINGS` or
+:data:`~.peer_methods.FROLS_SETTINGS` on records of another seed (:func:`~.peer_scoring.tune`) and scored on the
+benchmarks' records (:func:`~.peer_scoring.score_method`). The library, the settings and the results:
+docs/peers.md.
+"""
 
 from __future__ import annotations
 

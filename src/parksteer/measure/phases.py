@@ -1,48 +1,14 @@
 """Split a steering cycle into its phases, from the rack motion and the handwheel torque.
 
-The cycle (Section 3): from straight ahead to one lock, to the other lock, back to straight
-ahead. Each sample gets exactly one label:
-
-``initial_rise``
-    from the first sample until the rack starts moving steadily: the hand works against rack
-    friction (and the column winds up) before the rack moves.
-``wind_up``
-    the start of each stroke (after the initial rise, and after each reversal) until the
-    torque has covered ``windup_fraction`` (90 %) of its change from the stroke's starting
-    torque to the stroke's plateau level: the tyre carcasses twist before the tread slides.
-    On air bearings the tyres turn freely, so there is no carcass wind-up and no such phase.
-``plateau``
-    the rest of each stroke: the tread slides and the torque levels off (it still rises
-    slowly with the lifting effect and carries the Hooke joint ripple).
-``reversal``
-    a short window around each change of rack direction: the samples where the rack is not
-    moving steadily between two strokes of opposite direction, widened to at least
-    ``reversal_half_width_s`` either side of the turning point. The torque drop of the
-    reversing rack friction falls inside it.
-``return``
-    the sliding part of the final stroke when that stroke heads back to straight ahead (what
-    would otherwise be its plateau), and any rest after it.
-
-How the pieces are found, robustly for noisy, quantised data:
-
-- Rack velocity is the slope of a local straight-line fit over ``smoothing_s`` (0.5 s), which
-  averages out quantisation steps and noise and works for uneven sampling. The rack moves
-  steadily where its speed exceeds ``moving_fraction`` (20 %) of the typical speed (the 90th
-  percentile of the speed over the record), in the direction of the velocity's sign. Runs of
-  motion shorter than ``min_stroke_s`` (1 s) are jitter, not strokes; consecutive runs in the
-  same direction are one stroke (a pause of the hand).
-- The turning point of a reversal is the extreme of the smoothed rack between two strokes of
-  opposite direction.
-- The torque is smoothed by a running median over ``torque_smoothing_s`` (0.3 s), which keeps
-  the sharp drop at a reversal sharp. A stroke's starting torque is the smoothed torque at its
-  first sample; its plateau level is the median smoothed torque over the last
-  ``plateau_travel_fraction`` (25 %) of its rack travel. The wind-up ends at the first sample
-  whose smoothed torque has covered 90 % of the change between the two. (A rack-travel rule
-  would borrow the carcass stiffness from the model; this rule reads the data alone, so it
-  can show where the model's wind-up is wrong.)
-
-Boundaries found from smoothed data sit within about a quarter of the smoothing window of
-the true ones.
+The cycle (Section 3) runs from straight ahead to one lock, to the other, back to straight ahead; each sample gets
+exactly one label: ``initial_rise`` (before the rack moves steadily), ``wind_up`` (each stroke's start, until the
+torque has covered ``windup_fraction`` of its change to the stroke's plateau; none on air bearings), ``plateau``
+(the rest of the stroke), ``reversal`` (around each change of rack direction, at least ``reversal_half_width_s``
+either side of the turning point) and ``return`` (the sliding part of a final stroke back to straight ahead, and any
+rest after it). The phases are read from the data alone, robustly for noisy, quantised and unevenly sampled records:
+the rack's speed from local straight-line fits over ``smoothing_s``, the torque from a running median over
+``torque_smoothing_s``; durations in seconds. Boundaries sit within about a quarter of the smoothing window of the
+true ones. The rules and their settings: docs/measurement.md, "The cycle's phases".
 """
 
 from __future__ import annotations

@@ -1,31 +1,16 @@
 """A measured rack as a motion the model can follow: position, speed and acceleration at any time.
 
-Why smooth: the rack of an 8-bit logger moves in steps of 2 full_scale / 255 (0.8 mm for a +-0.1 m range). Replayed
-as it stands (through an interpolating spline, :func:`~parksteer.measure.rack_spline.interpolate_rack`), every step
-is a jump in position, so the rack's speed and acceleration (which a prescribed-rack model differentiates) are
-spikes, and the rack friction's tanh flips at every step: the replayed torque is then wrong by several N m. The
-rack is therefore replaced by a least-squares cubic spline (:func:`smooth_rack`; the fit and its settings:
-:mod:`parksteer.measure.rack_fit`) with evenly spaced knots and one knot at each reversal. The spacing is the
-largest that still fits the rack to within its own noise (estimated, as for the torque, from second differences;
-the discrepancy principle), inside a range the cycle sets: closer knots follow the noise, and the spline's speed
-then crosses zero where the rack never reverses, which flips the rack friction; wider ones cannot follow the hand
-through a reversal. Each end of the record is held at rest unless the data contradict it, so that a record starting
-from rest gets no spurious starting speed.
-
-What smoothing cannot fix: near a reversal the rack speed passes through zero, and the rack
-friction force, F tanh(beta v), turns over within about 1 mm/s of it (a few hundredths of a
-second). The rack data fix the turning time only to a few hundredths of a second, so a replay is
-least certain there. :meth:`SmoothedRack.perturbed` and :meth:`SmoothedRack.resmoothed` give
-other racks the data allow as well; :mod:`parksteer.diagnose.problem` replays them to measure
-that uncertainty at every sample. Nor do the data fix how the rack eases into and out of a turn: within a tenth
-of a second of it the rack moves by less than a converter step or its noise, so there the spline's speed follows
-its knots, and every spacing that passes the discrepancy test (``SmoothedRack.passing_spacings_s``) is as
-consistent with the data as the one kept; the replay's uncertainty smooths at each of them
-(:func:`parksteer.diagnose.ensemble.ensemble_sources`). A rack rounded more coarsely than its noise (one derived
-from a bus's handwheel angle) hides a motion of up to a step wherever it is slow; :func:`rounding_draw` adds one.
-
-Every rack here is a :class:`~parksteer.measure.rack_spline.RackSpline` (a piecewise polynomial: ``breaks``, ``coefficients``, ``start_s`` and
-``end_s``), the rack motion :func:`parksteer.model.numeric.prescribed.solve` takes.
+:func:`smooth_rack` replaces a quantised, noisy rack by a least-squares cubic spline (the fit and its settings:
+:mod:`parksteer.measure.rack_fit`) with evenly spaced knots and one at each reversal, the spacing the largest that
+fits the rack within its own noise (the discrepancy principle), each end held at rest unless the data contradict
+it: replayed as it stands, a converter's steps make the speed and acceleration spikes and flip the rack friction.
+:meth:`SmoothedRack.perturbed` and :meth:`SmoothedRack.resmoothed` give other racks the data allow as well, and
+``SmoothedRack.passing_spacings_s`` every spacing that passes the discrepancy test, for the replay uncertainty
+(:mod:`parksteer.diagnose.problem`, :func:`parksteer.diagnose.ensemble.ensemble_sources`); :func:`rounding_draw`
+adds the motion a coarsely rounded rack hides. Every rack here is a
+:class:`~parksteer.measure.rack_spline.RackSpline` (``breaks``, ``coefficients``, ``start_s``, ``end_s``; metres and
+seconds), the rack motion :func:`parksteer.model.numeric.prescribed.solve` takes. Why and what smoothing cannot fix:
+docs/measurement.md, "The smoothed rack".
 """
 
 from __future__ import annotations

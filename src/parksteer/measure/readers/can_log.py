@@ -1,34 +1,16 @@
 """Raw CAN bus logs, decoded with the car's DBC: SocketCAN ``candump -l`` logs, Vector ASC and BLF, PCAN TRC and
-ASAM MDF4 bus logging (frames in ``CAN_DataFrame`` channels, as CAN-to-SD loggers write them), read through the
-optional python-can's log readers (its MDF4 reader through asammdf) and decoded with cantools
-(``pip install 'parksteer[bus]'``; imported only when a bus log is read).
+ASAM MDF4 bus logging (frames in ``CAN_DataFrame`` channels), read through the optional python-can's log readers
+(its MDF4 reader through asammdf) and decoded with cantools (``pip install 'parksteer[bus]'``; imported only when
+a bus log is read).
 
-A bus log holds frames, not channels: which signals become which native columns is the channel map's
-(``--map 'LH_EPS_03.EPS_Lenkmoment[cN*m]=-handwheel_torque_Nm;sign=LH_EPS_03.EPS_VZ_Lenkmoment'``, or a
-ready map of ``parksteer/data/buses/NAME.toml`` through ``--bus NAME``), so this reader decodes only the mapped
-signals, each on the time stamps of its own message's frames. :func:`parksteer.measure.importers.load_record`
-then puts them on one time base as it does an MDF file's channels: the torque message's frames, the others
-interpolated linearly. A value so interpolated is read from frames at most half its message's period away; for a
-smooth signal linear interpolation adds no lag of its own, but the value is only as fresh as those frames (the
-metadata ``bus_time_base`` states the periods).
-
-What a bus does to data is checked frame by frame, each finding a note on stderr and in the metadata
-``bus_checks``, or a refusal in one line when the record cannot be trusted:
-
-- time stamps that go back are refused (the logger's clock jumped); an exact duplicate of the previous frame of
-  a message (same time stamp, or same counter and data) is dropped and counted;
-- the counter (``COUNTER`` or ``..._BZ``): a jump of more than one is frames lost, named with its time;
-- the checksum (``CHECKSUM`` or ``..._CRC``), where the bus file names its algorithm (VW MQB: AUTOSAR E2E
-  profile 2): a failing frame is dropped; more than :data:`MAX_BAD_SHARE` failing is refused (not this bus or not
-  this car's DBC). With a DBC alone the checksum is not checked, and the metadata says so;
-- the quality bit of a signal (``..._QBit`` of the same message, e.g. ``EPS_Lenkmoment_QBit``): a frame whose bit
-  is set carries a substitute value and is dropped;
-- gaps: a message's frames further apart than 1.5 of its period are frames lost (noted with their times); a gap
-  longer than :data:`MAX_GAP_S` is refused, and one where no frame at all is on the bus is named a bus-off or
-  logger pause;
-- a signal at its largest raw value is saturated (the torque beyond it is lost): refused;
-- a named message without any frame in the log (another bus, or another car's DBC) is one line naming the
-  message and the log's most frequent ids.
+The channel map (``--map`` or ``--bus NAME``, ``parksteer/data/buses/NAME.toml``) says which signals become which
+native columns; only those are decoded, each on the time stamps of its own message's frames, and
+:func:`parksteer.measure.importers.load_record` puts them on one time base (metadata ``bus_time_base``). Time
+stamps, duplicates, counters, checksums (where the bus file names the algorithm), quality bits, gaps and saturation
+are checked frame by frame: each finding is a note on stderr and in the metadata ``bus_checks``, or a one-line
+refusal when the record cannot be trusted (more than :data:`MAX_BAD_SHARE` failing checksums, a gap longer than
+:data:`MAX_GAP_S` seconds, a saturated signal, a time stamp going back, a mapped message without frames). The
+checks, one by one: docs/bus.md.
 """
 
 from __future__ import annotations
