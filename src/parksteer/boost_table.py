@@ -1,26 +1,17 @@
 """A boost table: the assist against torsion-bar torque as points, one row per vehicle speed, and its slopes.
 
 A vehicle file's ``[assist.boost]`` gives torsion-bar torques T_0 = 0 < T_1 < ... (N m) and, for each vehicle speed
-v_r (one row without ``vehicle_speed``), the assist at the point of action A_r,0 = 0 <= A_r,1 <= ... (N m at the
-column or pinion, N at the rack). Between the points the law is the monotone cubic Hermite interpolant of
-Fritsch and Carlson (SIAM J. Numer. Anal. 17, 238, 1980) with the slopes of its usual implementation (the weighted
-harmonic mean of the neighbouring secants inside, a one-sided three-point formula at the last point; as SciPy's
-PchipInterpolator), so that it is monotone wherever the points are and C1 everywhere. The law is odd in the torque:
-the point T_0 = 0 takes the slope of a row mirrored through the origin (its secant, or 0 after a flat segment).
-Where two neighbouring points carry the same assist the interpolant is flat between them, and a flat segment's end
-slopes are zero: points (0, 0), (D, 0) give a law exactly zero for |T| <= D (the dead band) that leaves it with a
-zero slope, with no corner. Beyond the last point the law goes on as a straight line with the last point's slope
-(the motor's limit bounds it). A table of two points (0, 0), (T_1, A_1) is the straight line A_1 / T_1 T exactly.
+(one row without ``vehicle_speed``), the assist at the point of action A_r,0 = 0 <= A_r,1 <= ... (N m at the column
+or pinion, N at the rack). The law is the monotone cubic Hermite interpolant of Fritsch and Carlson (SIAM J. Numer.
+Anal. 17, 238, 1980) with SciPy's PchipInterpolator's slopes, odd in the torque, exactly zero in a dead band of two
+zero points, a straight line with the last slope beyond the last point; a two-point table is a straight line.
 
 The effect reads the table as scalar quantities of fixed count (the generated code's parameter vector has a fixed
 layout): :data:`MAX_POINTS` torques, :data:`MAX_SPEEDS` speeds, an assist and a slope per speed and point, 552
-scalars, consecutive in the parameter vector in :func:`table_keys` order. A shorter table is padded: torques beyond
-the last continue in steps of :data:`PAD_STEP_NM` with the straight continuation's values and slope (the same law),
-speeds beyond the last in steps of :data:`PAD_STEP_MPS` with the last row again. The law itself (segment choice,
-Hermite basis, linear interpolation in speed) is in :mod:`parksteer.model.symbolic.effects.assist_common`, one
-definition for the generated C and the replay: the model's expressions hold it as one function node, and the
-generated C calls one function printed from that definition (``parksteer.model.codegen.generate``), so a map of
-production size costs the cold build little (``benchmarks/bench_codegen.py``, model ``assist_column``).
+scalars, consecutive in :func:`table_keys` order. A shorter table is padded: torques beyond the last in steps of
+:data:`PAD_STEP_NM` on the straight continuation, speeds beyond the last in steps of :data:`PAD_STEP_MPS` with the
+last row again. The law itself is in :mod:`parksteer.model.symbolic.effects.assist_common`, one definition for the
+generated C and the replay (docs/assist.md, "Boost tables").
 """
 
 from __future__ import annotations

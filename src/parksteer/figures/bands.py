@@ -1,35 +1,13 @@
 """Bands on the headline numbers: each number the paper quotes, over the reconstructed inputs.
 
-The model's headline numbers rest on inputs the source does not give and this project reconstructed or chose
-(the parameter file says which). Each such input is moved one at a time over its plausible range, through the
-parameter registry's overrides (values only: the compiled model is the figures' own, nothing is re-derived),
-and every headline number is recomputed from the simulated cycles:
-
-* Hooke joint phase: any column angle for the input yoke, eight phases over a full turn;
-* handwheel lock angle: +-10 % about the reconstructed two turns each way;
-* wheel radius: the Table 1 rig tyre's 0.263 m rolling radius to the 0.30 m of the Appendix B heights
-  (ground and roll axis moved together; the ground scrub changes sign between them);
-* mass centre of each steering assembly: on the king-pin axis (the choice) to the wheel centre;
-* the axis of the tyre's friction moment: the ground normal (the model) or the steer axis;
-* saw-tooth rounding: 0.2-0.8 s about the chosen 0.4 s.
-
-The headline numbers (all of the unladen car on the ground unless named otherwise):
-
-* plateau and near-lock torque as the figures quote them (:func:`parksteer.figures.model.cycle_summary`);
-* rise toward lock: near-lock torque minus plateau;
-* reversal step: the rack-friction step measured where it happens, the handwheel torque change while
-  tanh(beta v) of the rack speed passes from +0.99 to -0.99 at right lock
-  (:func:`parksteer.figures.model.reversal_step`), not the
-  torque 0.2 s either side of the lock, which adds the carcasses' unwinding;
-* the plateau share of tyre friction, rack friction and lifting, and lifting's share near lock;
-* offset effect: the plateau with the 68.5 mm spacer over the standard plateau, minus one;
-* A1 against the simulation: the lifting share of the air-bearing run over equation (A1) at the same steer
-  angle carried through the Hooke joint's speed ratio, minus one, over the plateau window (the comparison that
-  holds, :func:`a1_deviation`); and the air-bearing torque over A1 as Fig. 16 against Fig. A3 plot them;
-* part-laden rise: the part-laden plateau over the unladen plateau, minus one;
-* ground scrub radius at straight ahead (geometry alone, the sign convention of
-  :meth:`parksteer.geometry.SteerAxis.scrub_radius_m`); the wheel radius moves nothing else the model computes
-  with the wheel free to roll.
+The model's headline numbers rest on inputs the source does not give and this project reconstructed or chose (the
+parameter file says which). Each such input (the Hooke joint's phase, the handwheel lock angle, the wheel radius,
+each steering assembly's mass centre, the axis of the tyre's friction moment, the saw-tooth rounding) is moved one
+at a time over its plausible range through the parameter registry's overrides (values only: the compiled model is
+the figures' own, nothing is derived again), and every headline number (plateau and near-lock torque, rise,
+reversal step, shares, offset effect, A1 against the simulation (:func:`a1_deviation`), part-laden rise, ground
+scrub radius) is recomputed from the simulated cycles. The ranges and the numbers' definitions: docs/model.md,
+"Bands over the reconstructed inputs".
 """
 
 from __future__ import annotations

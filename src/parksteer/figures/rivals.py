@@ -1,30 +1,13 @@
 """Rivals of lifting: which of the paper's tests tells each from lifting, and which cannot.
 
-The model attributes the handwheel torque's rise toward lock partly to lifting: the car is raised through the
-steering geometry, and the work shows as a torque that grows with the steer angle, with the wheel load and with
-the king-pin offset (equation A1). Each rival effect of the library (one file each under
-:mod:`parksteer.model.symbolic.effects`, with its physics and provenance) could add a torque near lock of the
-same size in the standard test. Here each rival is given the strength that makes the rise toward lock it adds
-(its added torque near lock minus its added torque over the plateau) in the unladen test on the ground equal to
-lifting's (a secant search on the strength, from the rival's own probe, within the strength's bounds), and the
-four tests of the source are then simulated with it:
-
-* unladen, on the ground (the test the strength is matched in);
-* part laden, on the ground (the wheel loads change);
-* unladen, on air bearings (no tyre-to-ground friction);
-* unladen with the 68.5 mm spacers, on the ground (the king-pin offset changes).
-
-The rise is compared rather than the torque near lock, because a uniform added torque (a friction that does not
-grow toward lock) is absorbed by the calibrated rack friction and says nothing about lifting. A rival's added
-torque in a test is the difference of the cycle with the rival and without it (lifting's: its own term of the
-handwheel torque). The rival is added to the paper's model, lifting kept: for a rival of this size the
-difference is nearly the rival's own torque (superposition holds to the cross terms, which the rival changes
-through the wheel loads and the steer motion). A rival whose rise at its probe strength is a small fraction of
-lifting's does not rise toward lock and cannot stand in for it (``no rise``); one that cannot reach lifting's
-rise within its bounds is reported ``at bound``. The test that separates a matched rival from lifting is the one
-where their rises differ most; the source's tests could tell them apart when that difference is more than one
-step of the source's 8-bit torque converter (the parameter file's ``synthetic`` full scale and bits), the
-smallest change its logger could show.
+Each rival effect of the library (:mod:`parksteer.model.symbolic.effects`) is matched to lifting's rise toward lock
+(near-lock torque less plateau, N m) in the unladen test on the ground by a secant search on its strength within its
+bounds, then simulated in the source's four tests (unladen and part laden on the ground, unladen on air bearings,
+unladen with the 68.5 mm spacers), added to the paper's model with lifting kept. A rival that does not rise is
+reported ``no rise``, one that cannot reach lifting's rise ``at bound``; the test where the rises differ most
+separates it from lifting when the difference exceeds one step of the source's 8-bit torque converter (the
+parameter file's ``synthetic`` full scale and bits). Why the rise and how the search runs: docs/model.md, "Rivals
+of lifting".
 """
 
 from __future__ import annotations

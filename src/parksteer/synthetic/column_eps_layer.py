@@ -1,31 +1,18 @@
 """The assisted truth's column-EPS layer over the manual road (:mod:`parksteer.synthetic.assisted_truth`), solved
-quasi-statically at every instant of the fine grid:
+quasi-statically at every instant of the fine grid.
 
-- the column: the pinion follows the rack (theta_p = G_hr x), the column angle is the Hooke joint's inverse of it
-  (:func:`~parksteer.synthetic.assisted_truth.column_of_pinion`), its rate and acceleration by differences on the
-  fine grid;
-- the torsion bar carries T_s; its sensor reads S = T_s + o (o: a zero offset) on the logger's converter (the bus
-  carries the sensor's own value: the control unit reads the same steps);
-- the control unit: the assist the map asks for at the column, A_map(S)
-  (:class:`~parksteer.synthetic.assisted_truth.TruthMap`: a progressive power law c (|S| - d)^p beyond a dead band
-  d, or an exponential family c (exp((|S| - d)/w) - 1), odd in S; neither is the model's monotone cubic table),
-  times 1 + e (a gain error), turned into the motor's current through the data sheet's numbers, I = A_map / (eta_f N
-  k_t), clipped at the current limit;
-- the motor and the worm: the motor's electromagnetic torque k_t I less its loads (the rotor's inertia J_m N
-  theta_c'', a Coulomb friction saturated linearly below ``friction_speed_rad_s`` of the rotor) is the torque o the
-  worm transmits; the column receives eta_f N o when the motor drives it (o and the column's rate of one sign)
-  and N o / eta_b when the column drives the motor (back-driven), the factor passing linearly through 1 as the
-  rotor slows to rest (a worm at rest loses no power);
-- the balance T_s + D(o(T_s)) = T_road, with T_road the manual replay's column torque. The left side rises with
-  T_s (a staircase, the sensor's steps, plus T_s itself): the torsion-bar torque is where it first reaches
-  T_road; where T_road falls inside a step's jump, T_s sits at the step's edge and the control unit dithers
-  between the two levels, the delivered torque their mean (T_road - T_s) and the current the mean that delivers
-  it. The control unit filters its reading's noise (out of the mechanics' band): the logged channel carries the
-  noise, the loop does not.
-
-The handwheel angle (the angle-only tier: a bus log has no rack) is the column's plus the twist that passes T_s
-through the torsion bar in series with the column shaft, with the column's own damping time constant (the file's
-column law; :func:`parksteer.geometry.column_twist`).
+The pinion follows the rack and the column the pinion through the Hooke joint
+(:func:`~parksteer.synthetic.assisted_truth.column_of_pinion`); the torsion bar carries T_s (N m), read by its sensor
+as S = T_s + o on the logger's converter; the control unit asks its map
+(:class:`~parksteer.synthetic.assisted_truth.TruthMap`, a progressive power law or an exponential family beyond a
+dead band, odd in S, neither the model's cubic table), times 1 + e (a gain error), for the current
+I = A_map / (eta_f N k_t) (A), clipped at the limit; the motor's torque less its rotor's inertia and Coulomb friction
+(saturated linearly below ``friction_speed_rad_s``) reaches the column as eta_f N o driving and N o / eta_b
+back-driven, passing linearly through 1 at rest. T_s is where T_s + D(o(T_s)) first reaches the manual replay's
+column torque T_road; inside a sensor step's jump it sits at the step's edge and the unit dithers between the two
+levels. The loop does not see the logged noise. The handwheel angle is the column's plus the torsion bar's twist in
+series with the column shaft (:func:`parksteer.geometry.column_twist`). The truth and its numbers:
+docs/assist_diagnosis.md, "An independent truth of an assisted car".
 """
 
 from __future__ import annotations

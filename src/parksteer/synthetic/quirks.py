@@ -1,29 +1,16 @@
 """Manual cars the model does not fit: every record carries a quirk of the car's own, outside the library.
 
-The out-of-library forms of :mod:`.outoflibrary` are effects of the model, derived and replayed by it. A quirk here
-is written apart from the model, as a layer over the manual replay (the prescribed-rack solve of the car,
-:func:`parksteer.model.numeric.simulate.simulate`, on the rack a hand drives: :func:`manual_road`), in the way the
-column EPS of :mod:`.assisted_truth` is. The replay gives the column torque ``T`` the car needs, its column angle,
-its rack speed, its mean steer angle and the tyre's share of ``T``; each quirk then changes what the logger sees:
-
-- ``bore_friction`` (:class:`BoreFriction`): a rack friction that depends on the rack's position and on its
-  direction, ``F = S (0.55 + 0.45 (x / 65 mm)^2) d(v) (1 + 0.3 d(v))``, ``d(v) = v / sqrt(v^2 + v0^2)`` with
-  v0 = 2 mm/s (a bore worn toward the ends, a seal that drags more one way; its own smoothing, not the model's
-  tanh), at the column through the pinion and the Hooke joint, ``dx/dtheta_c``;
-- ``joint_phasing`` (:class:`JointPhasing`): a second universal joint on an intermediate shaft at angle ``S`` (rad)
-  whose yokes are out of phase by 0.9 rad: the handwheel carries ``T`` times the joint's speed ratio
-  ``cos S / (1 - sin^2 S sin^2(theta_c - 0.9))``, periodic at twice the column angle;
-- ``dahl_tyre`` (:class:`DahlTyre`): a tyre moment of another shape: a share ``S`` of the tyre's part of ``T`` is
-  replaced by Dahl's hysteresis in the mean steer angle, ``dM/d delta = (M_s / delta_0) (1 - M sgn(d delta) /
-  M_s)^2`` with M_s = 12 N m at the handwheel and delta_0 = 0.05 rad (a smooth approach to sliding where the model
-  has a carcass spring and a friction limit);
-- ``tie_rod_compliance`` (:class:`TieRodCompliance`): a tie-rod joint's bush that stiffens as it is loaded: the
-  wheels follow the rack less ``u = S F / sqrt(F^2 + F_1^2)`` (S its travel in m, F_1 = 1500 N, F the rack's
-  force ``T dtheta_c/dx``); the replay drives the wheels' rack, the logger reads the rack itself.
-
-The quirk's strength ``S`` is the car's: one value for every record of the car (:func:`quirk_strength` sizes it
-on the car's healthy record). Hidden library effects on later records enter the replay (``effects``,
-``overrides``), under the quirk.
+A quirk is written apart from the model, as a layer over the manual replay (the prescribed-rack solve,
+:func:`parksteer.model.numeric.simulate.simulate`, on the rack a hand drives: :func:`manual_road`), which gives the
+column torque ``T`` (N m) the car needs, its column angle, rack speed, mean steer angle and the tyre's share of
+``T``; each quirk changes what the logger sees: ``bore_friction`` (:class:`BoreFriction`, a rack friction growing
+toward the ends and stronger one way, N), ``joint_phasing`` (:class:`JointPhasing`, a second universal joint out
+of phase by its angle in rad), ``dahl_tyre`` (:class:`DahlTyre`, a share of the tyre's moment in Dahl's hysteresis
+of the steer angle) and ``tie_rod_compliance`` (:class:`TieRodCompliance`, tie-rod bushes stiffening with load: the
+wheels lag the logged rack by a travel in m that saturates). Each class holds its form and constants. The quirk's
+strength is the car's, one value for every record (:func:`quirk_strength` sizes it on the healthy record); hidden
+library effects on later records enter the replay (``effects``, ``overrides``), under the quirk. The benchmark:
+docs/diagnosis.md, "Cars the model does not fit".
 """
 
 from __future__ import annotations
