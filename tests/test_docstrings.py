@@ -37,14 +37,8 @@ EXCEPTIONS: dict[str, tuple[int, str]] = {
     "parksteer/model/symbolic/system.py": (409, STALES_PRE_DERIVED),
     "parksteer/synthetic/outoflibrary.py": (398, KEYS_OUT_OF_LIBRARY_MODELS),
     "parksteer/model/symbolic/effects/turn_slip.py": (385, STALES_PRE_DERIVED),
-    "parksteer/model/numeric/prescribed.py": (371, NOT_YET_CUT),
     "parksteer/model/symbolic/effects/carcass_hysteresis.py": (365, STALES_PRE_DERIVED),
-    "parksteer/experiments/assisted_truth.py": (353, NOT_YET_CUT),
     "parksteer/diagnose/suggest.py": (343, NOT_YET_CUT),
-    "parksteer/measure/metrics.py": (341, NOT_YET_CUT),
-    "parksteer/diagnose/stages/assumed.py": (339, NOT_YET_CUT),
-    "parksteer/diagnose/ensemble.py": (337, NOT_YET_CUT),
-    "parksteer/experiments/assisted_benchmark.py": (326, NOT_YET_CUT),
     "parksteer/diagnose/calibrate.py": (319, NOT_YET_CUT),
     "parksteer/experiments/baseline.py": (319, NOT_YET_CUT),
     "parksteer/portable/__init__.py": (311, NOT_YET_CUT),
@@ -66,7 +60,6 @@ EXCEPTIONS: dict[str, tuple[int, str]] = {
     "parksteer/model/symbolic/components.py:Effect": (258, STALES_PRE_DERIVED),
     "parksteer/synthetic/quirk_eps.py": (254, NOT_YET_CUT),
     "parksteer/figures/assist_creep.py": (253, NOT_YET_CUT),
-    "parksteer/diagnose/ensemble.py:ensemble_sources": (252, NOT_YET_CUT),
 }
 
 # Phrases that tell how the code or a number changed: "was 1.3 N m off", "as before", "previously", "no longer",

@@ -1,28 +1,17 @@
 """The replay ensemble: how far the replay alone can be off at each sample.
 
-The replay uncertainty is found by propagation, not assumed: the smoothed rack is one
-spline among many the rack data allow equally well. When the file states its logger (the
-rack's full scale and bits), the smoothed rack is logged again (analog noise, rounding to
-the converter's levels) and smoothed again, a few times
-(:func:`relogged_rack`, a parametric bootstrap of the
-whole logging and smoothing); otherwise splines are drawn from the least-squares
-distribution of the coefficients, as if the rack noise were white
-(:meth:`parksteer.measure.smoothing.SmoothedRack.perturbed`). The draws start from the rack smoothed at each
-knot spacing the data allow (:func:`ensemble_sources`), not from the chosen spline alone: at a reversal the
-spacing, not the data, sets how the spline eases through zero speed. A rack whose rounding is coarser than its
-noise and not dithered by it (one derived from a bus's handwheel angle: ``FileData.rack.rest_resolution_m``) is
-relogged to the same levels at every draw, so each draw also moves it within its rounding where it is slow
-(:func:`parksteer.measure.smoothing.rounding_draw`). Replaying them and taking the
-spread of the torque at each sample gives how far the replay alone can be off there (where the
-smoothing held an end of the record or a pause of the hand at rest, every other draw leaves
-them free: a record cut while the hand is still slowing passes the smoothing's rest test, the
-edges of a pause are not sharp, and the rack friction there hangs on that choice). It is tiny on the
-plateaus and large at a reversal, where the rack friction flips within about a millimetre
-per second of zero speed, so the turning time the data allow decides which sample carries
-the torque drop. Each sample then has an attainable error ``sigma_i = sqrt(noise_floor^2 +
-delta_i^2)``; residuals are weighted by it (``(measured - model) / sigma_i``), so a fit
-listens to the samples the replay can predict, and a perfect model has weighted residuals
-of unit variance.
+The smoothed rack is one spline among many the rack data allow equally well. When the file states its logger (the
+rack's full scale and bits), the smoothed rack is logged again (analog noise, rounding to the converter's levels) and
+smoothed again a few times (:func:`relogged_rack`, a parametric bootstrap of the logging and smoothing); otherwise
+splines are drawn from the least-squares distribution of the coefficients
+(:meth:`parksteer.measure.smoothing.SmoothedRack.perturbed`). The draws start from the rack smoothed at each knot
+spacing the data allow (:func:`ensemble_sources`); a rack rounded more coarsely than its noise
+(``FileData.rack.rest_resolution_m``) is moved within its rounding where it is slow
+(:func:`parksteer.measure.smoothing.rounding_draw`); where the smoothing held an end or a pause at rest, every other
+draw leaves it free. The spread of the replayed torque at each sample is delta_i (N m), small on the plateaus and
+large at a reversal; each sample's attainable error is ``sigma_i = sqrt(noise_floor^2 + delta_i^2)``, and residuals
+are weighted by it, so a perfect model has weighted residuals of unit variance. Why: docs/diagnosis.md and
+docs/measurement.md, "The smoothed rack".
 """
 
 from __future__ import annotations
@@ -112,19 +101,13 @@ def _spread(runs: np.ndarray, before: np.ndarray | None) -> np.ndarray:
 def ensemble_sources(f: FileData, draws: int, released: bool) -> list[tuple[SmoothedRack, bool]]:
     """The smoothed rack each draw of the replay ensemble is logged again from, and whether it holds rests.
 
-    The knot spacing is not fixed by the data: every spacing tried whose fit passes the discrepancy test
-    (:attr:`parksteer.measure.smoothing.SmoothedRack.passing_spacings_s`) fits the rack to within its noise, and
-    the smoothing keeps the coarsest only because the noise estimate cannot choose between them. Away from a
-    reversal they agree; at a reversal they do not, since there the rack stays within a converter step or its
-    noise for a tenth of a second or more, and how the spline eases into and out of the turn (which sets when
-    the speed passes the millimetre per second over which the rack friction turns over) is set by its knots, not
-    by the data. Redrawing the noise about one spline (the chosen one) measures that spline's variance but not
-    this choice: on a sound car's record at 50 Hz (the Polo, rate_8pc_50Hz) the chosen spline's replay is
-    1.3 N m off at the reversals where draws about it spread by 0.08 N m, while replays of the other passing
-    spacings bracket the truth. So the draws are spread over the passing spacings, the chosen one first and the
-    finest last (evenly by index); with `released`, the draws come in pairs, the first of each pair held at rest
-    as the chosen spline is, the second with the ends and pauses free. A record whose chosen spacing is the
-    only one to pass draws every time about that spline.
+    Every knot spacing whose fit passes the discrepancy test
+    (:attr:`parksteer.measure.smoothing.SmoothedRack.passing_spacings_s`) fits the rack within its noise, and at a
+    reversal they differ in how the spline eases into and out of the turn, which the data do not fix: the draws are
+    spread over the passing spacings, the chosen one first and the finest last (evenly by index). With `released`, the
+    draws come in pairs, the first held at rest as the chosen spline is, the second with the ends and pauses free. A
+    record whose chosen spacing is the only one to pass draws every time about that spline. Why about one spline alone
+    the replay misses the truth at a sound car's reversals: docs/diagnosis.md.
     """
     spacings = f.rack.passing_spacings_s
     pair = 2 if released else 1

@@ -1,27 +1,17 @@
 """The assisted benchmark: diagnose records of an assisted car with a hand and a logger of their own.
 
-The car is a vehicle file's with its assist (the Polo file's column assist by default). Each record's rack follows a
-hand of the variation benchmark (:data:`parksteer.synthetic.variations.VARIATIONS`: its rate wander, pauses, uneven
-strokes, a lock overshoot, a record cut mid-stroke), its torsion-bar torque and motor current are the assisted
-replay (:mod:`parksteer.synthetic.assisted`), and the variation's logger logs them (its rate, its rack converter
-and noise) with the assisted car's channels: a 10-bit torsion-bar torque on +-10 N m and a 12-bit current on +-100
-A, each with the variation benchmark's noise relative to its range (TORQUE_NOISE_NM, CURRENT_NOISE_A). The base parameters
-are moved off the file's values as the in-class benchmark moves them (its ``perturbation``). Three kinds of case:
-
-- nulls (nothing hidden): ``adequate`` is right;
-- hidden candidates of an assisted car, each at sizes in converter steps RMS of the torsion-bar torque (the
-  strength found by the benchmark's secant search on the clean torque): extra motor friction, a torsion-bar sensor
-  offset, a boost gain off the file's, and a rack friction off the file's. The first three are *named* as in the
-  variation benchmark (verdict ``missing``, the hidden effect named or in the indistinguishable group reported with
-  it). The rack friction is a calibrated parameter of the base model: its right answer is ``adequate`` (counted as
-  named), and whether the calibrated rack friction's 95 % interval holds the true value is reported beside it (the
-  variation benchmark keeps coverage apart from naming too);
-- out-of-class changes (:data:`parksteer.synthetic.assisted.OUT_OF_CLASS`): a *confident wrong* answer names a
-  candidate that is not related to the change with a BIC margin over the runner-up beyond the diagnosis's
-  indistinguishable band (the out-of-class benchmark's measure).
-
-The targets are the variation benchmark's: named at least NAMED_TARGET of hidden cases of at least NAMED_MIN_STEPS
-steps, nulls adequate at least NULL_ADEQUATE_TARGET, and no confident wrong answer out of class.
+The car is a vehicle file's with its assist (the Polo file's column assist by default), its base parameters moved
+off the file's values as the in-class benchmark moves them. Each record's rack follows a hand of the variation
+benchmark (:data:`parksteer.synthetic.variations.VARIATIONS`), its torsion-bar torque and motor current are the
+assisted replay (:mod:`parksteer.synthetic.assisted`), and the variation's logger logs them with a 10-bit
+torsion-bar torque on +-10 N m and a 12-bit current on +-100 A (noise TORQUE_NOISE_NM, CURRENT_NOISE_A). Cases:
+nulls (``adequate`` right); hidden assist candidates sized in converter steps RMS of the torsion-bar torque (motor
+friction, sensor offset, boost gain: named right; a rack friction off the file's: ``adequate`` right, its
+calibrated interval's coverage reported); out-of-class changes
+(:data:`parksteer.synthetic.assisted.OUT_OF_CLASS`), where naming an unrelated candidate beyond the
+indistinguishable band is a confident wrong answer. Targets: NAMED_TARGET of hidden cases of at least
+NAMED_MIN_STEPS steps named, NULL_ADEQUATE_TARGET of nulls adequate, no confident wrong answer. Results:
+docs/assist_diagnosis.md.
 """
 
 from __future__ import annotations

@@ -1,28 +1,17 @@
 """The assisted benchmark on an independent truth: records the model's assist did not make, diagnosed with the files
 an owner would have.
 
-The records (:mod:`parksteer.synthetic.assisted_truth`): a column EPS of its own (a progressive power-law map read
-through the torque sensor's steps, a worm gear with eta_f driving and 1 / eta_b back-driven, the rotor's inertia
-and Coulomb friction through the worm) over the manual replay of the Polo file's car, its base parameters moved
-as the other benchmarks move them (``perturbed_base``). Each case has a hand and a logger's rate and rack of the
-variation benchmark (:data:`parksteer.synthetic.variations.VARIATIONS`), a torsion-bar torque on one of the
-design's converters (10 bits on +-10 N m to 0.005 N m steps; the control unit reads the same steps) and a current
-in 0.05 A steps, and one of two tiers: the rack logged, or the handwheel angle only (a bus log: the diagnosis
-derives the rack through the column and the torsion bar, :func:`parksteer.measure.column.rack_from_angle`).
-
-The file the diagnosis is given is the owner's (:func:`~.assisted_truth_owner.owner_vehicle_text`): the Polo file
-with an ``[assist]`` from the gear's data sheet (reduction, both efficiencies, torque constant, current limit as
-motor torque, rotor inertia, torsion-bar stiffness) and the map written point by point in ``[assist.boost]`` (the
-control unit's calibration read at the design's torques); what no data sheet gives (the motor's friction, the band
-of rotor speed over which it and the worm's direction change over at a reversal) stays at the template's assumed
-default. A second route, the file written from a baseline null record by the identification of the assist
-(``parksteer assist identify``), is the entry ``identified`` of :data:`~.assisted_truth_owner.ROUTES`.
-
-Cases and what counts, as in :mod:`.assisted_benchmark`: nulls (``adequate`` right), hidden effects of the truth
-standing for the assisted candidates (the motor's extra friction, the sensor's offset, the map's gain error; the
-rack friction, calibrated: ``adequate`` right), sized by the RMS change of the clean torsion-bar reading in noise
-floors of its channel (noise and rounding, root sum of squares); out-of-class forms (cogging, map hysteresis, worm
-backlash, a friction that grows with the motor's torque) must never be named with confidence unless related.
+The records (:mod:`parksteer.synthetic.assisted_truth`) are a column EPS of its own over the manual replay of the
+Polo file's car, its base parameters moved as the other benchmarks move them (``perturbed_base``), each case with a
+hand, rate and rack of the variation benchmark (:data:`parksteer.synthetic.variations.VARIATIONS`), a torsion-bar
+torque on one of the design's converters, a current in 0.05 A steps, and the rack logged or the handwheel angle only
+(:func:`parksteer.measure.column.rack_from_angle`). The diagnosis is given the owner's file
+(:func:`~.assisted_truth_owner.owner_vehicle_text`: the gear's data sheet and the map point by point, the rest at
+the template's assumed defaults), or the file ``parksteer assist identify`` writes from a baseline null (the route
+``identified`` of :data:`~.assisted_truth_owner.ROUTES`). Cases count as in :mod:`.assisted_benchmark`: nulls,
+hidden effects of the truth sized in noise floors of the torsion-bar channel, and out-of-class forms (cogging, map
+hysteresis, worm backlash, a friction growing with the motor's torque) that must never be named with confidence
+unless related. The truth and the results: docs/assist_diagnosis.md, "An independent truth of an assisted car".
 """
 
 from __future__ import annotations

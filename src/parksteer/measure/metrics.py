@@ -1,30 +1,12 @@
 """How far a model is from a measurement, overall and in each phase, beside the noise floor of the data.
 
-The residual is ``measured - model`` on the measurement's own time samples (the model,
-written at a finer step, is interpolated onto them): a positive residual is torque the model
-is missing. For each phase of the cycle (:mod:`parksteer.measure.phases`) and overall: the
-number of samples, the mean (bias), the RMS and the peak absolute residual.
-
-The noise floor is the RMS residual a perfect model would still show: the quantisation error
-(``step / sqrt(12)`` for a uniform rounding error over one step) combined, root sum of squares,
-with the analog noise. The analog noise is estimated from the measured signal alone, from its
-second differences ``d2[i] = y[i+1] - 2 y[i] + y[i-1]``:
-
-- a signal that is locally a straight line has no second difference, and a smooth one very
-  little (a sinusoid of frequency f keeps a fraction ``(2 pi f dt)**2`` of its amplitude; the
-  Hooke joint ripple, about 0.9 Hz at the paper's hand speed, keeps 1.3 % at 50 Hz sampling);
-- white noise of RMS s gives ``var(d2) = (1 + 4 + 1) s**2 = 6 s**2``;
-- the few sharp features (the torque drop at a reversal, the knee at the end of a wind-up) are
-  outliers of d2, removed by iterated clipping at 4 RMS (a Gaussian loses 0.1 % of its variance
-  to that clip);
-- the RMS of the clipped d2, not their median absolute deviation, because quantised data take
-  a few discrete values for which the median is biased (it is often exactly 0 or one step).
-
-That gives the total (analog plus quantisation) noise; the analog part is
-``sqrt(total**2 - (step/sqrt(12))**2)`` (zero if negative). The split is sound when the analog
-noise is at least about half a step: then the rounding error is uniform and independent of the
-signal. With less analog noise the record cannot resolve it, and the floor is the
-quantisation error either way.
+The residual is ``measured - model`` (N m) on the measurement's own time samples (the model interpolated onto them):
+positive is torque the model is missing. For each phase of the cycle (:mod:`parksteer.measure.phases`) and overall:
+the number of samples, the mean (bias), the RMS and the peak absolute residual. The noise floor is the RMS residual a
+perfect model would still show: the quantisation error ``step / sqrt(12)`` and the analog noise, root sum of
+squares, the analog noise estimated from the signal's own second differences, clipped of their sharp features; with
+less analog noise than about half a step the floor is the quantisation error. The estimator and why it holds:
+docs/measurement.md, "The error against the noise floor".
 """
 
 from __future__ import annotations

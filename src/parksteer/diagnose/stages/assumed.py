@@ -1,26 +1,15 @@
 """What the verdict owes to the assist's assumed values: each one moved to the ends of its band, the verdict again.
 
-An assisted car's file gives some of its gear's numbers from a data sheet or from ``parksteer assist identify``,
-and takes the rest from the effect's defaults (the motor's friction and rotor, the gear's efficiencies, the
-corners the boost line and the motor limit are smoothed over...). On an assisted car's bus the torsion-bar torque is
-clean enough that a default harmless on a manual car's records decides the verdict. So for every quantity of the
-assist that the vehicle file declares assumed (``provenance = "assumed"``, or no provenance, or no entry: the
-effect's default; ``Parameters.provenance``) and that the model uses, this stage replays the final comparison with
-it at each end of its band (:data:`BANDS`: the range the quantity's own source gives) and gives the verdict those
-replays would have: the calibrated model and the best candidate's refit each replayed with the value moved, their
-residuals refitted to first order (projected off the fit's Jacobian columns: the calibrated parameters take up what
-they can), and :func:`~parksteer.diagnose.stages.verdict.choose_verdict` on the calibrated model's RMS over the
-floor, the candidate's BIC gain and the fraction of the excess it explains, by the headline's rule (a candidate
-whose strength there is 0, or with ``headline_interval_clear_of_zero`` whose interval holds 0, is not named:
-:func:`~parksteer.diagnose.stages.select.may_headline`); each end says why its verdict is what it is
-(:func:`end_reason`: the figures and the thresholds they were held against). A quantity whose band's end changes the
-verdict *decides* it: the report says it was assumed, and by how much the calibrated fit moves (in noise floors).
-Where ``parksteer assist identify`` fixed the product k_t eta_f N, the efficiency and the reduction are moved with
-the products the data fixed held (:func:`moved`).
-
-Four replays a quantity (two ends, the calibrated model and the best candidate's), none for a car without an
-assist. Quantities the data calibrate (the candidates' strengths, the calibrated parameters) are not here: the
-diagnosis fits them.
+For every quantity of the assist that the vehicle file declares assumed (``provenance = "assumed"``, or no
+provenance, or no entry: ``Parameters.provenance``) and that the model uses, this stage replays the final comparison
+with it at each end of its band (:data:`BANDS`: the range the quantity's own source gives): the calibrated model
+and the best candidate's refit replayed with the value moved, their residuals refitted to first order on the fit's
+Jacobian, and :func:`~parksteer.diagnose.stages.verdict.choose_verdict` applied by the headline's rule
+(:func:`~parksteer.diagnose.stages.select.may_headline`); each end says why (:func:`end_reason`). A quantity whose
+band's end changes the verdict decides it, and the report says so with how far the calibrated fit moves (noise
+floors). Where ``parksteer assist identify`` fixed the product k_t eta_f N, the efficiency and the reduction move
+with that product held (:func:`moved`). Four replays a quantity, none for a car without an assist; quantities the
+diagnosis fits are not here. Why: docs/assist_identify.md, "Defaults that decide nothing silently".
 """
 
 from __future__ import annotations

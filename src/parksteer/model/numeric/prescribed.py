@@ -1,27 +1,13 @@
 """The prescribed-rack solve: the model driven by a given rack motion, the handwheel torque solved for.
 
-With the rack's position, speed and acceleration given at every instant (any :class:`RackMotion`: a
-measured rack smoothed by :func:`parksteer.measure.smoothing.smooth_rack`, or a spline through
-samples), the rack is not a state. The other coordinates are integrated while each step solves the
-Kane equations ``M a = F + b T`` for their accelerations and the column torque T together, with the
-rack's acceleration given. The column twist (handwheel minus column angle) does not feed back on T;
-when outputs are asked for it follows from ``c dtwist/dt + k twist = T``, integrated exactly for a
-torque linear between samples at most ``TWIST_SAMPLE_S`` apart, from the static twist at the start.
-Under a column deflection law g (``ModelSpace.set_column_deflection``: the dead band of the rack lash
-candidate) the spring and damper act on g(twist), ``(k g + c g' dtwist/dt) g' = T``, and the twist is
-integrated from that law (:class:`ColumnLaw`): on an engaged flank it is the linear law's widened by
-the band, and inside the band, where the hand turns with no torque, it crosses as fast as the torque
-lets it (the rack and torque fix the handwheel angle there only within the band).
-
-Speed: the whole solve is one call of the compiled model's stiff integrator (``ps_integrate_prescribed``, the
-integrator of the handwheel-driven model applied to the reduced system of ``ps_prescribed_rhs`` and
-``ps_prescribed_jac`` in the generated runtime, the rack motion passed as a table of its polynomial pieces); no
-step calls back into Python. The Jacobian of the reduced system is analytic, from the compiled model's full one. With ``h = M^-1 b``,
-the reduced accelerations of the other coordinates are ``a_o + h_o dT``, with ``dT`` fixed by the rack's
-acceleration; differentiating gives ``d a_o/dy = J_o - (h_o / h_rack) J_rack``, where J is the full model's
-Jacobian evaluated with a handwheel input that makes its column torque equal the prescribed-rack torque (the
-column law's own dependence on the state cancels between the two terms, whatever the law: a linear spring,
-or the dead band of the rack lash candidate, whose twist is widened by the torque it would not pass).
+With the rack's position (m), speed and acceleration given at every instant (any :class:`RackMotion`: a measured
+rack smoothed by :func:`parksteer.measure.smoothing.smooth_rack`, or a spline through samples), the other
+coordinates are integrated while each step solves the Kane equations ``M a = F + b T`` for their accelerations and
+the column torque T (N m) together. The column twist follows from T for the outputs, under the linear column law or
+a column deflection law (:class:`ColumnLaw`, ``ModelSpace.set_column_deflection``), integrated exactly for a torque
+linear between samples at most ``TWIST_SAMPLE_S`` apart. The whole solve is one call of the compiled model's stiff
+integrator (``ps_integrate_prescribed``) with an analytic reduced Jacobian; no step calls back into Python. The
+reduction and its Jacobian: docs/model.md, "The prescribed-rack solve".
 """
 
 from __future__ import annotations
