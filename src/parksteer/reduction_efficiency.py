@@ -1,26 +1,13 @@
 """The efficiencies of an assist's reduction from its geometry and friction: a worm gear, a ball nut.
 
-Both are a thread: a wedge of lead angle lambda driven against a contact of friction coefficient mu, friction angle
-rho = atan(mu). Driven from the screw (the motor drives: power from the worm into its wheel, from the nut's drive
-into the rack), the force balance on the wedge gives
-
-    eta_f = tan(lambda) / tan(lambda + rho),
-
-and driven from the wheel or the rack (the motor back-driven), the friction turns against the motion the other way:
-
-    eta_b = tan(lambda - rho) / tan(lambda),     0 when lambda <= rho (the thread locks itself).
-
-For a worm these are the textbook worm-gear efficiencies in terms of the lead angle (the inclined-plane model of the
-thread; the normal pressure angle of the flank is left out, which is the form worm-gear calculators give:
-novasolver.jp, "Worm gear efficiency & self-locking calculator"). For a ball nut the lead angle follows from the
-lead L and the ball circle diameter d, tan(lambda) = L / (pi d), and with mu = tan(rho) the same two expressions
-are the ball-screw catalogues' forward and reverse efficiencies written in mu:
-
-    eta_f = (1 - mu tan(lambda)) / (1 + mu / tan(lambda)),   eta_b = (1 - mu / tan(lambda)) / (1 + mu tan(lambda)),
-
-(tan(l)/tan(l + r) = tan(l) (1 - tan(l) tan(r)) / (tan(l) + tan(r)): identical, not an approximation). A ball nut's
-rolling contact has mu of a few thousandths, so eta_b is within a few hundredths of eta_f; a worm's sliding flank
-(mu about 0.05) at a lead angle of 15-25 deg gives eta_b a few hundredths below eta_f.
+Both are a thread of lead angle lambda against a contact of friction coefficient mu, rho = atan(mu):
+eta_f = tan(lambda) / tan(lambda + rho) driven from the screw (the motor drives), and
+eta_b = tan(lambda - rho) / tan(lambda) driven from the wheel or the rack (back-driven), 0 when lambda <= rho (the
+thread locks itself): the textbook worm-gear efficiencies in the lead angle (the flank's pressure angle left out, as
+worm-gear calculators give them: novasolver.jp, "Worm gear efficiency & self-locking calculator"). For a ball nut
+tan(lambda) = L / (pi d), lead L and ball circle diameter d, and the same expressions are the ball-screw
+catalogues' forward and reverse efficiencies written in mu. Angles in rad, efficiencies dimensionless. The
+derivation and the shipped gears' numbers: docs/assist.md, "The gear's efficiencies, both ways".
 
 Only the four operations and tan/atan of the portable library: the same bits on every machine.
 """

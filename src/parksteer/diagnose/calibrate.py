@@ -1,28 +1,16 @@
 """Weighted nonlinear least squares of model parameters against measurement files.
 
-Before any candidate effect is considered, the base model's uncertain parameters (the tyre
-friction coefficient, the rack friction force, the carcass torsional stiffness) are fitted
-to all files at once (:func:`calibrate`), so that a wrong value of one of them is not taken
-for a missing effect. The same fitter refits a candidate's strength together with them
-(:mod:`parksteer.diagnose.select`).
-
-Method: Levenberg-Marquardt on the weighted residuals r_i = (measured - model) / sigma_i
-(:mod:`parksteer.diagnose.problem`). Positive physical parameters are fitted as the
-logarithm of their ratio to the model's default (so they stay positive and a step is a
-relative change); a candidate's strength is fitted as it stands, within its bounds. The
-Jacobian starts from finite differences (one replay per parameter and file) and is then
-updated by Broyden's rank-one formula from each step's actual change, so an iteration costs
-one replay per file. The fit has converged when the full Gauss-Newton step is below a
-fraction of every parameter's standard error; it is recomputed by finite differences at the end if the parameters
-have moved far since, because the confidence intervals and the projections of the
-candidates' signatures rely on it. The base calibration (:func:`calibrate`) is then polished (:func:`polish`):
-Gauss-Newton steps on a Jacobian taken afresh until the step is a tenth of every standard error, so that it ends
-at its optimum and a candidate's refit, which starts there, gains in the BIC only what the candidate itself
-brings. Confidence intervals are 95 % intervals from the
-Jacobian, ``cov = s^2 (J^T J)^-1`` with s^2 the residual variance, inflated by (1 + rho) / (1 -
-rho) for the lag-1 autocorrelation rho of the residuals (their effective sample size is
-smaller than their count), or, where larger, from a block sandwich over segments of the cycle
-(:meth:`Fit.intervals`), which holds when the residual is a structured misfit and not noise.
+:func:`calibrate` fits the base model's uncertain parameters (the tyre friction coefficient, the rack friction force,
+the carcass torsional stiffness) to all files at once, before any candidate is considered, so that a wrong value of
+one is not taken for a missing effect; the same fitter refits a candidate's strength with them
+(:mod:`parksteer.diagnose.select`). Levenberg-Marquardt on the weighted residuals
+r_i = (measured - model) / sigma_i (:mod:`parksteer.diagnose.problem`); positive physical parameters are fitted as
+the logarithm of their ratio to the default, a strength as it stands within its bounds; the Jacobian starts from
+finite differences and is updated by Broyden's rank-one formula, and taken afresh at the end if the parameters moved
+far. :func:`polish` then takes Gauss-Newton steps on a fresh Jacobian until the step is a tenth of every standard
+error, so that a candidate's refit gains in the BIC only what it brings. Intervals are 95 %: ``cov = s^2 (J^T J)^-1``
+inflated by (1 + rho) / (1 - rho) for the residuals' lag-1 autocorrelation rho, or, where larger, a block sandwich
+over segments of the cycle (:meth:`Fit.intervals`). Why: docs/diagnosis.md, "How sure the report says it is".
 """
 
 from __future__ import annotations

@@ -1,28 +1,22 @@
 """The replay engine: everything of a diagnosis that replays and changes, in one object the stages are handed.
 
-The state a stage reads and returns (:class:`parksteer.diagnose.state.DiagnosisState`) is frozen; what replays
-cannot be: models are compiled and prepared, replays are kept for reuse, worker processes are started, solves
-are counted. :func:`parksteer.diagnose.select.diagnose` makes one :class:`ReplayEngine` and hands it to every
-stage (``stage.run(state, engine)``). It is openly mutable and keeps its counts on itself, as scipy's
-``OdeSolver`` keeps ``nfev`` on the solver that spends them. It owns:
+:func:`parksteer.diagnose.select.diagnose` makes one :class:`ReplayEngine` and hands it to every stage
+(``stage.run(state, engine)``); the state a stage returns is frozen, the engine openly mutable, keeping its counts on
+itself as scipy's ``OdeSolver`` keeps ``nfev``. It owns:
 
-- `models`: the compiled models loaded (:class:`parksteer.model.numeric.compiled.CompiledModels`), each found
-  again by its effects without hashing their source for the cache key again (:class:`LoadedModels`);
-- `hosts`: which compiled model each effect set is replayed on (:func:`parksteer.diagnose.candidates.replay_models`:
-  most candidates share the diagnosis model);
-- `direct`: which quantities only enter a compiled model's equations (found once per model and key,
-  :meth:`parksteer.diagnose.replay.Replay._is_direct`);
-- `prepared`: the prepared runs (compiled model, parameter vector, static balance: what does not depend on the
-  rack) by host model, case, surface and parameters, shared by every replay on them, so that the candidates
-  replayed on one host model prepare its base run once, not once each;
-- `replays`: one :class:`parksteer.diagnose.replay.Replay` per effect set, file and torque lag (the file's replay
-  instants, :attr:`parksteer.diagnose.problem.FileData.replay_time_s`), each counting its own solves: a replay is
-  what its key says, whichever process made it and whatever was replayed before;
+- `models`: the compiled models loaded, each found again by its effects (:class:`LoadedModels`);
+- `hosts`: which compiled model each effect set is replayed on
+  (:func:`parksteer.diagnose.candidates.replay_models`);
+- `direct`: which quantities only enter a compiled model's equations
+  (:meth:`parksteer.diagnose.replay.Replay._is_direct`);
+- `prepared`: the prepared runs by host model, case, surface and parameters, shared by every replay on them;
+- `replays`: one :class:`parksteer.diagnose.replay.Replay` per effect set, file and torque lag, each counting its
+  own solves, whichever process made it;
 - `pool`, `workers`: the worker processes a prediction spreads its files over (:mod:`parksteer.diagnose.parallel`),
-  forked for the problem they serve and forked again when a prediction is asked on another problem (a stage that
-  derives files makes a new one), so that a worker never answers with the files of an earlier problem;
-- `other_replays`: the solves not counted by a kept replay (run in worker processes, or on the replay ensemble's
-  racks), so that :attr:`evaluations` counts every solve the diagnosis ran.
+  forked for the problem they serve and again for another problem, so that none answers for an earlier one;
+- `other_replays`: the solves no kept replay counts, so that :attr:`evaluations` counts every solve.
+
+How the stages use it: docs/diagnosis.md.
 """
 
 from __future__ import annotations

@@ -1,26 +1,17 @@
 """The baseline benchmark: cars the model does not fit, their later records diagnosed absolutely and against the
 car's healthy record.
 
-Each car carries a quirk of its own in every record (:mod:`parksteer.synthetic.quirks`: a manual car's rack friction
-that depends on position and direction, a second universal joint out of phase, a tyre moment of Dahl's shape, a
-tie-rod compliance that stiffens; :mod:`parksteer.synthetic.quirk_eps`: a column EPS whose worm, saturation, corner
-and sensor filter have forms of their own, eta_b drawn from its published band, its vehicle file giving only the
-gear's data). One car has one set of base parameters (the benchmarks' perturbation of the file's, seeded by the
-car) and one quirk strength (a manual car's sized on its healthy record to ``quirk_floors`` noise floors of torque
-RMS). Its healthy record becomes the baseline; each later record, on its own hand and logger (rate, converter of 10
-bits to 0.005 N m steps, rack logged or, for an assisted car, the handwheel angle only), is a null, hides a library
-effect (sized in noise floors of its torque channel, RMS change of the logged torque) or an out-of-class change
-(another quirk; the motor's cogging), and is diagnosed twice:
-
-- absolutely: a manual car's with its parameter file, an assisted car's with the file ``parksteer assist identify``
-  writes from the healthy record (the owner's best without a baseline);
-- against the baseline (:func:`parksteer.diagnose.baseline.learn_baseline` on the healthy record, then
-  ``diagnose(..., baseline=...)``), where the method is there; otherwise the side reads ``not run``.
-
-Scored per car and side: hidden effects named (the effect, or in its reported group; the bar 3 of 4), nulls
-``adequate`` (all), out-of-class changes never named with confidence (a BIC margin beyond the indistinguishable band),
-and no confident wrong name on any record. The thresholds of "as the baseline" are the method's, from the spread of
-the healthy data; nothing here is tuned on the model's own records.
+Each car carries a quirk of its own in every record (:mod:`parksteer.synthetic.quirks` for a manual car,
+:mod:`parksteer.synthetic.quirk_eps` for a column EPS whose vehicle file gives only the gear's data), one set of base
+parameters (the benchmarks' perturbation, seeded by the car) and one quirk strength (a manual car's sized on its
+healthy record to ``quirk_floors`` noise floors of torque RMS). Its healthy record becomes the baseline; each later
+record, on its own hand and logger, is a null, hides a library effect (sized in noise floors of its torque channel)
+or an out-of-class change, and is diagnosed twice: absolutely (a manual car with its parameter file, an assisted car
+with the file ``parksteer assist identify`` writes from the healthy record), and against the baseline
+(:func:`parksteer.diagnose.baseline.learn_baseline`, then ``diagnose(..., baseline=...)``), the side reading
+``not run`` where the method is not there. Scored per car and side: hidden effects named (the bar 3 of 4), nulls
+``adequate`` (all), out-of-class changes and every record free of confident wrong names. Nothing is tuned on the
+model's own records. The cars and results: docs/diagnosis.md, "Cars the model does not fit".
 """
 
 from __future__ import annotations

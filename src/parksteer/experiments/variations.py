@@ -1,28 +1,16 @@
 """The variation benchmark: diagnose records made by another hand, another logger and another drive.
 
-The in-class benchmark (:mod:`parksteer.experiments.benchmark`) makes its records with the hand, the logger and
-the handwheel-driven simulation the diagnosis was tuned on. Here each record comes from
-:mod:`parksteer.synthetic.variations` instead: one of its :data:`~parksteer.synthetic.variations.VARIATIONS`
-(another hand: a smooth rate variation, pauses, uneven strokes, a lock overshoot, a record cut mid-stroke or
-going on at rest; another logger: 8- to 16-bit rack, 8- to 12-bit torque, 50 Hz to 1 kHz, an anti-alias filter
-and a channel lag; one to three files), the torque from the model's prescribed-rack solve, and the base
-parameters moved off the parameter file's values as the in-class benchmark moves them. In each variation and
-replicate the same records are diagnosed:
-
-- with nothing hidden (a null): ``adequate`` is the right answer, ``missing`` a false alarm;
-- with each hidden library effect at each size (converter steps of torque RMS over the case's files; the
-  strength from a small probe and secant steps in log-log on the prescribed-rack solve): *named* when the
-  verdict is ``missing`` and the effect is the one named or in the indistinguishable group reported with it;
-  each such record also keeps the part of its hidden change that the calibrated parameters cannot absorb
-  (:func:`hidden_strength`), to first order what a diagnosis could see of it;
-- coverage: each 95 % interval of the model the diagnosis reports (the calibrated base, or with the named effect
-  when it says ``missing``) against the true value (the perturbed base, the hidden strength, 0 for a named
-  effect that was not hidden).
-
-The targets over the grid are the project's requirement, not tuned here: hidden effects of at least
-NAMED_MIN_STEPS steps named in NAMED_TARGET of records, nulls ``adequate`` in NULL_ADEQUATE_TARGET, intervals
-covering in COVERAGE_TARGET. :func:`parksteer.experiments.variation_summary.summarise` reports each and the
-variations whose own rate misses it.
+Each record comes from :mod:`parksteer.synthetic.variations` (one of its
+:data:`~parksteer.synthetic.variations.VARIATIONS`: another hand, logger and drive than the in-class benchmark's,
+:mod:`parksteer.experiments.benchmark`), the torque from the prescribed-rack solve and the base parameters moved as
+the in-class benchmark moves them. In each variation and replicate the same records are diagnosed with nothing
+hidden (``adequate`` right, ``missing`` a false alarm) and with each hidden library effect at each size (converter
+steps of torque RMS; the strength from a probe and secant steps in log-log): *named* when the verdict is ``missing``
+and the effect is the one named or in its indistinguishable group; each such record keeps the part of its hidden
+change the calibrated parameters cannot absorb (:func:`hidden_strength`). Coverage: each reported 95 % interval
+against the true value. The targets are the project's requirement, not tuned here: NAMED_TARGET named of hidden
+effects of at least NAMED_MIN_STEPS steps, NULL_ADEQUATE_TARGET nulls adequate, COVERAGE_TARGET covering;
+:func:`parksteer.experiments.variation_summary.summarise` reports each and the variations that miss it.
 """
 
 from __future__ import annotations

@@ -1,26 +1,21 @@
 """Records made independently of the benchmark's generator: another hand, another logger, another drive.
 
-The benchmark's records (:mod:`parksteer.synthetic.datasets`) are made by the same hand model, the same
-logger and the same handwheel-driven simulation that the diagnosis was tuned on. The records here differ
-in every one of these, each in a way a real test could:
+The benchmark's records (:mod:`parksteer.synthetic.datasets`) are made by the hand, logger and handwheel-driven
+simulation the diagnosis was tuned on; these differ in every one, each as a real test could:
 
-- the hand (:func:`variation_hand`): the Section 4 cycle with a smooth speed variation of a few per
-  cent (the rate a smooth C2 function of time, not piecewise linear), optional pauses at rest inside a
-  stroke, and a record that either ends mid-stroke while the hand is still slowing or goes on at rest
-  for a while after the hand has stopped;
+- the hand (:func:`variation_hand`): the Section 4 cycle with a smooth (C2) rate variation of a few per cent,
+  optional pauses at rest, and a record that ends mid-stroke or goes on at rest after the hand stops;
 - the drive: the rack follows the hand through a rigid column and the Hooke joint
-  (:func:`parksteer.synthetic.standin.rack_of_hand`) and the torque is the model's prescribed-rack
-  solve of that rack (as ``parksteer simulate --rack-from`` does), at a finer output spacing than any logger;
-- the logger (:class:`VariationLogger`): its own sample rate, and the rack and torque channels on
-  converters of different resolution (a 12-bit rack beside an 8-bit torque, say). A file states one
-  ``bits`` only, so it states the torque channel's logger (its full scale and bits) and not the rack's
-  (whose full scale is left out): the diagnosis then knows the torque's step and estimates the rack's noise
-  from the data.
+  (:func:`parksteer.synthetic.standin.rack_of_hand`), the torque the model's prescribed-rack solve of that rack (as
+  ``parksteer simulate --rack-from`` does), finer than any logger;
+- the logger (:class:`VariationLogger`): its own sample rate, rack and torque on converters of different
+  resolution; a file states only the torque channel's full scale and bits, so the diagnosis estimates the rack's
+  noise from the data.
 
-:data:`VARIATIONS` names one record per way of differing (besides the above: uneven strokes, a driver who
-overshoots the lock, 8-, 12- and 16-bit racks beside 8-, 10- and 12-bit torques, 50 Hz to 1 kHz, an anti-alias
-filter and a channel lag, three files to a case): with nothing hidden, a diagnosis must say ``adequate`` on
-each; the variation benchmark (:mod:`parksteer.experiments.variations`) hides library effects in them as well.
+:data:`VARIATIONS` names one record per way of differing (also uneven strokes, a lock overshoot, 8- to 16-bit racks,
+8- to 12-bit torques, 50 Hz to 1 kHz, an anti-alias filter, a channel lag, three files to a case): with nothing
+hidden a diagnosis must say ``adequate`` on each; :mod:`parksteer.experiments.variations` hides library effects in
+them as well.
 """
 
 from __future__ import annotations
