@@ -25,7 +25,8 @@ DOCSTRING_WORDS = 250
 STALES_PRE_DERIVED = "the symbolic half's source keys the pre-derived models; cut with its next regeneration"
 KEYS_OUT_OF_LIBRARY_MODELS = ("its source keys the pre-derived out-of-library models (model_key hashes an effect's "
                               "module); cut with their next regeneration")
-NOT_YET_CUT = "derivation and measurements not yet moved to the docs page that owns them"
+KEYS_SUGGESTED_MODELS = ("its source keys the models of the suggested effects it defines (model_key hashes an "
+                         "effect's module); cut with the next regeneration")
 EXCEPTIONS: dict[str, tuple[int, str]] = {
     "parksteer/model/symbolic/effects/electric_assist.py": (991, STALES_PRE_DERIVED),
     "parksteer/model/symbolic/effects/rack_presliding.py": (564, STALES_PRE_DERIVED),
@@ -38,21 +39,12 @@ EXCEPTIONS: dict[str, tuple[int, str]] = {
     "parksteer/synthetic/outoflibrary.py": (398, KEYS_OUT_OF_LIBRARY_MODELS),
     "parksteer/model/symbolic/effects/turn_slip.py": (385, STALES_PRE_DERIVED),
     "parksteer/model/symbolic/effects/carcass_hysteresis.py": (365, STALES_PRE_DERIVED),
-    "parksteer/diagnose/suggest.py": (343, NOT_YET_CUT),
+    "parksteer/diagnose/suggest.py": (343, KEYS_SUGGESTED_MODELS),
     "parksteer/model/symbolic/effects/rolling_resistance.py": (296, STALES_PRE_DERIVED),
     "parksteer/model/symbolic/effects/linkage_nonlinearity.py": (293, STALES_PRE_DERIVED),
-    "parksteer/measure/column.py:rack_from_angle": (289, NOT_YET_CUT),
-    "parksteer/rig.py": (287, NOT_YET_CUT),
     "parksteer/model/symbolic/effects/tyre_stribeck.py": (280, STALES_PRE_DERIVED),
-    "parksteer/measure/io.py": (277, NOT_YET_CUT),
     "parksteer/model/symbolic/effects/rack_lash.py": (277, STALES_PRE_DERIVED),
-    "parksteer/diagnose/stages/user_effect.py": (274, NOT_YET_CUT),
-    "parksteer/sweep/merit.py": (274, NOT_YET_CUT),
-    "parksteer/synthetic/datasets.py": (264, NOT_YET_CUT),
-    "parksteer/diagnose/problem.py": (259, NOT_YET_CUT),
     "parksteer/model/symbolic/components.py:Effect": (258, STALES_PRE_DERIVED),
-    "parksteer/synthetic/quirk_eps.py": (254, NOT_YET_CUT),
-    "parksteer/figures/assist_creep.py": (253, NOT_YET_CUT),
 }
 
 # Phrases that tell how the code or a number changed: "was 1.3 N m off", "as before", "previously", "no longer",

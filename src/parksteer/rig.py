@@ -1,27 +1,18 @@
 """The static tyre rig of section 2: limiting steer torque of a sliding contact patch.
 
-Model (Gough, as in the paper): the contact patch is a disc of radius R carrying the load
-W at a uniform contact pressure equal to the inflation pressure p, so pi R^2 p = W, and
-every element that slides carries the Coulomb friction mu p dA opposite to its sliding
-velocity.
+Model (Gough, as in the paper): the contact patch is a disc of radius R carrying the load W at a uniform pressure
+equal to the inflation pressure p (pi R^2 p = W), every sliding element carrying the Coulomb friction mu p dA
+opposite to its sliding velocity.
 
-* Equation (1), patch turning about its own centre:
-  T = (2/3) mu p pi R^3 = (2 mu / 3) W^1.5 / sqrt(pi p).
-* Equation (2), the paper's empirical pressure correction:
-  T = p0^(n - 0.5) (2 mu / (3 sqrt(pi))) W^1.5 / p^n, equal to (1) at p = p0.
+* Equation (1), patch turning about its own centre: T = (2/3) mu p pi R^3 = (2 mu / 3) W^1.5 / sqrt(pi p).
+* Equation (2), the paper's empirical pressure correction: T = p0^(n - 0.5) (2 mu / (3 sqrt(pi))) W^1.5 / p^n,
+  equal to (1) at p = p0.
 
-Beyond the paper, the patch turning about a pin at lateral offset e (the rig's
-loading-plate pin, Fig. 2), in two limits:
-
-* wheel free to roll: the patch centre moves along x at omega e, which rolling takes up
-  exactly, so the tread slides in pure spin about the patch centre. The net friction
-  force of pure spin is zero by symmetry, so the torque about the pin is equation (1)
-  for every e, and the wheel spins by e / rolling radius per unit steer (Table 1's
-  "ratio for pure rolling").
-* wheel braked: the patch slides rigidly about the pin, every element's friction is
-  perpendicular to its radius from the pin, so T(e) = mu p Integral |r - e| dA over the
-  disc. The integral has a closed form in complete elliptic integrals (below); T(0) is
-  equation (1) and T tends to mu W e once e >> R.
+Beyond the paper, the patch turning about a pin at lateral offset e (the loading-plate pin, Fig. 2): with the wheel
+free to roll the tread slides in pure spin about the patch centre, so the torque is equation (1) for every e and
+the wheel spins by e / rolling radius per unit steer (Table 1's "ratio for pure rolling"); with the wheel braked
+the patch slides rigidly about the pin, T(e) = mu p Integral |r - e| dA over the disc, in closed form in complete
+elliptic integrals, T(0) equation (1) and T tending to mu W e once e >> R.
 
 All physics functions take and return SI units and broadcast over numpy arrays.
 """

@@ -1,28 +1,19 @@
 """The data of a comparison or a diagnosis: measurement files, their smoothed racks, noise and weights.
 
-Each file (:class:`FileData`) carries what its residuals need: the measured torque, the
-phases of its cycle (:mod:`parksteer.measure.phases`), its noise floor
-(:mod:`parksteer.measure.metrics`: quantisation step / sqrt(12) combined with the analog
-noise estimated from the data) and, in the files
-:func:`parksteer.diagnose.ensemble.with_replay_uncertainty` makes,
-the replay's own uncertainty at every sample. A file is never changed: what a diagnosis derives for
-it (its replay uncertainty, its torque lag, whether its angle is fitted) goes into a new
-:class:`FileData` (``dataclasses.replace``), and into a new :class:`Problem` that holds it.
+Each file (:class:`FileData`) carries what its residuals need: the measured torque, the phases of its cycle
+(:mod:`parksteer.measure.phases`), its noise floor (:mod:`parksteer.measure.metrics`) and, in the files
+:func:`parksteer.diagnose.ensemble.with_replay_uncertainty` makes, the replay's own uncertainty at every sample. A
+file is never changed: what a diagnosis derives for it (its replay uncertainty, its torque lag, whether its angle is
+fitted) goes into a new :class:`FileData` (``dataclasses.replace``) and a new :class:`Problem` that holds it.
 
-The replay uncertainty (:mod:`parksteer.diagnose.ensemble`) is found by propagation: the spread of replays of the
-racks the data allow equally well.
+A file with no rack channel (a car's own bus: handwheel angle and torque) is replayed from a rack derived from the
+angle through the model's column (:mod:`parksteer.measure.column`, which :func:`load_files` reads through).
 
-A file with no rack channel (a car's own bus: handwheel angle and torque) is replayed from a rack derived from
-the angle through the model's column (:mod:`parksteer.measure.column`, which :func:`load_files` reads through).
-
-A file with a handwheel angle beside a measured rack may be fitted on both signals
-(:attr:`FileData.uses_angle`, in the copies the diagnosis makes when its settings ask): each prediction is
-then the torque followed by the replayed handwheel angle (column angle plus the twist that
-passes the replayed torque, :func:`parksteer.model.numeric.prescribed.solve`), shifted by the
-fitted zero of the angle sensor. The angle's attainable error combines its channel's noise
-floor, the replay ensemble's spread in angle, and the twist that a torque off by its own
-attainable error would give (:func:`parksteer.model.numeric.prescribed.twist_spread`: error / k
-on a linear column, a lash's whole band where the torque is that close to zero).
+A file with a handwheel angle beside a measured rack may be fitted on both signals (:attr:`FileData.uses_angle`):
+each prediction is then the torque followed by the replayed handwheel angle
+(:func:`parksteer.model.numeric.prescribed.solve`), shifted by the fitted zero of the angle sensor. The angle's
+attainable error combines its channel's noise floor, the replay ensemble's spread in angle, and the twist a torque
+off by its own attainable error would give (:func:`parksteer.model.numeric.prescribed.twist_spread`).
 """
 
 from __future__ import annotations

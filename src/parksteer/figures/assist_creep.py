@@ -1,20 +1,17 @@
 """Creeping over speed and tyre: how much of its standstill moment the rolling tyre keeps, and whether it or the
 rack's friction carries more of the parking torque, over the turn-slip slope q_Dz8 at 1, 3 and 5 km/h.
 
-The paper's car without assist runs the source's cycle, unladen on the ground, with the rolling tyre (turn_slip)
-at each creeping speed and each |q_Dz8| of a geometric grid over the quantity's range (0.01 to 1). On the plateau
-(parksteer.figures.assist_study.shares) the tyre's term is its friction moment times the turn-slip factor (the
-tyre_friction and turn_slip terms together), and
+The paper's car without assist runs the source's cycle, unladen on the ground, with the rolling tyre (turn_slip) at
+each creeping speed and each |q_Dz8| of a geometric grid over the quantity's range (0.01 to 1). On the plateau
+(parksteer.figures.assist_study.shares) the tyre's term is the tyre_friction and turn_slip terms together, and
 
     kept(q, v) = tyre term at (q, v) / tyre term at standstill,   share(q, v) = term / road torque.
 
-The turn-slip factor 1 / sqrt(1 + y^2) has y proportional to 1 / q_Dz8, so the tyre's term grows with q_Dz8 at
-every speed and the rack friction's, a constant force, loses share: the two shares cross once at most. The
-crossover q*(v), where the tyre's share equals the rack friction's, is found by bisection in log q_Dz8 (a fixed
-count of halvings, so the same runs on every machine); none where the tyre stays below (or above) over the whole
-range. The assumed band of q_Dz8 and the one passenger-car tyre found inside it come from
-``parksteer/data/published_loads.toml`` ([spin_slope]); the study reports the shares at those values and which side
-of the crossover each lies on.
+The tyre's term grows with q_Dz8 at every speed while the rack friction's is constant, so the shares cross once at
+most: the crossover q*(v) is found by bisection in log q_Dz8 (a fixed count of halvings), none where the tyre stays
+below (or above) over the whole range. The assumed band of q_Dz8 and the one passenger-car tyre in it come from
+``parksteer/data/published_loads.toml`` ([spin_slope]); the study reports the shares at those values and their side
+of the crossover (docs/assist.md, "Parking while the car creeps").
 
 Numbers on this path reach a checksummed figure: elementwise arithmetic, means, extrema and a bisection of fixed
 count only.

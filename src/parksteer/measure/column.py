@@ -85,15 +85,11 @@ def rack_from_angle(measurement: Measurement, params: Parameters, assist: Torsio
     column's spring and damper, ``c dtwist/dt + k twist = T`` (:func:`parksteer.geometry.column_twist`,
     exact for a torque linear between samples, from the static twist T(0) / k at the first sample), the Hooke joint
     turns it into the pinion angle (:func:`parksteer.geometry.pinion_angle_from_column`) and
-    rack = theta_p / handwheel_to_rack_ratio. This is the inverse of the replay's own handwheel angle
-    (:func:`parksteer.model.numeric.prescribed.solve`: column angle plus that twist).
-
-    The importer's static column law (:func:`parksteer.geometry.rack_from_handwheel`, twist T / k) leaves out the
-    damper: the twist lags the torque by c / k (0.2 s on the paper's car), and where the torque swings at a reversal
-    the static twist is off by (c / k) dtwist/dt, up to 4.8e-3 rad at the handwheel, a 26 um rack error, five times
-    the angle-derived rack's own noise (a 14-bit angle on +-16 rad: 1.05e-5 m steps). That error sits at the
-    reversals, where the rack friction flips, and made a null record unexplained. The torque's noise reaches the
-    rack through the twist only, divided by k and the ratio (0.1 N m: 5e-7 m) and low-passed by the damper.
+    rack = theta_p / handwheel_to_rack_ratio (m). This is the inverse of the replay's own handwheel angle
+    (:func:`parksteer.model.numeric.prescribed.solve`: column angle plus that twist). The importer's static law leaves
+    the damper out, an error at the reversals several times the angle-derived rack's noise (docs/bus.md).
+    The torque's noise reaches the rack only through the twist, divided by k and the ratio (0.1 N m: 5e-7 m), and
+    low-passed by the damper.
 
     Of an assisted car (`assist`, its torsion bar), the torque is the torsion bar's and the bar is in series with
     the column shaft: the twist is through their series stiffness k k_t / (k + k_t), with the damping that keeps

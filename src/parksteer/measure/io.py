@@ -10,24 +10,16 @@ header row names the columns, then one row per sample::
     0,0,0.1
     0.02,0.0003,2.4
 
-Columns (SI units; the unit is part of the name):
+Columns (SI units; the unit is part of the name): required ``time_s`` (strictly increasing), ``rack_m`` (positive
+to the right), ``handwheel_torque_Nm``; optional ``handwheel_angle_rad``, ``load_left_N``, ``load_right_N``,
+``vehicle_speed_mps``, and of an assisted car ``motor_current_A`` or ``motor_torque_Nm``. An assisted car's record
+may carry the torsion-bar torque in ``handwheel_torque_Nm`` with ``torque_sensor: torsion_bar`` (default
+``handwheel``).
 
-- required: ``time_s`` (strictly increasing), ``rack_m`` (positive to the right),
-  ``handwheel_torque_Nm``;
-- optional: ``handwheel_angle_rad``, ``load_left_N``, ``load_right_N``, ``vehicle_speed_mps``, and of an
-  assisted car ``motor_current_A`` or ``motor_torque_Nm`` (the assist motor's, as its control unit reports it).
-
-An assisted car's torque sensor is its torsion bar: its record's ``handwheel_torque_Nm`` is the torsion-bar torque
-and the metadata say so (``torque_sensor: torsion_bar``; the default is ``handwheel``). For a column assist the two
-are one torque (the column is massless: the bar carries the driver's torque); at the pinion they differ by the
-intermediate shaft's joint, and the assisted replay predicts the torsion bar's.
-
-Metadata: ``case`` (a case of the parameter file) and ``surface`` (``ground`` or
-``air_bearing``) are required, because a comparison with the model needs both;
-``extra_offset_m`` (spacer offset, m) and ``source`` are optional; ``full_scale_<column>``
-(the logger's full scale for that column, in the column's unit) and ``bits`` (the logger's
-resolution; ``bits_<column>`` for a channel with a converter of its own, e.g. an angle sensor) let the
-metrics work out the quantisation step. Any other key is kept as text.
+Metadata: ``case`` (a case of the parameter file) and ``surface`` (``ground`` or ``air_bearing``) are required;
+``extra_offset_m`` (spacer offset, m) and ``source`` are optional; ``full_scale_<column>`` (in the column's unit)
+and ``bits`` (or ``bits_<column>`` for a channel with a converter of its own) give the quantisation step. Any other
+key is kept as text.
 
 Every defect is refused with a :class:`~parksteer.errors.UsageError` whose one-line message
 names the file and, where it applies, the column and the data row (1-based, the first row

@@ -1,26 +1,19 @@
 """Figures of merit of one lock-to-lock cycle, as a steering engineer quotes them.
 
-All are taken from the simulated time history (columns as `simulate` writes them); the
-right-going stroke is the part from the start to the first maximum of the rack travel
-(right lock). The rack's reference speed is the median rack speed over that stroke.
+All are taken from the simulated time history (columns as `simulate` writes them); the right-going stroke runs from
+the start to the first maximum of the rack travel (right lock), and the rack's reference speed is the median rack
+speed over it. Torques in N m:
 
 * peak torque: the largest |handwheel torque| anywhere in the cycle;
-* plateau torque: the mean handwheel torque over the sliding part of the right-going
-  stroke, where the rack moves at least half its reference speed and, on both sides, the
-  tread ring turns relative to the body at least half as fast as the wheel steers (the
-  tread slides on the ground instead of twisting the carcass). The window is cut at its lock
-  end to a whole number of Hooke-joint ripple periods (half a column turn each: the ripple
-  has two cycles per revolution) so that the ripple averages out; the torque at lock is
-  quoted separately;
-* share of a mechanism: the mean of its contribution column over the same window divided
-  by the plateau torque (the contributions sum to the handwheel torque, so the shares sum
-  to one);
-* torque at lock: the handwheel torque at the last sample before right lock where the rack
-  still moves at half its reference speed (arriving at lock at the steering rate, before
-  the rounded reversal slows it);
-* drop at reversal: that torque minus the torque at the first sample after right lock
-  where the rack returns at half its reference speed: the rack friction has reversed and
-  the carcass has hardly begun to unwind.
+* plateau torque: the mean handwheel torque over the sliding part of the right-going stroke (the rack at least half
+  its reference speed, and on both sides the tread ring turning relative to the body at least half as fast as the
+  wheel steers), cut at its lock end to a whole number of Hooke-joint ripple periods (half a column turn) so that
+  the ripple averages out;
+* share of a mechanism: the mean of its contribution column over that window over the plateau torque (the shares
+  sum to one);
+* torque at lock: at the last sample before right lock where the rack still moves at half its reference speed;
+* drop at reversal: that torque less the torque at the first sample after right lock where the rack returns at half
+  its reference speed (the rack friction reversed, the carcass hardly unwound).
 """
 
 from __future__ import annotations

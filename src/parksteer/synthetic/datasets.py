@@ -1,29 +1,17 @@
 """Synthetic measurements with something hidden in them: the car data set and the benchmark's data sets.
 
-Every file is made the way a car test would be: the driver's hand turns the wheel through
-the paper's cycle with an irregular speed (:func:`parksteer.synthetic.logger.irregular_hand_profile`);
-the model is driven by that handwheel angle (:func:`parksteer.model.numeric.simulate.simulate` with
-``handwheel``: the column twists, the rack follows), so the data come from the other drive
-mode than the rack replay that analyses them; the logger then samples, adds noise and
-quantises every channel (:func:`parksteer.synthetic.logger.synthetic_measurement`, the
-settings of the parameter file's ``[synthetic]`` section). What is hidden is one of:
-
-- a candidate effect of the library at a strength that changes the torque by a given number
-  of converter steps RMS (found by secant steps on the strength, :func:`strength_for_rms`);
-- nothing (a null);
-- a disturbance no candidate models (:class:`Disturbance`): a drift of the torque sensor's
-  zero, a ripple from a damaged pinion tooth, a lag of the torque channel behind the rack,
-  or an effect from outside the library (the example's out-of-balance column).
-
-The base parameters of every data set are perturbed within stated ranges, so that a
-diagnosis must calibrate them first. What is hidden is recorded in a separate truth
-dictionary, never in the files: their metadata say only ``synthetic: true`` and the
-logger's and the hand's settings.
-
-The experiment design (what is hidden in the car data set, the benchmark's strengths, files
-and seeds) is the pipeline's configuration (``config/config.yaml``, sections ``car`` and
-``benchmark``), given here as :class:`CarDesign` and :class:`BenchmarkDesign`; the base
-perturbation, the same for every benchmark, is :data:`BASE_PERTURBATION`.
+Every file is made the way a car test would be: the hand turns the wheel through the paper's cycle at an irregular
+speed (:func:`parksteer.synthetic.logger.irregular_hand_profile`), the model is driven by that handwheel angle
+(:func:`parksteer.model.numeric.simulate.simulate` with ``handwheel``: the other drive mode than the rack replay
+that analyses the data), and the logger samples, adds noise and quantises every channel
+(:func:`parksteer.synthetic.logger.synthetic_measurement`, the parameter file's ``[synthetic]``). What is hidden is a
+library candidate at a strength that changes the torque by a given number of converter steps RMS
+(:func:`strength_for_rms`), nothing (a null), or a disturbance no candidate models (:class:`Disturbance`: a sensor
+zero drift, a damaged pinion tooth's ripple, a torque channel lag, or an effect from outside the library). The base
+parameters are perturbed within stated ranges (:data:`BASE_PERTURBATION`, the same for every benchmark), so that a
+diagnosis must calibrate them first. The truth is recorded apart, never in the files, whose metadata say only
+``synthetic: true`` and the logger's and hand's settings. The design is the pipeline's configuration
+(``config/config.yaml``, ``car`` and ``benchmark``), given here as :class:`CarDesign` and :class:`BenchmarkDesign`.
 """
 
 from __future__ import annotations

@@ -1,24 +1,21 @@
 """A column EPS whose gear, saturation, corner and sensor filtering have forms of their own: the assisted car the
 model does not fit.
 
-Beside :mod:`.assisted_truth` (whose map, road, gear data, hidden changes and logger this reuses), the layer over
-the manual replay differs from both that truth and the model's assist (:mod:`parksteer.model.symbolic.effects.
-electric_assist`) in four places, each a form a real unit may have:
+Beside :mod:`.assisted_truth` (whose map, road, gear data, hidden changes and logger this reuses), the layer over the
+manual replay differs from both that truth and the model's assist
+(:mod:`parksteer.model.symbolic.effects.electric_assist`) in four places, each a form a real unit may have:
 
-- the worm's back-driven factor (:func:`worm_factor`): from ``eta_f`` when the motor drives the column to
-  ``1 / eta_b`` when the column drives the motor, through the sign of the power, passing through 1 at rest along
-  ``1 - exp(-(omega / omega_0)^2)`` of the rotor's speed (a Gaussian onset: the model's is tanh, the other truth's
-  linear);
-- the saturation (:func:`soft_limit`): the current the control unit asks for is limited by
-  ``I / (1 + (|I| / I_max)^4)^(1/4)`` (a knee of its own; the model's is a hyperbola, the other truth's a clip);
-- the corner: the map is the other truth's exponential family ``c (exp((|S| - d) / w) - 1)`` beyond the dead band
-  (a corner of slope c / w), or its power law;
-- the sensor's filtering: the torsion-bar sensor's output, which the bus carries and the logger reads, passes a
-  first-order low-pass of ``sensor_time_constant_s`` (the control unit reads the sensor ahead of it).
+- the worm's back-driven factor (:func:`worm_factor`): from ``eta_f`` driving to ``1 / eta_b`` back-driven through
+  the sign of the power, passing through 1 at rest along ``1 - exp(-(omega / omega_0)^2)`` of the rotor's speed
+  (the model's onset is tanh, the other truth's linear);
+- the saturation (:func:`soft_limit`): the asked current limited by ``I / (1 + (|I| / I_max)^4)^(1/4)`` (the model's
+  is a hyperbola, the other truth's a clip);
+- the corner: the other truth's exponential map ``c (exp((|S| - d) / w) - 1)`` beyond the dead band, or its power law;
+- the sensor's filtering: a first-order low-pass of ``sensor_time_constant_s`` on the torsion-bar sensor's output,
+  which the bus carries (the control unit reads ahead of it).
 
 ``eta_b`` is drawn from its published band (:func:`drawn_back_efficiency`: 0.75-0.85, the Polo file's provenance of
-``back_efficiency``). Hidden changes (motor friction, the sensor's offset, the map's gain error) and cogging (out of
-class) are :class:`~parksteer.synthetic.assisted_truth.Hidden`'s.
+``back_efficiency``). Hidden changes and cogging are :class:`~parksteer.synthetic.assisted_truth.Hidden`'s.
 """
 
 from __future__ import annotations

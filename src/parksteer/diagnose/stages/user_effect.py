@@ -1,23 +1,20 @@
 """What a user's effect in the model does to the error: the ladder without it and with it, its fitted strengths, the
 residual by phase before and after, and the error as its strengths grow from 0 to their fitted values.
 
-A user's effect (``--effects=+FILE.py``) declares the strengths a diagnosis fits (``Quantity.free``); the
-calibration fits them with the base model's uncertain parameters (:func:`parksteer.diagnose.calibrate.
-free_strengths`), so every verdict of such a diagnosis is on the model with the effect. This stage, in the table
-only when the model has free strengths (:func:`with_user_effect_stage`), shows what the effect changed:
+A user's effect (``--effects=+FILE.py``) declares the strengths a diagnosis fits (``Quantity.free``), which the
+calibration fits with the base model's uncertain parameters (:func:`parksteer.diagnose.calibrate.free_strengths`).
+This stage, in the table only when the model has free strengths (:func:`with_user_effect_stage`), gives:
 
-- the ladder: the model without the effects that declare free strengths at the parameter file's values, the same
-  model calibrated (its own calibration, from the defaults), then the model with them (the diagnosis's calibration);
-- each free strength with its 95 % interval (:meth:`parksteer.diagnose.calibrate.Fit.intervals`) and unit, or why
-  these data give it none (:func:`why_not_fixed`);
-- the car's calibrated parameters' intervals with the free strengths held at their fit
-  (:func:`conditioned_on_strengths`: the intervals the report and "what these data fix" give), and for each the
-  share of its signature the strengths do not also make (:func:`not_made_by_strengths`): a strength's shape
-  that sums to a uniform rack friction leaves the rack friction force's value to hold only with that shape;
-- the residual's RMS in each phase of each file, calibrated without the effects and with them;
-- a sweep: every free strength whose 0 means absent (0 within its bounds) moved together from 0 to its fitted
-  value in :data:`SWEEP_POINTS` steps, the other parameters (a free width or phase among them) held at the fit,
-  the weighted error at each.
+- the ladder: the model without those effects at the parameter file's values, the same calibrated, then the model
+  with them;
+- each free strength with its 95 % interval and unit, or why these data give it none (:func:`why_not_fixed`);
+- the calibrated parameters' intervals with the strengths held at their fit (:func:`conditioned_on_strengths`),
+  and the share of each one's signature the strengths do not also make (:func:`not_made_by_strengths`);
+- the residual's RMS in each phase of each file, without the effects and with them;
+- a sweep: every free strength whose 0 means absent moved together from 0 to its fitted value in
+  :data:`SWEEP_POINTS` steps, the other parameters held at the fit, the weighted error at each.
+
+The worked example: docs/signature.md, "Adding an effect".
 """
 
 from __future__ import annotations
