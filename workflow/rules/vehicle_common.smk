@@ -38,7 +38,8 @@ def check_vehicle_data():
     import io
 
     from parksteer.errors import UsageError
-    from parksteer.measure.importers import channel_map_from_options, load_record
+    from parksteer.measure.channel_map import channel_map_from_options
+    from parksteer.measure.importers import load_record
 
     keys = "--case, --surface and --map-file are --config vehicle_case=, vehicle_surface= and vehicle_map="
     try:

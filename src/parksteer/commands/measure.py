@@ -56,7 +56,7 @@ def add_import_options(p) -> None:
 def channel_map_of(args):
     """The channel map of --map and --map-file (None when neither is given); with --bus or --dbc, one that carries
     the bus its signals are decoded with."""
-    from ..measure.importers import channel_map_from_options
+    from ..measure.channel_map import channel_map_from_options
 
     if getattr(args, "bus", None) is not None or getattr(args, "dbc", None) is not None:
         from ..measure.bus import bus_channel_map

@@ -130,7 +130,7 @@ def vehicle_study(items, parameters: str | Path, vehicle: str | Path, options: d
     """The vehicle study's records taken in as ``parksteer compare/diagnose --vehicle`` takes them: `items` files, or
     a folder whose .csv files are the records (the synthetic set), read with the workflow's import options
     (``case``, ``surface``, ``map_file``); `request` the rest of the :class:`Request`."""
-    from ..measure.importers import channel_map_from_options
+    from ..measure.channel_map import channel_map_from_options
 
     files = []
     for item in [items] if isinstance(items, str | Path) else list(items):
@@ -213,7 +213,7 @@ def with_record_speed(params: Parameters, effects, files):
     (as ``simulate --speed-kmh``); a speed that varies, or differs between files, is refused in one line."""
     import numpy as np
 
-    from ..measure.importers import SPEED
+    from ..measure.channel_map import SPEED
     from ..model.symbolic.components import discover_effects
     from ..vehicle import MAX_CREEPING_SPEED_KMH, creeping_overrides
 
@@ -274,7 +274,7 @@ def check_angle(files, settings: DiagnosisSettings) -> None:
     which files fit it."""
     if not settings.use_handwheel_angle:
         return
-    from ..measure.importers import ANGLE
+    from ..measure.channel_map import ANGLE
 
     with_angle = [f.label for f in files if f.angle_rad is not None]
     if not with_angle:

@@ -25,7 +25,8 @@ import numpy as np
 
 from ..errors import UsageError, naming
 from ..measure.column import TorsionBar, load_measurements
-from ..measure.importers import ANGLE, TORQUE
+from ..measure.channel_map import ANGLE
+from ..names import TORQUE
 from ..measure.io import Measurement
 from ..measure.metrics import NoiseFloor, noise_floor
 from ..measure.phases import CyclePhases, find_phases

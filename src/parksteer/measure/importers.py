@@ -37,8 +37,6 @@ from .readers import Record, Source, reader_for
 from .readers.base import TIME_ALIASES, normal_name, refusal
 from .units import SI_UNITS, to_si
 
-# parksteer.measure.importers stays the import path of the channel map's options that the command line reads
-from .channel_map import channel_map_from_options  # noqa: F401
 
 RACK_DRIVE_COLUMNS = (TIME, RACK)
 
