@@ -96,11 +96,11 @@ def copy_with_models(repo_root, copy_repository):
     return copy
 
 
-def _placeholder_outputs(work: Path, summary: str) -> None:
-    """Create every output listed by `snakemake --summary` (`summary`) in `work` empty: the workflow's
-    directory() outputs (the diagnosis benchmarks' job folders) are the names without a suffix, made as folders."""
-    for line in summary.splitlines()[1:]:
-        output = work / line.split("\t")[0]
+def _placeholder_files(work: Path, outputs: list[str]) -> None:
+    """Create each of the workflow's `outputs` (paths relative to `work`) empty: its directory() outputs (the
+    diagnosis benchmarks' job folders) are the names without a suffix, made as folders."""
+    for name in outputs:
+        output = work / name
         if output.suffix:
             output.parent.mkdir(parents=True, exist_ok=True)
             output.touch()
@@ -108,10 +108,21 @@ def _placeholder_outputs(work: Path, summary: str) -> None:
             output.mkdir(parents=True, exist_ok=True)
 
 
+def _placeholder_outputs(work: Path, summary: str) -> None:
+    """Create every output listed by `snakemake --summary` (`summary`) in `work` empty."""
+    _placeholder_files(work, [line.split("\t")[0] for line in summary.splitlines()[1:]])
+
+
 @pytest.fixture(scope="session")
 def placeholder_outputs():
     """placeholder(work, summary): every output of a `snakemake --summary` listing created empty in `work`."""
     return _placeholder_outputs
+
+
+@pytest.fixture(scope="session")
+def placeholder_files():
+    """placeholder(work, outputs): each of the workflow's outputs (paths relative to `work`) created empty."""
+    return _placeholder_files
 
 
 @pytest.fixture(scope="session")

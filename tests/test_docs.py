@@ -9,8 +9,8 @@ blocks under one heading), in reading order (README.md, then the table of conten
 in order. A page that runs a command on what another page wrote is in that page's chain, after it; a page that
 needs what its chain has not yet written fails, as one that needs another chain's output does (its copy has none
 of it). `parksteer`, `snakemake` and `python` are this environment's, the package is the copy's (PYTHONPATH),
-and the model cache is one for the test process, seeded with the worktree's compiled models (a model a
-document's commands need and no earlier run in the process built is derived there once).
+and the model cache is the checkout's own (results/model, where the rest of the test run builds its models too),
+so that a model is compiled, or derived, once in a test run, by whichever test or chain needs it first.
 
 What a document may say about a block, in HTML comments the rendered page does not show, each on a line of its own:
 
@@ -43,7 +43,6 @@ from __future__ import annotations
 
 import os
 import re
-import shutil
 import subprocess
 import sys
 import time
@@ -275,14 +274,13 @@ def test_marker_checks_can_fail(tmp_path):
 # --- running the blocks: slow --------------------------------------------------------------------------------------
 
 @pytest.fixture(scope="session")
-def model_cache(tmp_path_factory):
-    """One model cache for the session's document runs, seeded with the worktree's compiled models."""
-    cache = tmp_path_factory.mktemp("docs-model-cache")
-    source = REPO / "results" / "model"
-    if source.is_dir():
-        for entry in source.iterdir():
-            if entry.is_dir() and not entry.name.startswith("."):
-                shutil.copytree(entry, cache / entry.name)
+def model_cache():
+    """The checkout's model cache (results/model, the package's own cache when it runs from the checkout), shared by
+    every chain and every other test of the run, in whichever worker process: an entry is built aside and renamed
+    into place under a build lock (parksteer.model.codegen.cache), so two processes needing one model build it
+    once. A copied or per-process cache would compile the same models again in each worker and each copy."""
+    cache = REPO / "results" / "model"
+    cache.mkdir(parents=True, exist_ok=True)
     return cache
 
 
