@@ -113,3 +113,19 @@ def test_a_cubic_is_reproduced_exactly_by_its_piecewise_form():
     np.testing.assert_allclose(pieces[1], 0.9 * start - 1.0, atol=1e-10)
     np.testing.assert_allclose(pieces[2], 0.9 * start**2 - 2.0 * start + 2.0, atol=1e-10)
     np.testing.assert_allclose(pieces[3], poly(start), atol=1e-10)
+
+
+def test_the_assisted_replays_rack_speed_is_ppolys_derivative_to_the_bit():
+    """parksteer.model.numeric.assisted.rack_speed_mps (the rack speed the assist's law reads) equals scipy's
+    PPoly(...).derivative() of the same pieces bit for bit, at the samples, at the breaks themselves and beyond
+    the record's ends (where the rack is held: speed 0), and is the derivative of the position."""
+    from parksteer.measure.smoothing import smooth_rack
+    from parksteer.model.numeric.assisted import rack_speed_mps
+
+    t, x, _ = CASES[0]
+    rack = smooth_rack(t, x)
+    for times in (t, rack.breaks.copy(), np.linspace(rack.start_s - 1.0, rack.end_s + 1.0, 2001)):
+        inside = (times >= rack.start_s) & (times <= rack.end_s)
+        expected = np.where(inside, interpolate.PPoly(rack.coefficients, rack.breaks).derivative()(times), 0.0)
+        assert _bits(rack_speed_mps(rack, times)) == _bits(expected)
+    np.testing.assert_allclose(rack_speed_mps(rack, t), rack.evaluate(t)[1], rtol=1e-9, atol=1e-12)

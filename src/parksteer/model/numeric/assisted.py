@@ -221,11 +221,22 @@ def boost_law(run, p: np.ndarray) -> BoostLaw | None:
 
 
 def rack_speed_mps(rack: RackMotion, t) -> np.ndarray:
-    """The speed of `rack` at the times `t` (m/s; 0 where it is held, before its first and after its last break)."""
-    from scipy.interpolate import PPoly
+    """The speed of `rack` at the times `t` (m/s; 0 where it is held, before its first and after its last break).
 
+    The cubic pieces' derivative evaluated as scipy's PPoly(...).derivative() evaluates it, operation for operation
+    (the derivative's coefficients c_i times their powers, then summed from the constant term up), so with its bits
+    and without importing scipy.interpolate (a second of every assisted diagnosis)."""
     breaks = np.asarray(rack.breaks, dtype=float)
-    speed = PPoly(np.asarray(rack.coefficients, dtype=float), breaks).derivative()(np.asarray(t, dtype=float))
+    c = np.asarray(rack.coefficients, dtype=float)
+    times = np.asarray(t, dtype=float)
+    piece = np.clip(np.searchsorted(breaks, times, side="right") - 1, 0, len(breaks) - 2)
+    s = times - breaks[piece]
+    degree = len(c) - 1
+    speed = np.zeros_like(s)
+    power = np.ones_like(s)
+    for i in range(degree):  # the term of s**i: the coefficient of s**(i + 1) times i + 1
+        speed = speed + (c[degree - 1 - i, piece] * float(i + 1)) * power
+        power = power * s
     inside = (np.asarray(t) >= breaks[0]) & (np.asarray(t) <= breaks[-1])
     return np.where(inside, speed, 0.0)
 
