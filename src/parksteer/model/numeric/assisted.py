@@ -14,7 +14,7 @@ eta_f 0.85); below it the law is refused. The derivation: docs/assist.md, "Repla
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
-from functools import cached_property, lru_cache
+from functools import lru_cache
 
 import numpy as np
 
@@ -23,7 +23,7 @@ from ...errors import UsageError
 from ...parameters import VEHICLE_SPEED
 from ...reduction_efficiency import min_monotone_back_efficiency
 from ..symbolic.components import power_assist_of
-from ..symbolic.effects.assist_common import (clamp, deadband, directional_efficiency, speed_gain, table_law,
+from ..symbolic.effects.assist_common import (_half_numeric, clamp, deadband, directional_efficiency, speed_gain,
                                               table_points)
 from .prescribed import PRESCRIBED_ATOL_FACTOR, PRESCRIBED_RTOL, PrescribedSolution, RackMotion, solve
 
@@ -77,18 +77,17 @@ class BoostLaw:
         scale = self.ratio if self.location == "rack" and not self.hydraulic else 1.0
         demand = self.gain * opening * scale
         if any(self.table):
-            demand = demand + self.table_scale * table_law(np.asarray(torsion_bar_Nm, dtype=float), None, self.speed,
-                                                           self._table_points)
+            demand = demand + self.table_scale * _table_law_numeric(np.asarray(torsion_bar_Nm, dtype=float),
+                                                                    self._table_points)
         if self.hydraulic:
             return clamp(demand, self.limit, self.limit_width)
         return clamp(demand / (self.efficiency * self.reduction), self.limit, self.limit_width)
 
-    @cached_property
+    @property
     def _table_points(self):
-        """The table's points at this law's speed, read once: the inversion evaluates the law some 50 times a
-        sample."""
-        values = dict(zip(table_keys(), self.table))
-        return table_points(values.__getitem__, self.speed)
+        """The table's points at this law's speed, read once per table and speed (:func:`_points_at_speed`): the
+        inversion evaluates the law some 50 times a sample, and every replay of a diagnosis builds its own law."""
+        return _points_at_speed(self.table, self.speed)
 
     def with_wider_dead_band(self, size_Nm: float) -> BoostLaw:
         """This law with its dead band wider by `size_Nm`: the line's band, and every point of a table but the
@@ -188,6 +187,23 @@ def check_back_efficiency(name: str, forward: float, back: float, where: str = "
         raise UsageError(f"{where}{name}.back_efficiency {back:g}: below {least:.3f}, the least at which the gear's "
                          f"delivered torque rises with the motor torque at every speed (efficiency {forward:g}); the "
                          "law would not be increasing and the replay could not invert it")
+
+
+@lru_cache(maxsize=64)
+def _points_at_speed(table: tuple, speed: float):
+    """:func:`~parksteer.model.symbolic.effects.assist_common.table_points` of the table's scalars (table_keys
+    order) at the vehicle speed `speed`, as float arrays."""
+    values = dict(zip(table_keys(), table))
+    return tuple(np.asarray(points, dtype=float) for points in table_points(values.__getitem__, speed))
+
+
+def _table_law_numeric(torque: np.ndarray, points) -> np.ndarray:
+    """:func:`~parksteer.model.symbolic.effects.assist_common.table_law` at `torque` on a table read at one speed
+    (`points`: :func:`_points_at_speed`, all numbers): its numeric branch, the same operations, without the check
+    of every point for a symbol at each of the inversion's calls."""
+    knots, assist, slope = points
+    magnitude = _half_numeric(np.abs(torque), knots, assist, slope)
+    return np.where(torque >= 0, magnitude, -magnitude)
 
 
 def boost_law(run, p: np.ndarray) -> BoostLaw | None:
