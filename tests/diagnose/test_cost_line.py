@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import re
 
-from parksteer.reporting.sections import cost_line
+from parksteer.reporting.cost import cost_line
 
 
 def test_the_cost_line_splits_the_replays_and_seconds_by_stage():

@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 
 from .report import (confound_separates, interval_text, num, separating, shown_unit, signature_lines,
                      strength_text, tie_headline)
+from .cost import cost_line
 from .relative_text import relative_sentence
 from .user_effect_pages import user_effect_intervals, user_effect_sentence, user_effect_tables
 
@@ -397,21 +398,4 @@ def report_sections(result: dict, phases: list[dict] | None = None, ladder: dict
         out.append(Section(None, tuple(notes)))
     if result.get("signature"):
         out.append(Section("The residual's signature", (Bullets(tuple(signature_lines(result))),)))
-    out.append(Section(None, (Paragraph(cost_line(result["cost"])),)))
-    return out
-
-
-def cost_line(cost: dict) -> str:
-    """The replays and the seconds of the diagnosis, in all and by stage (the stages that replayed or took a
-    hundredth of a second), from the result's ``cost``: where a diagnosis spends its time."""
-    timings = cost.get("timings_s", {})
-    by_stage = cost.get("replays_by_stage", {})  # the replays run when each stage ended
-    parts, before = [], 0
-    for stage, seconds in timings.items():
-        replays = by_stage.get(stage, before) - before
-        before = by_stage.get(stage, before)
-        if replays or seconds >= 0.01:
-            parts.append(f"{stage.replace('_', ' ')}: {replays} replays, {seconds:.2f} s")
-    total = sum(timings.values())
-    line = f"Cost: {cost['replays']} replays"
-    return line + (f", {total:.2f} s ({'; '.join(parts)})." if timings else ".")
+    return out + [Section(None, (Paragraph(cost_line(result["cost"])),))]
