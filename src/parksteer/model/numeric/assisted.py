@@ -87,7 +87,7 @@ class BoostLaw:
     def _table_points(self):
         """The table's points at this law's speed, read once per table and speed (:func:`_points_at_speed`): the
         inversion evaluates the law some 50 times a sample, and every replay of a diagnosis builds its own law."""
-        return _points_at_speed(self.table, self.speed)
+        return _points_at_speed(np.asarray(self.table, dtype=float).tobytes(), np.float64(self.speed).tobytes())
 
     def with_wider_dead_band(self, size_Nm: float) -> BoostLaw:
         """This law with its dead band wider by `size_Nm`: the line's band, and every point of a table but the
@@ -190,11 +190,12 @@ def check_back_efficiency(name: str, forward: float, back: float, where: str = "
 
 
 @lru_cache(maxsize=64)
-def _points_at_speed(table: tuple, speed: float):
+def _points_at_speed(table: bytes, speed: bytes):
     """:func:`~parksteer.model.symbolic.effects.assist_common.table_points` of the table's scalars (table_keys
-    order) at the vehicle speed `speed`, as float arrays."""
-    values = dict(zip(table_keys(), table))
-    return tuple(np.asarray(points, dtype=float) for points in table_points(values.__getitem__, speed))
+    order) at the vehicle speed, as float arrays; both given by their bytes (so a -0.0 is not taken for a 0.0)."""
+    values = dict(zip(table_keys(), (float(v) for v in np.frombuffer(table))))
+    return tuple(np.asarray(points, dtype=float)
+                 for points in table_points(values.__getitem__, float(np.frombuffer(speed)[0])))
 
 
 def _table_law_numeric(torque: np.ndarray, points) -> np.ndarray:
