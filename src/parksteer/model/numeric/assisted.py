@@ -14,7 +14,7 @@ eta_f 0.85); below it the law is refused. The derivation: docs/assist.md, "Repla
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
-from functools import lru_cache
+from functools import cached_property, lru_cache
 
 import numpy as np
 
@@ -83,11 +83,12 @@ class BoostLaw:
             return clamp(demand, self.limit, self.limit_width)
         return clamp(demand / (self.efficiency * self.reduction), self.limit, self.limit_width)
 
-    @property
+    @cached_property
     def _table_points(self):
-        """The table's points at this law's speed, read once per table and speed (:func:`_points_at_speed`): the
-        inversion evaluates the law some 50 times a sample, and every replay of a diagnosis builds its own law."""
-        return _points_at_speed(np.asarray(self.table, dtype=float).tobytes(), np.float64(self.speed).tobytes())
+        """The table's points at this law's speed as arrays, read once per table and speed (:func:`_points_at_speed`):
+        the inversion evaluates the law some 50 times a sample, and every replay of a diagnosis builds its own law."""
+        points = _points_at_speed(np.asarray(self.table, dtype=float).tobytes(), np.float64(self.speed).tobytes())
+        return tuple(np.asarray(v, dtype=float) for v in points)
 
     def with_wider_dead_band(self, size_Nm: float) -> BoostLaw:
         """This law with its dead band wider by `size_Nm`: the line's band, and every point of a table but the
@@ -190,12 +191,13 @@ def check_back_efficiency(name: str, forward: float, back: float, where: str = "
 
 
 @lru_cache(maxsize=64)
-def _points_at_speed(table: bytes, speed: bytes):
+def _points_at_speed(table: bytes, speed: bytes) -> tuple[tuple[float, ...], tuple[float, ...], tuple[float, ...]]:
     """:func:`~parksteer.model.symbolic.effects.assist_common.table_points` of the table's scalars (table_keys
-    order) at the vehicle speed, as float arrays; both given by their bytes (so a -0.0 is not taken for a 0.0)."""
+    order) at the vehicle speed: (torques, assists, slopes); both given by their bytes (so that a -0.0 is not
+    taken for a 0.0)."""
     values = dict(zip(table_keys(), (float(v) for v in np.frombuffer(table))))
-    return tuple(np.asarray(points, dtype=float)
-                 for points in table_points(values.__getitem__, float(np.frombuffer(speed)[0])))
+    knots, assist, slope = table_points(values.__getitem__, float(np.frombuffer(speed)[0]))
+    return tuple(float(v) for v in knots), tuple(float(v) for v in assist), tuple(float(v) for v in slope)
 
 
 def _table_law_numeric(torque: np.ndarray, points) -> np.ndarray:
