@@ -14,12 +14,14 @@ interpreters with that ``src`` first on the path, on the model cache the first (
   data/vehicles/polo_vi.toml --json --quiet``.
 
 Each is repeated ``--repeats`` times in turn (tree by tree within a repeat, so a machine's drift touches every tree
-alike) and reported as its median, and as the ratio of this tree's median to each reference's. Replays per second
-is replays / wall of the diagnosis's own stages (``cost.timings_s``), the method without the process around it.
+alike) and reported as its median, and as the ratio of this tree's median to each reference's. Time per replay is
+the wall of the diagnosis's own stages (``cost.timings_s``, the method without the process around it) over its
+replays. Beside each wall, ``*_cpu_s`` is the CPU time (user + system) of the process and the workers it waited
+for: on a machine shared with other work the wall waits for the CPU, the CPU time much less.
 
-Against the commit before this round's speed work:
+The output names each reference tree first. Against the main branch before this round's speed work:
 
-    mkdir /tmp/ref && git archive 53f1b0c | tar -x -C /tmp/ref
+    mkdir /tmp/ref && git archive 755c37a | tar -x -C /tmp/ref
     python benchmarks/bench_warm_diagnosis.py --reference before=/tmp/ref/src --repeats 5
 """
 
@@ -28,6 +30,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import resource
 import statistics
 import subprocess
 import sys
@@ -44,21 +47,27 @@ DIAGNOSES = {
 }
 
 
-def run(src: Path, args: list[str]) -> tuple[float, str]:
-    """One fresh interpreter on `src`: its wall time and its stdout."""
+def _children_cpu_s() -> float:
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return usage.ru_utime + usage.ru_stime
+
+
+def run(src: Path, args: list[str]) -> tuple[float, float, str]:
+    """One fresh interpreter on `src`: its wall time, its CPU time (with the workers it waited for) and its stdout."""
     env = {**os.environ, "PYTHONPATH": str(src)}
-    start = time.perf_counter()
+    cpu, start = _children_cpu_s(), time.perf_counter()
     out = subprocess.run([sys.executable, *args], cwd=ROOT, env=env, capture_output=True, text=True, check=True)
-    return time.perf_counter() - start, out.stdout
+    return time.perf_counter() - start, _children_cpu_s() - cpu, out.stdout
 
 
 def measure(src: Path, jobs: int) -> dict[str, float]:
-    out = {"import_s": float(run(src, ["-c", IMPORT_PROBE])[1].strip()),
-           "help_s": run(src, ["-m", "parksteer.cli", "diagnose", "--help"])[0]}
+    help_wall, help_cpu, _ = run(src, ["-m", "parksteer.cli", "diagnose", "--help"])
+    out = {"import_s": float(run(src, ["-c", IMPORT_PROBE])[2].strip()), "help_s": help_wall, "help_cpu_s": help_cpu}
     for name, args in DIAGNOSES.items():
-        wall, stdout = run(src, ["-m", "parksteer.cli", *args, "--jobs", str(jobs)])
+        wall, cpu, stdout = run(src, ["-m", "parksteer.cli", *args, "--jobs", str(jobs)])
         cost = json.loads(stdout)["cost"]
         out[f"{name}_s"] = wall
+        out[f"{name}_cpu_s"] = cpu
         out[f"{name}_replays"] = float(cost["replays"])
         out[f"{name}_per_replay_ms"] = 1e3 * sum(cost["timings_s"].values()) / max(cost["replays"], 1)
     return out
@@ -82,6 +91,8 @@ def main(argv: list[str] | None = None) -> None:
         for name, src in trees.items():
             print(f"repeat {repeat + 1}/{args.repeats}: {name}", file=sys.stderr, flush=True)
             samples[name].append(measure(src, args.jobs))
+    for name, src in trees.items():
+        print(f"{name}: {src}")
     medians = {name: {k: statistics.median(s[k] for s in runs) for k in runs[0]} for name, runs in samples.items()}
     keys = list(medians["this"])
     print(f"{'median':<24}" + "".join(f"{name:>12}" for name in trees)

@@ -1,8 +1,10 @@
 """What importing the command line and the diagnosis costs: no heavy package is imported before it is used.
 
 scipy.signal (with scipy.stats, which it imports) is more than a second of every process that imports it, sympy
-seconds; a diagnosis needs neither (its decimation and running filters are written out in parksteer.portable), and
-the command line's help needs no scipy at all. These tests import in a fresh interpreter and read sys.modules.
+seconds; a diagnosis needs neither (its decimation and running filters are written out in parksteer.portable), nor
+scipy.interpolate (a second, with scipy.linalg, sparse and optimize: the rack smoothing's B-splines are written out
+in parksteer.measure.bspline). The command line's help needs no numpy at all, nor the package metadata (read for
+``--version`` alone). These tests import in a fresh interpreter and read sys.modules.
 """
 
 from __future__ import annotations
@@ -17,7 +19,9 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 NEVER_AT_IMPORT = ("scipy", "sympy", "matplotlib")
-NEVER_IN_A_DIAGNOSIS = ("scipy.signal", "scipy.stats", "sympy", "matplotlib")
+NEVER_FOR_HELP = NEVER_AT_IMPORT + ("numpy", "importlib.metadata")
+NEVER_IN_A_DIAGNOSIS = ("scipy.signal", "scipy.stats", "scipy.interpolate", "scipy.sparse", "scipy.linalg",
+                        "scipy.optimize", "sympy", "matplotlib")
 
 
 def _loaded_after(code: str) -> list[str]:
@@ -37,12 +41,14 @@ def test_importing_the_command_line_and_the_diagnosis_imports_no_scipy_sympy_or_
     assert _heavy(modules, NEVER_AT_IMPORT) == []
 
 
-def test_help_of_diagnose_imports_no_scipy():
-    """`parksteer diagnose --help` prints its options without importing scipy, sympy or matplotlib."""
+def test_help_of_diagnose_imports_no_numpy():
+    """`parksteer diagnose --help` prints its options without importing numpy, scipy, sympy or matplotlib, or the
+    package metadata: every subcommand's module imports its numerical layers where its command runs."""
     modules = _loaded_after("import contextlib, io\nfrom parksteer.cli import main\n"
                             "with contextlib.redirect_stdout(io.StringIO()), contextlib.suppress(SystemExit):\n"
                             "    main(['diagnose', '--help'])")
-    assert _heavy(modules, NEVER_AT_IMPORT) == []
+    assert "parksteer.commands.measure" in modules  # the probe did build the diagnose parser
+    assert _heavy(modules, NEVER_FOR_HELP) == []
 
 
 def _resampled(source: Path, target: Path, factor: int) -> None:
@@ -60,7 +66,9 @@ def _resampled(source: Path, target: Path, factor: int) -> None:
 @pytest.mark.slow
 def test_a_diagnosis_of_a_decimated_record_never_imports_scipy_signal_stats_or_sympy(tmp_path):
     """The README's example record at five times its rate (so decimated to the method's rate on import), diagnosed
-    from start to verdict, imports neither scipy.signal nor scipy.stats nor sympy nor matplotlib."""
+    from start to verdict (its rack smoothed, with the replay ensemble's racks), imports neither scipy.signal nor
+    scipy.stats nor scipy.interpolate (nor the scipy.linalg, sparse and optimize it brings) nor sympy nor
+    matplotlib."""
     from parksteer.measure.importers import load_record
 
     record = tmp_path / "example_250Hz.csv"

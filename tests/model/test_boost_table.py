@@ -301,3 +301,27 @@ def test_the_slope_the_jacobian_takes_is_the_laws_derivative():
     h = 1e-6
     difference = (law(values, t + h, 1.5) - law(values, t - h, 1.5)) / (2 * h)
     assert np.max(np.abs(difference - table_slope(t, values.__getitem__, 1.5))) < 1e-5
+
+
+def test_the_replays_boost_law_reads_its_table_as_table_law_does_bit_for_bit(golf):
+    """The replay's boost law reads its table from points found once per table and speed (shared by every replay
+    of a diagnosis) and evaluated without table_law's per-call check for symbols: at torques across and beyond
+    the table, at a vehicle speed between rows, its motor demand is table_law's (plus the straight line), bit for
+    bit, and a second law of the same table and speed shares the first one's points."""
+    from parksteer.boost_table import table_keys
+    from parksteer.model.numeric.assisted import BoostLaw, _points_at_speed
+    from parksteer.model.symbolic.effects.assist_common import clamp
+
+    values = {k: golf[f"{HYDRAULIC}.{k}"] for k in table_keys()}
+    table = tuple(values[k] for k in table_keys())
+    t = np.concatenate([np.linspace(-6.0, 6.0, 4001), VALVE_TORQUES, [-x for x in VALVE_TORQUES]])
+    for speed in (0.0, 0.7):
+        first = BoostLaw(HYDRAULIC, "rack", 0.0, 0.5, 0.05, 3.0e7, 5.0e4, 131.4, area=8e-4, table=table, speed=speed)
+        second = BoostLaw(HYDRAULIC, "rack", 0.0, 0.5, 0.05, 3.0e7, 5.0e4, 131.4, area=8e-4, table=table, speed=speed)
+        first._table_points  # noqa: B018 (read: the points of this table and speed cached)
+        hits = _points_at_speed.cache_info().hits
+        second._table_points  # noqa: B018 (another law of the same table and speed)
+        assert _points_at_speed.cache_info().hits == hits + 1
+        opening = np.zeros_like(t)  # valve slope 0: the table alone
+        expected = clamp(opening + 1.0 * table_law(t, values.__getitem__, speed), first.limit, first.limit_width)
+        assert np.asarray(first.motor(t)).tobytes() == np.asarray(expected).tobytes()

@@ -11,7 +11,6 @@ from pathlib import Path
 from ..names import SURFACES
 from ..errors import UsageError, naming
 from ..parameters import DEFAULT_PATH, load_parameters
-from ..tables import write_json
 from . import add_quiet_option
 from .measure import add_import_options, channel_map_of
 from .vehicle import add_vehicle_option, parameters_of
@@ -241,6 +240,8 @@ def _derive(args) -> int:
         raise UsageError(f"{args.manifests[0]}: manifests are read only with --prebuilt")
     manifest = ensure(resolve_effects(args.effects), note_cached=True)
     if args.out:
+        from ..tables import write_json  # numpy: imported where a manifest is written, not for --help
+
         write_json(args.out, manifest)
     elapsed = time.perf_counter() - start
     print(f"{'derived' if manifest['built_now'] else 'cached'} {','.join(manifest['effects']) or 'none'} -> "

@@ -7,7 +7,6 @@ import re
 from pathlib import Path
 
 from .. import model  # noqa: F401  (its effects declare their quantities, which a vehicle file may give)
-from .. import portable as pm
 from ..errors import UsageError
 from ..parameters import DEFAULT_PATH, load_parameters
 from ..vehicle import ASSIST_EFFECTS
@@ -105,6 +104,8 @@ def specification(args, gravity: float):
     if args.scrub_radius_m is not None:
         scrub = args.scrub_radius_m
     else:  # the axis runs inboard by tan(kpi)/cos(castor) per unit height above the ground
+        from .. import portable as pm  # numpy: imported where used, not for --help
+
         scrub = args.kingpin_offset_m - radius * pm.tan(chi) / pm.cos(eps)
     for option, value, low, high in (("--left-share", args.left_share, 0.0, 1.0),
                                      ("--steering-ratio", args.steering_ratio, 1.0, 100.0),

@@ -10,6 +10,7 @@ import math
 import numpy as np
 
 from .. import portable as pm
+from .bspline import DesignMatrix, derivative_rows
 from .phases import local_linear_fit
 
 # Smoothing settings (settings of the method, not properties of the car; each with its reason).
@@ -180,18 +181,16 @@ def lsq_fit(t: np.ndarray, x: np.ndarray, spacing_s: float, turns: tuple[float, 
     reaching the end holds it). Over each of `rests` the spline is constant.
     None if the spline is ill-posed.
     """
-    from scipy.interpolate import BSpline
-
     knots = _knot_vector(t, spacing_s, turns, rests)
-    # Sparse (four B-splines are nonzero at a time): scipy's sparse products sum in a fixed order, without BLAS.
-    design = BSpline.design_matrix(t, knots, 3).tocsr()
-    gram = (design.T @ design).toarray()
+    # Four B-splines are nonzero at a time; the products sum over the samples in order, without BLAS.
+    design = DesignMatrix(t, knots)
+    gram = design.gram()
     try:
         pm.cholesky(gram)
     except pm.LinAlgError:  # Schoenberg-Whitney fails: an interval without data
         return None
     inverse = pm.inv(gram)
-    rhs = design.T @ x
+    rhs = design.transpose_times(x)
     still = []  # B-spline coefficients acting over a rest are equal: the spline is constant there
     for a, b in rests:
         active = [j for j in range(len(rhs)) if knots[j] < b - 1e-9 and knots[j + 4] > a + 1e-9]
@@ -200,19 +199,18 @@ def lsq_fit(t: np.ndarray, x: np.ndarray, spacing_s: float, turns: tuple[float, 
             row[j], row[k] = 1.0, -1.0
             still.append(row)
     free, _ = _constrained_solve(inverse, rhs, np.array(still).reshape(len(still), len(rhs)))
-    rss_free = float(np.sum((design @ free - x) ** 2))
+    rss_free = float(np.sum((design.times(free) - x) ** 2))
     noise_var = max(rss_free / max(len(t) - len(rhs), 1), 1e-30)
-    speed_rows = np.array([BSpline(knots, np.eye(len(rhs))[j], 3)(np.array([t[0], t[-1]]), 1)
-                           for j in range(len(rhs))]).T
+    speed_rows = derivative_rows(knots, np.array([t[0], t[-1]]))
     held, at_rest = list(still), []
     for row in speed_rows:
         trial, _ = _constrained_solve(inverse, rhs, np.array(held + [row]))
-        rss = float(np.sum((design @ trial - x) ** 2))
+        rss = float(np.sum((design.times(trial) - x) ** 2))
         at_rest.append(hold_rest and rss - rss_free < RACK_REST_TEST_CHI2 * noise_var)
         if at_rest[-1]:
             held.append(row)
     coefficients, covariance = _constrained_solve(inverse, rhs, np.array(held).reshape(len(held), len(rhs)))
-    rms = float(np.sqrt(np.mean((design @ coefficients - x) ** 2)))
+    rms = float(np.sqrt(np.mean((design.times(coefficients) - x) ** 2)))
     return knots, coefficients, covariance, rms, tuple(at_rest)
 
 

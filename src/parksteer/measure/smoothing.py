@@ -23,6 +23,7 @@ import numpy as np
 
 from .. import portable as pm
 from ..errors import UsageError
+from .bspline import piecewise_cubic
 from .metrics import estimate_noise_rms
 from .rack_fit import (
     RACK_DISCREPANCY_FACTOR,
@@ -63,9 +64,7 @@ class SmoothedRack(RackSpline):
     def from_bspline(cls, knots, bspline, covariance, knot_spacing_s, fit_rms_m, noise_rms_m,
                      held_at_rest=(False, False), turning_times_s=(), rest_intervals_s=(),
                      passing_spacings_s=(), rest_resolution_m=0.0) -> SmoothedRack:
-        from scipy.interpolate import BSpline, PPoly
-
-        piecewise = RackSpline.from_ppoly(PPoly.from_spline(BSpline(knots, bspline, 3, extrapolate=False)))
+        piecewise = RackSpline(*piecewise_cubic(knots, bspline))
         return cls(piecewise.breaks, piecewise.coefficients, knots, bspline, covariance, float(knot_spacing_s),
                    float(fit_rms_m), float(noise_rms_m), tuple(held_at_rest), tuple(turning_times_s),
                    tuple(rest_intervals_s), tuple(float(x) for x in passing_spacings_s) or (float(knot_spacing_s),),
@@ -121,8 +120,6 @@ def rounding_draw(rack: RackSpline, time_s: np.ndarray, step_m: float, rng: np.r
     levels crossed): the draw moves where the rack is slow and is left as it is where the rack moves. Over a
     stretch in `held` (a pause the draw holds at rest) it fades out within four knot intervals of the stretch's ends
     (the B-splines wholly inside get nothing), so the pause's edges keep their doubt and its middle stays at rest."""
-    from scipy.interpolate import BSpline, PPoly
-
     t = np.asarray(time_s, dtype=float)
     interval = RACK_MIN_SAMPLES_PER_KNOT * float(np.median(np.diff(t)))
     pieces = max(1, int(round((t[-1] - t[0]) / interval)))
@@ -136,7 +133,7 @@ def rounding_draw(rack: RackSpline, time_s: np.ndarray, step_m: float, rng: np.r
     for a, b in held:
         sigma[(first >= a) & (last <= b)] = 0.0
     draw = sigma * rng.standard_normal(count)
-    return rack.plus(RackSpline.from_ppoly(PPoly.from_spline(BSpline(knots, draw, 3, extrapolate=False))))
+    return rack.plus(RackSpline(*piecewise_cubic(knots, draw)))
 
 
 def smooth_rack(time_s, rack_m, knot_spacing_s: float | None = None, hold_rest: bool = True,

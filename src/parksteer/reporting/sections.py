@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 
 from .report import (confound_separates, interval_text, num, separating, shown_unit, signature_lines,
                      strength_text, tie_headline)
+from .cost import cost_line
 from .relative_text import relative_sentence
 from .user_effect_pages import user_effect_intervals, user_effect_sentence, user_effect_tables
 
@@ -397,5 +398,4 @@ def report_sections(result: dict, phases: list[dict] | None = None, ladder: dict
         out.append(Section(None, tuple(notes)))
     if result.get("signature"):
         out.append(Section("The residual's signature", (Bullets(tuple(signature_lines(result))),)))
-    out.append(Section(None, (Paragraph(f"Cost: {result['cost']['replays']} replays."),)))
-    return out
+    return out + [Section(None, (Paragraph(cost_line(result["cost"])),))]

@@ -24,7 +24,6 @@ from typing import Any
 
 from ..boost_table import KMH, BoostTableError, entries
 from ..errors import UsageError, cannot_read
-from ..geometry import lock_steer_angle, steer_axis
 from ..parameter_entries import (PROVENANCE, PROVENANCES, check_entry, check_provenance, check_statics, check_table,
                                  provenance_key)
 from ..parameters import (CASE_SCHEMA, DEFAULT_PATH, SCHEMA, VEHICLE_SPEED, ParameterError, Parameters, load_parameters,
@@ -319,6 +318,8 @@ def _file_or_effect_quantity(path: Path, section: str, name: str):
 
 def check_car(params: Parameters) -> None:
     """Statics and sign checks of a car; one-line :class:`ParameterError` naming the file and the key."""
+    from ..geometry import lock_steer_angle, steer_axis  # numpy: imported here, not by the command line's --help
+
     path, s = params.path, params.sections
     parts_kg = (2.0 * s["steering"]["steering_assembly_mass"] + 2.0 * s["tyre"]["tread_ring_mass"]
                 + s["steering"]["rack_mass"])

@@ -23,7 +23,7 @@ from ...errors import UsageError
 from ...parameters import VEHICLE_SPEED
 from ...reduction_efficiency import min_monotone_back_efficiency
 from ..symbolic.components import power_assist_of
-from ..symbolic.effects.assist_common import (clamp, deadband, directional_efficiency, speed_gain, table_law,
+from ..symbolic.effects.assist_common import (_half_numeric, clamp, deadband, directional_efficiency, speed_gain,
                                               table_points)
 from .prescribed import PRESCRIBED_ATOL_FACTOR, PRESCRIBED_RTOL, PrescribedSolution, RackMotion, solve
 
@@ -77,18 +77,18 @@ class BoostLaw:
         scale = self.ratio if self.location == "rack" and not self.hydraulic else 1.0
         demand = self.gain * opening * scale
         if any(self.table):
-            demand = demand + self.table_scale * table_law(np.asarray(torsion_bar_Nm, dtype=float), None, self.speed,
-                                                           self._table_points)
+            demand = demand + self.table_scale * _table_law_numeric(np.asarray(torsion_bar_Nm, dtype=float),
+                                                                    self._table_points)
         if self.hydraulic:
             return clamp(demand, self.limit, self.limit_width)
         return clamp(demand / (self.efficiency * self.reduction), self.limit, self.limit_width)
 
     @cached_property
     def _table_points(self):
-        """The table's points at this law's speed, read once: the inversion evaluates the law some 50 times a
-        sample."""
-        values = dict(zip(table_keys(), self.table))
-        return table_points(values.__getitem__, self.speed)
+        """The table's points at this law's speed as arrays, read once per table and speed (:func:`_points_at_speed`):
+        the inversion evaluates the law some 50 times a sample, and every replay of a diagnosis builds its own law."""
+        points = _points_at_speed(np.asarray(self.table, dtype=float).tobytes(), np.float64(self.speed).tobytes())
+        return tuple(np.asarray(v, dtype=float) for v in points)
 
     def with_wider_dead_band(self, size_Nm: float) -> BoostLaw:
         """This law with its dead band wider by `size_Nm`: the line's band, and every point of a table but the
@@ -190,6 +190,25 @@ def check_back_efficiency(name: str, forward: float, back: float, where: str = "
                          "law would not be increasing and the replay could not invert it")
 
 
+@lru_cache(maxsize=64)
+def _points_at_speed(table: bytes, speed: bytes) -> tuple[tuple[float, ...], tuple[float, ...], tuple[float, ...]]:
+    """:func:`~parksteer.model.symbolic.effects.assist_common.table_points` of the table's scalars (table_keys
+    order) at the vehicle speed: (torques, assists, slopes); both given by their bytes (so that a -0.0 is not
+    taken for a 0.0)."""
+    values = dict(zip(table_keys(), (float(v) for v in np.frombuffer(table))))
+    knots, assist, slope = table_points(values.__getitem__, float(np.frombuffer(speed)[0]))
+    return tuple(float(v) for v in knots), tuple(float(v) for v in assist), tuple(float(v) for v in slope)
+
+
+def _table_law_numeric(torque: np.ndarray, points) -> np.ndarray:
+    """:func:`~parksteer.model.symbolic.effects.assist_common.table_law` at `torque` on a table read at one speed
+    (`points`: :func:`_points_at_speed`, all numbers): its numeric branch, the same operations, without the check
+    of every point for a symbol at each of the inversion's calls."""
+    knots, assist, slope = points
+    magnitude = _half_numeric(np.abs(torque), knots, assist, slope)
+    return np.where(torque >= 0, magnitude, -magnitude)
+
+
 def boost_law(run, p: np.ndarray) -> BoostLaw | None:
     """The boost law of `run`'s assist with the values of the parameter vector `p` (None without an assist)."""
     effect = power_assist_of(run.effects)
@@ -221,11 +240,22 @@ def boost_law(run, p: np.ndarray) -> BoostLaw | None:
 
 
 def rack_speed_mps(rack: RackMotion, t) -> np.ndarray:
-    """The speed of `rack` at the times `t` (m/s; 0 where it is held, before its first and after its last break)."""
-    from scipy.interpolate import PPoly
+    """The speed of `rack` at the times `t` (m/s; 0 where it is held, before its first and after its last break).
 
+    The cubic pieces' derivative evaluated as scipy's PPoly(...).derivative() evaluates it, operation for operation
+    (the derivative's coefficients c_i times their powers, then summed from the constant term up), so with its bits
+    and without importing scipy.interpolate (a second of every assisted diagnosis)."""
     breaks = np.asarray(rack.breaks, dtype=float)
-    speed = PPoly(np.asarray(rack.coefficients, dtype=float), breaks).derivative()(np.asarray(t, dtype=float))
+    c = np.asarray(rack.coefficients, dtype=float)
+    times = np.asarray(t, dtype=float)
+    piece = np.clip(np.searchsorted(breaks, times, side="right") - 1, 0, len(breaks) - 2)
+    s = times - breaks[piece]
+    degree = len(c) - 1
+    speed = np.zeros_like(s)
+    power = np.ones_like(s)
+    for i in range(degree):  # the term of s**i: the coefficient of s**(i + 1) times i + 1
+        speed = speed + (c[degree - 1 - i, piece] * float(i + 1)) * power
+        power = power * s
     inside = (np.asarray(t) >= breaks[0]) & (np.asarray(t) <= breaks[-1])
     return np.where(inside, speed, 0.0)
 

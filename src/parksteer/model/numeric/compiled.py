@@ -5,6 +5,7 @@ from __future__ import annotations
 import ctypes
 import json
 from dataclasses import dataclass
+from functools import cached_property
 from pathlib import Path
 
 import numpy as np
@@ -39,6 +40,15 @@ class CompiledModel:
 
     def index(self, coordinate: str) -> int:
         return self.coordinates.index(coordinate)
+
+    @cached_property
+    def parameter_positions(self) -> dict[str, int]:
+        """Each parameter's position in the vector, found once (an assisted replay reads its boost table's hundred
+        entries by name at every replay)."""
+        positions: dict[str, int] = {}
+        for i, name in enumerate(self.info["parameters"]):
+            positions.setdefault(name, i)
+        return positions
 
     # Thin wrappers (each returns new arrays); the integrator uses the raw functions directly.
     def rhs(self, t: float, y: np.ndarray, p: np.ndarray) -> np.ndarray:

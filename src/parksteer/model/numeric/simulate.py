@@ -69,7 +69,8 @@ class PreparedRun:
     profile: object
 
     def parameter_index(self, key: str) -> int:
-        return self.model.info["parameters"].index(key)
+        position = self.model.parameter_positions.get(key)
+        return self.model.info["parameters"].index(key) if position is None else position  # absent: ValueError
 
 
 def prepare(case: str, effects=None, overrides: dict | None = None, surface: str = "ground",
