@@ -125,7 +125,7 @@ def _best_of(candidate) -> dict:
 def refit_form(form: HeldForm, train, params: Parameters, model: list[Effect], start: dict,
                settings: DiagnosisSettings) -> HeldForm:
     """The form's strengths fitted again on the records `train` alone (samples weighted out of them,
-    :func:`left_out`, take no part), the car's calibrated parameters held at `start` (the whole healthy record's
+    :func:`left_out`, take no part), the car's calibrated parameters held at `start` (the healthy records'
     calibration). Refitted together with them on a part, a form's strengths trade with the base parameters along
     the valley where the two give one torque (knots of rack friction summing to the calibrated one), and each part
     lands elsewhere along it: the parts' spread is then that trade's, which a later record, judged with the
