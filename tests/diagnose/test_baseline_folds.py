@@ -87,9 +87,13 @@ def test_the_pooled_bound_is_the_bound_on_a_mean_of_as_many_blocks():
 def test_against_a_baseline_no_interval_holding_zero_is_the_headline():
     """The settings a later record is judged with: the adequate factor the larger of the sensor's and the healthy
     spread, the BIC gain the larger of the sensor's and the healthy parts' per sample times the samples, and the
-    headline rule that names no candidate whose 95 % interval holds 0 (the held strengths are uncertain)."""
+    headline rule that names no candidate whose 95 % interval holds 0 (the held strengths are uncertain); and
+    nothing calibrated again, the car's calibrated values being the baseline's."""
     threshold = Threshold(2.0, 0.01, "folds")
     settings = threshold.settings_for(DEFAULT_SETTINGS, 2000)
+    assert DEFAULT_SETTINGS.calibrated_parameters and DEFAULT_SETTINGS.calibrated_with_angle
+    assert settings.calibrated_parameters == settings.calibrated_with_angle == ()
+    assert settings.calibrated_with_angle_offsets == ()
     assert settings.adequate_rms_factor == 2.0
     assert settings.bic_missing_threshold == pytest.approx(20.0)
     assert settings.headline_interval_clear_of_zero

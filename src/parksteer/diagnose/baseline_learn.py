@@ -150,12 +150,14 @@ def refit_form(form: HeldForm, train, params: Parameters, model: list[Effect], s
                                                 for k, v in form.strengths.items()})
 
 
-def _judged(make, judged, params, base, registry, form, train, settings, workers):
-    """The relative diagnosis of the records `judged` against `form` (held) with a threshold of the sensor's."""
+def _judged(make, judged, params, base, registry, form, train, start, settings, workers):
+    """The relative diagnosis of the records `judged` against `form` (held) and the calibrated values `start`, with
+    a threshold of the sensor's."""
     from .select import diagnose
 
+    calibrated = {k: {"value": float(v)} for k, v in start.items()}
     part = make(None, vehicle_fingerprint(params), tuple(f.label for f in train), tuple(e.name for e in base),
-                    {}, "", math.nan, form, Threshold(0.0, 0.0, "the sensor's floor"))
+                calibrated, "", math.nan, form, Threshold(0.0, 0.0, "the sensor's floor"))
     return diagnose(list(judged), params, base, registry, settings=settings, workers=workers, quiet=True,
                     baseline=part)
 
@@ -215,8 +217,8 @@ def _folds(make, f: FileData, params: Parameters, base: list[Effect], registry, 
            settings: DiagnosisSettings, workers: int, say) -> Threshold:
     """One healthy record's threshold, out of sample: each block of :attr:`DiagnosisSettings.interval_block_s` a fold
     (:func:`fold_of`), judged with the form fitted on the others (the record replayed whole, the block weighted out
-    of the fit: :func:`left_out`) held, and the calibration of the whole record, as a later record is; the bound
-    pooled over the blocks (:func:`_block_threshold`)."""
+    of the fit: :func:`left_out`) held, and the calibrated values of the whole record, as a later record is; the
+    bound pooled over the blocks (:func:`_block_threshold`)."""
     block_s = settings.interval_block_s
     folds = blocks_of(f, block_s)
     fold = fold_of(f, folds, block_s)
@@ -227,16 +229,16 @@ def _folds(make, f: FileData, params: Parameters, base: list[Effect], registry, 
         if form is not None:  # nothing held: every block is read off the one diagnosis of the record
             say(f"baseline: {label} against the form fitted on the other blocks")
             held = refit_form(form, [left_out(f, fold == k)], params, model, start, settings)
-            found = _judged(make, [f], params, base, registry, held, [f], settings, workers)
+            found = _judged(make, [f], params, base, registry, held, [f], start, settings, workers)
         elif found is None:
             say(f"baseline: the {folds} blocks of {f.label}, nothing held")
-            found = _judged(make, [f], params, base, registry, None, [f], settings, workers)
+            found = _judged(make, [f], params, base, registry, None, [f], start, settings, workers)
         rows.append(fold_row(found, label, fold == k))
     held = ("with the form fitted on the other blocks (the car's calibrated parameters held) held, out of sample"
             if form is not None else "with nothing held (the healthy record is adequate: one diagnosis of it)")
     method = (f"blocks: the one healthy record cut into blocks of {block_s:g} s, each left out in turn; each "
-              f"block's weighted RMS error and share of the best candidate's BIC gain {held}, and the whole record "
-              "calibrated, as a later record is")
+              f"block's weighted RMS error and share of the best candidate's BIC gain {held}, and the car's "
+              "calibrated values held, as a later record is judged")
     return _block_threshold(rows, method)
 
 
@@ -254,7 +256,7 @@ def spread(make, files, params: Parameters, base: list[Effect], registry, form: 
         if form is not None:
             model = sorted([*base, form.model_effect(registry)], key=lambda e: e.name)
             held = refit_form(form, train, params, model, start, settings)
-        found = _judged(make, [judged], params, base, registry, held, train, settings, workers)
+        found = _judged(make, [judged], params, base, registry, held, train, start, settings, workers)
         n = found.problem.n
         rows.append({"part": judged.label, "samples": int(n), "over_floor": math.sqrt(found.calibration.rss / n),
                      **_best_of(found.best), "delta_bic": _best_gain(found),
