@@ -101,3 +101,21 @@ def test_against_a_baseline_no_interval_holding_zero_is_the_headline():
     low = Threshold(1.0, 0.0, "folds").settings_for(DEFAULT_SETTINGS, 2000)
     assert low.adequate_rms_factor == DEFAULT_SETTINGS.adequate_rms_factor
     assert low.bic_missing_threshold == DEFAULT_SETTINGS.bic_missing_threshold
+
+
+def test_a_later_record_is_given_the_baselines_calibrated_values():
+    """Against a baseline nothing is calibrated again, so the car a later record is replayed with must carry the
+    baseline's calibrated values: a rack friction calibrated to 650 N on the healthy record (the file says
+    otherwise) is the later record's rack friction, and every other value is the file's."""
+    from parksteer.diagnose.baseline import Baseline
+    from parksteer.parameters import load_parameters
+
+    params = load_parameters()
+    key = "steering.rack_friction_force"
+    assert params.value(key, "unladen") != 650.0
+    baseline = Baseline(None, "0" * 16, ("healthy.csv",), (), {key: {"value": 650.0}}, "adequate", 1.0, None,
+                        Threshold(1.0, 0.0, "blocks"))
+    later = baseline.parameters(params)
+    assert later.value(key, "unladen") == 650.0
+    other = "tyre.friction_coefficient"
+    assert later.value(other, "unladen") == params.value(other, "unladen")
