@@ -18,6 +18,7 @@ import pytest
 
 from parksteer.cli import main
 from parksteer.diagnose.baseline import Baseline, learn_baseline
+from parksteer.diagnose.baseline_learn import blocks_of
 from parksteer.diagnose.problem import load_files
 from parksteer.reporting.report import diagnosis_dict
 from parksteer.diagnose.select import diagnose
@@ -164,7 +165,7 @@ def test_the_baseline_file_round_trips(car):
 
 
 def test_command_line_baseline_then_diagnose(car, tmp_path, capsys):
-    """`parksteer baseline` on one healthy record (the threshold from its three folds, each out of sample), then
+    """`parksteer baseline` on one healthy record (the threshold from its 2 s blocks, each out of sample), then
     `diagnose --baseline` on a later record: exit 0, the file written, the JSON valid and naming the file; the
     healthy record itself given as the baseline is learnt in memory to the same verdict and fitted values;
     `baseline` refuses to overwrite without --force."""
@@ -173,8 +174,10 @@ def test_command_line_baseline_then_diagnose(car, tmp_path, capsys):
     assert "wrote" in capsys.readouterr().out
     text = out.read_text(encoding="utf-8")
     threshold = tomllib.loads(text)["threshold"]
-    assert threshold["method"].startswith("folds")
-    assert [p["part"] for p in threshold["parts"]] == [f"healthy_a.csv (fold {k} of 3)" for k in (1, 2, 3)]
+    assert threshold["method"].startswith("blocks")
+    blocks = blocks_of(load_files([car["paths"]["healthy_a"]], PARAMS)[0], DEFAULT_SETTINGS.interval_block_s)
+    assert [p["part"] for p in threshold["parts"]] == [f"healthy_a.csv (block {k} of {blocks})"
+                                                       for k in range(1, blocks + 1)]
     assert main(["diagnose", str(car["paths"]["column"]), "--baseline", str(out), "--json", "--quiet"]) == 0
     result = json.loads(capsys.readouterr().out)
     jsonschema.validate(result, json.loads(data_file("diagnosis.schema.json").read_text(encoding="utf-8")))

@@ -4,14 +4,15 @@
 (:meth:`parksteer.diagnose.calibrate.Fit.intervals`), what the healthy car has that the model lacks
 (:class:`HeldForm`: the named library candidate at its fitted strength, or the form the residual's signature
 points to, :func:`parksteer.diagnose.suggest.suggest`), and how far apart healthy data are (:class:`Threshold`,
-out of sample: leave one record out, or with one record three folds of 2 s blocks; the one-sided 95 % prediction
-bound, in noise floors, for one more healthy part). A later record is diagnosed (``diagnose(..., baseline=...)``)
-with the form's strengths held at the baseline's values, from its calibrated values, and with that threshold where
-it is above the sensor's (:meth:`Threshold.settings_for`): ``adequate`` reads "as the baseline", ``missing``
-"changed: X", ``unexplained`` "changed, outside the library"; against a baseline no candidate whose 95 % interval
-holds 0 is named. The diagnosis's JSON names the baseline (``relative_to``). The file (:meth:`Baseline.write`,
-:mod:`parksteer.diagnose.baseline_file`) is TOML a person reads, every value with its interval and source. Why and
-how: docs/diagnosis.md, "Against a car's baseline".
+out of sample: leave one record out, or with one record each of its 2 s blocks left out; the one-sided 95 %
+prediction bound, in noise floors, for one more healthy record). A later record is diagnosed
+(``diagnose(..., baseline=...)``) with the form's strengths and the car's calibrated values held at the baseline's
+(nothing calibrated again), and with that threshold where it is above the sensor's
+(:meth:`Threshold.settings_for`): ``adequate`` reads "as the baseline", ``missing`` "changed: X", ``unexplained``
+"changed, outside the library"; against a baseline no candidate whose 95 % interval holds 0 is named. The
+diagnosis's JSON names the baseline (``relative_to``).
+The file (:meth:`Baseline.write`, :mod:`parksteer.diagnose.baseline_file`) is TOML a person reads, every value with its
+interval and source. Why and how: docs/diagnosis.md, "Against a car's baseline".
 """
 
 from __future__ import annotations
@@ -92,13 +93,13 @@ class Baseline:
 
     def parameters(self, params: Parameters) -> Parameters:
         """The car's parameters a later record is diagnosed with: the identified vehicle file's where the baseline
-        identified the assist, with the held form's values."""
+        identified the assist, with the calibrated values and the held form's values."""
         if self.identified_vehicle is not None:
             params = identified_parameters(self.identified_vehicle)
         if self.form is None:
-            return params
+            return params.with_overrides(self.start)
         self.form.model_effect()  # a signature's form registers its quantities
-        return params.with_overrides(self.form.values)
+        return params.with_overrides({**self.start, **self.form.values})
 
     def model(self, effects, registry: dict[str, Effect] | None = None) -> list[Effect]:
         """The model's `effects` with the held form added."""

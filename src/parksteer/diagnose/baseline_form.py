@@ -72,15 +72,20 @@ class Threshold:
     def settings_for(self, settings: DiagnosisSettings, samples: int) -> DiagnosisSettings:
         """`settings` with the thresholds of "as the baseline" for a later record of `samples` samples: the adequate
         factor at least the healthy spread, the ceiling on a named effect's error raised in proportion, and the BIC
-        gain a candidate needs at least what healthy parts reached at the same length; and no candidate named whose
+        gain a candidate needs at least what healthy parts reached at the same length; no candidate named whose
         95 % interval holds 0 (``headline_interval_clear_of_zero``): against a baseline the held strengths are
-        uncertain, and a strength the data do not hold apart from 0 is within what the healthy car already does."""
+        uncertain, and a strength the data do not hold apart from 0 is within what the healthy car already does; and
+        nothing calibrated again (the car's calibrated values are the baseline's, :meth:`Baseline.parameters`): a
+        change that a calibrated value can carry (a column friction through the rack friction) is otherwise taken up
+        by it and never named."""
         adequate = max(settings.adequate_rms_factor, self.over_floor)
         ceiling = max(settings.missing_rms_ceiling, adequate * settings.missing_rms_ceiling
                       / settings.adequate_rms_factor)
         bic = max(settings.bic_missing_threshold, self.bic_per_sample * samples)
         return dataclasses.replace(settings, adequate_rms_factor=adequate, missing_rms_ceiling=ceiling,
-                                   bic_missing_threshold=bic, headline_interval_clear_of_zero=True)
+                                   bic_missing_threshold=bic, headline_interval_clear_of_zero=True,
+                                   calibrated_parameters=(), calibrated_with_angle=(),
+                                   calibrated_with_angle_offsets=())
 
     def as_dict(self) -> dict:
         return {"over_floor": self.over_floor, "bic_per_sample": self.bic_per_sample, "method": self.method,

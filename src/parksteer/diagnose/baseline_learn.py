@@ -14,7 +14,7 @@ from ..model.symbolic.components import Effect, discover_effects, power_assist_o
 from ..parameters import Parameters
 from .baseline_file import identified_parameters
 from .baseline_form import HeldForm, Threshold, vehicle_fingerprint
-from .calibrate import Fit, calibrate
+from .calibrate import Fit, free_parameter, free_strengths, least_squares, linear_parameter, polish
 from .engine import ReplayEngine
 from .problem import FileData, Problem
 from .settings import DiagnosisSettings
@@ -124,25 +124,40 @@ def _best_of(candidate) -> dict:
 
 def refit_form(form: HeldForm, train, params: Parameters, model: list[Effect], start: dict,
                settings: DiagnosisSettings) -> HeldForm:
-    """The form's strengths fitted again, with the calibrated parameters, on the records `train` alone (samples
-    weighted out of them, :func:`left_out`, take no part)."""
+    """The form's strengths fitted again on the records `train` alone (samples weighted out of them,
+    :func:`left_out`, take no part), the car's calibrated parameters held at `start` (the healthy records'
+    calibration). Refitted together with them on a part, a form's strengths trade with the base parameters along
+    the valley where the two give one torque (knots of rack friction summing to the calibrated one), and each part
+    lands elsewhere along it: the parts' spread is then that trade's, which a later record, judged with the
+    strengths held and only the base calibrated, never sees."""
     problem = Problem(list(train), params.with_overrides(form.places))
     engine = ReplayEngine()
-    strengths = None
+    steps = {k: max(abs(float(v["value"])) * 1e-2, 1e-9) for k, v in form.strengths.items()}
     if form.source == "candidate":  # a library strength, stepped by a hundredth of its value
-        strengths = {k: max(abs(float(v["value"])) * 1e-2, 1e-9) for k, v in form.strengths.items()}
-    fit = calibrate(engine, problem, model, strengths=strengths, start={**start, **form.values}, settings=settings)
-    values = fit.values
-    return dataclasses.replace(form, strengths={k: {**v, "value": float(values.get(k, v["value"]))}
+        parameters = [linear_parameter(model, k, step) for k, step in steps.items()]
+    else:  # a form's free strengths, fitted as they stand within their bounds
+        parameters = [free_parameter(engine, problem, model, q) for q in free_strengths(model)
+                      if q.key in form.strengths]
+    values = {**start, **form.values}
+    theta0 = np.array([p.theta(values[p.key]) for p in parameters])
+    fixed = {k: v for k, v in start.items() if k not in form.strengths}
+    fit = least_squares(engine, problem, model, parameters, theta0, fixed, settings=settings,
+                        refresh_at_end=not settings.calibration_polished)
+    if settings.calibration_polished:
+        fit = polish(engine, problem, fit, settings)
+    fitted = fit.values
+    return dataclasses.replace(form, strengths={k: {**v, "value": float(fitted.get(k, v["value"]))}
                                                 for k, v in form.strengths.items()})
 
 
-def _judged(make, judged, params, base, registry, form, train, settings, workers):
-    """The relative diagnosis of the records `judged` against `form` (held) with a threshold of the sensor's."""
+def _judged(make, judged, params, base, registry, form, train, start, settings, workers):
+    """The relative diagnosis of the records `judged` against `form` (held) and the calibrated values `start`, with
+    a threshold of the sensor's."""
     from .select import diagnose
 
+    calibrated = {k: {"value": float(v)} for k, v in start.items()}
     part = make(None, vehicle_fingerprint(params), tuple(f.label for f in train), tuple(e.name for e in base),
-                    {}, "", math.nan, form, Threshold(0.0, 0.0, "the sensor's floor"))
+                calibrated, "", math.nan, form, Threshold(0.0, 0.0, "the sensor's floor"))
     return diagnose(list(judged), params, base, registry, settings=settings, workers=workers, quiet=True,
                     baseline=part)
 
@@ -165,37 +180,66 @@ def _threshold(rows: list[dict], method: str) -> Threshold:
                      "one more healthy part (Student's t over the parts)", tuple(rows))
 
 
+def pooled_bound(values, per_record: int) -> float:
+    """The one-sided 95 % prediction bound for the mean of `per_record` more draws of what `values` are draws of:
+    mean + t(0.95, k-1) s sqrt(1/m + 1/k) (k values, s their standard deviation, m = `per_record`). A later record
+    is a mean over its blocks, as long as the healthy record: the spread of its mean is the blocks' spread pooled,
+    not that of a few folds' means, each itself noisy (three folds give t = 2.92 on a spread from two degrees of
+    freedom)."""
+    values = np.asarray(values, dtype=float)
+    k = values.size
+    if k < 2:
+        return float(values.max())
+    return float(values.mean() + stdtrit(k - 1, 0.95) * values.std(ddof=1) * math.sqrt(1.0 / per_record + 1.0 / k))
+
+
+def _block_threshold(rows: list[dict], method: str) -> Threshold:
+    """The threshold of one record's blocks (:func:`_folds`): the bounds on a later record's mean square error and
+    mean BIC gain per sample over as many blocks as the healthy record has, pooled over its blocks."""
+    k = len(rows)
+    mean_square = pooled_bound([r["over_floor"] ** 2 for r in rows], k)
+    gain = pooled_bound([r["delta_bic"] / r["samples"] for r in rows], k)
+    return Threshold(math.sqrt(max(mean_square, 0.0)), max(gain, 0.0), method + "; the threshold is the one-sided "
+                     f"95 % prediction bound for a later record's mean over {k} blocks, the blocks' variance pooled "
+                     "(Student's t over the blocks)", tuple(rows))
+
+
 def _best_gain(found) -> float:
     return max([0.0, *(c.delta_bic for c in found.candidates if c.delta_bic is not None)])
 
 
-FOLDS = 3  # a single record's parts: t(0.95, 2) = 2.92 over three, against 6.31 over two
+def blocks_of(f: FileData, block_s: float) -> int:
+    """How many blocks of `block_s` a record holds (its last, shorter block one of them)."""
+    return int(math.floor((f.time_s[-1] - f.time_s[0]) / block_s)) + 1
 
 
 def _folds(make, f: FileData, params: Parameters, base: list[Effect], registry, form: HeldForm | None, start: dict,
            settings: DiagnosisSettings, workers: int, say) -> Threshold:
-    """One healthy record's threshold, out of sample: its samples dealt to :data:`FOLDS` folds (:func:`fold_of`),
-    each fold judged with the form fitted on the others (the record replayed whole, the fold weighted out of the
-    fit: :func:`left_out`) held, and the calibration of the whole record, as a later record is judged."""
-    fold = fold_of(f, FOLDS, settings.interval_block_s)
+    """One healthy record's threshold, out of sample: each block of :attr:`DiagnosisSettings.interval_block_s` a fold
+    (:func:`fold_of`), judged with the form fitted on the others (the record replayed whole, the block weighted out
+    of the fit: :func:`left_out`) held, and the calibrated values of the whole record, as a later record is; the
+    bound pooled over the blocks (:func:`_block_threshold`)."""
+    block_s = settings.interval_block_s
+    folds = blocks_of(f, block_s)
+    fold = fold_of(f, folds, block_s)
     model = None if form is None else sorted([*base, form.model_effect(registry)], key=lambda e: e.name)
     rows, found = [], None
-    for k in range(FOLDS):
-        label = f"{f.label} (fold {k + 1} of {FOLDS})"
-        if form is not None:  # nothing held: every fold is read off the one diagnosis of the record
-            say(f"baseline: {label} against the form fitted on the other folds")
+    for k in range(folds):
+        label = f"{f.label} (block {k + 1} of {folds})"
+        if form is not None:  # nothing held: every block is read off the one diagnosis of the record
+            say(f"baseline: {label} against the form fitted on the other blocks")
             held = refit_form(form, [left_out(f, fold == k)], params, model, start, settings)
-            found = _judged(make, [f], params, base, registry, held, [f], settings, workers)
+            found = _judged(make, [f], params, base, registry, held, [f], start, settings, workers)
         elif found is None:
-            say(f"baseline: the {FOLDS} folds of {f.label}, nothing held")
-            found = _judged(make, [f], params, base, registry, None, [f], settings, workers)
+            say(f"baseline: the {folds} blocks of {f.label}, nothing held")
+            found = _judged(make, [f], params, base, registry, None, [f], start, settings, workers)
         rows.append(fold_row(found, label, fold == k))
-    held = ("with the form fitted on the other folds held (out of sample)" if form is not None
-            else "with nothing held (the healthy record is adequate: one diagnosis of it)")
-    method = (f"folds: the one healthy record's samples dealt in blocks of {settings.interval_block_s:g} s to "
-              f"{FOLDS} folds in turn; each fold's weighted RMS error and share of the best candidate's BIC gain "
-              f"{held} and the whole record calibrated, as a later record is")
-    return _threshold(rows, method)
+    held = ("with the form fitted on the other blocks (the car's calibrated parameters held) held, out of sample"
+            if form is not None else "with nothing held (the healthy record is adequate: one diagnosis of it)")
+    method = (f"blocks: the one healthy record cut into blocks of {block_s:g} s, each left out in turn; each "
+              f"block's weighted RMS error and share of the best candidate's BIC gain {held}, and the car's "
+              "calibrated values held, as a later record is judged")
+    return _block_threshold(rows, method)
 
 
 def spread(make, files, params: Parameters, base: list[Effect], registry, form: HeldForm | None, start: dict,
@@ -212,7 +256,7 @@ def spread(make, files, params: Parameters, base: list[Effect], registry, form: 
         if form is not None:
             model = sorted([*base, form.model_effect(registry)], key=lambda e: e.name)
             held = refit_form(form, train, params, model, start, settings)
-        found = _judged(make, [judged], params, base, registry, held, train, settings, workers)
+        found = _judged(make, [judged], params, base, registry, held, train, start, settings, workers)
         n = found.problem.n
         rows.append({"part": judged.label, "samples": int(n), "over_floor": math.sqrt(found.calibration.rss / n),
                      **_best_of(found.best), "delta_bic": _best_gain(found),

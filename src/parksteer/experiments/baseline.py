@@ -22,10 +22,10 @@ import time
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
-from ..reporting.report import diagnosis_dict
-from ..diagnose.select import diagnose
+from ..diagnose.intake import Request, intake
 from ..errors import UsageError
 from ..parameters import Parameters
+from ..reporting.report import diagnosis_dict
 from ..synthetic.quirks import QUIRKS
 from ..synthetic.variations import variation_by_name
 from .baseline_cars import (ASSISTED_CONVERTERS, ASSISTED_HIDDEN, ASSISTED_OUT_OF_CLASS, MANUAL_CONVERTERS,
@@ -141,12 +141,11 @@ def run_car(params: Parameters, car: Car, vehicle_path=None, progress=None) -> d
             found = identified_route(Owner(maker.owner, maker.assist, maker.effects), healthy, folder)
             absolute_params, absolute_effects = found.params, found.effects
 
-        def files(paths, p):
-            return maker.files(paths) if car.kind == "manual" else maker.files(paths, p)
+        def taken(paths, p, effects, settings=BENCHMARK_SETTINGS, command="diagnose"):
+            return intake(Request(paths, p, effects, settings=settings, command=command))
 
         def absolute(paths):
-            return diagnosis_dict(diagnose(files(paths, absolute_params), absolute_params, absolute_effects,
-                                           settings=BENCHMARK_SETTINGS))
+            return diagnosis_dict(taken(paths, absolute_params, absolute_effects).diagnose())
 
         started = time.perf_counter()
         baseline, learnt = None, None
@@ -154,7 +153,8 @@ def run_car(params: Parameters, car: Car, vehicle_path=None, progress=None) -> d
             owner = params if car.kind == "manual" else maker.owner
             effects = None if car.kind == "manual" else maker.effects
             vehicle = None if car.kind == "manual" else maker.owner_path
-            baseline = learn(files([healthy, *more], owner), owner, effects, LEARN_SETTINGS, vehicle=vehicle)
+            records = taken([healthy, *more], owner, effects, LEARN_SETTINGS, "baseline")
+            baseline = learn(records.files, records.params, records.effects, records.settings, vehicle=vehicle)
             learnt = time.perf_counter() - started
         healthy_result = absolute([healthy])
         out = {"car": car.name, "kind": car.kind, "quirk": car.quirk, "tier": car.tier,
@@ -182,8 +182,7 @@ def run_car(params: Parameters, car: Car, vehicle_path=None, progress=None) -> d
             if baseline is not None:
                 owner = params if car.kind == "manual" else maker.owner
                 effects = None if car.kind == "manual" else maker.effects
-                result = diagnosis_dict(diagnose(files([path], owner), owner, effects, settings=BENCHMARK_SETTINGS,
-                                                 baseline=baseline))
+                result = diagnosis_dict(taken([path], owner, effects).diagnose(baseline=baseline))
                 row["baseline"] = judged(truth, result)
             else:
                 row["baseline"] = None

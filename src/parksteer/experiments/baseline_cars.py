@@ -14,7 +14,6 @@ import re
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-from ..diagnose.problem import load_files
 from ..errors import UsageError
 from ..measure.io import write_measurement
 from ..parameters import Parameters
@@ -157,9 +156,6 @@ class ManualCar:
     def write(self, path: Path, record) -> None:
         write_measurement(path, record, self.params)
 
-    def files(self, paths):
-        return load_files(paths, self.params)
-
 
 # --- an assisted car -----------------------------------------------------------------------------------------
 
@@ -254,9 +250,6 @@ class AssistedCar:
         from .assisted_truth import _write
 
         _write(path, record, self.owner)
-
-    def files(self, paths, params=None):
-        return load_files(paths, params or self.owner, assist=self.assist)
 
 
 __all__ = ["ASSISTED_HIDDEN", "MANUAL_HIDDEN", "AssistedCar", "Car", "Later", "ManualCar", "owner_gear_text"]
