@@ -234,10 +234,10 @@ def _folds(make, f: FileData, params: Parameters, base: list[Effect], registry, 
             say(f"baseline: the {folds} blocks of {f.label}, nothing held")
             found = _judged(make, [f], params, base, registry, None, [f], start, settings, workers)
         rows.append(fold_row(found, label, fold == k))
-    held = ("with the form fitted on the other blocks (the car's calibrated parameters held) held, out of sample"
+    held = ("with the held form refitted on the other blocks (out of sample)"
             if form is not None else "with nothing held (the healthy record is adequate: one diagnosis of it)")
     method = (f"blocks: the one healthy record cut into blocks of {block_s:g} s, each left out in turn; each "
-              f"block's weighted RMS error and share of the best candidate's BIC gain {held}, and the car's "
+              f"block's weighted RMS error and share of the best candidate's BIC gain {held}, the car's "
               "calibrated values held, as a later record is judged")
     return _block_threshold(rows, method)
 
