@@ -24,7 +24,7 @@ from ..model.symbolic.components import Effect, discover_effects, power_assist_o
 from ..parameters import Parameters
 from .candidates import candidate_effects, models_to_build, replay_models
 from .compare import check_torque_sensors
-from .parallel import Progress, by_reference, signals_held
+from .parallel import Progress, signals_held
 from .engine import ReplayEngine
 from .problem import FileData, Problem
 from .settings import DEFAULT_SETTINGS, DiagnosisSettings
@@ -80,8 +80,6 @@ def diagnose(files: list[FileData], params: Parameters, effects=None, registry: 
         settings = baseline.threshold.settings_for(settings, problem.n)
     progress = Progress(quiet)
     registry = registry if registry is not None else discover_effects()
-    # an effect loaded from a file (the model's, or a candidate named in the environment) replays in the workers
-    by_reference([*base, *registry.values()])
     # with a user's effect that declares free strengths, the error without it and with it (stages/user_effect.py)
     state = DiagnosisState(settings, problem, tuple(base), frozen_mapping(registry),
                            None if strengths is None else frozen_mapping(strengths),
@@ -92,7 +90,9 @@ def diagnose(files: list[FileData], params: Parameters, effects=None, registry: 
     # The models the candidates replay in are built in the background while the base model's stages run (the base
     # model itself is built, if missing, when first replayed).
     builders = start_builds(models_to_build(base, testable, params)[1:], workers)
-    engine = ReplayEngine(workers, hosts=replay_models(base, testable, params))
+    # the workers hold every effect a stage may replay: one loaded from a file (the model's, or a candidate named in
+    # the environment) among them
+    engine = ReplayEngine(workers, hosts=replay_models(base, testable, params), effects=(*base, *registry.values()))
     try:
         state = run_table(state, engine)
         if baseline is not None:  # after the table: a stage that runs it again starts from nothing found
