@@ -26,10 +26,6 @@ PACKAGE = Path(__file__).resolve().parents[1] / "src" / "parksteer"
 
 # (module path under src/parksteer, name) -> why the module keeps that state.
 EXCEPTIONS: dict[tuple[str, str], str] = {
-    ("parameters.py", "_DECLARED"): (
-        "the quantities effects declare, joined as effects load (an effect file given by a user among them) and "
-        "looked up by key from any Parameters; moving them onto a value every caller carries is not done yet"),
-    ("parameters.py", "_DECLARERS"): "the loaders of _DECLARED (its exception)",
     ("model/symbolic/derive.py", "Expr"): (
         "memoised_diff installs its short route as sympy's Expr.diff and puts sympy's own back when the last block "
         "using it ends: Kane's method and every node it recurses through call expr.diff, looked up on sympy's "
@@ -38,11 +34,12 @@ EXCEPTIONS: dict[tuple[str, str], str] = {
 
 MUTATORS = frozenset({"append", "extend", "insert", "pop", "popitem", "remove", "discard", "add", "update",
                       "setdefault", "clear", "sort", "reverse", "__setitem__", "__delitem__", "__setattr__"})
-# Types whose values hold nothing mutable: the package's own are frozen dataclasses of immutable fields or, for
+# Types whose values hold nothing mutable: the package's own are frozen dataclasses of immutable fields, a
+# read-only mapping of them (parameters.DeclaredQuantities: every method that changes a dict refuses) or, for
 # Effect, stateless by contract (its per-build state lives on the model being built: components.Effect); a class
 # (``type``) is a definition, made once.
 IMMUTABLE_TYPES = frozenset({"str", "bytes", "int", "float", "bool", "complex", "None", "tuple", "frozenset",
-                             "Path", "Quantity", "Effect", "MappingProxyType", "type"})
+                             "Path", "Quantity", "Effect", "MappingProxyType", "DeclaredQuantities", "type"})
 CACHE_DECORATORS = frozenset({"cache", "lru_cache"})
 
 

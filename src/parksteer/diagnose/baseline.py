@@ -1,7 +1,7 @@
 """A car's baseline: what its healthy records fix, and later records judged against it.
 
 :func:`learn_baseline` learns from a car's healthy records its calibrated parameters with their 95 % intervals
-(:meth:`parksteer.diagnose.calibrate.Fit.intervals`), what the healthy car has that the model lacks
+(:meth:`parksteer.diagnose.fitting.Fit.intervals`), what the healthy car has that the model lacks
 (:class:`HeldForm`: the named library candidate at its fitted strength, or the form the residual's signature
 points to, :func:`parksteer.diagnose.suggest.suggest`), and how far apart healthy data are (:class:`Threshold`,
 out of sample: leave one record out, or with one record three folds of 2 s blocks; the one-sided 95 % prediction

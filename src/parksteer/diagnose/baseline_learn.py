@@ -14,7 +14,8 @@ from ..model.symbolic.components import Effect, discover_effects, power_assist_o
 from ..parameters import Parameters
 from .baseline_file import identified_parameters
 from .baseline_form import HeldForm, Threshold, vehicle_fingerprint
-from .calibrate import Fit, calibrate
+from .calibrate import calibrate
+from .fitting import Fit
 from .engine import ReplayEngine
 from .problem import FileData, Problem
 from .settings import DiagnosisSettings

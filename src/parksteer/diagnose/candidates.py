@@ -23,7 +23,7 @@ from .. import portable as pm
 from ..model.symbolic.components import (Effect, discover_effects, power_assist_of, resolve_effects,
                                          strength_parameter)
 from .settings import DEFAULT_SETTINGS, DiagnosisSettings
-from .calibrate import Fit
+from .fitting import Fit
 from .engine import ReplayEngine
 from .problem import Problem
 

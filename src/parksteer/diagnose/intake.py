@@ -88,10 +88,11 @@ class Intake:
 
 def car_parameters(parameters: str | Path = DEFAULT_PATH, vehicle: str | Path | None = None) -> Parameters:
     """The car's parameters: the parameter file, with the vehicle file's car over it when given (its ``[assist]``
-    checked)."""
+    checked), knowing the installed effects' quantities."""
+    from ..model.symbolic.components import with_effect_quantities
     from ..parameters import load_parameters
 
-    params = load_parameters(parameters)
+    params = with_effect_quantities(load_parameters(parameters))
     if vehicle is None:
         return params
     from ..model.numeric.assist import check_assist

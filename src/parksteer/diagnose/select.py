@@ -3,7 +3,7 @@
 :func:`diagnose` runs the stages of :data:`parksteer.diagnose.stages.STAGES` in order on a frozen
 :class:`parksteer.diagnose.state.DiagnosisState`: the files replayed through the base model with each sample's
 replay uncertainty (:mod:`parksteer.diagnose.problem`); the base model's uncertain parameters calibrated to the
-optimum (:mod:`parksteer.diagnose.calibrate`, :func:`parksteer.diagnose.calibrate.polish`); every candidate not in
+optimum (:mod:`parksteer.diagnose.calibrate`, :func:`parksteer.diagnose.fitting.polish`); every candidate not in
 the model scored at the calibrated model (:mod:`parksteer.diagnose.candidates`); the best-scored few refitted in the
 full nonlinear model; the comparison by the BIC over the effective sample size, only a candidate whose fitted
 strength is above 0 heading it (:func:`parksteer.diagnose.stages.select.may_headline`); the verdict ``missing``,
@@ -20,7 +20,8 @@ from dataclasses import replace
 
 from ..errors import UsageError
 from ..model.codegen.cache import finish_builds, start_builds
-from ..model.symbolic.components import Effect, discover_effects, power_assist_of, resolve_effects
+from ..model.symbolic.components import (Effect, discover_effects, power_assist_of, resolve_effects,
+                                          with_effect_quantities)
 from ..parameters import Parameters
 from .candidates import candidate_effects, models_to_build, replay_models
 from .compare import check_torque_sensors
@@ -59,6 +60,7 @@ def diagnose(files: list[FileData], params: Parameters, effects=None, registry: 
     """
     base = effects if isinstance(effects, list) and all(isinstance(e, Effect) for e in effects) \
         else resolve_effects(effects)
+    params = with_effect_quantities(params, base)  # a value or an override of an effect's own quantity is known
     held = None
     if baseline is not None:
         baseline.check(params, base)
