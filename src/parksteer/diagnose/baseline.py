@@ -20,7 +20,7 @@ import dataclasses
 from dataclasses import dataclass
 
 from ..errors import UsageError
-from ..model.symbolic.components import Effect, resolve_effects
+from ..model.symbolic.components import Effect, resolve_effects, with_effect_quantities
 from ..parameters import Parameters
 from .baseline_file import baseline_text, content_hash, identified_parameters, parse_baseline, read_bytes
 from .baseline_form import FORMAT, HEADLINE, HeldForm, Threshold, vehicle_fingerprint
@@ -97,8 +97,7 @@ class Baseline:
             params = identified_parameters(self.identified_vehicle)
         if self.form is None:
             return params
-        self.form.model_effect()  # a signature's form registers its quantities
-        return params.with_overrides(self.form.values)
+        return with_effect_quantities(params, [self.form.model_effect()]).with_overrides(self.form.values)
 
     def model(self, effects, registry: dict[str, Effect] | None = None) -> list[Effect]:
         """The model's `effects` with the held form added."""

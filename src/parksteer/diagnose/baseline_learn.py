@@ -10,7 +10,8 @@ import math
 import numpy as np
 from scipy.special import stdtrit  # the t quantile, without importing scipy.stats
 
-from ..model.symbolic.components import Effect, discover_effects, power_assist_of, resolve_effects
+from ..model.symbolic.components import (Effect, discover_effects, power_assist_of, resolve_effects,
+                                          with_effect_quantities)
 from ..parameters import Parameters
 from .baseline_file import identified_parameters
 from .baseline_form import HeldForm, Threshold, vehicle_fingerprint
@@ -127,7 +128,7 @@ def refit_form(form: HeldForm, train, params: Parameters, model: list[Effect], s
                settings: DiagnosisSettings) -> HeldForm:
     """The form's strengths fitted again, with the calibrated parameters, on the records `train` alone (samples
     weighted out of them, :func:`left_out`, take no part)."""
-    problem = Problem(list(train), params.with_overrides(form.places))
+    problem = Problem(list(train), with_effect_quantities(params, model).with_overrides(form.places))
     engine = ReplayEngine()
     strengths = None
     if form.source == "candidate":  # a library strength, stepped by a hundredth of its value
