@@ -8,11 +8,6 @@ exactly the computation the process would have run itself: the results are the s
 same order, whatever the number of workers. Only plain results (arrays, numbers) travel back.
 A worker never forks again (:func:`fork_map` inside a worker runs in line).
 
-A task sent to a pool's workers is pickled with the objects the pool was forked holding (its ``inherited``: a
-diagnosis's effect classes) named by their place among them (:class:`InheritedPickler`, pickle's
-``persistent_id``): a worker finds each in its own inherited copy, so a class with no importable home (an effect
-loaded from a user's file, or made by a factory) reaches it without being registered anywhere by name.
-
 Where the platform cannot fork (Windows, or ``workers`` <= 1), everything runs in line.
 
 A worker ignores SIGINT (a terminal's Ctrl-C reaches the whole process group): the diagnosing process alone
@@ -79,7 +74,9 @@ SERVE_ATTRIBUTE = "parksteer_serve"
 
 class InheritedPickler(pickle.Pickler):
     """A pickler that writes each object of `inherited` (by identity) as its place in it, for a worker forked
-    holding the same sequence to read back with :func:`loads_inherited` (module docstring)."""
+    holding the same sequence to read back with :func:`loads_inherited`: a pool's tasks name the objects its
+    workers inherited (a diagnosis's effects and their classes) so, and a class with no importable home (an effect
+    loaded from a user's file, or made by a factory) reaches them without being registered anywhere by name."""
 
     def __init__(self, file, inherited: Sequence[Any]):
         super().__init__(file, protocol=pickle.HIGHEST_PROTOCOL)

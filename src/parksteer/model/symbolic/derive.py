@@ -76,10 +76,8 @@ def memoised_diff():
     count above 1, an expression without _eval_derivative or one that leaves the derivative unevaluated) takes
     sympy's own route every time.
 
-    The memo is a :class:`ShortDiff` made on entry and held by the Expr.diff installed, so nested or concurrent
-    uses (threads) share one installation and one memo; the last to leave puts sympy's own Expr.diff back. The
-    patch is of sympy's class itself (Expr.diff is looked up on the class by every node it recurses through),
-    written and restored here, as os.environ is where it is set.
+    The memo is a :class:`ShortDiff` the installed Expr.diff holds, shared by nested or concurrent uses; the last
+    to leave restores sympy's own (a patch of sympy's class, written and restored here).
     """
     from sympy.core.expr import Expr
 
