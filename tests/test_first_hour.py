@@ -7,8 +7,9 @@
   naming the cache folder, PARKSTEER_MODEL_CACHE and XDG_CACHE_HOME, status 2, and no scratch folder left behind;
 - a vehicle file with an [assist] left out of a compare or diagnose (no --with-assist) is said in one line on
   stderr, and not said for a file without one;
-- an effect loaded from a file (--effects=+path.py) pickles by reference once the command has resolved it, as the
-  diagnosis's worker pool needs (a cold diagnosis with the example user effect failed with a PicklingError).
+- an effect loaded from a file (--effects=+path.py), which pickle cannot find by its module's name, reaches the
+  worker processes of a diagnosis's engine all the same (a cold diagnosis with the example user effect failed with
+  a PicklingError).
 """
 
 from __future__ import annotations
@@ -58,18 +59,32 @@ def test_no_assist_no_warning():
     assert "warning" not in done.stderr
 
 
-def test_effect_from_a_file_pickles_by_reference():
-    """The example user effect loaded from its file, as --effects=+path.py loads it, pickles and unpickles to the
-    same class once effects_of has resolved it (before, its module was in no sys.modules entry)."""
+def test_effect_from_a_file_reaches_the_diagnosis_workers():
+    """The example user effect loaded from its file, as --effects=+path.py loads it, has no importable home (plain
+    pickle refuses it), yet a task holding it reaches the workers of a diagnosis's engine as the very effect and
+    class it was loaded as, which the workers inherited; loaded twice in one process (as a long-lived one may),
+    each load's own."""
     from parksteer.commands.measure import effects_of
+    from parksteer.diagnose.engine import ReplayEngine
+    from parksteer.diagnose.parallel import can_fork
     from parksteer.parameters import load_parameters
 
     path = REPO / "src" / "parksteer" / "examples" / "column_imbalance.py"
     args = argparse.Namespace(effects=f"+{path}", with_assist=False, vehicle=None, command="diagnose")
-    for _ in range(2):  # loaded twice in one process (as a long-lived one may), each load's class pickles
+    for _ in range(2):
         effects = effects_of(args, load_parameters())
         user = next(e for e in effects if e.name == "column_imbalance")
-        assert type(pickle.loads(pickle.dumps(user))) is type(user)
+        with pytest.raises(pickle.PicklingError):
+            pickle.dumps(user)
+        if not can_fork():
+            continue
+        engine = ReplayEngine(2, effects=tuple(effects))
+        try:
+            out = engine.pool.map(object(), lambda task: (task[0] is user, type(task[0]) is type(user), task[1]),
+                                  [(user, 1), (user, 2)])
+        finally:
+            engine.close()
+        assert out == [(True, True, 1), (True, True, 2)]
 
 
 def one_line(done: subprocess.CompletedProcess) -> str:

@@ -26,27 +26,20 @@ PACKAGE = Path(__file__).resolve().parents[1] / "src" / "parksteer"
 
 # (module path under src/parksteer, name) -> why the module keeps that state.
 EXCEPTIONS: dict[tuple[str, str], str] = {
-    ("parameters.py", "_DECLARED"): (
-        "the quantities effects declare, joined as effects load (an effect file given by a user among them) and "
-        "looked up by key from any Parameters; moving them onto a value every caller carries is not done yet"),
-    ("parameters.py", "_DECLARERS"): "the loaders of _DECLARED (its exception)",
-    ("model/symbolic/derive.py", "_DIFF_STATE"): (
-        "the memo of the derivation's patched Expr.diff: any edit under model/symbolic/ changes every shipped "
-        "model's cache key, and the patch is process-wide by sympy's design (Expr.diff is looked up on the class)"),
-    ("model/symbolic/derive.py", "Expr"): "the patch of sympy's Expr.diff that _DIFF_STATE's exception keeps",
-    ("diagnose/parallel.py", "sys"): (
-        "by_reference registers an effect class that has no importable home (loaded from a user's file, or made "
-        "by a factory) in sys.modules, where pickle looks a class up by name when a diagnosis's pool sends it to "
-        "its forked workers; pickle offers no other lookup short of a pickler of the package's own"),
+    ("model/symbolic/derive.py", "Expr"): (
+        "memoised_diff installs its short route as sympy's Expr.diff and puts sympy's own back when the last block "
+        "using it ends: Kane's method and every node it recurses through call expr.diff, looked up on sympy's "
+        "class, and sympy offers no other hook; the memo lives on the ShortDiff object the installed route holds"),
 }
 
 MUTATORS = frozenset({"append", "extend", "insert", "pop", "popitem", "remove", "discard", "add", "update",
                       "setdefault", "clear", "sort", "reverse", "__setitem__", "__delitem__", "__setattr__"})
-# Types whose values hold nothing mutable: the package's own are frozen dataclasses of immutable fields or, for
+# Types whose values hold nothing mutable: the package's own are frozen dataclasses of immutable fields, a
+# read-only mapping of them (parameters.DeclaredQuantities: every method that changes a dict refuses) or, for
 # Effect, stateless by contract (its per-build state lives on the model being built: components.Effect); a class
 # (``type``) is a definition, made once.
 IMMUTABLE_TYPES = frozenset({"str", "bytes", "int", "float", "bool", "complex", "None", "tuple", "frozenset",
-                             "Path", "Quantity", "Effect", "MappingProxyType", "type"})
+                             "Path", "Quantity", "Effect", "MappingProxyType", "DeclaredQuantities", "type"})
 CACHE_DECORATORS = frozenset({"cache", "lru_cache"})
 
 

@@ -202,11 +202,21 @@ def test_table_b1_loads_satisfy_the_chassis_statics_to_printing_precision(params
 
 def test_an_effect_quantity_out_of_its_declared_bounds_is_refused(params):
     """An effect's own quantity is declared on the effect with its bounds (a rack's lash, half the free play of the
-    mesh, is 0-0.5 mm in a worn rack; the bound is 5 mm): a lash of 0.5 m is refused in one line naming the key,
-    as a value of the parameter file out of its bounds is."""
-    assert params["rack_lash.lash"] == 0.0  # declared default: absent
+    mesh, is 0-0.5 mm in a worn rack; the bound is 5 mm): parameters used with the effects know it (its default
+    reads 0, absent), and a lash of 0.5 m is refused in one line naming the key, as a value of the parameter file
+    out of its bounds is. The parameter file alone knows no effect's quantity, whatever was imported or loaded
+    before: the key is unknown there."""
+    from parksteer.model.symbolic.components import resolve_effects, with_effect_quantities
+
+    resolve_effects("+rack_lash")  # loading an effect registers nothing anywhere
+    assert "rack_lash.lash" not in params.declared
+    with pytest.raises(UsageError) as unknown:
+        params.with_overrides({"rack_lash.lash": 1e-4})
+    assert "unknown key" in str(unknown.value)
+    with_effects = with_effect_quantities(params)
+    assert with_effects["rack_lash.lash"] == 0.0  # declared default: absent
     with pytest.raises(UsageError) as info:
-        params.with_overrides({"rack_lash.lash": 0.5})
+        with_effects.with_overrides({"rack_lash.lash": 0.5})
     message = str(info.value)
     assert "\n" not in message and message.startswith("rack_lash.lash:") and "non-physical" in message
 

@@ -25,8 +25,6 @@ EXCEPTIONS: dict[str, tuple[int, str]] = {
     "parksteer/model/codegen/cache.py": (487, STALES_PRE_DERIVED),
     "parksteer/model/symbolic/system.py": (464, STALES_PRE_DERIVED),
     "parksteer/model/codegen/generate.py:generate": (118, STALES_PRE_DERIVED),
-    "parksteer/diagnose/calibrate.py": (440, f"the calibration of the base model; {NOT_YET_SPLIT}"),
-    "parksteer/reporting/sections.py": (401, f"the diagnosis report's sections; {NOT_YET_SPLIT}"),
     "parksteer/diagnose/identify/assist_identify.py:identify_boost": (194, f"the assist's identification; {NOT_YET_CUT}"),
     "parksteer/diagnose/suggest.py:effect_source": (113, f"the suggested effect's source text; {NOT_YET_CUT}"),
     "parksteer/reporting/report.py:diagnosis_dict": (110, f"the diagnosis's JSON; {NOT_YET_CUT}"),

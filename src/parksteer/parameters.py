@@ -4,13 +4,14 @@ that gives their values.
 Every quantity has one key (``section.name``), one SI unit and one pair of physical bounds. The car's quantities
 are listed in :mod:`parksteer.quantities` (:data:`SCHEMA`) and the file gives each its value and source as
 ``{value, unit, source}`` (checked by :mod:`parksteer.parameter_entries`); an effect's own quantities
-(``<effect>.<name>``) are declared on the effect, with default and source, and join the registry
-(:func:`registry`) when the effect is loaded (:func:`declare`); the run's vehicle speed (``run.vehicle_speed``,
-:data:`VEHICLE_SPEED`), which several effects read, is declared here. Overrides (``--set``, sweeps, diagnosis,
-the workflow's config) use the same keys, plus ``case.<name>`` for the active Table B1 case
-(:meth:`Parameters.with_overrides`). Any unknown key, missing key, wrong unit, non-physical value or wheel loads
-that contradict the chassis statics are refused with a :class:`ParameterError` whose message is one line naming
-the file and the key.
+(``<effect>.<name>``) are declared on the effect, with default and source, and a :class:`Parameters` knows those
+of the effects it is used with (:attr:`Parameters.declared`, :meth:`Parameters.declaring`: the model's effects
+add theirs, :func:`parksteer.model.symbolic.components.with_effect_quantities`); the run's vehicle speed
+(``run.vehicle_speed``, :data:`VEHICLE_SPEED`), which several effects read, is declared here and known to every
+Parameters. Overrides (``--set``, sweeps, diagnosis, the workflow's config) use the same keys, plus
+``case.<name>`` for the active Table B1 case (:meth:`Parameters.with_overrides`). Any unknown key, missing key,
+wrong unit, non-physical value or wheel loads that contradict the chassis statics are refused with a
+:class:`ParameterError` whose message is one line naming the file and the key.
 """
 from __future__ import annotations
 
@@ -18,7 +19,7 @@ import dataclasses
 import math
 import numbers
 import tomllib
-from collections.abc import Callable
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -30,33 +31,16 @@ from .resources import data_file
 
 DEFAULT_PATH = data_file("parameters.toml")
 
-# Quantities declared in code by effects (key <effect>.<name>), joined when the effect is loaded.
-_DECLARED: dict[str, Quantity] = {}
-# Functions that load what declares quantities (the model's effect registry adds one when it is imported), each
-# called once, the first time a key is not found: a key of an effect not loaded yet is found all the same.
-_DECLARERS: list[Callable[[], object]] = []
+def registry(declared: Mapping[str, Quantity] | None = None) -> dict[str, Quantity]:
+    """Every key known: the parameter file's, ``case.*``, the run's and those `declared` in code (an effect's own:
+    :attr:`Parameters.declared`)."""
+    return {**FILE_AND_CASE_KEYS, **RUN_QUANTITIES, **(declared or {})}
 
 
-def add_declarer(load: Callable[[], object]) -> None:
-    """Register `load`, called once when a key is first not found, to declare quantities (load effects)."""
-    _DECLARERS.append(load)
-
-
-def _declared(key: str) -> Quantity | None:
-    if key not in _DECLARED and _DECLARERS:
-        while _DECLARERS:
-            _DECLARERS.pop(0)()
-    return _DECLARED.get(key)
-
-
-def registry() -> dict[str, Quantity]:
-    """Every known key: the parameter file's, ``case.*``, and those declared by loaded effects."""
-    return {**FILE_AND_CASE_KEYS, **_DECLARED}
-
-
-def quantity(key: str) -> Quantity:
-    """The quantity of `key`; an unknown or renamed key is a one-line UsageError."""
-    found = FILE_AND_CASE_KEYS.get(key) or _declared(key)
+def quantity(key: str, declared: Mapping[str, Quantity] | None = None) -> Quantity:
+    """The quantity of `key` (a key of the file, ``case.*``, the run's, or one of `declared`); an unknown or
+    renamed key is a one-line UsageError."""
+    found = FILE_AND_CASE_KEYS.get(key) or RUN_QUANTITIES.get(key) or (declared or {}).get(key)
     if found is None:
         raise UsageError(unknown_key_message(key))
     return found
@@ -97,27 +81,28 @@ def declaration_problem(q: Quantity) -> str | None:
     return None
 
 
-def declare(q: Quantity) -> Quantity:
-    """Join a quantity declared in code (an effect's own, with default and source) to the registry; a declaration
-    :func:`declaration_problem` finds wrong is a one-line UsageError naming the key."""
+def checked_declaration(q: Quantity, known: Mapping[str, Quantity]) -> Quantity:
+    """`q`, a quantity declared in code (an effect's own, with default and source), checked to join `known`: a
+    declaration :func:`declaration_problem` finds wrong, or one whose unit or bounds differ from those `known` has
+    for its key, is a one-line UsageError naming the key."""
     if q.section in SCHEMA or q.section == CASE:
         raise UsageError(f"{q.key}: section {q.section} belongs to the parameter file; declare {q.section}.* there")
     problem = declaration_problem(q)
     if problem is not None:
         raise UsageError(f"{q.key}: {problem}")
-    known = _DECLARED.get(q.key)
-    # the same effect's file loaded again in one process (a suggested effect written again with its fitted values as
-    # defaults) declares its quantities anew: the latest default, source and freedom win; another unit or bounds is a
-    # clash
-    if known is not None and (known.unit, known.lower, known.upper, known.lower_inclusive, known.upper_inclusive,
-                              known.is_list) != (q.unit, q.lower, q.upper, q.lower_inclusive, q.upper_inclusive,
-                                                 q.is_list):
-        raise UsageError(f"{q.key}: declared twice with different unit or bounds ({known.unit} {known.bounds_text()}, "
-                         f"then {q.unit} {q.bounds_text()}): another effect named {q.section!r} is loaded")
+    before = known.get(q.key)
+    # the same effect's file loaded again (a suggested effect written again with its fitted values as defaults)
+    # declares its quantities anew: the latest default, source and freedom win; another unit or bounds is a clash
+    if before is not None and (before.unit, before.lower, before.upper, before.lower_inclusive,
+                               before.upper_inclusive, before.is_list) != (q.unit, q.lower, q.upper, q.lower_inclusive,
+                                                                           q.upper_inclusive, q.is_list):
+        raise UsageError(f"{q.key}: declared twice with different unit or bounds ({before.unit} "
+                         f"{before.bounds_text()}, then {q.unit} {q.bounds_text()}): another effect named "
+                         f"{q.section!r} is loaded")
     if not (math.isfinite(q.default) and q.within(q.default)):
         raise UsageError(f"{q.key}: default {q.default:g} {q.unit} is outside its bounds {q.bounds_text()}")
-    _DECLARED[q.key] = q
     return q
+
 
 # The car's speed while it steers: one quantity of the run that every effect depending on it reads (the rolling
 # tyre's turn slip, the electric assist's speed-dependent boost curve), set once per run (`parksteer simulate
@@ -126,10 +111,39 @@ def declare(q: Quantity) -> Quantity:
 # parameter vector nor in its header; it is declared here, with its default 0 (standstill, the paper's test), in
 # the lowest layer, which the model, the sweeps and the measurements (whose speed channel is vehicle_speed_mps)
 # all reach.
-VEHICLE_SPEED = declare(Quantity(
+VEHICLE_SPEED = checked_declaration(Quantity(
     "run.vehicle_speed", "m/s", 0.0, 3.0, lower_inclusive=True, default=0.0,
     description="the car's speed while it steers (constant over the run)",
-    source="input of the run: 0 = standstill (the paper), up to 3 m/s (10.8 km/h) of creeping"))
+    source="input of the run: 0 = standstill (the paper), up to 3 m/s (10.8 km/h) of creeping"), {})
+
+
+class DeclaredQuantities(dict):
+    """Quantities declared in code by key, read-only (it pickles, so parameters holding it may cross a process)."""
+
+    def _read_only(self, *args, **kwargs):
+        raise TypeError("declared quantities are read-only: Parameters.declaring makes parameters knowing more")
+
+    __setitem__ = __delitem__ = clear = pop = popitem = setdefault = update = __ior__ = _read_only
+
+    def __reduce__(self):
+        return DeclaredQuantities, (dict(self),)
+
+
+# The quantities declared in code that every Parameters knows: the run's.
+RUN_QUANTITIES: Mapping[str, Quantity] = DeclaredQuantities({VEHICLE_SPEED.key: VEHICLE_SPEED})
+
+def declared_with(quantities: Iterable[Quantity], known: Mapping[str, Quantity] = RUN_QUANTITIES
+                  ) -> Mapping[str, Quantity]:
+    """`known` with `quantities` (declared in code), each checked to join it (:func:`checked_declaration`; a later one
+    of a key replaces an earlier one); `known` itself when it holds each already."""
+    new = [q for q in quantities if known.get(q.key) is not q]
+    if not new:
+        return known
+    out = dict(known)
+    for q in new:
+        out[q.key] = checked_declaration(q, out)
+    return out
+
 
 # A run's overrides (--set, a sweep point) may move the loads off the printed statics a little (a study of one
 # load), but loads more than a tenth off the front-end weight are a typo or a wrong unit: the body would not be
@@ -139,27 +153,55 @@ OVERRIDE_LOAD_FRACTION = 0.10
 
 @dataclass(frozen=True)
 class Parameters:
-    """Validated parameter values in SI units, with the source of each."""
+    """Validated parameter values in SI units, with the source of each.
+
+    `declared` holds the quantities declared in code that these parameters know beyond the file's: the run's,
+    and those of the effects they are used with (:meth:`declaring`); a quantity declared there and given no value
+    reads its default."""
 
     path: Path
     sections: dict[str, dict[str, Any]]
     cases: dict[str, dict[str, float]]
     sources: dict[str, str] = field(repr=False)
+    declared: Mapping[str, Quantity] = field(default_factory=lambda: RUN_QUANTITIES, repr=False, compare=False)
 
     def __getitem__(self, dotted: str) -> Any:
         """``params["tyre.friction_coefficient"]`` or ``params["cases.unladen.load_left"]``.
 
-        A quantity declared in code by a loaded effect (no file entry) reads its default.
+        A quantity declared in code that these parameters know (:attr:`declared`; no file entry) reads its default.
         """
         parts = dotted.split(".")
         if parts[0] == "cases" and len(parts) == 3:
             return self.case(parts[1])[parts[2]]
         if len(parts) == 2 and parts[0] in self.sections and parts[1] in self.sections[parts[0]]:
             return self.sections[parts[0]][parts[1]]
-        declared = _declared(dotted)
+        declared = self.declared.get(dotted)
         if declared is not None:
             return declared.default
         raise KeyError(dotted)
+
+    def quantity(self, key: str) -> Quantity:
+        """The quantity of `key` (:func:`quantity` with the quantities these parameters know)."""
+        return quantity(key, self.declared)
+
+    def declaring(self, quantities: Iterable[Quantity]) -> Parameters:
+        """These parameters knowing `quantities` too (each an effect's own, checked: :func:`checked_declaration`;
+        a later declaration of a key replaces an earlier one); these very parameters when they know each already."""
+        known = declared_with(quantities, self.declared)
+        return self if known is self.declared else dataclasses.replace(self, declared=DeclaredQuantities(known))
+
+    def knowing(self, known: DeclaredQuantities) -> Parameters:
+        """These parameters knowing `known`, quantities declared in code already checked together, the run's among
+        them (:func:`parksteer.model.symbolic.components.known_quantities`), besides those they know that `known`
+        lacks; where both declare a key, `known`'s replaces theirs (checked)."""
+        if known is self.declared:
+            return self
+        extra = {key: q for key, q in self.declared.items() if known.get(key) is not q}
+        if not extra:
+            return dataclasses.replace(self, declared=known)
+        for key in extra.keys() & known.keys():
+            checked_declaration(known[key], extra)
+        return dataclasses.replace(self, declared=DeclaredQuantities({**extra, **known}))
 
     def value(self, key: str, case: str) -> float:
         """The value of any registry key, ``case.<name>`` read from the case `case`."""
@@ -175,8 +217,8 @@ class Parameters:
         return dict(self.cases[name])
 
     def source(self, dotted: str) -> str:
-        if dotted not in self.sources and _declared(dotted) is not None:
-            return _DECLARED[dotted].source
+        if dotted not in self.sources and dotted in self.declared:
+            return self.declared[dotted].source
         return self.sources[dotted]
 
     def provenance(self, dotted: str) -> str:
@@ -201,7 +243,7 @@ class Parameters:
         if case is not None:
             self.case(case)
         for key, value in overrides.items():
-            q = quantity(key)
+            q = self.quantity(key)
             if q.is_list:
                 raise UsageError(f"{key}: a list; it cannot be overridden by one value")
             value = q.check(value, where=key)

@@ -21,8 +21,8 @@ def model_set(spec: Any) -> dict:
 
 def rival_names(selection: list | None = None) -> list[str]:
     """The rival effects the rivals figure compares: the configuration's `selection` checked to be rivals, or
-    every effect that declares a rival (parksteer.model.symbolic.components.chosen_rivals)."""
-    from .model.symbolic.components import chosen_rivals
+    every effect that declares a rival (parksteer.model.symbolic.rivals.chosen_rivals)."""
+    from .model.symbolic.rivals import chosen_rivals
 
     return list(chosen_rivals(selection, "config rivals"))
 

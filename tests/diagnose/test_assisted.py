@@ -237,7 +237,9 @@ def test_an_angle_only_record_gives_the_rack_through_the_torsion_bar(params, nam
     from parksteer.measure.column import rack_from_angle
     from parksteer.measure.io import Measurement
     from parksteer.model.numeric.simulate import simulate
+    from parksteer.model.symbolic.components import with_effect_quantities
 
+    params = with_effect_quantities(params)  # the assist's torsion bar at its declared stiffness
     run = simulate("unladen", effects=f"+{name}", params=params, output_dt_s=0.005, rtol=1e-8).columns
     measurement = Measurement(None, {"time_s": run["time_s"], "handwheel_angle_rad": run["handwheel_angle_rad"],
                                      "handwheel_torque_Nm": run["torsion_bar_torque_Nm"]},

@@ -2,7 +2,7 @@
 
 A candidate's refit starts from the calibrated base model; if the calibration stopped short, the refit walks on
 and the fall of the sum of squares that the base parameters alone would give is counted as the candidate's BIC
-gain (parksteer.diagnose.calibrate.polish, parksteer.diagnose.stages.select.may_headline).
+gain (parksteer.diagnose.fitting.polish, parksteer.diagnose.stages.select.may_headline).
 """
 
 from __future__ import annotations
@@ -15,7 +15,8 @@ import pytest
 from scipy.optimize import least_squares as scipy_least_squares
 from scipy.optimize import lsq_linear
 
-from parksteer.diagnose.calibrate import Fit, FitParameter, _predict, calibrate, gauss_newton_step, polish
+from parksteer.diagnose.calibrate import calibrate
+from parksteer.diagnose.fitting import Fit, FitParameter, _predict, gauss_newton_step, polish
 from parksteer.diagnose.engine import ReplayEngine
 from parksteer.diagnose.problem import load_files
 from parksteer.diagnose.select import diagnose

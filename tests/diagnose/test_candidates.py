@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from parksteer.diagnose.calibrate import Fit, FitParameter
+from parksteer.diagnose.fitting import Fit, FitParameter
 from parksteer.diagnose.candidates import Signature, score, strength_parameter
 from parksteer.model.symbolic.components import Effect
 from parksteer.parameters import Quantity

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.stats import t as student_t
 
-from parksteer.diagnose.calibrate import Z95
+from parksteer.diagnose.fitting import Z95
 from parksteer.diagnose.statistics import block_sandwich
 
 

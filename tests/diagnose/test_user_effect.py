@@ -160,12 +160,32 @@ def test_the_form_a_suggestion_is_fitted_on_is_the_force_its_file_writes(record,
     assert change > 0.05 and gap < 1e-6
 
 
-def test_a_file_effect_in_a_diagnosis_pickles_by_reference(hand_written):
-    """An effect loaded from its file and handed to diagnose() (the Python route, not only the command line's) is
-    findable by its module's name once the diagnosis has started, so a worker process it forks can be sent it
-    (before, only the command line registered it, and a diagnosis on several workers failed with a PicklingError)."""
-    user = next(e for e in hand_written.base_effects if e.name == "centre_friction")
-    assert type(pickle.loads(pickle.dumps(user))) is type(user)
+def test_a_file_effect_replays_on_workers_as_in_line(hand_written):
+    """An effect loaded from its file and handed to diagnose() (the Python route, not only the command line's)
+    replays on a diagnosis's worker processes, which are sent it by its place among the effects they inherited
+    (pickle cannot find its class by name): two files' predictions with two workers are those of one process, bit
+    for bit (before, a diagnosis on several workers failed with a PicklingError)."""
+    import numpy as np
+
+    from parksteer.diagnose.engine import ReplayEngine
+    from parksteer.diagnose.parallel import can_fork
+
+    if not can_fork():
+        pytest.skip("the platform cannot fork: everything runs in line")
+    effects = list(hand_written.base_effects)
+    assert any(e.name == "centre_friction" for e in effects)
+    with pytest.raises(pickle.PicklingError):
+        pickle.dumps(next(e for e in effects if e.name == "centre_friction"))
+    problem = hand_written.problem.with_files([hand_written.problem.files[0]] * 2)
+    predictions = {}
+    for workers in (1, 2):
+        engine = ReplayEngine(workers, effects=tuple(effects))
+        try:
+            assert engine.parallel_files(problem) == (workers == 2)
+            predictions[workers] = engine.predict(problem, effects, {})
+        finally:
+            engine.close()
+    assert all(np.array_equal(a, b) for a, b in zip(predictions[1], predictions[2]))
 
 
 def test_compare_fits_the_free_strengths_it_is_not_given(record, params, repo_root):

@@ -66,7 +66,9 @@ def test_a_car_in_gear_leaves_the_steered_pair_free_to_roll(params):
         left, right = spins
         assert abs(left - right) > 0.01  # the scrub needs the wheels to turn
         assert abs(left + right) < 1e-9 * abs(left - right)  # the held carrier (the mean) does not turn
-    source = params.source("braked_wheels.brake_fraction")
+    from parksteer.model.symbolic.components import with_effect_quantities
+
+    source = with_effect_quantities(params).source("braked_wheels.brake_fraction")
     assert "front-drive car in gear with both wheels held" not in source
 
 

@@ -13,6 +13,7 @@ from parksteer.measure.rack_spline import RackSpline, interpolate_rack
 from parksteer.geometry import column_twist
 from parksteer.model.numeric.prescribed import solve
 from parksteer.model.numeric.simulate import prepare, simulate, static_state
+from parksteer.model.symbolic.components import with_effect_quantities
 from parksteer.tables import read_csv
 
 FRICTION_OFF = "-tyre_friction,-rack_friction"
@@ -165,7 +166,7 @@ def test_prescribed_rack_with_lash_gives_back_the_free_handwheel_angle(params):
     the band the hand turns with no torque, so the rack and torque fix the angle only within the band: within 2a
     there, and the whole record's RMS angle error under 5 % of the band."""
     lash_m, ratio = 0.0002, params["steering.handwheel_to_rack_ratio"]
-    a, corner = lash_m * ratio, params["rack_lash.smoothing_width"] * ratio
+    a, corner = lash_m * ratio, with_effect_quantities(params)["rack_lash.smoothing_width"] * ratio
     overrides = {"rack_lash.lash": lash_m}
     free = simulate("unladen", effects="+rack_lash", overrides=overrides, params=params, output_dt_s=0.005)
     model, n = free.model, free.model.n_q

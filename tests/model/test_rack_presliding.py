@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from parksteer.model.numeric.simulate import simulate
+from parksteer.model.symbolic.components import with_effect_quantities
 from parksteer.parameters import load_parameters
 
 FORCE_N = 100.0
@@ -48,7 +49,7 @@ def test_reversal_spreads_over_the_presliding_displacement(runs):
     """At the reversal at right lock the bristle unloads elastically: its force, F_d before, passes zero after
     the rack has travelled back about x_p (0.2 mm; between 0.5 and 2 x_p allows for the knee's rounding), while
     the Coulomb friction has already flipped there."""
-    params = load_parameters()
+    params = with_effect_quantities(load_parameters())
     x_p = params["rack_presliding.presliding_displacement"]
     rack = runs["bristle"]["rack_m"]
     extra = runs["bristle"]["handwheel_torque_Nm"] - runs["base"]["handwheel_torque_Nm"]

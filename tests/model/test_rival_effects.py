@@ -20,8 +20,9 @@ from parksteer.diagnose.candidates import candidate_effects
 from parksteer.errors import UsageError
 from parksteer.geometry import steer_axis
 from parksteer.model.numeric.simulate import simulate
-from parksteer.model.symbolic.components import discover_effects, resolve_effects, strength_parameter
-from parksteer.parameters import registry
+from parksteer.model.symbolic.components import (discover_effects, known_quantities, resolve_effects,
+                                                 strength_parameter, with_effect_quantities)
+from parksteer.parameters import load_parameters, registry
 
 from model_helpers import DISSIPATION_OFF, with_effect, column_angle_per_rack, first_ramp, plateau_mean
 
@@ -35,6 +36,12 @@ RIVALS = {
     "rolling_resistance": ("coefficient", 0.012),
 }
 CASES = ("unladen", "part_laden", "offset_68_5mm")
+
+
+@pytest.fixture(scope="module")
+def params():
+    """The shipped parameter file, knowing the installed effects' quantities (the rivals' among them)."""
+    return with_effect_quantities(load_parameters())
 
 
 def with_rival(name: str, case: str = "unladen", strength: float | None = None, overrides=None, **kwargs):
@@ -87,7 +94,7 @@ def test_rivals_are_off_by_default_and_kept_out_of_the_diagnosis(params):
     defaults to 0 inside its bounds with a unit and a source, and the diagnosis does not offer it as a candidate
     (diagnosis_candidate = False), while the eight earlier candidates stay in its list."""
     effects = discover_effects()
-    table = registry()
+    table = registry(known_quantities())
     for name, (strength, typical) in RIVALS.items():
         effect = effects[name]
         assert not effect.in_default_set and not effect.diagnosis_candidate

@@ -66,7 +66,7 @@ def test_the_rivals_are_a_selection_of_the_effects_that_declare_one(config):
     the order given (the rows of the rivals figure, the seeds of the out-of-class data sets), every rival when a
     list is left out; rack_lash is a diagnosis candidate, not a rival, and naming it is refused in one line naming
     the entry."""
-    from parksteer.model.symbolic.components import rival_effects
+    from parksteer.model.symbolic.rivals import rival_effects
     from parksteer.plan import rival_names
     from parksteer.synthetic.outclass import OutclassDesign
 

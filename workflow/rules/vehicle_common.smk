@@ -1,6 +1,5 @@
 # Names the vehicle study's rules (workflow/rules/vehicle.smk) share: the vehicle file, its measurement files (a
 # folder, or synthetic ones of its load cases), the import options from the configuration, the study's files.
-import parksteer.model  # its effects declare their own quantities, which a vehicle file may give a value of
 from parksteer.vehicle import load_vehicle as _load_vehicle
 
 VEHICLE_SUFFIXES = (".csv", ".txt", ".mf4", ".mdf", ".dat")

@@ -6,7 +6,6 @@ import math
 import re
 from pathlib import Path
 
-from .. import model  # noqa: F401  (its effects declare their quantities, which a vehicle file may give)
 from ..errors import UsageError
 from ..parameters import DEFAULT_PATH, load_parameters
 from ..vehicle import ASSIST_EFFECTS

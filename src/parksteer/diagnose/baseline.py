@@ -1,7 +1,7 @@
 """A car's baseline: what its healthy records fix, and later records judged against it.
 
 :func:`learn_baseline` learns from a car's healthy records its calibrated parameters with their 95 % intervals
-(:meth:`parksteer.diagnose.calibrate.Fit.intervals`), what the healthy car has that the model lacks
+(:meth:`parksteer.diagnose.fitting.Fit.intervals`), what the healthy car has that the model lacks
 (:class:`HeldForm`: the named library candidate at its fitted strength, or the form the residual's signature
 points to, :func:`parksteer.diagnose.suggest.suggest`), and how far apart healthy data are (:class:`Threshold`,
 out of sample: leave one record out, or with one record each of its 2 s blocks left out; the one-sided 95 %
@@ -21,7 +21,7 @@ import dataclasses
 from dataclasses import dataclass
 
 from ..errors import UsageError
-from ..model.symbolic.components import Effect, resolve_effects
+from ..model.symbolic.components import Effect, resolve_effects, with_effect_quantities
 from ..parameters import Parameters
 from .baseline_file import baseline_text, content_hash, identified_parameters, parse_baseline, read_bytes
 from .baseline_form import FORMAT, HEADLINE, HeldForm, Threshold, vehicle_fingerprint
@@ -98,8 +98,8 @@ class Baseline:
             params = identified_parameters(self.identified_vehicle)
         if self.form is None:
             return params.with_overrides(self.start)
-        self.form.model_effect()  # a signature's form registers its quantities
-        return params.with_overrides({**self.start, **self.form.values})
+        return with_effect_quantities(params, [self.form.model_effect()]).with_overrides(
+            {**self.start, **self.form.values})
 
     def model(self, effects, registry: dict[str, Effect] | None = None) -> list[Effect]:
         """The model's `effects` with the held form added."""

@@ -10,11 +10,13 @@ import math
 import numpy as np
 from scipy.special import stdtrit  # the t quantile, without importing scipy.stats
 
-from ..model.symbolic.components import Effect, discover_effects, power_assist_of, resolve_effects
+from ..model.symbolic.components import (Effect, discover_effects, power_assist_of, resolve_effects,
+                                          with_effect_quantities)
 from ..parameters import Parameters
 from .baseline_file import identified_parameters
 from .baseline_form import HeldForm, Threshold, vehicle_fingerprint
-from .calibrate import Fit, free_parameter, free_strengths, least_squares, linear_parameter, polish
+from .calibrate import free_parameter, free_strengths, linear_parameter
+from .fitting import Fit, least_squares, polish
 from .engine import ReplayEngine
 from .problem import FileData, Problem
 from .settings import DiagnosisSettings
@@ -130,7 +132,7 @@ def refit_form(form: HeldForm, train, params: Parameters, model: list[Effect], s
     the valley where the two give one torque (knots of rack friction summing to the calibrated one), and each part
     lands elsewhere along it: the parts' spread is then that trade's, which a later record, judged with the
     strengths held and only the base calibrated, never sees."""
-    problem = Problem(list(train), params.with_overrides(form.places))
+    problem = Problem(list(train), with_effect_quantities(params, model).with_overrides(form.places))
     engine = ReplayEngine()
     steps = {k: max(abs(float(v["value"])) * 1e-2, 1e-9) for k, v in form.strengths.items()}
     if form.source == "candidate":  # a library strength, stepped by a hundredth of its value

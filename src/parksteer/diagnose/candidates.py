@@ -21,9 +21,9 @@ import numpy as np
 
 from .. import portable as pm
 from ..model.symbolic.components import (Effect, discover_effects, power_assist_of, resolve_effects,
-                                         strength_parameter)
+                                         strength_parameter, with_effect_quantities)
 from .settings import DEFAULT_SETTINGS, DiagnosisSettings
-from .calibrate import Fit
+from .fitting import Fit
 from .engine import ReplayEngine
 from .problem import Problem
 
@@ -64,7 +64,7 @@ def shares_diagnosis_model(effect: Effect, base_effects: list[Effect], params=No
     slot_ok = effect.replaces is None or effect.replaces not in filled
     return (spec is not None and slot_ok and kind.configure is Effect.configure
             and kind.bodies is Effect.bodies and set(effect.requires) <= {e.name for e in base_effects}
-            and (params is None or float(params[spec.key]) == 0.0))
+            and (params is None or float(with_effect_quantities(params, [effect])[spec.key]) == 0.0))
 
 
 def diagnosis_model(base_effects: list[Effect], candidates: list[Effect], params=None) -> list[Effect]:

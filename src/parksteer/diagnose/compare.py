@@ -18,8 +18,8 @@ import numpy as np
 
 from ..errors import UsageError
 from ..measure.metrics import Comparison, compare
-from ..model.symbolic.components import Effect, power_assist_of, resolve_effects
-from ..parameters import Parameters, quantity
+from ..model.symbolic.components import Effect, power_assist_of, quantity_of, resolve_effects
+from ..parameters import Parameters
 from .calibrate import calibrate, free_strengths
 from .engine import ReplayEngine
 from .ensemble import with_replay_uncertainty
@@ -111,7 +111,8 @@ def compare_files(files: list[FileData], params: Parameters, effects=None,
         # their values, and the files compared with the fitted model
         fit = calibrate(engine, problem, chosen, fixed=overrides)
         predictions, overrides = fit.predictions, {**overrides, **fit.values}
-        fitted = {key: {**entry, "unit": quantity(key).unit} for key, entry in fit.intervals(problem).items()}
+        fitted = {key: {**entry, "unit": quantity_of(key, chosen).unit}
+                  for key, entry in fit.intervals(problem).items()}
     files = list(problem.files)
     comparisons = [
         compare(f.time_s, f.torque_Nm, f.torque_part(m), phases=f.phases,

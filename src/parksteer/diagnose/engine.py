@@ -13,7 +13,8 @@ itself as scipy's ``OdeSolver`` keeps ``nfev``. It owns:
 - `replays`: one :class:`parksteer.diagnose.replay.Replay` per effect set, file and torque lag, each counting its
   own solves, whichever process made it;
 - `pool`, `workers`: the worker processes a prediction spreads its files over (:mod:`parksteer.diagnose.parallel`),
-  forked for the problem they serve and again for another problem, so that none answers for an earlier one;
+  forked for the problem they serve and again for another problem, so that none answers for an earlier one, and
+  holding the diagnosis's effects and their classes, which a prediction's tasks name by place;
 - `other_replays`: the solves no kept replay counts, so that :attr:`evaluations` counts every solve.
 
 How the stages use it: docs/diagnosis.md.
@@ -54,14 +55,28 @@ def effect_key(effects: list[Effect]) -> tuple[str, ...]:
     return tuple(sorted(e.name for e in effects))
 
 
+def inherited_effects(effects: list[Effect]) -> tuple:
+    """`effects` and their classes, each once, in order: what a diagnosis's workers hold when forked, so that a
+    prediction's tasks name them by place (:class:`parksteer.diagnose.parallel.InheritedPickler`), a class loaded
+    from a user's file or made by a factory among them."""
+    found: dict[int, object] = {}
+    for effect in effects:
+        found.setdefault(id(effect), effect)
+        found.setdefault(id(type(effect)), type(effect))
+    return tuple(found.values())
+
+
 class ReplayEngine:
     """The replays of one diagnosis (module docstring). `workers` > 1 spreads independent replays over forked
     processes (the same numbers as in line); `hosts` maps an effect set's key (:func:`effect_key`) to the effects
     of the compiled model it is replayed on, each host's effects beyond the set absent at their values in the
-    parameters (:func:`parksteer.diagnose.candidates.shares_diagnosis_model`). :meth:`close` ends the pool,
-    :meth:`terminate` at once (on an interrupt or an error)."""
+    parameters (:func:`parksteer.diagnose.candidates.shares_diagnosis_model`); the workers hold the hosts'
+    effects and `effects` (the diagnosis's model and candidates), which a prediction may replay
+    (:func:`inherited_effects`). :meth:`close` ends the pool, :meth:`terminate` at once (on an interrupt or an
+    error)."""
 
-    def __init__(self, workers: int = 1, hosts: dict[tuple[str, ...], list[Effect]] | None = None):
+    def __init__(self, workers: int = 1, hosts: dict[tuple[str, ...], list[Effect]] | None = None,
+                 effects: tuple[Effect, ...] = ()):
         self.workers = max(int(workers), 1)
         self.models = LoadedModels()
         self.hosts: dict[tuple[str, ...], list[Effect]] = dict(hosts or {})
@@ -70,7 +85,8 @@ class ReplayEngine:
         self.prepared: dict[tuple, tuple[object, dict]] = {}
         self.replays: dict[tuple, Replay] = {}
         self.other_replays = 0
-        self.pool = ServingPool(self.workers)
+        self.pool = ServingPool(self.workers, inherited_effects([*effects, *(e for host in self.hosts.values()
+                                                                          for e in host)]))
 
     @property
     def evaluations(self) -> int:

@@ -88,10 +88,11 @@ class Intake:
 
 def car_parameters(parameters: str | Path = DEFAULT_PATH, vehicle: str | Path | None = None) -> Parameters:
     """The car's parameters: the parameter file, with the vehicle file's car over it when given (its ``[assist]``
-    checked)."""
+    checked), knowing the installed effects' quantities."""
+    from ..model.symbolic.components import with_effect_quantities
     from ..parameters import load_parameters
 
-    params = load_parameters(parameters)
+    params = with_effect_quantities(load_parameters(parameters))
     if vehicle is None:
         return params
     from ..model.numeric.assist import check_assist
@@ -157,28 +158,20 @@ def model_effects(request: Request) -> list:
     if not request.with_assist:
         effects = given if _effect_list(given) else resolve_effects(given)
         _warn_unused_assist(request, effects)
-        return _by_reference(effects)
+        return effects
     if request.vehicle is None:
         raise UsageError("--with-assist needs --vehicle FILE (the assist is the vehicle file's [assist])")
     from ..model.numeric.assist import check_assist, effects_with_assist
 
     if check_assist(request.params) is None:
         raise UsageError(f"--with-assist: {request.vehicle} has no [assist] section")
-    return _by_reference(resolve_effects(effects_with_assist(given, request.params)))
+    return resolve_effects(effects_with_assist(given, request.params))
 
 
 def _effect_list(effects) -> bool:
     from ..model.symbolic.components import Effect
 
     return isinstance(effects, (list, tuple)) and all(isinstance(e, Effect) for e in effects)
-
-
-def _by_reference(effects) -> list:
-    """`effects`, each one's class findable by its module's name before any worker process forks
-    (:func:`parksteer.diagnose.parallel.by_reference`)."""
-    from .parallel import by_reference
-
-    return by_reference(effects)
 
 
 def _warn_unused_assist(request: Request, effects) -> None:

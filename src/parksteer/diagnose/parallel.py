@@ -22,8 +22,10 @@ long diagnosis says where it is.
 
 from __future__ import annotations
 
+import io
 import multiprocessing
 import os
+import pickle
 import signal
 import threading
 import time
@@ -70,19 +72,56 @@ def forks(count: int, workers: int) -> bool:
 SERVE_ATTRIBUTE = "parksteer_serve"
 
 
-def start_worker(serve: Callable[[Any], Any]) -> None:
-    """A pool worker's initializer: keep `serve` on the worker's own process object, where :func:`_serve` finds
-    it for each task (multiprocessing sends a task's function by name, so the function a worker runs is found
-    through an object the worker owns, not a closure). :func:`pool` forks its workers with `serve` (a closure over
-    anything in the forking process, inherited, never pickled). The diagnosing process's own process object holds
-    nothing, which is how :func:`in_worker` tells a worker, which never forks again, from the process that forked
-    it."""
+class InheritedPickler(pickle.Pickler):
+    """A pickler that writes each object of `inherited` (by identity) as its place in it, for a worker forked
+    holding the same sequence to read back with :func:`loads_inherited`: a pool's tasks name the objects its
+    workers inherited (a diagnosis's effects and their classes) so, and a class with no importable home (an effect
+    loaded from a user's file, or made by a factory) reaches them without being registered anywhere by name."""
+
+    def __init__(self, file, inherited: Sequence[Any]):
+        super().__init__(file, protocol=pickle.HIGHEST_PROTOCOL)
+        self.inherited = inherited
+        self.places = {id(obj): place for place, obj in enumerate(inherited)}
+
+    def persistent_id(self, obj):
+        place = self.places.get(id(obj))
+        return place if place is not None and self.inherited[place] is obj else None
+
+
+class InheritedUnpickler(pickle.Unpickler):
+    """Reads what :class:`InheritedPickler` wrote, each place taken from the worker's copy of `inherited`."""
+
+    def __init__(self, file, inherited: Sequence[Any]):
+        super().__init__(file)
+        self.inherited = inherited
+
+    def persistent_load(self, place):
+        return self.inherited[place]
+
+
+def dumps_inherited(obj: Any, inherited: Sequence[Any]) -> bytes:
+    buffer = io.BytesIO()
+    InheritedPickler(buffer, inherited).dump(obj)
+    return buffer.getvalue()
+
+
+def loads_inherited(data: bytes, inherited: Sequence[Any]) -> Any:
+    return InheritedUnpickler(io.BytesIO(data), inherited).load()
+
+
+def start_worker(serve: Callable[[Any], Any], inherited: Sequence[Any] = ()) -> None:
+    """A pool worker's initializer: keep `serve` and `inherited` on the worker's own process object, where
+    :func:`_serve` finds them for each task (multiprocessing sends a task's function by name, so the function a
+    worker runs is found through an object the worker owns, not a closure). :func:`pool` forks its workers with
+    both (a closure over anything in the forking process, and the objects tasks name by place: inherited, never
+    pickled). The diagnosing process's own process object holds nothing, which is how :func:`in_worker` tells a
+    worker, which never forks again, from the process that forked it."""
     # Ctrl-C is the forking process's to answer (module docstring); SIGTERM, which ends a pool's workers,
     # ends this one at once, even inside a solve, whatever handler it inherited
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
     signal.pthread_sigmask(signal.SIG_UNBLOCK, STOPPING_SIGNALS)  # held while the pool forked it
-    setattr(multiprocessing.current_process(), SERVE_ATTRIBUTE, serve)
+    setattr(multiprocessing.current_process(), SERVE_ATTRIBUTE, (serve, tuple(inherited)))
 
 
 def in_worker() -> bool:
@@ -90,22 +129,27 @@ def in_worker() -> bool:
     return getattr(multiprocessing.current_process(), SERVE_ATTRIBUTE, None) is not None
 
 
-def _serve(argument):
-    return getattr(multiprocessing.current_process(), SERVE_ATTRIBUTE)(argument)
+def _serve(task: bytes):
+    serve, inherited = getattr(multiprocessing.current_process(), SERVE_ATTRIBUTE)
+    return serve(loads_inherited(task, inherited))
 
 
-def pool(workers: int, serve: Callable[[Any], Any]):
-    """A pool of `workers` processes forked from this one, each serving `serve` (:func:`start_worker`), or None
-    where it would not fork. Map items over it with :func:`pool_map`; close it when done."""
+def pool(workers: int, serve: Callable[[Any], Any], inherited: Sequence[Any] = ()):
+    """A pool of `workers` processes forked from this one, each serving `serve` and holding `inherited`
+    (:func:`start_worker`), or None where it would not fork. Map items over it with :func:`pool_map` and the same
+    `inherited`; close it when done."""
     if not forks(workers, workers):
         return None
     with signals_held():
-        return multiprocessing.get_context("fork").Pool(workers, initializer=start_worker, initargs=(serve,))
+        return multiprocessing.get_context("fork").Pool(workers, initializer=start_worker,
+                                                        initargs=(serve, tuple(inherited)))
 
 
-def pool_map(workers_pool, items: Sequence[Any]) -> list:
-    """``[serve(item) for item in items]`` on the workers of `workers_pool` (:func:`pool`), in order."""
-    return workers_pool.map(_serve, list(items), chunksize=1)
+def pool_map(workers_pool, items: Sequence[Any], inherited: Sequence[Any] = ()) -> list:
+    """``[serve(item) for item in items]`` on the workers of `workers_pool` (:func:`pool`, forked holding
+    `inherited`), in order."""
+    tasks = [dumps_inherited(item, inherited) for item in items]
+    return workers_pool.map(_serve, tasks, chunksize=1)
 
 
 class ServingPool:
@@ -114,10 +158,12 @@ class ServingPool:
     A worker holds what the forking process held when it was forked (a diagnosis's problem, its files, its
     replays): asked to serve another key, the pool ends its workers and forks new ones from the process as it is
     then, so no worker ever answers for a key it was not made for. Keys are compared by identity, and the pool
-    holds the key it serves, so that key's identity cannot pass to another object meanwhile."""
+    holds the key it serves, so that key's identity cannot pass to another object meanwhile. Its workers hold
+    `inherited` (objects an item may hold, e.g. a diagnosis's effect classes), sent by their place in it."""
 
-    def __init__(self, workers: int):
+    def __init__(self, workers: int, inherited: Sequence[Any] = ()):
         self.workers = workers
+        self.inherited = tuple(inherited)
         self.key: Any = None
         self.pool = None
 
@@ -128,11 +174,11 @@ class ServingPool:
         if self.pool is None or self.key is not key:
             with signals_held():  # the pool is this object's before an interrupt can arrive
                 self.close()
-                self.pool = pool(self.workers, serve)
+                self.pool = pool(self.workers, serve, self.inherited)
                 self.key = key if self.pool is not None else None
         if self.pool is None:
             return None
-        return pool_map(self.pool, items)
+        return pool_map(self.pool, items, self.inherited)
 
     def close(self) -> None:
         """Let the workers finish and end them."""
@@ -187,31 +233,3 @@ class Progress:
         else:
             print(line, file=self.stream, flush=True)
 
-
-def by_reference(effects) -> list:
-    """`effects`, each one's class findable by its module's name. A diagnosis's worker pool pickles the effects it
-    sends to its forked workers, which looks a class up by that name, and two kinds of class have none: an effect
-    loaded from a file (--effects=+path.py) is of a module kept out of sys.modules (its name carries a hash of the
-    file's text: parksteer.model.symbolic.components.load_effect_module), and a class a factory makes (an electric
-    assist at its point of action, ``ElectricAssist.at``) is no attribute of its module. Each is registered under
-    its name here, before any pool forks, so the workers inherit it; a name the module gives another object is
-    left alone."""
-    import sys
-    import types
-
-    effects = list(effects)
-    for effect in effects:
-        cls = type(effect)
-        if "." in cls.__qualname__:
-            continue
-        module = sys.modules.get(cls.__module__)
-        if module is None:  # the file loaded again in one process is a new class of the same name: the latest wins
-            module = types.ModuleType(cls.__module__)
-            module._parksteer_by_reference = True
-            sys.modules[cls.__module__] = module
-        elif getattr(module, cls.__qualname__, None) is cls:
-            continue
-        elif hasattr(module, cls.__qualname__) and not getattr(module, "_parksteer_by_reference", False):
-            continue
-        setattr(module, cls.__qualname__, cls)
-    return effects

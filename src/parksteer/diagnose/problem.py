@@ -192,7 +192,12 @@ def torsion_bar(assist: str | None) -> TorsionBar | None:
 def load_files(paths: list[str | Path], params: Parameters, case: str | None = None, surface: str | None = None,
                channel_map=None, assist: str | None = None) -> list[FileData]:
     """Read and validate measurement files (:func:`parksteer.measure.column.load_measurements`, which says what
-    `case`, `surface`, `channel_map` and `assist` do) and prepare each (:func:`prepare_file`)."""
+    `case`, `surface`, `channel_map` and `assist` do) and prepare each (:func:`prepare_file`); the assist's torsion
+    bar is the car's, else its effect's default."""
+    if assist is not None:
+        from ..model.symbolic.components import with_effect_quantities
+
+        params = with_effect_quantities(params)
     files = []
     for path, measurement, chosen, resolution in load_measurements(paths, params, case, surface, channel_map,
                                                                    torsion_bar(assist)):

@@ -26,7 +26,7 @@ from ..model.numeric.compiled import CompiledModels
 from ..model.numeric.prescribed import PrescribedSolution, solve, twist_spread
 from ..model.numeric.simulate import PreparedRun, prepare
 from ..model.symbolic.components import Effect, power_assist_of
-from ..parameters import Parameters, quantity
+from ..parameters import Parameters
 
 # Prepared runs kept per replay: the base run and the latest others.
 KEPT_RUNS = 8
@@ -137,8 +137,9 @@ class Replay:
         if not direct:
             return run, run.p
         p = run.p.copy()
+        known = run.values.params  # the run's parameters know the quantities of its effects
         for key, value in direct.items():
-            p[run.parameter_index(key)] = _checked(key, value)
+            p[run.parameter_index(key)] = known.quantity(key).check(value, f"--set {key}")
         return run, p
 
     def value(self, key: str) -> float:
@@ -175,7 +176,3 @@ class Replay:
         """Handwheel torque (N m) at `time_s`."""
         return self.solve(overrides).torque_Nm
 
-
-def _checked(key: str, value: float) -> float:
-    """`value` of `key` after the bounds check that preparing a run would apply (one line naming the key)."""
-    return quantity(key).check(value, f"--set {key}")

@@ -3,7 +3,7 @@
 :func:`diagnose` runs the stages of :data:`parksteer.diagnose.stages.STAGES` in order on a frozen
 :class:`parksteer.diagnose.state.DiagnosisState`: the files replayed through the base model with each sample's
 replay uncertainty (:mod:`parksteer.diagnose.problem`); the base model's uncertain parameters calibrated to the
-optimum (:mod:`parksteer.diagnose.calibrate`, :func:`parksteer.diagnose.calibrate.polish`); every candidate not in
+optimum (:mod:`parksteer.diagnose.calibrate`, :func:`parksteer.diagnose.fitting.polish`); every candidate not in
 the model scored at the calibrated model (:mod:`parksteer.diagnose.candidates`); the best-scored few refitted in the
 full nonlinear model; the comparison by the BIC over the effective sample size, only a candidate whose fitted
 strength is above 0 heading it (:func:`parksteer.diagnose.stages.select.may_headline`); the verdict ``missing``,
@@ -20,11 +20,12 @@ from dataclasses import replace
 
 from ..errors import UsageError
 from ..model.codegen.cache import finish_builds, start_builds
-from ..model.symbolic.components import Effect, discover_effects, power_assist_of, resolve_effects
+from ..model.symbolic.components import (Effect, discover_effects, power_assist_of, resolve_effects,
+                                          with_effect_quantities)
 from ..parameters import Parameters
 from .candidates import candidate_effects, models_to_build, replay_models
 from .compare import check_torque_sensors
-from .parallel import Progress, by_reference, signals_held
+from .parallel import Progress, signals_held
 from .engine import ReplayEngine
 from .problem import FileData, Problem
 from .settings import DEFAULT_SETTINGS, DiagnosisSettings
@@ -59,6 +60,7 @@ def diagnose(files: list[FileData], params: Parameters, effects=None, registry: 
     """
     base = effects if isinstance(effects, list) and all(isinstance(e, Effect) for e in effects) \
         else resolve_effects(effects)
+    params = with_effect_quantities(params, base)  # a value or an override of an effect's own quantity is known
     held = None
     if baseline is not None:
         baseline.check(params, base)
@@ -80,8 +82,6 @@ def diagnose(files: list[FileData], params: Parameters, effects=None, registry: 
         settings = baseline.threshold.settings_for(settings, problem.n)
     progress = Progress(quiet)
     registry = registry if registry is not None else discover_effects()
-    # an effect loaded from a file (the model's, or a candidate named in the environment) replays in the workers
-    by_reference([*base, *registry.values()])
     # with a user's effect that declares free strengths, the error without it and with it (stages/user_effect.py)
     state = DiagnosisState(settings, problem, tuple(base), frozen_mapping(registry),
                            None if strengths is None else frozen_mapping(strengths),
@@ -92,7 +92,9 @@ def diagnose(files: list[FileData], params: Parameters, effects=None, registry: 
     # The models the candidates replay in are built in the background while the base model's stages run (the base
     # model itself is built, if missing, when first replayed).
     builders = start_builds(models_to_build(base, testable, params)[1:], workers)
-    engine = ReplayEngine(workers, hosts=replay_models(base, testable, params))
+    # the workers hold every effect a stage may replay: one loaded from a file (the model's, or a candidate named in
+    # the environment) among them
+    engine = ReplayEngine(workers, hosts=replay_models(base, testable, params), effects=(*base, *registry.values()))
     try:
         state = run_table(state, engine)
         if baseline is not None:  # after the table: a stage that runs it again starts from nothing found

@@ -132,7 +132,7 @@ class DiagnosisSettings:
     calibration_max_iterations: int = 10
     # A fit has converged when its Gauss-Newton step is below this fraction of every parameter's standard error.
     calibration_tolerance: float = 0.3
-    # The base calibration is then taken on to its optimum (parksteer.diagnose.calibrate.polish): on a Jacobian
+    # The base calibration is then taken on to its optimum (parksteer.diagnose.fitting.polish): on a Jacobian
     # taken afresh by finite differences, Gauss-Newton steps until the full step is within this fraction of every
     # parameter's standard error (what a candidate's refit could then gain from the base parameters moving on is
     # under 0.03 in the BIC for three parameters); a step that does not lower the sum of squares is halved up to
@@ -146,7 +146,7 @@ class DiagnosisSettings:
     # by more than this (in its fitted variable: 0.15 is 15 % of a log-fitted value) since it was taken.
     jacobian_refresh_theta: float = 0.15
     # Intervals of fitted parameters: the larger of the model-based one and a block sandwich over segments of
-    # this length, s (parksteer.diagnose.calibrate.Fit.intervals). A misfit of a wrong model class keeps one sign
+    # this length, s (parksteer.diagnose.fitting.Fit.intervals). A misfit of a wrong model class keeps one sign
     # over a stretch of a stroke (about 2 s of the 4.5 to 9 s strokes), so residuals within a segment are
     # taken as dependent and segments as independent; an 18 s record gives 9 segments.
     interval_block_s: float = 2.0

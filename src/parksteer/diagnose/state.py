@@ -15,7 +15,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ..model.symbolic.components import Effect
-from .calibrate import Fit
+from .fitting import Fit
 from .candidates import Score, Signature
 from .problem import Problem
 from .statistics import fit_statistics
@@ -179,6 +179,12 @@ class Diagnosis:
     @property
     def effect(self) -> str | None:
         return self.best.name if self.verdict == "missing" and self.best is not None else None
+
+    @property
+    def effects(self) -> list[Effect]:
+        """Every effect the diagnosis replayed: the model's, the calibrated fit's, each candidate's and its refit's."""
+        refits = [e for c in self.candidates if c.refit is not None for e in c.refit.effects]
+        return [*self.base_effects, *self.calibration.effects, *(c.signature.effect for c in self.candidates), *refits]
 
     @property
     def ranked(self) -> list[Candidate]:

@@ -18,7 +18,7 @@ used), written as sympy expressions code generation takes (exp, tanh, sin, cos; 
 The strengths are declared free (``Quantity.free``) within wide bounds: passed back with ``--effects=+FILE.py``,
 the diagnosis (and ``parksteer compare``) fits them together with the calibrated parameters. They are signed (a
 force may be larger or smaller than the calibrated model's along the axis) and fitted first here, by the
-diagnosis's Levenberg-Marquardt (:func:`parksteer.diagnose.calibrate.least_squares`), from the calibrated values and
+diagnosis's Levenberg-Marquardt (:func:`parksteer.diagnose.fitting.least_squares`), from the calibrated values and
 zero strengths, on the effect's form (:mod:`parksteer.model.symbolic.shapes`: the same terms with the knots as
 given values, one compiled model per form, so a suggestion derives no model of its own); the file is then written
 again with the fitted values as its defaults (``START``), so that the fit of the file passed back starts where
@@ -37,7 +37,8 @@ import numpy as np
 from ..errors import UsageError
 from ..model.symbolic.shapes import FORCE_BOUND_N, TORQUE_BOUND_NM, shape_effect
 from ..tables import atomic_path
-from .calibrate import Fit, calibration_parameters, least_squares
+from .calibrate import calibration_parameters
+from .fitting import Fit, least_squares
 from .engine import ReplayEngine
 from .problem import Problem
 from .statistics import bic_gain, effective_samples, fit_statistics, lag1_autocorrelation

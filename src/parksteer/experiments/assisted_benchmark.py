@@ -26,7 +26,8 @@ import numpy as np
 
 from ..errors import UsageError
 from ..measure.io import write_measurement
-from ..model.symbolic.components import Effect, discover_effects, resolve_effects, strength_parameter
+from ..model.symbolic.components import (Effect, discover_effects, resolve_effects, strength_parameter,
+                                          with_effect_quantities)
 from ..parameters import Parameters
 from ..synthetic.assisted import OUT_OF_CLASS, AssistedLogger, assisted_clean, assisted_record
 from ..synthetic.assisted_truth import HIDDEN_TRUTH
@@ -274,7 +275,7 @@ def summarise(rows: list[dict]) -> dict:
 
 def run(params: Parameters, design: AssistedDesign = AssistedDesign(), only=None, progress=None) -> tuple[list, dict]:
     """Make, write, read back and diagnose every case of `design` (or those named in `only`); (rows, summary)."""
-    discover_effects()
+    params = with_effect_quantities(params)  # the assist's own quantities, with their assumed defaults
     from ..model.numeric.assist import effects_with_assist
 
     assist = effects_with_assist(None, params)

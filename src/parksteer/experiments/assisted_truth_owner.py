@@ -54,10 +54,9 @@ class Owner:
 
 def owner_file(base_path: str | Path, design: TruthDesign, folder: str | Path) -> Owner:
     from ..model.numeric.assist import effects_with_assist
-    from ..model.symbolic.components import discover_effects, resolve_effects
+    from ..model.symbolic.components import resolve_effects
     from ..vehicle import vehicle_from_text
 
-    discover_effects()
     path = Path(folder) / "owner.toml"
     text = owner_vehicle_text(Path(base_path).read_text(encoding="utf-8"), design)
     path.write_text(text, encoding="utf-8")

@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from ..model.numeric.simulate import SimulationResult, simulate
-from ..model.symbolic.components import discover_effects
+from ..model.symbolic.components import discover_effects, with_effect_quantities
 from ..parameters import Parameters, load_parameters
 from ..sweep.assist_sizing import (FRICTION_BAND, PUBLISHED_STANDSTILL_RACK_FORCE_N, SPEEDS_KMH, published_loads,
                                    rack_force_without_rack_friction_N, size_for_rack_force)
@@ -170,7 +170,7 @@ def assist_study(params: Parameters, target_torque_Nm: float, run=simulate, prog
     """Every run of the study and the numbers the paper quotes (module docstring); `target_torque_Nm` is the driver's
     torque the class-load sizing keeps (the pipeline's config, assist.target_torque). `run` is the simulation
     (simulate's signature); `progress`, if given, is called with a line per run."""
-    discover_effects()  # the assists' own quantities, with their assumed defaults
+    params = with_effect_quantities(params)  # the assists' own quantities, with their assumed defaults
     results = _study_runs(params, run, progress or (lambda line: None))
     numbers: dict = {"case": CASE, "surface": "ground", "speeds_kmh": list(SPEEDS_KMH), "offset_cases": list(OFFSET_CASES),
                      "turn_slip": turn_slip_values(), "assists": {}, "runs": {}}

@@ -62,11 +62,9 @@ def assisted_figure(rows: list[dict], summary: dict, path: str | Path) -> None:
 
 
 def _assisted_params(parameters: str | Path, vehicle: str | Path):
-    from ..model.symbolic.components import discover_effects
     from ..parameters import load_parameters
     from ..vehicle import load_vehicle
 
-    discover_effects()
     return load_vehicle(vehicle, load_parameters(parameters))
 
 

@@ -86,11 +86,9 @@ def assisted_truth_figure(rows: list[dict], summary: dict, path: str | Path) -> 
 
 
 def _base_params(parameters: str | Path, vehicle: str | Path):
-    from ..model.symbolic.components import discover_effects
     from ..parameters import load_parameters
     from ..vehicle import load_vehicle
 
-    discover_effects()
     return load_vehicle(vehicle, load_parameters(parameters))
 
 

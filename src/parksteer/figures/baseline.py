@@ -90,11 +90,9 @@ def baseline_figure(cars: list[dict], path: str | Path) -> None:
 
 
 def _base_params(parameters: str | Path, vehicle: str | Path | None):
-    from ..model.symbolic.components import discover_effects
     from ..parameters import load_parameters
     from ..vehicle import load_vehicle
 
-    discover_effects()
     params = load_parameters(parameters)
     return load_vehicle(vehicle, params) if vehicle is not None else params
 

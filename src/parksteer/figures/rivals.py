@@ -17,7 +17,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..model.symbolic.components import chosen_rivals, discover_effects, strength_parameter
+from ..model.symbolic.components import discover_effects, strength_parameter
+from ..model.symbolic.rivals import chosen_rivals
 from ..parameters import Parameters, load_parameters
 from ..tables import write_csv, write_json
 from .model import cycle_summary

@@ -8,16 +8,3 @@
 
 Use :func:`parksteer.model.numeric.simulate.simulate`, or the ``parksteer simulate`` command.
 """
-
-from ..parameters import add_declarer
-
-
-def _load_effects() -> None:
-    """Load every effect the registry finds, so that their own quantities (``<effect>.<name>``, declared on each
-    effect) are known to :mod:`parksteer.parameters` when a key of one is first looked up."""
-    from .symbolic.components import discover_effects
-
-    discover_effects()
-
-
-add_declarer(_load_effects)

@@ -10,7 +10,8 @@ from pathlib import Path
 
 from ..tables import atomic_path
 from .report import html_table
-from .sections import Bullets, FigurePlace, Paragraph, Section, Table, report_sections
+from .parts import Bullets, FigurePlace, Paragraph, Section, Table
+from .sections import report_sections
 
 
 def markdown_report(result: dict, figure: str | None = None, user_figure: str | None = None,

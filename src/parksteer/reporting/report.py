@@ -197,17 +197,17 @@ def diagnosis_dict(diagnosis: Diagnosis) -> dict:
         out["signature"] = diagnosis.outputs["signature"].as_dict()
     if "user_effect" in diagnosis.outputs:  # a user's effect with free strengths (stages/user_effect.py)
         out["user_effect"] = diagnosis.outputs["user_effect"].as_dict()
-    out["units"] = parameter_units(out)
+    out["units"] = parameter_units(out, diagnosis.effects)
     return _json_safe(out)
 
 
 # --------------------------------------------------------------------- how sure the diagnosis is: units, ties
-def parameter_units(result: dict) -> dict[str, str]:
+def parameter_units(result: dict, effects=()) -> dict[str, str]:
     """The unit of every parameter the JSON `result` gives a value or an interval of (calibrated, the candidates'
-    fitted strengths, what the data fix), from the registry of quantities (an effect loaded from a file has
-    declared its own there)."""
+    fitted strengths, what the data fix), from the quantities known with the diagnosis's `effects` (an effect
+    loaded from a file declares its own: :func:`parksteer.model.symbolic.components.known_quantities`)."""
     from ..errors import UsageError
-    from ..parameters import quantity
+    from ..model.symbolic.components import quantity_of
 
     keys = set(result["calibrated"])
     for c in result["ranking"]:
@@ -216,8 +216,8 @@ def parameter_units(result: dict) -> dict[str, str]:
     units = {}
     for k in sorted(keys):
         try:
-            units[k] = quantity(k).unit
-        except UsageError:  # a key no loaded effect declares: shown without a unit
+            units[k] = quantity_of(k, effects).unit
+        except UsageError:  # a key none of the effects declares: shown without a unit
             pass
     return units
 

@@ -1,55 +1,18 @@
 """The sections of a diagnosis's report, one structure that both pages render (:mod:`parksteer.reporting.pages`: the
-markdown report and the HTML page): each section a title and its parts, a paragraph, a list, a table or a figure's
-place, from the diagnosis's JSON (:func:`parksteer.reporting.report.diagnosis_dict`) and, where the caller computed
+markdown report and the HTML page): each section a title and its parts (:mod:`parksteer.reporting.parts`: a
+paragraph, a list, a table or a figure's place), from the diagnosis's JSON (:func:`parksteer.reporting.report.diagnosis_dict`) and, where the caller computed
 them, the residual by phase (:func:`parksteer.reporting.report.phase_residuals`) and the error ladder
 (:meth:`parksteer.reporting.ladder.Ladder.as_dict`). Text is written once, with markdown's backticks around names;
 the HTML page drops them."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-
 from .report import (confound_separates, interval_text, num, separating, shown_unit, signature_lines,
                      strength_text, tie_headline)
 from .cost import cost_line
+from .parts import Bullets, FigurePlace, Paragraph, Section, table
 from .relative_text import relative_sentence
 from .user_effect_pages import user_effect_intervals, user_effect_sentence, user_effect_tables
-
-
-@dataclass(frozen=True)
-class Paragraph:
-    text: str
-    lead: str | None = None  # a bold lead (the verdict's head)
-
-
-@dataclass(frozen=True)
-class Bullets:
-    lines: tuple[str, ...]
-
-
-@dataclass(frozen=True)
-class Table:
-    head: tuple[str, ...]
-    rows: tuple[tuple, ...]
-
-
-@dataclass(frozen=True)
-class FigurePlace:
-    """Where a figure goes, by its name (``diagnosis``, ``phases``, ``ladder``, ``user_effect``): each page puts
-    the figure it was given under that name there (the markdown report links it, the HTML page inlines it)."""
-
-    name: str
-
-
-@dataclass(frozen=True)
-class Section:
-    title: str | None  # None: the verdict (before the first heading) or a note without a heading
-    parts: tuple = field(default_factory=tuple)
-    level: int = 2
-
-
-def table(head, rows) -> Table:
-    return Table(tuple(head), tuple(tuple(r) for r in rows))
 
 
 def _interval(ci, digits: int = 4, unit: str = "") -> str:

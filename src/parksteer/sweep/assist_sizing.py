@@ -27,7 +27,7 @@ import numpy as np
 from ..errors import UsageError
 from ..model.numeric.assist import check_assist, table_off
 from ..model.numeric.simulate import SimulationResult, simulate
-from ..model.symbolic.components import discover_effects
+from ..model.symbolic.components import with_effect_quantities
 from ..parameters import Parameters
 from ..resources import data_file
 from ..vehicle import ASSIST_EFFECTS, ASSISTED_EFFECTS, CREEPING_EFFECTS, creeping_overrides
@@ -153,7 +153,7 @@ def size_assist(params: Parameters, case: str, target_torque_Nm: float, speeds_k
     """The sizing study of the car of `params` in load case `case` (module docstring)."""
     if not target_torque_Nm > 0:
         raise UsageError(f"--target-torque {target_torque_Nm:g}: must be positive (N m)")
-    discover_effects()  # the assists' own quantities, with their assumed defaults
+    params = with_effect_quantities(params)  # the assists' own quantities, with their assumed defaults
     name = assist or check_assist(params) or ASSIST_EFFECTS["column"]
     v = lambda key: float(params[f"{name}.{key}"])  # noqa: E731
     hydraulic = name == ASSIST_EFFECTS["hydraulic"]

@@ -245,6 +245,9 @@ def load_sweep(path: str | Path, params: Parameters, full: bool = False, expand:
     of them in a cycle, and each collection it triggers walks every object made so far (a million points: about
     2 s of 7).
     """
+    from ..model.symbolic.components import with_effect_quantities
+
+    params = with_effect_quantities(params)  # an axis may be an installed effect's quantity
     enabled = gc.isenabled()
     gc.disable()
     try:

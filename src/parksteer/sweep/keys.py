@@ -8,6 +8,7 @@ from typing import Any
 
 import numpy as np
 
+from ..model.symbolic.components import shipped_quantities
 from ..parameters import registry
 from .design import SweepError
 
@@ -63,7 +64,8 @@ DESIGN_VARIABLES: dict[str, DesignVariable] = {
 def parameter_bounds(key: str) -> tuple[float, float, bool, str]:
     """(lower, upper, lower_inclusive, unit) of a sweepable key; raise KeyError for an unknown key.
 
-    A model quantity's bounds are its registry's (:mod:`parksteer.parameters`); a design variable's are its own.
+    A model quantity's bounds are its declaration's (the parameter file's, or an installed effect's); a design
+    variable's are its own.
     """
     owner, _, name = key.partition(".")
     if not name:
@@ -71,7 +73,7 @@ def parameter_bounds(key: str) -> tuple[float, float, bool, str]:
     if owner == "design":
         v = DESIGN_VARIABLES[name]
         return v.minimum, v.maximum, True, v.unit
-    q = registry().get(key)
+    q = registry(shipped_quantities()).get(key)
     if q is None or q.is_list:
         raise KeyError(key)
     return q.lower, q.upper, q.lower_inclusive, q.unit

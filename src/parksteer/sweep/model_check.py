@@ -9,7 +9,8 @@ import operator
 from pathlib import Path
 from typing import Any
 
-from ..parameters import Parameters, quantity
+from ..model.symbolic.components import quantity_of
+from ..parameters import Parameters
 from .design import SweepError, point_overrides
 from .expansion import Grid
 
@@ -61,7 +62,7 @@ def check_model_consistency(path: Path, params: Parameters, case: str, effects: 
         for key, value in derived.items():
             if key in values:
                 continue  # checked with its axis
-            q = quantity(key)
+            q = quantity_of(key)
             if not q.within(value):
                 raise SweepError(f"{path}: {what} {i if numbers is None else numbers[i]}: derived {key} = "
                                  f"{value:g} {q.unit} is out of bounds "

@@ -19,7 +19,7 @@ from typing import Any
 
 from ..errors import UsageError
 from ..geometry import steer_axis
-from ..parameters import Parameters, load_parameters, quantity
+from ..parameters import Parameters, load_parameters
 from ..tables import write_json
 from .design import SweepError
 from .fields import BRAKE_PARAMETER, BRAKED_NONE, BRAKED_RIG_THEORY
@@ -81,7 +81,7 @@ def _tyre_total(merits: dict, names: list[str]) -> float:
 
 def _braked(spec: dict[str, Any], params: Parameters, overrides: dict, free, free_merits: dict) -> dict[str, Any]:
     """The point with its wheels braked: simulated with the braked effect, or estimated by rig theory."""
-    from ..model.symbolic.components import resolve_effects
+    from ..model.symbolic.components import quantity_of, resolve_effects
     from ..model.numeric.simulate import simulate
 
     method = spec.get("braked", BRAKED_NONE)
@@ -98,7 +98,7 @@ def _braked(spec: dict[str, Any], params: Parameters, overrides: dict, free, fre
                 **{q: estimate[q] for q in BRAKED_QUANTITIES}}
     effects = resolve_effects(spec["braked_effects"])
     entry = require_cached_model(effects)
-    locked = quantity(f"{method}.{BRAKE_PARAMETER}").upper
+    locked = quantity_of(f"{method}.{BRAKE_PARAMETER}", effects).upper
     run = simulate(case, effects=effects, overrides={**overrides, f"{method}.{BRAKE_PARAMETER}": locked},
                    surface=spec["surface"], params=params)
     braked = figures_of_merit(run.columns)

@@ -153,10 +153,8 @@ def write_assisted_example(path, vehicle_path) -> None:
     """Write the example record of the assisted car of the vehicle file `vehicle_path` (its ``[assist]``)."""
     from ..measure.io import write_measurement
     from ..model.numeric.assist import check_assist
-    from ..model.symbolic.components import discover_effects
     from ..vehicle import load_vehicle
 
-    discover_effects()  # the vehicle file's assist entries are the assist effect's quantities
     params = load_vehicle(vehicle_path)
     assist = check_assist(params)
     if assist is None:

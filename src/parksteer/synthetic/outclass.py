@@ -21,7 +21,8 @@ from .. import portable as pm
 from ..measure.converter import quantisation_step
 from ..measure.io import Measurement
 from ..model.numeric.simulate import simulate
-from ..model.symbolic.components import chosen_rivals, discover_effects, rival_effects, strength_parameter
+from ..model.symbolic.components import discover_effects, strength_parameter
+from ..model.symbolic.rivals import chosen_rivals, rival_effects
 from ..parameters import Parameters
 from .datasets import (
     RANGE_HEADROOM,

@@ -26,6 +26,8 @@ from ..boost_table import KMH, BoostTableError, entries
 from ..errors import UsageError, cannot_read
 from ..parameter_entries import (PROVENANCE, PROVENANCES, check_entry, check_provenance, check_statics, check_table,
                                  provenance_key)
+from ..model.numeric.assist import ASSIST_EFFECTS, assist_of
+from ..model.symbolic.components import shipped_quantities, with_effect_quantities
 from ..parameters import (CASE_SCHEMA, DEFAULT_PATH, SCHEMA, VEHICLE_SPEED, ParameterError, Parameters, load_parameters,
                           quantity)
 
@@ -48,12 +50,10 @@ MAX_LOCK_STEER_RAD = 1.0
 UNSPRUNG_TOLERANCE_KG = 0.5
 
 
-# ``[assist]`` of a vehicle file: its ``type`` and the assist effect (parksteer.model.symbolic.effects) it names. The
-# entries ({value, unit, source}, the effect's quantities by name) go into that effect's section; the model layer,
-# which knows the quantities, checks them (parksteer.model.numeric.assist.check_assist).
+# ``[assist]`` of a vehicle file: its ``type`` and the assist effect it names (ASSIST_EFFECTS). The entries
+# ({value, unit, source}, the effect's quantities by name) go into that effect's section; the model layer, which
+# knows the quantities, checks them (parksteer.model.numeric.assist.check_assist).
 ASSIST_SECTION = "assist"
-ASSIST_EFFECTS = {"column": "electric_assist_column", "pinion": "electric_assist_pinion",
-                  "rack": "electric_assist_rack", "hydraulic": "hydraulic_assist"}
 
 # ``[assist.boost]``: the boost table of an assist (parksteer.boost_table) and the units its entries take: the
 # assist at the point of action (N m at the column or pinion, N at the rack), or the hydraulic valve's pressure (bar
@@ -80,12 +80,6 @@ ASSISTED_EFFECTS = {kind: f"{CREEPING_EFFECTS},+{name}" for kind, name in ASSIST
 def creeping_overrides(speed_kmh: float) -> dict:
     """The overrides of a run at `speed_kmh`: the run's vehicle speed (VEHICLE_SPEED), in m/s."""
     return {VEHICLE_SPEED.key: speed_kmh / 3.6}
-
-
-def assist_of(params: Parameters) -> str | None:
-    """The assist effect a vehicle's parameters carry (from ``[assist]``), or None."""
-    found = [name for name in ASSIST_EFFECTS.values() if name in params.sections]
-    return found[0] if found else None
 
 
 def _read_assist(path: Path, table: Any, sections: dict, sources: dict) -> None:
@@ -234,8 +228,9 @@ def _read_boost(path: Path, kind: str, table: Any, name: str, sources: dict,
 
 def motor_to_point_of_action(name: str, gear: dict[str, float]) -> float:
     """eta N of the electric assist `name`: its ``efficiency`` and ``reduction_ratio`` as the file gives them
-    (`gear`), else as the effect declares them (the registry knows them once parksteer.model is imported)."""
-    value = lambda key: gear[key] if key in gear else quantity(f"{name}.{key}").default  # noqa: E731
+    (`gear`), else as the effect declares them."""
+    declared = shipped_quantities()
+    value = lambda key: gear[key] if key in gear else quantity(f"{name}.{key}", declared).default  # noqa: E731
     return value("efficiency") * value("reduction_ratio")
 
 
@@ -247,8 +242,9 @@ def vehicle_name(path: str | Path) -> str:
 def load_vehicle(path: str | Path, base: str | Path | Parameters = DEFAULT_PATH) -> Parameters:
     """The base parameters with the car of the vehicle file `path`: its values replace the base's, its cases
     replace the base's cases. Raises :class:`ParameterError` (one line, file and key) on any defect. A value of an
-    effect's own quantity (``[ackermann] track_to_wheelbase``) is checked against the effect's declaration, which
-    the registry knows once :mod:`parksteer.model` is imported (the command line and the workflow import it)."""
+    effect's own quantity (``[ackermann] track_to_wheelbase``) is checked against the effect's declaration, and
+    the parameters know the installed effects' quantities
+    (:func:`parksteer.model.symbolic.components.with_effect_quantities`)."""
     path = Path(path)
     try:
         text = path.read_text(encoding="utf-8")
@@ -295,22 +291,22 @@ def vehicle_from_text(text: str, path: str | Path, base: str | Path | Parameters
         raise ParameterError(f"{path}: cases: missing section (at least one load case, [cases.<name>])")
     cases = {name: check_table(path, f"cases.{name}", table, CASE_SCHEMA, sources)
              for name, table in cases_doc.items()}
-    params = Parameters(path=path, sections=sections, cases=cases, sources=sources)
+    params = Parameters(path=path, sections=sections, cases=cases, sources=sources,
+                        declared=with_effect_quantities(base_params).declared)
     check_car(params)
     return params
 
 
 def _file_or_effect_quantity(path: Path, section: str, name: str):
-    """The quantity of ``section.name``: a key of the parameter file, or an effect's own quantity (a car's value of
-    it, e.g. ``ackermann.track_to_wheelbase``, declared on the effect; known once :mod:`parksteer.model` is
-    imported, as the command line does)."""
+    """The quantity of ``section.name``: a key of the parameter file, or an installed effect's own quantity (a car's
+    value of it, e.g. ``ackermann.track_to_wheelbase``, declared on the effect)."""
     if section in SCHEMA:
         spec = SCHEMA[section].get(name)
         if spec is None:
             raise ParameterError(f"{path}: {section}.{name}: unknown key")
         return spec
     try:
-        return quantity(f"{section}.{name}")
+        return quantity(f"{section}.{name}", shipped_quantities())
     except UsageError:
         raise ParameterError(f"{path}: {section}.{name}: unknown key (a key of the parameter file, cases, or an "
                              "effect's own quantity)") from None

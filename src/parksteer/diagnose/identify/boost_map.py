@@ -15,7 +15,7 @@ import numpy as np
 from ... import portable as pm
 from ...boost_table import entries
 from ...model.symbolic.effects.assist_common import table_law
-from ..calibrate import Z95
+from ..fitting import Z95
 from ..problem import FileData
 from ...names import TORQUE
 

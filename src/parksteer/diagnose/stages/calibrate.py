@@ -5,7 +5,8 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-from ..calibrate import Fit, calibrate, free_strengths
+from ..calibrate import calibrate, free_strengths
+from ..fitting import Fit
 from ..problem import Problem
 from ..engine import ReplayEngine
 from ..state import DiagnosisState

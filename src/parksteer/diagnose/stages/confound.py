@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-from ..calibrate import Fit
+from ..fitting import Fit
 from ..problem import Problem
 from ..state import Candidate, DiagnosisState, confounded_candidates, frozen_mapping
 from ..engine import ReplayEngine

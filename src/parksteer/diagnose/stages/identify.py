@@ -6,7 +6,8 @@ import math
 from dataclasses import replace
 
 from ...model.symbolic.components import power_assist_of
-from ..calibrate import Fit, free_strengths
+from ..calibrate import free_strengths
+from ..fitting import Fit
 from ..problem import Problem
 from ..settings import DEFAULT_SETTINGS, DiagnosisSettings
 from ..state import DiagnosisState

@@ -7,7 +7,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..calibrate import Fit, FitParameter, least_squares
+from ..fitting import Fit, FitParameter, least_squares
 from ..candidates import Signature, strength_parameter
 from ..problem import Problem
 from ..settings import DEFAULT_SETTINGS, DiagnosisSettings

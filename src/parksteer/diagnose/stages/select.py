@@ -8,7 +8,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..calibrate import Fit
+from ..fitting import Fit
 from ..problem import Problem
 from ..settings import DEFAULT_SETTINGS, DiagnosisSettings
 from ..statistics import bic_gain, effective_samples, lag1_autocorrelation
@@ -21,7 +21,7 @@ from .replay_uncertainty import with_replay_uncertainty
 def may_headline(problem: Problem, candidate: Candidate,
                  settings: DiagnosisSettings = DEFAULT_SETTINGS) -> bool:
     """Whether a refitted candidate may be the one a diagnosis names: its fitted strength above 0 and, with the
-    setting ``headline_interval_clear_of_zero``, its 95 % interval (:meth:`parksteer.diagnose.calibrate.Fit.
+    setting ``headline_interval_clear_of_zero``, its 95 % interval (:meth:`parksteer.diagnose.fitting.Fit.
     intervals`) clear of 0. A candidate is absent at strength 0, so a refit that ends there says that the data do
     not need the candidate: whatever it gained in the BIC came from the calibrated parameters moving with it, not
     from the candidate."""

@@ -25,7 +25,8 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ...measure.phases import PHASES
-from ..calibrate import Fit, calibrate, free_strengths
+from ..calibrate import calibrate, free_strengths
+from ..fitting import Fit
 from ..engine import ReplayEngine
 from ..statistics import block_sandwich
 from ..state import DiagnosisState

@@ -1,10 +1,9 @@
 """A vehicle's power assist: the ``[assist]`` section of a vehicle file, checked against the assist effects.
 
 The vehicle layer reads ``[assist]`` (``type`` and entries of ``{value, unit, source}``) into the section of the
-effect its type names (:data:`parksteer.vehicle.ASSIST_EFFECTS`); it cannot know the effects' quantities, which
-live in the model. Here, with the effects loaded, every entry is checked against its quantity (unit and bounds),
-the assist is checked as a whole (the largest rack force it can give), and the effects spec of a run gains the
-assist. :func:`assist_template` writes the section for ``parksteer vehicle new --assist``.
+effect its type names (:data:`ASSIST_EFFECTS`). Here every entry is checked against its quantity (unit and
+bounds), the assist is checked as a whole (the largest rack force it can give), and the effects spec of a run gains
+the assist. :func:`assist_template` writes the section for ``parksteer vehicle new --assist``.
 """
 
 from __future__ import annotations
@@ -13,8 +12,18 @@ from ...boost_table import off_keys, table_keys
 from ...errors import UsageError
 from ...boost_table import table_size
 from ...parameters import ParameterError, Parameters, Quantity
-from ...vehicle import ASSIST_EFFECTS, assist_of
 from ..symbolic.components import discover_effects
+
+# ``[assist]`` of a vehicle file (parksteer.vehicle): its ``type`` and the assist effect
+# (parksteer.model.symbolic.effects) it names; the entries go into that effect's section.
+ASSIST_EFFECTS = {"column": "electric_assist_column", "pinion": "electric_assist_pinion",
+                  "rack": "electric_assist_rack", "hydraulic": "hydraulic_assist"}
+
+
+def assist_of(params: Parameters) -> str | None:
+    """The assist effect a vehicle's parameters carry (from ``[assist]``), or None."""
+    found = [name for name in ASSIST_EFFECTS.values() if name in params.sections]
+    return found[0] if found else None
 
 # The window of plausible rack forces of an assist: the largest its motor (or relief valve) can give through its
 # gear, and the largest its boost table asks for at its last point. Its ends are assumptions, each with why.

@@ -19,8 +19,8 @@ from ... import portable as pm
 from ...errors import UsageError
 from ...geometry import steer_axis
 from ...names import SIDES, SURFACES
-from ...parameters import CASE_SCHEMA, SCHEMA, Parameters, quantity
-from ..symbolic.components import Effect
+from ...parameters import CASE_SCHEMA, SCHEMA, Parameters
+from ..symbolic.components import Effect, with_effect_quantities
 from ..symbolic.system import CORE_PARAMETERS, DERIVED
 
 
@@ -59,7 +59,7 @@ class RunValues:
         keys = [*CORE_PARAMETERS, *_GEOMETRY_KEYS, *_INPUT_KEYS, *(f"case.{name}" for name in CASE_SCHEMA)]
         for effect in effects:
             keys += [k for k in effect.uses if k not in keys]
-        return {f"param.{key}": f"{self.value(key):.10g} {quantity(key).unit}" for key in keys}
+        return {f"param.{key}": f"{self.value(key):.10g} {self.params.quantity(key).unit}" for key in keys}
 
 
 _GEOMETRY_KEYS = tuple(f"geometry.{k}" for k in SCHEMA["geometry"]) + (
@@ -72,7 +72,9 @@ _INPUT_KEYS = tuple(f"input.{k}" for k in SCHEMA["input"])
 
 def resolve_values(params: Parameters, case: str, effects: list[Effect], overrides: dict[str, float] | None,
                    surface: str = "ground", all_effects: dict[str, Effect] | None = None) -> RunValues:
-    """The parameter file's values with `overrides` applied, for the case `case`.
+    """The parameter file's values with `overrides` applied, for the case `case`, knowing the quantities of the
+    installed effects, of `effects` and of `all_effects` (:func:`parksteer.model.symbolic.components.
+    with_effect_quantities`).
 
     An override of a quantity only an effect has is refused when that effect is not in the model.
     """
@@ -84,6 +86,7 @@ def resolve_values(params: Parameters, case: str, effects: list[Effect], overrid
         section = key.partition(".")[0]
         if all_effects is not None and section in all_effects and section not in in_model:
             raise UsageError(f"--set {key}: effect {section} is not in the model")
+    params = with_effect_quantities(params, [*effects, *(all_effects or {}).values()])
     try:
         params = params.with_overrides(overrides, case=case)
     except UsageError as exc:

@@ -31,6 +31,7 @@ import importlib.util
 import inspect
 import os
 import pkgutil
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from functools import lru_cache
 from importlib.metadata import entry_points
@@ -39,7 +40,8 @@ from types import MappingProxyType
 from typing import TYPE_CHECKING, Any, ClassVar
 
 from ...errors import UsageError
-from ...parameters import DEFAULT_PATH, Quantity, declare, load_parameters, registry, unknown_key_message
+from ...parameters import (DEFAULT_PATH, FILE_AND_CASE_KEYS, RUN_QUANTITIES, DeclaredQuantities, Parameters, Quantity,
+                           declared_with, load_parameters, quantity, registry, unknown_key_message)
 
 from .system import SLOTS
 
@@ -73,8 +75,8 @@ class Effect:
     ``uses`` lists every quantity key the effect reads (``tyre.tyre_pressure``, ``rack_lash.lash``). The car's
     quantities (``tyre.*``, ``steering.*``, ...) are in the parameter file; an effect declares its own in
     ``quantities`` (key ``<name>.<quantity>``, with unit, bounds, default and source), the package's effects and a
-    user's alike; they join the registry when the effect is loaded. ``requires`` names the effects it needs;
-    ``replaces`` names the slot it fills (see :data:`SLOTS`). Per-build state lives on the model being built
+    user's alike; they are known wherever the effect is (:func:`known_quantities`). ``requires`` names the effects
+    it needs; ``replaces`` names the slot it fills (see :data:`SLOTS`). Per-build state lives on the model being built
     (``model.state(self)``), never on the effect.
 
     The effect's roles are the class attributes below the line ``# roles``, declared here and only here (a
@@ -152,7 +154,7 @@ class Effect:
 
     def describe(self, params) -> dict:
         """Name, description, slot, needs and quantities with their values (for ``parksteer effects --json``)."""
-        table = registry()
+        table, params = registry(known_quantities([self])), with_effect_quantities(params, [self])
         return {
             "name": self.name,
             "description": self.description,
@@ -180,42 +182,41 @@ def power_assist_of(effects) -> Effect | None:
     return next((e for e in effects if e.power_assist), None)
 
 
-def _register_quantities(effect: Effect, where: str) -> Effect:
-    """Join the effect's declared quantities to the registry and check every key it uses is known."""
+def _checked_effect(effect: Effect, where: str, known: Mapping[str, Quantity] | None = None) -> Effect:
+    """`effect`, its quantities checked against `known` (:func:`shipped_quantities`) and every key it uses known."""
     for q in effect.quantities:
         if q.section != effect.name:
             raise UsageError(f"{where}: quantity {q.key} must be named {effect.name}.<name>")
-        declare(q)
+    known = declared_with(effect.quantities, shipped_quantities() if known is None else known)
     if effect.rival is not None and effect.diagnosis_candidate:
         raise UsageError(f"{where}: effect {effect.name} is a rival, so it cannot be a diagnosis candidate")
     if effect.replaces is not None and effect.replaces not in SLOTS:
         raise UsageError(f"{where}: effect {effect.name} replaces unknown slot {effect.replaces!r} "
                          f"(slots: {', '.join(SLOTS)})")
-    table = registry()
     for key in effect.uses:
-        if key not in table:
+        if key not in known and key not in FILE_AND_CASE_KEYS:
             raise UsageError(f"{where}: effect {effect.name} uses {unknown_key_message(key)}")
     return effect
 
 
 def register_effect(effect: Effect, where: str) -> Effect:
-    """An effect made in code (not a module's EFFECT), its quantities joined to the registry and its keys checked;
+    """An effect made in code (not a module's EFFECT), its quantities and keys checked (:func:`_checked_effect`);
     `where` names it in an error."""
-    return _register_quantities(effect, where)
+    return _checked_effect(effect, where)
 
 
-def _effect_of(obj: Any, where: str) -> Effect:
+def _effect_of(obj: Any, where: str, known: Mapping[str, Quantity] | None = None) -> Effect:
     if inspect.isclass(obj) and issubclass(obj, Effect):
         obj = obj()
     if not isinstance(obj, Effect) or not obj.name:
         raise UsageError(f"{where}: does not define an Effect with a name")
-    return _register_quantities(obj, where)
+    return _checked_effect(obj, where, known)
 
 
-def _effect_of_module(module: Any, where: str) -> Effect:
+def _effect_of_module(module: Any, where: str, known: Mapping[str, Quantity] | None = None) -> Effect:
     if not hasattr(module, "EFFECT"):
         raise UsageError(f"{where}: module defines no EFFECT")
-    return _effect_of(module.EFFECT, where)
+    return _effect_of(module.EFFECT, where, known)
 
 
 def load_effect_module(ref: str) -> Effect:
@@ -248,16 +249,40 @@ def _installed_effects() -> tuple[tuple[str, Effect], ...]:
     installed distribution's entry points costs milliseconds, and a diagnosis prepares hundreds of runs)."""
     from . import effects as package
 
-    found: dict[str, Effect] = {}
-    for info in sorted(pkgutil.iter_modules(package.__path__), key=lambda i: i.name):
-        module = importlib.import_module(f"{package.__name__}.{info.name}")
-        if hasattr(module, "EFFECT"):
-            effect = _effect_of_module(module, module.__name__)
-            found[effect.name] = effect
-    for ep in sorted(entry_points(group=ENTRY_POINT_GROUP), key=lambda e: e.name):
-        effect = _effect_of(ep.load(), f"entry point {ep.name}")
+    modules = (importlib.import_module(f"{package.__name__}.{info.name}")
+               for info in sorted(pkgutil.iter_modules(package.__path__), key=lambda i: i.name))
+    loaded = [(module.__name__, module.EFFECT) for module in modules if hasattr(module, "EFFECT")]
+    loaded += [(f"entry point {ep.name}", ep.load())
+               for ep in sorted(entry_points(group=ENTRY_POINT_GROUP), key=lambda e: e.name)]
+    known, found = RUN_QUANTITIES, {}
+    for where, obj in loaded:  # each checked against the quantities of those before it and its own
+        effect = _effect_of(obj, where, known)
+        known = declared_with(effect.quantities, known)
         found.setdefault(effect.name, effect)
     return tuple(found.items())
+
+
+@lru_cache(maxsize=1)
+def shipped_quantities() -> DeclaredQuantities:
+    """The quantities the installed effects and the run declare, by key (read-only)."""
+    return DeclaredQuantities(declared_with(q for _, e in _installed_effects() for q in e.quantities))
+
+
+def known_quantities(effects: Iterable[Effect] = ()) -> DeclaredQuantities:
+    """The quantities a run of `effects` can name beyond the file's (the run's, the installed effects', theirs)."""
+    shipped = shipped_quantities()
+    known = declared_with((q for e in effects for q in e.quantities), shipped)
+    return known if known is shipped else DeclaredQuantities(known)
+
+
+def quantity_of(key: str, effects: Iterable[Effect] = ()) -> Quantity:
+    """The quantity of `key` (:func:`parksteer.parameters.quantity`) among the :func:`known_quantities` of `effects`."""
+    return quantity(key, known_quantities(effects))
+
+
+def with_effect_quantities(params: Parameters, effects: Iterable[Effect] = ()) -> Parameters:
+    """`params` knowing the :func:`known_quantities` of `effects`: their defaults read, their overrides checked."""
+    return params.knowing(known_quantities(effects))
 
 
 def discover_effects() -> dict[str, Effect]:
@@ -267,25 +292,6 @@ def discover_effects() -> dict[str, Effect]:
         effect = load_effect_module(ref)
         found[effect.name] = effect
     return found
-
-
-def rival_effects(registry: dict[str, Effect] | None = None) -> dict[str, Effect]:
-    """The effects that declare themselves rivals of the paper's mechanisms (``rival`` set), in name order."""
-    registry = registry if registry is not None else discover_effects()
-    return {name: registry[name] for name in sorted(registry) if registry[name].rival is not None}
-
-
-def chosen_rivals(names, where: str, registry: dict[str, Effect] | None = None) -> tuple[str, ...]:
-    """`names` (a selection, e.g. a configuration's list) checked to be rival effects; None is every rival in name
-    order. A name that is no rival is a one-line UsageError naming `where`."""
-    rivals = rival_effects(registry)
-    if names is None:
-        return tuple(rivals)
-    for name in names:
-        if name not in rivals:
-            raise UsageError(f"{where}: {name!r} is not a rival effect (the rivals: {', '.join(rivals)}; an effect "
-                             "is one when it declares `rival`)")
-    return tuple(str(n) for n in names)
 
 
 STRENGTH_NAME = "strength"
@@ -306,7 +312,7 @@ def strength_parameter(effect: Effect, params=None) -> Quantity | None:
     A candidate effect (off by default) is added to a model at a fitted or chosen size through it.
     """
     declared = {q.key: q for q in effect.quantities}
-    table = registry()
+    table = registry(known_quantities([effect]))
     own = [declared.get(k) or table[k] for k in effect.own_keys()]
     named = [q for q in own if q.name == STRENGTH_NAME]
     if named:
@@ -360,7 +366,7 @@ def _chosen(spec) -> list[Effect]:
     if isinstance(spec, (list, tuple)):
         chosen: dict[str, Effect] = {}
         for item in spec:
-            effect = _register_quantities(item, item.name) if isinstance(item, Effect) else _lookup(registry, str(item))
+            effect = _checked_effect(item, item.name) if isinstance(item, Effect) else _lookup(registry, str(item))
             chosen[effect.name] = effect
         return [chosen[n] for n in sorted(chosen)]
     text = (spec or "").strip()

@@ -75,29 +75,34 @@ def memoised_diff():
     differentiate the velocities of the same points load after load. Anything else (another kind of variable, a
     count above 1, an expression without _eval_derivative or one that leaves the derivative unevaluated) takes
     sympy's own route every time.
+
+    The memo is a :class:`ShortDiff` the installed Expr.diff holds, shared by nested or concurrent uses; the last
+    to leave restores sympy's own (a patch of sympy's class, written and restored here).
     """
     from sympy.core.expr import Expr
 
     with _DIFF_LOCK:
-        if _DIFF_STATE["depth"] == 0:
-            _DIFF_STATE["original"], _DIFF_STATE["memo"] = Expr.diff, {}
-            _DIFF_STATE["free"], _DIFF_STATE["holds"] = {}, {}
-            Expr.diff = _short_diff
-        _DIFF_STATE["depth"] += 1
+        installed = getattr(Expr.diff, "short_diff", None)
+        if installed is None:
+            installed = ShortDiff(Expr.diff)
+
+            def diff(self, *symbols, **assumptions):
+                return installed(self, *symbols, **assumptions)
+
+            diff.short_diff = installed
+            Expr.diff = diff
+        installed.users += 1
     try:
         yield
     finally:
         with _DIFF_LOCK:
-            _DIFF_STATE["depth"] -= 1
-            if _DIFF_STATE["depth"] == 0:
-                Expr.diff, _DIFF_STATE["memo"] = _DIFF_STATE["original"], None
-                _DIFF_STATE["free"], _DIFF_STATE["holds"] = None, None
+            installed.users -= 1
+            if installed.users == 0:
+                Expr.diff = installed.original
 
 
-# memoised_diff's state, one for the process: nested or concurrent uses (threads) share one installation and one
-# memo, and the last to leave restores sympy's own Expr.diff.
+# Serialises installing and restoring the patch of Expr.diff between threads (it holds no state itself).
 _DIFF_LOCK = threading.Lock()
-_DIFF_STATE: dict[str, Any] = {"depth": 0, "original": None, "memo": None, "free": None, "holds": None}
 _BASIC_FREE_SYMBOLS = sp.Basic.free_symbols  # the property, as a class without a free_symbols of its own has it
 
 
@@ -123,50 +128,61 @@ def _holds_derivative(node, memo: dict) -> bool:
     return found
 
 
-def _short_diff(self, *symbols, **assumptions):
-    """Expr.diff within memoised_diff."""
-    original, memo = _DIFF_STATE["original"], _DIFF_STATE["memo"]
-    derivative_type = sp.Derivative
+class ShortDiff:
+    """Expr.diff within memoised_diff: sympy's own `original`, and the memos of one installation (derivatives by
+    (expression, symbol), each node's free symbols, whether a node holds an unevaluated Derivative); `users`
+    counts the memoised_diff blocks that hold it."""
 
-    if assumptions or len(symbols) != 1:
-        return original(self, *symbols, **assumptions)
-    s = symbols[0]
-    if isinstance(s, tuple):
-        if len(s) != 2 or not isinstance(s[0], sp.Symbol) or s[1] not in (0, 1) or isinstance(s[1], bool):
-            return original(self, *symbols)
-        s, count = s
-        if count == 0:
-            return self
-    elif isinstance(s, AppliedUndef):  # a coordinate or speed q(t), u(t): sympy's own route, memoised
-        key = (self, s)
+    def __init__(self, original):
+        self.original = original
+        self.memo: dict = {}
+        self.free: dict = {}
+        self.holds: dict = {}
+        self.users = 0
+
+    def __call__(self, expr, *symbols, **assumptions):
+        original, memo = self.original, self.memo
+        derivative_type = sp.Derivative
+
+        if assumptions or len(symbols) != 1:
+            return original(expr, *symbols, **assumptions)
+        s = symbols[0]
+        if isinstance(s, tuple):
+            if len(s) != 2 or not isinstance(s[0], sp.Symbol) or s[1] not in (0, 1) or isinstance(s[1], bool):
+                return original(expr, *symbols)
+            s, count = s
+            if count == 0:
+                return expr
+        elif isinstance(s, AppliedUndef):  # a coordinate or speed q(t), u(t): sympy's own route, memoised
+            key = (expr, s)
+            found = memo.get(key)
+            if found is None:
+                found = memo[key] = original(expr, s)
+            return found
+        elif not isinstance(s, sp.Symbol):
+            return original(expr, *symbols)
+        key = (expr, s)
         found = memo.get(key)
-        if found is None:
-            found = memo[key] = original(self, s)
-        return found
-    elif not isinstance(s, sp.Symbol):
-        return original(self, *symbols)
-    key = (self, s)
-    found = memo.get(key)
-    if found is not None:
-        return found
-    if isinstance(self, derivative_type) or not hasattr(self, "_eval_derivative"):
-        result = original(self, s)
-    elif s not in free_symbols(self, _DIFF_STATE["free"]):
-        result = sp.S.Zero
-    else:
-        obj = self._eval_derivative_n_times(s, 1)
-        if obj is None:
-            result = original(self, s)
-        elif not _holds_derivative(obj, _DIFF_STATE["holds"]):
-            # zero or not, the expression Derivative.__new__ returns is obj itself (replace changes nothing in an
-            # expression without a Derivative): the zero test, an assumptions query over all of obj, is not made
-            result = obj
-        elif obj.is_zero:
-            result = obj
-        else:  # as Derivative.__new__ ends: every Derivative in the result made canonical
-            result = obj.replace(lambda x: isinstance(x, derivative_type), lambda x: x.canonical)
-    memo[key] = result
-    return result
+        if found is not None:
+            return found
+        if isinstance(expr, derivative_type) or not hasattr(expr, "_eval_derivative"):
+            result = original(expr, s)
+        elif s not in free_symbols(expr, self.free):
+            result = sp.S.Zero
+        else:
+            obj = expr._eval_derivative_n_times(s, 1)
+            if obj is None:
+                result = original(expr, s)
+            elif not _holds_derivative(obj, self.holds):
+                # zero or not, the expression Derivative.__new__ returns is obj itself (replace changes nothing in an
+                # expression without a Derivative): the zero test, an assumptions query over all of obj, is not made
+                result = obj
+            elif obj.is_zero:
+                result = obj
+            else:  # as Derivative.__new__ ends: every Derivative in the result made canonical
+                result = obj.replace(lambda x: isinstance(x, derivative_type), lambda x: x.canonical)
+        memo[key] = result
+        return result
 
 
 class Replacer:
