@@ -8,7 +8,7 @@ from pathlib import Path
 
 from ..errors import UsageError
 from ..parameters import DEFAULT_PATH, load_parameters
-from ..vehicle import ASSIST_EFFECTS
+from ..model.numeric.assist import ASSIST_EFFECTS
 
 BAR_PA = 1.0e5
 INCH_M = 0.0254

@@ -27,7 +27,6 @@ from ..errors import UsageError, cannot_read
 from ..parameter_entries import (PROVENANCE, PROVENANCES, check_entry, check_provenance, check_statics, check_table,
                                  provenance_key)
 from ..model.numeric.assist import ASSIST_EFFECTS, assist_of
-from ..model.symbolic.components import shipped_quantities, with_effect_quantities
 from ..parameters import (CASE_SCHEMA, DEFAULT_PATH, SCHEMA, VEHICLE_SPEED, ParameterError, Parameters, load_parameters,
                           quantity)
 
@@ -229,6 +228,7 @@ def _read_boost(path: Path, kind: str, table: Any, name: str, sources: dict,
 def motor_to_point_of_action(name: str, gear: dict[str, float]) -> float:
     """eta N of the electric assist `name`: its ``efficiency`` and ``reduction_ratio`` as the file gives them
     (`gear`), else as the effect declares them."""
+    from ..model.symbolic.components import shipped_quantities  # not for --help
     declared = shipped_quantities()
     value = lambda key: gear[key] if key in gear else quantity(f"{name}.{key}", declared).default  # noqa: E731
     return value("efficiency") * value("reduction_ratio")
@@ -255,6 +255,7 @@ def load_vehicle(path: str | Path, base: str | Path | Parameters = DEFAULT_PATH)
 
 def vehicle_from_text(text: str, path: str | Path, base: str | Path | Parameters = DEFAULT_PATH) -> Parameters:
     """:func:`load_vehicle` of the text `text`, named `path` in every message."""
+    from ..model.symbolic.components import with_effect_quantities  # not for --help
     path = Path(path)
     base_params = base if isinstance(base, Parameters) else load_parameters(base)
     try:
@@ -300,6 +301,7 @@ def vehicle_from_text(text: str, path: str | Path, base: str | Path | Parameters
 def _file_or_effect_quantity(path: Path, section: str, name: str):
     """The quantity of ``section.name``: a key of the parameter file, or an installed effect's own quantity (a car's
     value of it, e.g. ``ackermann.track_to_wheelbase``, declared on the effect)."""
+    from ..model.symbolic.components import shipped_quantities  # not for --help
     if section in SCHEMA:
         spec = SCHEMA[section].get(name)
         if spec is None:

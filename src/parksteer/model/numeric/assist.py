@@ -12,7 +12,6 @@ from ...boost_table import off_keys, table_keys
 from ...errors import UsageError
 from ...boost_table import table_size
 from ...parameters import ParameterError, Parameters, Quantity
-from ..symbolic.components import discover_effects
 
 # ``[assist]`` of a vehicle file (parksteer.vehicle): its ``type`` and the assist effect
 # (parksteer.model.symbolic.effects) it names; the entries go into that effect's section.
@@ -50,6 +49,8 @@ def rack_force_window_N() -> tuple[float, float]:
 
 
 def _quantities(name: str) -> dict:
+    from ..symbolic.components import discover_effects  # the effect table: not for --help
+
     effect = discover_effects()[name]
     return {q.name: q for q in effect.quantities}
 
