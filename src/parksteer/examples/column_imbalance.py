@@ -36,7 +36,7 @@ class ColumnImbalance(Effect):
     description = "Out-of-balance mass on the inclined column: torque -T_u sin(column angle - phase), once per turn"
     in_default_set = False
     # Quantities only this effect has, declared here as every effect declares its own (the parameter file holds the
-    # car's): they join the registry when the effect is loaded.
+    # car's): a run that uses the effect knows them from it.
     quantities = (
         Quantity("column_imbalance.strength", "N m", 0.0, 20.0, lower_inclusive=True, default=0.0,
                  source="example: m g e sin(lambda); 0.2 kg at 30 mm on a column inclined 25 deg gives 0.025 N m "
