@@ -22,30 +22,7 @@ DOCSTRING_WORDS = 250
 
 # Key: a module's path under src/, or "path:Qualified.name" for a class, function or method. Value: (its cap in
 # words, why it is longer).
-STALES_PRE_DERIVED = "the symbolic half's source keys the pre-derived models; cut with its next regeneration"
-KEYS_OUT_OF_LIBRARY_MODELS = ("its source keys the pre-derived out-of-library models (model_key hashes an effect's "
-                              "module); cut with their next regeneration")
-KEYS_SUGGESTED_MODELS = ("its source keys the models of the suggested effects it defines (model_key hashes an "
-                         "effect's module); cut with the next regeneration")
-EXCEPTIONS: dict[str, tuple[int, str]] = {
-    "parksteer/model/symbolic/effects/electric_assist.py": (991, STALES_PRE_DERIVED),
-    "parksteer/model/symbolic/effects/rack_presliding.py": (564, STALES_PRE_DERIVED),
-    "parksteer/model/symbolic/effects/brush_patch.py": (522, STALES_PRE_DERIVED),
-    "parksteer/model/symbolic/effects/assist_common.py": (484, STALES_PRE_DERIVED),
-    "parksteer/model/symbolic/effects/braked_wheels.py": (480, STALES_PRE_DERIVED),
-    "parksteer/model/symbolic/effects/hydraulic_assist.py": (456, STALES_PRE_DERIVED),
-    "parksteer/model/symbolic/effects/gear_efficiency.py": (421, STALES_PRE_DERIVED),
-    "parksteer/model/symbolic/system.py": (409, STALES_PRE_DERIVED),
-    "parksteer/synthetic/outoflibrary.py": (398, KEYS_OUT_OF_LIBRARY_MODELS),
-    "parksteer/model/symbolic/effects/turn_slip.py": (385, STALES_PRE_DERIVED),
-    "parksteer/model/symbolic/effects/carcass_hysteresis.py": (365, STALES_PRE_DERIVED),
-    "parksteer/diagnose/suggest.py": (343, KEYS_SUGGESTED_MODELS),
-    "parksteer/model/symbolic/effects/rolling_resistance.py": (296, STALES_PRE_DERIVED),
-    "parksteer/model/symbolic/effects/linkage_nonlinearity.py": (293, STALES_PRE_DERIVED),
-    "parksteer/model/symbolic/effects/tyre_stribeck.py": (280, STALES_PRE_DERIVED),
-    "parksteer/model/symbolic/effects/rack_lash.py": (277, STALES_PRE_DERIVED),
-    "parksteer/model/symbolic/components.py:Effect": (258, STALES_PRE_DERIVED),
-}
+EXCEPTIONS: dict[str, tuple[int, str]] = {}
 
 # Phrases that tell how the code or a number changed: "was 1.3 N m off", "as before", "previously", "no longer",
 # "used to" (not the passive "is used to"), "last round", "formerly", "now that".

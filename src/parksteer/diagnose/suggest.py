@@ -5,25 +5,12 @@ effect is that shape as a mechanism of the model, in the format of ``examples/us
 defines ``EFFECT`` (a :class:`parksteer.model.symbolic.components.Effect`) with its own quantities, which a user
 reads, edits, and passes back with ``--effects=+FILE.py``. Its magnitude is a sum of knot strengths ``a_k``
 times smooth bumps ``exp(-((z - c_k) / h)^2)`` along the axis the signature found (the knots its best basis
-used), written as sympy expressions code generation takes (exp, tanh, sin, cos; no Piecewise):
+used), written as sympy expressions code generation takes (exp, tanh, sin, cos; no Piecewise),
+one form per class of the signature.
 
-- dissipative: a force on the rack ``-tanh(beta v) sum_k a_k phi_k(x)`` (uniform: ``-a_0 tanh(beta v)``);
-- direction: ``-tanh(beta v)^2 sum_k a_k phi_k(x)`` (zero at rest, the same sign both ways);
-- elastic: ``-sum_k a_k phi_k(x)``;
-- speed: ``-tanh(beta v) sum_k a_k phi_k(|v| / v_90)``, ``|v|`` smoothed as ``v tanh(beta v)``;
-- column: a torque on the column ``sum_m a_m sin(m theta_c) + b_m cos(m theta_c)`` (its phase free);
-- dissipative x column: a friction torque on the column ``-tanh(beta v) sum_m a_m sin(m theta_c) + b_m
-  cos(m theta_c)`` (:func:`dissipative_column_body`).
-
-The strengths are declared free (``Quantity.free``) within wide bounds: passed back with ``--effects=+FILE.py``,
-the diagnosis (and ``parksteer compare``) fits them together with the calibrated parameters. They are signed (a
-force may be larger or smaller than the calibrated model's along the axis) and fitted first here, by the
-diagnosis's Levenberg-Marquardt (:func:`parksteer.diagnose.fitting.least_squares`), from the calibrated values and
-zero strengths, on the effect's form (:mod:`parksteer.model.symbolic.shapes`: the same terms with the knots as
-given values, one compiled model per form, so a suggestion derives no model of its own); the file is then written
-again with the fitted values as its defaults (``START``), so that the fit of the file passed back starts where
-this one ended and a replay of it as it stands is the fitted effect.
-:func:`suggest` returns the error before and after in noise floors and the BIC gain over the calibrated model.
+:func:`suggest` returns the error before and after in noise floors and the BIC gain over the calibrated model. The
+derivation, its reasoning and its sources: docs/signature.md, "The suggested effect's forms and fit
+(`parksteer.diagnose.suggest`)".
 """
 
 from __future__ import annotations
@@ -74,7 +61,7 @@ def _tuple(values) -> str:
 
 def effect_source(signature: Signature, fitted: dict[str, float] | None = None, speed_90_m_s: float | None = None
                   ) -> str:
-    """The text of the effect file for `signature`'s class and shape (module docstring)."""
+    """The text of the effect file for `signature`'s class and shape (docs/signature.md)."""
     if signature.effect_class is None or signature.best is None:
         raise UsageError("suggest: the residual shows no structure beyond the noise; there is no effect to suggest")
     kind, best = signature.effect_class, signature.best

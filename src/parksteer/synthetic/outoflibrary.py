@@ -3,26 +3,9 @@
 Each form is an :class:`~parksteer.model.symbolic.components.Effect` with one strength (0 = absent) and its
 shape fixed by constants here; none is a library candidate's form (rack friction, damping, stiction, lash,
 column friction, gear efficiency, king-pin friction, ...: :mod:`parksteer.model.symbolic.effects`). They come
-in the signature's classes (:data:`parksteer.diagnose.signature.CLASSES`), several per class:
-
-- dissipative: a rack friction bump ``A exp(-((x - c)/w)^2) tanh(beta v)`` (a dent or a dry spot in the rack
-  bore, at c = +20 mm, w = 12 mm); a friction growing toward lock ``A (x / x_l)^2 tanh(beta v)`` (a bent rack,
-  a boot that binds near the ends);
-- elastic: a centring spring with a dead zone, ``k (x - d tanh(x / d))`` (a torsion-bar centring whose
-  preload leaves +-d free; zero slope at the centre, slope k beyond d); a centre detent ``A (x/w) exp(-(x/w)^2)``
-  (a notch that holds the rack straight ahead);
-- direction: a drag only while the rack moves right, ``A (1 + tanh(beta v)) / 2 tanh(beta v)`` (a seal lip
-  that drags one way; its odd half is a rack friction, its even half does not reverse); a symmetric
-  moving-only offset ``A tanh(beta v)^2`` (a boot pushing the rack toward the left whenever it moves);
-- speed: rack damping ``c v (1 + (v / v_c)^2)`` with the cubic term dominant above v_c = 20 mm/s (grease
-  shearing thicker than Newtonian); a quadratic drag ``c v |v|`` (a fluid forced through the boot's vents);
-- column: a once-per-turn column torque ``A sin(theta_c - 0.7)`` (an eccentric column bearing); a second-order
-  ripple ``A sin(2 theta_c + 0.4)`` (a worn intermediate joint, on top of the Hooke joint's own);
-- dissipative x column (a product of two classes): a column bearing pinched once per turn, its friction torque
-  ``A exp((cos(theta_c - 0.9) - 1) / 0.25) tanh(omega_c / 0.5 rad/s)`` (a narrow peak once per turn, orders
-  1-4 and more, not a sinusoid); a joint friction that grows with the joint's angle twice per turn,
-  ``A sin(theta_c + 0.3)^4 tanh(omega_c / 0.5 rad/s)`` (orders 2 and 4 about a mean). Both reverse with the
-  column's rate ``omega_c`` through a smoothing of their own, softer than the model's friction smoothing.
+in the signature's classes (:data:`parksteer.diagnose.signature.CLASSES`), several per class; each form, its
+formula and the mechanism it stands for: docs/signature.md, "The out-of-library forms
+(`parksteer.synthetic.outoflibrary`)".
 
 Forces act between rack and housing, torques on the column shaft against the body, as the library's do.
 """

@@ -79,8 +79,8 @@ class Effect:
     it needs; ``replaces`` names the slot it fills (see :data:`SLOTS`). Per-build state lives on the model being built
     (``model.state(self)``), never on the effect.
 
-    The effect's roles are the class attributes below the line ``# roles``, declared here and only here (a
-    subclass sets those that differ; nothing reads a role by the effect's name or by ``getattr``):
+    The effect's roles are the class attributes below the line ``# roles``, declared here and only here (see
+    docs/model.md, "The effect's roles (`Effect`)"):
 
     - ``in_default_set``: in the model when no effect set is named (the paper's five);
     - ``diagnosis_candidate``: a candidate of the diagnosis of a car without power assist;

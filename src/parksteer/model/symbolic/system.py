@@ -1,39 +1,12 @@
 """The core multibody system of the front end (paper section 4), built symbolically.
 
-Bodies (a parent/child tree, as in AutoSim; axes x forward, y right, z down):
-
-- chassis B: bounce ``bounce_m`` (down) and roll ``roll_rad`` about a fore-aft axis on the
-  centreline at height ``vehicle.roll_axis_z``; roll spring and damper to the ground;
-- rack: translates along B.y (``rack_m``, positive to the right) and rolls with the chassis;
-- per side, a steering assembly S turning about its king-pin axis by the steer angle
-  delta(rack) (supplied by the linkage: linear unless an effect replaces it);
-- per side, a tread ring R, child of S; rigid to S unless an effect adds a twist coordinate.
-
-The handwheel angle is prescribed; the massless column is a torsion spring and damper from
-the handwheel to the column angle theta_c, a function of the rack through the pinion
-(theta_p = handwheel_to_rack_ratio * rack) and the column-to-pinion map (theta_c = theta_p
-unless an effect such as the Hooke joint replaces it). The column torque acts on a massless
-frame turned by theta_c, so its generalized force on the rack is T * d(theta_c)/d(rack).
-
-Vertical loads on the steered parts (tyre contact forces and the weights of the steering
-assemblies and rings) are applied by the core at points fixed in the chassis that coincide
-with their true points at zero steer: so the core alone does no work against them when
-steering. The ``lifting`` effect moves them to where the steer geometry puts them.
-
-Inertia: the chassis roll inertia is about its own mass centre (AutoSim's convention); the
-rack's given inertia is about its own axis (B.y); each steering assembly's diag(x, y, z) is
-about axes parallel to the body axes at zero steer, turning with the wheel; each tread
-ring has its yaw inertia about the steer axis only (the paper gives no other component, and
-the others would only add a little to the roll inertia).
-
 Effects fill slots of this system (``Effect.replaces``, :data:`SLOTS`): the linkage's steer function,
 the column-to-pinion map, the column spring's deflection law, the tread ring's twist, the points where
 vertical loads act. They read the built kinematics through :class:`Kinematics` (``model.kinematics``),
 the declared fields effects may use, and keep per-build state in ``model.state(effect)``.
 
-Geometry is numeric: every position, axis direction and inertia is a parameter symbol whose
-value is computed at run time from src/parksteer/data/parameters.toml (see :mod:`parksteer.model.numeric.values`),
-so the expressions stay small and changing a value never re-derives.
+Every position, axis direction and inertia is a parameter symbol valued at run time. The derivation, its reasoning
+and its sources: docs/model.md, "The core multibody system (`model.symbolic.system`)".
 """
 
 from __future__ import annotations

@@ -2,35 +2,9 @@
 
 No ``EFFECT`` here: the registry skips this module; :mod:`.electric_assist` and :mod:`.hydraulic_assist` use it.
 
-Torsion bar. An assisted gear measures the driver's torque as the twist of a torsion bar between the
-handwheel and the point where the assist acts. The model's column is massless, so the column shaft (the
-paper's stiffness k_c) and the torsion bar (k_t) are two springs in series: they carry the same torque and
-act as one spring of stiffness k_s = k_c k_t / (k_c + k_t). The effect fills the column_deflection slot with
-g(x) = sqrt(k_s / k_c) x, so that the column torque (k_c g + c_c g' dx/dt) g' becomes
-k_s x + c_c (k_s / k_c) dx/dt: the series stiffness, and a damping that keeps the column's time constant
-c_c / k_c. The torsion-bar torque is then the column torque (series elements carry one torque); at the pinion
-it is the column torque times d(theta_c)/d(theta_p) (the intermediate shaft's Hooke joint, if any).
-
-Boost curve. The assist demand is a dead band, a slope and a limit, each corner smoothed by the hyperbola
-ramp(z, w) = (z + sqrt(z^2 + w^2)) / 2 (a smooth max(z, 0), as the rack lash's dead band):
-
-    deadband(x) = ramp(x - D) - ramp(-x - D)          (= x exactly at D = 0)
-    clamp(y, L) = y - ramp(y - L) + ramp(-y - L)      (= 0 exactly at y = 0; -> y well inside +-L)
-
-so the Jacobian stays continuous, a zero gain gives exactly no assist, and only sqrt (exact in IEEE
-arithmetic) enters the generated C.
-
-Boost table. A table (:mod:`parksteer.boost_table`: points, one row per vehicle speed, Fritsch-Carlson slopes) is
-evaluated by :func:`table_law`: each point's assist and slope interpolated linearly in the vehicle speed between
-the rows (held beyond the first and last), as a_r + lambda (a_r+1 - a_r) so that equal rows give a_r exactly; then
-the cubic Hermite segment the torque falls in, and beyond the last point the straight continuation; odd through
-A(-T) = -A(T). At a point the segment's basis is (1, 0, 0, 0), so the law gives the point's assist exactly; a
-segment between two zero points with zero slopes gives exactly 0 (the dead band). On sympy expressions the choice of
-segment and row is a Piecewise (conditional expressions in the C), on numbers the same branches chosen elementwise.
-The effects put it into the model as one function node (:func:`table_law_node`), whose torque derivative is
-:func:`table_slope`; the generated C evaluates both through two functions printed once from them. The same three functions evaluate the law on numbers (the assisted replay,
-:mod:`parksteer.model.numeric.assisted`): on sympy expressions they build the model's terms, on floats and numpy
-arrays they compute them, with products for squares (no ``pow``) so the numbers are the same on every machine.
+It gives the torsion bar's deflection law, the smooth dead band and clamp of the boost curve and the boost table's
+law (:func:`table_law`, :func:`table_slope`, :func:`table_law_node`), on sympy expressions and on numbers alike. The
+derivation, its reasoning and its sources: docs/assist.md, "What the assists share (`assist_common`)".
 """
 
 from __future__ import annotations
@@ -90,7 +64,7 @@ def speed_gain(gain, dependence, speed, half_speed):
 
 
 def series_deflection(model, twist, torsion_bar_key: str):
-    """The column spring's deflection law with the torsion bar in series (module docstring)."""
+    """The column spring's deflection law with the torsion bar in series (docs/assist.md)."""
     k_c = model.p("steering.column_torsional_stiffness")
     k_t = model.p(torsion_bar_key)
     return sp.sqrt(k_t / (k_c + k_t)) * twist
@@ -165,7 +139,7 @@ def table_points(value, speed):
 
 
 def table_law(torque, value, speed, points=None):
-    """The boost table's assist at the torsion-bar torque `torque` and the vehicle speed `speed` (module docstring);
+    """The boost table's assist at the torsion-bar torque `torque` and the vehicle speed `speed` (docs/assist.md);
     `value(key)` gives the table's scalar (``boost_torque_<k>``, ...) as a symbol or a number. `points`, the
     :func:`table_points` of the same table and speed, spares a caller that evaluates the law many times reading
     them again (the same numbers)."""

@@ -1,38 +1,8 @@
 """Braked front wheels: the contact patch cannot roll, so it also slides sideways about the steer axis.
 
-With the wheel free to roll (the paper's model), steering about an axis that meets the
-ground at a lateral distance e from the patch centre (the scrub offset) only carries the patch
-centre along the wheel's rolling direction, which rolling takes up: the tread slides in pure
-spin and the friction moment is equation (2) whatever e (section 2, Table 1). A braked wheel
-cannot roll, so the whole patch slides rigidly about the axis intercept, each element
-perpendicular to its radius from there: the moment about the axis is the rig's braked pin
-torque (parksteer.rig.braked_pin_torque_Nm),
-
-    T_braked(e) = mu p Integral |r - e| dA = M_spin f(e / R),   f(0) = 1,  f -> 3 e / (2 R) for e >> R,
-
-over the uniform-pressure disc of radius R (pi R^2 p = W). This effect adds the drag part, the
-excess s M_1(W) (f(e / R) - 1) with M_1 equation (1), to each tread ring's friction moment with
-the same tanh of the ring's yaw rate (s: the brake fraction, 0 = rolling freely, 1 = locked); the
-spin part stays the tyre_friction effect's equation (2). As in the rig's Fig. 4
-(parksteer.rig.pin_torques_Nm), only the spin part carries equation (2)'s pressure correction
-(p0/p)^(n - 1/2): a pressure distribution changes the spin friction's moment arm, never the net
-sliding force mu W, so the drag part stays the uniform-pressure integral, at most mu W e.
-It is a lumped equivalent: the net sliding force that goes with the moment is not applied.
-
-Only brakes hold the wheels. A front-drive car in gear is not braked in this sense: its open
-differential, with the carrier held by the gearbox, still lets the two wheels turn in opposite
-senses, and steering a mirror-image pair needs exactly that (each patch centre travels round its
-axis the opposite way along its rolling direction), so in gear the front wheels roll freely.
-
-f is evaluated from its series: for e <= R, 1 + 3k^2/4 - 3k^4/64 - k^6/256 - 15k^8/16384
-- 21k^10/65536 (k = e/R, within 0.02 % of the elliptic closed form), for e > R the far-field
-series 3k/2 (1 + 1/(8k^2) + 1/(192k^4) + 1/(1024k^6)) (within 0.05 %). The offset e is the
-scrub offset, the lateral distance at the ground from the king-pin axis's intercept to the
-contact centre at zero steer (5.8 mm for the standard car, 6.9, 38.7 and 62.7 mm with the
-spacers). The fore-aft part of the intercept's offset (the castor's trail at the ground,
-3.2 mm) makes even a rolling wheel's patch slide sideways, braked or not; the paper's model
-leaves it out, and to leading order ((3/4)(e/R)^2) it does not change the braked excess.
-Requires the tyre_friction effect (its friction law and quantities).
+Strength s: the brake fraction (0 = rolling freely, 1 = locked); it adds the drag part of the braked pin torque (N
+m) to each tread ring's friction moment. Requires tyre_friction. The derivation, its reasoning and its sources:
+docs/model.md, "Braked wheels (`braked_wheels`)".
 """
 
 from __future__ import annotations

@@ -1,38 +1,8 @@
 """Brush-model contact patch: the patch slides progressively from its rim inwards (a candidate).
 
-The paper's tyre is a lumped law: the carcass spring k (728 N m/rad) winds up until the whole
-tread ring slides at the moment M of equation (2), a sharp knee. In a brush model the tread
-elements of a uniform-pressure disc of radius R twist with the wheel and each slides when
-its shear reaches mu p: the rim slides first, so the moment-twist curve leaves the straight
-line at 3/4 of M and rounds off towards M (for pure spin: M f(x), x = k twist / M,
-f = x up to 3/4, then 1 - (27/256) / x^3). After a reversal every element sticks again, so
-the unloading is at the full stiffness (Masing).
-
-Here the patch is split into concentric annuli, each a spring-slider element between the
-wheel and the ground, in parallel (an Iwan model of the brush): the annulus between radii
-r_(j-1) and r_j has the stiffness share w_j = (r_j^4 - r_(j-1)^4) / R^4 (bristle stiffness
-times r^2 over its area) and the friction share m_j = (r_j^3 - r_(j-1)^3) / R^3 (mu p r over
-its area), so it slides at x = m_j / w_j, the rim first. Three annuli split at 0.53 R and
-0.78 R (the radii that minimise the largest departure from the continuous law) slide at
-x = 0.83, 1.12 and 1.89, and their piecewise-linear curve stays within 0.016 M of the
-continuous brush law. The total stiffness (sum of w_j k) and the total sliding moment (sum of
-m_j M) are the paper's, so the initial slope and the plateau are unchanged.
-
-The paper's tread ring becomes the rim annulus (this effect takes the share 1 - w_rim of its
-carcass spring and damper and 1 - m_rim of its friction off it); the inner annuli are new
-coordinates (their yaw about the steer axis, from the body), each with the spring, damper
-and friction shares and the yaw inertia share w_j of the tread ring. The strength s blends:
-the removed shares and the inner annuli's springs, dampers, frictions and inertias are all
-scaled by s (the inertias by s + 0.001, which keeps the mass matrix positive definite at s = 0,
-where the annuli are free and carry nothing). Requires carcass_compliance and tyre_friction.
-
-Sidewall and brush: in a tyre the carcass sidewall is a spring in series with the tread bristles
-(wheel - sidewall - tread base - bristles - ground). This effect has no separate sidewall: the
-paper's whole carcass compliance 1/k is given to the bristles, so s = 1 is the series arrangement's
-limit of a rigid sidewall. With a sidewall taking a fraction phi of the compliance (1/k_s = phi/k,
-1/k_b = (1 - phi)/k, the same initial slope), the extra twist the rounded knee adds to the lumped law
-at any moment below M is (1 - phi) times this effect's, and the sliding moment is the same M: the
-rounding modelled here is an upper bound, reached when the bristles carry all the compliance.
+Strength s (0 = the paper's lumped tread ring, 1 = the brush of three annuli); the inner annuli's yaw about the
+steer axis (rad) are new coordinates. Requires carcass_compliance and tyre_friction. The derivation, its reasoning
+and its sources: docs/model.md, "The brush patch (`brush_patch`)".
 """
 
 from __future__ import annotations

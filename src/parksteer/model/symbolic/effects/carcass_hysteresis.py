@@ -1,30 +1,8 @@
 """Visco-elastic hysteresis of the tyre carcass: a Maxwell branch beside the carcass spring (a rival).
 
-Physics. The paper's carcass is a spring k (728 N m/rad) and a damper c (25 N m s/rad) in
-parallel between each wheel and its tread ring (Kelvin-Voigt). Rubber and cord are visco-elastic:
-their stiffness is higher at fast twisting than at slow, and a loop is lost on each load cycle.
-The simplest model of that is a Maxwell branch, a spring k_m in series with a damper c_m, in
-parallel with the carcass spring (a standard linear solid): at rates well above 1/tau
-(tau = c_m / k_m) the carcass is k + k_m stiff, at rates well below it relaxes to k.
-
-Model. Each side gets one new coordinate, the angle of the branch's inner node about the steer
-axis (from the body). Wheel -- spring k_m -- node -- damper c_m -- tread ring:
-
-    spring torque k_m (node - delta),   damper torque c_m (d node/dt - d(delta + twist)/dt),
-
-with k_m = s k (s the branch's stiffness as a fraction of the carcass's, 0 = absent) and
-c_m = k_m tau. The node is massless in the ideal model; it carries (s + 0.001) 0.01 of the tread
-ring's yaw inertia so that the mass matrix stays positive definite at s = 0, where the node is
-free and carries nothing (its own time, sqrt(I / k_m), is about 2.6 ms at any s, far below the carcass's
-1.4 s wind-up in the cycle).
-Requires carcass_compliance (the twist coordinate and the tread ring).
-
-Signature against the rack: a rate-dependent stiffening of the carcass wind-up (the start and each
-reversal), relaxing with time tau; in steady sliding the twist is constant, the branch relaxes and
-the plateau is the paper's. It scales with nothing geometric: it is the same at every spacer offset,
-and with the wheel load only through how far the carcass winds up (M(W) / k). Lifting is absent at the
-reversals' first instants and grows towards lock, proportional to W and with the offset.
-Provenance: a candidate beyond the paper; s and tau are chosen (tyre relaxation times of 0.05-0.5 s).
+Strength s: the branch's stiffness as a fraction of the carcass's (0 = absent), with its relaxation time tau (s);
+one new coordinate per side, the branch node's angle about the steer axis (rad). Requires carcass_compliance. The
+derivation, its reasoning and its sources: docs/model.md, "Carcass hysteresis (`carcass_hysteresis`)".
 """
 
 from __future__ import annotations

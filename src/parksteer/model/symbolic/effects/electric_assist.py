@@ -1,72 +1,16 @@
 """Electric power assistance (EPS), acting at the column (EPS-C); the pinion and rack variants use the same class.
 
-Mechanism. A torsion bar between the handwheel and the gear measures the driver's torque T_s; the control unit
-asks the motor for an assist by a boost curve of T_s; the motor drives the point of action x through a
-reduction of ratio N (motor angle theta_m = N x) with the efficiency eta: a worm gear on the column
-(x = column angle, rad) or on a second pinion (x = pinion angle, rad), a ball nut and belt on the rack
-(x = rack travel, m; N in rad/m). The point of action is the effect's option: ``electric_assist_column`` (this
-module), ``electric_assist_pinion``, ``electric_assist_rack``; each fills the column_deflection slot with its
-torsion bar (see :mod:`.assist_common`), so two assists in one set, or an assist with the rack lash (which
-fills the same slot), are refused in one line.
-
-Boost curve (quasi-static). The demand at the point of action is
-
-    A_cmd = G(v) deadband(T_s, D) c,     c = 1 (torque at column or pinion), c = G_hr (force at the rack)
-
-with the gain G(v) (assist per driver torque beyond the dead band D), c turning a pinion torque into a rack force
-(G_hr = handwheel_to_rack_ratio, rad/m). The gain may fall with the vehicle speed v (the run's
-``run.vehicle_speed``, the quantity the rolling tyre's turn_slip reads), as the speed-sensitive boost curves of
-current cars do (full assist for parking, less as the car gathers speed):
-
-    G(v) = G / (1 + s (v / v_half)^2),     s = speed_dependence (0: off, 1: on),
-
-flat at standstill (dG/dv = 0 at v = 0), the parking gain G halved at v = v_half (s = 1), falling as 1/v^2 well
-beyond. At v = 0 or s = 0 the denominator is 1 + 0 = 1 exactly in IEEE arithmetic, so G(v) is G bit for bit:
-today's speed-independent curve. The rational form and v_half are assumed (a smooth stand-in for the speed
-tables of the control unit, the rational fall of EPS assist maps, k0 / (1 + k_v v) (MathWorks Cody problem
-61311, "EPS assist map with respect to the vehicle speed"), squared here so that the gain is flat at parking
-speed; the quantities' sources give the typical v_half). Quasi-statically the driver's torque is
-T_road / (1 + G(v)) (the tests).
-
-Boost table. A vehicle file's ``[assist.boost]`` gives the curve as the control unit's table instead: torsion-bar
-torques and the assist at the point of action, optionally one row per vehicle speed (:mod:`parksteer.boost_table`).
-The demand is then the table's law, the monotone cubic through the points, odd, exactly zero in the dead band,
-linear in speed between rows (:func:`.assist_common.table_law`), read at the torsion-bar torque and the run's
-vehicle speed; the file's gain is 0 (the reader refuses both), and the table's default, all zeros, adds exactly
-nothing to today's law.
-
-The motor torque is the demand through the reduction, limited:
-
-    T_m = clamp(A_cmd / (eta N), T_max),     i = T_m / k_t (the motor current, torque constant k_t),
-
-and the torque e T_m acts on the motor's rotor (reacted on the body): its generalized force on the rack is
-e N T_m dx/d(rack), the assist e N T_m at the point of action. The gear's efficiency depends on which way the power
-flows: e = eta_f when the motor drives (T_m and dx/dt of one sign), e = 1 / eta_b when the point of action drives
-the motor against its torque (after a reversal, the tyre's wind-up returning the rack): a back-driven worm or
-ball nut passes on eta_b of the power put in at the rack, so the motor's torque N T_m / eta_b at the point of
-action, not eta_f N T_m. Between the two, smoothly through the power's sign
-(:func:`.assist_common.directional_efficiency`, sharp over the assist's ``friction_speed`` w of rotor speed and
-limit_smoothing of motor torque), so that the gear's loss, T_m N dx/dt (1 - e), is never negative. The control
-unit commands T_m = A_cmd / (eta_f N): while the motor drives, the assist is the demand. The rotor's inertia J_m
-turns at omega = N dx/dt (kinetic energy J_m omega^2 / 2, N^2 J_m reflected to x), its bearings' Coulomb friction
-T_f tanh(omega / w) opposes it; both reach the point of action through N alone, without the gear's efficiency
-(a real worm passes them on with it too: at most (1 / eta_b - 1) N T_f of difference). At rest the factor e is 1
-(a stationary gear passes the motor's torque without loss), where a real worm holds by static friction anywhere
-between eta_f and 1 / eta_b; the defaults of eta_f and eta_b are a thread's (:mod:`parksteer.reduction_efficiency`). The band w is the assist's own: how sharply the motor's friction and the worm's
-direction change over at a reversal is a property of the gear, not the car-wide smoothing of the rack's sliding
-contacts, and on a torsion-bar channel of a bus's resolution it decides whether a reversal is read right.
-
-Quasi-static consequences (the tests): with no dead band and the motor below its limit, the column carries
-T_s + G(v) T_s = T_road, so the driver's torque is T_road / (1 + G(v)) (with a table, the root of T_s + A(T_s) =
-T_road); at the limit, T_s = T_road - eta N T_max (column) rises with the road torque at the manual steering's
-slope; a zero gain adds no torque at all.
-
 Outputs: torsion_bar_torque_Nm (T_s), assist_torque_Nm or assist_force_N (e N T_m at x), motor_torque_Nm,
 motor_current_A; the simulation adds rack_force_N (the force the pinion and the assist together put on the
 rack). The model has no tie rods (a linear linkage), so no tie-rod force.
 
 Values: every default is assumed, a typical value of current production gears with its range and source in
 the quantity; a vehicle file's ``[assist]`` gives the car's own.
+
+The point of action is the effect's option: ``electric_assist_column`` (this module), ``electric_assist_pinion``,
+``electric_assist_rack``. Its torsion bar fills the column_deflection slot (:mod:`.assist_common`), so a second
+assist, or the rack lash, in the same set is refused in one line. The derivation, its reasoning and its sources:
+docs/assist.md, "The electric assist (`electric_assist`)".
 """
 
 from __future__ import annotations
@@ -225,7 +169,7 @@ def assist_quantities(name: str, location: str) -> tuple[Quantity, ...]:
 class ElectricAssist(Effect):
     """An electric assist; its point of action (``column``, ``pinion``, ``rack``) is chosen by :meth:`at`, which
     gives the effect class of that point (its name, quantities and description are class attributes, so that an
-    instance keeps no state; module docstring)."""
+    instance keeps no state; docs/assist.md)."""
 
     in_default_set = False
     diagnosis_candidate = False
@@ -276,7 +220,7 @@ class ElectricAssist(Effect):
         return torsion_bar_torque(model, self.location)
 
     def gain(self, model):
-        """G(v) = G / (1 + s (v / v_half)^2): exactly G at v = 0 or s = 0 (module docstring)."""
+        """G(v) = G / (1 + s (v / v_half)^2): exactly G at v = 0 or s = 0 (docs/assist.md)."""
         return speed_gain(self.q(model, "gain"), self.q(model, "speed_dependence"), model.p(VEHICLE_SPEED.key),
                           self.q(model, "gain_half_speed"))
 
@@ -301,7 +245,7 @@ class ElectricAssist(Effect):
 
     def delivered_factor(self, model, motor):
         """The gear's efficiency in the direction the power flows (eta_f driving, 1 / eta_b back-driven), smooth
-        through the power's sign (module docstring)."""
+        through the power's sign (docs/assist.md)."""
         return directional_efficiency(motor, self.rotor_speed(model), self.q(model, "efficiency"),
                                       self.q(model, "back_efficiency"), self.q(model, "limit_smoothing"),
                                       1 / self.q(model, "friction_speed"))

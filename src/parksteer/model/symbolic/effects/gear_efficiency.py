@@ -1,35 +1,8 @@
 """Load-dependent friction of the rack-and-pinion mesh (gear efficiency): a rival of the paper's constant rack friction.
 
-Physics. A gear mesh loses a fixed fraction of the power it transmits: tooth sliding friction
-grows with the tooth load, so the friction torque on the pinion is (1 - eta) times the torque
-it carries, opposing the pinion's rotation, where eta is the forward efficiency of the mesh
-(rack-and-pinion steering gears run at about 0.8-0.9). Unlike the paper's Coulomb rack friction
-(a constant 730 N), this friction scales with the load the steering carries: it is a fraction
-of the whole handwheel torque, larger at the tyre-friction plateau, at lock and on a laden car.
-Losses of the column's Hooke joint and bearings under load have the same form and are lumped
-into the same fraction.
-
-Model. The load the mesh carries is the force the rack needs on its road side: F = -Q, with Q the
-generalized force on the rack coordinate of every load but the column's (and this effect's): the
-tyre moments, lifting, the rack's own friction and the rest, through the linkage (at parking speed
-inertia is negligible; in quasi-static steering F times d(rack)/d(theta_c) is the column torque).
-Taking it from the road side rather than from the column torque keeps the friction an explicit
-function of the state also when the rack is prescribed and the column torque is the unknown (the
-replay of measured data). A force
-
-    F_f = (1 - eta) |F| tanh(beta * rack speed)   (to first order in 1 - eta),
-
-i.e. a torque (1 - eta) |F| / G_hr on the pinion, acts between the rack and its housing against the
-rack's motion (beta: the project's friction smoothing). |F| is smoothed as sqrt(F^2 + w^2) - w over
-a force width w, so the friction is zero at zero load and the Jacobian stays continuous. Strength:
-1 - eta, 0 = a lossless mesh (absent).
-
-Signature against the rack: a friction share in phase with the handwheel torque, (1 - eta) of
-it, of the sign of the rack speed, so it flips at each reversal and adds on every stroke
-(hysteresis), and grows with whatever raises the steering load (the wheel load through the tyre
-moment, W^1.5). Lifting instead is conservative: a function of the rack position, adding on the
-way out and returning the work on the way back, proportional to the wheel load W and growing
-with the spacer offset. Provenance: a candidate beyond the paper (textbook gear-mesh losses).
+Strength 1 - eta (0 = a lossless mesh): a force (N) between the rack and its housing against the rack's motion, in
+proportion to the load the mesh carries. The derivation, its reasoning and its sources: docs/model.md, "The gear
+mesh's efficiency (`gear_efficiency`)".
 """
 
 from __future__ import annotations

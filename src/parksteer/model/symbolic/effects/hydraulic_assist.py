@@ -1,36 +1,10 @@
 """Hydraulic power assistance: a rotary valve on the pinion and a double-acting piston on the rack.
 
-Mechanism. The valve's torsion bar sits between the column and the pinion; its twist opens the valve, which
-sets a pressure difference across the piston on the rack (an integral rack-and-pinion gear, the pump's flow
-returning through the open centre). The valve characteristic, pressure against torsion-bar torque, is taken as
-a dead band, a slope and the relief valve's limit, each corner smoothed (see :mod:`.assist_common`):
-
-    dp = clamp(k_v deadband(T_s, D) + B(T_s, v), p_relief),     F_h = A dp   on the rack, reacted on the housing,
-
-with T_s the torsion-bar torque at the pinion (the column torque through the intermediate shaft's joint), k_v
-the valve's slope (Pa per N m), A the piston's effective area (bore less rod). The piston's seals rub with a
-Coulomb force F_s tanh(beta rack speed). The torsion bar is in series with the column (the column_deflection
-slot, as for the electric assist; the two are refused together). The pump is the source of the assist's work,
-A dp times the rack speed. Not modelled: the pump's flow limit (at parking rates the rack needs about
-A x 0.1 m/s = 5 l/min, within a pump's 6-10 l/min) and the oil's compressibility and inertia.
-
-Valve table. A real rotary valve is progressive: the contours of its metering edges make the pressure rise slowly
-about the centre and steeply towards parking pressures. A vehicle file's ``[assist.boost]`` gives that
-characteristic as a table, the pressure (bar in the file, Pa here) against the torsion-bar torque, optionally one
-row per vehicle speed (a speed-sensitive valve, as ZF's Servotronic); B(T_s, v) is its law, the electric assist's
-(:func:`.assist_common.table_law`: exact at the points, monotone cubic between them, odd, exactly zero in the
-table's dead band, linear in speed between rows), read at the run's vehicle speed, and the file's valve slope is 0
-(the reader refuses both). The table's default, all zeros, adds exactly nothing: today's law. The relief valve still
-bounds the sum.
-
-Quasi-static consequences (the tests): in the linear range of the valve the gear carries T_s + A k_v T_s / G_hr
-= T_road at the pinion, so the driver's torque is T_road / (1 + G_h) with G_h = A k_v / G_hr (G_hr the
-handwheel-to-rack ratio); with a table, T_s is the root of T_s + A B(T_s) / G_hr = T_road; at the relief pressure
-the driver's torque rises with the unassisted slope; a valve of zero slope gives the manual steering with the seal
-friction added.
-
 Outputs: torsion_bar_torque_Nm, assist_force_N (A dp), pressure_Pa (dp); the simulation adds rack_force_N.
 Values: assumed, typical of hydraulic gears of small and medium cars, with range and source in each quantity.
+
+Its torsion bar fills the column_deflection slot, as the electric assist's does: the two are refused together. The
+derivation, its reasoning and its sources: docs/assist.md, "The hydraulic assist (`hydraulic_assist`)".
 """
 
 from __future__ import annotations

@@ -1,25 +1,12 @@
 """Backlash between the handwheel and the rack (pinion mesh), as a dead band of the column (a candidate).
 
-Formulation. The column is massless in the paper's model, so everything between the
-prescribed handwheel and the rack (column spring and damper, Hooke joint, pinion) is a
-chain of massless elements, and a lash anywhere in that chain acts like a lash in series
-with the column spring: the chain carries no torque until the lash is taken up. A lash of
-+-b of rack travel is therefore a dead band of +-b * handwheel_to_rack_ratio in the column
-twist (handwheel minus column angle), at the mean pinion ratio (the Hooke joint's speed
-ratio, 0.90-1.11, scales the band seen at the rack by as much). The column's spring and
-damper act on the deflection
-
-    g(x) = phi(x - a) - phi(-x - a),  phi(z) = (z + sqrt(z^2 + e^2)) / 2,  a = b G, e = w G,
-
-a dead zone smoothed over the width w (the hyperbola phi is a smooth max(z, 0)); the
-column torque is (k g + c dg/dt) dg/dx (the column_deflection slot of ModelSpace). No coordinate is
-added and nothing is stiffer than the engaged column, so the integrator sees the paper's
-stiffness when the lash is taken up and a free rack while it is crossed. At b = 0, g(x) = x
-exactly and the model is the paper's.
-
 Signature: the rack position against the handwheel angle jumps by 2b whenever the torque
 changes sign; the torque against the (measured) rack does not change, the torque against
 the handwheel angle has a flat step at zero torque 2b * G wide.
+
+Strength b: the lash in rack travel (m, 0 = the paper's model), a dead band of the column twist; it fills the
+column_deflection slot and adds no coordinate. The derivation, its reasoning and its sources: docs/model.md, "Rack
+lash (`rack_lash`)".
 """
 
 from __future__ import annotations

@@ -1,37 +1,8 @@
 """Pre-sliding, history-dependent friction of the rack (a bristle of the Dahl kind): a rival of the tanh friction.
 
-Physics. The paper's rack friction is Coulomb, smoothed as -F tanh(beta v): a function of the rack
-speed alone, which flips sign within about 1 / beta = 1 mm/s of a reversal whatever the rack did
-before. Real sliding contacts have a pre-sliding regime: after a reversal the asperities (the
-"bristles") first deform elastically, the friction force grows with the displacement since the
-reversal over a pre-sliding distance of the order of 0.01-1 mm, and only then does the contact slide
-at the full force. The force depends on the path (the last reversal), not on the speed: Dahl's
-model, dF/dt = sigma v (1 - (F / F_c) sgn v), with initial stiffness sigma and saturation F_c.
-
-Model. One bristle between the rack and its housing: a spring k in series with a Coulomb slider of
-force F_d. A new coordinate y is the position of the bristle's root along the rack axis (from the
-housing, like the rack's): the spring acts between rack and root, -k (x - y), and the slider between
-root and housing, -F_d tanh(beta_s dy/dt). k = F_d / x_p, with x_p the pre-sliding displacement, so
-the force saturates at F_d after a rack travel of about x_p from a reversal. In the limit of a massless
-root, F = k (x - y) obeys dF/dt = k dx/dt - (k / beta_s) atanh(F / F_d): the same initial stiffness and
-saturation as Dahl's model with a sharper knee, and a slow creep at rest (time beta_s x_p), the smoothed
-slider's residue. The root carries a small mass (``node_mass``) so that the mass matrix stays regular;
-its own time sqrt(m / k) is far below the pre-sliding time. That mass makes a mode of its own, the root
-oscillating on the spring at sqrt(k / m) (7,000 rad/s at 100 N), undamped while the slider slides; a
-damper c = 2 zeta sqrt(k m) in parallel with the spring (``damping_ratio`` zeta, 1: the bristle damping of
-the LuGre model) ends it within a period. Without it the integrator follows the oscillation, some
-100,000 steps per simulated second (1.6 s for a cycle at 100 N, against 0.013 s); with it the torque moves
-by at most 0.006 N m. The damper's force, c times the bristle's deformation rate, is zero in steady sliding
-and vanishes with the root's mass, as the mode does. The effect adds F_d to the rack friction
-(strength F_d in N, 0 = absent: then spring, damper and slider vanish and the root is a free, resting mass).
-
-Signature against the rack: in steady sliding the bristle has slid and carries F_d exactly, like an
-extra Coulomb friction of F_d; after each reversal the force changes sign over a rack travel of
-about 2 x_p instead of over a speed of 1 / beta, so the torque's drop at a reversal is spread over
-the first few tenths of a millimetre of travel, whatever the rack speed. Lifting is conservative and
-follows the rack position, proportional to the wheel load and growing with the offset; this friction
-depends on neither. Provenance: a rival beyond the paper (Dahl, 1968 and 1976; the elasto-plastic
-bristle of Dupont et al., 2002); F_d and x_p are chosen, not measured.
+Strength F_d (N, 0 = absent): the extra Coulomb force of steady sliding, reached within about the pre-sliding
+displacement x_p (m) of rack travel after a reversal. It adds one coordinate, the bristle's root along the rack axis
+(m). The derivation, its reasoning and its sources: docs/model.md, "Rack pre-sliding (`rack_presliding`)".
 """
 
 from __future__ import annotations

@@ -1,25 +1,8 @@
 """Rolling resistance of the free-rolling wheel, acting through the ground scrub radius (a rival).
 
-Physics. With the wheel free to roll (the paper's model), steering carries the contact patch
-centre round the king-pin axis's ground intercept along the wheel's rolling direction, at omega e
-(e the scrub radius at the ground), and the wheel rolls to take it up (section 2, Table 1). Rolling
-is not free of loss: the tyre's rolling resistance, a force C_rr W against the rolling, acts at
-the patch centre, a moment C_rr W |e| about the steer axis against the steer rate. The paper's
-model leaves it out. Model: at each wheel a torque about the steer axis on the tread ring,
-
-    T = -C_rr W |e| tanh(beta * ring steer rate),
-
-with the ring's rate about the axis relative to the body (the tread is what rolls), W the wheel
-load (0 off the ground), |e| the scrub offset as computed for braked_wheels (5.8 mm standard,
-62.7 mm with the 68.5 mm spacer), times the surface grip (0 on air bearings: nothing rolls).
-C_rr (0 = absent) is chosen: car tyres on a hard floor have 0.01-0.015, more at low pressure.
-
-Signature against the rack: a friction share, flipping at each reversal (dissipative, unlike
-lifting), proportional to the wheel load W like lifting, and growing in proportion to the scrub
-offset |e| with the spacers (about ten times larger at 68.5 mm than standard), so load and offset
-do not separate it from lifting, but its sign does: lifting's share follows the rack position and
-is returned on the way back, this one follows the rack speed. It is small: 0.012 W |e| is
-0.2 N m per wheel on the standard car. Provenance: a candidate beyond the paper.
+Strength C_rr (dimensionless, 0 = absent): a torque C_rr W |e| (N m) about each steer axis against the tread ring's
+steer rate, W the wheel load (N), e the scrub offset (m). The derivation, its reasoning and its sources:
+docs/model.md, "Rolling resistance (`rolling_resistance`)".
 """
 
 from __future__ import annotations

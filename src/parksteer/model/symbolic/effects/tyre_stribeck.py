@@ -1,26 +1,8 @@
 """Rubber friction falling with sliding speed: a breakaway peak of the tyre's friction moment (a rival).
 
-Physics. The paper's tyre moment is Coulomb: M(W) of equation (2) at any sliding speed,
-smoothed by tanh. Rubber on a road often breaks away at a higher friction than it slides with
-(adhesion of the tread at rest, falling as the sliding speed rises: a Stribeck-type curve), so
-the tread's moment would peak when the patch starts to slide, after the carcass has wound up at
-the start and after each reversal, and fall back to the sliding level. Model: the moment of each
-tread ring is multiplied by
-
-    1 + a exp(-(omega / omega_s)^2),
-
-omega the ring's yaw rate: the effect adds -a M(W) exp(-(omega / omega_s)^2) tanh(beta omega) (grip
-as for tyre_friction: 0 on air bearings). a is the breakaway excess (0 = Coulomb, absent), omega_s
-the Stribeck rate (the tread's sliding speed at the patch rim is omega R, R about 0.08 m).
-Requires tyre_friction (its moment law and quantities).
-
-Signature against the rack: humps of the torque where the tread is slow: where it breaks away at
-the end of the carcass wind-up (at the start and after each reversal) and as it slows into each
-reversal; none in steady sliding (the ring's yaw rate there, about 0.12 rad/s, is six omega_s), scaled like the tyre moment (W^1.5, falling
-with pressure) and independent of the spacer offset. Lifting adds a torque that grows steadily
-towards lock, proportional to W and growing with the offset. Provenance: a candidate beyond the
-paper (rubber friction against sliding speed, e.g. Persson's and Grosch's measurements); values
-are chosen, none are measured for this tyre.
+Strength a, the breakaway excess of the tyre moment (0 = Coulomb, absent), with the Stribeck rate omega_s (rad/s) of
+the tread ring's yaw. Requires tyre_friction. The derivation, its reasoning and its sources: docs/model.md,
+"Rubber's breakaway (`tyre_stribeck`)".
 """
 
 from __future__ import annotations
