@@ -1,5 +1,5 @@
-"""The registry of quantities, and the parameter file (src/parksteer/data/parameters.toml, shipped as package data)
-that gives their values.
+"""The parameters of a run: the parameter file (src/parksteer/data/parameters.toml, shipped as package data) that
+gives the car's values, and the effects' quantities a :class:`Parameters` knows.
 
 Every quantity has one key (``section.name``), one SI unit and one pair of physical bounds. The car's quantities
 are listed in :mod:`parksteer.quantities` (:data:`SCHEMA`) and the file gives each its value and source as
@@ -25,6 +25,7 @@ from pathlib import Path
 from typing import Any
 
 from .errors import UsageError, cannot_read
+from .frozen import FrozenDict
 from .parameter_entries import check_statics, check_table, provenance_key
 from .quantities import CASE, CASE_SCHEMA, FILE_AND_CASE_KEYS, RENAMED, SCHEMA, ParameterError, Quantity
 from .resources import data_file
@@ -117,16 +118,10 @@ VEHICLE_SPEED = checked_declaration(Quantity(
     source="input of the run: 0 = standstill (the paper), up to 3 m/s (10.8 km/h) of creeping"), {})
 
 
-class DeclaredQuantities(dict):
+class DeclaredQuantities(FrozenDict):
     """Quantities declared in code by key, read-only (it pickles, so parameters holding it may cross a process)."""
 
-    def _read_only(self, *args, **kwargs):
-        raise TypeError("declared quantities are read-only: Parameters.declaring makes parameters knowing more")
-
-    __setitem__ = __delitem__ = clear = pop = popitem = setdefault = update = __ior__ = _read_only
-
-    def __reduce__(self):
-        return DeclaredQuantities, (dict(self),)
+    refusal = "declared quantities are read-only: Parameters.declaring makes parameters knowing more"
 
 
 # The quantities declared in code that every Parameters knows: the run's.

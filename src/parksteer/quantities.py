@@ -1,7 +1,8 @@
 """The quantities of the parameter file (src/parksteer/data/parameters.toml): what a quantity is
 (:class:`Quantity`: key, SI unit, physical bounds) and the table of the file's (:data:`SCHEMA`) and of a Table B1
 case's (:data:`CASE_SCHEMA`), the one home of each key's unit and bounds; the keys of earlier versions
-(:data:`RENAMED`). The registry that effects' own quantities join is :mod:`parksteer.parameters`."""
+(:data:`RENAMED`). Effects declare their own quantities; a :class:`~parksteer.parameters.Parameters` carries
+those of the effects it is used with."""
 
 from __future__ import annotations
 

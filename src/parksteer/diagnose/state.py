@@ -19,21 +19,16 @@ from .fitting import Fit
 from .candidates import Score, Signature
 from .problem import Problem
 from .statistics import fit_statistics
+from ..frozen import FrozenDict as BaseFrozenDict
 from .settings import DEFAULT_SETTINGS, DiagnosisSettings
 
 VERDICTS = ("missing", "adequate", "unexplained")
 
 
-class FrozenDict(dict):
-    """A dict that cannot be changed once made (it pickles, so a result may cross a process fork)."""
+class FrozenDict(BaseFrozenDict):
+    """A diagnosis's read-only mapping (it pickles, so a result may cross a process fork)."""
 
-    def _read_only(self, *args, **kwargs):
-        raise TypeError("a diagnosis's mapping is read-only: make a new one")
-
-    __setitem__ = __delitem__ = clear = pop = popitem = setdefault = update = __ior__ = _read_only
-
-    def __reduce__(self):
-        return FrozenDict, (dict(self),)
+    refusal = "a diagnosis's mapping is read-only: make a new one"
 
 
 def frozen_mapping(items=()) -> FrozenDict:
