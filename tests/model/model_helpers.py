@@ -72,3 +72,21 @@ class {class_name}(Effect):
 
 EFFECT = {class_name}()
 '''
+
+
+def effect_documentation(name: str) -> str:
+    """What the effect `name` documents of itself: its module's docstring (the contract) and its section of the docs
+    (a heading ending in ``(`name`)`` on a page of docs/: the derivation, its reasoning and its sources)."""
+    import re
+    import sys
+    from pathlib import Path
+
+    from parksteer.model.symbolic.components import discover_effects
+
+    text = sys.modules[type(discover_effects()[name]).__module__].__doc__ or ""
+    heading = re.compile(r"^#{2,4} [^\n]*\(`%s`\)\n(.*?)(?=^#{2,3} |\Z)" % re.escape(name), re.S | re.M)
+    for page in sorted((Path(__file__).resolve().parents[2] / "docs").glob("*.md")):
+        found = heading.search(page.read_text(encoding="utf-8"))
+        if found:
+            text += "\n" + found.group(1)
+    return text

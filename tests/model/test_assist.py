@@ -10,10 +10,15 @@ from model_helpers import DISSIPATION_OFF, first_ramp
 
 from parksteer.errors import UsageError
 from parksteer.model.numeric.simulate import simulate
-from parksteer.model.symbolic.components import discover_effects, resolve_effects
+from parksteer.model.symbolic.components import resolve_effects, with_effect_quantities
 from parksteer.vehicle import creeping_overrides
 
-discover_effects()  # declares the assists' own quantities (their defaults are read below)
+
+@pytest.fixture(scope="module")
+def params(params):
+    """The shipped parameters, knowing the installed effects' quantities (the assists' own, read below)."""
+    return with_effect_quantities(params)
+
 
 ELECTRIC = ("electric_assist_column", "electric_assist_pinion", "electric_assist_rack")
 K_COLUMN, C_COLUMN = "steering.column_torsional_stiffness", "steering.column_torsional_damping"

@@ -13,10 +13,15 @@ from model_helpers import first_ramp
 
 from parksteer.boost_table import BoostTableError, check_table, entries
 from parksteer.model.numeric.simulate import simulate
-from parksteer.model.symbolic.components import discover_effects
+from parksteer.model.symbolic.components import with_effect_quantities
 from parksteer.model.symbolic.effects.assist_common import directional_efficiency, table_law
 
-discover_effects()  # declares the assists' own quantities
+
+@pytest.fixture(scope="module")
+def params(params):
+    """The shipped parameters, knowing the installed effects' quantities (the assists' own, read below)."""
+    return with_effect_quantities(params)
+
 
 # A progressive curve, 3.9 (|T| - 0.4)^1.6 N m beyond a 0.4 N m dead band (the Polo file's).
 TORQUES = [0.0, 0.4, 0.8, 1.2, 1.6, 2.0, 2.5, 3.0, 4.0]

@@ -11,7 +11,7 @@ from parksteer.figures.model import cycle_summary
 from parksteer.geometry import steer_axis
 from parksteer.model.numeric.simulate import simulate
 
-from model_helpers import column_angle_per_rack
+from model_helpers import column_angle_per_rack, effect_documentation
 
 
 @pytest.fixture(scope="module")
@@ -111,16 +111,14 @@ def test_brush_patch_states_its_rounding_as_the_rigid_sidewall_bound():
     """Physical fact: a sidewall spring in series with the brush (compliance fraction phi, same total compliance
     1/k) leaves the sliding moment M and scales the knee's extra twist over the lumped law by (1 - phi); the
     brush_patch effect, which gives all of 1/k to the bristles, is the phi = 0 limit, an upper bound on the
-    rounding. Checked on the continuous brush law, and the effect's docstring says so."""
-    from parksteer.model.symbolic.effects import brush_patch
-
+    rounding. Checked on the continuous brush law, and the effect's documentation (docstring and docs section) says so."""
     m = np.linspace(0.0, 0.99, 200)
     all_bristles = _brush_twist(m) - m  # phi = 0: twist k theta / M minus the lumped law's
     for phi in (0.3, 0.7):
         series = phi * m + (1.0 - phi) * _brush_twist(m) - m
         assert np.allclose(series, (1.0 - phi) * all_bristles, atol=1e-12)
         assert np.all(series <= all_bristles + 1e-12)
-    doc = brush_patch.__doc__
+    doc = effect_documentation("brush_patch")
     assert "series" in doc and "upper bound" in doc
 
 

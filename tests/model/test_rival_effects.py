@@ -10,7 +10,6 @@ against a closed form written from the physics, not from the effect's code, wher
 
 from __future__ import annotations
 
-import sys
 
 import numpy as np
 import pytest
@@ -24,7 +23,7 @@ from parksteer.model.symbolic.components import (discover_effects, known_quantit
                                                  strength_parameter, with_effect_quantities)
 from parksteer.parameters import load_parameters, registry
 
-from model_helpers import DISSIPATION_OFF, with_effect, column_angle_per_rack, first_ramp, plateau_mean
+from model_helpers import DISSIPATION_OFF, effect_documentation, with_effect, column_angle_per_rack, first_ramp, plateau_mean
 
 # rival -> (strength quantity, a strength well inside its typical range)
 RIVALS = {
@@ -98,8 +97,8 @@ def test_rivals_are_off_by_default_and_kept_out_of_the_diagnosis(params):
     for name, (strength, typical) in RIVALS.items():
         effect = effects[name]
         assert not effect.in_default_set and not effect.diagnosis_candidate
-        docstring = sys.modules[type(effect).__module__].__doc__
-        assert "Signature" in docstring and "Provenance" in docstring
+        documentation = effect_documentation(name)
+        assert "Signature" in documentation and "Provenance" in documentation
         key = f"{name}.{strength}"
         assert strength_parameter(effect, params).key == key
         assert params[key] == 0.0 and table[key].unit and params.source(key).startswith("candidate")
