@@ -131,12 +131,12 @@ def refit_form(form: HeldForm, train, params: Parameters, model: list[Effect], s
     calibration). Refitted together with them on a part, a form's strengths trade with the base parameters along
     the valley where the two give one torque (knots of rack friction summing to the calibrated one), and each part
     lands elsewhere along it: the parts' spread is then that trade's, which a later record, judged with the
-    strengths held and only the base calibrated, never sees."""
+    strengths and the calibration held, never sees."""
     problem = Problem(list(train), with_effect_quantities(params, model).with_overrides(form.places))
     engine = ReplayEngine()
-    steps = {k: max(abs(float(v["value"])) * 1e-2, 1e-9) for k, v in form.strengths.items()}
     if form.source == "candidate":  # a library strength, stepped by a hundredth of its value
-        parameters = [linear_parameter(model, k, step) for k, step in steps.items()]
+        parameters = [linear_parameter(model, k, max(abs(float(v["value"])) * 1e-2, 1e-9))
+                      for k, v in form.strengths.items()]
     else:  # a form's free strengths, fitted as they stand within their bounds
         parameters = [free_parameter(engine, problem, model, q) for q in free_strengths(model)
                       if q.key in form.strengths]
