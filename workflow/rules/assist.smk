@@ -74,6 +74,7 @@ rule assist_creep:
         json="results/assist_creep.json",
     params:
         code=code("assist_creep"),
+    priority: PRIORITY["assist_creep"]
     log:
         "logs/assist_creep.log",
     benchmark:
@@ -113,6 +114,7 @@ rule diag_assisted_batch:
         cases=lambda wildcards: DIAG_ASSISTED_BATCHES[wildcards.batch],
     wildcard_constraints:
         batch="|".join(DIAG_ASSISTED_BATCHES) if DIAG_ASSISTED_BATCHES else "none",
+    priority: PRIORITY["diag_assisted_batch"]
     log:
         "logs/diag_assisted_batch/{batch}.log",
     benchmark:

@@ -24,6 +24,7 @@ rule diag_assisted_truth_batch:
         design=config.get("assisted_truth"),
     wildcard_constraints:
         batch="|".join(DIAG_ASSISTED_TRUTH_BATCHES) if DIAG_ASSISTED_TRUTH_BATCHES else "none",
+    priority: PRIORITY["diag_assisted_truth_batch"]
     log:
         "logs/diag_assisted_truth_batch/{batch}.log",
     benchmark:

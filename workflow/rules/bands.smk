@@ -14,6 +14,7 @@ rule bands:
         json="results/bands.json",
     params:
         code=code("bands"),
+    priority: PRIORITY["bands"]
     log:
         "logs/bands.log",
     benchmark:

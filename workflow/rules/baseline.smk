@@ -18,6 +18,7 @@ rule diag_baseline_batch:
         design=config.get("baseline"),
     wildcard_constraints:
         car="|".join(DIAG_BASELINE_CARS) if DIAG_BASELINE_CARS else "none",
+    priority: PRIORITY["diag_baseline_batch"]
     log:
         "logs/diag_baseline_batch/{car}.log",
     benchmark:

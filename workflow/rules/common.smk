@@ -100,6 +100,29 @@ def benchmark_file(rule, *wildcards):
     return f"results/benchmarks/{rule}/{stem}.tsv"
 
 
+# --- the order of jobs on few cores: Snakemake's `priority:` (0 unless listed) ----------------------------------
+# A cold build on 2 cores is bound by its work, so what costs wall time is a core left idle at the end while one
+# long job runs alone. The compiled models go first (every benchmark job waits on them, and each derive job takes a
+# few seconds), then the jobs that take longest, longest first (list scheduling, longest job first), so that the
+# short figure and summary jobs fill the cores at the end. diag_car_data is short but the case study waits on it.
+# The order follows each rule's longest job in results/benchmarks/<rule>/ of a cold build.
+PRIORITY = {
+    "derive": 100,
+    "diag_car_data": 90,
+    "diag_assisted_batch": 60,
+    "diag_signature_batch": 55,
+    "diag_peers_batch": 50,
+    "diag_variation_batch": 50,
+    "diag_baseline_batch": 45,
+    "diag_assisted_truth_batch": 45,
+    "case_study": 40,
+    "diag_bench_batch": 35,
+    "diag_outclass_batch": 30,
+    "bands": 20,
+    "assist_creep": 20,
+}
+
+
 # --- compiled models: every named effect set the pipeline needs, derived once by rule derive ----------------
 MODEL_SETS = {}  # name -> effects spec
 _MODEL_NAMES = {}  # the resolved effect names -> the name first registered for them

@@ -16,6 +16,7 @@ rule derive:
         effects=lambda w: model_set(w.model),
     wildcard_constraints:
         model="[^/]+",
+    priority: PRIORITY["derive"]
     log:
         "logs/derive/{model}.log",
     benchmark:

@@ -47,6 +47,7 @@ rule diag_car_data:
     params:
         code=code("diag_car_data"),
         car=config["car"],
+    priority: PRIORITY["diag_car_data"]
     log:
         "logs/diag_car_data.log",
     benchmark:
@@ -87,6 +88,8 @@ rule case_study:
         truth="results/diagnose/car_truth.json",
         assisted_record="data/measurements/example_polo_assisted.csv",
         assisted_vehicle="data/vehicles/polo_vi.toml",
+        # the models its diagnosis of the assisted record replays (assist.smk), derived before it like a benchmark's
+        assisted_models=lambda wildcards: DIAG_ASSISTED_MODELS,
     output:
         notebook="results/case_study.ipynb",
         json="results/case_study.json",
@@ -94,6 +97,7 @@ rule case_study:
     params:
         code=code("diag_case_study"),
         notebook_code=code("workflow/notebooks/case_study.py"),
+    priority: PRIORITY["case_study"]
     log:
         "logs/case_study.log",
     benchmark:
@@ -136,6 +140,7 @@ rule diag_bench_batch:
         cases=lambda wildcards: DIAG_BENCH_BATCHES[wildcards.batch],
     wildcard_constraints:
         batch="|".join(DIAG_BENCH_BATCHES) if DIAG_BENCH_BATCHES else "none",
+    priority: PRIORITY["diag_bench_batch"]
     log:
         "logs/diag_bench_batch/{batch}.log",
     benchmark:
@@ -181,6 +186,7 @@ rule diag_outclass_batch:
         cases=lambda wildcards: DIAG_OUTCLASS_BATCHES[wildcards.batch],
     wildcard_constraints:
         batch="|".join(DIAG_OUTCLASS_BATCHES) if DIAG_OUTCLASS_BATCHES else "none",
+    priority: PRIORITY["diag_outclass_batch"]
     log:
         "logs/diag_outclass_batch/{batch}.log",
     benchmark:
@@ -226,6 +232,7 @@ rule diag_variation_batch:
         cases=lambda wildcards: DIAG_VARIATION_BATCHES[wildcards.batch],
     wildcard_constraints:
         batch="|".join(DIAG_VARIATION_BATCHES) if DIAG_VARIATION_BATCHES else "none",
+    priority: PRIORITY["diag_variation_batch"]
     log:
         "logs/diag_variation_batch/{batch}.log",
     benchmark:
@@ -270,6 +277,7 @@ rule diag_signature_batch:
         cases=lambda wildcards: DIAG_SIGNATURE_BATCHES[wildcards.batch],
     wildcard_constraints:
         batch="|".join(DIAG_SIGNATURE_BATCHES) if DIAG_SIGNATURE_BATCHES else "none",
+    priority: PRIORITY["diag_signature_batch"]
     log:
         "logs/diag_signature_batch/{batch}.log",
     benchmark:

@@ -21,6 +21,7 @@ rule diag_peers_batch:
         jobs=lambda wildcards: PEER_BATCHES[wildcards.batch],
     wildcard_constraints:
         batch="|".join(PEER_BATCHES) if PEER_BATCHES else "none",
+    priority: PRIORITY["diag_peers_batch"]
     log:
         "logs/diag_peers_batch/{batch}.log",
     benchmark:
