@@ -61,10 +61,11 @@ def register(sub) -> None:
                         "pipeline's model manifests given, and keep their C in the package "
                         "(src/parksteer/model/prebuilt), where a cold cache compiles it without deriving; run after "
                         "any change to the symbolic half (the tests say when) as "
-                        "`parksteer derive --prebuilt results/model/*.json`")
+                        "`parksteer derive --prebuilt results/model/*.json results/diagnose/baseline/*.json`")
     p.add_argument("manifests", nargs="*", metavar="MANIFEST",
-                   help="with --prebuilt: model manifests the pipeline wrote (results/model/<name>.json); their "
-                        "effect sets are pre-derived too")
+                   help="with --prebuilt: model manifests the pipeline wrote (results/model/<name>.json), whose "
+                        "effect sets are pre-derived too, and the baseline benchmark's cars "
+                        "(results/diagnose/baseline/<car>.json), whose held form's diagnosis models are")
     add_quiet_option(p)
     p.set_defaults(func=_derive)
 
@@ -103,6 +104,33 @@ def _signature_truth_sets() -> list:
     from ..synthetic.outoflibrary import ALL_FORMS
 
     return [({"truth_form": form.effect.name}, truth_effects(form)) for form in ALL_FORMS]
+
+
+def _held_form_sets(path: str) -> list | None:
+    """(spec, effects) of the models a diagnosis against the baseline of the benchmark's car `path` builds
+    (results/diagnose/baseline/<car>.json; None for a file that is not one): a manual car's learnt form held on the
+    default set, with the diagnosis models over it (:func:`parksteer.diagnose.candidates.models_to_build`), spec
+    ``{"shape": name, "effects": [the other effects]}``. An assisted car's or a form a suggestion cannot take is
+    said and left out (its job derives it)."""
+    try:
+        result = json.loads(Path(path).read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    if not isinstance(result, dict) or not isinstance(result.get("learnt"), dict) or "spec" in result:
+        return None
+    from ..diagnose.candidates import candidate_effects, models_to_build
+    from ..diagnose.suggest import shape_forms
+    from ..model.symbolic.components import resolve_effects
+    from ..progress import note
+
+    name = result["learnt"].get("form")
+    form = next((f for f in shape_forms() if f.name == name), None)
+    if result.get("kind") != "manual" or form is None:
+        note(f"{path}: held form {name!r} of a {result.get('kind')} car not pre-derived (its job derives its models)")
+        return []
+    base = sorted([*resolve_effects(None), form], key=lambda e: e.name)
+    return [({"shape": form.name, "effects": [e.name for e in model if e.name != form.name]}, model)
+            for model in models_to_build(base, candidate_effects(base)[0])]
 
 
 def _manifest_spec(path: str):
@@ -231,6 +259,10 @@ def _derive(args) -> int:
         sets = [([e.name for e in effects], effects) for effects in default_diagnosis_models()]
         sets += _assisted_vehicle_sets() + _signature_truth_sets() + _suggestion_shape_sets()
         for path in args.manifests:
+            held = _held_form_sets(path)
+            if held is not None:
+                sets += held
+                continue
             spec = _manifest_spec(path)
             sets.append((spec, resolve_effects(spec)))
         written = write_prebuilt(sets)
