@@ -63,7 +63,6 @@ def with_replay_uncertainty(engine: ReplayEngine, problem: Problem, effects: lis
                 rack = rounding_draw(rack, f.time_s, f.rack.rest_resolution_m, rng,
                                      held=rack.rest_intervals_s if hold else ())
             racks.append((base, rack))
-        engine.count(draws)  # the draws' solves (on one-off replays)
     owners = [i for i in range(len(problem.files)) for _ in range(draws)]
     replayed = engine.map(
         lambda job: engine.signals(problem, effects, job[0], overrides, job[1][0].on_rack(job[1][1])),
