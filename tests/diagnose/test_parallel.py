@@ -159,3 +159,27 @@ def test_the_separating_replays_are_the_same_in_workers_and_in_line(params):
     alone = Replay(effects, case, surface, params, f.rack, f.time_s)
     expected = float(np.sqrt(np.mean((alone.torque() - alone.torque(runs[2][1])) ** 2)))
     assert rows[2][1][-1]["predicted_difference_rms_Nm"] == expected
+
+
+def test_the_replay_ensemble_is_the_same_on_two_workers(params):
+    """with_replay_uncertainty (the replay's own uncertainty: racks logged again, smoothed and replayed): its
+    random numbers drawn in order in this process and its racks smoothed and replayed on two workers, every
+    draw's torque and the spread are the one process's, bit for bit, also with a rack rounded coarser than its
+    noise (a second draw per rack, within its levels); the spread is not zero."""
+    from parksteer.diagnose.ensemble import with_replay_uncertainty
+
+    f = load_files([REPO / "data" / "samples" / "car" / "unladen__ground.csv"], params)[0]
+    effects = resolve_effects(None)
+    for rounding_m in (0.0, 0.0008):
+        problem = Problem([replace(f, rack=replace(f.rack, rest_resolution_m=rounding_m))], params)
+        found = {}
+        for workers in (1, 2):
+            engine = ReplayEngine(workers)
+            try:
+                found[workers] = with_replay_uncertainty(engine, problem, effects, draws=4).files[0]
+            finally:
+                engine.close()
+            assert engine.evaluations == 4
+        assert np.array_equal(found[1].replay_draws_Nm, found[2].replay_draws_Nm)
+        assert np.array_equal(found[1].replay_uncertainty_Nm, found[2].replay_uncertainty_Nm)
+        assert np.max(found[2].replay_uncertainty_Nm) > 0.0
