@@ -183,3 +183,28 @@ def test_the_replay_ensemble_is_the_same_on_two_workers(params):
         assert np.array_equal(found[1].replay_draws_Nm, found[2].replay_draws_Nm)
         assert np.array_equal(found[1].replay_uncertainty_Nm, found[2].replay_uncertainty_Nm)
         assert np.max(found[2].replay_uncertainty_Nm) > 0.0
+
+
+def test_what_workers_find_of_a_models_direct_quantities_is_kept(params):
+    """ReplayEngine.map keeps what its workers found of which quantities only enter a compiled model's equations
+    (ReplayEngine.direct, found by preparing the run with the quantity moved): after a map whose workers replayed
+    a rack friction and a wheel load moved, the engine knows both, as a replay in this process finds them (the
+    friction only in the equations, the load in the preparation too), so workers forked later need not test them."""
+    from parksteer.diagnose.replay import Replay
+
+    f = load_files([REPO / "data" / "samples" / "car" / "unladen__ground.csv"], params)[0]
+    effects = resolve_effects(None)
+    moves = [{"steering.rack_friction_force": params["steering.rack_friction_force"] + 80.0},
+             {"case.load_left": 1.05 * params["cases.unladen.load_left"]}]
+    engine = ReplayEngine(2)
+    try:
+        replay = engine.new_replay(effects, f.case, f.surface, params, f.rack, f.time_s)
+        pids = engine.map(lambda overrides: replay.torque(overrides).size and os.getpid(), moves)
+    finally:
+        engine.close()
+    alone = Replay(effects, f.case, f.surface, params, f.rack, f.time_s)
+    for overrides in moves:
+        alone.torque(overrides)
+    assert os.getpid() not in pids  # found by the workers alone
+    assert engine.direct == alone.direct
+    assert sorted(engine.direct.values()) == [False, True]

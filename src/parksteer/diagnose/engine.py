@@ -161,17 +161,23 @@ class ReplayEngine:
 
     def map(self, function: Callable, items: list) -> list:
         """``[function(item) for item in items]`` on the workers (:func:`parksteer.diagnose.parallel.fork_map`),
-        the solves they ran counted (in line, :attr:`solves` counts them itself)."""
+        the solves they ran counted (in line, :attr:`solves` counts them itself), and what they found of which
+        quantities only enter a compiled model's equations (:attr:`direct`, a property of the model) kept here, so
+        that workers forked later do not test it again."""
         if not forks(len(items), self.workers):
             return [function(item) for item in items]
 
         def counted(item):
-            before = self.evaluations
-            return function(item), self.evaluations - before
+            before, known = self.evaluations, set(self.direct)
+            result = function(item)
+            return result, self.evaluations - before, {k: v for k, v in self.direct.items() if k not in known}
 
         out = fork_map(counted, items, self.workers)
-        self.count(sum(evaluations for _, evaluations in out))
-        return [result for result, _ in out]
+        self.count(sum(evaluations for _, evaluations, _ in out))
+        for _, _, found in out:
+            for known, direct in found.items():
+                self.direct.setdefault(known, direct)
+        return [result for result, _, _ in out]
 
     def in_workers(self, problem: Problem, function: Callable, items: list, by_candidate: bool) -> list:
         """`function` over `items` (candidates), spread over the workers if `by_candidate` or the predictions do

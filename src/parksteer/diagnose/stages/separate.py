@@ -26,29 +26,26 @@ def differences_by_condition(engine: ReplayEngine, problem: Problem, runs: list[
                              ) -> list[list[dict]]:
     """The first run and each other ((effects, overrides) each), replayed on the first file's rack under each
     load case and surface the data do not cover: for each other run, one row per condition with the RMS torque
-    difference from the first there, in N m and in the file's noise floors. The replays are independent, spread
-    over the engine's workers; runs of the same effect set share one prepared replay per condition in each
-    process."""
+    difference from the first there, in N m and in the file's noise floors. The conditions are independent, spread
+    over the engine's workers, a condition's runs in one process, where runs of the same effect set share one
+    prepared replay (each run is prepared once, not once a worker)."""
     f = problem.files[0]
     conditions = conditions_not_covered(problem)
-    replays: dict[tuple[int, int], Replay] = {}
 
-    def torque(job: tuple[int, int]) -> np.ndarray:
-        condition, run = job
-        effects, overrides = runs[run]
-        if (condition, id(effects)) not in replays:
-            case, surface = conditions[condition]
-            replays[condition, id(effects)] = engine.new_replay(effects, case, surface, problem.params, f.rack,
-                                                                f.time_s)
-        return replays[condition, id(effects)].torque(overrides)
+    def replayed(condition: tuple[str, str]) -> list[np.ndarray]:
+        case, surface = condition
+        replays: dict[int, Replay] = {}
+        predicted = []
+        for effects, overrides in runs:
+            if id(effects) not in replays:
+                replays[id(effects)] = engine.new_replay(effects, case, surface, problem.params, f.rack, f.time_s)
+            predicted.append(replays[id(effects)].torque(overrides))
+        return predicted
 
-    jobs = [(condition, run) for condition in range(len(conditions)) for run in range(len(runs))]
-    predicted = engine.map(torque, jobs)
     rows: list[list[dict]] = [[] for _ in runs[1:]]
-    for condition, (case, surface) in enumerate(conditions):
-        first = predicted[condition * len(runs)]
-        for out, other in zip(rows, predicted[condition * len(runs) + 1:(condition + 1) * len(runs)]):
-            difference = float(np.sqrt(np.mean((first - other) ** 2)))
+    for (case, surface), predicted in zip(conditions, engine.map(replayed, conditions)):
+        for out, other in zip(rows, predicted[1:]):
+            difference = float(np.sqrt(np.mean((predicted[0] - other) ** 2)))
             out.append({"case": case, "surface": surface, "predicted_difference_rms_Nm": difference,
                         "over_noise_floor": difference / f.noise.total_rms})
     return rows
