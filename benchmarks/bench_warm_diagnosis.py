@@ -13,6 +13,11 @@ interpreters with that ``src`` first on the path, on the model cache the first (
 - **assisted**: an assisted record, ``parksteer diagnose data/samples/polo_drag.csv --with-assist --vehicle
   data/vehicles/polo_vi.toml --json --quiet``.
 
+Warm means the bytecode too: each interpreter compiles a module's source only once, into a cache of this run's
+own (``PYTHONPYCACHEPREFIX``, a temporary folder, so that no tree is written into), whatever
+``PYTHONDONTWRITEBYTECODE`` says; an installed package has its bytecode, and without it every process compiles
+some 140 modules again (0.3 s a process here).
+
 Each is repeated ``--repeats`` times in turn (tree by tree within a repeat, so a machine's drift touches every tree
 alike) and reported as its median, and as the ratio of this tree's median to each reference's. Time per replay is
 the wall of the diagnosis's own stages (``cost.timings_s``, the method without the process around it) over its
@@ -31,9 +36,11 @@ import argparse
 import json
 import os
 import resource
+import shutil
 import statistics
 import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -52,19 +59,22 @@ def _children_cpu_s() -> float:
     return usage.ru_utime + usage.ru_stime
 
 
-def run(src: Path, args: list[str]) -> tuple[float, float, str]:
-    """One fresh interpreter on `src`: its wall time, its CPU time (with the workers it waited for) and its stdout."""
-    env = {**os.environ, "PYTHONPATH": str(src)}
+def run(src: Path, args: list[str], bytecode: Path) -> tuple[float, float, str]:
+    """One fresh interpreter on `src`, its bytecode cached under `bytecode`: its wall time, its CPU time (with the
+    workers it waited for) and its stdout."""
+    env = {**os.environ, "PYTHONPATH": str(src), "PYTHONPYCACHEPREFIX": str(bytecode)}
+    env.pop("PYTHONDONTWRITEBYTECODE", None)
     cpu, start = _children_cpu_s(), time.perf_counter()
     out = subprocess.run([sys.executable, *args], cwd=ROOT, env=env, capture_output=True, text=True, check=True)
     return time.perf_counter() - start, _children_cpu_s() - cpu, out.stdout
 
 
-def measure(src: Path, jobs: int) -> dict[str, float]:
-    help_wall, help_cpu, _ = run(src, ["-m", "parksteer.cli", "diagnose", "--help"])
-    out = {"import_s": float(run(src, ["-c", IMPORT_PROBE])[2].strip()), "help_s": help_wall, "help_cpu_s": help_cpu}
+def measure(src: Path, jobs: int, bytecode: Path) -> dict[str, float]:
+    help_wall, help_cpu, _ = run(src, ["-m", "parksteer.cli", "diagnose", "--help"], bytecode)
+    out = {"import_s": float(run(src, ["-c", IMPORT_PROBE], bytecode)[2].strip()), "help_s": help_wall,
+           "help_cpu_s": help_cpu}
     for name, args in DIAGNOSES.items():
-        wall, cpu, stdout = run(src, ["-m", "parksteer.cli", *args, "--jobs", str(jobs)])
+        wall, cpu, stdout = run(src, ["-m", "parksteer.cli", *args, "--jobs", str(jobs)], bytecode)
         cost = json.loads(stdout)["cost"]
         out[f"{name}_s"] = wall
         out[f"{name}_cpu_s"] = cpu
@@ -83,14 +93,18 @@ def main(argv: list[str] | None = None) -> None:
     for ref in args.reference:
         name, _, src = ref.rpartition("=")
         trees[name or "reference"] = Path(src).resolve()
-    for name, src in trees.items():  # the warm-up: fills the model cache for each tree's keys
-        print(f"warm-up {name}", file=sys.stderr, flush=True)
-        measure(src, args.jobs)
-    samples: dict[str, list[dict[str, float]]] = {name: [] for name in trees}
-    for repeat in range(args.repeats):
-        for name, src in trees.items():
-            print(f"repeat {repeat + 1}/{args.repeats}: {name}", file=sys.stderr, flush=True)
-            samples[name].append(measure(src, args.jobs))
+    bytecode = Path(tempfile.mkdtemp(prefix="bench_warm_bytecode_"))
+    try:
+        for name, src in trees.items():  # the warm-up: fills the model cache for each tree's keys, and the bytecode
+            print(f"warm-up {name}", file=sys.stderr, flush=True)
+            measure(src, args.jobs, bytecode)
+        samples: dict[str, list[dict[str, float]]] = {name: [] for name in trees}
+        for repeat in range(args.repeats):
+            for name, src in trees.items():
+                print(f"repeat {repeat + 1}/{args.repeats}: {name}", file=sys.stderr, flush=True)
+                samples[name].append(measure(src, args.jobs, bytecode))
+    finally:
+        shutil.rmtree(bytecode, ignore_errors=True)
     for name, src in trees.items():
         print(f"{name}: {src}")
     medians = {name: {k: statistics.median(s[k] for s in runs) for k in runs[0]} for name, runs in samples.items()}

@@ -55,7 +55,8 @@ def unknown_key_message(key: str) -> str:
 
 def _is_number(value: Any) -> bool:
     """A real number as code writes one (int, float, a NumPy scalar), not a boolean, a string or None."""
-    return not isinstance(value, bool) and isinstance(value, numbers.Real)
+    kind = type(value)  # a plain float or int first: the abstract class's check is the slow path
+    return kind is float or kind is int or (kind is not bool and isinstance(value, numbers.Real))
 
 
 def declaration_problem(q: Quantity) -> str | None:

@@ -96,3 +96,115 @@ def test_predictions_follow_the_problem_they_are_asked_on(params):
         assert all(np.array_equal(a, b) for a, b in zip(one, two))
     assert not np.allclose(predictions[2][0][0], predictions[2][1][0], atol=1e-3)
     assert all(np.array_equal(a, b) for a, b in zip(predictions[2][0], predictions[2][2]))
+
+
+@pytest.mark.parametrize("workers", [1, 2])
+def test_the_engine_counts_every_solve_once_wherever_it_runs(params, monkeypatch, workers):
+    """ReplayEngine.evaluations (the report's replay count) is the number of model solves run: one on a replay
+    the engine made and did not keep, one on a replay made from it on another rack, one at other instants, and
+    three mapped over the workers (counted there by an independent tally of the solver's calls, returned with each
+    result), each once, in line or in two worker processes."""
+    import parksteer.diagnose.replay as replay_module
+
+    real, calls = replay_module.solve, []
+    monkeypatch.setattr(replay_module, "solve", lambda *a, **k: calls.append(os.getpid()) or real(*a, **k))
+    f = load_files([REPO / "data" / "samples" / "car" / "unladen__ground.csv"], params)[0]
+    effects = resolve_effects(None)
+    moved = {"steering.rack_friction_force": params["steering.rack_friction_force"] + 80.0}
+    engine = ReplayEngine(workers)
+    try:
+        one_off = engine.new_replay(effects, f.case, f.surface, params, f.rack, f.time_s)
+        one_off.torque()
+        one_off.on_rack(f.rack).torque(moved)
+        one_off.at_times(f.time_s[1:]).torque()
+
+        def job(overrides):
+            before = len(calls)
+            one_off.torque(overrides)
+            return os.getpid(), len(calls) - before
+
+        mapped = engine.map(job, [{}, moved, {}])
+    finally:
+        engine.close()
+    in_workers = [solves for pid, solves in mapped if pid != os.getpid()]
+    assert len(in_workers) == (3 if workers == 2 else 0)
+    assert len(calls) + sum(in_workers) == 6
+    assert engine.evaluations == 6
+
+
+def test_the_separating_replays_are_the_same_in_workers_and_in_line(params):
+    """differences_by_condition (where two fitted models would differ, in the conditions the data do not cover):
+    spread over two workers, every row is the one a single process gives, bit for bit, and each is the RMS
+    difference of two replays made alone on that condition's prepared run."""
+    from parksteer.diagnose.replay import Replay
+    from parksteer.diagnose.stages.separate import conditions_not_covered, differences_by_condition
+
+    problem = Problem(load_files([REPO / "data" / "samples" / "car" / "unladen__ground.csv"], params), params)
+    effects = resolve_effects(None)
+    friction = params["steering.rack_friction_force"]
+    runs = [(effects, {}), (effects, {"steering.rack_friction_force": friction + 80.0}),
+            (effects, {"steering.rack_friction_force": friction - 50.0})]
+    rows = {}
+    for workers in (1, 2):
+        engine = ReplayEngine(workers)
+        try:
+            rows[workers] = differences_by_condition(engine, problem, runs)
+        finally:
+            engine.close()
+    assert rows[1] == rows[2]
+    f = problem.files[0]
+    conditions = conditions_not_covered(problem)
+    assert [(r["case"], r["surface"]) for r in rows[1][0]] == conditions
+    case, surface = conditions[-1]
+    alone = Replay(effects, case, surface, params, f.rack, f.time_s)
+    expected = float(np.sqrt(np.mean((alone.torque() - alone.torque(runs[2][1])) ** 2)))
+    assert rows[2][1][-1]["predicted_difference_rms_Nm"] == expected
+
+
+def test_the_replay_ensemble_is_the_same_on_two_workers(params):
+    """with_replay_uncertainty (the replay's own uncertainty: racks logged again, smoothed and replayed): its
+    random numbers drawn in order in this process and its racks smoothed and replayed on two workers, every
+    draw's torque and the spread are the one process's, bit for bit, also with a rack rounded coarser than its
+    noise (a second draw per rack, within its levels); the spread is not zero."""
+    from parksteer.diagnose.ensemble import with_replay_uncertainty
+
+    f = load_files([REPO / "data" / "samples" / "car" / "unladen__ground.csv"], params)[0]
+    effects = resolve_effects(None)
+    for rounding_m in (0.0, 0.0008):
+        problem = Problem([replace(f, rack=replace(f.rack, rest_resolution_m=rounding_m))], params)
+        found = {}
+        for workers in (1, 2):
+            engine = ReplayEngine(workers)
+            try:
+                found[workers] = with_replay_uncertainty(engine, problem, effects, draws=4).files[0]
+            finally:
+                engine.close()
+            assert engine.evaluations == 4
+        assert np.array_equal(found[1].replay_draws_Nm, found[2].replay_draws_Nm)
+        assert np.array_equal(found[1].replay_uncertainty_Nm, found[2].replay_uncertainty_Nm)
+        assert np.max(found[2].replay_uncertainty_Nm) > 0.0
+
+
+def test_what_workers_find_of_a_models_direct_quantities_is_kept(params):
+    """ReplayEngine.map keeps what its workers found of which quantities only enter a compiled model's equations
+    (ReplayEngine.direct, found by preparing the run with the quantity moved): after a map whose workers replayed
+    a rack friction and a wheel load moved, the engine knows both, as a replay in this process finds them (the
+    friction only in the equations, the load in the preparation too), so workers forked later need not test them."""
+    from parksteer.diagnose.replay import Replay
+
+    f = load_files([REPO / "data" / "samples" / "car" / "unladen__ground.csv"], params)[0]
+    effects = resolve_effects(None)
+    moves = [{"steering.rack_friction_force": params["steering.rack_friction_force"] + 80.0},
+             {"case.load_left": 1.05 * params["cases.unladen.load_left"]}]
+    engine = ReplayEngine(2)
+    try:
+        replay = engine.new_replay(effects, f.case, f.surface, params, f.rack, f.time_s)
+        pids = engine.map(lambda overrides: replay.torque(overrides).size and os.getpid(), moves)
+    finally:
+        engine.close()
+    alone = Replay(effects, f.case, f.surface, params, f.rack, f.time_s)
+    for overrides in moves:
+        alone.torque(overrides)
+    assert os.getpid() not in pids  # found by the workers alone
+    assert engine.direct == alone.direct
+    assert sorted(engine.direct.values()) == [False, True]

@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 
 from parksteer.diagnose.engine import ReplayEngine, effect_key
-from parksteer.diagnose.ensemble import relogged_rack
+from parksteer.diagnose.ensemble import DrawnInAdvance, relogged_rack
 from parksteer.diagnose.replay import Replay
-from parksteer.measure.smoothing import smooth_rack
+from parksteer.measure.smoothing import rounding_draw, rounding_draw_size, smooth_rack
 from parksteer.model.codegen.cache import entry_path as compiled_entry_path
 from parksteer.model.numeric.prescribed import solve
 from parksteer.model.numeric.simulate import prepare
@@ -88,6 +88,27 @@ def test_relogged_racks_scatter_about_the_smoothed_one():
     difference = again.evaluate(t)[0] - rack.evaluate(t)[0]
     assert again.knot_spacing_s == rack.knot_spacing_s
     assert 0.0 < np.sqrt(np.mean(difference**2)) < quantisation_step(FULL_SCALE_M)
+
+
+def test_a_rack_drawn_from_numbers_drawn_in_advance_is_the_one_drawn_in_line():
+    """DrawnInAdvance (the replay ensemble's random numbers drawn in order, its racks made in a worker): a rack
+    logged again, smoothed and moved within a coarse rounding from numbers drawn in advance is, bit for bit, the
+    rack drawn from the generator itself; a call for other numbers than those drawn, or numbers left unused, is
+    refused."""
+    t, logged, _ = _logged_rack(3, True)
+    rack = smooth_rack(t, logged)
+    rng = np.random.default_rng(5)
+    in_line = rounding_draw(relogged_rack(rack, t, FULL_SCALE_M, 8, 0.0002, rng), t, 0.001, rng)
+    rng, count = np.random.default_rng(5), rounding_draw_size(t)
+    numbers = DrawnInAdvance([("normal", (0.0, 0.0002, t.shape), rng.normal(0.0, 0.0002, t.shape)),
+                              ("standard_normal", (count,), rng.standard_normal(count))])
+    ahead = rounding_draw(relogged_rack(rack, t, FULL_SCALE_M, 8, 0.0002, numbers), t, 0.001, numbers)
+    numbers.check_used()
+    assert np.array_equal(ahead.breaks, in_line.breaks) and np.array_equal(ahead.coefficients, in_line.coefficients)
+    with pytest.raises(RuntimeError, match="asked for"):
+        DrawnInAdvance([("standard_normal", (count,), np.zeros(count))]).standard_normal(count + 1)
+    with pytest.raises(RuntimeError, match="not used"):
+        DrawnInAdvance([("standard_normal", (count,), np.zeros(count))]).check_used()
 
 
 def test_an_override_set_in_the_vector_replays_as_a_prepared_run(params):

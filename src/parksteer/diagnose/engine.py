@@ -10,12 +10,14 @@ itself as scipy's ``OdeSolver`` keeps ``nfev``. It owns:
 - `direct`: which quantities only enter a compiled model's equations
   (:meth:`parksteer.diagnose.replay.Replay._is_direct`);
 - `prepared`: the prepared runs by host model, case, surface and parameters, shared by every replay on them;
-- `replays`: one :class:`parksteer.diagnose.replay.Replay` per effect set, file and torque lag, each counting its
-  own solves, whichever process made it;
+- `replays`: one :class:`parksteer.diagnose.replay.Replay` per effect set, file and torque lag (the kept ones);
+- `solves`: the count every replay it makes adds its solves to, kept or not (a replay on another rack or at
+  other instants made from one of them too: :class:`parksteer.diagnose.replay.SolveCount`);
 - `pool`, `workers`: the worker processes a prediction spreads its files over (:mod:`parksteer.diagnose.parallel`),
   forked for the problem they serve and again for another problem, so that none answers for an earlier one, and
   holding the diagnosis's effects and their classes, which a prediction's tasks name by place;
-- `other_replays`: the solves no kept replay counts, so that :attr:`evaluations` counts every solve.
+- `other_replays`: the solves run in worker processes, which each worker's copy of `solves` counted, so that
+  :attr:`evaluations` counts every solve, wherever it ran.
 
 How the stages use it: docs/diagnosis.md.
 """
@@ -30,7 +32,7 @@ from ..model.numeric.compiled import CompiledModel, CompiledModels
 from ..model.symbolic.components import Effect
 from .parallel import ServingPool, fork_map, forks
 from .problem import Problem
-from .replay import Replay
+from .replay import Replay, SolveCount
 
 
 class LoadedModels(CompiledModels):
@@ -84,28 +86,29 @@ class ReplayEngine:
         # (host key, case, surface, id(parameters)) -> (the parameters, kept so that their id stays theirs; runs)
         self.prepared: dict[tuple, tuple[object, dict]] = {}
         self.replays: dict[tuple, Replay] = {}
+        self.solves = SolveCount()
         self.other_replays = 0
         self.pool = ServingPool(self.workers, inherited_effects([*effects, *(e for host in self.hosts.values()
                                                                           for e in host)]))
 
     @property
     def evaluations(self) -> int:
-        """Every solve run so far: those of the kept replays and :attr:`other_replays`."""
-        return sum(r.evaluations for r in self.replays.values()) + self.other_replays
+        """Every solve run so far: those of the replays made here (:attr:`solves`) and :attr:`other_replays`."""
+        return self.solves.solves + self.other_replays
 
     def count(self, evaluations: int) -> None:
-        """Count solves no kept replay counts (run in worker processes, or on one-off racks)."""
+        """Count solves run in worker processes (whose replays counted them in their own copy of :attr:`solves`)."""
         self.other_replays += evaluations
 
     def new_replay(self, effects: list[Effect], case: str, surface: str, params, rack, time_s) -> Replay:
         """A replay of `effects` on its host's compiled model, sharing what the engine knows of that model and the
-        runs prepared on it; not kept (its solves are not counted)."""
+        runs prepared on it; not kept, its solves counted in :attr:`solves`."""
         model_effects = self.hosts.get(effect_key(effects), list(effects))
         key = (effect_key(model_effects), case, surface, id(params))
         if key not in self.prepared:
             self.prepared[key] = (params, {})
         return Replay(list(effects), case, surface, params, rack, time_s, model_effects=model_effects,
-                      direct=self.direct, models=self.models, shared_runs=self.prepared[key][1])
+                      direct=self.direct, models=self.models, shared_runs=self.prepared[key][1], counter=self.solves)
 
     def replay(self, problem: Problem, effects: list[Effect], index: int) -> Replay:
         """The kept replay of `effects` on file `index` of `problem`, at the file's instants (made when first asked
@@ -157,24 +160,32 @@ class ReplayEngine:
         return [self.signals(problem, effects, i, overrides) for i in range(len(problem.files))]
 
     def map(self, function: Callable, items: list) -> list:
-        """``[function(item) for item in items]`` on the workers (:func:`parksteer.diagnose.parallel.fork_map`)."""
-        return fork_map(function, items, self.workers)
-
-    def in_workers(self, problem: Problem, function: Callable, items: list, by_candidate: bool) -> list:
-        """`function` over `items` (candidates), spread over the workers if `by_candidate` or the predictions do
-        not spread the files; the solves the workers ran are counted. `function` must return what pickles: a
-        result that holds effects returns a copy without them (``dataclasses.replace``), and the caller puts them
-        back."""
-        if (self.parallel_files(problem) and not by_candidate) or not forks(len(items), self.workers):
+        """``[function(item) for item in items]`` on the workers (:func:`parksteer.diagnose.parallel.fork_map`),
+        the solves they ran counted (in line, :attr:`solves` counts them itself), and what they found of which
+        quantities only enter a compiled model's equations (:attr:`direct`, a property of the model) kept here, so
+        that workers forked later do not test it again."""
+        if not forks(len(items), self.workers):
             return [function(item) for item in items]
 
         def counted(item):
-            before = self.evaluations
-            return function(item), self.evaluations - before
+            before, known = self.evaluations, set(self.direct)
+            result = function(item)
+            return result, self.evaluations - before, {k: v for k, v in self.direct.items() if k not in known}
 
-        out = self.map(counted, items)
-        self.count(sum(evaluations for _, evaluations in out))
-        return [result for result, _ in out]
+        out = fork_map(counted, items, self.workers)
+        self.count(sum(evaluations for _, evaluations, _ in out))
+        for _, _, found in out:
+            for known, direct in found.items():
+                self.direct.setdefault(known, direct)
+        return [result for result, _, _ in out]
+
+    def in_workers(self, problem: Problem, function: Callable, items: list, by_candidate: bool) -> list:
+        """`function` over `items` (candidates), spread over the workers if `by_candidate` or the predictions do
+        not spread the files (:meth:`map`). `function` must return what pickles: a result that holds effects
+        returns a copy without them (``dataclasses.replace``), and the caller puts them back."""
+        if self.parallel_files(problem) and not by_candidate:
+            return [function(item) for item in items]
+        return self.map(function, items)
 
     def close(self) -> None:
         """End the worker pool, if one was started; later predictions run in line."""

@@ -22,7 +22,7 @@ import numpy as np
 
 from .. import portable as pm
 from ..measure.converter import add_noise, quantise
-from ..measure.smoothing import SmoothedRack, rounding_draw, smooth_rack
+from ..measure.smoothing import SmoothedRack, rounding_draw, rounding_draw_size, smooth_rack
 from ..model.symbolic.components import Effect
 from .engine import ReplayEngine
 from ..measure.column import rack_logger
@@ -42,8 +42,9 @@ def with_replay_uncertainty(engine: ReplayEngine, problem: Problem, effects: lis
     sample keeps the larger of this and the uncertainty already estimated.
     """
     rng = np.random.default_rng(seed)
-    # The racks are drawn in line, in order (one random stream), then replayed side by side.
-    racks = []
+    # The random numbers are drawn here, in order (one random stream); each draw's rack is logged, smoothed and
+    # replayed side by side on the workers from its numbers (DrawnInAdvance).
+    jobs, sources = [], {}
     for i, f in enumerate(problem.files):
         base = engine.replay(problem, effects, i)
         base.parameter_vector(overrides)  # any run the overrides need is prepared once, here
@@ -52,22 +53,30 @@ def with_replay_uncertainty(engine: ReplayEngine, problem: Problem, effects: lis
         # (rack_fit.RACK_REST_TEST_CHI2, RACK_REST_MIN_S): every other draw smooths with the ends and the
         # pauses free, so the samples there carry that doubt.
         released = any(f.rack.held_at_rest) or bool(f.rack.rest_intervals_s)
-        sources = ensemble_sources(f, draws, released)
-        for k in range(draws):
-            source, hold = sources[k]
-            if logger is not None:
-                rack = relogged_rack(source, f.time_s, *logger, rng, hold_rest=hold)
-            else:
-                rack = source.perturbed(rng)
-            if f.rack.rest_resolution_m > 0.0:  # a rounding coarser than the noise: the rack within its levels
-                rack = rounding_draw(rack, f.time_s, f.rack.rest_resolution_m, rng,
-                                     held=rack.rest_intervals_s if hold else ())
-            racks.append((base, rack))
-        engine.count(draws)  # the draws' solves (on one-off replays)
-    owners = [i for i in range(len(problem.files)) for _ in range(draws)]
-    replayed = engine.map(
-        lambda job: engine.signals(problem, effects, job[0], overrides, job[1][0].on_rack(job[1][1])),
-        list(zip(owners, racks)))
+        for spacing, hold in ensemble_plan(f, draws, released):
+            source = _source(sources, f, i, spacing, hold)  # made here, once, before the workers fork
+            perturbed = None if logger is not None else source.perturbed(rng)
+            drawn = []
+            if logger is not None and logger[2] > 0.0:  # the analog noise add_noise draws (none at 0 RMS)
+                drawn.append(("normal", (0.0, logger[2], f.time_s.shape), rng.normal(0.0, logger[2], f.time_s.shape)))
+            if f.rack.rest_resolution_m > 0.0:
+                count = rounding_draw_size(f.time_s)
+                drawn.append(("standard_normal", (count,), rng.standard_normal(count)))
+            jobs.append((i, spacing, hold, perturbed, tuple(drawn)))
+
+    def replayed_draw(job) -> np.ndarray:
+        i, spacing, hold, rack, drawn = job
+        f, numbers = problem.files[i], DrawnInAdvance(drawn)
+        logger = rack_logger(f.measurement, problem.params)
+        if rack is None:
+            rack = relogged_rack(_source(sources, f, i, spacing, hold), f.time_s, *logger, numbers, hold_rest=hold)
+        if f.rack.rest_resolution_m > 0.0:  # a rounding coarser than the noise: the rack within its levels
+            rack = rounding_draw(rack, f.time_s, f.rack.rest_resolution_m, numbers,
+                                 held=rack.rest_intervals_s if hold else ())
+        numbers.check_used()
+        return engine.signals(problem, effects, i, overrides, engine.replay(problem, effects, i).on_rack(rack))
+
+    replayed = engine.map(replayed_draw, jobs)
     files = []
     for i, f in enumerate(problem.files):
         runs = np.array(replayed[i * draws : (i + 1) * draws])
@@ -98,8 +107,9 @@ def _spread(runs: np.ndarray, before: np.ndarray | None) -> np.ndarray:
     return spread if before is None else np.maximum(spread, before)
 
 
-def ensemble_sources(f: FileData, draws: int, released: bool) -> list[tuple[SmoothedRack, bool]]:
-    """The smoothed rack each draw of the replay ensemble is logged again from, and whether it holds rests.
+def ensemble_plan(f: FileData, draws: int, released: bool) -> list[tuple[float, bool]]:
+    """The knot spacing of the smoothed rack each draw of the replay ensemble is logged again from, and whether it
+    holds rests.
 
     Every knot spacing whose fit passes the discrepancy test
     (:attr:`parksteer.measure.smoothing.SmoothedRack.passing_spacings_s`) fits the rack within its noise, and at a
@@ -112,23 +122,56 @@ def ensemble_sources(f: FileData, draws: int, released: bool) -> list[tuple[Smoo
     spacings = f.rack.passing_spacings_s
     pair = 2 if released else 1
     slots = max(draws // pair, 1)
-    smoothed = {}
-
-    def at(spacing: float, hold: bool) -> SmoothedRack:
-        if hold and spacing == f.rack.knot_spacing_s:
-            return f.rack
-        if (spacing, hold) not in smoothed:
-            smoothed[spacing, hold] = smooth_rack(f.time_s, f.rack_m, spacing, hold_rest=hold,
-                                                  rest_resolution_m=f.rack.rest_resolution_m)
-        return smoothed[spacing, hold]
-
     out = []
     for k in range(draws):
         slot = (k // pair) % slots
         index = int(slot * (len(spacings) - 1) / (slots - 1) + 0.5) if slots > 1 else 0
-        hold = not (released and k % 2)
-        out.append((at(spacings[index], hold), hold))
+        out.append((spacings[index], not (released and k % 2)))
     return out
+
+
+def ensemble_sources(f: FileData, draws: int, released: bool) -> list[tuple[SmoothedRack, bool]]:
+    """The smoothed rack each draw of the replay ensemble is logged again from, and whether it holds rests
+    (:func:`ensemble_plan`), each spacing's smoothed once."""
+    smoothed: dict = {}
+    return [(_source(smoothed, f, 0, spacing, hold), hold) for spacing, hold in ensemble_plan(f, draws, released)]
+
+
+def _source(smoothed: dict, f: FileData, index: int, spacing: float, hold: bool) -> SmoothedRack:
+    """File `index`'s rack smoothed at `spacing` (holding rests or not), made once per `smoothed` (a process's)."""
+    if hold and spacing == f.rack.knot_spacing_s:
+        return f.rack
+    if (index, spacing, hold) not in smoothed:
+        smoothed[index, spacing, hold] = smooth_rack(f.time_s, f.rack_m, spacing, hold_rest=hold,
+                                                     rest_resolution_m=f.rack.rest_resolution_m)
+    return smoothed[index, spacing, hold]
+
+
+class DrawnInAdvance:
+    """Stands in for a random generator (``numpy.random.Generator``) in a function that draws from one, as
+    :func:`relogged_rack` and :func:`parksteer.measure.smoothing.rounding_draw` do: it gives back, in order, the
+    numbers drawn in advance from the generator itself (`drawn`: each call's method, arguments and values) and
+    refuses any other call, so the function computes, in another process, exactly what it would have computed
+    drawing from the generator in order."""
+
+    def __init__(self, drawn) -> None:
+        self.drawn = list(drawn)
+
+    def _next(self, method: str, arguments: tuple) -> np.ndarray:
+        if not self.drawn or self.drawn[0][:2] != (method, arguments):
+            raise RuntimeError(f"replay ensemble: {method}{arguments} asked for, but drawn in advance: "
+                               f"{[d[:2] for d in self.drawn]}")
+        return self.drawn.pop(0)[2]
+
+    def normal(self, loc: float = 0.0, scale: float = 1.0, size=None) -> np.ndarray:
+        return self._next("normal", (loc, scale, size))
+
+    def standard_normal(self, size=None) -> np.ndarray:
+        return self._next("standard_normal", (size,))
+
+    def check_used(self) -> None:
+        if self.drawn:
+            raise RuntimeError(f"replay ensemble: drawn in advance but not used: {[d[:2] for d in self.drawn]}")
 
 
 def relogged_rack(rack: SmoothedRack, time_s: np.ndarray, full_scale: float, bits: int, analog_rms: float,

@@ -32,6 +32,17 @@ from ..parameters import Parameters
 KEPT_RUNS = 8
 
 
+class SolveCount:
+    """The solves of a family of replays, counted together: the replays a replay engine makes share one
+    (:attr:`parksteer.diagnose.engine.ReplayEngine.solves`), and so do the replays made from one of them on
+    another rack or at other instants (:meth:`Replay.on_rack`, :meth:`Replay.at_times`), kept or not."""
+
+    __slots__ = ("solves",)
+
+    def __init__(self) -> None:
+        self.solves = 0
+
+
 @dataclass
 class Replay:
     """The model of one effect set, driven by one smoothed rack, for one case and surface.
@@ -66,6 +77,8 @@ class Replay:
     # the compiled models it loads through, shared by the replays of one engine (ReplayEngine.models); by default
     # this replay's own
     models: CompiledModels | None = field(default=None, repr=False, compare=False)
+    # the count its solves add to besides its own `evaluations`, shared with the replays made from it
+    counter: SolveCount | None = field(default=None, repr=False, compare=False)
 
     def __post_init__(self):
         self.time_s = np.asarray(self.time_s, dtype=float)
@@ -95,7 +108,7 @@ class Replay:
     def _sharing(self, rack: RackSpline, time_s: np.ndarray) -> Replay:
         return Replay(self.effects, self.case, self.surface, self.params, rack, time_s, dict(self.base_overrides),
                       runs=self._runs, model_effects=self.model_effects, direct=self.direct,
-                      models=self.models)
+                      models=self.models, counter=self.counter)
 
     def _prepared(self, overrides: dict[str, float]) -> PreparedRun:
         key = tuple(sorted(overrides.items()))
@@ -158,6 +171,8 @@ class Replay:
         assisted car, the assisted solve (torsion-bar torque, motor torque and current; no outputs)."""
         run, p = self.parameter_vector(overrides)
         self.evaluations += 1
+        if self.counter is not None:
+            self.counter.solves += 1
         if self.assisted:
             if outputs:
                 raise UsageError("the handwheel angle of an assisted car is not replayed (its twist passes the "

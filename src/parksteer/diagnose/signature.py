@@ -15,6 +15,7 @@ the result is frozen. The bases, the classes and what each means: docs/signature
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -138,9 +139,13 @@ def _axis_groups(axes: Axes, models: list[Basis]) -> list[tuple[str, np.ndarray]
     return out
 
 
+def _in_line(function: Callable, items: list) -> list:
+    return [function(item) for item in items]
+
+
 def signature_from_axes(axes: Axes, settings: DiagnosisSettings = DEFAULT_SETTINGS,
-                        calibrated_rack_friction_N: float | None = None, nuisance: np.ndarray | None = None
-                        ) -> Signature:
+                        calibrated_rack_friction_N: float | None = None, nuisance: np.ndarray | None = None,
+                        map_fits: Callable[[Callable, list], list] = _in_line) -> Signature:
     """The signature of the residual on `axes` (module docstring). `calibrated_rack_friction_N`, if given, is
     what a dissipative change along the stroke is stated relative to.
 
@@ -148,23 +153,31 @@ def signature_from_axes(axes: Axes, settings: DiagnosisSettings = DEFAULT_SETTIN
     basis is fitted beside them, so that a shape counts by what the calibrated parameters cannot take up when
     they are fitted again with it (as the suggested effect will be): the calibration has already absorbed the
     part of the truth along its own directions, and the residual is the truth less that projection, which a
-    basis alone would have to mimic."""
+    basis alone would have to mimic.
+
+    `map_fits(function, items)` gives ``[function(item) for item in items]``: the least-squares fits, independent of
+    each other, may run side by side (:meth:`parksteer.diagnose.engine.ReplayEngine.map`), with the same numbers."""
     sigma = np.asarray(axes.sigma_Nm, dtype=float)
     weighted = np.asarray(axes.residual_Nm, dtype=float) / sigma
     n = weighted.size
     if nuisance is not None and nuisance.shape[0] != n:
         raise UsageError(f"signature: {nuisance.shape[0]} rows of sensitivities for {n} samples")
-    _, rss0 = _fit(np.zeros((n, 0)), weighted, sigma, nuisance)
     models = bases(axes, settings)
     groups = _axis_groups(axes, models)
     design = np.column_stack([b.columns for b in models]) / sigma[:, None]
     if nuisance is not None:
         design = np.column_stack([design, nuisance])
-    left = weighted - pm.matmul(design, pm.lstsq(design, weighted))
+
+    def fitted(columns: np.ndarray | None):  # None: every basis together (the largest fit, so sent first)
+        return pm.lstsq(design, weighted) if columns is None else _fit(columns, weighted, sigma, nuisance)
+
+    blocks = [np.zeros((n, 0)), *(b.columns for b in models), *(columns for _, columns in groups)]
+    together, (_, rss0), *rest = map_fits(fitted, [None, *blocks])
+    fits, group_fits = rest[:len(models)], rest[len(models):]
+    left = weighted - pm.matmul(design, together)
     rho = pooled_lag1(left[axes.record == r] for r in np.unique(axes.record))
     n_eff = effective_samples(n, rho)
 
-    fits = [_fit(b.columns, weighted, sigma, nuisance) for b in models]
     scores = []
     for b, (_, rss) in zip(models, fits):
         k = b.columns.shape[1]
@@ -174,8 +187,7 @@ def signature_from_axes(axes: Axes, settings: DiagnosisSettings = DEFAULT_SETTIN
 
     shares = []
     excess = rss0 - n
-    for name, columns in groups:
-        _, rss = _fit(columns, weighted, sigma, nuisance)
+    for (name, columns), (_, rss) in zip(groups, group_fits):
         k = columns.shape[1]
         statistic = (rss0 - rss) * n_eff / n
         p = float(chdtrc(k, statistic))
@@ -295,12 +307,12 @@ def _describe_dissipative_column(best: Basis, c: np.ndarray) -> tuple[str, dict]
 
 
 def signature_of(files, predictions: list[np.ndarray], params: Parameters, overrides: dict[str, float] | None = None,
-                 jacobian: np.ndarray | None = None, settings: DiagnosisSettings = DEFAULT_SETTINGS
-                 ) -> Signature:
+                 jacobian: np.ndarray | None = None, settings: DiagnosisSettings = DEFAULT_SETTINGS,
+                 map_fits: Callable[[Callable, list], list] = _in_line) -> Signature:
     """The signature of the torque residual of a diagnosis's files (:class:`parksteer.diagnose.problem.FileData`)
     under the calibrated model's `predictions`, with the model's parameters `params` and `overrides` (the
     calibration's values) and, if given, the calibration's `jacobian` (``Fit.jacobian``: its sensitivities,
-    fitted beside every basis, :func:`signature_from_axes`)."""
+    fitted beside every basis, :func:`signature_from_axes`, whose fits `map_fits` runs)."""
     axes = axes_of(files, predictions, params, overrides)
     values = {**steering_values(params), **(overrides or {})}
     nuisance = None
@@ -310,4 +322,4 @@ def signature_of(files, predictions: list[np.ndarray], params: Parameters, overr
             rows.append(np.arange(start, start + f.n))
             start += f.m
         nuisance = np.asarray(jacobian, dtype=float)[np.concatenate(rows)]
-    return signature_from_axes(axes, settings, values.get("steering.rack_friction_force"), nuisance)
+    return signature_from_axes(axes, settings, values.get("steering.rack_friction_force"), nuisance, map_fits)

@@ -121,10 +121,7 @@ def rounding_draw(rack: RackSpline, time_s: np.ndarray, step_m: float, rng: np.r
     stretch in `held` (a pause the draw holds at rest) it fades out within four knot intervals of the stretch's ends
     (the B-splines wholly inside get nothing), so the pause's edges keep their doubt and its middle stays at rest."""
     t = np.asarray(time_s, dtype=float)
-    interval = RACK_MIN_SAMPLES_PER_KNOT * float(np.median(np.diff(t)))
-    pieces = max(1, int(round((t[-1] - t[0]) / interval)))
-    inner = t[0] + (t[-1] - t[0]) * np.arange(pieces + 1) / pieces
-    knots = np.concatenate([[t[0]] * 3, inner, [t[-1]] * 3])
+    knots, interval = _rounding_knots(t)
     count = len(knots) - 4
     first, last = knots[:count], knots[4 : count + 4]  # the span of each B-spline
     centres = 0.5 * (first + last)
@@ -134,6 +131,19 @@ def rounding_draw(rack: RackSpline, time_s: np.ndarray, step_m: float, rng: np.r
         sigma[(first >= a) & (last <= b)] = 0.0
     draw = sigma * rng.standard_normal(count)
     return rack.plus(RackSpline(*piecewise_cubic(knots, draw)))
+
+
+def _rounding_knots(t: np.ndarray) -> tuple[np.ndarray, float]:
+    """The knots of :func:`rounding_draw`'s B-spline on `t` and their interval (s)."""
+    interval = RACK_MIN_SAMPLES_PER_KNOT * float(np.median(np.diff(t)))
+    pieces = max(1, int(round((t[-1] - t[0]) / interval)))
+    inner = t[0] + (t[-1] - t[0]) * np.arange(pieces + 1) / pieces
+    return np.concatenate([[t[0]] * 3, inner, [t[-1]] * 3]), interval
+
+
+def rounding_draw_size(time_s: np.ndarray) -> int:
+    """How many standard normal numbers :func:`rounding_draw` on `time_s` draws (one call, whatever the rack)."""
+    return len(_rounding_knots(np.asarray(time_s, dtype=float))[0]) - 4
 
 
 def smooth_rack(time_s, rack_m, knot_spacing_s: float | None = None, hold_rest: bool = True,

@@ -26,17 +26,24 @@ def differences_by_condition(engine: ReplayEngine, problem: Problem, runs: list[
                              ) -> list[list[dict]]:
     """The first run and each other ((effects, overrides) each), replayed on the first file's rack under each
     load case and surface the data do not cover: for each other run, one row per condition with the RMS torque
-    difference from the first there, in N m and in the file's noise floors. Runs of the same effect set share
-    one prepared replay per condition."""
+    difference from the first there, in N m and in the file's noise floors. The conditions are independent, spread
+    over the engine's workers, a condition's runs in one process, where runs of the same effect set share one
+    prepared replay (each run is prepared once, not once a worker)."""
     f = problem.files[0]
-    rows: list[list[dict]] = [[] for _ in runs[1:]]
-    for case, surface in conditions_not_covered(problem):
+    conditions = conditions_not_covered(problem)
+
+    def replayed(condition: tuple[str, str]) -> list[np.ndarray]:
+        case, surface = condition
         replays: dict[int, Replay] = {}
         predicted = []
         for effects, overrides in runs:
             if id(effects) not in replays:
                 replays[id(effects)] = engine.new_replay(effects, case, surface, problem.params, f.rack, f.time_s)
             predicted.append(replays[id(effects)].torque(overrides))
+        return predicted
+
+    rows: list[list[dict]] = [[] for _ in runs[1:]]
+    for (case, surface), predicted in zip(conditions, engine.map(replayed, conditions)):
         for out, other in zip(rows, predicted[1:]):
             difference = float(np.sqrt(np.mean((predicted[0] - other) ** 2)))
             out.append({"case": case, "surface": surface, "predicted_difference_rms_Nm": difference,

@@ -20,5 +20,5 @@ class ResidualSignature(Stage):
             return state
         calibration = state.calibration
         signature = signature_of(state.problem.files, calibration.predictions, state.problem.params,
-                                 calibration.overrides, calibration.jacobian, state.settings)
+                                 calibration.overrides, calibration.jacobian, state.settings, engine.map)
         return state.with_output(self.name, signature)
