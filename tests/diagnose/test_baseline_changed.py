@@ -85,6 +85,7 @@ def test_a_grown_rack_friction_is_named_as_the_value_that_changed(judged):
     assert not low <= judged["was"] <= high
     sentence = relative_sentence(diagnosis_dict(found))
     assert f"Changed: {RACK}, from" in sentence and "not a library effect" in sentence
+    assert "(content hash None; the healthy records were adequate)" in sentence
 
 
 @pytest.mark.slow

@@ -23,10 +23,10 @@ def relative_sentence(result: dict) -> str | None:
         ci = strength.get("ci95")
         unit = shown_unit(result.get("units", {}).get(key, ""))
         unit = f" {unit}" if unit else ""
-        held = (rel.get("calibrated") or {}).get(key) if result["effect"].startswith("changed:") else None
-        if held is not None:  # a calibrated value that moved (parksteer.diagnose.baseline_changed)
-            was = held.get("ci95")
-            said = (f"Changed: {key}, from {num(held['value'])}{unit}"
+        before = (rel.get("calibrated") or {}).get(key) if result["effect"].startswith("changed:") else None
+        if before is not None:  # a calibrated value that moved (parksteer.diagnose.baseline_changed)
+            was = before.get("ci95")
+            said = (f"Changed: {key}, from {num(before['value'])}{unit}"
                     + (f" (95 %: {num(was[0])} to {num(was[1])})" if was else "")
                     + f" to {num(strength['value'])}{unit}"
                     + (f" (95 %: {num(ci[0])} to {num(ci[1])}{unit})" if ci else "")
