@@ -2,18 +2,16 @@
 
 Against a baseline the car's calibrated values are held at the baseline's (:meth:`parksteer.diagnose.baseline_form.
 Threshold.settings_for`): calibrated again, a value takes up any change it can carry (a column friction through the
-rack friction) and nothing is named. But the value itself may be what changed (a rack whose friction grew): held,
-such a change could only show as the library candidate nearest to it. So each held value is a candidate,
-``changed:<key>`` (:class:`ChangedValues`, a stage run after the library's refits): the value freed alone (in its
-logarithm within ``calibration_range_factor`` of the baseline's; an angle as it stands within its half range),
-everything else held, in the car's own model, one parameter, as each library candidate's refit is one strength. Its
-BIC gain enters the same selection (:mod:`parksteer.diagnose.stages.select`), against the same threshold of "as the
-baseline", which the healthy parts were judged with these candidates in play. It may be named only where its 95 %
-interval leaves out the baseline's value (the headline rule against a baseline: a change the data do not hold apart
-from none is no change); where it does not, it is listed, not refitted. Named, the verdict is ``missing`` with
-``effect`` ``changed:<key>``: a change found (the owner learns which value moved, from what to what), never a
-library effect. Where it and a library candidate explain a record alike, both are refitted and within the BIC band
-of each other, and the margin says so. Why: docs/diagnosis.md, "A calibrated value that changed".
+rack friction). But the value itself may be what changed (a rack whose friction grew), and held it could only show
+as the library candidate nearest to it. So each held value is a candidate, ``changed:<key>`` (:class:`ChangedValues`,
+a stage after the library's refits): the value freed alone (in its logarithm within ``calibration_range_factor`` of
+the baseline's; an angle as it stands within its half range), everything else held, one parameter as a library
+candidate's strength is one. Its BIC gain enters the same selection (:mod:`parksteer.diagnose.stages.select`)
+against the same thresholds of "as the baseline". It may be named only where its 95 % interval leaves out the
+baseline's value (a change the data do not hold apart from none is no change); otherwise it is listed, not
+refitted. Named, the verdict is ``missing`` with ``effect`` ``changed:<key>``: a change found, never a library
+effect. Where it and a library candidate explain a record alike, both are refitted within the BIC band of each
+other, and the margin says so. Why: docs/diagnosis.md, "Against a car's baseline".
 """
 
 from __future__ import annotations
