@@ -17,7 +17,8 @@ CAR = {"name": "bore", "kind": "manual", "quirk": "bore_friction", "quirk_floors
 
 def _said(verdict="adequate", effect="", named=False, confident=False, wrong=False, over=1.0):
     return {"verdict": verdict, "effect": effect, "indistinguishable": "", "named": named, "confident": confident,
-            "confident_wrong": wrong, "bic_margin": None, "over_floor": over}
+            "confident_wrong": wrong, "changed_value": effect.startswith("changed:"), "bic_margin": None,
+            "over_floor": over}
 
 
 def _row(kind, hidden, absolute, baseline, floors=3.0):
@@ -55,6 +56,49 @@ def test_scoring_holds_each_bar_to_its_definition():
     assert not score(named + nulls + confident, "absolute")["bars"]["out_of_class_not_confident"]
     small = [_row("hidden", "h", _said("unexplained"), None, floors=1.0)]  # below 2 floors: not counted
     assert score(named + small, "absolute")["named"] == [3, 4]
+
+
+def test_an_out_of_class_change_read_as_a_changed_value_is_its_own_column():
+    """An out-of-class change named with confidence as a calibrated value that moved (changed:<key>) is counted in a
+    column of its own, not as a library effect named (the bar on those holds) and not as not named; a hidden change
+    of a calibrated value is named right only by its own changed:<key>, and a library effect named instead of it
+    with confidence is a confident wrong name."""
+    from parksteer.experiments.baseline import judged
+
+    nulls = [_row("null", "null", _said(), None, 0.0)]
+    read = [_row("outclass", "bore_friction", _said("missing", "changed:steering.rack_friction_force",
+                                                     confident=True), None)]
+    scored = score(nulls + read, "absolute")
+    assert scored["out_of_class_changed_value"] == [1, 1] and scored["out_of_class_confident"] == [0, 1]
+    assert scored["bars"]["out_of_class_not_confident"]
+    key = "changed:steering.rack_friction_force"
+    truth = {"kind": "hidden", "hidden": key}
+
+    def result(effect, gains):
+        return {"verdict": "missing", "effect": effect, "indistinguishable": [],
+                "ranking": [{"delta_bic": g} for g in gains],
+                "selection": {"thresholds": {"bic_indistinguishable": 6.0}},
+                "statistics": {"calibrated": {"weighted_rms_Nm": 0.03}}, "noise_floor_Nm": 0.02}
+
+    right = judged(truth, result(key, [40.0, 12.0]))
+    assert right["named"] and right["changed_value"] and not right["confident_wrong"]
+    wrong = judged(truth, result("kingpin_friction", [40.0, 12.0]))
+    assert not wrong["named"] and wrong["confident_wrong"] and not wrong["changed_value"]
+
+
+def test_a_later_record_may_hide_a_change_of_a_calibrated_value():
+    """The design knows a change of the rack friction as a hidden change (kind hidden), its record's name free of
+    the key's colon; an assisted car refuses it (its calibration is another)."""
+    key = "changed:steering.rack_friction_force"
+    later = Later(key, "pauses", 12, 3.0)
+    assert later.kind == "hidden" and ":" not in later.name
+    design = design_from_config({"cars": [{**CAR, "later": [{"what": key, "hand": "pauses", "bits": 12,
+                                                              "floors": 3.0}]}]})
+    assert design.cars[0].later == (later,)
+    assisted = {**CAR, "kind": "assisted", "quirk": "exp", "later": [{"what": key, "hand": "pauses", "bits": 12}]}
+    with pytest.raises(UsageError, match="changed:steering.rack_friction_force") as error:
+        design_from_config({"cars": [assisted]})
+    assert "\n" not in str(error.value)
 
 
 def test_figure_renders_both_sides_and_the_json_scores_them(tmp_path):

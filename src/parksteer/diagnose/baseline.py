@@ -23,6 +23,7 @@ from dataclasses import dataclass
 from ..errors import UsageError
 from ..model.symbolic.components import Effect, resolve_effects, with_effect_quantities
 from ..parameters import Parameters
+from .baseline_changed import with_changed_values
 from .baseline_file import baseline_text, content_hash, identified_parameters, parse_baseline, read_bytes
 from .baseline_form import FORMAT, HEADLINE, HeldForm, Threshold, vehicle_fingerprint
 from .baseline_learn import learn
@@ -75,7 +76,10 @@ class Baseline:
         """What a diagnosis against this baseline names it by (JSON ``relative_to``)."""
         return {"baseline": self.path, "content_hash": self.content_hash, "records": list(self.records),
                 "verdict": self.verdict, "form": None if self.form is None else self.form.effect,
-                "threshold": self.threshold.as_dict(), "headline": HEADLINE}
+                "threshold": self.threshold.as_dict(), "headline": HEADLINE,
+                "calibrated": {k: {"value": float(v["value"]),
+                                   "ci95": [float(c) for c in v["ci95"]] if "ci95" in v else None}
+                               for k, v in self.calibrated.items()}}
 
     def check(self, params: Parameters, effects=None) -> None:
         """Refuse, in one line naming the file and the key, records of another car (its values' hash) or a model of
@@ -108,6 +112,12 @@ class Baseline:
         if self.form is None or any(e.name == self.form.effect for e in base):
             return list(base)
         return sorted([*base, self.form.model_effect(registry)], key=lambda e: e.name)
+
+    def table(self, stages, settings: DiagnosisSettings) -> tuple:
+        """The stages a later record is diagnosed with: `stages` with each calibrated value the baseline holds a
+        candidate of its own, ``changed:<key>`` (:mod:`parksteer.diagnose.baseline_changed`; `settings` say which
+        are fitted as angles)."""
+        return with_changed_values(tuple(stages), tuple(self.calibrated), settings)
 
     @property
     def held(self) -> dict[str, float]:

@@ -78,7 +78,9 @@ def diagnose(files: list[FileData], params: Parameters, effects=None, registry: 
                       uses_motor=assisted and settings.use_motor_channel and f.motor is not None,
                       replay_uncertainty_motor=None, replay_draws_motor=None) for f in files]
     problem = Problem(copies, params, angle_offset_fitted=settings.angle_offset_fitted)
-    if baseline is not None:
+    table = with_user_effect_stage(tuple(stages), base)
+    if baseline is not None:  # each held calibrated value a candidate (before settings_for holds them)
+        table = baseline.table(tuple(stages), settings)
         settings = baseline.threshold.settings_for(settings, problem.n)
     progress = Progress(quiet)
     registry = registry if registry is not None else discover_effects()
@@ -86,7 +88,7 @@ def diagnose(files: list[FileData], params: Parameters, effects=None, registry: 
     state = DiagnosisState(settings, problem, tuple(base), frozen_mapping(registry),
                            None if strengths is None else frozen_mapping(strengths),
                            None if start is None else frozen_mapping(start), progress,
-                           tuple(stages) if baseline is not None else with_user_effect_stage(tuple(stages), base),
+                           table,
                            held=None if held is None else frozen_mapping(held))
     testable, _ = candidate_effects(base, registry)
     # The models the candidates replay in are built in the background while the base model's stages run (the base

@@ -22,14 +22,15 @@ import time
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
+from ..diagnose.baseline_changed import changed_key
 from ..diagnose.intake import Request, intake
 from ..errors import UsageError
 from ..parameters import Parameters
 from ..reporting.report import diagnosis_dict
 from ..synthetic.quirks import QUIRKS
 from ..synthetic.variations import variation_by_name
-from .baseline_cars import (ASSISTED_CONVERTERS, ASSISTED_HIDDEN, ASSISTED_OUT_OF_CLASS, MANUAL_CONVERTERS,
-                            MANUAL_HIDDEN, AssistedCar, Car, Later, ManualCar)
+from .baseline_cars import (ASSISTED_CONVERTERS, ASSISTED_HIDDEN, ASSISTED_OUT_OF_CLASS, MANUAL_CHANGED,
+                            MANUAL_CONVERTERS, MANUAL_HIDDEN, AssistedCar, Car, Later, ManualCar)
 from .benchmark import BENCHMARK_SETTINGS
 from .outclass import bic_margin
 
@@ -47,7 +48,7 @@ class BaselineDesign:
 
 
 def _check(car: Car) -> None:
-    known_hidden = MANUAL_HIDDEN if car.kind == "manual" else ASSISTED_HIDDEN
+    known_hidden = MANUAL_HIDDEN + MANUAL_CHANGED if car.kind == "manual" else ASSISTED_HIDDEN
     known_out = tuple(QUIRKS) if car.kind == "manual" else ASSISTED_OUT_OF_CLASS
     converters = MANUAL_CONVERTERS if car.kind == "manual" else ASSISTED_CONVERTERS
     where = f"config baseline.cars {car.name}"
@@ -107,6 +108,7 @@ def judged(truth: dict, result: dict) -> dict:
     right = truth["kind"] == "hidden" and named is not None and (named == truth["hidden"] or truth["hidden"] in group)
     return {"verdict": result["verdict"], "effect": named or "", "indistinguishable": " ".join(group),
             "named": bool(right), "confident": confident, "confident_wrong": confident and not right,
+            "changed_value": changed_key(named) is not None,
             "bic_margin": margin,
             "over_floor": result["statistics"]["calibrated"]["weighted_rms_Nm"] / result["noise_floor_Nm"]}
 
@@ -205,13 +207,17 @@ def score(rows: list[dict], side: str) -> dict | None:
     outclass = [r for r in rows if r["kind"] == "outclass"]
     named = _count(hidden, lambda r: r[side]["named"])
     adequate = _count(nulls, lambda r: r[side]["verdict"] == "adequate")
-    out_named = _count(outclass, lambda r: r[side]["confident"])
+    # an out-of-class change read with confidence as a calibrated value that moved is its own column: a change
+    # found (the owner learns that value moved), never a library effect named
+    out_named = _count(outclass, lambda r: r[side]["confident"] and not r[side].get("changed_value"))
+    out_changed = _count(outclass, lambda r: r[side]["confident"] and r[side].get("changed_value"))
     wrong = [r["name"] for r in rows if r[side]["confident_wrong"] and r["kind"] != "outclass"]
     bars = {"named": not hidden or named[0] >= NAMED_BAR * named[1],
             "nulls_adequate": adequate[0] == adequate[1],
             "out_of_class_not_confident": out_named[0] == 0,
             "no_confident_wrong": not wrong}
     return {"named": named, "nulls_adequate": adequate, "out_of_class_confident": out_named,
+            "out_of_class_changed_value": out_changed,
             "confident_wrong": wrong, "bars": bars, "met": all(bars.values())}
 
 

@@ -25,6 +25,10 @@ from ..synthetic.datasets import BASE_PERTURBATION
 from ..names import TORQUE
 
 MANUAL_HIDDEN = ("column_friction", "rack_stiction", "kingpin_friction", "rack_damping")
+# a change of a value the baseline calibrates (named right only as changed:<key>, diagnose.baseline_changed): the
+# car's rack friction grown since its healthy record
+MANUAL_CHANGED = ("changed:steering.rack_friction_force",)
+CHANGED_MAX_FRACTION = 2.0  # the search's largest change of the value, as a fraction of the car's
 ASSISTED_HIDDEN = ("assist_motor_friction", "torsion_bar_offset", "boost_gain_error")
 ASSISTED_OUT_OF_CLASS = ("cogging",)
 # torque converters by bits: (full scale N m); 10 bits to steps of 0.005 N m
@@ -51,12 +55,12 @@ class Later:
     def kind(self) -> str:
         if self.what == "null":
             return "null"
-        return "hidden" if self.what in MANUAL_HIDDEN + ASSISTED_HIDDEN else "outclass"
+        return "hidden" if self.what in MANUAL_HIDDEN + MANUAL_CHANGED + ASSISTED_HIDDEN else "outclass"
 
     @property
     def name(self) -> str:
         size = f"_{self.floors:g}" if self.kind != "null" else ""
-        return f"{self.what}{size}__{self.hand}__t{self.bits}"
+        return f"{self.what.replace(':', '_')}{size}__{self.hand}__t{self.bits}"
 
 
 @dataclass(frozen=True)
@@ -123,7 +127,24 @@ class ManualCar:
                  "floors": 0.0, "strength": None}
         road = manual_road(self.params, hand, self.car.case, self.base)
         unchanged = road
-        if later.kind == "hidden":
+        if later.what in MANUAL_CHANGED:  # the calibrated value itself moved: value x (1 + s)
+            key = later.what.split(":", 1)[1]
+            was = float(self.base.get(key, self.params[key]))
+
+            def changed(s: float):
+                if s == 0.0:
+                    return self.quirk.logged(coarse, self.strength)[1]
+                moved = manual_road(self.params, hand, self.car.case, {**self.base, key: was * (1.0 + s)},
+                                    dt_s=SEARCH_DT_S)
+                return self.quirk.logged(moved, self.strength)[1]
+
+            coarse = manual_road(self.params, hand, self.car.case, self.base, dt_s=SEARCH_DT_S)
+            s = strength_for_rms(changed, later.floors * logger.floor_Nm, 1e-3, CHANGED_MAX_FRACTION, SEARCH)
+            road = manual_road(self.params, hand, self.car.case, {**self.base, key: was * (1.0 + s)})
+            size = rms_difference(self.quirk.logged(road, self.strength)[1],
+                                  self.quirk.logged(unchanged, self.strength)[1])
+            truth.update(strength=was * (1.0 + s), was=was, floors=size / logger.floor_Nm)
+        elif later.kind == "hidden":
             quantity = strength_parameter(discover_effects()[later.what], self.params)
             effects = f"+{later.what}"
 
@@ -252,4 +273,4 @@ class AssistedCar:
         _write(path, record, self.owner)
 
 
-__all__ = ["ASSISTED_HIDDEN", "MANUAL_HIDDEN", "AssistedCar", "Car", "Later", "ManualCar", "owner_gear_text"]
+__all__ = ["ASSISTED_HIDDEN", "MANUAL_CHANGED", "MANUAL_HIDDEN", "AssistedCar", "Car", "Later", "ManualCar", "owner_gear_text"]

@@ -27,10 +27,15 @@ def right(row: dict, side: str) -> bool | None:
     return not said["confident"]
 
 
+def _short(name: str) -> str:
+    """A name as a cell shows it: a changed calibrated value by its quantity (changed: rack_friction_force)."""
+    return "changed: " + name.split(":", 1)[1].rsplit(".", 1)[-1] if name.startswith("changed:") else name
+
+
 def _label(said: dict | None) -> str:
     if said is None:
         return "not run"
-    return said["effect"] if said["verdict"] == "missing" else SHORT.get(said["verdict"], said["verdict"])
+    return _short(said["effect"]) if said["verdict"] == "missing" else SHORT.get(said["verdict"], said["verdict"])
 
 
 def baseline_figure(cars: list[dict], path: str | Path) -> None:
@@ -52,7 +57,7 @@ def baseline_figure(cars: list[dict], path: str | Path) -> None:
         for j, side in enumerate(("absolute", "baseline")):
             ax.add_patch(grid_cell(j, i, VARIATION_SHADES[right(row, side)]))
             ax.text(j, i, _label(row[side]), ha="center", va="center", fontsize=6)
-    labels = [f"{r['car']}: {r['hidden'] if r['kind'] != 'null' else 'nothing'}"
+    labels = [f"{r['car']}: {_short(r['hidden']) if r['kind'] != 'null' else 'nothing'}"
               + (f" {r['floors']:.1f}" if r["kind"] != "null" else "") for r in rows]
     ax.set_xlim(-0.5, 1.5)
     ax.set_ylim(len(rows) - 0.5, -0.5)

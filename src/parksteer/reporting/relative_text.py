@@ -23,8 +23,18 @@ def relative_sentence(result: dict) -> str | None:
         ci = strength.get("ci95")
         unit = shown_unit(result.get("units", {}).get(key, ""))
         unit = f" {unit}" if unit else ""
-        said = (f"Changed: {result['effect']}" + (f", {num(strength['value'])}{unit}" if "value" in strength else "")
-                + (f" (95 %: {num(ci[0])} to {num(ci[1])}{unit})" if ci else "") + ".")
+        before = (rel.get("calibrated") or {}).get(key) if result["effect"].startswith("changed:") else None
+        if before is not None:  # a calibrated value that moved (parksteer.diagnose.baseline_changed)
+            was = before.get("ci95")
+            said = (f"Changed: {key}, from {num(before['value'])}{unit}"
+                    + (f" (95 %: {num(was[0])} to {num(was[1])})" if was else "")
+                    + f" to {num(strength['value'])}{unit}"
+                    + (f" (95 %: {num(ci[0])} to {num(ci[1])}{unit})" if ci else "")
+                    + "; a calibrated value of the car, not a library effect.")
+        else:
+            said = (f"Changed: {result['effect']}" + (f", {num(strength['value'])}{unit}" if "value" in strength
+                                                      else "")
+                    + (f" (95 %: {num(ci[0])} to {num(ci[1])}{unit})" if ci else "") + ".")
     else:
         said = "Changed, outside the library: see the residual's signature below."
     return (f"{name} (content hash {rel['content_hash']}; {held}). {said} \"As the baseline\" allows up to "
