@@ -329,14 +329,14 @@ def readme_order() -> list[str]:
 # models it uses again (docs/targets.md's fig3 is README.md's). Split so that no chain alone takes longer than the others together take on a second worker, and
 # listed longest first (the order the test run's workers start them in: tests/conftest.py).
 CHAINS: dict[str, list[str]] = {
+    "buses_and_vehicles": ["docs/bus.md", "docs/vehicles.md", "docs/assist.md", "docs/assist_sizing.md"],
     "figures_and_models": ["README.md#What it builds", "docs/targets.md", "docs/model.md", "docs/reproducibility.md",
                            "docs/workflow.md", "docs/sweeps.md", "docs/scaling.md", "docs/measurement.md",
                            "docs/diagnosis.md", "docs/peers.md", "docs/house.md", "docs/development.md"],
-    "buses_and_vehicles": ["docs/bus.md", "docs/vehicles.md", "docs/assist.md", "docs/assist_sizing.md"],
-    "assist_identify": ["docs/assist_identify.md"],
-    "assisted_car": ["docs/assist_diagnosis.md"],
     "missing_effect": ["docs/signature.md"],
+    "assist_identify": ["docs/assist_identify.md"],
     "use_it": ["README.md#Quick start", "README.md#Use it", "README.md#A worked example"],
+    "assisted_car": ["docs/assist_diagnosis.md"],
 }
 
 
