@@ -16,7 +16,19 @@ for _variable in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
 
 import pytest  # noqa: E402
 
+import parksteer.diagnose.parallel as _parallel  # noqa: E402
 from parksteer.parameters import DEFAULT_PATH, Parameters, load_parameters  # noqa: E402
+
+# For the same reason, a diagnosis or baseline run in a test process without --jobs (the command line, or a
+# caller of parksteer.diagnose.intake) replays in line when the test run's workers already take every CPU,
+# instead of forking a pool of one process per CPU on top of them: the pool's processes each set up their
+# replays again (about 10 % more CPU for the same JSON, which tests/diagnose/test_job_counts.py shows equal at
+# every job count, and that test and tests/diagnose/test_parallel.py still run the pools). Subprocesses (the
+# documents' commands) are not concerned.
+_TEST_WORKERS = int(os.environ.get("PYTEST_XDIST_WORKER_COUNT", "1"))
+if _TEST_WORKERS > 1:
+    _cpus = _parallel.available_workers()
+    _parallel.available_workers = lambda: max(_cpus // _TEST_WORKERS, 1)
 
 REPO_ROOT = Path(__file__).resolve().parents[1]
 

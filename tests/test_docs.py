@@ -17,6 +17,10 @@ What a document may say about a block, in HTML comments the rendered page does n
 - ``<!-- docs-test: skip (REASON) -->`` before a block: it is not run (the whole pipeline, a SLURM cluster, a
   benchmark of minutes); REASON is required and is listed in the test's output;
 - ``<!-- docs-test: skip-line "TEXT" (REASON) -->`` before a block: its commands containing TEXT are left out;
+- ``<!-- docs-test: ran-above "TEXT" -->`` before a block: its commands containing TEXT are left out, each being,
+  as written, a command an earlier block of its chain ran in the same copy (a page showing again a command it ran
+  above: :func:`test_a_command_left_out_as_ran_above_ran_above_in_its_chain`); such a block ties no value to its
+  output, which would then lack those commands';
 - ``<!-- docs-test: heavy "TEXT" (REASON) -->`` before a block: its commands containing TEXT (a pipeline target or
   a derivation of tens of seconds) run only with PARKSTEER_DOCS_TEST=full in the environment, so that the suite's
   default run stays within its time; the full run is the same test with every such command in;
@@ -60,6 +64,7 @@ MARKER = re.compile(r"^<!--\s*docs-test:\s*(.*?)\s*-->", re.S | re.M)  # on a li
 SKIP = re.compile(r"skip\s+\((.+)\)$", re.S)
 SKIP_LINE = re.compile(r'skip-line\s+"([^"]+)"\s+\((.+)\)$', re.S)
 HEAVY = re.compile(r'heavy\s+"([^"]+)"\s+\((.+)\)$', re.S)
+RAN_ABOVE = re.compile(r'ran-above\s+"([^"]+)"$')
 FULL = os.environ.get("PARKSTEER_DOCS_TEST") == "full"
 EXITS = re.compile(r"exits\s+(\d+)$")
 QUOTES = re.compile(r"quotes\s+(\S+)\s+from\s+(\S+?):\s+(.+)$", re.S)
@@ -76,6 +81,7 @@ class Block:
     text: str
     skip: str | None = None
     skip_lines: list[tuple[str, str]] = field(default_factory=list)
+    ran_above: list[str] = field(default_factory=list)  # TEXT of each ran-above marker
     exits: int = 0
     quotes: list[tuple[str, str, str]] = field(default_factory=list)
     appears: list[tuple[tuple[str, ...], str]] = field(default_factory=list)  # (values, source)
@@ -83,8 +89,8 @@ class Block:
     after: str = ""  # the prose after the block, to the next block or heading (markers removed)
     heavy_left_out: bool = False  # lines of a heavy marker left out (PARKSTEER_DOCS_TEST not full)
 
-    def commands(self) -> list[str]:
-        """The block's commands (continuation lines joined), those a skip-line marker names left out."""
+    def all_commands(self) -> list[str]:
+        """Every command of the block (continuation lines joined)."""
         out, current = [], ""
         for line in self.text.splitlines():
             current += line + "\n"
@@ -93,7 +99,16 @@ class Block:
                 current = ""
         if current:
             out.append(current)
-        return [c for c in out if not any(text in c for text, _ in self.skip_lines)]
+        return out
+
+    def commands(self) -> list[str]:
+        """The block's commands that run: those a skip-line (or left-out heavy) or ran-above marker names left out."""
+        return [c for c in self.all_commands() if not any(text in c for text, _ in self.skip_lines)
+                and not any(text in c for text in self.ran_above)]
+
+    def ran_above_commands(self) -> list[str]:
+        """The block's commands a ran-above marker names (each must have run earlier in the block's chain)."""
+        return [c for c in self.all_commands() if any(text in c for text in self.ran_above)]
 
 
 def parse(document: str, text: str) -> list[Block]:
@@ -120,12 +135,14 @@ def parse(document: str, text: str) -> list[Block]:
                     last.appears.append((tuple(values.split()), source))
                 else:
                     last.given += GIVEN.match(body).group(1).replace(",", " ").split()
-            elif SKIP.match(body) or SKIP_LINE.match(body) or HEAVY.match(body) or EXITS.match(body):
+            elif (SKIP.match(body) or SKIP_LINE.match(body) or HEAVY.match(body) or EXITS.match(body)
+                  or RAN_ABOVE.match(body)):
                 pending.append(body)
             else:
                 raise AssertionError(f"{document}:{line}: unknown docs-test marker {body!r} (skip (REASON), "
-                                     "skip-line \"TEXT\" (REASON), heavy \"TEXT\" (REASON), exits N, quotes VALUE from SOURCE: REGEX, "
-                                     "appear VALUES in SOURCE, given VALUES (REASON))")
+                                     "skip-line \"TEXT\" (REASON), heavy \"TEXT\" (REASON), ran-above \"TEXT\", "
+                                     "exits N, quotes VALUE from SOURCE: REGEX, appear VALUES in SOURCE, "
+                                     "given VALUES (REASON))")
             continue
         language, body = item.group(1), item.group(2)
         if language != "sh":
@@ -142,6 +159,8 @@ def parse(document: str, text: str) -> list[Block]:
                 block.skip = m.group(1)
             elif (m := SKIP_LINE.match(marker)) is not None:
                 block.skip_lines.append((m.group(1), m.group(2)))
+            elif (m := RAN_ABOVE.match(marker)) is not None:
+                block.ran_above.append(m.group(1))
             elif (m := HEAVY.match(marker)) is not None:
                 if not FULL:
                     block.skip_lines.append((m.group(1), f"heavy, run with PARKSTEER_DOCS_TEST=full: {m.group(2)}"))
@@ -310,14 +329,14 @@ def readme_order() -> list[str]:
 # models it uses again (docs/targets.md's fig3 is README.md's). Split so that no chain alone takes longer than the others together take on a second worker, and
 # listed longest first (the order the test run's workers start them in: tests/conftest.py).
 CHAINS: dict[str, list[str]] = {
+    "buses_and_vehicles": ["docs/bus.md", "docs/vehicles.md", "docs/assist.md", "docs/assist_sizing.md"],
     "figures_and_models": ["README.md#What it builds", "docs/targets.md", "docs/model.md", "docs/reproducibility.md",
                            "docs/workflow.md", "docs/sweeps.md", "docs/scaling.md", "docs/measurement.md",
                            "docs/diagnosis.md", "docs/peers.md", "docs/house.md", "docs/development.md"],
-    "buses_and_vehicles": ["docs/bus.md", "docs/vehicles.md", "docs/assist.md", "docs/assist_sizing.md"],
-    "assist_identify": ["docs/assist_identify.md"],
-    "assisted_car": ["docs/assist_diagnosis.md"],
     "missing_effect": ["docs/signature.md"],
+    "assist_identify": ["docs/assist_identify.md"],
     "use_it": ["README.md#Quick start", "README.md#Use it", "README.md#A worked example"],
+    "assisted_car": ["docs/assist_diagnosis.md"],
 }
 
 
@@ -370,6 +389,49 @@ def test_chains_run_every_block_once_in_readme_order():
         assert position == sorted(position), f"chain {name} is not in README order"
     every = {(name, b.line) for name, text in documents().items() for b in parse(name, text)}
     assert every - set(seen) == set(), f"blocks in no chain: {sorted(every - set(seen))}"
+
+
+def ran_above_problems(blocks: list[Block]) -> list[str]:
+    """What is wrong with the ran-above markers of `blocks` (one chain's blocks, in its order), one line each: each
+    marker names a command of its block, each command it names is, as written, one an earlier block of the chain
+    ran (not skipped), and the block ties no value to its output."""
+    ran: set[str] = set()
+    problems = []
+    for block in blocks:
+        where = f"{block.document}:{block.line}"
+        if block.ran_above:
+            named = block.ran_above_commands()
+            if block.skip is not None:
+                problems.append(f"{where}: a ran-above marker on a skipped block")
+            for text in block.ran_above:
+                if not any(text in command for command in named):
+                    problems.append(f"{where}: ran-above {text!r} names no command of the block")
+            for command in named:
+                if command not in ran:
+                    problems.append(f"{where}: {command.strip()!r} did not run earlier in its chain")
+            if any(source == "output" for _, source, _ in block.quotes) or any(
+                    source == "output" for _, source in block.appears):
+                problems.append(f"{where}: ties a value to its output, which lacks the commands left out as ran above")
+        if block.skip is None:
+            ran.update(block.commands())
+    return problems
+
+
+def test_a_command_left_out_as_ran_above_ran_above_in_its_chain():
+    """A command a ran-above marker leaves out ran, as written, in an earlier block of the same chain (the same
+    copy of the repository), so every command of every document still runs once in its chain; a marker naming a
+    command that ran nowhere above, or in another chain only, fails (checked on a made-up chain too)."""
+    problems = [p for chain in CHAINS.values() for p in ran_above_problems(
+        [block for _, blocks in chain_blocks(chain) for block in blocks])]
+    assert not problems, "\n".join(problems)
+    first = parse("doc.md", "```sh\nparksteer effects\nls\n```\n")
+    again = parse("doc.md", '<!-- docs-test: ran-above "effects" -->\n```sh\nparksteer effects\npwd\n```\n')
+    assert again[0].commands() == ["pwd\n"] and again[0].ran_above_commands() == ["parksteer effects\n"]
+    assert ran_above_problems(first + again) == []
+    assert "did not run earlier" in ran_above_problems(again + first)[0]
+    tied = parse("doc.md", '<!-- docs-test: ran-above "effects" -->\n```sh\nparksteer effects\n```\n'
+                           "<!-- docs-test: quotes 1.5 from output: (1.5) -->\n\nIt prints 1.5.\n")
+    assert "ties a value to its output" in ran_above_problems(first + tied)[0]
 
 
 def test_every_document_in_readme_order():
@@ -432,6 +494,8 @@ def run_document(document: str, work: Path, model_cache: Path, blocks: list[Bloc
             continue
         for text_, reason in block.skip_lines:
             report.append(f"{document}:{block.line}: lines with {text_!r} skipped ({reason})")
+        for text_ in block.ran_above:
+            report.append(f"{document}:{block.line}: lines with {text_!r} ran above in this copy")
         status, output, seconds = run_block(block, work, env)
         report.append(f"{document}:{block.line}: ran in {seconds:.1f} s, status {status}")
         if status != block.exits:
