@@ -98,3 +98,24 @@ def test_a_record_with_nothing_changed_stays_as_the_baseline(judged):
     assert sorted(changed_key(c.name) for c in freed) == sorted(CALIBRATED)
     assert all(c.refit is None for c in freed)
     assert np.isfinite([c.score.statistic for c in freed]).all()
+
+
+@pytest.mark.slow
+def test_the_error_ladder_ends_at_a_changed_value(judged):
+    """The HTML report's error ladder grows the model by named effects; a calibrated value that changed is no effect:
+    its rung (the freed value's refit, whose error is below the held calibration's) is the last, and no diagnosis is
+    made with the value's key taken for an effect's strength."""
+    from parksteer.reporting.ladder import error_ladder
+
+    from dataclasses import replace
+
+    # The ladder stops at the floor too: with an adequate factor no error meets, only the changed value stops it.
+    found = judged["grown"]
+    found = replace(found, settings=replace(found.settings, adequate_rms_factor=1e-3))
+    ladder = error_ladder(found.problem.files, PARAMS, list(found.base_effects), first=found)
+    labels = [r["label"] for r in ladder.as_dict()["rungs"]]
+    assert labels[-1] == f"+ {PREFIX}{RACK}" and len(labels) == 3
+    assert len(ladder.diagnoses) == 1
+    rungs = ladder.as_dict()["rungs"]
+    assert rungs[-1]["parameters"][RACK] > judged["was"]
+    assert rungs[-1]["weighted_rms_Nm"] < rungs[1]["weighted_rms_Nm"]

@@ -5,7 +5,9 @@ parameters calibrated to the files; then, while the diagnosis names a missing ef
 model with that effect added (its strength fitted with the calibrated parameters). After
 each addition the ladder stops if the weighted error has reached the floor (within
 ``ADEQUATE_RMS_FACTOR``; with a fitted handwheel angle, the weighted error of both signals); otherwise the grown model is diagnosed again (its added strengths
-calibrated with the base parameters), up to ``LADDER_MAX_STEPS`` additions.
+calibrated with the base parameters), up to ``LADDER_MAX_STEPS`` additions. A calibrated value named as changed
+since a baseline (``changed:<key>``) is the ladder's last rung: it adds no effect whose strength a next diagnosis
+could fit, and that diagnosis would not hold the baseline's values.
 """
 
 from __future__ import annotations
@@ -14,6 +16,7 @@ from dataclasses import dataclass
 
 from ..model.symbolic.components import Effect, resolve_effects
 from ..parameters import Parameters
+from ..diagnose.baseline_changed import changed_key
 from ..diagnose.settings import DEFAULT_SETTINGS, DiagnosisSettings
 from ..diagnose.problem import FileData
 from ..diagnose.select import Diagnosis, diagnose
@@ -82,10 +85,10 @@ def error_ladder(files: list[FileData], params: Parameters, effects=None, first:
         fit = best.refit
         statistics = diagnosis.statistics(fit.predictions)
         model = list(best.signature.model)
-        strengths[best.signature.key] = best.signature.probe
         rungs.append(_rung(f"+ {best.name}", model, statistics, fit.values))
-        if _at_floor(statistics, settings):
+        if changed_key(best.name) is not None or _at_floor(statistics, settings):
             break
+        strengths[best.signature.key] = best.signature.probe
         diagnosis = diagnose(files, params, model, strengths=dict(strengths), start=fit.values, settings=settings,
                              workers=workers)
         diagnoses.append(diagnosis)
