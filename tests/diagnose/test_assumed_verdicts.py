@@ -3,6 +3,13 @@
 
 from __future__ import annotations
 
+import json
+from pathlib import Path
+
+import pytest
+
+from parksteer.cli import main
+from parksteer.diagnose.parallel import can_fork
 from parksteer.diagnose.settings import DEFAULT_SETTINGS as S
 from parksteer.diagnose.stages.assumed import end_reason
 
@@ -105,3 +112,30 @@ def test_the_template_declares_given_values_measured_and_defaults_assumed(tmp_pa
     declared = dict(re.findall(r'^(\w+) = \{.*provenance = "(\w+)" \}$', section, flags=re.M))
     assert declared.pop("reduction_ratio") == "measured"
     assert declared and set(declared.values()) == {"assumed"}
+
+
+# --- the band ends' replays, spread over the workers ------------------------------------------------------------
+
+@pytest.mark.slow
+@pytest.mark.skipif(not can_fork(), reason="the platform cannot fork: everything runs in line")
+def test_the_band_ends_replayed_in_workers_give_the_table_of_one_process(capsys):
+    """The band ends' replays are independent, so two worker processes give the table one process gives, to the
+    bit (each end's fitted figures, verdicts and reasons), for the one record of an assisted car (whose ends the
+    workers share out, not its files); and every solve a worker runs is counted: four a quantity (the calibrated
+    model and the best candidate's refit at each end), in both."""
+    root = Path(__file__).resolve().parents[2]
+    arguments = ["diagnose", str(root / "data" / "samples" / "polo_drag.csv"), "--with-assist", "--vehicle",
+                 str(root / "data" / "vehicles" / "polo_vi.toml"), "--json", "--quiet"]
+    out = {}
+    for jobs in (1, 2):
+        assert main([*arguments, "--jobs", str(jobs)]) == 0
+        out[jobs] = json.loads(capsys.readouterr().out)
+    table = out[1]["assumed"]
+    assert len(table["quantities"]) >= 5 and table["nominal"]["delta_bic"] is not None  # a refit replayed too
+    assert json.dumps(out[2]["assumed"]) == json.dumps(table)
+    for result in out.values():
+        by_stage = result["cost"]["replays_by_stage"]  # cumulative, in the stages' order
+        stages = list(by_stage)
+        before = by_stage[stages[stages.index("assumed") - 1]]
+        assert by_stage["assumed"] - before == 4 * len(table["quantities"])
+    assert out[2]["cost"]["replays"] == out[1]["cost"]["replays"]

@@ -182,3 +182,135 @@ def test_worm_direction_changes_over_on_the_assists_own_band():
     wider = BoostLaw("electric_assist_column", "column", 6.0, 0.5, 0.05, 4.0, 0.05, 125.0, 18.0, eta_f, 0.05,
                      back_efficiency=eta_b, direction_width=0.05, friction_speed=10 * band)
     assert abs(float(wider.delivered(1.0, 3 * band)) - 1.0) < 0.5 * (1 - eta_f)  # the same speed, not yet over
+
+
+def _plain_torsion_bar(law, y, factor=1.0, rotor_speed=0.0):
+    """The inversion of BoostLaw.torsion_bar written plainly: every sample's bracket kept in full-length arrays,
+    the open ones gathered and scattered back at each step, the law evaluated through BoostLaw.assist. Returns the
+    root and the number of samples whose bracket had to be widened."""
+    y = np.asarray(y, dtype=float)
+    speed = np.broadcast_to(np.asarray(rotor_speed, dtype=float), y.shape)
+    gain = np.broadcast_to(np.asarray(factor, dtype=float), y.shape)
+
+    def excess(x, rows):
+        return x + gain[rows] * law.assist(x, speed[rows]) - y[rows]
+
+    low, high = np.minimum(y, 0.0), np.maximum(y, 0.0)
+    f_low, f_high = excess(low, slice(None)), excess(high, slice(None))
+    wide = np.flatnonzero((f_low > 0.0) | (f_high < 0.0))
+    if wide.size:
+        width = law.bound() * float(np.max(factor)) + 1.0
+        low[wide], high[wide] = y[wide] - width, y[wide] + width
+        f_low[wide], f_high[wide] = excess(low[wide], wide), excess(high[wide], wide)
+    low = np.where(f_high == 0.0, high, low)
+    high = np.where(f_low == 0.0, low, high)
+    side = np.zeros(y.shape, dtype=np.int8)
+    open_ = np.flatnonzero(high - low > 1e-12)
+    for _ in range(200):
+        if open_.size == 0:
+            break
+        lo, hi, flo, fhi = low[open_], high[open_], f_low[open_], f_high[open_]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            x = lo - flo * (hi - lo) / (fhi - flo)
+        x = np.where((x > lo) & (x < hi), x, 0.5 * (lo + hi))
+        fx = excess(x, open_)
+        above = fx > 0.0
+        last = side[open_]
+        flo = np.where(above & (last == 1), 0.5 * flo, flo)
+        fhi = np.where(~above & (last == -1), 0.5 * fhi, fhi)
+        low[open_], f_low[open_] = np.where(above, lo, x), np.where(above, flo, fx)
+        high[open_], f_high[open_] = np.where(above, x, hi), np.where(above, fx, fhi)
+        side[open_] = np.where(above, 1, -1)
+        exact = fx == 0.0
+        low[open_[exact]] = high[open_[exact]] = x[exact]
+        open_ = open_[high[open_] - low[open_] > 1e-12]
+    return 0.5 * (low + high), wide.size
+
+
+def _table(scale: float = 1.0) -> tuple:
+    """A two-row boost table (0 and 2 m/s; the second row 0.8 of the first), in table_keys order."""
+    from parksteer.boost_table import table_keys
+
+    torques = [0.0, 0.4, 0.8, 1.2, 1.6, 2.0, 2.5, 3.0, 4.0]
+    row = [0.0, 0.0, 0.9, 2.73, 5.22, 8.27, 12.78, 18.0, 30.3]
+    values = entries(torques, [0.0, 2.0], [[scale * a for a in row], [0.8 * scale * a for a in row]])
+    return tuple(float(values.get(k, 0.0)) for k in table_keys())
+
+
+def test_the_inversion_gives_the_plain_inversions_bits():
+    """The same arithmetic, so the same bits: the inversion as shipped (the open samples' brackets packed, the
+    gear's direction and the table's segments read once per call) returns, bit for bit, what the plain form of
+    the same regula falsi (above: full-length brackets, the law through BoostLaw.assist) returns, for column,
+    pinion and rack gears and a hydraulic valve, with and without a table read between its speed rows, motors
+    delivering 0-2 times the law, rotor speeds of either sign, and torques of 1e-15 N m, where the valve's
+    smoothed dead band rounds to the wrong sign and the root's bracket is widened."""
+    table = _table()
+    cases = [
+        BoostLaw("electric_assist_column", "column", 6.0, 0.5, 0.05, 4.0, 0.05, 125.0, 18.0, 0.85, 0.05,
+                 back_efficiency=0.6, direction_width=0.05, friction_speed=0.5),
+        BoostLaw("electric_assist_pinion", "pinion", 0.0, 0.0, 0.05, 3.0, 0.02, 125.0, 20.0, 0.8, 0.05, table=table,
+                 speed=0.7, table_scale=1.1, back_efficiency=0.75, direction_width=0.05, friction_speed=1.5),
+        BoostLaw("electric_assist_rack", "rack", 5.0, 0.8, 0.01, 5.0, 0.05, 150.0, 2500.0, 0.9, 0.05, table=table,
+                 back_efficiency=0.85, direction_width=0.05, friction_speed=0.3),
+        BoostLaw("hydraulic_assist", "rack", 4e5, 0.3, 0.05, 7e6, 1e5, 150.0, area=8e-4),
+        BoostLaw("hydraulic_assist", "rack", 0.0, 0.3, 0.05, 7e6, 1e5, 150.0, area=8e-4, table=_table(scale=1e5),
+                 speed=3.0),
+    ]
+    rng = np.random.default_rng(11)
+    wide_taken = 0
+    for law in cases:
+        for trial in range(3):
+            y = np.concatenate([rng.uniform(-40.0, 40.0, 300), rng.uniform(-1.0, 1.0, 100),
+                                rng.uniform(-1e-15, 1e-15, 100), [0.0, -0.0, 1e-13]])
+            speed = (0.0, rng.choice([-0.02, -1e-4, 0.0, 1e-4, 0.02, 3.0], size=y.size), 0.7)[trial]
+            factor = (1.0, 0.5, rng.choice([0.0, 0.5, 1.0, 2.0], size=y.size))[trial]
+            plain, widened = _plain_torsion_bar(law, y, factor, speed)
+            assert law.torsion_bar(y, factor, speed).tobytes() == plain.tobytes()
+            wide_taken += widened
+    assert wide_taken > 0
+
+
+def test_the_replays_law_is_assist_commons_law_bit_for_bit():
+    """The replay evaluates the boost law's pieces on numbers without assist_common's check for sympy expressions
+    (whose first call imports sympy): its ramp, dead band, clamp, gear direction and table read at a speed are
+    assist_common's, bit for bit, at values across the corners (and at -0.0), and at vehicle speeds below, on,
+    between and beyond the table's rows."""
+    from parksteer.boost_table import table_keys
+    from parksteer.model.numeric import assisted
+    from parksteer.model.symbolic.effects import assist_common
+
+    rng = np.random.default_rng(5)
+    x = np.concatenate([rng.uniform(-10.0, 10.0, 2000), rng.uniform(-0.6, 0.6, 500), [0.0, -0.0, 0.5, -0.5]])
+    for band, width in ((0.5, 0.05), (0.0, 0.05), (0.3, 0.0)):
+        assert (assisted._deadband(x, band, width).tobytes()
+                == assist_common.deadband(x, band, width).tobytes())
+        assert assisted._clamp(x, 4.0 + band, width).tobytes() == assist_common.clamp(x, 4.0 + band, width).tobytes()
+    speed = rng.uniform(-3.0, 3.0, x.size)
+    for sharpness in (2.0, 1000.0):
+        expected = assist_common.directional_efficiency(x, speed, 0.85, 0.8, 0.05, sharpness)
+        assert (assisted._directional_efficiency(x, np.tanh(sharpness * speed), 0.85, 0.8, 0.05).tobytes()
+                == expected.tobytes())
+    values = dict(zip(table_keys(), _table()))
+    for v in (0.0, 0.7, 2.0, 5.0, -1.0):
+        numeric = assisted._table_points_numeric(values.__getitem__, v)
+        expected = assist_common.table_points(values.__getitem__, v)
+        assert [np.float64(a).tobytes() for part in numeric for a in part] == [
+            np.asarray(a, dtype=float).tobytes() for part in expected for a in part]
+
+
+def test_an_assisted_replays_law_imports_no_sympy():
+    """A replay runs compiled models, so its process never needs sympy (a second of every assisted diagnosis to
+    import): the boost law of a table read between its speed rows, inverted, its motor torque and assist
+    evaluated, in a fresh interpreter, leave sympy unimported."""
+    import subprocess
+    import sys
+
+    code = ("import sys, numpy as np\n"
+            "from parksteer.model.numeric.assisted import BoostLaw\n"
+            f"law = BoostLaw('electric_assist_column', 'column', 6.0, 0.5, 0.05, 4.0, 0.05, 125.0, 18.0, 0.85, 0.05,"
+            f" table={_table()!r}, speed=0.7, back_efficiency=0.8, direction_width=0.05, friction_speed=0.5)\n"
+            "t = law.torsion_bar(np.linspace(-20.0, 20.0, 101), 1.0, 0.01)\n"
+            "law.motor(t), law.assist(t, 0.01)\n"
+            "print('sympy' in sys.modules)\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "False"

@@ -8,8 +8,9 @@ Jacobian, and :func:`~parksteer.diagnose.stages.verdict.choose_verdict` applied 
 (:func:`~parksteer.diagnose.stages.select.may_headline`); each end says why (:func:`end_reason`). A quantity whose
 band's end changes the verdict decides it, and the report says so with how far the calibrated fit moves (noise
 floors). Where ``parksteer assist identify`` fixed the product k_t eta_f N, the efficiency and the reduction move
-with that product held (:func:`moved`). Four replays a quantity, none for a car without an assist; quantities the
-diagnosis fits are not here. Why: docs/assist_identify.md, "Defaults that decide nothing silently".
+with that product held (:func:`moved`). Four replays a quantity, none for a car without an assist (the ends'
+replays are independent, and run side by side on the engine's workers); quantities the diagnosis fits are not here.
+Why: docs/assist_identify.md, "Defaults that decide nothing silently".
 """
 
 from __future__ import annotations
@@ -161,13 +162,28 @@ class AssumedValues(Stage):
         refit = best.refit if best is not None else None
 
         strength_key = best.signature.key if best is not None else None
+        strength_index = None if refit is None else [p.key for p in refit.parameters].index(strength_key)
+        quantities = assumed_quantities(problem.params, effect.name, effect, settings.calibrated_parameters)
+
+        def replayed(item: tuple[str, float] | None):
+            """The calibrated model and the best candidate's refit replayed with one quantity at one band end; for
+            None, the candidate's 95 % interval as it stands (no replay: worked out beside the ends' replays)."""
+            if item is None:
+                return refit.intervals(problem, settings.interval_block_s)[strength_key]["ci95"]
+            change = moved(problem.params, effect.name, *item)
+            return (engine.predict(problem, calibration.effects, {**calibration.overrides, **change}),
+                    None if refit is None else engine.predict(problem, refit.effects, {**refit.overrides, **change}))
+
+        # every end's replays are independent: spread over the workers (or, with several files, each prediction
+        # spreads its files), the first-order refits below in this process, in the table's order
+        items = ([None] if refit is not None else []) + [(key, end) for key, _, _, band in quantities for end in band]
+        predicted = iter(engine.in_workers(problem, replayed, items, False))
         # the candidate's 95 % half-width as it stands: moving an assumed value shifts its strength, to first order
         # not its spread
         halfwidth = None
         if refit is not None:
-            low, high = refit.intervals(problem, settings.interval_block_s)[strength_key]["ci95"]
+            low, high = next(predicted)
             halfwidth = (high - low) / 2.0
-        strength_index = None if refit is None else [p.key for p in refit.parameters].index(strength_key)
 
         def verdict_of(base_rss: float, with_fit: tuple[float, np.ndarray, np.ndarray] | None) -> dict:
             """The verdict by the headline's rule: choose_verdict, with a candidate that may be named only while its
@@ -194,17 +210,13 @@ class AssumedValues(Stage):
         # the same rule on the fits as they stand: the reference the moved values are held against
         nominal = verdict_of(calibration.rss, None if refit is None else (refit.rss, refit.weighted, refit.theta))
         rows = []
-        for key, value, source, band in assumed_quantities(problem.params, effect.name, effect,
-                                                           settings.calibrated_parameters):
-            full = f"{effect.name}.{key}"
+        for key, value, source, band in quantities:
             ends = []
             for end in band:
-                change = moved(problem.params, effect.name, key, end)
-                base_rss, _, _ = _refitted_rss(calibration, problem, engine.predict(
-                    problem, calibration.effects, {**calibration.overrides, **change}))
-                with_fit = None if refit is None else _refitted_rss(refit, problem, engine.predict(
-                    problem, refit.effects, {**refit.overrides, **change}))
+                calibrated, with_candidate = next(predicted)
+                base_rss, _, _ = _refitted_rss(calibration, problem, calibrated)
+                with_fit = None if refit is None else _refitted_rss(refit, problem, with_candidate)
                 ends.append({"value": end, **verdict_of(base_rss, with_fit)})
-            rows.append({"quantity": full, "value": value, "source": source, "band": list(band), "ends": ends,
-                         "decides": any(e["verdict"] != nominal["verdict"] for e in ends)})
+            rows.append({"quantity": f"{effect.name}.{key}", "value": value, "source": source, "band": list(band),
+                         "ends": ends, "decides": any(e["verdict"] != nominal["verdict"] for e in ends)})
         return state.with_output(self.name, {"verdict": state.verdict, "nominal": nominal, "quantities": rows})

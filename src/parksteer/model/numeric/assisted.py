@@ -18,13 +18,12 @@ from functools import cached_property, lru_cache
 
 import numpy as np
 
-from ...boost_table import MAX_POINTS, off_keys, table_keys
+from ...boost_table import MAX_POINTS, MAX_SPEEDS, off_keys, table_keys
 from ...errors import UsageError
 from ...parameters import VEHICLE_SPEED
 from ...reduction_efficiency import min_monotone_back_efficiency
 from ..symbolic.components import power_assist_of
-from ..symbolic.effects.assist_common import (_half_numeric, clamp, deadband, directional_efficiency, speed_gain,
-                                              table_points)
+from ..symbolic.effects.assist_common import _half_numeric, speed_gain
 from .prescribed import PRESCRIBED_ATOL_FACTOR, PRESCRIBED_RTOL, PrescribedSolution, RackMotion, solve
 
 # The inversion stops when the bracket is this narrow (N m of torsion-bar torque), far below a sensor's resolution.
@@ -73,15 +72,15 @@ class BoostLaw:
 
     def motor(self, torsion_bar_Nm):
         """The motor torque (N m; hydraulic: the pressure, Pa) at the torsion-bar torque (module docstring)."""
-        opening = deadband(np.asarray(torsion_bar_Nm, dtype=float), self.dead_band, self.band_width)
+        opening = _deadband(np.asarray(torsion_bar_Nm, dtype=float), self.dead_band, self.band_width)
         scale = self.ratio if self.location == "rack" and not self.hydraulic else 1.0
         demand = self.gain * opening * scale
         if any(self.table):
             demand = demand + self.table_scale * _table_law_numeric(np.asarray(torsion_bar_Nm, dtype=float),
                                                                     self._table_points)
         if self.hydraulic:
-            return clamp(demand, self.limit, self.limit_width)
-        return clamp(demand / (self.efficiency * self.reduction), self.limit, self.limit_width)
+            return _clamp(demand, self.limit, self.limit_width)
+        return _clamp(demand / (self.efficiency * self.reduction), self.limit, self.limit_width)
 
     @cached_property
     def _table_points(self):
@@ -89,6 +88,11 @@ class BoostLaw:
         the inversion evaluates the law some 50 times a sample, and every replay of a diagnosis builds its own law."""
         points = _points_at_speed(np.asarray(self.table, dtype=float).tobytes(), np.float64(self.speed).tobytes())
         return tuple(np.asarray(v, dtype=float) for v in points)
+
+    @cached_property
+    def _segments(self):
+        """The table's segments at this law's speed (:func:`_table_segments`), read once per law."""
+        return _table_segments(self._table_points)
 
     def with_wider_dead_band(self, size_Nm: float) -> BoostLaw:
         """This law with its dead band wider by `size_Nm`: the line's band, and every point of a table but the
@@ -103,8 +107,8 @@ class BoostLaw:
         """What the gear delivers per motor torque, in the direction the power flows (eta_f driving, 1 / eta_b
         back-driven; :func:`~parksteer.model.symbolic.effects.assist_common.directional_efficiency`), the rotor
         turning at `rotor_speed` (rad/s)."""
-        return directional_efficiency(motor, np.asarray(rotor_speed, dtype=float), self.efficiency,
-                                      self.back_efficiency, self.direction_width, 1.0 / self.friction_speed)
+        direction = np.tanh((1.0 / self.friction_speed) * np.asarray(rotor_speed, dtype=float))
+        return _directional_efficiency(motor, direction, self.efficiency, self.back_efficiency, self.direction_width)
 
     def assist(self, torsion_bar_Nm, rotor_speed=0.0):
         """A(T_s): the assist in torsion-bar torque units (what it adds to the torsion bar's torque in y), with the
@@ -128,14 +132,13 @@ class BoostLaw:
         increasing, and factor >= 0: a motor whose delivered torque departs from the law by `factor`), so the root
         is bracketed and kept bracketed: regula falsi with the Illinois rule (the end that stays has its value
         halved), falling back to the bracket's midpoint where the secant leaves it, until the bracket is
-        INVERSION_TOLERANCE_NM wide. Only comparisons and the four operations: the same bits on any machine."""
+        INVERSION_TOLERANCE_NM wide. Only comparisons and the four operations: the same bits on any machine.
+
+        Each sample's steps are its own; the samples still open are stepped together, and the law's parts that do
+        not change from step to step (the gear's direction at each sample's rotor speed, the table's segments) are
+        read once (:class:`_Excess`)."""
         y = np.asarray(y, dtype=float)
-        speed = np.broadcast_to(np.asarray(rotor_speed, dtype=float), y.shape)
-        gain = np.broadcast_to(np.asarray(factor, dtype=float), y.shape)
-
-        def excess(x, rows):
-            return x + gain[rows] * self.assist(x, speed[rows]) - y[rows]
-
+        excess = _Excess(self, y, factor, rotor_speed)
         # A has the sign of its argument, so the root lies between 0 and y; where rounding says otherwise, a
         # bracket as wide as the assist can be
         low, high = np.minimum(y, 0.0), np.maximum(y, 0.0)
@@ -147,30 +150,76 @@ class BoostLaw:
             f_low[wide], f_high[wide] = excess(low[wide], wide), excess(high[wide], wide)
         low = np.where(f_high == 0.0, high, low)  # an end that is the root
         high = np.where(f_low == 0.0, low, high)
-        side = np.zeros(y.shape, dtype=np.int8)  # the end the last step moved: -1 low, +1 high
-        open_ = np.flatnonzero(high - low > INVERSION_TOLERANCE_NM)
-        for _ in range(200):
-            if open_.size == 0:
-                break
-            lo, hi, flo, fhi = low[open_], high[open_], f_low[open_], f_high[open_]
-            with np.errstate(divide="ignore", invalid="ignore"):
+        # the open samples' brackets, packed: their indices, ends, values there and the end the last step moved
+        # (-1 low, +1 high)
+        rows = np.flatnonzero(high - low > INVERSION_TOLERANCE_NM)
+        lo, hi, flo, fhi = low[rows], high[rows], f_low[rows], f_high[rows]
+        side = np.zeros(rows.shape, dtype=np.int8)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            for _ in range(200):
+                if rows.size == 0:
+                    break
                 x = lo - flo * (hi - lo) / (fhi - flo)
-            x = np.where((x > lo) & (x < hi), x, 0.5 * (lo + hi))
-            fx = excess(x, open_)
-            above = fx > 0.0
-            last = side[open_]
-            # Illinois: the end that did not move twice in a row has its value halved
-            flo = np.where(above & (last == 1), 0.5 * flo, flo)
-            fhi = np.where(~above & (last == -1), 0.5 * fhi, fhi)
-            low[open_] = np.where(above, lo, x)
-            f_low[open_] = np.where(above, flo, fx)
-            high[open_] = np.where(above, x, hi)
-            f_high[open_] = np.where(above, fx, fhi)
-            side[open_] = np.where(above, 1, -1)
-            exact = fx == 0.0
-            low[open_[exact]] = high[open_[exact]] = x[exact]
-            open_ = open_[high[open_] - low[open_] > INVERSION_TOLERANCE_NM]
+                x = np.where((x > lo) & (x < hi), x, 0.5 * (lo + hi))
+                fx = excess(x, rows)
+                above = fx > 0.0
+                # Illinois: the end that did not move twice in a row has its value halved
+                flo = np.where(above & (side == 1), 0.5 * flo, flo)
+                fhi = np.where(~above & (side == -1), 0.5 * fhi, fhi)
+                lo, flo, hi, fhi = (np.where(above, lo, x), np.where(above, flo, fx), np.where(above, x, hi),
+                                    np.where(above, fx, fhi))
+                side = np.where(above, 1, -1).astype(np.int8)
+                exact = fx == 0.0
+                if exact.any():
+                    lo[exact] = hi[exact] = x[exact]
+                still = hi - lo > INVERSION_TOLERANCE_NM
+                if not still.all():
+                    done = ~still
+                    low[rows[done]], high[rows[done]] = lo[done], hi[done]
+                    rows, lo, hi, flo, fhi, side = (a[still] for a in (rows, lo, hi, flo, fhi, side))
+        low[rows], high[rows] = lo, hi
         return 0.5 * (low + high)
+
+
+class _Excess:
+    """x + factor A(x) - y of :meth:`BoostLaw.torsion_bar` at the samples `rows` (an index array, or every sample),
+    with the operations of :meth:`BoostLaw.assist`, one by one and in their order (so with its bits), and what does
+    not change with x read once: the gear's direction tanh(omega / w) at each sample's rotor speed, the table's
+    segments (each one's width and width times its end slopes, as :func:`_hermite_at` takes them)."""
+
+    def __init__(self, law: BoostLaw, y: np.ndarray, factor, rotor_speed) -> None:
+        self.law, self.y = law, y
+        factor = np.asarray(factor, dtype=float)
+        # a factor of 1 everywhere multiplies by 1: the same bits without the product
+        self.factor = None if factor.ndim == 0 and float(factor) == 1.0 else np.broadcast_to(factor, y.shape)
+        self.table = law._segments if any(law.table) else None
+        self.direction = None
+        if not law.hydraulic:
+            speed = np.array(np.broadcast_to(np.asarray(rotor_speed, dtype=float), y.shape))
+            self.direction = np.tanh((1.0 / law.friction_speed) * speed)
+        self.line_scale = law.ratio if law.location == "rack" and not law.hydraulic else 1.0
+        self.assist_scale = law.ratio if law.location == "rack" else 1.0
+
+    def __call__(self, x: np.ndarray, rows) -> np.ndarray:
+        law = self.law
+        demand = law.gain * _deadband(x, law.dead_band, law.band_width)
+        if self.line_scale != 1.0:
+            demand = demand * self.line_scale
+        if self.table is not None:
+            table = _table_law_segments(x, self.table)
+            demand = demand + (table if law.table_scale == 1.0 else law.table_scale * table)
+        if law.hydraulic:
+            assist = law.area * _clamp(demand, law.limit, law.limit_width) / law.ratio
+        else:
+            motor = _clamp(demand / (law.efficiency * law.reduction), law.limit, law.limit_width)
+            delivered = _directional_efficiency(motor, self.direction[rows], law.efficiency, law.back_efficiency,
+                                                law.direction_width)
+            assist = delivered * law.reduction * motor
+            if self.assist_scale != 1.0:
+                assist = assist / self.assist_scale
+        if self.factor is not None:
+            assist = self.factor[rows] * assist
+        return x + assist - self.y[rows]
 
 
 @lru_cache(maxsize=64)
@@ -196,8 +245,27 @@ def _points_at_speed(table: bytes, speed: bytes) -> tuple[tuple[float, ...], tup
     order) at the vehicle speed: (torques, assists, slopes); both given by their bytes (so that a -0.0 is not
     taken for a 0.0)."""
     values = dict(zip(table_keys(), (float(v) for v in np.frombuffer(table))))
-    knots, assist, slope = table_points(values.__getitem__, float(np.frombuffer(speed)[0]))
+    knots, assist, slope = _table_points_numeric(values.__getitem__, float(np.frombuffer(speed)[0]))
     return tuple(float(v) for v in knots), tuple(float(v) for v in assist), tuple(float(v) for v in slope)
+
+
+def _table_points_numeric(value, speed: float):
+    """:func:`~parksteer.model.symbolic.effects.assist_common.table_points` on numbers (its selection of the first
+    branch whose condition holds, without the check for a sympy expression, whose first call imports sympy): the
+    same operations."""
+
+    def at_speed(speeds, row_values):
+        branches = [(speed < speeds[0], row_values[0])]
+        for r in range(len(speeds) - 1):
+            fraction = (speed - speeds[r]) / (speeds[r + 1] - speeds[r])
+            branches.append((speed < speeds[r + 1], row_values[r] + fraction * (row_values[r + 1] - row_values[r])))
+        return next((v for condition, v in branches if condition), row_values[-1])
+
+    knots = [value(f"boost_torque_{k}") for k in range(MAX_POINTS)]
+    speeds = [value(f"boost_speed_{r}") for r in range(MAX_SPEEDS)]
+    assist = [at_speed(speeds, [value(f"boost_assist_{r}_{k}") for r in range(MAX_SPEEDS)]) for k in range(MAX_POINTS)]
+    slope = [at_speed(speeds, [value(f"boost_slope_{r}_{k}") for r in range(MAX_SPEEDS)]) for k in range(MAX_POINTS)]
+    return knots, assist, slope
 
 
 def _table_law_numeric(torque: np.ndarray, points) -> np.ndarray:
@@ -207,6 +275,78 @@ def _table_law_numeric(torque: np.ndarray, points) -> np.ndarray:
     knots, assist, slope = points
     magnitude = _half_numeric(np.abs(torque), knots, assist, slope)
     return np.where(torque >= 0, magnitude, -magnitude)
+
+
+def _ramp(z, width):
+    """:func:`~parksteer.model.symbolic.effects.assist_common.ramp` on numbers (np.sqrt, not the sympy-aware
+    square root, whose first call imports sympy): the same operations."""
+    return (z + np.sqrt(z * z + width * width)) / 2
+
+
+def _deadband(x, band, width):
+    """:func:`~parksteer.model.symbolic.effects.assist_common.deadband` on numbers: the same operations."""
+    return _ramp(x - band, width) - _ramp(-x - band, width)
+
+
+def _clamp(y, limit, width):
+    """:func:`~parksteer.model.symbolic.effects.assist_common.clamp` on numbers: the same operations."""
+    return y - _ramp(y - limit, width) + _ramp(-y - limit, width)
+
+
+def _directional_efficiency(motor, direction, forward, back, width):
+    """:func:`~parksteer.model.symbolic.effects.assist_common.directional_efficiency` on numbers, its
+    tanh(sharpness speed) given (`direction`): the same operations."""
+    s = direction * motor / np.sqrt(motor * motor + width * width)
+    return 1 + s * ((forward - 1) * (1 + s) / 2 + (1 - 1 / back) * (1 - s) / 2)
+
+
+def _table_segments(points):
+    """The table's Hermite segments read once (`points`: :func:`_points_at_speed`): the inner knots (the first k
+    with x < knots[k + 1] is the segment), each segment's start t0, width h = t1 - t0, end values a0, a1 and h m0,
+    h m1 (the products :func:`_hermite_at` takes, as _hermite forms them), and the line beyond the last point."""
+    knots, assist, slope = (np.asarray(v, dtype=float) for v in points)
+    width = knots[1:] - knots[:-1]
+    return (knots[1:], knots[:-1], width, assist[:-1], assist[1:], width * slope[:-1], width * slope[1:],
+            knots[-1], assist[-1], slope[-1])
+
+
+def _hermite_at(x, t0, h, a0, a1, h_m0, h_m1):
+    """:func:`~parksteer.model.symbolic.effects.assist_common._hermite` with h = t1 - t0, h m0 and h m1 formed
+    beforehand: the same operations in the same order (2 s and s s each formed once, as the same products)."""
+    s = (x - t0) / h
+    r = 1 - s
+    two_s = 2 * s
+    ss = s * s
+    return a0 * ((1 + two_s) * r * r) + h_m0 * (s * r * r) + a1 * (ss * (3 - two_s)) + h_m1 * (ss * (s - 1))
+
+
+def _table_law_segments(torque: np.ndarray, segments) -> np.ndarray:
+    """:func:`_table_law_numeric` on the table's segments read once (:func:`_table_segments`): the same
+    operations (:func:`~parksteer.model.symbolic.effects.assist_common._half_numeric`'s)."""
+    upper, t0, h, a0, a1, h_m0, h_m1, last_knot, last_assist, last_slope = segments
+    x = np.abs(torque)
+    k = np.searchsorted(upper, x, side="right")  # len(upper) beyond the last point
+    beyond = k == len(upper)
+    inner = np.minimum(k, len(upper) - 1)
+    magnitude = _hermite_at(x, t0[inner], h[inner], a0[inner], a1[inner], h_m0[inner], h_m1[inner])
+    if beyond.any():
+        magnitude = np.where(beyond, last_assist + last_slope * (x - last_knot), magnitude)
+    return np.where(torque >= 0, magnitude, -magnitude)
+
+
+# (id of a compiled model's parameter positions, assist) -> (those positions, kept so that the id stays theirs; the
+# boost table's scalars' indices in the parameter vector, table_keys order)
+_TABLE_INDICES: dict[tuple[int, str], tuple[dict, np.ndarray]] = {}
+
+
+def _table_values(run, p: np.ndarray, name: str) -> tuple[float, ...]:
+    """The boost table's scalars of the assist `name` in `p` (table_keys order), their indices found once per
+    compiled model: a replay's law reads all 552 at every replay."""
+    positions = run.model.parameter_positions
+    key = (id(positions), name)
+    if key not in _TABLE_INDICES:
+        _TABLE_INDICES[key] = (positions, np.array([run.parameter_index(f"{name}.{k}") for k in table_keys()]))
+    return tuple(np.asarray(p, dtype=float)[_TABLE_INDICES[key][1]].tolist())
 
 
 def boost_law(run, p: np.ndarray) -> BoostLaw | None:
@@ -220,14 +360,14 @@ def boost_law(run, p: np.ndarray) -> BoostLaw | None:
     if name == HYDRAULIC:
         law = BoostLaw(name, "rack", v("valve_slope"), v("dead_band"), v("dead_band_smoothing"),
                        v("relief_pressure"), v("pressure_smoothing"), ratio, area=v("piston_area"),
-                       table=tuple(v(key) for key in table_keys()),
+                       table=_table_values(run, p, name),
                        speed=float(p[run.parameter_index(VEHICLE_SPEED.key)]))
     else:
         gain = speed_gain(v("gain"), v("speed_dependence"), float(p[run.parameter_index(VEHICLE_SPEED.key)]),
                           v("gain_half_speed"))
         law = BoostLaw(name, effect.location, gain, v("dead_band"), v("dead_band_smoothing"),
                        v("motor_torque_limit"), v("limit_smoothing"), ratio, v("reduction_ratio"), v("efficiency"),
-                       v("torque_constant"), table=tuple(v(key) for key in table_keys()),
+                       v("torque_constant"), table=_table_values(run, p, name),
                        speed=float(p[run.parameter_index(VEHICLE_SPEED.key)]),
                        back_efficiency=v("back_efficiency"), direction_width=v("limit_smoothing"),
                        friction_speed=v("friction_speed"))
