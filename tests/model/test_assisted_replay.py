@@ -276,23 +276,23 @@ def test_the_replays_law_is_assist_commons_law_bit_for_bit():
     assist_common's, bit for bit, at values across the corners (and at -0.0), and at vehicle speeds below, on,
     between and beyond the table's rows."""
     from parksteer.boost_table import table_keys
-    from parksteer.model.numeric import assisted
+    from parksteer.model.numeric import boost_numeric
     from parksteer.model.symbolic.effects import assist_common
 
     rng = np.random.default_rng(5)
     x = np.concatenate([rng.uniform(-10.0, 10.0, 2000), rng.uniform(-0.6, 0.6, 500), [0.0, -0.0, 0.5, -0.5]])
     for band, width in ((0.5, 0.05), (0.0, 0.05), (0.3, 0.0)):
-        assert (assisted._deadband(x, band, width).tobytes()
+        assert (boost_numeric.deadband(x, band, width).tobytes()
                 == assist_common.deadband(x, band, width).tobytes())
-        assert assisted._clamp(x, 4.0 + band, width).tobytes() == assist_common.clamp(x, 4.0 + band, width).tobytes()
+        assert boost_numeric.clamp(x, 4.0 + band, width).tobytes() == assist_common.clamp(x, 4.0 + band, width).tobytes()
     speed = rng.uniform(-3.0, 3.0, x.size)
     for sharpness in (2.0, 1000.0):
         expected = assist_common.directional_efficiency(x, speed, 0.85, 0.8, 0.05, sharpness)
-        assert (assisted._directional_efficiency(x, np.tanh(sharpness * speed), 0.85, 0.8, 0.05).tobytes()
+        assert (boost_numeric.directional_efficiency(x, np.tanh(sharpness * speed), 0.85, 0.8, 0.05).tobytes()
                 == expected.tobytes())
     values = dict(zip(table_keys(), _table()))
     for v in (0.0, 0.7, 2.0, 5.0, -1.0):
-        numeric = assisted._table_points_numeric(values.__getitem__, v)
+        numeric = boost_numeric.table_points_numeric(values.__getitem__, v)
         expected = assist_common.table_points(values.__getitem__, v)
         assert [np.float64(a).tobytes() for part in numeric for a in part] == [
             np.asarray(a, dtype=float).tobytes() for part in expected for a in part]

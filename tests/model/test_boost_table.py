@@ -314,7 +314,8 @@ def test_the_replays_boost_law_reads_its_table_as_table_law_does_bit_for_bit(gol
     the table, at a vehicle speed between rows, its motor demand is table_law's (plus the straight line), bit for
     bit, and a second law of the same table and speed shares the first one's points."""
     from parksteer.boost_table import table_keys
-    from parksteer.model.numeric.assisted import BoostLaw, _points_at_speed
+    from parksteer.model.numeric.assisted import BoostLaw
+    from parksteer.model.numeric.boost_numeric import points_at_speed
     from parksteer.model.symbolic.effects.assist_common import clamp
 
     values = {k: golf[f"{HYDRAULIC}.{k}"] for k in table_keys()}
@@ -324,9 +325,9 @@ def test_the_replays_boost_law_reads_its_table_as_table_law_does_bit_for_bit(gol
         first = BoostLaw(HYDRAULIC, "rack", 0.0, 0.5, 0.05, 3.0e7, 5.0e4, 131.4, area=8e-4, table=table, speed=speed)
         second = BoostLaw(HYDRAULIC, "rack", 0.0, 0.5, 0.05, 3.0e7, 5.0e4, 131.4, area=8e-4, table=table, speed=speed)
         first._table_points  # noqa: B018 (read: the points of this table and speed cached)
-        hits = _points_at_speed.cache_info().hits
+        hits = points_at_speed.cache_info().hits
         second._table_points  # noqa: B018 (another law of the same table and speed)
-        assert _points_at_speed.cache_info().hits == hits + 1
+        assert points_at_speed.cache_info().hits == hits + 1
         opening = np.zeros_like(t)  # valve slope 0: the table alone
         expected = clamp(opening + 1.0 * table_law(t, values.__getitem__, speed), first.limit, first.limit_width)
         assert np.asarray(first.motor(t)).tobytes() == np.asarray(expected).tobytes()

@@ -18,12 +18,14 @@ from functools import cached_property, lru_cache
 
 import numpy as np
 
-from ...boost_table import MAX_POINTS, MAX_SPEEDS, off_keys, table_keys
+from ...boost_table import MAX_POINTS, off_keys, table_keys
 from ...errors import UsageError
 from ...parameters import VEHICLE_SPEED
 from ...reduction_efficiency import min_monotone_back_efficiency
 from ..symbolic.components import power_assist_of
-from ..symbolic.effects.assist_common import _half_numeric, speed_gain
+from ..symbolic.effects.assist_common import speed_gain
+from .boost_numeric import (clamp, deadband, directional_efficiency, points_at_speed, table_law_numeric,
+                            table_law_segments, table_segments)
 from .prescribed import PRESCRIBED_ATOL_FACTOR, PRESCRIBED_RTOL, PrescribedSolution, RackMotion, solve
 
 # The inversion stops when the bracket is this narrow (N m of torsion-bar torque), far below a sensor's resolution.
@@ -72,27 +74,27 @@ class BoostLaw:
 
     def motor(self, torsion_bar_Nm):
         """The motor torque (N m; hydraulic: the pressure, Pa) at the torsion-bar torque (module docstring)."""
-        opening = _deadband(np.asarray(torsion_bar_Nm, dtype=float), self.dead_band, self.band_width)
+        opening = deadband(np.asarray(torsion_bar_Nm, dtype=float), self.dead_band, self.band_width)
         scale = self.ratio if self.location == "rack" and not self.hydraulic else 1.0
         demand = self.gain * opening * scale
         if any(self.table):
-            demand = demand + self.table_scale * _table_law_numeric(np.asarray(torsion_bar_Nm, dtype=float),
+            demand = demand + self.table_scale * table_law_numeric(np.asarray(torsion_bar_Nm, dtype=float),
                                                                     self._table_points)
         if self.hydraulic:
-            return _clamp(demand, self.limit, self.limit_width)
-        return _clamp(demand / (self.efficiency * self.reduction), self.limit, self.limit_width)
+            return clamp(demand, self.limit, self.limit_width)
+        return clamp(demand / (self.efficiency * self.reduction), self.limit, self.limit_width)
 
     @cached_property
     def _table_points(self):
-        """The table's points at this law's speed as arrays, read once per table and speed (:func:`_points_at_speed`):
+        """The table's points at this law's speed as arrays, read once per table and speed (:func:`.boost_numeric.points_at_speed`):
         the inversion evaluates the law some 50 times a sample, and every replay of a diagnosis builds its own law."""
-        points = _points_at_speed(np.asarray(self.table, dtype=float).tobytes(), np.float64(self.speed).tobytes())
+        points = points_at_speed(np.asarray(self.table, dtype=float).tobytes(), np.float64(self.speed).tobytes())
         return tuple(np.asarray(v, dtype=float) for v in points)
 
     @cached_property
     def _segments(self):
-        """The table's segments at this law's speed (:func:`_table_segments`), read once per law."""
-        return _table_segments(self._table_points)
+        """The table's segments at this law's speed (:func:`.boost_numeric.table_segments`), read once per law."""
+        return table_segments(self._table_points)
 
     def with_wider_dead_band(self, size_Nm: float) -> BoostLaw:
         """This law with its dead band wider by `size_Nm`: the line's band, and every point of a table but the
@@ -108,7 +110,7 @@ class BoostLaw:
         back-driven; :func:`~parksteer.model.symbolic.effects.assist_common.directional_efficiency`), the rotor
         turning at `rotor_speed` (rad/s)."""
         direction = np.tanh((1.0 / self.friction_speed) * np.asarray(rotor_speed, dtype=float))
-        return _directional_efficiency(motor, direction, self.efficiency, self.back_efficiency, self.direction_width)
+        return directional_efficiency(motor, direction, self.efficiency, self.back_efficiency, self.direction_width)
 
     def assist(self, torsion_bar_Nm, rotor_speed=0.0):
         """A(T_s): the assist in torsion-bar torque units (what it adds to the torsion bar's torque in y), with the
@@ -185,7 +187,7 @@ class _Excess:
     """x + factor A(x) - y of :meth:`BoostLaw.torsion_bar` at the samples `rows` (an index array, or every sample),
     with the operations of :meth:`BoostLaw.assist`, one by one and in their order (so with its bits), and what does
     not change with x read once: the gear's direction tanh(omega / w) at each sample's rotor speed, the table's
-    segments (each one's width and width times its end slopes, as :func:`_hermite_at` takes them)."""
+    segments (each one's width and width times its end slopes, as :func:`.boost_numeric.hermite_at` takes them)."""
 
     def __init__(self, law: BoostLaw, y: np.ndarray, factor, rotor_speed) -> None:
         self.law, self.y = law, y
@@ -202,17 +204,17 @@ class _Excess:
 
     def __call__(self, x: np.ndarray, rows) -> np.ndarray:
         law = self.law
-        demand = law.gain * _deadband(x, law.dead_band, law.band_width)
+        demand = law.gain * deadband(x, law.dead_band, law.band_width)
         if self.line_scale != 1.0:
             demand = demand * self.line_scale
         if self.table is not None:
-            table = _table_law_segments(x, self.table)
+            table = table_law_segments(x, self.table)
             demand = demand + (table if law.table_scale == 1.0 else law.table_scale * table)
         if law.hydraulic:
-            assist = law.area * _clamp(demand, law.limit, law.limit_width) / law.ratio
+            assist = law.area * clamp(demand, law.limit, law.limit_width) / law.ratio
         else:
-            motor = _clamp(demand / (law.efficiency * law.reduction), law.limit, law.limit_width)
-            delivered = _directional_efficiency(motor, self.direction[rows], law.efficiency, law.back_efficiency,
+            motor = clamp(demand / (law.efficiency * law.reduction), law.limit, law.limit_width)
+            delivered = directional_efficiency(motor, self.direction[rows], law.efficiency, law.back_efficiency,
                                                 law.direction_width)
             assist = delivered * law.reduction * motor
             if self.assist_scale != 1.0:
@@ -239,114 +241,12 @@ def check_back_efficiency(name: str, forward: float, back: float, where: str = "
                          "law would not be increasing and the replay could not invert it")
 
 
-@lru_cache(maxsize=64)
-def _points_at_speed(table: bytes, speed: bytes) -> tuple[tuple[float, ...], tuple[float, ...], tuple[float, ...]]:
-    """:func:`~parksteer.model.symbolic.effects.assist_common.table_points` of the table's scalars (table_keys
-    order) at the vehicle speed: (torques, assists, slopes); both given by their bytes (so that a -0.0 is not
-    taken for a 0.0)."""
-    values = dict(zip(table_keys(), (float(v) for v in np.frombuffer(table))))
-    knots, assist, slope = _table_points_numeric(values.__getitem__, float(np.frombuffer(speed)[0]))
-    return tuple(float(v) for v in knots), tuple(float(v) for v in assist), tuple(float(v) for v in slope)
-
-
-def _table_points_numeric(value, speed: float):
-    """:func:`~parksteer.model.symbolic.effects.assist_common.table_points` on numbers (its selection of the first
-    branch whose condition holds, without the check for a sympy expression, whose first call imports sympy): the
-    same operations."""
-
-    def at_speed(speeds, row_values):
-        branches = [(speed < speeds[0], row_values[0])]
-        for r in range(len(speeds) - 1):
-            fraction = (speed - speeds[r]) / (speeds[r + 1] - speeds[r])
-            branches.append((speed < speeds[r + 1], row_values[r] + fraction * (row_values[r + 1] - row_values[r])))
-        return next((v for condition, v in branches if condition), row_values[-1])
-
-    knots = [value(f"boost_torque_{k}") for k in range(MAX_POINTS)]
-    speeds = [value(f"boost_speed_{r}") for r in range(MAX_SPEEDS)]
-    assist = [at_speed(speeds, [value(f"boost_assist_{r}_{k}") for r in range(MAX_SPEEDS)]) for k in range(MAX_POINTS)]
-    slope = [at_speed(speeds, [value(f"boost_slope_{r}_{k}") for r in range(MAX_SPEEDS)]) for k in range(MAX_POINTS)]
-    return knots, assist, slope
-
-
-def _table_law_numeric(torque: np.ndarray, points) -> np.ndarray:
-    """:func:`~parksteer.model.symbolic.effects.assist_common.table_law` at `torque` on a table read at one speed
-    (`points`: :func:`_points_at_speed`, all numbers): its numeric branch, the same operations, without the check
-    of every point for a symbol at each of the inversion's calls."""
-    knots, assist, slope = points
-    magnitude = _half_numeric(np.abs(torque), knots, assist, slope)
-    return np.where(torque >= 0, magnitude, -magnitude)
-
-
-def _ramp(z, width):
-    """:func:`~parksteer.model.symbolic.effects.assist_common.ramp` on numbers (np.sqrt, not the sympy-aware
-    square root, whose first call imports sympy): the same operations."""
-    return (z + np.sqrt(z * z + width * width)) / 2
-
-
-def _deadband(x, band, width):
-    """:func:`~parksteer.model.symbolic.effects.assist_common.deadband` on numbers: the same operations."""
-    return _ramp(x - band, width) - _ramp(-x - band, width)
-
-
-def _clamp(y, limit, width):
-    """:func:`~parksteer.model.symbolic.effects.assist_common.clamp` on numbers: the same operations."""
-    return y - _ramp(y - limit, width) + _ramp(-y - limit, width)
-
-
-def _directional_efficiency(motor, direction, forward, back, width):
-    """:func:`~parksteer.model.symbolic.effects.assist_common.directional_efficiency` on numbers, its
-    tanh(sharpness speed) given (`direction`): the same operations."""
-    s = direction * motor / np.sqrt(motor * motor + width * width)
-    return 1 + s * ((forward - 1) * (1 + s) / 2 + (1 - 1 / back) * (1 - s) / 2)
-
-
-def _table_segments(points):
-    """The table's Hermite segments read once (`points`: :func:`_points_at_speed`): the inner knots (the first k
-    with x < knots[k + 1] is the segment), each segment's start t0, width h = t1 - t0, end values a0, a1 and h m0,
-    h m1 (the products :func:`_hermite_at` takes, as _hermite forms them), and the line beyond the last point."""
-    knots, assist, slope = (np.asarray(v, dtype=float) for v in points)
-    width = knots[1:] - knots[:-1]
-    return (knots[1:], knots[:-1], width, assist[:-1], assist[1:], width * slope[:-1], width * slope[1:],
-            knots[-1], assist[-1], slope[-1])
-
-
-def _hermite_at(x, t0, h, a0, a1, h_m0, h_m1):
-    """:func:`~parksteer.model.symbolic.effects.assist_common._hermite` with h = t1 - t0, h m0 and h m1 formed
-    beforehand: the same operations in the same order (2 s and s s each formed once, as the same products)."""
-    s = (x - t0) / h
-    r = 1 - s
-    two_s = 2 * s
-    ss = s * s
-    return a0 * ((1 + two_s) * r * r) + h_m0 * (s * r * r) + a1 * (ss * (3 - two_s)) + h_m1 * (ss * (s - 1))
-
-
-def _table_law_segments(torque: np.ndarray, segments) -> np.ndarray:
-    """:func:`_table_law_numeric` on the table's segments read once (:func:`_table_segments`): the same
-    operations (:func:`~parksteer.model.symbolic.effects.assist_common._half_numeric`'s)."""
-    upper, t0, h, a0, a1, h_m0, h_m1, last_knot, last_assist, last_slope = segments
-    x = np.abs(torque)
-    k = np.searchsorted(upper, x, side="right")  # len(upper) beyond the last point
-    beyond = k == len(upper)
-    inner = np.minimum(k, len(upper) - 1)
-    magnitude = _hermite_at(x, t0[inner], h[inner], a0[inner], a1[inner], h_m0[inner], h_m1[inner])
-    if beyond.any():
-        magnitude = np.where(beyond, last_assist + last_slope * (x - last_knot), magnitude)
-    return np.where(torque >= 0, magnitude, -magnitude)
-
-
-# (id of a compiled model's parameter positions, assist) -> (those positions, kept so that the id stays theirs; the
-# boost table's scalars' indices in the parameter vector, table_keys order)
-_TABLE_INDICES: dict[tuple[int, str], tuple[dict, np.ndarray]] = {}
-
-
 def _table_values(run, p: np.ndarray, name: str) -> tuple[float, ...]:
-    """The boost table's scalars of the assist `name` in `p` (table_keys order), their indices found once per
-    compiled model: a replay's law reads all 552 at every replay."""
-    positions = run.model.parameter_positions
-    key = (id(positions), name)
-    if key not in _TABLE_INDICES:
-        _TABLE_INDICES[key] = (positions, np.array([run.parameter_index(f"{name}.{k}") for k in table_keys()]))
-    return tuple(np.asarray(p, dtype=float)[_TABLE_INDICES[key][1]].tolist())
+    """The boost table's scalars of the assist `name` in `p` (table_keys order), their positions found once per
+    compiled model (:meth:`parksteer.model.numeric.compiled.CompiledModel.positions`): a replay's law reads all 552
+    at every replay."""
+    positions = run.model.positions(tuple(f"{name}.{k}" for k in table_keys()))
+    return tuple(np.asarray(p, dtype=float)[positions].tolist())
 
 
 def boost_law(run, p: np.ndarray) -> BoostLaw | None:

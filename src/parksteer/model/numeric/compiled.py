@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import ctypes
 import json
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
 
@@ -21,6 +21,8 @@ class CompiledModel:
     directory: Path
     info: dict
     lib: ctypes.CDLL
+    # positions of tuples of parameter keys, found once (positions)
+    _positions_of_keys: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
     @property
     def n_q(self) -> int:
@@ -49,6 +51,13 @@ class CompiledModel:
         for i, name in enumerate(self.info["parameters"]):
             positions.setdefault(name, i)
         return positions
+
+    def positions(self, keys: tuple[str, ...]) -> np.ndarray:
+        """The positions of `keys` in the parameter vector (each name's first), found once per tuple of keys and
+        kept on this model: an assisted replay reads its boost table's 552 scalars at every replay."""
+        if keys not in self._positions_of_keys:
+            self._positions_of_keys[keys] = np.array([self.parameter_positions[k] for k in keys], dtype=np.intp)
+        return self._positions_of_keys[keys]
 
     # Thin wrappers (each returns new arrays); the integrator uses the raw functions directly.
     def rhs(self, t: float, y: np.ndarray, p: np.ndarray) -> np.ndarray:
