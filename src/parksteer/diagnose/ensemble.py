@@ -5,7 +5,7 @@ rack's full scale and bits), the smoothed rack is logged again (analog noise, ro
 smoothed again a few times (:func:`relogged_rack`, a parametric bootstrap of the logging and smoothing); otherwise
 splines are drawn from the least-squares distribution of the coefficients
 (:meth:`parksteer.measure.smoothing.SmoothedRack.perturbed`). The draws start from the rack smoothed at each knot
-spacing the data allow (:func:`ensemble_sources`); a rack rounded more coarsely than its noise
+spacing the data allow (:func:`ensemble_plan`); a rack rounded more coarsely than its noise
 (``FileData.rack.rest_resolution_m``) is moved within its rounding where it is slow
 (:func:`parksteer.measure.smoothing.rounding_draw`); where the smoothing held an end or a pause at rest, every other
 draw leaves it free. The spread of the replayed torque at each sample is delta_i (N m), small on the plateaus and
@@ -128,13 +128,6 @@ def ensemble_plan(f: FileData, draws: int, released: bool) -> list[tuple[float, 
         index = int(slot * (len(spacings) - 1) / (slots - 1) + 0.5) if slots > 1 else 0
         out.append((spacings[index], not (released and k % 2)))
     return out
-
-
-def ensemble_sources(f: FileData, draws: int, released: bool) -> list[tuple[SmoothedRack, bool]]:
-    """The smoothed rack each draw of the replay ensemble is logged again from, and whether it holds rests
-    (:func:`ensemble_plan`), each spacing's smoothed once."""
-    smoothed: dict = {}
-    return [(_source(smoothed, f, 0, spacing, hold), hold) for spacing, hold in ensemble_plan(f, draws, released)]
 
 
 def _source(smoothed: dict, f: FileData, index: int, spacing: float, hold: bool) -> SmoothedRack:

@@ -54,7 +54,7 @@ SHIPPED_EFFECTS = "parksteer.model.symbolic.effects."
 # The channels' noise, relative to their parking range as the variation benchmark's (0.1 N m on a 12 N m peak: 0.8 %):
 # 0.03 N m on a torsion bar's 3.5 N m, 0.25 A on a current's 27 A. With channels twice as clean (0.02 N m, 0.1 A)
 # the nulls are adequate too (20 of 20), since the replay ensemble smooths at every knot spacing the rack data
-# allow (parksteer.diagnose.ensemble.ensemble_sources): draws about one spline alone miss the smoothing's bias at the
+# allow (parksteer.diagnose.ensemble.ensemble_plan): draws about one spline alone miss the smoothing's bias at the
 # lock reversals, where the rack turns by less than its resolution, and leave 6 of 20 unexplained or missing.
 TORQUE_NOISE_NM = 0.03
 CURRENT_NOISE_A = 0.25

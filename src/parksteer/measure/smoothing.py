@@ -6,7 +6,7 @@ fits the rack within its own noise (the discrepancy principle), each end held at
 it: replayed as it stands, a converter's steps make the speed and acceleration spikes and flip the rack friction.
 :meth:`SmoothedRack.perturbed` and :meth:`SmoothedRack.resmoothed` give other racks the data allow as well, and
 ``SmoothedRack.passing_spacings_s`` every spacing that passes the discrepancy test, for the replay uncertainty
-(:mod:`parksteer.diagnose.problem`, :func:`parksteer.diagnose.ensemble.ensemble_sources`); :func:`rounding_draw`
+(:mod:`parksteer.diagnose.problem`, :func:`parksteer.diagnose.ensemble.ensemble_plan`); :func:`rounding_draw`
 adds the motion a coarsely rounded rack hides. Every rack here is a
 :class:`~parksteer.measure.rack_spline.RackSpline` (``breaks``, ``coefficients``, ``start_s``, ``end_s``; metres and
 seconds), the rack motion :func:`parksteer.model.numeric.prescribed.solve` takes. Why and what smoothing cannot fix:
