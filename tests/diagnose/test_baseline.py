@@ -43,6 +43,9 @@ CAR_SEED = 77  # one car: the same base parameters, moved off the file's, in eve
 QUIRK_STEPS = 4.0
 CHANGE_STEPS = 3.5
 PROBES = {QUIRK: 100.0, "column_friction": 0.5, "rack_damping": 1000.0}
+# The library effects added to the later records. Both records are made with one model holding both, the one not
+# added at its default strength, 0 (absent): the same forces as a model of the one added, and one derivation.
+LATER_EFFECTS = ("column_friction", "rack_damping")
 # (record, the hand's variation, seed, the library effect added later)
 RECORDS = (("healthy_a", "rest_after_stop", 11, None), ("healthy_b", "uneven_strokes", 12, None),
            ("healthy_c", "lock_overshoot", 13, None), ("column", "rest_after_stop", 14, "column_friction"),
@@ -71,9 +74,8 @@ def _record(variation: str, seed: int, added: str | None):
     quirk_key = f"{QUIRK}.strength"
     overrides[quirk_key] = _sized(resolve_effects(effects), quirk_key, QUIRK_STEPS, hand, logger, overrides)
     if added is not None:
-        effect = discover_effects()[added]
-        effects = [*effects, effect]
-        key = strength_parameter(effect).key
+        effects = [*effects, *(discover_effects()[name] for name in LATER_EFFECTS)]
+        key = strength_parameter(discover_effects()[added]).key
         overrides[key] = _sized(resolve_effects(effects), key, CHANGE_STEPS, hand, logger, overrides)
     return variation_record(PARAMS, hand, logger, overrides=overrides, effects=resolve_effects(effects)), overrides
 
