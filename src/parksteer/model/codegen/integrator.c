@@ -44,11 +44,22 @@
    same accuracy, for a slightly smaller stability angle at orders 3 and 4). Step-size control as scipy:
    safety 0.9 scaled by the Newton iterations used, error^(-1/(k+1)), a step cut at most to 0.2 of itself
    after a failed error test and grown at most 10-fold.
+
+   Forward sensitivities (ps_integrate_prescribed_sens): beside the state z, S = dz/dp . v for each of a few
+   parameter directions v, by the staggered direct method (Caracotsios & Stewart, Comput. Chem. Eng. 9 (1985)
+   359-365; CVODES's CV_STAGGERED): after each accepted step of the state, the same NDF of the same order on the
+   same step is applied to the sensitivity equations S' = J S + f_p v. They are linear in S, so the corrector is
+   one solve, d_S = (I - c J)^-1 (c (J S_pred + f_p v) - psi_S), with J exact at the step's end
+   (ps_prescribed_tangent along the unit directions, factored apart from the state's Newton matrix, which it never
+   touches). Each S keeps its own differences, rescaled with the state's whenever h or the order changes, and is
+   interpolated as the state is. S does not enter the error control (CVODES's errconS off): the steps, and so
+   every byte of the state, are those of the run without sensitivities; S is as accurate as the state's steps
+   make it, which tests/model/test_sensitivities.py checks against finite differences at tight tolerances.
 */
 
 #include <float.h>
 
-enum { BDF_MAX_ORDER = 5, BDF_NEWTON_MAXITER = 4 };
+enum { BDF_MAX_ORDER = 5, BDF_NEWTON_MAXITER = 4, BDF_MAX_SENS = 16 };
 enum { BDF_OK = 0, BDF_BUDGET = 1, BDF_STEP_TOO_SMALL = 2, BDF_EVAL_FAILED = 3 };
 
 static const double bdf_kappa[BDF_MAX_ORDER + 1] = {0.0, -0.1850, -1.0 / 9.0, -0.0823, -0.0415, 0.0};
@@ -89,6 +100,8 @@ typedef struct {
     const double *p;
     const double *rack;
     double *p_jac;
+    int n_sens;             /* sensitivity directions (prescribed rack only; at most BDF_MAX_SENS) */
+    const double *sens_dp;  /* their parameter directions, n_sens rows of INPUT_OFFSET */
 } bdf_system;
 
 /* The right-hand side, with non-finite results reported as failure too; counts the call. */
@@ -172,11 +185,12 @@ static void bdf_compute_R(int order, double factor, double R[BDF_MAX_ORDER + 1][
     }
 }
 
-/* Rescale the differences D[0..order] from step h to step factor * h (the same interpolating polynomial). */
-static void bdf_change_D(int n, double D[][NY], int order, double factor)
+/* Rescale the differences D[0..order] (rows `stride` apart, `width` values each) from step h to step factor * h
+   (the same interpolating polynomial). */
+static void bdf_rescale(int width, double *D, int stride, int order, double factor)
 {
     double R[BDF_MAX_ORDER + 1][BDF_MAX_ORDER + 1], U[BDF_MAX_ORDER + 1][BDF_MAX_ORDER + 1];
-    double RU[BDF_MAX_ORDER + 1][BDF_MAX_ORDER + 1], old[BDF_MAX_ORDER + 1][NY];
+    double RU[BDF_MAX_ORDER + 1][BDF_MAX_ORDER + 1], old[BDF_MAX_ORDER + 1];
     bdf_compute_R(order, factor, R);
     bdf_compute_R(order, 1.0, U);
     for (int i = 0; i <= order; i++)
@@ -185,13 +199,24 @@ static void bdf_change_D(int n, double D[][NY], int order, double factor)
             for (int m = 0; m <= order; m++) s += R[i][m] * U[m][j];
             RU[i][j] = s;
         }
-    memcpy(old, D, (size_t)(order + 1) * sizeof old[0]);
-    for (int j = 0; j <= order; j++)
-        for (int i = 0; i < n; i++) {
+    for (int i = 0; i < width; i++) {
+        for (int m = 0; m <= order; m++) old[m] = D[m * stride + i];
+        for (int j = 0; j <= order; j++) {
             double s = 0.0;
-            for (int m = 0; m <= order; m++) s += RU[m][j] * old[m][i];
-            D[j][i] = s;
+            for (int m = 0; m <= order; m++) s += RU[m][j] * old[m];
+            D[j * stride + i] = s;
         }
+    }
+}
+
+/* Differences of the sensitivities: BDF_MAX_ORDER + 3 rows of n_sens x n (direction k's at k * n). */
+typedef double bdf_sens_differences[BDF_MAX_ORDER + 3][BDF_MAX_SENS * NY];
+
+/* Rescale the state's differences and the sensitivities' alike. */
+static void bdf_change_D(const bdf_system *s, double D[][NY], bdf_sens_differences DS, int order, double factor)
+{
+    bdf_rescale(s->n, &D[0][0], NY, order, factor);
+    if (s->n_sens) bdf_rescale(s->n * s->n_sens, &DS[0][0], BDF_MAX_SENS * NY, order, factor);
 }
 
 /* The first end point after t that a step may not cross: the nearest t_crit beyond t, or t_end. */
@@ -252,16 +277,72 @@ static int bdf_newton(const bdf_system *s, double t_new, const double *y_pred, d
     return 0;
 }
 
-/* The interpolating polynomial of the differences at time t (scipy's BdfDenseOutput): y at t_now, and
-   prod_{m<j} (t - t_now + m h) / ((m + 1) h) times D[j]. */
-static void bdf_interpolate(int n, double t, double t_now, double h, int order, double D[][NY], double *y)
+/* The interpolating polynomial of the differences (rows `stride` apart, `width` values each) at time t (scipy's
+   BdfDenseOutput): y at t_now, and prod_{m<j} (t - t_now + m h) / ((m + 1) h) times D[j]. */
+static void bdf_interpolate(int width, double t, double t_now, double h, int order, const double *D, int stride,
+                            double *y)
 {
     double product = 1.0;
-    memcpy(y, D[0], n * sizeof(double));
+    memcpy(y, D, width * sizeof(double));
     for (int j = 1; j <= order; j++) {
         product *= (t - (t_now - (j - 1) * h)) / (j * h);
-        for (int i = 0; i < n; i++) y[i] += D[j][i] * product;
+        for (int i = 0; i < width; i++) y[i] += D[j * stride + i] * product;
     }
+}
+
+/* The sensitivities' right-hand sides J S + f_p v at (t, z) for S = rows of `S` (n_sens x n), into f; with
+   `jac` not NULL, also J (row-major n x n) from the unit directions in the same call. */
+static int bdf_sens_rhs(const bdf_system *s, double t, const double *z, const double *S, double *f, double *jac)
+{
+    const int n = s->n, m = s->n_sens, units = jac ? n : 0;
+    double dz[(NY + BDF_MAX_SENS) * NY], dzdot[(NY + BDF_MAX_SENS) * NY];
+    double dy[(NY + BDF_MAX_SENS) * NY], dG[(NY + BDF_MAX_SENS) * NQ], dH[(NY + BDF_MAX_SENS) * NQ];
+    const double *dps[NY + BDF_MAX_SENS];
+    memset(dz, 0, (size_t)units * n * sizeof(double));
+    for (int k = 0; k < units; k++) { dz[k * n + k] = 1.0; dps[k] = ps_no_parameters; }
+    memcpy(dz + units * n, S, (size_t)m * n * sizeof(double));
+    for (int k = 0; k < m; k++) dps[units + k] = s->sens_dp + (long)k * INPUT_OFFSET;
+    if (prescribed_tangent(t, z, s->p, s->rack, units + m, dz, dps, dzdot, NULL, dy, dG, dH)) return 1;
+    if (!bdf_all_finite(dzdot, (units + m) * n)) return 1;
+    for (int j = 0; j < units; j++)
+        for (int i = 0; i < n; i++) jac[i * n + j] = dzdot[j * n + i];
+    memcpy(f, dzdot + units * n, (size_t)m * n * sizeof(double));
+    return 0;
+}
+
+/* The sensitivities' NDF step of the given order and h to t_new, whose state y_new the step has just accepted:
+   the linear corrector solved with the LU of I - c J at (t_new, y_new), then the differences updated as the
+   state's. 0, or 1 when the sensitivities' right-hand side fails or I - c J is singular. */
+static int bdf_sens_step(const bdf_system *s, const bdf_coefficients *co, double t_new, const double *y_new,
+                         double h, int order, bdf_sens_differences DS)
+{
+    const int n = s->n, w = s->n * s->n_sens;
+    double S_pred[BDF_MAX_SENS * NY], psi[BDF_MAX_SENS * NY], f[BDF_MAX_SENS * NY], d[BDF_MAX_SENS * NY];
+    double jac[NY * NY], lu[NY * NY];
+    int pivot[NY];
+    const double c = h / co->alpha[order];
+    for (int i = 0; i < w; i++) {
+        double sum = 0.0, weighted = 0.0;
+        for (int j = 0; j <= order; j++) sum += DS[j][i];
+        for (int j = 1; j <= order; j++) weighted += co->gamma[j] * DS[j][i];
+        S_pred[i] = sum;
+        psi[i] = weighted / co->alpha[order];
+    }
+    if (bdf_sens_rhs(s, t_new, y_new, S_pred, f, jac)) return 1;
+    for (int i = 0; i < n * n; i++) lu[i] = -c * jac[i];
+    for (int i = 0; i < n; i++) lu[i * n + i] += 1.0;
+    if (bdf_lu_factor(n, lu, pivot)) return 1;
+    for (int k = 0; k < s->n_sens; k++) {
+        for (int i = 0; i < n; i++) d[k * n + i] = c * f[k * n + i] - psi[k * n + i];
+        bdf_lu_solve(n, lu, pivot, d + k * n);
+    }
+    for (int i = 0; i < w; i++) {
+        DS[order + 2][i] = d[i] - DS[order + 1][i];
+        DS[order + 1][i] = d[i];
+    }
+    for (int j = order; j >= 0; j--)
+        for (int i = 0; i < w; i++) DS[j][i] += DS[j + 1][i];
+    return 0;
 }
 
 /* Integrate the system s from t_out[0] (state y0) and write the state at every t_out[k] (increasing)
@@ -273,9 +354,9 @@ static void bdf_interpolate(int n, double t, double t_now, double h, int order, 
    after 10 halvings of the step. */
 static int bdf_solve(const bdf_system *s, const double *y0, int n_out, const double *t_out, int n_crit,
                      const double *t_crit, double rtol, const double *atol, long max_steps, double *y_out,
-                     double *stats)
+                     double *stats, const double *s0, double *s_out)
 {
-    const int n = s->n;
+    const int n = s->n, w = s->n * s->n_sens;
     long n_steps = 0, n_rhs = 0, n_jac = 0;
     double t = n_out > 0 ? t_out[0] : 0.0;
     int status = BDF_OK;
@@ -291,11 +372,17 @@ static int bdf_solve(const bdf_system *s, const double *y0, int n_out, const dou
     double jac[NY * NY], lu[NY * NY], f[NY];
     double y_pred[NY], y_new[NY], d[NY], psi[NY], scale[NY], error[NY];
     int pivot[NY];
+    bdf_sens_differences DS; /* the sensitivities' differences, as D (s->n_sens of them) */
     double h = 0.0, c_factored = 0.0; /* c of the current LU; 0 = no valid LU */
     int order = 1, n_equal_steps = 0, jac_is_current = 0, restart = 1, failed_evaluations = 0;
     int next_out = 1;
     long attempts_since_output = 0;
     memcpy(D[0], y0, n * sizeof(double));
+    if (w) {
+        memset(DS, 0, sizeof(bdf_sens_differences));
+        memcpy(DS[0], s0, w * sizeof(double));
+        if (n_out > 0) memcpy(s_out, s0, w * sizeof(double));
+    }
 
     while (next_out < n_out) {
         double stop = bdf_next_stop(t, t_end, n_crit, t_crit);
@@ -304,8 +391,10 @@ static int bdf_solve(const bdf_system *s, const double *y0, int n_out, const dou
            resolve it, and y changes by no more than rounding there, so arrive by moving t alone. */
         if (stop - t <= 64.0 * DBL_EPSILON * fabs(stop)) {
             t = stop;
-            for (; next_out < n_out && t_out[next_out] <= t; ++next_out)
+            for (; next_out < n_out && t_out[next_out] <= t; ++next_out) {
                 memcpy(y_out + (long)next_out * n, D[0], n * sizeof(double));
+                if (w) memcpy(s_out + (long)next_out * w, DS[0], w * sizeof(double));
+            }
             attempts_since_output = 0;
             restart = 1;
             continue;
@@ -318,6 +407,11 @@ static int bdf_solve(const bdf_system *s, const double *y0, int n_out, const dou
             }
             h = bdf_initial_step(s, t, D[0], f, rtol, atol, stop, &n_rhs);
             for (int i = 0; i < n; i++) D[1][i] = h * f[i];
+            if (w) {
+                double f_sens[BDF_MAX_SENS * NY];
+                if (bdf_sens_rhs(s, t, D[0], DS[0], f_sens, NULL)) { status = BDF_EVAL_FAILED; goto done; }
+                for (int i = 0; i < w; i++) DS[1][i] = h * f_sens[i];
+            }
             order = 1;
             n_equal_steps = 0;
             jac_is_current = 1;
@@ -335,7 +429,7 @@ static int bdf_solve(const bdf_system *s, const double *y0, int n_out, const dou
 
             if (t + 1.0001 * h >= stop) { /* land exactly on the stop (stretching h by up to 0.01 %) */
                 double shortened = stop - t;
-                bdf_change_D(n, D, order, shortened / h);
+                bdf_change_D(s, D, DS, order, shortened / h);
                 h = shortened;
                 n_equal_steps = 0;
                 t_new = stop;
@@ -374,7 +468,7 @@ static int bdf_solve(const bdf_system *s, const double *y0, int n_out, const dou
                     status = BDF_EVAL_FAILED;
                     goto done;
                 }
-                bdf_change_D(n, D, order, 0.5);
+                bdf_change_D(s, D, DS, order, 0.5);
                 h *= 0.5;
                 n_equal_steps = 0;
                 continue;
@@ -388,7 +482,7 @@ static int bdf_solve(const bdf_system *s, const double *y0, int n_out, const dou
             double error_norm = bdf_norm(n, error, scale);
             if (error_norm > 1.0) {
                 double factor = fmax(bdf_min_factor, safety * ps_pow(error_norm, -1.0 / (order + 1)));
-                bdf_change_D(n, D, order, factor);
+                bdf_change_D(s, D, DS, order, factor);
                 h *= factor;
                 n_equal_steps = 0;
                 continue;
@@ -407,6 +501,7 @@ static int bdf_solve(const bdf_system *s, const double *y0, int n_out, const dou
             for (int j = order; j >= 0; j--)
                 for (int i = 0; i < n; i++) D[j][i] += D[j + 1][i];
             t = t_new;
+            if (w && bdf_sens_step(s, &co, t, D[0], h, order, DS)) { status = BDF_EVAL_FAILED; goto done; }
 
             /* After order + 1 steps of equal size: choose order q-1, q or q+1 and the next step from the error
                estimates of each (the order allowing the longest step wins). */
@@ -427,7 +522,7 @@ static int bdf_solve(const bdf_system *s, const double *y0, int n_out, const dou
                 if (factor_higher > best) { best = factor_higher; new_order = order + 1; }
                 order = new_order;
                 double factor = fmin(bdf_max_factor, safety * best);
-                bdf_change_D(n, D, order, factor);
+                bdf_change_D(s, D, DS, order, factor);
                 h *= factor;
                 n_equal_steps = 0;
             }
@@ -439,7 +534,12 @@ static int bdf_solve(const bdf_system *s, const double *y0, int n_out, const dou
             while (next_out < n_out && t_out[next_out] <= t) {
                 double *row = y_out + (long)next_out * n;
                 if (t_out[next_out] == t) memcpy(row, D[0], n * sizeof(double));
-                else bdf_interpolate(n, t_out[next_out], t, h, order, D, row);
+                else bdf_interpolate(n, t_out[next_out], t, h, order, &D[0][0], NY, row);
+                if (w) {
+                    double *sens_row = s_out + (long)next_out * w;
+                    if (t_out[next_out] == t) memcpy(sens_row, DS[0], w * sizeof(double));
+                    else bdf_interpolate(w, t_out[next_out], t, h, order, &DS[0][0], BDF_MAX_SENS * NY, sens_row);
+                }
                 ++next_out;
             }
             attempts_since_output = 0;
@@ -461,8 +561,8 @@ done:
 int ps_integrate(const double *p, const double *y0, int n_out, const double *t_out, int n_crit, const double *t_crit,
                  double rtol, const double *atol, long max_steps, double *y_out, double *stats)
 {
-    const bdf_system s = {NY, p, NULL, NULL};
-    return bdf_solve(&s, y0, n_out, t_out, n_crit, t_crit, rtol, atol, max_steps, y_out, stats);
+    const bdf_system s = {NY, p, NULL, NULL, 0, NULL};
+    return bdf_solve(&s, y0, n_out, t_out, n_crit, t_crit, rtol, atol, max_steps, y_out, stats, NULL, NULL);
 }
 
 /* The model with its rack prescribed by the table `rack` (ps_rack): the reduced system of the other coordinates,
@@ -471,6 +571,33 @@ int ps_integrate_prescribed(const double *p, double *p_jac, const double *rack, 
                             const double *t_out, int n_crit, const double *t_crit, double rtol, const double *atol,
                             long max_steps, double *z_out, double *stats)
 {
-    const bdf_system s = {2 * NO, p, rack, p_jac};
-    return bdf_solve(&s, z0, n_out, t_out, n_crit, t_crit, rtol, atol, max_steps, z_out, stats);
+    const bdf_system s = {2 * NO, p, rack, p_jac, 0, NULL};
+    return bdf_solve(&s, z0, n_out, t_out, n_crit, t_crit, rtol, atol, max_steps, z_out, stats, NULL, NULL);
+}
+
+/* ps_integrate_prescribed with forward sensitivities along n_sens (1 to BDF_MAX_SENS; else -1) parameter
+   directions dp (n_sens rows of INPUT_OFFSET): from s0 (n_sens x 2 NO, direction k's at k * 2 NO), s_out
+   (n_out x n_sens x 2 NO) gets dz/dp . v at every output time. The state's steps and values are those of
+   ps_integrate_prescribed. */
+int ps_integrate_prescribed_sens(const double *p, double *p_jac, const double *rack, const double *z0, int n_out,
+                                 const double *t_out, int n_crit, const double *t_crit, double rtol,
+                                 const double *atol, long max_steps, double *z_out, double *stats, int n_sens,
+                                 const double *dp, const double *s0, double *s_out)
+{
+    if (!PS_SENSITIVITIES || n_sens < 1 || n_sens > BDF_MAX_SENS) return -1;
+    const bdf_system s = {2 * NO, p, rack, p_jac, n_sens, dp};
+    return bdf_solve(&s, z0, n_out, t_out, n_crit, t_crit, rtol, atol, max_steps, z_out, stats, s0, s_out);
+}
+
+/* The column torque's sensitivities at m samples (t, z, S: n_sens x 2 NO per sample) along the parameter
+   directions dp (n_sens rows of INPUT_OFFSET): dtorque (m x n_sens) = h_z S + h_p v. */
+int ps_prescribed_torque_sens(int m, const double *t, const double *z, const double *S, const double *p,
+                              const double *rack, int n_sens, const double *dp, double *dtorque)
+{
+    double dzdot[BDF_MAX_SENS * 2 * NO];
+    if (n_sens < 1 || n_sens > BDF_MAX_SENS) return -1;
+    for (int k = 0; k < m; k++)
+        if (ps_prescribed_tangent(t[k], z + (long)k * 2 * NO, p, rack, n_sens, S + (long)k * n_sens * 2 * NO, dp,
+                                  dzdot, dtorque + (long)k * n_sens)) return -1;
+    return 0;
 }

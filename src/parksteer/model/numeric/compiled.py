@@ -147,6 +147,12 @@ class CompiledModels:
             ("ps_prescribed_samples", i32, [i32, vp, vp, vp, vp, vp, vp, vp]),
             ("ps_integrate", i32, [vp, vp, i32, vp, i32, vp, dbl, vp, ctypes.c_long, vp, vp]),
             ("ps_integrate_prescribed", i32, [vp, vp, vp, vp, i32, vp, i32, vp, dbl, vp, ctypes.c_long, vp, vp]),
+            ("ps_sensitivities_available", i32, []),
+            ("ps_prescribed_tangent", i32, [dbl, vp, vp, vp, i32, vp, vp, vp, vp]),
+            ("ps_forcing_tangent", i32, [dbl, vp, vp, i32, vp, vp]),
+            ("ps_integrate_prescribed_sens", i32, [vp, vp, vp, vp, i32, vp, i32, vp, dbl, vp, ctypes.c_long, vp, vp,
+                                                   i32, vp, vp, vp]),
+            ("ps_prescribed_torque_sens", i32, [i32, vp, vp, vp, vp, vp, i32, vp, vp]),
         ):
             function = getattr(lib, name)
             function.restype = restype
