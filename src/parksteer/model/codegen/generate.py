@@ -22,6 +22,7 @@ import sympy as sp
 from sympy.printing.c import C99CodePrinter
 
 from ..symbolic.derive import Derivation, Replacer, free_symbols, memoised_diff
+from .tangent import SENSITIVITY_RUNTIME, tangent_function
 
 # The handwheel input is a piecewise-quadratic table in p: count, then (t0, angle0, rate0, accel) per piece.
 MAX_INPUT_PIECES = 24
@@ -177,62 +178,6 @@ def _derivative_block(expressions: list[sp.Expr], variables: list[sp.Symbol], ta
     return lines
 
 
-def _directional_block(expressions: list[sp.Expr], directions: dict[sp.Symbol, sp.Symbol], targets: list[str],
-                       printer: _Printer, loop: str) -> list[str]:
-    """Lines assigning the directional derivative of expressions[i] along `directions` (each variable's direction
-    symbol) to targets[i], forward mode through the common subexpressions: for x_k = e_k(x_<k, v),
-    dx_k = sum over v in e_k of de_k/dv dv + sum over x_m in e_k of de_k/dx_m dx_m, one line per intermediate
-    that depends on a variable. The values are computed once; the derivative lines sit in the C `loop` header's
-    body (`loop` opens it), once per direction. Subexpression symbols are real, so |x|' is sign(x)."""
-    replacements, reduced = sp.cse(expressions, symbols=sp.numbered_symbols("x", real=True), order="none")
-    lines = [f"    const double {sym} = {printer.doprint(val)};" for sym, val in replacements]
-    lines.append(f"    {loop}")
-    tangent: dict[sp.Symbol, sp.Symbol] = {}
-    names = sp.numbered_symbols("dx", real=True)
-
-    def along(expr: sp.Expr) -> sp.Expr:
-        # a condition shared by cse is piecewise constant (a Symbol is a Boolean too in sympy: not that test)
-        if isinstance(expr, (sp.logic.boolalg.BooleanFunction, sp.logic.boolalg.BooleanAtom, sp.core.relational.Relational)):
-            return sp.S.Zero
-        # summed at once: a sum is canonical, the same expression in whatever order the free symbols come
-        terms = [sp.diff(expr, arg) * (directions.get(arg) or tangent[arg])
-                 for arg in expr.free_symbols if arg in directions or arg in tangent]
-        return sp.Add(*terms)
-
-    with memoised_diff():
-        for sym, val in replacements:
-            derivative = along(val)
-            if derivative != 0:
-                tangent[sym] = next(names)
-                lines.append(f"        const double {tangent[sym]} = {printer.doprint(derivative)};")
-        lines += [f"        {target} = {printer.doprint(along(expr))};" for target, expr in zip(targets, reduced)]
-    lines.append("    }")
-    return lines
-
-
-def _tangent_function(derivation: Derivation, plain: dict, F_drive, F_full, M, bcol, a, printer: _Printer) -> str:
-    """eval_tangent: along m directions (dq, du, dp: the coordinates', speeds' and parameters'), the derivatives of
-    the prescribed-rack residual G = F_drive + b T - M a (the column torque T and the accelerations a held) and of
-    the full forcing F (the statics' residual, at the handwheel input th, thd), the directions' values computed
-    once. The forward sensitivities of the prescribed-rack solve are made of them (RUNTIME's ps_prescribed_tangent,
-    ps_forcing_tangent)."""
-    space = derivation.space
-    n = len(space.coordinates)
-    torque = sp.Symbol("T", real=True)
-    directions = {plain[x]: sp.Symbol(f"dq[{i}]", real=True) for i, x in enumerate(space.q)}
-    directions.update({plain[x]: sp.Symbol(f"du[{i}]", real=True) for i, x in enumerate(space.u)})
-    directions.update({sp.Symbol(f"p[{i}]", real=True): sp.Symbol(f"dp[{i}]", real=True)
-                       for i in range(len(derivation.parameter_names))})
-    residual = [F_drive[i] + bcol[i] * torque - sum(M[i, j] * a[j] for j in range(n)) for i in range(n)]
-    targets = [f"dG[k * NQ + {i}]" for i in range(n)] + [f"dH[k * NQ + {i}]" for i in range(n)]
-    loop = ("for (int k = 0; k < m; k++) {\n        const double *dq = dy + k * NY, *du = dq + NQ, *dp = dps[k];"
-            "\n        (void)dq; (void)du; (void)dp;")  # the loop's head and the direction's arrays
-    lines = _directional_block(residual + list(F_full), directions, targets, printer, loop)
-    return _function("eval_tangent", "const double *q, const double *u, const double *a, const double *p, double T, "
-                     "double th, double thd, int m, const double *dy, const double *const *dps, double *dG, "
-                     "double *dH", lines)
-
-
 def generate(derivation: Derivation) -> tuple[str, dict]:
     """C source of the model and its description (state names, parameter order, output names)."""
     timings = {}
@@ -322,13 +267,7 @@ def generate(derivation: Derivation) -> tuple[str, dict]:
             _c_block(out_assign, printer),
         ),
     ]
-    # The forward sensitivities (eval_tangent) of a model the prescribed rack drives; an assist's drive, written at
-    # zero handwheel input, has none (prescribed.solve refuses sensitivities of it).
-    parts.append(_tangent_function(derivation, plain, F_nocol, F, M, bcol, a, printer) if not drive_hand else
-                 _function("eval_tangent", "const double *q, const double *u, const double *a, const double *p, "
-                           "double T, double th, double thd, int m, const double *dy, const double *const *dps, "
-                           "double *dG, double *dH", ["    (void)q; (void)u; (void)a; (void)p; (void)T; (void)th; "
-                                                       "(void)thd; (void)m; (void)dy; (void)dps; (void)dG; (void)dH;"]))
+    parts.append(tangent_function(derivation, plain, F_nocol, F, M, bcol, a, printer, drive_hand))  # tangent.py
     if any(f"{TABLE_LAW}(" in part or f"{TABLE_SLOPE}(" in part for part in parts):
         parts.insert(0, _table_functions(printer))
     timings["cse_derivatives_print_s"] = time.perf_counter() - start
@@ -345,7 +284,6 @@ def generate(derivation: Derivation) -> tuple[str, dict]:
         "outputs": [name for name, _ in outputs],
         "effect_outputs": [name for name, _ in effect_outputs],
         "rack_drive": not drive_hand,
-        "sensitivities": not drive_hand,
         "rack_index": rack,
     }
     header = (
@@ -354,10 +292,9 @@ def generate(derivation: Derivation) -> tuple[str, dict]:
         f"#define NQ {n}\n#define NY {2 * n}\n#define NOUT {len(outputs)}\n"
         f"#define INPUT_OFFSET {n_params}\n#define MAX_PIECES {MAX_INPUT_PIECES}\n"
         f"#define RACK {rack}\n#define OUT_COLUMN_ANGLE {info['outputs'].index('column_angle_rad')}\n"
-        f"#define OUT_COLUMN_TORQUE {info['outputs'].index('column_torque_Nm')}\n"
-        f"#define PS_SENSITIVITIES {int(not drive_hand)}\n\n"
+        f"#define OUT_COLUMN_TORQUE {info['outputs'].index('column_torque_Nm')}\n\n"
     )
-    source = header + "\n".join(parts) + RUNTIME + INTEGRATOR
+    source = header + "\n".join(parts) + RUNTIME + SENSITIVITY_RUNTIME + INTEGRATOR
     check_portable(source)
     return source, {**info, "codegen_timings_s": timings}
 
@@ -629,86 +566,6 @@ int ps_prescribed_jac(double t, const double *z, const double *p, double *p_jac,
         double ratio = b[reduced[i]] / b[RACK];
         for (int j = 0; j < 2 * NO; j++)
             J[(NO + i) * 2 * NO + j] = row[reduced[j]] - ratio * rack_row[reduced[j]];
-    }
-    return 0;
-}
-
-/* ---- forward sensitivities of the prescribed-rack solve ---------------------------------
-   Along a direction (dz, dp) of the reduced state and the parameters, the Kane equations M a = F + b T, with the
-   rack's motion given, move by A (da_o, dT) = dG, A = [M_o | -b] (the matrix prescribed_solve factors) and
-   dG = G_y dy + G_p dp the directional derivative of G = F + b T - M a with a and T held (eval_tangent). So one
-   call gives J dz + f_p dp, the reduced right-hand side's derivative (dz' = (du_o, da_o)), and the column torque's,
-   h_z dz + h_p dp. Directions: m rows of dz (2 NO each); dps[k] the k-th direction's parameters (INPUT_OFFSET). */
-#define NPAR (INPUT_OFFSET > 0 ? INPUT_OFFSET : 1)
-static const double ps_no_parameters[NPAR];
-
-int ps_sensitivities_available(void) { return PS_SENSITIVITIES; }
-
-static int prescribed_tangent(double t, const double *z, const double *p, const double *rack, int m,
-                              const double *dz, const double *const *dps, double *dzdot, double *dtorque,
-                              double *dy, double *dG, double *dH)
-{
-    double y[NY], x[NQ], M[NQ * NQ], b[NQ], r[3], acc[NQ], A[NQ * NQ], LU[NQ * NQ], c[NQ];
-    if (!PS_SENSITIVITIES || prescribed_solve(t, z, p, rack, y, x, M, b, r)) return -1;
-    for (int i = 0, j = 0; i < NQ; i++) acc[i] = (i == RACK) ? r[2] : x[j++];
-    for (int i = 0; i < NQ; i++) {
-        for (int j = 0, k = 0; j < NQ; j++) {
-            if (j == RACK) continue;
-            A[i * NQ + k++] = M[i * NQ + j];
-        }
-        A[i * NQ + NO] = -b[i];
-    }
-    for (int k = 0; k < m; k++) {  /* the rack's position and speed are given: no direction moves them */
-        double *d = dy + k * NY;
-        for (int i = 0, j = 0; i < NQ; i++) {
-            if (i == RACK) { d[i] = 0.0; d[NQ + i] = 0.0; continue; }
-            d[i] = dz[k * 2 * NO + j]; d[NQ + i] = dz[k * 2 * NO + NO + j]; j++;
-        }
-    }
-    eval_tangent(y, y + NQ, acc, p, x[NO], 0.0, 0.0, m, dy, dps, dG, dH);
-    for (int k = 0; k < m; k++) {
-        memcpy(LU, A, sizeof A);
-        memcpy(c, dG + k * NQ, sizeof c);
-        if (lu_solve(LU, c, NQ)) return -1;
-        memcpy(dzdot + k * 2 * NO, dz + k * 2 * NO + NO, NO * sizeof(double));
-        memcpy(dzdot + k * 2 * NO + NO, c, NO * sizeof(double));
-        if (dtorque) dtorque[k] = c[NO];
-    }
-    return 0;
-}
-
-/* The reduced system's tangent along m directions (dz row k, parameters dp row k of INPUT_OFFSET, dp NULL: none):
-   dzdot (m x 2 NO) and the column torque's dtorque (m; NULL: not wanted). Scratch on the heap-free stack for at
-   most MAX_TANGENTS directions a call. */
-#define MAX_TANGENTS 64
-int ps_prescribed_tangent(double t, const double *z, const double *p, const double *rack, int m, const double *dz,
-                          const double *dp, double *dzdot, double *dtorque)
-{
-    double dy[MAX_TANGENTS * NY], dG[MAX_TANGENTS * NQ], dH[MAX_TANGENTS * NQ];
-    const double *dps[MAX_TANGENTS];
-    for (int start = 0; start < m; start += MAX_TANGENTS) {
-        int count = m - start < MAX_TANGENTS ? m - start : MAX_TANGENTS;
-        for (int k = 0; k < count; k++) dps[k] = dp ? dp + (long)(start + k) * INPUT_OFFSET : ps_no_parameters;
-        if (prescribed_tangent(t, z, p, rack, count, dz + (long)start * 2 * NO, dps, dzdot + (long)start * 2 * NO,
-                               dtorque ? dtorque + start : NULL, dy, dG, dH)) return -1;
-    }
-    return 0;
-}
-
-/* The full forcing's derivative along m parameter directions (dp row k) at the state y (coordinates held) and
-   the handwheel input of time t: the statics' f_p dp, for the initial sensitivities (implicit function theorem). */
-int ps_forcing_tangent(double t, const double *y, const double *p, int m, const double *dp, double *dF)
-{
-    double th, thd, a[NQ], dy[MAX_TANGENTS * NY], dG[MAX_TANGENTS * NQ];
-    const double *dps[MAX_TANGENTS];
-    if (!PS_SENSITIVITIES) return -1;
-    memset(a, 0, sizeof a);
-    memset(dy, 0, sizeof dy);
-    ps_handwheel(t, p, &th, &thd);
-    for (int start = 0; start < m; start += MAX_TANGENTS) {
-        int count = m - start < MAX_TANGENTS ? m - start : MAX_TANGENTS;
-        for (int k = 0; k < count; k++) dps[k] = dp + (long)(start + k) * INPUT_OFFSET;
-        eval_tangent(y, y + NQ, a, p, 0.0, th, thd, count, dy, dps, dG, dF + (long)start * NQ);
     }
     return 0;
 }

@@ -1,8 +1,9 @@
 /* Stiff integration of the model in C: one call runs a whole cycle, handwheel-driven (ps_integrate: y' = ps_rhs)
    or with the rack prescribed (ps_integrate_prescribed: the reduced system of ps_prescribed_rhs).
 
-   Appended as text after the generated model code and its runtime (one translation unit), which define NY, NO,
-   ps_rhs, ps_jac, ps_prescribed_rhs and ps_prescribed_jac and include <math.h> and <string.h>. Every name here
+   Appended as text after the generated model code and its runtime (one translation unit), which define NY, NQ, NO,
+   INPUT_OFFSET, PS_SENSITIVITIES, ps_rhs, ps_jac, ps_prescribed_rhs, ps_prescribed_jac and, for the
+   sensitivities, prescribed_tangent and ps_no_parameters (sensitivities.c), and include <math.h> and <string.h>. Every name here
    starts with bdf_ (or is ps_integrate...), so as not to clash with the model code's own static helpers; all state
    lives on the call's stack (reentrant).
 
@@ -587,17 +588,4 @@ int ps_integrate_prescribed_sens(const double *p, double *p_jac, const double *r
     if (!PS_SENSITIVITIES || n_sens < 1 || n_sens > BDF_MAX_SENS) return -1;
     const bdf_system s = {2 * NO, p, rack, p_jac, n_sens, dp};
     return bdf_solve(&s, z0, n_out, t_out, n_crit, t_crit, rtol, atol, max_steps, z_out, stats, s0, s_out);
-}
-
-/* The column torque's sensitivities at m samples (t, z, S: n_sens x 2 NO per sample) along the parameter
-   directions dp (n_sens rows of INPUT_OFFSET): dtorque (m x n_sens) = h_z S + h_p v. */
-int ps_prescribed_torque_sens(int m, const double *t, const double *z, const double *S, const double *p,
-                              const double *rack, int n_sens, const double *dp, double *dtorque)
-{
-    double dzdot[BDF_MAX_SENS * 2 * NO];
-    if (n_sens < 1 || n_sens > BDF_MAX_SENS) return -1;
-    for (int k = 0; k < m; k++)
-        if (ps_prescribed_tangent(t[k], z + (long)k * 2 * NO, p, rack, n_sens, S + (long)k * n_sens * 2 * NO, dp,
-                                  dzdot, dtorque + (long)k * n_sens)) return -1;
-    return 0;
 }

@@ -74,7 +74,7 @@ def solve_sensitivities(run, p: np.ndarray, rack: RackMotion, t_out, directions:
     torque to the byte) with the torque's derivatives along `directions` (rows of the parameter vector's length,
     e.g. :func:`parameter_directions`)."""
     model = run.model
-    if not model.info.get("sensitivities", False):
+    if not model.info.get("rack_drive", True):  # the generated C has sensitivities exactly where the rack drives
         raise UsageError(f"no sensitivities of the effects {', '.join(model.effects)}: an assist feeds the "
                          "torsion-bar torque back into the load, and its replay is not the prescribed-rack solve")
     n_par = len(model.info["parameters"])
