@@ -63,7 +63,6 @@ PRESCRIBED_STUBS = """
 #define NO (NQ - 1)
 #define INPUT_OFFSET 2
 #define PS_SENSITIVITIES 0
-static const double ps_no_parameters[INPUT_OFFSET];
 int ps_prescribed_rhs(double t, const double *z, const double *p, const double *rack, double *zdot) { return -1; }
 int ps_prescribed_jac(double t, const double *z, const double *p, double *p_jac, const double *rack, double *J)
 { return -1; }
@@ -350,7 +349,6 @@ SENSITIVITY_PROBLEM = """
 #define NO (NQ - 1)
 #define INPUT_OFFSET 2
 #define PS_SENSITIVITIES 1
-static const double ps_no_parameters[INPUT_OFFSET];
 int ps_prescribed_rhs(double t, const double *z, const double *p, const double *rack, double *zdot)
 { zdot[0] = -p[0] * z[0]; zdot[1] = -p[1] * z[1]; return 0; }
 int ps_prescribed_jac(double t, const double *z, const double *p, double *p_jac, const double *rack, double *J)

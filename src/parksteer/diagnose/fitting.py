@@ -4,7 +4,8 @@ Levenberg-Marquardt on the weighted residuals r_i = (measured - model) / sigma_i
 of the parameters :mod:`parksteer.diagnose.calibrate` chooses (:class:`FitParameter`): positive physical parameters
 are fitted as the logarithm of their ratio to the default, a strength as it stands within its bounds; the Jacobian
 starts from finite differences and is updated by Broyden's rank-one formula, and taken afresh at the end if the
-parameters moved far. :func:`polish` then takes Gauss-Newton steps on a fresh Jacobian until the step is a tenth of
+parameters moved far (with ``DiagnosisSettings.exact_jacobian``, exact from the replays' forward sensitivities
+instead, afresh at every accepted step). :func:`polish` then takes Gauss-Newton steps on a fresh Jacobian until the step is a tenth of
 every standard error, so that a candidate's refit gains in the BIC only what it brings. Intervals are 95 %:
 ``cov = s^2 (J^T J)^-1`` inflated by (1 + rho) / (1 - rho) for the residuals' lag-1 autocorrelation rho, or, where
 larger, a block sandwich over segments of the cycle (:meth:`Fit.intervals`). Why: docs/diagnosis.md, "How sure the
@@ -162,6 +163,56 @@ def finite_difference_jacobian(engine: ReplayEngine, problem: Problem, effects: 
     return np.column_stack(columns) if columns else np.zeros((base.size, 0))
 
 
+def exact_jacobian(engine: ReplayEngine, problem: Problem, effects: list[Effect], parameters: list[FitParameter],
+                   theta: np.ndarray, fixed: dict[str, float]) -> np.ndarray | None:
+    """d(model / sigma)/d(theta) from each file's replay with forward sensitivities (one integration a file, counted
+    as one solve), or None where they do not apply: a file fitted on its angle or motor channel, an assisted car.
+
+    A parameter the compiled model reads directly has its unit direction in the parameter vector; one that the run's
+    preparation turns into other entries (a tyre's friction coefficient into the surface grip), the central
+    difference of the prepared vectors at 1e-6 of its value (no replay: the preparation's own arithmetic)."""
+    from ..model.numeric.sensitivities import solve_sensitivities
+
+    if any(f.uses_angle or f.uses_motor for f in problem.files):
+        return None
+    values = [p.value(t) for p, t in zip(parameters, theta)]
+    overrides = {**fixed, **{p.key: v for p, v in zip(parameters, values)}}
+    per_theta = np.array([v if p.transform == "log" else 1.0 for p, v in zip(parameters, values)])
+    blocks = []
+    for index, f in enumerate(problem.files):
+        replay = engine.replay(problem, effects, index)
+        if replay.assisted:
+            return None
+        run, p_vector = replay.parameter_vector(overrides)
+        directions = np.zeros((len(parameters), len(run.model.info["parameters"])))
+        for k, (parameter, value) in enumerate(zip(parameters, values)):
+            key = parameter.key
+            if key in run.model.parameter_positions and not key.startswith("derived."):
+                directions[k, run.parameter_index(key)] = 1.0
+                continue
+            h = 1e-6 * max(abs(value), 1e-12)
+            up = replay.parameter_vector({**overrides, key: value + h})[1]
+            down = replay.parameter_vector({**overrides, key: value - h})[1]
+            directions[k] = (up - down)[: directions.shape[1]] / (2.0 * h)
+        replay.evaluations += 1
+        if replay.counter is not None:
+            replay.counter.solves += 1
+        solution = solve_sensitivities(run, p_vector, replay.rack, replay.time_s, directions)
+        blocks.append(solution.torque_sensitivities * per_theta / np.asarray(f.sigma, dtype=float).reshape(-1, 1))
+    return np.vstack(blocks)
+
+
+def fresh_jacobian(engine: ReplayEngine, problem: Problem, effects: list[Effect], parameters: list[FitParameter],
+                   theta: np.ndarray, fixed: dict[str, float], predictions: list[np.ndarray],
+                   settings: DiagnosisSettings) -> tuple[np.ndarray, bool]:
+    """(A Jacobian taken afresh at `theta`, whether it is exact): exact where the settings ask and the replays allow
+    (:func:`exact_jacobian`), else by finite differences."""
+    exact = exact_jacobian(engine, problem, effects, parameters, theta, fixed) if settings.exact_jacobian else None
+    if exact is not None:
+        return exact, True
+    return finite_difference_jacobian(engine, problem, effects, parameters, theta, fixed, predictions), False
+
+
 def least_squares(engine: ReplayEngine, problem: Problem, effects: list[Effect], parameters: list[FitParameter],
                   theta0: np.ndarray, fixed: dict[str, float] | None = None, jacobian: np.ndarray | None = None,
                   max_iterations: int | None = None, tolerance: float | None = None,
@@ -183,8 +234,9 @@ def least_squares(engine: ReplayEngine, problem: Problem, effects: list[Effect],
     history = [rss]
     if not parameters:
         return Fit(effects, parameters, theta, fixed, predictions, r, np.zeros((r.size, 0)), 0, 0, history)
-    J = jacobian.copy() if jacobian is not None else finite_difference_jacobian(
-        engine, problem, effects, parameters, theta, fixed, predictions)
+    # exact: every accepted step takes a fresh exact Jacobian, and no Broyden update
+    J, exact = (jacobian.copy(), False) if jacobian is not None and not settings.exact_jacobian else fresh_jacobian(
+        engine, problem, effects, parameters, theta, fixed, predictions, settings)
     theta_at_jacobian = theta.copy()
     damping = 1e-3
     iterations = 0
@@ -216,7 +268,7 @@ def least_squares(engine: ReplayEngine, problem: Problem, effects: list[Effect],
         predicted = rss - float(np.sum((r - pm.matmul(J, step)) ** 2))
         # Broyden: the actual change of model / sigma is r - trial_r. A step much smaller than the standard
         # errors moves the model by little more than the integrator's own noise: it would corrupt J.
-        if np.any(np.abs(step) > se):
+        if not exact and np.any(np.abs(step) > se):
             J += np.outer((r - trial_r) - pm.matmul(J, step), step) / pm.dot(step, step)
         if trial_rss < rss:
             poor = predicted > 0 and (rss - trial_rss) < 0.25 * predicted
@@ -224,13 +276,13 @@ def least_squares(engine: ReplayEngine, problem: Problem, effects: list[Effect],
             history.append(rss)
             damping = max(damping / 3.0, 1e-7)
             failures = 0
-            if poor:  # the linear model promised much more than the step gave: renew it
-                J = finite_difference_jacobian(engine, problem, effects, parameters, theta, fixed, predictions)
+            if exact or poor:  # poor: the linear model promised much more than the step gave: renew it
+                J, _ = fresh_jacobian(engine, problem, effects, parameters, theta, fixed, predictions, settings)
                 theta_at_jacobian = theta.copy()
         else:
             damping *= 4.0
             failures += 1
-            if failures == 2:  # the updated Jacobian misleads: start again from finite differences
+            if failures == 2 and not exact:  # the updated Jacobian misleads: start again from finite differences
                 J = finite_difference_jacobian(engine, problem, effects, parameters, theta, fixed, predictions)
                 theta_at_jacobian = theta.copy()
             elif failures > 3:
@@ -281,7 +333,7 @@ def polish(engine: ReplayEngine, problem: Problem, fit: Fit, settings: Diagnosis
     rss, history, J, rounds = pm.dot(r, r), list(fit.history), fit.jacobian, 0
     while rounds < settings.calibration_polish_rounds:
         rounds += 1
-        J = finite_difference_jacobian(engine, problem, effects, parameters, theta, fixed, predictions)
+        J, _ = fresh_jacobian(engine, problem, effects, parameters, theta, fixed, predictions, settings)
         newton, se = gauss_newton_step(J, r, theta, lower, upper)
         if np.all(np.abs(newton) <= settings.calibration_polish_tolerance * se):
             break

@@ -2,8 +2,8 @@
    or with the rack prescribed (ps_integrate_prescribed: the reduced system of ps_prescribed_rhs).
 
    Appended as text after the generated model code and its runtime (one translation unit), which define NY, NQ, NO,
-   INPUT_OFFSET, PS_SENSITIVITIES, ps_rhs, ps_jac, ps_prescribed_rhs, ps_prescribed_jac and, for the
-   sensitivities, prescribed_tangent and ps_no_parameters (sensitivities.c), and include <math.h> and <string.h>. Every name here
+   INPUT_OFFSET, ps_rhs, ps_jac, ps_prescribed_rhs, ps_prescribed_jac and, for the sensitivities,
+   PS_SENSITIVITIES and prescribed_tangent (sensitivities.c), and include <math.h> and <string.h>. Every name here
    starts with bdf_ (or is ps_integrate...), so as not to clash with the model code's own static helpers; all state
    lives on the call's stack (reentrant).
 
@@ -51,8 +51,8 @@
    359-365; CVODES's CV_STAGGERED): after each accepted step of the state, the same NDF of the same order on the
    same step is applied to the sensitivity equations S' = J S + f_p v. They are linear in S, so the corrector is
    one solve, d_S = (I - c J)^-1 (c (J S_pred + f_p v) - psi_S), with J exact at the step's end
-   (ps_prescribed_tangent along the unit directions, factored apart from the state's Newton matrix, which it never
-   touches). Each S keeps its own differences, rescaled with the state's whenever h or the order changes, and is
+   (ps_prescribed_jac, factored apart from the state's Newton matrix, which it never touches; J S_pred + f_p v from
+   prescribed_tangent in one call for all directions). Each S keeps its own differences, rescaled with the state's whenever h or the order changes, and is
    interpolated as the state is. S does not enter the error control (CVODES's errconS off): the steps, and so
    every byte of the state, are those of the run without sensitivities; S is as accurate as the state's steps
    make it, which tests/model/test_sensitivities.py checks against finite differences at tight tolerances.
@@ -291,24 +291,15 @@ static void bdf_interpolate(int width, double t, double t_now, double h, int ord
     }
 }
 
-/* The sensitivities' right-hand sides J S + f_p v at (t, z) for S = rows of `S` (n_sens x n), into f; with
-   `jac` not NULL, also J (row-major n x n) from the unit directions in the same call. */
-static int bdf_sens_rhs(const bdf_system *s, double t, const double *z, const double *S, double *f, double *jac)
+/* The sensitivities' right-hand sides J S + f_p v at (t, z) for S = rows of `S` (n_sens x n), into f. */
+static int bdf_sens_rhs(const bdf_system *s, double t, const double *z, const double *S, double *f)
 {
-    const int n = s->n, m = s->n_sens, units = jac ? n : 0;
-    double dz[(NY + BDF_MAX_SENS) * NY], dzdot[(NY + BDF_MAX_SENS) * NY];
-    double dy[(NY + BDF_MAX_SENS) * NY], dG[(NY + BDF_MAX_SENS) * NQ], dH[(NY + BDF_MAX_SENS) * NQ];
-    const double *dps[NY + BDF_MAX_SENS];
-    memset(dz, 0, (size_t)units * n * sizeof(double));
-    for (int k = 0; k < units; k++) { dz[k * n + k] = 1.0; dps[k] = ps_no_parameters; }
-    memcpy(dz + units * n, S, (size_t)m * n * sizeof(double));
-    for (int k = 0; k < m; k++) dps[units + k] = s->sens_dp + (long)k * INPUT_OFFSET;
-    if (prescribed_tangent(t, z, s->p, s->rack, units + m, dz, dps, dzdot, NULL, dy, dG, dH)) return 1;
-    if (!bdf_all_finite(dzdot, (units + m) * n)) return 1;
-    for (int j = 0; j < units; j++)
-        for (int i = 0; i < n; i++) jac[i * n + j] = dzdot[j * n + i];
-    memcpy(f, dzdot + units * n, (size_t)m * n * sizeof(double));
-    return 0;
+    const int n = s->n, m = s->n_sens;
+    double dy[BDF_MAX_SENS * NY], dG[BDF_MAX_SENS * NQ], dH[BDF_MAX_SENS * NQ];
+    const double *dps[BDF_MAX_SENS];
+    for (int k = 0; k < m; k++) dps[k] = s->sens_dp + (long)k * INPUT_OFFSET;
+    if (prescribed_tangent(t, z, s->p, s->rack, m, S, dps, f, NULL, dy, dG, dH)) return 1;
+    return !bdf_all_finite(f, m * n);
 }
 
 /* The sensitivities' NDF step of the given order and h to t_new, whose state y_new the step has just accepted:
@@ -329,7 +320,8 @@ static int bdf_sens_step(const bdf_system *s, const bdf_coefficients *co, double
         S_pred[i] = sum;
         psi[i] = weighted / co->alpha[order];
     }
-    if (bdf_sens_rhs(s, t_new, y_new, S_pred, f, jac)) return 1;
+    long n_jac = 0;
+    if (bdf_jac(s, t_new, y_new, jac, &n_jac) || bdf_sens_rhs(s, t_new, y_new, S_pred, f)) return 1;
     for (int i = 0; i < n * n; i++) lu[i] = -c * jac[i];
     for (int i = 0; i < n; i++) lu[i * n + i] += 1.0;
     if (bdf_lu_factor(n, lu, pivot)) return 1;
@@ -410,7 +402,7 @@ static int bdf_solve(const bdf_system *s, const double *y0, int n_out, const dou
             for (int i = 0; i < n; i++) D[1][i] = h * f[i];
             if (w) {
                 double f_sens[BDF_MAX_SENS * NY];
-                if (bdf_sens_rhs(s, t, D[0], DS[0], f_sens, NULL)) { status = BDF_EVAL_FAILED; goto done; }
+                if (bdf_sens_rhs(s, t, D[0], DS[0], f_sens)) { status = BDF_EVAL_FAILED; goto done; }
                 for (int i = 0; i < w; i++) DS[1][i] = h * f_sens[i];
             }
             order = 1;
