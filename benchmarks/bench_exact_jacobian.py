@@ -7,8 +7,8 @@ Each run is a fresh interpreter (``--child``) that diagnoses the file in line (o
 unmeasured run of each setting fills the cache) and prints its wall (the diagnosis alone, imports and intake left
 out), the calibration's replays and wall (``replays_by_stage`` and ``timings_s`` of the calibration stage), every
 replay, the verdict, the missing effect and the calibrated values. The settings alternate within a repeat, so a
-machine's drift touches both alike; the table gives the medians and says whether every run's verdict and effect
-agree between the settings. An exact Jacobian's integration with sensitivities counts as one replay.
+machine's drift touches both alike; the table gives the medians (the stages' too) and says whether every run's
+verdict and effect agree between the settings. An exact Jacobian's integration with sensitivities counts as one replay.
 """
 
 from __future__ import annotations
@@ -66,10 +66,11 @@ def main() -> None:
             runs[exact].append(run(args.file, exact))
     for exact, label in ((False, "finite differences"), (True, "exact")):
         r = runs[exact]
+        stages = {name: statistics.median(x["timings_s"].get(name, 0.0) for x in r) for name in r[0]["timings_s"]}
         print(f"{label:20s} wall {statistics.median(x['wall_s'] for x in r):.3f} s  "
               f"calibration replays {statistics.median(x['calibration_evaluations'] for x in r):.0f}  "
-              f"replays {statistics.median(x['replays'] for x in r):.0f}  "
-              f"stages {r[0]['timings_s']}  verdict {r[0]['verdict']} {r[0]['effect']}")
+              f"replays {statistics.median(x['replays'] for x in r):.0f}  verdict {r[0]['verdict']} {r[0]['effect']}")
+        print(f"{'':20s} stages (s) " + ", ".join(f"{name} {t:.3f}" for name, t in stages.items() if t >= 0.001))
         print(f"{'':20s} calibrated {r[0]['calibrated']}")
     same = all(a["verdict"] == b["verdict"] and a["effect"] == b["effect"] for a, b in zip(runs[False], runs[True]))
     print(f"verdicts and effects the same in every run: {same}")

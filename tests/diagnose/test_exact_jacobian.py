@@ -58,9 +58,9 @@ def test_exact_jacobian_is_the_central_difference_of_the_weighted_model(problem_
 
 
 def test_calibration_on_exact_jacobians_finds_the_same_values(problem_and_effects):
-    """Levenberg-Marquardt on exact Jacobians (afresh at every accepted step) and on finite differences with
-    Broyden's update minimise the same weighted residual: their calibrated values agree within a tenth of each
-    value's standard error, and each recovers the moved car's values within its 95 % interval."""
+    """Levenberg-Marquardt and the polish on exact Jacobians and on finite differences (Broyden's update between
+    fresh ones in both) minimise the same weighted residual: their calibrated values agree within a tenth of each
+    value's standard error, and the exact one recovers the moved car's values within their 95 % intervals."""
     problem, effects = problem_and_effects
     plain = calibrate(ReplayEngine(1), problem, effects)
     exact = calibrate(ReplayEngine(1), problem, effects, settings=replace(DEFAULT_SETTINGS, exact_jacobian=True))

@@ -4,8 +4,8 @@ Levenberg-Marquardt on the weighted residuals r_i = (measured - model) / sigma_i
 of the parameters :mod:`parksteer.diagnose.calibrate` chooses (:class:`FitParameter`): positive physical parameters
 are fitted as the logarithm of their ratio to the default, a strength as it stands within its bounds; the Jacobian
 starts from finite differences and is updated by Broyden's rank-one formula, and taken afresh at the end if the
-parameters moved far (with ``DiagnosisSettings.exact_jacobian``, exact from the replays' forward sensitivities
-instead, afresh at every accepted step). :func:`polish` then takes Gauss-Newton steps on a fresh Jacobian until the step is a tenth of
+parameters moved far (with ``DiagnosisSettings.exact_jacobian``, each Jacobian taken afresh is exact, from the
+replays' forward sensitivities, instead of by finite differences). :func:`polish` then takes Gauss-Newton steps on a fresh Jacobian until the step is a tenth of
 every standard error, so that a candidate's refit gains in the BIC only what it brings. Intervals are 95 %:
 ``cov = s^2 (J^T J)^-1`` inflated by (1 + rho) / (1 - rho) for the residuals' lag-1 autocorrelation rho, or, where
 larger, a block sandwich over segments of the cycle (:meth:`Fit.intervals`). Why: docs/diagnosis.md, "How sure the
@@ -204,13 +204,12 @@ def exact_jacobian(engine: ReplayEngine, problem: Problem, effects: list[Effect]
 
 def fresh_jacobian(engine: ReplayEngine, problem: Problem, effects: list[Effect], parameters: list[FitParameter],
                    theta: np.ndarray, fixed: dict[str, float], predictions: list[np.ndarray],
-                   settings: DiagnosisSettings) -> tuple[np.ndarray, bool]:
-    """(A Jacobian taken afresh at `theta`, whether it is exact): exact where the settings ask and the replays allow
-    (:func:`exact_jacobian`), else by finite differences."""
+                   settings: DiagnosisSettings) -> np.ndarray:
+    """A Jacobian taken afresh at `theta`: exact where the settings ask and the replays allow (:func:`exact_jacobian`),
+    else by finite differences."""
     exact = exact_jacobian(engine, problem, effects, parameters, theta, fixed) if settings.exact_jacobian else None
-    if exact is not None:
-        return exact, True
-    return finite_difference_jacobian(engine, problem, effects, parameters, theta, fixed, predictions), False
+    return exact if exact is not None else finite_difference_jacobian(engine, problem, effects, parameters, theta,
+                                                                       fixed, predictions)
 
 
 def least_squares(engine: ReplayEngine, problem: Problem, effects: list[Effect], parameters: list[FitParameter],
@@ -234,8 +233,7 @@ def least_squares(engine: ReplayEngine, problem: Problem, effects: list[Effect],
     history = [rss]
     if not parameters:
         return Fit(effects, parameters, theta, fixed, predictions, r, np.zeros((r.size, 0)), 0, 0, history)
-    # exact: every accepted step takes a fresh exact Jacobian, and no Broyden update
-    J, exact = (jacobian.copy(), False) if jacobian is not None and not settings.exact_jacobian else fresh_jacobian(
+    J = jacobian.copy() if jacobian is not None and not settings.exact_jacobian else fresh_jacobian(
         engine, problem, effects, parameters, theta, fixed, predictions, settings)
     theta_at_jacobian = theta.copy()
     damping = 1e-3
@@ -268,7 +266,7 @@ def least_squares(engine: ReplayEngine, problem: Problem, effects: list[Effect],
         predicted = rss - float(np.sum((r - pm.matmul(J, step)) ** 2))
         # Broyden: the actual change of model / sigma is r - trial_r. A step much smaller than the standard
         # errors moves the model by little more than the integrator's own noise: it would corrupt J.
-        if not exact and np.any(np.abs(step) > se):
+        if np.any(np.abs(step) > se):
             J += np.outer((r - trial_r) - pm.matmul(J, step), step) / pm.dot(step, step)
         if trial_rss < rss:
             poor = predicted > 0 and (rss - trial_rss) < 0.25 * predicted
@@ -276,19 +274,19 @@ def least_squares(engine: ReplayEngine, problem: Problem, effects: list[Effect],
             history.append(rss)
             damping = max(damping / 3.0, 1e-7)
             failures = 0
-            if exact or poor:  # poor: the linear model promised much more than the step gave: renew it
-                J, _ = fresh_jacobian(engine, problem, effects, parameters, theta, fixed, predictions, settings)
+            if poor:  # the linear model promised much more than the step gave: renew it
+                J = fresh_jacobian(engine, problem, effects, parameters, theta, fixed, predictions, settings)
                 theta_at_jacobian = theta.copy()
         else:
             damping *= 4.0
             failures += 1
-            if failures == 2 and not exact:  # the updated Jacobian misleads: start again from finite differences
-                J = finite_difference_jacobian(engine, problem, effects, parameters, theta, fixed, predictions)
+            if failures == 2:  # the updated Jacobian misleads: start again from finite differences
+                J = fresh_jacobian(engine, problem, effects, parameters, theta, fixed, predictions, settings)
                 theta_at_jacobian = theta.copy()
             elif failures > 3:
                 break
     if refresh_at_end and np.max(np.abs(theta - theta_at_jacobian)) > settings.jacobian_refresh_theta:
-        J = finite_difference_jacobian(engine, problem, effects, parameters, theta, fixed, predictions)
+        J = fresh_jacobian(engine, problem, effects, parameters, theta, fixed, predictions, settings)
     return Fit(effects, parameters, theta, fixed, predictions, r, J, iterations,
                engine.evaluations - start_evaluations, history)
 
@@ -333,7 +331,7 @@ def polish(engine: ReplayEngine, problem: Problem, fit: Fit, settings: Diagnosis
     rss, history, J, rounds = pm.dot(r, r), list(fit.history), fit.jacobian, 0
     while rounds < settings.calibration_polish_rounds:
         rounds += 1
-        J, _ = fresh_jacobian(engine, problem, effects, parameters, theta, fixed, predictions, settings)
+        J = fresh_jacobian(engine, problem, effects, parameters, theta, fixed, predictions, settings)
         newton, se = gauss_newton_step(J, r, theta, lower, upper)
         if np.all(np.abs(newton) <= settings.calibration_polish_tolerance * se):
             break

@@ -145,9 +145,10 @@ class DiagnosisSettings:
     # The Jacobian is recomputed by finite differences at the end of a fit when a parameter has moved
     # by more than this (in its fitted variable: 0.15 is 15 % of a log-fitted value) since it was taken.
     jacobian_refresh_theta: float = 0.15
-    # Each fit's Jacobian from the replays' forward sensitivities (parksteer.model.numeric.sensitivities: exact,
-    # one integration a file), taken afresh after every accepted step instead of Broyden's update, where every
-    # file is a manual car's torque alone; else, and by default, finite differences and Broyden's update.
+    # Each Jacobian a fit takes afresh (at its start, on a poor step, after two failed ones, at its end and in
+    # polish) from the replays' forward sensitivities (parksteer.model.numeric.sensitivities: exact, one integration
+    # a file) instead of by finite differences, Broyden's update between, where every file is a manual car's torque
+    # alone. Off by default: on the README example it saves 5 of the calibration's 12 replays but not time.
     exact_jacobian: bool = False
     # Intervals of fitted parameters: the larger of the model-based one and a block sandwich over segments of
     # this length, s (parksteer.diagnose.fitting.Fit.intervals). A misfit of a wrong model class keeps one sign
