@@ -17,9 +17,15 @@ from ..symbolic.derive import Derivation, memoised_diff
 SENSITIVITY_RUNTIME = "\n" + (Path(__file__).with_name("sensitivities.c")).read_text(encoding="utf-8")
 
 
+# eval_tangent compiled without optimisation: optimised, its some 600 lines of chain rule cost about 1.2 s of the
+# compiler's time a model (half again what the rest costs), paid by every model built, while only a fit that asks for
+# exact Jacobians runs it. The arithmetic is the same (no fused multiply-add at any level: -ffp-contract=off).
+UNOPTIMISED = '__attribute__((optimize("O0"))) '
+
+
 def _function(name: str, args: str, lines: list[str]) -> str:
     body = "\n".join(lines)
-    return f"static void {name}({args})\n{{\n{body}\n}}\n"
+    return f"{UNOPTIMISED}static void {name}({args})\n{{\n{body}\n}}\n"
 
 
 def _directional_block(expressions: list[sp.Expr], directions: dict[sp.Symbol, sp.Symbol], targets: list[str],
