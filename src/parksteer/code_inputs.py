@@ -44,12 +44,23 @@ def _read(path: Path) -> tuple[tuple[str, ...], str]:
     return _read_version(path, stat.st_mtime_ns, stat.st_size)
 
 
+def _statements(nodes):
+    """Every statement under `nodes`, nested ones included (an import or a definition is a statement, and no
+    expression holds one, so the expressions need no visit)."""
+    for node in nodes:
+        yield node
+        for field in ("body", "orelse", "finalbody", "handlers", "cases"):
+            inner = getattr(node, field, None)
+            if isinstance(inner, list):
+                yield from _statements(inner)
+
+
 @lru_cache(maxsize=None)
 def _read_version(path: Path, mtime_ns: int, size: int) -> tuple[tuple[str, ...], str]:
     text = path.read_text(encoding="utf-8")
     tree = ast.parse(text, filename=str(path))
     imports, docstrings = [], []
-    for node in ast.walk(tree):
+    for node in (tree, *_statements(tree.body)):
         if isinstance(node, ast.Import):
             imports.extend(alias.name for alias in node.names)
         elif isinstance(node, ast.ImportFrom):
@@ -89,21 +100,34 @@ def _registered(root: Path, name: str) -> tuple[str, ...]:
     return tuple(f"{prefix}.{p.stem}" for p in sorted((root / folder).glob("*.py")) if p.stem != "__init__")
 
 
+@lru_cache(maxsize=None)
+def _edges(root: Path, source: Path, name: str | None, mtime_ns: int, size: int) -> tuple[tuple[str, Path], ...]:
+    """The package modules `source` (module `name`) loads directly, as (name, file): each module's edges are found
+    once, however many scripts reach it (read again when the file's size or modification time changed)."""
+    out: dict[str, Path] = {}
+    for imported in imported_names(source, name):
+        parts = imported.split(".")
+        for depth in range(1, len(parts) + 1):
+            prefix = ".".join(parts[:depth])
+            for loaded in (prefix, *_registered(root, prefix)):
+                if loaded not in out:
+                    found = _module_file(root, loaded)
+                    if found is not None:
+                        out[loaded] = found
+    return tuple(out.items())
+
+
 def loaded_modules(root: Path, script: Path) -> set[str]:
     """The package modules running `script` (a file outside the package) can load, by name."""
     seen: set[str] = set()
     todo: list[tuple[Path, str | None]] = [(script, None)]
     while todo:
         source, name = todo.pop()
-        for imported in imported_names(source, name):
-            parts = imported.split(".")
-            for depth in range(1, len(parts) + 1):
-                prefix = ".".join(parts[:depth])
-                for loaded in (prefix, *_registered(root, prefix)):
-                    found = _module_file(root, loaded)
-                    if found is not None and loaded not in seen:
-                        seen.add(loaded)
-                        todo.append((found, loaded))
+        stat = source.stat()
+        for loaded, found in _edges(root, source, name, stat.st_mtime_ns, stat.st_size):
+            if loaded not in seen:
+                seen.add(loaded)
+                todo.append((found, loaded))
     return seen
 
 

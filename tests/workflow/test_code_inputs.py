@@ -72,3 +72,24 @@ def test_an_added_import_is_followed_without_a_step(package_copy):
     declaration = package_copy / "src/parksteer/sweep/declaration.py"
     declaration.write_text(declaration.read_text(encoding="utf-8") + "\n_EDITED = 1\n", encoding="utf-8")
     assert code_digest(package_copy, "workflow/scripts/figA3.py") != before
+
+
+def test_imports_are_found_wherever_a_statement_can_hold_them():
+    """Every module the package's files and the workflow's scripts import, at any depth (inside functions, `try`,
+    `with`, `if` and `match` blocks), is among the names the digest follows: checked against a walk of every node of
+    each file's syntax tree, an independent way of finding the same import statements."""
+    import ast
+
+    from parksteer.code_inputs import _read
+
+    files = [*(ROOT / "src/parksteer").rglob("*.py"), *(ROOT / p for p in _scripts(ROOT))]
+    for path in files:
+        every = []
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.Import):
+                every += [alias.name for alias in node.names]
+            elif isinstance(node, ast.ImportFrom):
+                every.append("." * node.level + (node.module or ""))
+        assert set(every) <= set(_read(path)[0]), path
+    nested = [p for p in files if "\n        from " in p.read_text(encoding="utf-8")]
+    assert nested  # the package does import inside blocks within functions: the check above covers such imports
