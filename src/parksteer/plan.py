@@ -42,8 +42,8 @@ def diagnosis(config: dict, parameters_path: str, user_effect: str) -> dict:
     from .experiments.benchmark import case_names as bench_case_names
     from .diagnose.candidates import candidate_models
     from .experiments.outclass import case_names as outclass_case_names
+    from .experiments.outoflibrary import case_names as signature_case_names, design_from_config as signature_design
     from .experiments.variations import VariationDesign, case_names as variation_case_names
-    from .figures.signature import case_names as signature_case_names, design_from_config as signature_design
     from .parameters import load_parameters
     from .synthetic.datasets import BenchmarkDesign, CarDesign, file_name
     from .synthetic.outclass import OutclassDesign

@@ -1,5 +1,6 @@
 # Thin rule script: the logic is parksteer.figures.signature.make_signature_figure.
-from parksteer.figures.signature import design_from_config, make_signature_figure
+from parksteer.experiments.outoflibrary import design_from_config
+from parksteer.figures.signature import make_signature_figure
 from parksteer.rules import rule_log
 
 with rule_log(snakemake):

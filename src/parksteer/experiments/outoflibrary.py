@@ -38,6 +38,7 @@ from ..synthetic.variations import VARIATIONS, variation_rack, variation_record
 from .benchmark import BENCHMARK_SETTINGS
 from ..diagnose.intake import Request, intake
 from ..diagnose.signature import signature_of
+from ..errors import UsageError
 from ..diagnose.suggest import suggest
 from ..names import TORQUE
 
@@ -90,6 +91,26 @@ class SignatureDesign:
                                          self.seed + k))
                 k += 1
         return out
+
+
+def design_from_config(config: dict) -> SignatureDesign:
+    """The grid of config["signature"] (config/config.yaml)."""
+    try:
+        design = SignatureDesign(steps=tuple(float(s) for s in config["steps"]), nulls=int(config["nulls"]),
+                                 variations=int(config["variations"]), seed=int(config["seed"]),
+                                 first_variation=int(config["first_variation"]),
+                                 combined=tuple(str(n) for n in config["combined_forms"]))
+    except KeyError as missing:
+        raise UsageError(f"config signature: no {missing.args[0]!r}") from None
+    known = [f.effect.name for f in COMBINED_FORMS]
+    unknown = [n for n in design.combined if n not in known]
+    if unknown:
+        raise UsageError(f"config signature: combined_forms: no form {unknown[0]!r} (the forms: {', '.join(known)})")
+    return design
+
+
+def case_names(design: SignatureDesign) -> list[str]:
+    return [c.name for c in design.cases()]
 
 
 def truth_effects(form: TruthForm) -> list:

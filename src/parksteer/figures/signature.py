@@ -37,24 +37,6 @@ ROW_KEYS = ("name", "form", "class", "variation", "steps", "said_class", "class_
             "suggestion_written", "sentence")
 
 
-def design_from_config(config: dict) -> SignatureDesign:
-    """The grid of config["signature"] (config/config.yaml)."""
-    try:
-        design = SignatureDesign(steps=tuple(float(s) for s in config["steps"]), nulls=int(config["nulls"]),
-                                 variations=int(config["variations"]), seed=int(config["seed"]),
-                                 first_variation=int(config["first_variation"]),
-                                 combined=tuple(str(n) for n in config["combined_forms"]))
-    except KeyError as missing:
-        raise UsageError(f"config signature: no {missing.args[0]!r}") from None
-    from ..synthetic.outoflibrary import COMBINED_FORMS
-
-    known = [f.effect.name for f in COMBINED_FORMS]
-    unknown = [n for n in design.combined if n not in known]
-    if unknown:
-        raise UsageError(f"config signature: combined_forms: no form {unknown[0]!r} (the forms: {', '.join(known)})")
-    return design
-
-
 def design_dict(design: SignatureDesign) -> dict:
     return {"steps": list(design.steps), "nulls": design.nulls, "variations": design.variations,
             "seed": design.seed, "first_variation": design.first_variation, "combined_forms": list(design.combined)}
@@ -79,10 +61,6 @@ def forms_dict(names=None) -> dict:
 
     return {f.effect.name: {"class": f.signature_class, "description": f.effect.description, "why": f.effect.why}
             for f in ALL_FORMS if names is None or f.effect.name in names}
-
-
-def case_names(design: SignatureDesign) -> list[str]:
-    return [c.name for c in design.cases()]
 
 
 def run_case(parameters_path: str | Path, design: SignatureDesign, name: str, folder: str | Path,
