@@ -18,12 +18,16 @@ REFRESH = "run `parksteer derive --prebuilt results/model/*.json` and commit src
 def _effects(spec):
     """The effects of a shipped model's spec: an effects spec, a truth form of the signature benchmark, or a form
     a suggested effect is fitted on (with the default effects, or the effects the spec lists: a baseline's held
-    form under a diagnosis model)."""
+    form under a diagnosis model), or an example effect file with the effects the spec lists."""
     if isinstance(spec, dict) and "shape" in spec:
         from parksteer.diagnose.suggest import shape_forms
 
         form = next(f for f in shape_forms() if f.name == spec["shape"])
         return sorted([*resolve_effects(spec.get("effects")), form], key=lambda e: e.name)
+    if isinstance(spec, dict) and "example" in spec:  # an effect file of the checkout's examples/
+        from parksteer.model.codegen.cache import checkout_root
+
+        return resolve_effects([*spec["effects"], str(checkout_root() / spec["example"])])
     if isinstance(spec, dict):
         from parksteer.experiments.outoflibrary import truth_effects
         from parksteer.synthetic.outoflibrary import form_by_name

@@ -96,6 +96,24 @@ def _suggestion_shape_sets() -> list:
     return [({"shape": form.name}, sorted([*base, form], key=lambda e: e.name)) for form in shape_forms()]
 
 
+def _example_effect_sets() -> list:
+    """(spec, effects) of the models a diagnosis with each effect file of the checkout's examples/user_effect
+    (`--effects=+FILE`) builds, spec ``{"example": the file relative to the checkout, "effects": the other
+    effects}``: the worked examples of docs/signature.md compile them instead of deriving them."""
+    from ..diagnose.candidates import candidate_effects, models_to_build
+    from ..model.codegen.cache import checkout_root
+    from ..model.symbolic.components import resolve_effects
+
+    root = checkout_root()
+    sets = []
+    for path in sorted((root / "examples" / "user_effect").glob("*.py")) if root is not None else []:
+        base = resolve_effects(f"+{path}")
+        example = next(e for e in base if e.name == path.stem)
+        sets += [({"example": path.relative_to(root).as_posix(), "effects": [e.name for e in effects if e is not example]},
+                  effects) for effects in models_to_build(base, candidate_effects(base)[0])]
+    return sets
+
+
 def _signature_truth_sets() -> list:
     """(spec, effects) of the models the signature benchmark makes its records with: the default set and each truth
     form outside the library (parksteer.synthetic.outoflibrary), spec ``{"truth_form": name}``; its jobs then
@@ -257,7 +275,8 @@ def _derive(args) -> int:
             raise UsageError("--prebuilt derives the default diagnosis' models and the manifests' sets: give it no "
                              "--effects or --out")
         sets = [([e.name for e in effects], effects) for effects in default_diagnosis_models()]
-        sets += _assisted_vehicle_sets() + _signature_truth_sets() + _suggestion_shape_sets()
+        sets += (_assisted_vehicle_sets() + _signature_truth_sets() + _suggestion_shape_sets()
+                 + _example_effect_sets())
         for path in args.manifests:
             held = _held_form_sets(path)
             if held is not None:
