@@ -177,10 +177,11 @@ def test_ctrl_c_stops_every_long_subcommand(arguments, outputs, at, tmp_path):
 
 
 def test_ctrl_c_stops_a_derivation(tmp_path):
-    """`parksteer derive` of an effect set nothing has derived (a user's effect, an empty model cache), signalled
-    while sympy derives it: 130, one line, no manifest written and no entry in the cache."""
+    """`parksteer derive` of an effect set nothing has derived (a user's effect in a set the package ships no C for,
+    an empty model cache), signalled while sympy derives it: 130, one line, no manifest written and no entry in the
+    cache."""
     cache = tmp_path / "cache"
-    arguments = ["derive", f"--effects=+{ROOT / 'examples' / 'user_effect' / 'centre_friction.py'}",
+    arguments = ["derive", f"--effects=+{ROOT / 'examples' / 'user_effect' / 'centre_friction.py'},-lifting",
                  "--out", "manifest.json"]
     result = interrupted(arguments, "deriving the model", tmp_path, env={"PARKSTEER_MODEL_CACHE": str(cache)})
     assert_stopped_cleanly(result, tmp_path, ["manifest.json"])
