@@ -15,6 +15,7 @@ from ..model.symbolic.components import (Effect, discover_effects, power_assist_
 from ..parameters import Parameters
 from .baseline_file import identified_parameters
 from .baseline_form import HeldForm, Threshold, vehicle_fingerprint
+from .baseline_share import ShareFreeBasis, refit_in_basis, share_free_fit
 from .calibrate import free_parameter, free_strengths, linear_parameter
 from .fitting import Fit, least_squares, polish
 from .engine import ReplayEngine
@@ -46,10 +47,13 @@ def _estimates(fit: Fit, problem: Problem, settings: DiagnosisSettings, keys, so
             for k in chosen}
 
 
-def held_form(diagnosis, settings: DiagnosisSettings, say) -> tuple[HeldForm | None, Fit, Problem]:
+def held_form(diagnosis, settings: DiagnosisSettings, say) -> tuple[HeldForm | None, Fit, Problem,
+                                                                    ShareFreeBasis | None]:
     """What the healthy records have that the model lacks, with the fit it was read from: nothing where the
     absolute verdict is adequate; the named candidate at its fitted strength; or the form the residual's signature
-    points to with its strengths fitted with the calibrated parameters (:func:`parksteer.diagnose.suggest.suggest`)."""
+    points to (:func:`parksteer.diagnose.suggest.suggest`) with its strengths fitted with the calibrated parameters,
+    confined to the directions that take no share of what a calibrated value carries
+    (:func:`parksteer.diagnose.baseline_share.share_free_fit`), and that confinement."""
     from .signature import COLUMN_CLASSES
     from .suggest import suggest
 
@@ -59,22 +63,24 @@ def held_form(diagnosis, settings: DiagnosisSettings, say) -> tuple[HeldForm | N
         key = best.signature.key
         strengths = _estimates(best.refit, problem, settings, [key],
                                f"fitted with the calibrated parameters on {labels} (the absolute diagnosis)")
-        return HeldForm("candidate", best.name, strengths), best.refit, problem
+        return HeldForm("candidate", best.name, strengths), best.refit, problem, None
     signature = diagnosis.outputs.get("signature")
     if diagnosis.verdict != "unexplained" or signature is None or signature.effect_class is None:
-        return None, diagnosis.calibration, problem
+        return None, diagnosis.calibration, problem, None
     say(f"baseline: the form the residual's signature points to ({signature.effect_class}), its strengths fitted")
-    found = suggest(problem, diagnosis.calibration, signature, None, settings)
+    found = suggest(problem, diagnosis.calibration, signature, None, settings)  # the form and its knots' places
     shape = next(e for e in found.fit.effects if e.name.startswith("shape_"))
     free = [q.key for q in shape.quantities if q.free]
     places = {k: float(v) for k, v in found.fit.fixed.items() if k.startswith(shape.name + ".") and k not in free}
-    strengths = _estimates(found.fit, problem, settings, free,
-                           f"fitted with the calibrated parameters on {labels} (the signature's form)")
+    fit, share = share_free_fit(problem, diagnosis.calibration, shape, places, free, settings)
+    strengths = _estimates(fit, problem, settings, free,
+                           f"fitted with the calibrated parameters on {labels} (the signature's form), in the "
+                           "directions orthogonal to every calibrated value's sensitivity")
     kind, best = signature.effect_class, signature.best
     column = kind in COLUMN_CLASSES
     form = HeldForm("signature", shape.name, strengths, places, kind, 0 if column else len(best.knots),
                     tuple(best.orders) if column else (), signature.sentence)
-    return form, found.fit, problem
+    return form, fit, problem, share
 
 
 def _parts(files) -> tuple[str, list[tuple[list[FileData], FileData]]]:
@@ -125,10 +131,11 @@ def _best_of(candidate) -> dict:
 
 
 def refit_form(form: HeldForm, train, params: Parameters, model: list[Effect], start: dict,
-               settings: DiagnosisSettings) -> HeldForm:
+               settings: DiagnosisSettings, share: ShareFreeBasis | None = None) -> HeldForm:
     """The form's strengths fitted again on the records `train` alone (samples weighted out of them,
     :func:`left_out`, take no part), the car's calibrated parameters held at `start` (the healthy records'
-    calibration). Refitted together with them on a part, a form's strengths trade with the base parameters along
+    calibration), and within `share`'s directions where the form was learnt in them (:func:`held_form`).
+    Refitted together with them on a part, a form's strengths trade with the base parameters along
     the valley where the two give one torque (knots of rack friction summing to the calibrated one), and each part
     lands elsewhere along it: the parts' spread is then that trade's, which a later record, judged with the
     strengths and the calibration held, never sees."""
@@ -143,6 +150,10 @@ def refit_form(form: HeldForm, train, params: Parameters, model: list[Effect], s
     values = {**start, **form.values}
     theta0 = np.array([p.theta(values[p.key]) for p in parameters])
     fixed = {k: v for k, v in start.items() if k not in form.strengths}
+    if share is not None and form.source == "signature":
+        fitted = refit_in_basis(engine, problem, model, share, values, fixed, parameters[0].step, settings)
+        return dataclasses.replace(form, strengths={k: {**v, "value": float(fitted.get(k, v["value"]))}
+                                                    for k, v in form.strengths.items()})
     fit = least_squares(engine, problem, model, parameters, theta0, fixed, settings=settings,
                         refresh_at_end=not settings.calibration_polished)
     if settings.calibration_polished:
@@ -216,7 +227,7 @@ def blocks_of(f: FileData, block_s: float) -> int:
 
 
 def _folds(make, f: FileData, params: Parameters, base: list[Effect], registry, form: HeldForm | None, start: dict,
-           settings: DiagnosisSettings, workers: int, say) -> Threshold:
+           settings: DiagnosisSettings, workers: int, say, share: ShareFreeBasis | None = None) -> Threshold:
     """One healthy record's threshold, out of sample: each block of :attr:`DiagnosisSettings.interval_block_s` a fold
     (:func:`fold_of`), judged with the form fitted on the others (the record replayed whole, the block weighted out
     of the fit: :func:`left_out`) held, and the calibrated values of the whole record, as a later record is; the
@@ -230,7 +241,7 @@ def _folds(make, f: FileData, params: Parameters, base: list[Effect], registry, 
         label = f"{f.label} (block {k + 1} of {folds})"
         if form is not None:  # nothing held: every block is read off the one diagnosis of the record
             say(f"baseline: {label} against the form fitted on the other blocks")
-            held = refit_form(form, [left_out(f, fold == k)], params, model, start, settings)
+            held = refit_form(form, [left_out(f, fold == k)], params, model, start, settings, share)
             found = _judged(make, [f], params, base, registry, held, [f], start, settings, workers)
         elif found is None:
             say(f"baseline: the {folds} blocks of {f.label}, nothing held")
@@ -245,11 +256,11 @@ def _folds(make, f: FileData, params: Parameters, base: list[Effect], registry, 
 
 
 def spread(make, files, params: Parameters, base: list[Effect], registry, form: HeldForm | None, start: dict,
-           settings: DiagnosisSettings, workers: int, say) -> Threshold:
+           settings: DiagnosisSettings, workers: int, say, share: ShareFreeBasis | None = None) -> Threshold:
     """The threshold of "as the baseline" from the healthy parts (module docstring of
     :mod:`parksteer.diagnose.baseline`)."""
     if len(files) == 1:
-        return _folds(make, files[0], params, base, registry, form, start, settings, workers, say)
+        return _folds(make, files[0], params, base, registry, form, start, settings, workers, say, share)
     method, parts = _parts(files)
     rows = []
     for train, judged in parts:
@@ -257,7 +268,7 @@ def spread(make, files, params: Parameters, base: list[Effect], registry, form: 
         held = form
         if form is not None:
             model = sorted([*base, form.model_effect(registry)], key=lambda e: e.name)
-            held = refit_form(form, train, params, model, start, settings)
+            held = refit_form(form, train, params, model, start, settings, share)
         found = _judged(make, [judged], params, base, registry, held, train, start, settings, workers)
         n = found.problem.n
         rows.append({"part": judged.label, "samples": int(n), "over_floor": math.sqrt(found.calibration.rss / n),
@@ -288,14 +299,14 @@ def learn(make, files, params: Parameters, effects=None, settings: DiagnosisSett
             params = identified_parameters(identified)
     say(f"baseline: the absolute diagnosis of {len(files)} healthy record(s)")
     absolute = diagnose(files, params, base, registry, settings=settings, workers=workers, quiet=progress is None)
-    form, fit, problem = held_form(absolute, settings, say)
+    form, fit, problem, share = held_form(absolute, settings, say)
     held = set(form.strengths) if form is not None else set()
     keys = [p.key for p in absolute.calibration.parameters if p.key not in held]
     labels = ", ".join(f.label for f in files)
     calibrated = _estimates(fit, problem, settings, keys, f"calibrated on {labels}"
                             + (f" with {form.effect}" if form is not None else ""))
     start = {k: v["value"] for k, v in calibrated.items()}
-    threshold = spread(make, files, params, base, registry, form, start, settings, workers, say)
+    threshold = spread(make, files, params, base, registry, form, start, settings, workers, say, share)
     say(f"baseline: as the baseline up to {threshold.over_floor:.2f} noise floors and a BIC gain of "
         f"{threshold.bic_per_sample:.4f} per sample ({threshold.method.split(':')[0]})")
     return make(None if vehicle is None else str(vehicle), fingerprint, tuple(f.label for f in files),
