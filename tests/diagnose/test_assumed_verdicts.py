@@ -139,3 +139,26 @@ def test_the_band_ends_replayed_in_workers_give_the_table_of_one_process(capsys)
         before = by_stage[stages[stages.index("assumed") - 1]]
         assert by_stage["assumed"] - before == 4 * len(table["quantities"])
     assert out[2]["cost"]["replays"] == out[1]["cost"]["replays"]
+
+
+# --- against a baseline: a calibrated value that changed, by the headline's rule for it -------------------------
+
+def test_a_changed_value_at_an_end_is_judged_by_its_interval_against_the_baselines_value():
+    """A library strength is absent at 0: named only above 0 with its interval clear of 0. A calibrated value freed
+    against a baseline (``changed:<key>``, fitted in its logarithm from the baseline's value, or as it stands from
+    it for an angle) is absent at the baseline's value: it may be named where its interval leaves that value out,
+    grown or shrunk, as the headline rule of diagnose/baseline_changed.py, never because it is far from 0."""
+    from parksteer.diagnose.fitting import FitParameter
+    from parksteer.diagnose.stages.assumed import clear_of_absence
+
+    strength = FitParameter("column_friction.friction_torque", "linear", 1.0, 0.0, 5.0, 1e-3)
+    assert clear_of_absence(strength, 0.05, 0.03, True)
+    assert not clear_of_absence(strength, 0.02, 0.03, True) and clear_of_absence(strength, 0.02, 0.03, False)
+    grown = FitParameter("steering.rack_friction_force", "log", 750.0, 375.0, 1500.0, 0.03)
+    assert clear_of_absence(grown, 0.05, 0.03, True) and clear_of_absence(grown, -0.05, 0.03, True)
+    assert not clear_of_absence(grown, 0.02, 0.03, True)  # 766 N: its interval holds the baseline's 750 N
+    phase = FitParameter("steering.hooke_joint_phase", "offset", 0.4, -1.17, 1.97, 0.05)
+    assert clear_of_absence(phase, 0.45, 0.03, True) and not clear_of_absence(phase, 0.42, 0.03, True)
+    why = end_reason(_end("unexplained", 3.0, 40.0, "changed:steering.rack_friction_force", False, 1.0, 1.0), S,
+                     "the baseline's value")
+    assert "changed:steering.rack_friction_force's interval here holds the baseline's value" in why

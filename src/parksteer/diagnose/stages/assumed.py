@@ -5,7 +5,8 @@ provenance, or no entry: ``Parameters.provenance``) and that the model uses, thi
 with it at each end of its band (:data:`BANDS`: the range the quantity's own source gives): the calibrated model
 and the best candidate's refit replayed with the value moved, their residuals refitted to first order on the fit's
 Jacobian, and :func:`~parksteer.diagnose.stages.verdict.choose_verdict` applied by the headline's rule
-(:func:`~parksteer.diagnose.stages.select.may_headline`); each end says why (:func:`end_reason`). A quantity whose
+(:func:`~parksteer.diagnose.stages.select.may_headline`; against a baseline, a calibrated value that changed by its
+interval against the baseline's value: :func:`clear_of_absence`); each end says why (:func:`end_reason`). A quantity whose
 band's end changes the verdict decides it, and the report says so with how far the calibrated fit moves (noise
 floors). Where ``parksteer assist identify`` fixed the product k_t eta_f N, the efficiency and the reduction move
 with that product held (:func:`moved`). Four replays a quantity, none for a car without an assist (the ends'
@@ -119,10 +120,23 @@ def _refitted_rss(fit, problem, moved: list[np.ndarray]) -> tuple[float, np.ndar
     return float(weighted @ weighted), weighted, theta
 
 
-def end_reason(end: dict, settings) -> str:
+def clear_of_absence(parameter, theta: float, half: float, interval_rule: bool) -> bool:
+    """The headline's condition on a candidate at a band end (stages/select.py, ``may_headline``; against a
+    baseline, diagnose/baseline_changed.py): a library strength, fitted as it stands, is absent at 0, so it must be
+    above 0 and, with `interval_rule`, its 95 % interval (`theta` +- `half`) clear of 0; a calibrated value freed
+    against a baseline, fitted from the baseline's value (in its logarithm, theta 0 there, or as it stands from
+    it), is absent at that value, and its interval must leave it out."""
+    if parameter.transform == "linear":
+        return bool(theta > 0.0 and (theta - half > 0.0 or not interval_rule))
+    absent = parameter.reference if parameter.transform == "offset" else 0.0
+    return bool(theta != absent and (abs(theta - absent) > half or not interval_rule))
+
+
+def end_reason(end: dict, settings, absent: str = "0") -> str:
     """Why the rule gives an end's verdict (:func:`~parksteer.diagnose.stages.verdict.choose_verdict`, with the
-    headline's condition that a named candidate's strength is above 0 and its interval clear of 0): the
-    thresholds each figure was held against, so that an end that is not adequate says why."""
+    headline's condition that a named candidate is clear of its absence, :func:`clear_of_absence`: `absent` says
+    where that is, 0 or the baseline's value): the thresholds each figure was held against, so that an end that
+    is not adequate says why."""
     over, gain, name = end["calibrated_over_floor"], end["delta_bic"], end["candidate"]
     base = (f"the calibrated model {over:.3g} noise floors, "
             + ("within" if over <= settings.adequate_rms_factor else "above")
@@ -131,7 +145,8 @@ def end_reason(end: dict, settings) -> str:
         return (f"{name} evidenced (BIC gain {gain:.3g} > {settings.bic_missing_threshold:g}), "
                 f"{end['after_over_floor']:.3g} floors with it")
     if name is not None and not end["candidate_clear_of_zero"]:
-        candidate = f"{name}'s strength here holds 0, so it may not be named"
+        candidate = (f"{name}'s strength here holds 0, so it may not be named" if absent == "0" else
+                     f"{name}'s interval here holds {absent}, so it may not be named")
     elif gain is None or gain <= settings.bic_missing_threshold:
         candidate = ("no candidate evidenced" if gain is None else
                      f"{name} not evidenced (BIC gain {gain:.3g}, {settings.bic_missing_threshold:g} needed)")
@@ -163,6 +178,8 @@ class AssumedValues(Stage):
 
         strength_key = best.signature.key if best is not None else None
         strength_index = None if refit is None else [p.key for p in refit.parameters].index(strength_key)
+        parameter = None if refit is None else refit.parameters[strength_index]
+        absent = "0" if parameter is None or parameter.transform == "linear" else "the baseline's value"
         quantities = assumed_quantities(problem.params, effect.name, effect, settings.calibrated_parameters)
 
         def replayed(item: tuple[str, float] | None):
@@ -178,12 +195,12 @@ class AssumedValues(Stage):
         # spreads its files), the first-order refits below in this process, in the table's order
         items = ([None] if refit is not None else []) + [(key, end) for key, _, _, band in quantities for end in band]
         predicted = iter(engine.in_workers(problem, replayed, items, False))
-        # the candidate's 95 % half-width as it stands: moving an assumed value shifts its strength, to first order
-        # not its spread
+        # the candidate's 95 % half-width as it stands, in its fitted variable (a freed calibrated value's in its
+        # logarithm): moving an assumed value shifts its strength, to first order not its spread
         halfwidth = None
         if refit is not None:
             low, high = next(predicted)
-            halfwidth = (high - low) / 2.0
+            halfwidth = (parameter.theta(high) - parameter.theta(low)) / 2.0
 
         def verdict_of(base_rss: float, with_fit: tuple[float, np.ndarray, np.ndarray] | None) -> dict:
             """The verdict by the headline's rule: choose_verdict, with a candidate that may be named only while its
@@ -192,9 +209,8 @@ class AssumedValues(Stage):
             clear = None
             if with_fit is not None:
                 with_rss, with_weighted, theta = with_fit
-                strength = float(theta[strength_index])
-                clear = bool(strength > 0.0 and (strength - halfwidth > 0.0
-                                                 or not settings.headline_interval_clear_of_zero))
+                clear = clear_of_absence(parameter, float(theta[strength_index]), halfwidth,
+                                         settings.headline_interval_clear_of_zero)
                 delta_bic = bic_gain(base_rss, with_rss, state.n_eff or n, 1)
                 after = math.sqrt(with_rss / n)
                 spread = trimmed_rms(with_weighted, settings.missing_ceiling_trim)
@@ -204,7 +220,7 @@ class AssumedValues(Stage):
             end = {"calibrated_over_floor": math.sqrt(base_rss / n), "delta_bic": delta_bic, "verdict": verdict,
                    "candidate": best.name if best is not None else None, "candidate_clear_of_zero": clear,
                    "after_over_floor": after, "spread_over_floor": spread}
-            end["why"] = end_reason(end, settings)
+            end["why"] = end_reason(end, settings, absent)
             return end
 
         # the same rule on the fits as they stand: the reference the moved values are held against
