@@ -3,7 +3,8 @@
 :func:`learn_baseline` learns from a car's healthy records its calibrated parameters with their 95 % intervals
 (:meth:`parksteer.diagnose.fitting.Fit.intervals`), what the healthy car has that the model lacks
 (:class:`HeldForm`: the named library candidate at its fitted strength, or the form the residual's signature
-points to, :func:`parksteer.diagnose.suggest.suggest`), and how far apart healthy data are (:class:`Threshold`,
+points to, :func:`parksteer.diagnose.suggest.suggest`, its strengths fitted only where no calibrated value can carry
+them, :mod:`parksteer.diagnose.baseline_share`), and how far apart healthy data are (:class:`Threshold`,
 out of sample: leave one record out, or with one record each of its 2 s blocks left out; the one-sided 95 %
 prediction bound, in noise floors, for one more healthy record). A later record is diagnosed
 (``diagnose(..., baseline=...)``) with the form's strengths and the car's calibrated values held at the baseline's
