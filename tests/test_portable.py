@@ -171,6 +171,27 @@ def test_generalised_inverse_and_semidefinite_factor():
     assert np.allclose(pm.solve_tridiagonal(lower, diagonal, upper, dense @ x), x, rtol=1e-9, atol=1e-9)
 
 
+def test_symmetric_eigen_diagonalizes_with_orthonormal_vectors():
+    """A V = V diag(w) with V^T V = I and w descending, the eigenvalues those of the characteristic polynomial
+    (numpy's LAPACK as the reference); a known spectrum is recovered (Q diag(d) Q^T); a diagonal matrix is its
+    own answer; a repeated eigenvalue still gives orthonormal vectors."""
+    rng = np.random.default_rng(11)
+    for n in (1, 2, 5, 12):
+        x = rng.normal(size=(n, n))
+        a = x + x.T
+        w, v = pm.symmetric_eigen(a)
+        assert np.all(np.diff(w) <= 0.0)
+        assert np.allclose(a @ v, v * w, atol=1e-12 * np.abs(a).max())
+        assert np.allclose(v.T @ v, np.eye(n), atol=1e-13)
+        assert np.allclose(w, np.linalg.eigvalsh(a)[::-1], atol=1e-12 * np.abs(a).max())
+    q, _ = np.linalg.qr(rng.normal(size=(6, 6)))
+    spectrum = np.array([7.0, 3.0, 3.0, 1.0, 0.0, -2.0])
+    w, v = pm.symmetric_eigen(q @ np.diag(spectrum) @ q.T)
+    assert np.allclose(w, spectrum, atol=1e-12) and np.allclose(v.T @ v, np.eye(6), atol=1e-13)
+    w, v = pm.symmetric_eigen(np.diag([1.0, 4.0, 2.0]))
+    assert np.array_equal(w, [4.0, 2.0, 1.0]) and np.array_equal(np.abs(v), np.eye(3)[:, [1, 2, 0]])
+
+
 @pytest.mark.parametrize("order", [1, 2, 3, 4])
 def test_butterworth_response(order):
     """|H| = 1 at DC and 1/sqrt(2) at the cutoff (the -3 dB point), monotonic between: Butterworth's definition."""
@@ -238,7 +259,7 @@ x = rng.uniform(-20.0, 20.0, 20000)
 a = rng.normal(size=(300, 9))
 parts = [pm.sin(x), pm.cos(x), pm.atan(x), pm.exp(x), pm.tanh(x), pm.log(np.abs(x)), pm.power(np.abs(x), 1.7),
          pm.matmul(a.T, a), pm.solve(pm.matmul(a.T, a), pm.matmul(a.T, x[:300])), pm.lstsq(a, x[:300]),
-         pm.qr(a)[0], pm.inv(pm.matmul(a.T, a)), pm.norm(a, axis=0),
+         pm.qr(a)[0], pm.inv(pm.matmul(a.T, a)), pm.norm(a, axis=0), *pm.symmetric_eigen(pm.matmul(a.T, a)),
          pm.butterworth_lowpass_sos(4, 30.0, 1000.0), pm.hamming_lowpass_fir(41, 0.2),
          pm.fir_decimate(x, pm.hamming_lowpass_fir(101, 0.2), 5), pm.running_median(x, 21), pm.running_max3(x)]
 print(hashlib.sha256(b"".join(np.ascontiguousarray(p).tobytes() for p in parts)).hexdigest())

@@ -52,7 +52,7 @@ def held_form(diagnosis, settings: DiagnosisSettings, say) -> tuple[HeldForm | N
     """What the healthy records have that the model lacks, with the fit it was read from: nothing where the
     absolute verdict is adequate; the named candidate at its fitted strength; or the form the residual's signature
     points to (:func:`parksteer.diagnose.suggest.suggest`) with its strengths fitted with the calibrated parameters,
-    confined to the directions that take no share of what a calibrated value carries
+    confined to the directions the calibrated values do not carry
     (:func:`parksteer.diagnose.baseline_share.share_free_fit`), and that confinement."""
     from .signature import COLUMN_CLASSES
     from .suggest import suggest
@@ -75,7 +75,7 @@ def held_form(diagnosis, settings: DiagnosisSettings, say) -> tuple[HeldForm | N
     fit, share = share_free_fit(problem, diagnosis.calibration, shape, places, free, settings)
     strengths = _estimates(fit, problem, settings, free,
                            f"fitted with the calibrated parameters on {labels} (the signature's form), in the "
-                           "directions orthogonal to every calibrated value's sensitivity")
+                           "directions whose torque the calibrated values reproduce for at most half")
     kind, best = signature.effect_class, signature.best
     column = kind in COLUMN_CLASSES
     form = HeldForm("signature", shape.name, strengths, places, kind, 0 if column else len(best.knots),

@@ -5,13 +5,15 @@ the car's calibrated values it can take over part of what one of them carries: k
 uniform force are a Coulomb rack friction, and the healthy record fixes only their sum. The split is then the fit's
 accident (on the baseline benchmark's Dahl-tyre car the calibrated rack friction came out well under the car's,
 the knots carrying the rest), and a later record, judged with both held, meets a friction shaped by the knots where
-the car has a uniform one. So the baseline fits the form's strengths only in the directions whose torque is
-orthogonal, on the healthy records, to every calibrated value's sensitivity: ``C s = 0`` with ``C = J_c^T J_s``
-(weighted sensitivities, taken at the calibration with the form absent). To first order the calibrated values are
-then those the healthy records give without the form, and the form carries only what none of them can; for a
-friction of knots, the uniform part (their mean) is the rack friction's.
+the car has a uniform one. So the baseline ranks the form's strength directions by the share of their weighted
+torque, on the healthy records, that the calibrated values' sensitivities reproduce (:func:`carried_shares`, taken
+at the calibration with the form absent), and fits the strengths only in the directions of share at most one half:
+a direction the calibration reproduces more of than it leaves is the calibration's to carry. For a friction of
+knots against a Coulomb rack friction alone, the uniform part (their mean) has share 1 and the rest share 0. Confining every
+direction with any share at all (``C s = 0``, ``C = J_c^T J_s``) would leave a form of few knots hardly a direction
+to fit in: each knot's torque correlates a little with some calibrated value's.
 
-The strengths are fitted in coordinates of that subspace, ``s = s_0 + F z`` (F a basis of the null space of C):
+The strengths are fitted in coordinates of that subspace, ``s = s_0 + F z`` (F a basis of the free directions):
 :class:`CoordinateEngine` turns the coordinates into strengths for the replay, so the fitter is the calibration's
 own (:func:`parksteer.diagnose.fitting.least_squares`, :func:`~parksteer.diagnose.fitting.polish`)."""
 
@@ -29,13 +31,12 @@ from .problem import Problem
 from .settings import DiagnosisSettings
 
 COORDINATE = "baseline_share.z"  # the coordinates' keys: COORDINATE + index; never a model quantity
-NULL_RCOND = 1e-9  # a null-space direction of C: its projector's pivot above this fraction of the largest
 
 
 @dataclasses.dataclass(frozen=True)
 class ShareFreeBasis:
-    """Strengths `keys` confined to ``s = origin + basis @ z``: `basis` (K x m) spans the directions whose torque is
-    orthogonal to each calibrated value's sensitivity; `calibrated` names those values."""
+    """Strengths `keys` confined to ``s = origin + basis @ z``: `basis` (K x m) spans the directions whose torque the
+    calibrated values reproduce for at most CARRIED_SHARE; `calibrated` names those values."""
 
     keys: tuple[str, ...]
     basis: np.ndarray
@@ -45,24 +46,49 @@ class ShareFreeBasis:
         return origin + pm.matmul(self.basis, z)
 
 
-def null_basis(constraints: np.ndarray) -> np.ndarray:
-    """A basis (K x m) of the vectors s with ``constraints @ s = 0`` (rows scaled to unit length first; a row of
-    zeros constrains nothing): the factor of the projector ``I - C^T (C C^T)^- C``."""
-    rows = np.asarray(constraints, dtype=float)
-    k = rows.shape[1]
-    lengths = pm.norm(rows, axis=1)
-    rows = rows[lengths > 0.0] / lengths[lengths > 0.0][:, None]
-    if rows.shape[0] == 0:
-        return np.eye(k)
-    projector = np.eye(k) - pm.matmul(rows.T, pm.matmul(pm.generalized_inverse(pm.matmul(rows, rows.T)), rows))
-    return pm.psd_factor((projector + projector.T) / 2.0, NULL_RCOND)
+CARRIED_SHARE = 0.5  # confine a direction whose torque the calibrated values reproduce more of than the form
+
+
+def carried_shares(jacobian: np.ndarray, calibrated: list[int], strengths: list[int]) -> tuple[np.ndarray,
+                                                                                                  np.ndarray]:
+    """The form's strength directions ranked by the share of their weighted torque that the calibrated values'
+    sensitivities reproduce: the generalized eigenproblem ``J_s^T P_c J_s v = share J_s^T J_s v`` (P_c the
+    projector on the calibrated columns), solved as a symmetric one through the Cholesky factor of ``J_s^T J_s``
+    (columns scaled to unit length first). Returns the shares (descending, each in [0, 1]) and the directions
+    (columns, in the strengths' own units). A strength that moves no torque is left out (share 0, its own axis)."""
+    strength_columns = np.asarray(jacobian, dtype=float)[:, strengths]
+    calibrated_columns = np.asarray(jacobian, dtype=float)[:, calibrated]
+    k = strength_columns.shape[1]
+    lengths = pm.norm(strength_columns, axis=0)
+    moving = np.flatnonzero(lengths > 0.0)
+    unit = strength_columns[:, moving] / lengths[moving]
+    shares, directions = np.zeros(k), np.zeros((k, k))
+    still = np.setdiff1d(np.arange(k), moving)
+    directions[still, len(moving) + np.arange(len(still))] = 1.0
+    if len(moving) == 0:
+        return shares, directions
+    c_lengths = pm.norm(calibrated_columns, axis=0)
+    c_unit = calibrated_columns[:, c_lengths > 0.0] / c_lengths[c_lengths > 0.0]
+    cross = pm.matmul(c_unit.T, unit)  # C = J_c^T J_s
+    carried = pm.matmul(cross.T, pm.matmul(pm.generalized_inverse(pm.matmul(c_unit.T, c_unit)), cross))
+    low = pm.cholesky(pm.matmul(unit.T, unit))
+    half = pm.solve(low, carried)  # L^-1 A
+    reduced = pm.solve(low, half.T)  # L^-1 A L^-T
+    values, vectors = pm.symmetric_eigen((reduced + reduced.T) / 2.0)
+    shares[:len(moving)] = np.clip(values, 0.0, 1.0)
+    directions[moving, :len(moving)] = pm.solve(low.T, vectors) / lengths[moving][:, None]
+    return shares, directions
 
 
 def share_free_basis(jacobian: np.ndarray, calibrated: list[int], strengths: list[int], keys: list[str],
                      names: list[str]) -> ShareFreeBasis:
-    """The basis of the strengths' share-free directions from a Jacobian (columns `calibrated` and `strengths`)."""
-    constraints = pm.matmul(jacobian[:, calibrated].T, jacobian[:, strengths])
-    return ShareFreeBasis(tuple(keys), null_basis(constraints), tuple(names))
+    """The strengths' free directions from a Jacobian (columns `calibrated` and `strengths`): those of
+    :func:`carried_shares` whose torque the calibrated values reproduce for at most CARRIED_SHARE, each scaled to
+    unit length (their torques orthogonal to every confined direction's)."""
+    shares, directions = carried_shares(jacobian, calibrated, strengths)
+    free = directions[:, shares <= CARRIED_SHARE]
+    lengths = pm.norm(free, axis=0)
+    return ShareFreeBasis(tuple(keys), free / np.where(lengths > 0.0, lengths, 1.0), tuple(names))
 
 
 class CoordinateEngine:
@@ -119,8 +145,7 @@ def _in_strengths(engine: ReplayEngine, problem: Problem, fit: Fit, share: Share
 def share_free_fit(problem: Problem, calibration: Fit, shape, places: dict, keys: list[str],
                    settings: DiagnosisSettings) -> tuple[Fit, ShareFreeBasis]:
     """The form `shape` (its knots `places`, its strengths `keys`) fitted with the calibrated parameters of
-    `calibration`, its strengths confined to the directions orthogonal to every calibrated value's sensitivity (the
-    module docstring); from the calibration and zero strengths. Returns the fit, written in the strengths, and the
+    `calibration`, its strengths confined to the directions the calibration does not carry (the module docstring); from the calibration and zero strengths. Returns the fit, written in the strengths, and the
     basis."""
     from .statistics import fit_statistics
 
@@ -153,7 +178,7 @@ def share_free_fit(problem: Problem, calibration: Fit, shape, places: dict, keys
 
 def refit_in_basis(engine: ReplayEngine, problem: Problem, model, share: ShareFreeBasis, origin: dict[str, float],
                    fixed: dict[str, float], step: float, settings: DiagnosisSettings) -> dict[str, float]:
-    """The strengths refitted on `problem` within the share-free directions from `origin` (the calibrated values
+    """The strengths refitted on `problem` within the free directions from `origin` (the calibrated values
     and the form's places held in `fixed`): the fitted strengths."""
     start = np.array([origin[k] for k in share.keys])
     proxy = CoordinateEngine(engine, share, start)

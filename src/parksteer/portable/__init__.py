@@ -7,7 +7,8 @@ IEEE 754 fixes exactly (elementwise +, -, *, /, sqrt, floor, frexp, ldexp, and `
 depends on the shape alone), so the same inputs give the same bits on any machine:
 
 - linear algebra for systems of up to a few hundred unknowns: :func:`dot`, :func:`matmul`, :func:`norm`,
-  :func:`solve`, :func:`inv`, :func:`cholesky`, :func:`lstsq`, :func:`qr` (LAPACK's algorithms written out);
+  :func:`solve`, :func:`inv`, :func:`cholesky`, :func:`lstsq`, :func:`qr` (LAPACK's algorithms written out),
+  :func:`symmetric_eigen` (cyclic Jacobi);
 - elementary functions :func:`sin`, :func:`cos`, :func:`tan`, :func:`atan`, :func:`atan2`, :func:`exp`,
   :func:`expm1`, :func:`tanh`, :func:`log`, :func:`power`, :func:`hypot`: fdlibm's algorithms, mirroring the C of
   ``model/codegen/portable_math.c`` to the bit (``tests/test_portable.py``), each within about one ulp;
@@ -42,10 +43,11 @@ from .linalg import (
     qr,
     solve,
     solve_tridiagonal,
+    symmetric_eigen,
 )
 
 __all__ = ["LinAlgError", "dot", "matmul", "norm", "solve", "inv", "cholesky", "lstsq", "qr", "inv_spd_batched",
-           "generalized_inverse", "psd_factor", "solve_tridiagonal",
+           "generalized_inverse", "psd_factor", "solve_tridiagonal", "symmetric_eigen",
            "sin", "cos", "tan", "atan", "atan2", "exp", "expm1", "tanh", "log", "power", "hypot",
            "butterworth_lowpass_sos", "sos_steady_state", "hamming_lowpass_fir", "fir_decimate",
            "running_median", "running_max3"]

@@ -208,6 +208,39 @@ def psd_factor(a, rcond: float = 1e-12) -> np.ndarray:
     return factor[:, :rank]
 
 
+def symmetric_eigen(a, max_sweeps: int = 64) -> tuple[np.ndarray, np.ndarray]:
+    """Eigenvalues (descending) and orthonormal eigenvectors (columns) of a symmetric matrix: cyclic Jacobi
+    rotations, pairs (p, q) in row order, until the off-diagonal part is below 1e-30 of the whole in squares (or
+    `max_sweeps` sweeps; a sweep at least squares the off-diagonal part once it is small)."""
+    work = np.array(a, dtype=float)
+    work = (work + work.T) / 2.0
+    n = work.shape[0]
+    vectors = np.eye(n)
+    whole = float(np.sum(np.square(work)))
+    for _ in range(max_sweeps):
+        off = float(np.sum(np.square(work - np.diag(np.diagonal(work)))))
+        if not off > 1e-30 * whole:
+            break
+        for p in range(n - 1):
+            for q in range(p + 1, n):
+                if work[p, q] == 0.0:
+                    continue
+                theta = (work[q, q] - work[p, p]) / (2.0 * work[p, q])
+                t = 1.0 / (abs(theta) + np.sqrt(theta * theta + 1.0))
+                t = -t if theta < 0.0 else t
+                c = 1.0 / np.sqrt(t * t + 1.0)
+                s = t * c
+                for m in (work, vectors):
+                    mp, mq = m[:, p].copy(), m[:, q].copy()
+                    m[:, p], m[:, q] = c * mp - s * mq, s * mp + c * mq
+                rp, rq = work[p, :].copy(), work[q, :].copy()
+                work[p, :], work[q, :] = c * rp - s * rq, s * rp + c * rq
+                work[p, q] = work[q, p] = 0.0
+    values = np.diagonal(work).copy()
+    order = np.argsort(-values, kind="stable")
+    return values[order], vectors[:, order]
+
+
 def solve_tridiagonal(lower, diagonal, upper, rhs) -> np.ndarray:
     """x with A x = rhs for tridiagonal A (``lower[i]`` = A[i+1, i], ``upper[i]`` = A[i, i+1]): Gaussian
     elimination with partial pivoting, as LAPACK's dgtsv (a row swap makes a second superdiagonal)."""
