@@ -3,15 +3,14 @@
 The signature's form (:func:`parksteer.diagnose.suggest.suggest`) is a sum of knot strengths; fitted together with
 the car's calibrated values it can take over part of what one of them carries: knots of rack friction summing to a
 uniform force are a Coulomb rack friction, and the healthy record fixes only their sum. The split is then the fit's
-accident (on the baseline benchmark's Dahl-tyre car the calibrated rack friction came out well under the car's,
-the knots carrying the rest), and a later record, judged with both held, meets a friction shaped by the knots where
-the car has a uniform one. So the baseline ranks the form's strength directions by the share of their weighted
-torque, on the healthy records, that the calibrated values' sensitivities reproduce (:func:`carried_shares`, taken
-at the calibration with the form absent), and fits the strengths only in the directions of share at most one half:
-a direction the calibration reproduces more of than it leaves is the calibration's to carry. For a friction of
-knots against a Coulomb rack friction alone, the uniform part (their mean) has share 1 and the rest share 0. Confining every
-direction with any share at all (``C s = 0``, ``C = J_c^T J_s``) would leave a form of few knots hardly a direction
-to fit in: each knot's torque correlates a little with some calibrated value's.
+accident, and a later record, judged with both held, meets a friction shaped by the knots where the car has a
+uniform one. So the baseline ranks the form's strength directions by the share of their weighted torque, on the
+healthy records, that the calibrated values' sensitivities reproduce (:func:`carried_shares`, at the calibration
+with the form absent), and fits the strengths only in the directions of share at most one half: a direction the
+calibration reproduces more of than it leaves is the calibration's. For knots against a Coulomb rack friction
+alone, their mean has share 1 and the rest share 0. Confining every direction with any share (``C s = 0``,
+``C = J_c^T J_s``) would leave a form of few knots hardly a direction: each knot's torque correlates a little with
+some calibrated value's.
 
 The strengths are fitted in coordinates of that subspace, ``s = s_0 + F z`` (F a basis of the free directions):
 :class:`CoordinateEngine` turns the coordinates into strengths for the replay, so the fitter is the calibration's
