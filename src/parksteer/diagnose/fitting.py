@@ -194,9 +194,7 @@ def exact_jacobian(engine: ReplayEngine, problem: Problem, effects: list[Effect]
             up = replay.parameter_vector({**overrides, key: value + h})[1]
             down = replay.parameter_vector({**overrides, key: value - h})[1]
             directions[k] = (up - down)[: directions.shape[1]] / (2.0 * h)
-        replay.evaluations += 1
-        if replay.counter is not None:
-            replay.counter.solves += 1
+        replay.count_solve()
         solution = solve_sensitivities(run, p_vector, replay.rack, replay.time_s, directions)
         blocks.append(solution.torque_sensitivities * per_theta / np.asarray(f.sigma, dtype=float).reshape(-1, 1))
     return np.vstack(blocks)

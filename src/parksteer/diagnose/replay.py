@@ -166,13 +166,17 @@ class Replay:
         (:func:`parksteer.model.numeric.assisted.solve_assisted`), its torque the torsion bar's."""
         return power_assist_of(self._base.effects) is not None
 
+    def count_solve(self) -> None:
+        """One solve of this replay spent (by :meth:`solve`, or by a caller integrating its model itself)."""
+        self.evaluations += 1
+        if self.counter is not None:
+            self.counter.solves += 1
+
     def solve(self, overrides: dict[str, float] | None = None, outputs: bool = False) -> PrescribedSolution:
         """The prescribed-rack solve at `time_s` (with `outputs`, also the states and the model's outputs); of an
         assisted car, the assisted solve (torsion-bar torque, motor torque and current; no outputs)."""
         run, p = self.parameter_vector(overrides)
-        self.evaluations += 1
-        if self.counter is not None:
-            self.counter.solves += 1
+        self.count_solve()
         if self.assisted:
             if outputs:
                 raise UsageError("the handwheel angle of an assisted car is not replayed (its twist passes the "

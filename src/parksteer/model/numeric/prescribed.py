@@ -123,6 +123,43 @@ class PrescribedSolution:
     outputs: dict[str, np.ndarray] | None = None
 
 
+@dataclass
+class PrescribedStart:
+    """What a prescribed-rack integration starts from (:func:`prescribed_start`): the checked output times and
+    parameter vector, the rack's table, the Jacobian's parameter vector, the reduced state's absolute tolerances,
+    the coordinates other than the rack, the static equilibrium and the reduced state there."""
+
+    t_out: np.ndarray
+    p: np.ndarray
+    table: np.ndarray
+    p_jac: np.ndarray
+    atol: np.ndarray
+    others: np.ndarray
+    y_static: np.ndarray
+    z0: np.ndarray
+
+
+def prescribed_start(run, p: np.ndarray, rack: RackMotion, t_out, atol_factor: float) -> PrescribedStart:
+    """The start of :func:`solve` and of the solve with sensitivities
+    (:func:`parksteer.model.numeric.sensitivities.solve_sensitivities`): the same start, so the same steps."""
+    model = run.model
+    i_rack = model.index("rack")
+    others = np.array([i for i in range(model.n_q) if i != i_rack], dtype=int)
+    t_out = np.ascontiguousarray(t_out, dtype=float)  # read by the compiled model: a strided view would not do
+    if t_out.ndim != 1 or len(t_out) < 2 or np.any(np.diff(t_out) <= 0):
+        raise ValueError("output times must be at least two, strictly increasing")
+    p = np.ascontiguousarray(p, dtype=float)
+    table = rack_table(rack)
+    p_jac = jacobian_parameters(run, p)
+    units = model.info["coordinate_units"]
+    atol = np.ascontiguousarray(absolute_tolerances([units[i] for i in others], atol_factor))
+    rack_start = np.zeros(3)
+    model.lib.ps_rack(float(t_out[0]), table.ctypes.data, rack_start.ctypes.data)
+    y_static = static_state(run, fixed={"rack": rack_start[0]}, p=p)
+    z0 = np.ascontiguousarray(np.concatenate([y_static[others], np.zeros(len(others))]))
+    return PrescribedStart(t_out, p, table, p_jac, atol, others, y_static, z0)
+
+
 def solve(run, p: np.ndarray, rack: RackMotion, t_out, rtol: float = PRESCRIBED_RTOL,
           atol_factor: float = PRESCRIBED_ATOL_FACTOR, outputs: bool = False,
           assist_off: bool = False, handwheel: bool = True) -> PrescribedSolution:
@@ -144,22 +181,10 @@ def solve(run, p: np.ndarray, rack: RackMotion, t_out, rtol: float = PRESCRIBED_
     lib = model.lib
     n = model.n_q
     i_rack = model.index("rack")
-    others = np.array([i for i in range(n) if i != i_rack], dtype=int)
-    n_o = len(others)
-    t_out = np.ascontiguousarray(t_out, dtype=float)  # read by the compiled model: a strided view would not do
-    if t_out.ndim != 1 or len(t_out) < 2 or np.any(np.diff(t_out) <= 0):
-        raise ValueError("output times must be at least two, strictly increasing")
-    p = np.ascontiguousarray(p, dtype=float)
-    table = rack_table(rack)
+    start = prescribed_start(run, p, rack, t_out, atol_factor)
+    t_out, p, table, p_jac, atol, others = start.t_out, start.p, start.table, start.p_jac, start.atol, start.others
+    n_o, z0 = len(others), start.z0
     p_ptr, table_ptr = p.ctypes.data, table.ctypes.data
-
-    p_jac = jacobian_parameters(run, p)
-    units = model.info["coordinate_units"]
-    atol = np.ascontiguousarray(absolute_tolerances([units[i] for i in others], atol_factor))
-    rack_start = np.zeros(3)
-    lib.ps_rack(float(t_out[0]), table_ptr, rack_start.ctypes.data)
-    y_static = static_state(run, fixed={"rack": rack_start[0]}, p=p)
-    z0 = np.ascontiguousarray(np.concatenate([y_static[others], np.zeros(n_o)]))
     # The integrator interpolates at the output times without stepping to them, so the refined grid of the
     # twist changes no step.
     grid, at_out = _refined(t_out, TWIST_SAMPLE_S) if outputs and handwheel else (t_out, np.arange(len(t_out)))

@@ -22,10 +22,8 @@ import numpy as np
 
 from ... import portable as pm
 from ...errors import UsageError
-from .prescribed import (PRESCRIBED_ATOL_FACTOR, PRESCRIBED_RTOL, RackMotion, jacobian_parameters, rack_corners,
-                         rack_table)
-from .statics import static_state
-from .tolerances import absolute_tolerances, integrator_failure, max_steps
+from .prescribed import PRESCRIBED_ATOL_FACTOR, PRESCRIBED_RTOL, RackMotion, prescribed_start, rack_corners
+from .tolerances import integrator_failure, max_steps
 
 # The directions one integration carries (the compiled integrator's BDF_MAX_SENS); more are integrated in batches.
 MAX_DIRECTIONS = 16
@@ -81,22 +79,9 @@ def solve_sensitivities(run, p: np.ndarray, rack: RackMotion, t_out, directions:
     directions = np.ascontiguousarray(np.atleast_2d(np.asarray(directions, dtype=float)))
     if directions.shape[1] != n_par or len(directions) == 0:
         raise ValueError(f"sensitivity directions: need rows of {n_par} parameters")
-    t_out = np.ascontiguousarray(t_out, dtype=float)
-    if t_out.ndim != 1 or len(t_out) < 2 or np.any(np.diff(t_out) <= 0):
-        raise ValueError("output times must be at least two, strictly increasing")
-    p = np.ascontiguousarray(p, dtype=float)
-    lib = model.lib
-    i_rack = model.index("rack")
-    others = [i for i in range(model.n_q) if i != i_rack]
-    n_z = 2 * len(others)
-    table = rack_table(rack)
-    p_jac = jacobian_parameters(run, p)
-    units = model.info["coordinate_units"]
-    atol = np.ascontiguousarray(absolute_tolerances([units[i] for i in others], atol_factor))
-    rack_start = np.zeros(3)
-    lib.ps_rack(float(t_out[0]), table.ctypes.data, rack_start.ctypes.data)
-    y_static = static_state(run, fixed={"rack": rack_start[0]}, p=p)
-    z0 = np.ascontiguousarray(np.concatenate([y_static[others], np.zeros(len(others))]))
+    begin = prescribed_start(run, p, rack, t_out, atol_factor)  # solve's start, so solve's steps
+    t_out, p, table, p_jac, atol = begin.t_out, begin.p, begin.table, begin.p_jac, begin.atol
+    lib, n_z, z0, y_static = model.lib, 2 * len(begin.others), begin.z0, begin.y_static
     corners = np.ascontiguousarray(rack_corners(rack, t_out[0], t_out[-1]))
     m = len(t_out)
     torque = np.empty(m)
@@ -113,10 +98,10 @@ def solve_sensitivities(run, p: np.ndarray, rack: RackMotion, t_out, directions:
         if code != 0:
             raise integrator_failure("prescribed-rack integration with sensitivities", code, float(stats[3]))
         full, accs = np.empty((m, 2 * model.n_q)), np.empty((m, model.n_q))
-        if lib.ps_prescribed_samples(m, t_out.ctypes.data, states.ctypes.data, p.ctypes.data, table.ctypes.data,
+        if start == 0 and lib.ps_prescribed_samples(m, t_out.ctypes.data, states.ctypes.data, p.ctypes.data, table.ctypes.data,
                                      full.ctypes.data, accs.ctypes.data, torque.ctypes.data):
             raise FloatingPointError("prescribed rack: the equations for the accelerations and torque are singular")
-        out = np.empty((m, k))
+        out = np.empty((m, k))  # every batch takes the same steps: the torque is the first batch's
         if lib.ps_prescribed_torque_sens(m, t_out.ctypes.data, states.ctypes.data, s_out.ctypes.data,
                                          p.ctypes.data, table.ctypes.data, k, batch.ctypes.data, out.ctypes.data):
             raise FloatingPointError("prescribed rack: the torque's sensitivities are singular")
