@@ -334,8 +334,7 @@ CHAINS: dict[str, list[str]] = {
                            "docs/workflow.md", "docs/sweeps.md", "docs/scaling.md", "docs/measurement.md",
                            "docs/diagnosis.md", "docs/peers.md", "docs/house.md", "docs/development.md"],
     "missing_effect": ["docs/signature.md"],
-    "assist_identify": ["docs/assist_identify.md"],
-    "use_it": ["README.md#Quick start", "README.md#Use it", "README.md#A worked example"],
+    "use_it": ["README.md#Quick start", "README.md#Use it", "README.md#A worked example", "docs/assist_identify.md"],
     "assisted_car": ["docs/assist_diagnosis.md"],
 }
 
