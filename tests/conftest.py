@@ -182,3 +182,22 @@ def written(tmp_path_factory, params, benchmark_design):
         return cache[name]
 
     return make
+
+
+@pytest.fixture(scope="session")
+def diagnosed(written, params):
+    """diagnosed(name, **dataset) -> the diagnosis (the default effects and settings) of the data set `written` makes
+    under `name`, with the same arguments; each diagnosed once per session, for the modules that read the same
+    diagnosis (a Diagnosis is read by the tests, never changed)."""
+    from parksteer.diagnose.problem import load_files
+    from parksteer.diagnose.select import diagnose
+
+    cache = {}
+
+    def once(name, **dataset):
+        if name not in cache:
+            paths, _ = written(name, **dataset)
+            cache[name] = diagnose(load_files(paths, params), params)
+        return cache[name]
+
+    return once

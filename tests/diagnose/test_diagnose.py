@@ -48,9 +48,8 @@ def hidden_user_effect(written, params, registry_with_user_effect):
 
 
 @pytest.fixture(scope="module")
-def null_diagnosis(written, params):
-    paths, _ = written("null_off_nominal", kind="null", base_overrides=OFF_NOMINAL)
-    return diagnose(load_files(paths, params), params)
+def null_diagnosis(diagnosed):
+    return diagnosed("null_off_nominal", kind="null", base_overrides=OFF_NOMINAL)
 
 
 @pytest.fixture(scope="module")

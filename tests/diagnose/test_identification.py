@@ -41,26 +41,24 @@ def test_tyres_on_air_bearings_fix_no_tyre_parameter_and_a_ground_test_would(wri
     assert "## What these data fix" in markdown_report(result)
 
 
-def test_a_ground_record_fixes_the_three_calibrated_parameters(written, params):
+def test_a_ground_record_fixes_the_three_calibrated_parameters(diagnosed):
     """On the ground the tyre's friction moment (the friction coefficient), the carcass's wind-up at each reversal
     (its stiffness) and the rack friction's step at each reversal are all seen: each is fixed within 10 %, and its
     interval holds the value the record was made with."""
-    paths, _ = written("null_off_nominal", kind="null", base_overrides=OFF_NOMINAL)
-    rows = _rows(diagnosis_dict(diagnose(load_files(paths, params), params)))
+    rows = _rows(diagnosis_dict(diagnosed("null_off_nominal", kind="null", base_overrides=OFF_NOMINAL)))
     for key, value in OFF_NOMINAL.items():
         assert rows[key]["status"] == "fixed" and rows[key]["fixed_by"] is None
         assert rows[key]["ci95"][0] < value < rows[key]["ci95"][1]
 
 
-def test_a_confounded_candidate_is_given_the_measurement_that_would_show_it(written, params):
+def test_a_confounded_candidate_is_given_the_measurement_that_would_show_it(diagnosed):
     """On one load case a king-pin friction (a moment growing with the wheel load) is nearly a rack friction:
     the calibrated rack friction takes it up, moving down to make room for it, and leaves less than a tenth of
     it. The one condition with another wheel load, the part-laden car, is the measurement that would tell
     them apart, and there it still shows more than twice what is left here (2.8 and 33 times on two records). Braked wheels push at the contact patch
     on the scrub radius: on the standard wheels they barely move the torque, and the measurement that shows them
     is the 68.5 mm spacers (the largest scrub radius) on the ground, where they move it tens of times more."""
-    paths, _ = written("null_off_nominal", kind="null", base_overrides=OFF_NOMINAL)
-    result = diagnosis_dict(diagnose(load_files(paths, params), params))
+    result = diagnosis_dict(diagnosed("null_off_nominal", kind="null", base_overrides=OFF_NOMINAL))
     jsonschema.validate(result, json.loads(SCHEMA_PATH.read_text(encoding="utf-8")))
     confounded = {c["effect"]: c for c in result["confounded"]}
 
