@@ -169,8 +169,9 @@ def test_the_baseline_file_round_trips(car):
 def test_command_line_baseline_then_diagnose(car, tmp_path, capsys):
     """`parksteer baseline` on one healthy record (the threshold from its 2 s blocks, each out of sample), then
     `diagnose --baseline` on a later record: exit 0, the file written, the JSON valid and naming the file; the
-    healthy record itself given as the baseline is learnt in memory to the same verdict and fitted values;
-    `baseline` refuses to overwrite without --force."""
+    healthy records themselves given as the baseline (the two the module's baseline file was learnt from) are
+    learnt in memory to the same verdict and fitted values as that file gives; `baseline` refuses to overwrite
+    without --force."""
     out = tmp_path / "one.toml"
     assert main(["baseline", str(car["paths"]["healthy_a"]), "--out", str(out), "--quiet"]) == 0
     assert "wrote" in capsys.readouterr().out
@@ -184,12 +185,18 @@ def test_command_line_baseline_then_diagnose(car, tmp_path, capsys):
     result = json.loads(capsys.readouterr().out)
     jsonschema.validate(result, json.loads(data_file("diagnosis.schema.json").read_text(encoding="utf-8")))
     assert result["relative_to"]["baseline"] == str(out)
-    assert main(["diagnose", str(car["paths"]["column"]), "--baseline", str(car["paths"]["healthy_a"]), "--json",
-                 "--quiet"]) == 0
+    # in memory against from the file: the healthy records the module's baseline file was learnt from, whose
+    # diagnosis against the file the module holds (a baseline of two records is learnt at half the replays of one
+    # record's blocks)
+    assert main(["diagnose", str(car["paths"]["column"]), "--baseline", str(car["paths"]["healthy_a"]),
+                 "--baseline", str(car["paths"]["healthy_b"]), "--json", "--quiet"]) == 0
     in_memory = json.loads(capsys.readouterr().out)
-    assert in_memory["relative_to"]["baseline"] is None and in_memory["relative_to"]["records"] == ["healthy_a.csv"]
+    assert in_memory["relative_to"]["baseline"] is None
+    assert in_memory["relative_to"]["records"] == ["healthy_a.csv", "healthy_b.csv"]
+    from_file = json.loads(json.dumps(diagnosis_dict(car["relative"]["column"]), allow_nan=False))
+    assert from_file["relative_to"]["baseline"] == car["written"].path
     assert (in_memory["verdict"], in_memory["effect"], in_memory["calibrated"]) == \
-        (result["verdict"], result["effect"], result["calibrated"])
+        (from_file["verdict"], from_file["effect"], from_file["calibrated"])
     assert main(["baseline", str(car["paths"]["healthy_a"]), "--out", str(out), "--quiet"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "--out" in err[0] and "--force" in err[0]
