@@ -4,11 +4,13 @@ layer (half a second a process).
 
 With whole degrees of freedom both have closed forms in elementary functions (Abramowitz and Stegun 26.7.3-4 and
 26.4.4-5), evaluated here in IEEE arithmetic, ``math.sqrt`` and the portable :func:`~.elementary.atan` and
-:func:`~.elementary.exp`:
+:func:`~.elementary.exp` and :func:`~.elementary.log`:
 
 - :func:`student_t_quantile`: t with ``P(T <= t) = p``, found by Newton's method on ``A(t) = P(|T| < t)``
   (A&S 26.7.3-4: with ``theta = atan(t / sqrt(dof))``, a finite series in ``cos^2 theta``), first in theta (where A
-  is concave and bounded, so that the iteration from 0 rises to the root whatever the tail), then in t;
+  is concave and bounded, so that the iteration from 0 rises to the root whatever the tail), then in t on the
+  upper tail ``P(T > t) = I_x(dof/2, 1/2) / 2`` (A&S 26.7.1, 26.5.8: the incomplete beta function's continued
+  fraction, which keeps the tail's relative accuracy where ``1 - A`` would lose it);
 - :func:`chi2_survival`: ``P(X > x)`` for X chi-square with `dof` degrees of freedom (A&S 26.4.4-5: ``exp(-x/2)``
   times a finite sum for even `dof`; ``erfc(sqrt(x/2))`` plus one for odd, erfc from its power series or, beyond
   ``x/2 = 1.5``, Legendre's continued fraction).
@@ -20,6 +22,7 @@ Their agreement with scipy.special's ``stdtrit`` and ``chdtrc`` and with the tru
 from __future__ import annotations
 
 import math
+from functools import lru_cache
 
 from .elementary import atan, cos, exp, log, sin
 
@@ -142,6 +145,12 @@ def student_t_quantile(p: float, dof: int) -> float:
     p = float(p)
     if not 0.0 < p < 1.0:
         raise ValueError(f"probability must be in (0, 1), not {p!r}")
+    return _t_quantile(p, dof)
+
+
+@lru_cache(maxsize=256)
+def _t_quantile(p: float, dof: int) -> float:
+    """:func:`student_t_quantile` of checked arguments, kept: a diagnosis asks for the same few (a few ms each)."""
     if p == 0.5:
         return 0.0
     tail = min(p, 1.0 - p)  # exact: 1 - p for p >= 1/2 is (Sterbenz)
