@@ -11,7 +11,9 @@ interpreters with that ``src`` first on the path, on the model cache the first (
 - **manual**: the README's example, ``parksteer diagnose data/measurements/example_unladen.csv --json --quiet``,
   wall, with the replays and the stage times its JSON reports (``cost``);
 - **assisted**: an assisted record, ``parksteer diagnose data/samples/polo_drag.csv --with-assist --vehicle
-  data/vehicles/polo_vi.toml --json --quiet``.
+  data/vehicles/polo_vi.toml --json --quiet``;
+- **each stage** of both (``manual.<stage>_s``, ``assisted.<stage>_s``): its wall time as the JSON's
+  ``cost.timings_s`` gives it, where the stage took 5 ms or more in some tree.
 
 Warm means the bytecode too: each interpreter compiles a module's source only once, into a cache of this run's
 own (``PYTHONPYCACHEPREFIX``, a temporary folder, so that no tree is written into), whatever
@@ -80,6 +82,8 @@ def measure(src: Path, jobs: int, bytecode: Path) -> dict[str, float]:
         out[f"{name}_cpu_s"] = cpu
         out[f"{name}_replays"] = float(cost["replays"])
         out[f"{name}_per_replay_ms"] = 1e3 * sum(cost["timings_s"].values()) / max(cost["replays"], 1)
+        for stage, seconds in cost["timings_s"].items():
+            out[f"{name}.{stage}_s"] = seconds
     return out
 
 
@@ -108,12 +112,19 @@ def main(argv: list[str] | None = None) -> None:
     for name, src in trees.items():
         print(f"{name}: {src}")
     medians = {name: {k: statistics.median(s[k] for s in runs) for k in runs[0]} for name, runs in samples.items()}
-    keys = list(medians["this"])
-    print(f"{'median':<24}" + "".join(f"{name:>12}" for name in trees)
+    # a stage whose time is under 5 ms in every tree is left out (the table is long enough); a stage one tree lacks
+    # shows nan there
+    keys = [k for k in medians["this"] if "." not in k or max(m.get(k, 0.0) for m in medians.values()) >= 0.005]
+    for m in medians.values():
+        for k in keys:
+            m.setdefault(k, float("nan"))
+    width = max(24, *(len(k) + 2 for k in keys))
+    print(f"{'median':<{width}}" + "".join(f"{name:>12}" for name in trees)
           + "".join(f"{'this/' + name:>14}" for name in trees if name != "this"))
     for k in keys:
-        row = f"{k:<24}" + "".join(f"{medians[name][k]:>12.3f}" for name in trees)
-        row += "".join(f"{medians['this'][k] / medians[name][k]:>14.2f}" for name in trees if name != "this")
+        row = f"{k:<{width}}" + "".join(f"{medians[name][k]:>12.3f}" for name in trees)
+        row += "".join(f"{medians['this'][k] / medians[name][k] if medians[name][k] else float('nan'):>14.2f}"
+                       for name in trees if name != "this")
         print(row)
 
 

@@ -3,7 +3,9 @@
 scipy.signal (with scipy.stats, which it imports) is more than a second of every process that imports it, sympy
 seconds; a diagnosis needs neither (its decimation and running filters are written out in parksteer.portable), nor
 scipy.interpolate (a second, with scipy.linalg, sparse and optimize: the rack smoothing's B-splines are written out
-in parksteer.measure.bspline). The command line's help needs no numpy at all, nor the package metadata (read for
+in parksteer.measure.bspline), nor scipy.special (half a second, with numpy.f2py and the array-API layer: the t
+quantile and the chi-square survival of its intervals and signature are parksteer.portable.distributions'). The
+command line's help needs no numpy at all, nor the package metadata (read for
 ``--version`` alone). These tests import in a fresh interpreter and read sys.modules.
 """
 
@@ -21,7 +23,7 @@ ROOT = Path(__file__).resolve().parents[1]
 NEVER_AT_IMPORT = ("scipy", "sympy", "matplotlib")
 NEVER_FOR_HELP = NEVER_AT_IMPORT + ("numpy", "importlib.metadata")
 NEVER_IN_A_DIAGNOSIS = ("scipy.signal", "scipy.stats", "scipy.interpolate", "scipy.sparse", "scipy.linalg",
-                        "scipy.optimize", "sympy", "matplotlib")
+                        "scipy.optimize", "scipy.special", "sympy", "matplotlib")
 
 
 def _loaded_after(code: str) -> list[str]:
@@ -67,8 +69,8 @@ def _resampled(source: Path, target: Path, factor: int) -> None:
 def test_a_diagnosis_of_a_decimated_record_never_imports_scipy_signal_stats_or_sympy(tmp_path):
     """The README's example record at five times its rate (so decimated to the method's rate on import), diagnosed
     from start to verdict (its rack smoothed, with the replay ensemble's racks), imports neither scipy.signal nor
-    scipy.stats nor scipy.interpolate (nor the scipy.linalg, sparse and optimize it brings) nor sympy nor
-    matplotlib."""
+    scipy.stats nor scipy.interpolate (nor the scipy.linalg, sparse and optimize it brings) nor scipy.special
+    (its intervals' t quantile and its signature's p-values included) nor sympy nor matplotlib."""
     from parksteer.measure.importers import load_record
 
     record = tmp_path / "example_250Hz.csv"

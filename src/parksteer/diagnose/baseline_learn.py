@@ -8,7 +8,8 @@ import dataclasses
 import math
 
 import numpy as np
-from scipy.special import stdtrit  # the t quantile, without importing scipy.stats
+
+from .. import portable as pm
 
 from ..model.symbolic.components import (Effect, discover_effects, power_assist_of, resolve_effects,
                                           with_effect_quantities)
@@ -183,7 +184,7 @@ def prediction_bound(values) -> float:
     k = values.size
     if k < 2:
         return float(values.max())
-    return float(values.mean() + stdtrit(k - 1, 0.95) * values.std(ddof=1) * math.sqrt(1.0 + 1.0 / k))
+    return float(values.mean() + pm.student_t_quantile(0.95, k - 1) * values.std(ddof=1) * math.sqrt(1.0 + 1.0 / k))
 
 
 def _threshold(rows: list[dict], method: str) -> Threshold:
@@ -203,7 +204,7 @@ def pooled_bound(values, per_record: int) -> float:
     k = values.size
     if k < 2:
         return float(values.max())
-    return float(values.mean() + stdtrit(k - 1, 0.95) * values.std(ddof=1) * math.sqrt(1.0 / per_record + 1.0 / k))
+    return float(values.mean() + pm.student_t_quantile(0.95, k - 1) * values.std(ddof=1) * math.sqrt(1.0 / per_record + 1.0 / k))
 
 
 def _block_threshold(rows: list[dict], method: str) -> Threshold:

@@ -121,9 +121,7 @@ class Fit:
             except pm.LinAlgError:
                 covariance, sandwich, blocks = np.full((k, k), np.inf), np.full((k, k), np.inf), 0
                 replay = np.zeros((k, k))
-        from scipy.special import stdtrit  # the t quantile without scipy.stats; imported where used, not with the module
-
-        quantile = float(stdtrit(blocks - k, 0.975)) if blocks > k else math.inf
+        quantile = pm.student_t_quantile(0.975, blocks - k) if blocks > k else math.inf
         out = {}
         for i, (p, t) in enumerate(zip(self.parameters, self.theta)):
             model_se = math.sqrt(max(covariance[i, i], 0.0))

@@ -7,7 +7,7 @@ column), by weighted least squares (:func:`parksteer.portable.lstsq`). Each basi
 diagnosis's information criterion, ``BIC = n_eff ln(RSS / n) + k ln(n_eff)`` with ``n_eff`` from the lag-1
 autocorrelation (:func:`parksteer.diagnose.statistics.effective_samples`); the lowest names the class, none when no
 basis gains ``bic_missing_threshold``. Every axis gets its share of the weighted sum of squares and its
-likelihood-ratio significance ``LR = Delta RSS n_eff / n`` against chi-square(k) (:func:`scipy.special.chdtrc`).
+likelihood-ratio significance ``LR = Delta RSS n_eff / n`` against chi-square(k) (:func:`parksteer.portable.chi2_survival`).
 A handwheel torque residual is read as a rack force through the handwheel-to-rack ratio (the Hooke joint's ripple
 left out of this reading). :func:`signature_of` reads the axes off a diagnosis's files and calibrated predictions;
 the result is frozen. The bases, the classes and what each means: docs/signature.md.
@@ -183,14 +183,12 @@ def signature_from_axes(axes: Axes, settings: DiagnosisSettings = DEFAULT_SETTIN
         k = b.columns.shape[1]
         gain = bic_gain(rss0, rss, n_eff, k)
         scores.append(ModelScore(b.family, b.label, k, float(rss), float(gain)))
-    from scipy.special import chdtrc  # chi2.sf without scipy.stats; imported here, where it is used, not with the module
-
     shares = []
     excess = rss0 - n
     for (name, columns), (_, rss) in zip(groups, group_fits):
         k = columns.shape[1]
         statistic = (rss0 - rss) * n_eff / n
-        p = float(chdtrc(k, statistic))
+        p = pm.chi2_survival(statistic, k)
         shares.append(AxisShare(name, k, float((rss0 - rss) / rss0), float((rss0 - rss) / excess) if excess > 0 else None,
                                 float(statistic), p, p < settings.signature.significance))
     best_index = max(range(len(models)), key=lambda i: (scores[i].delta_bic, -scores[i].columns))

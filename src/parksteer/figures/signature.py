@@ -13,7 +13,7 @@ and the paper). :func:`aggregate` scores the rows again from their numbers alone
 - a null fails when the diagnosis would write a suggestion for it (an ``unexplained`` verdict with a class).
 
 Every number written is the diagnosis's (portable arithmetic) or a count; the likelihood-ratio p-values of the
-signature's axes (``scipy.special.chdtrc``, through the C library) are not written.
+signature's axes are not written (the diagnosis rounds them to three digits).
 """
 
 from __future__ import annotations

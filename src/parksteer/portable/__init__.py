@@ -12,6 +12,8 @@ depends on the shape alone), so the same inputs give the same bits on any machin
 - elementary functions :func:`sin`, :func:`cos`, :func:`tan`, :func:`atan`, :func:`atan2`, :func:`exp`,
   :func:`expm1`, :func:`tanh`, :func:`log`, :func:`power`, :func:`hypot`: fdlibm's algorithms, mirroring the C of
   ``model/codegen/portable_math.c`` to the bit (``tests/test_portable.py``), each within about one ulp;
+- Student's t quantile and the chi-square survival for whole degrees of freedom, in closed form:
+  :func:`student_t_quantile`, :func:`chi2_survival` (no scipy.special, whose import costs half a second);
 - the filters the loggers and the import use, designed in closed form: :func:`butterworth_lowpass_sos`,
   :func:`sos_steady_state`, :func:`hamming_lowpass_fir`.
 
@@ -20,6 +22,7 @@ Scalars in give Python floats out; arrays give arrays. Why and what was verified
 
 # The package is the one import path of all of it (`from parksteer import portable as pm`, then pm.solve, pm.sin,
 # ...: a drop-in where numpy's own would leave the last bit to the machine); each job is a module of its own.
+from .distributions import chi2_survival, student_t_quantile
 from .elementary import atan, atan2, cos, exp, expm1, hypot, log, power, sin, tan, tanh
 from .filters import (
     butterworth_lowpass_sos,
@@ -50,4 +53,4 @@ __all__ = ["LinAlgError", "dot", "matmul", "norm", "solve", "inv", "cholesky", "
            "generalized_inverse", "psd_factor", "solve_tridiagonal", "symmetric_eigen",
            "sin", "cos", "tan", "atan", "atan2", "exp", "expm1", "tanh", "log", "power", "hypot",
            "butterworth_lowpass_sos", "sos_steady_state", "hamming_lowpass_fir", "fir_decimate",
-           "running_median", "running_max3"]
+           "running_median", "running_max3", "student_t_quantile", "chi2_survival"]

@@ -46,9 +46,7 @@ def _estimate(value: float, se: float, unit: str, z: float = Z95) -> Estimate:
 
 def _t95(dof: int) -> float:
     """The two-sided 95 % quantile of Student's t: a sandwich over few blocks estimates its variance from few."""
-    from scipy.special import stdtrit
-
-    return float(stdtrit(max(dof, 1), 0.975))
+    return pm.student_t_quantile(0.975, max(dof, 1))
 
 
 def _map_law(torques: list[float], values: list[float]):
