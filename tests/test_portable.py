@@ -288,3 +288,26 @@ def test_generated_c_calls_no_machine_dependent_libm():
     for call in ("sin(x)", "pow(x, 2.5)", "tanh(x)", "exp(x)"):
         with pytest.raises(RuntimeError, match="C library"):
             generate.check_portable(f"double f(double x) {{ return {call}; }}")
+
+
+def test_no_module_outside_portable_calls_blas_or_lapack():
+    """Every number the package computes stays off the CPU-dispatched BLAS and LAPACK: outside ``portable/``, no
+    ``@`` operator, no ``np.linalg`` routine (its ``LinAlgError`` aside) and no ``np.dot``/``np.matmul``/``np.einsum``
+    (which go through the BLAS for floats), so that a figure's bytes do not depend on the machine's kernel."""
+    import ast
+
+    root = Path(pm.__file__).parents[1]
+    found = []
+    for path in sorted(root.rglob("*.py")):
+        if "portable" in path.relative_to(root).parts:
+            continue
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.BinOp) and isinstance(node.op, ast.MatMult):
+                found.append(f"{path.relative_to(root)}:{node.lineno}: @")
+            elif (isinstance(node, ast.Attribute) and isinstance(node.value, ast.Attribute)
+                  and node.value.attr == "linalg" and node.attr != "LinAlgError"):
+                found.append(f"{path.relative_to(root)}:{node.lineno}: linalg.{node.attr}")
+            elif (isinstance(node, ast.Attribute) and isinstance(node.value, ast.Name) and node.value.id == "np"
+                  and node.attr in ("dot", "matmul", "einsum", "tensordot", "inner", "vdot")):
+                found.append(f"{path.relative_to(root)}:{node.lineno}: np.{node.attr}")
+    assert not found, "BLAS/LAPACK outside parksteer.portable: " + "; ".join(found)

@@ -20,6 +20,7 @@ import math
 
 import numpy as np
 
+from ... import portable as pm
 from ...model.symbolic.components import power_assist_of
 from ..engine import ReplayEngine
 from ..state import DiagnosisState
@@ -114,10 +115,10 @@ def _refitted_rss(fit, problem, moved: list[np.ndarray]) -> tuple[float, np.ndar
     weighted = fit.weighted - change
     theta = np.asarray(fit.theta, dtype=float)
     if fit.jacobian.size:
-        step, *_ = np.linalg.lstsq(fit.jacobian, weighted, rcond=None)
-        weighted = weighted - fit.jacobian @ step
+        step = pm.lstsq(fit.jacobian, weighted)  # the portable routines: these numbers reach the report
+        weighted = weighted - pm.matmul(fit.jacobian, step)
         theta = theta + step
-    return float(weighted @ weighted), weighted, theta
+    return pm.dot(weighted, weighted), weighted, theta
 
 
 def clear_of_absence(parameter, theta: float, half: float, interval_rule: bool) -> bool:

@@ -24,6 +24,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from ... import portable as pm
 from ...measure.phases import PHASES
 from ..calibrate import calibrate, free_strengths
 from ..fitting import Fit
@@ -81,12 +82,12 @@ def not_made_by_strengths(fit: Fit, free_keys) -> dict[str, float]:
     out = {}
     for i in keep:
         column = fit.jacobian[:, i]
-        norm = float(np.linalg.norm(column))
+        norm = float(pm.norm(column))
         if norm == 0.0 or not free:
             out[fit.parameters[i].key] = 1.0 if norm > 0.0 else 0.0
             continue
-        coefficients = np.linalg.lstsq(strengths, column, rcond=None)[0]
-        out[fit.parameters[i].key] = float(np.linalg.norm(column - strengths @ coefficients) / norm)
+        coefficients = pm.lstsq(strengths, column)
+        out[fit.parameters[i].key] = float(pm.norm(column - pm.matmul(strengths, coefficients)) / norm)
     return out
 
 
