@@ -82,7 +82,8 @@ def make_assisted_figure(parameters: str | Path, vehicle: str | Path, svg: str |
 def gather_assisted_figure(batches, names: list[str], vehicle: str | Path, svg: str | Path, csv: str | Path,
                            json_path: str | Path) -> dict:
     """make_assisted_figure's files from the rows the jobs of rule diag_assisted_batch wrote into the folders
-    `batches` (parksteer.experiments.assisted_benchmark.run_batch), the cases `names` in the design's order: the same bytes."""
+    `batches` (parksteer.experiments.assisted_benchmark.run_batch), the cases `names` in the design's order: the
+    same bytes."""
     from ..experiments.assisted_benchmark import read_rows, summarise
 
     rows = read_rows(batches, list(names))

@@ -149,7 +149,7 @@ def signature_figure(rows: list[dict], summary: dict, path: str | Path) -> None:
     suggested effect (filled), coloured by the truth form's class, against the AFTER_LIMIT line; nulls in grey,
     a cross where a suggestion would be written. Right: the class confusion, truth class against the class
     named."""
-    from ..plotting import COLOURS, new_figure, save_svg  # here: the benchmark's jobs import this module, not matplotlib
+    from ..plotting import COLOURS, new_figure, save_svg  # here: the batch jobs import this module
 
     class_colours = {cls: COLOURS[k] for k, cls in enumerate(CLASSES)}
     order = sorted(range(len(rows)), key=lambda i: (rows[i]["form"] is None,
