@@ -92,3 +92,30 @@ def test_the_benchmark_covers_every_candidate_nulls_and_disturbances(params, ben
     for s in specs:
         for key, value in s.base_overrides.items():
             assert abs(value / params[key] - 1.0) <= benchmark_design.perturbation[key]
+
+
+def test_a_hidden_candidates_record_simulates_each_run_once(params, benchmark_design, monkeypatch):
+    """A data set's size search ends on the clean run at the strength it returns; the truth's size and the record
+    are that run: no file is simulated twice with the same effects and values, and the record's clean torque is
+    the run at the truth's strength (its RMS change from the base run is the truth's steps, as the size is defined)."""
+    import parksteer.synthetic.datasets as datasets
+
+    runs = []
+    original = datasets.clean_run
+
+    def counted(params, case, surface, profile, effects=None, overrides=None):
+        runs.append((case, surface, id(profile), effects,
+                     tuple(sorted((overrides or {}).items()))))
+        return original(params, case, surface, profile, effects, overrides)
+
+    monkeypatch.setattr(datasets, "clean_run", counted)
+    spec = datasets.DatasetSpec("rack_damping_2", 4243, (("unladen", "ground"),), "candidate", "rack_damping", 2.0,
+                                {}, search=benchmark_design.search)
+    truth = datasets.make_dataset(params, spec).truth
+    assert len(runs) == len(set(runs))
+    profile = hand(params, spec.seed * 100)
+    key = truth["strength_key"]
+    with_it = original(params, "unladen", "ground", profile, "+rack_damping", {key: truth["strength"]})
+    without = original(params, "unladen", "ground", profile)
+    change = np.sqrt(np.mean((with_it["handwheel_torque_Nm"] - without["handwheel_torque_Nm"]) ** 2))
+    assert change / torque_step_Nm(params) == pytest.approx(truth["steps"], rel=1e-12)

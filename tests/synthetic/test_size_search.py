@@ -7,7 +7,7 @@ is) reaches a target RMS T at s = (T / c)^(1/p).
 import numpy as np
 import pytest
 
-from parksteer.synthetic.size_search import SizeSearch, strength_for_rms
+from parksteer.synthetic.size_search import SizeSearch, remembered, strength_for_rms
 
 SHAPE = np.sin(np.linspace(0.0, 20.0, 400))
 SEARCH = SizeSearch(iterations=12, tolerance=0.05, max_lag_s=0.3)
@@ -48,3 +48,16 @@ def test_a_threshold_effect_is_still_found():
     rms = float(np.sqrt(np.mean(SHAPE**2)))
     found = strength_for_rms(torque_of, 0.5, 1e-3, 100.0, SEARCH)
     assert (found - 2.0) * rms == pytest.approx(0.5, rel=SEARCH.tolerance)
+
+
+def test_the_change_at_the_size_found_is_the_searchs_own_run():
+    """remembered(torque_of) runs each size once: the size the search returns was run by the search, so reading
+    its torque again to record the change runs nothing, and gives the closed form's c s^p at that size."""
+    calls = []
+    torque_of = remembered(_torque(2.0, calls))
+    found = strength_for_rms(torque_of, 0.7, 1e-3, 100.0, SEARCH)
+    searched = len(calls)
+    again = torque_of(found)
+    assert len(calls) == searched and found in calls
+    assert len(set(calls)) == len(calls)
+    np.testing.assert_array_equal(again, 3.0 + found**2 * SHAPE)

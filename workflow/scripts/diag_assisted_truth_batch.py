@@ -1,8 +1,12 @@
-# Thin rule script: the logic is parksteer.experiments.assisted_truth.run_batch (via
-# parksteer.figures.assisted_truth.run_assisted_truth_batch), once for the cases of the job.
-from parksteer.figures.assisted_truth import run_assisted_truth_batch
+# Thin rule script: the logic is parksteer.experiments.assisted_truth.run_batch, once for the cases of the job, on
+# the vehicle file's car over the parameter file. Called here rather than through parksteer.figures.assisted_truth,
+# whose plotting would import matplotlib into a job that draws nothing.
+from parksteer.experiments.assisted_truth import design_from_config, run_batch
+from parksteer.parameters import load_parameters
 from parksteer.rules import rule_log
+from parksteer.vehicle import load_vehicle
 
 with rule_log(snakemake):
-    run_assisted_truth_batch(snakemake.input.parameters, snakemake.input.vehicle, snakemake.params.design,
-                             list(snakemake.params.cases), snakemake.output[0])
+    run_batch(load_vehicle(snakemake.input.vehicle, load_parameters(snakemake.input.parameters)),
+              snakemake.input.vehicle, list(snakemake.params.cases), snakemake.output[0],
+              design_from_config(snakemake.params.design))

@@ -32,7 +32,7 @@ from ..parameters import Parameters
 from ..synthetic.assisted import OUT_OF_CLASS, AssistedLogger, assisted_clean, assisted_record
 from ..synthetic.assisted_truth import HIDDEN_TRUTH
 from ..synthetic.datasets import BASE_PERTURBATION, perturbed_base
-from ..synthetic.size_search import SizeSearch, rms_difference, strength_for_rms
+from ..synthetic.size_search import SizeSearch, remembered, rms_difference, strength_for_rms
 from ..measure.converter import quantisation_step
 from ..synthetic.variations import variation_by_name
 from .benchmark import BENCHMARK_SETTINGS
@@ -154,8 +154,11 @@ def _logger(variation, seed: int) -> AssistedLogger:
                           torque_noise_Nm=TORQUE_NOISE_NM, current_noise_A=CURRENT_NOISE_A, seed=seed)
 
 
-def case_truth_and_record(params: Parameters, design: AssistedDesign, case: AssistedCase, assist: str):
-    """(truth, measurement) of `case`: its hidden strength found by the secant search on the clean torque."""
+def case_truth_and_record(params: Parameters, design: AssistedDesign, case: AssistedCase, assist: str,
+                          references: dict | None = None):
+    """(truth, measurement) of `case`: its hidden strength found by the secant search on the clean torque.
+    `references` keeps the clean torque of each (variation, seed) a hidden or out-of-class case is sized against,
+    for the next case of the same variation in the same process (the same hand, base and assist: the same run)."""
     variation = variation_by_name(case.variation)
     hand, _ = variation.settings(case.seed)
     logger = _logger(variation, case.seed)
@@ -167,18 +170,24 @@ def case_truth_and_record(params: Parameters, design: AssistedDesign, case: Assi
         return assisted_clean(params, hand, effects, design.case, overrides=overrides, out_of_class=change,
                               dt_s=0.01)[TORQUE]
 
-    reference = torque(assist, base)
+    references = {} if references is None else references
+
+    def reference() -> np.ndarray:  # the nulls are not sized: no reference run
+        if (case.variation, case.seed) not in references:
+            references[case.variation, case.seed] = torque(assist, base)
+        return references[case.variation, case.seed]
+
     hidden = hidden_candidates()
     if case.kind == "hidden":
         key = hidden[case.hidden][0]
         if case.hidden == "rack_friction":
-            of = lambda s: torque(assist, {**base, key: base[key] + s})  # noqa: E731
+            of = remembered(lambda s: torque(assist, {**base, key: base[key] + s}))
         else:
             spec = f"{assist},+{case.hidden}"
-            of = lambda s: torque(spec, {**base, key: s})  # noqa: E731
+            of = remembered(lambda s: torque(spec, {**base, key: s}))
         largest = largest_size(case.hidden, hidden)
         strength = strength_for_rms(of, case.steps * step, largest * 1e-2, largest, SEARCH)
-        size = rms_difference(of(strength), reference) / step
+        size = rms_difference(of(strength), reference()) / step
     elif case.kind == "outclass":
         if case.hidden == "torsion_bar_stiffness":
             strength = case.steps
@@ -187,7 +196,7 @@ def case_truth_and_record(params: Parameters, design: AssistedDesign, case: Assi
             largest = largest_size(case.hidden, hidden)
             strength = strength_for_rms(of, case.steps * step, largest * 1e-2, largest, SEARCH)
         out_of_class = (case.hidden, strength)
-        size = rms_difference(torque(assist, base, out_of_class), reference) / step
+        size = rms_difference(torque(assist, base, out_of_class), reference()) / step
     else:
         size = 0.0
     overrides = dict(base)
@@ -282,12 +291,13 @@ def run(params: Parameters, design: AssistedDesign = AssistedDesign(), only=None
     effects = resolve_effects(assist)
     settings = BENCHMARK_SETTINGS
     rows = []
+    references: dict = {}
     with tempfile.TemporaryDirectory() as folder:
         for case in cases(design):
             if only and case.name not in only:
                 continue
             start = time.perf_counter()
-            truth, record = case_truth_and_record(params, design, case, assist)
+            truth, record = case_truth_and_record(params, design, case, assist, references)
             path = Path(folder) / f"{case.name}.csv"
             write_measurement(path, record, params)
             made = time.perf_counter()

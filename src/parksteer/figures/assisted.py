@@ -68,14 +68,6 @@ def _assisted_params(parameters: str | Path, vehicle: str | Path):
     return load_vehicle(vehicle, load_parameters(parameters))
 
 
-def run_assisted_batch(parameters: str | Path, vehicle: str | Path, names: list[str], folder: str | Path) -> None:
-    """Run the assisted benchmark's cases `names` on `vehicle` (its [assist]) over `parameters`, each one's row
-    into `folder` (parksteer.experiments.assisted_benchmark.run_batch): one job of rule diag_assisted_batch."""
-    from ..experiments.assisted_benchmark import run_batch
-
-    run_batch(_assisted_params(parameters, vehicle), names, folder)
-
-
 def make_assisted_figure(parameters: str | Path, vehicle: str | Path, svg: str | Path, csv: str | Path,
                          json_path: str | Path, progress=None) -> dict:
     """Run the assisted benchmark on `vehicle` (its [assist]) over `parameters` in this process, write
@@ -90,7 +82,8 @@ def make_assisted_figure(parameters: str | Path, vehicle: str | Path, svg: str |
 def gather_assisted_figure(batches, names: list[str], vehicle: str | Path, svg: str | Path, csv: str | Path,
                            json_path: str | Path) -> dict:
     """make_assisted_figure's files from the rows the jobs of rule diag_assisted_batch wrote into the folders
-    `batches` (run_assisted_batch), the cases `names` in the design's order: the same bytes."""
+    `batches` (parksteer.experiments.assisted_benchmark.run_batch), the cases `names` in the design's order: the
+    same bytes."""
     from ..experiments.assisted_benchmark import read_rows, summarise
 
     rows = read_rows(batches, list(names))

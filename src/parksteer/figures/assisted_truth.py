@@ -85,23 +85,6 @@ def assisted_truth_figure(rows: list[dict], summary: dict, path: str | Path) -> 
     save_svg(fig, path)
 
 
-def _base_params(parameters: str | Path, vehicle: str | Path):
-    from ..parameters import load_parameters
-    from ..vehicle import load_vehicle
-
-    return load_vehicle(vehicle, load_parameters(parameters))
-
-
-def run_assisted_truth_batch(parameters: str | Path, vehicle: str | Path, section: dict | None, names: list[str],
-                             folder: str | Path) -> None:
-    """Run the cases `names` of the design config["assisted_truth"] (`section`) on the car of `vehicle` over
-    `parameters`, each one's rows into `folder` (parksteer.experiments.assisted_truth.run_batch): one job of rule
-    diag_assisted_truth_batch."""
-    from ..experiments.assisted_truth import design_from_config, run_batch
-
-    run_batch(_base_params(parameters, vehicle), vehicle, names, folder, design_from_config(section))
-
-
 def gather_assisted_truth_figure(batches, names: list[str], section: dict | None, vehicle: str | Path,
                                  svg: str | Path, csv: str | Path, json_path: str | Path) -> dict:
     """figures/diag_assisted_truth.svg, its CSV (one row per record and route) and results/diag_assisted_truth.json

@@ -27,9 +27,6 @@ import numpy as np
 from ..experiments.outoflibrary import AFTER_LIMIT, CLASS_TARGET, SUGGESTION_TARGET, SignatureDesign
 from ..diagnose.signature import CLASSES
 from ..errors import UsageError
-from ..plotting import COLOURS, new_figure, save_svg
-
-CLASS_COLOURS = {cls: COLOURS[k] for k, cls in enumerate(CLASSES)}
 NULL_COLOUR = "#777777"
 TIME_KEYS = ("diagnosis_s", "signature_s", "suggestion_s")
 ROW_KEYS = ("name", "form", "class", "variation", "steps", "said_class", "class_right", "class_in_group",
@@ -152,6 +149,9 @@ def signature_figure(rows: list[dict], summary: dict, path: str | Path) -> None:
     suggested effect (filled), coloured by the truth form's class, against the AFTER_LIMIT line; nulls in grey,
     a cross where a suggestion would be written. Right: the class confusion, truth class against the class
     named."""
+    from ..plotting import COLOURS, new_figure, save_svg  # here: the batch jobs import this module
+
+    class_colours = {cls: COLOURS[k] for k, cls in enumerate(CLASSES)}
     order = sorted(range(len(rows)), key=lambda i: (rows[i]["form"] is None,
                                                     CLASSES.index(rows[i]["class"]) if rows[i]["class"] else 0,
                                                     rows[i]["name"]))
@@ -159,7 +159,7 @@ def signature_figure(rows: list[dict], summary: dict, path: str | Path) -> None:
     ax = axes[0]
     for y, i in enumerate(order):
         r = rows[i]
-        colour = CLASS_COLOURS[r["class"]] if r["class"] else NULL_COLOUR
+        colour = class_colours[r["class"]] if r["class"] else NULL_COLOUR
         before, after = r["calibrated_over_floor"], r["after_over_floor"]
         if after is not None:
             ax.annotate("", xy=(after, y), xytext=(before, y),
@@ -197,7 +197,7 @@ def signature_figure(rows: list[dict], summary: dict, path: str | Path) -> None:
     ax.grid(True, axis="x", which="both", alpha=0.3)
     from matplotlib.lines import Line2D
 
-    handles = [Line2D([], [], marker="o", linestyle="", color=CLASS_COLOURS[c], label=c) for c in summary["table"]]
+    handles = [Line2D([], [], marker="o", linestyle="", color=class_colours[c], label=c) for c in summary["table"]]
     handles.append(Line2D([], [], marker="o", linestyle="", markerfacecolor="white", markeredgecolor=NULL_COLOUR,
                           label="nothing hidden"))
     if summary["targets"]["nulls"]["suggested_on"]:

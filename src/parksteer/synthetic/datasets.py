@@ -240,11 +240,20 @@ def make_dataset(params: Parameters, spec: DatasetSpec) -> Dataset:
         raise UsageError(f"data set {spec.name}: a size in converter steps needs a size search (DatasetSpec.search)")
     hands = [hand(params, spec.seed * 100 + i) for i in range(len(spec.files))]
     base = dict(spec.base_overrides)
+    # each file's clean run of each effect set and values, simulated once: the size search ends on the run at the
+    # strength it returns, which the truth's size and the record then take again (read-only: logging copies)
+    runs: dict[tuple, dict[str, np.ndarray]] = {}
+
+    def clean(i: int, effects, overrides) -> dict[str, np.ndarray]:
+        key = (i, effects, tuple(sorted(overrides.items())))
+        if key not in runs:
+            runs[key] = clean_run(params, *spec.files[i], hands[i], effects, overrides)
+        return runs[key]
 
     def torques(effects, overrides, disturbance=None):
         out = []
-        for (case, surface), hand_profile in zip(spec.files, hands):
-            columns = clean_run(params, case, surface, hand_profile, effects, overrides)
+        for i in range(len(spec.files)):
+            columns = clean(i, effects, overrides)
             if disturbance is not None:
                 columns = disturbance.apply(params, columns)
             out.append(columns[TORQUE])
@@ -276,7 +285,7 @@ def make_dataset(params: Parameters, spec: DatasetSpec) -> Dataset:
         steps = rms_difference(hidden, torques(None, base)) / step
     measurements = []
     for i, ((case, surface), hand_profile) in enumerate(zip(spec.files, hands)):
-        columns = clean_run(params, case, surface, hand_profile, effects, overrides)
+        columns = clean(i, effects, overrides)
         if disturbance is not None:
             columns = disturbance.apply(params, columns)
         measurements.append(_logged(params, columns, case, surface, spec.seed * 100 + 50 + i, hand_profile))

@@ -198,9 +198,14 @@ def make_outclass_dataset(params: Parameters, spec: DatasetSpec, design: Outclas
     hands = [hand(params, spec.seed * 100 + i) for i in range(len(spec.files))]
     base = dict(spec.base_overrides)
 
+    made: dict[tuple, list] = {}  # each effect set and values run once: the record is the search's last run
+
     def runs(effects, overrides):
-        return [_fine_run(params, case, surface, h, effects, overrides, design.rtol)
-                for (case, surface), h in zip(spec.files, hands)]
+        key = (effects, tuple(sorted(overrides.items())))
+        if key not in made:
+            made[key] = [_fine_run(params, case, surface, h, effects, overrides, design.rtol)
+                         for (case, surface), h in zip(spec.files, hands)]
+        return made[key]
 
     def torque(effects, overrides):
         return np.concatenate([r[TORQUE] for r in runs(effects, overrides)])
