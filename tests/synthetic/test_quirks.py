@@ -14,12 +14,14 @@ from parksteer.synthetic.quirk_eps import (BACK_EFFICIENCY_BAND, EpsQuirk, drawn
 from parksteer.synthetic.quirks import BoreFriction, DahlTyre, JointPhasing, ManualRoad, TieRodCompliance
 
 
-def _road(n=4001, torque=None, column=None, rack=None, speed=None, steer=None, tyre=None) -> ManualRoad:
+def _road(n=4001, torque=None, column=None, rack=None, speed=None, steer=None, tyre=None, column_per_rack=None,
+          steer_per_rack=None) -> ManualRoad:
     def filled(a, value):
         return np.full(n, value) if a is None else np.asarray(a, dtype=float)
 
     return ManualRoad(np.arange(n) * 0.002, filled(rack, 0.0), filled(torque, 10.0), filled(column, 0.0),
-                      filled(speed, 0.0), filled(steer, 0.0), filled(tyre, 0.0), np.full(n, 186.47))
+                      filled(speed, 0.0), filled(steer, 0.0), filled(tyre, 0.0), filled(column_per_rack, 186.47),
+                      filled(steer_per_rack, 8.3682))
 
 
 def test_joint_phasing_passes_the_mean_speed_so_its_torque_change_averages_out_over_a_turn():
@@ -47,6 +49,70 @@ def test_dahl_tyre_follows_its_closed_form_and_never_passes_saturation():
     assert np.max(np.abs(back)) <= dahl.saturation_Nm
     middle = len(path) // 2
     assert back[middle] - back[-1 - middle] > 0.5 * dahl.saturation_Nm
+
+
+def _steer_cycle(n=20001, amplitude_rad=0.5):
+    """A lock-to-lock cycle of the mean steer angle: out to +amplitude, over to -amplitude, back to 0."""
+    return amplitude_rad * np.sin(np.linspace(0.0, 2.0 * np.pi, n))
+
+
+def test_dahl_tyre_loop_at_the_handwheel_is_the_wheels_loop_times_the_linkage_ratio():
+    """Through a linkage of constant ratio r = d(steer)/d(column) a moment M about the king-pins is r M at the
+    handwheel (virtual work), so the hysteresis loop's height there (the moment turning one way less the other
+    at the same angle) is the wheels' loop height times r; at strength 0 the torque is unchanged to the bit."""
+    dahl, steer = DahlTyre(), _steer_cycle()
+    road = _road(len(steer), steer=steer, column_per_rack=186.47, steer_per_rack=8.3682)
+    ratio = 8.3682 / 186.47
+    wheels = dahl.dahl(steer)
+    handwheel = dahl.added_torque(road, 1.0)  # the model's tyre moment 0 here: all of it Dahl's
+    quarter, three_quarters = len(steer) // 4, 3 * len(steer) // 4  # +amplitude, then -amplitude
+    going_up = three_quarters + np.argmin(np.abs(steer[three_quarters:]))  # at 0 again, turning right
+    going_down = quarter + np.argmin(np.abs(steer[quarter:three_quarters]))  # at 0 turning left
+    wheel_loop = wheels[going_up] - wheels[going_down]
+    assert wheel_loop > 1.5 * dahl.saturation_Nm  # a wide loop: the moment saturates both ways
+    assert handwheel[going_up] - handwheel[going_down] == pytest.approx(ratio * wheel_loop, rel=1e-12)
+    logged_rack, logged_torque = dahl.logged(road, 0.0)
+    assert np.array_equal(logged_torque, road.torque_Nm) and logged_rack is road.rack_m
+
+
+def test_dahl_tyre_dissipates_at_the_handwheel_what_it_dissipates_at_the_wheels():
+    """The linkage stores no energy: with a ratio r = d(steer)/d(column) that changes along the travel and twice per
+    column turn (a Hooke joint), the handwheel torque's work over a closed cycle of the column, the integral of
+    T d(column), is the king-pin moment's work over it, the integral of M d(steer): the energy the hysteresis takes
+    (positive). A given king-pin moment reaches the handwheel with the ratio's sign; a linkage of the other sense
+    (steer -f, ratio -r) turns the wheels the other way and the hysteresis resists the handwheel all the same."""
+    dahl = DahlTyre()
+    column = 12.0 * np.sin(np.linspace(0.0, 2.0 * np.pi, 400001))
+    a, b, c = 0.045, 0.05, 1.04e-5  # steer = a (column + b sin 2 column) + c column^3: 10 % steeper at 12 rad
+    steer = a * (column + b * np.sin(2.0 * column)) + c * column ** 3
+    ratio = a * (1.0 + 2.0 * b * np.cos(2.0 * column)) + 3.0 * c * column ** 2
+    road = _road(len(column), column=column, steer=steer, column_per_rack=186.47, steer_per_rack=186.47 * ratio)
+    torque = dahl.added_torque(road, 1.0)  # the model's tyre moment 0 here: all of it Dahl's
+    moment = dahl.dahl(steer)
+    handwheel_work = float(np.sum(0.5 * (torque[1:] + torque[:-1]) * np.diff(column)))
+    wheel_work = float(np.sum(0.5 * (moment[1:] + moment[:-1]) * np.diff(steer)))
+    assert wheel_work > 0.1 * dahl.saturation_Nm
+    assert handwheel_work == pytest.approx(wheel_work, rel=1e-4)
+    reversed_ratio = _road(len(column), column=column, steer=steer, column_per_rack=186.47,
+                           steer_per_rack=-186.47 * ratio)
+    assert np.array_equal(dahl.added_torque(reversed_ratio, 1.0), -torque)
+    mirrored = _road(len(column), column=column, steer=-steer, column_per_rack=186.47, steer_per_rack=-186.47 * ratio)
+    assert np.array_equal(dahl.added_torque(mirrored, 1.0), torque)
+
+
+def test_manual_replay_steer_per_rack_is_the_paper_linkage_ratio():
+    """The paper's linkage steers both wheels by roadwheel_to_rack_ratio x rack, so the replay's steer per metre
+    of rack (a central difference of the model's steer map) is that ratio at every sample, the rack's reversals
+    and rests included, where a difference along the series would be 0/0."""
+    from parksteer.parameters import load_parameters
+    from parksteer.synthetic.quirks import manual_road
+    from parksteer.synthetic.variations import variation_by_name
+
+    params = load_parameters()
+    hand, _ = variation_by_name("rest_after_stop").settings(5)
+    road = manual_road(params, hand, "unladen", dt_s=0.01)
+    assert np.any(road.rack_speed_m_s == 0.0) or np.min(np.abs(road.rack_speed_m_s)) < 1e-4  # it rests
+    assert np.allclose(road.steer_per_rack, params["steering.roadwheel_to_rack_ratio"], rtol=1e-8, atol=0.0)
 
 
 def test_bore_friction_dissipates_and_drags_more_one_way():

@@ -2,11 +2,12 @@
 
 A quirk is written apart from the model, as a layer over the manual replay (the prescribed-rack solve,
 :func:`parksteer.model.numeric.simulate.simulate`, on the rack a hand drives: :func:`manual_road`), which gives the
-column torque ``T`` (N m) the car needs, its column angle, rack speed, mean steer angle and the tyre's share of
-``T``; each quirk changes what the logger sees: ``bore_friction`` (:class:`BoreFriction`, a rack friction growing
-toward the ends and stronger one way, N), ``joint_phasing`` (:class:`JointPhasing`, a second universal joint out
-of phase by its angle in rad), ``dahl_tyre`` (:class:`DahlTyre`, a share of the tyre's moment in Dahl's hysteresis
-of the steer angle) and ``tie_rod_compliance`` (:class:`TieRodCompliance`, tie-rod bushes stiffening with load: the
+column torque ``T`` (N m) the car needs, its column angle, rack speed, mean steer angle, the tyre's share of ``T``
+and the linkage's ratios (column angle and steer angle per metre of rack); each quirk changes what the logger sees:
+``bore_friction`` (:class:`BoreFriction`, a rack friction growing toward the ends and stronger one way, N),
+``joint_phasing`` (:class:`JointPhasing`, a second universal joint out of phase by its angle in rad), ``dahl_tyre``
+(:class:`DahlTyre`, a share of the tyre's moment about the king-pins in Dahl's hysteresis of the steer angle,
+through the linkage) and ``tie_rod_compliance`` (:class:`TieRodCompliance`, tie-rod bushes stiffening with load: the
 wheels lag the logged rack by a travel in m that saturates). Each class holds its form and constants. The quirk's
 strength is the car's, one value for every record (:func:`quirk_strength` sizes it on the healthy record); hidden
 library effects on later records enter the replay (``effects``, ``overrides``), under the quirk. The benchmark:
@@ -31,12 +32,14 @@ from .variations import CLEAN_DT_S, HandVariant, variation_rack
 from ..names import TORQUE
 
 JOINT_STEP_RAD = 1e-6  # the central difference of the Hooke joint's map that gives its speed ratio
+STEER_STEP_M = 1e-6  # the central difference of the model's steer map that gives the steer per metre of rack
 
 
 @dataclass
 class ManualRoad:
     """The manual replay of one hand: time, the wheels' rack, the column torque, the column angle, the rack's
-    speed, the mean steer angle, the tyre's share of the torque and the column angle per metre of rack."""
+    speed, the mean steer angle, the tyre's share of the torque, the column angle per metre of rack and the mean
+    steer angle per metre of rack."""
 
     time_s: np.ndarray
     rack_m: np.ndarray
@@ -46,7 +49,14 @@ class ManualRoad:
     steer_rad: np.ndarray
     tyre_Nm: np.ndarray
     column_per_rack: np.ndarray
+    steer_per_rack: np.ndarray
     replayed_Nm: np.ndarray | None = None  # the replay of this rack as a logged rack is replayed (apparent_change)
+
+    @property
+    def steer_per_column(self) -> np.ndarray:
+        """d(mean steer)/d(column angle): by virtual work, the handwheel torque of a moment about the king-pins
+        (both wheels, N m) is the moment times this."""
+        return self.steer_per_rack / self.column_per_rack
 
 
 def manual_road(params: Parameters, hand: HandVariant, case: str, overrides: dict[str, float] | None = None,
@@ -57,8 +67,9 @@ def manual_road(params: Parameters, hand: HandVariant, case: str, overrides: dic
     from ..model.numeric.simulate import simulate
 
     drive = rack_drive if rack_drive is not None else variation_rack(params, hand)
-    c = simulate(case, effects=effects, overrides=dict(overrides or {}), surface=surface, rack_drive=drive,
-                 params=params, output_dt_s=dt_s).columns
+    run = simulate(case, effects=effects, overrides=dict(overrides or {}), surface=surface, rack_drive=drive,
+                   params=params, output_dt_s=dt_s)
+    c = run.columns
     x = np.asarray(c["rack_m"], dtype=float)
     s = params.sections["steering"]
     ratio, angle, phase = s["handwheel_to_rack_ratio"], s["hooke_joint_angle"], s["hooke_joint_phase"]
@@ -68,7 +79,23 @@ def manual_road(params: Parameters, hand: HandVariant, case: str, overrides: dic
     steer = 0.5 * (np.asarray(c["steer_left_rad"], dtype=float) + np.asarray(c["steer_right_rad"], dtype=float))
     return ManualRoad(np.asarray(c["time_s"], dtype=float), x, np.asarray(c[TORQUE], dtype=float),
                       np.asarray(c["column_angle_rad"], dtype=float), np.asarray(c["rack_speed_m_s"], dtype=float),
-                      steer, np.asarray(c["contrib_tyre_friction_Nm"], dtype=float), ratio * speed_ratio)
+                      steer, np.asarray(c["contrib_tyre_friction_Nm"], dtype=float), ratio * speed_ratio,
+                      _steer_per_rack(run))
+
+
+def _steer_per_rack(run) -> np.ndarray:
+    """d(mean steer)/d(rack), rad/m, at each sample: the model's own steer map (its steer outputs, which depend on
+    the rack alone) at the replay's states with the rack moved by +-STEER_STEP_M, a central difference of the
+    kinematics; a difference along the series would be 0/0 wherever the rack reverses."""
+    rack = run.model.index("rack")
+
+    def mean_steer(shift_m: float) -> np.ndarray:
+        states = np.array(run.states, dtype=float)
+        states[:, rack] += shift_m
+        out = run.model.evaluate_outputs(run.columns["time_s"], states, run.parameter_vector)
+        return 0.5 * (np.asarray(out["steer_left_rad"], dtype=float) + np.asarray(out["steer_right_rad"], dtype=float))
+
+    return (mean_steer(STEER_STEP_M) - mean_steer(-STEER_STEP_M)) / (2.0 * STEER_STEP_M)
 
 
 class Quirk:
@@ -118,16 +145,25 @@ class JointPhasing(Quirk):
 
 
 class DahlTyre(Quirk):
+    """A tyre moment of another shape: Dahl's hysteresis of the mean steer angle, a moment about the king-pins (both
+    wheels, N m), reaching the handwheel through the linkage as the model's own tyre moment does (times
+    d(steer)/d(column), :attr:`ManualRoad.steer_per_column`: with the rack's position and twice per column turn),
+    and taking the place of the same share of the model's tyre moment."""
+
     name = "dahl_tyre"
-    what = "a share of the tyre's moment in Dahl's hysteresis of the steer angle"
+    what = "a share of the tyre's moment about the king-pins in Dahl's hysteresis of the steer angle, via the linkage"
     unit = "1"
     upper = 1.0
-    saturation_Nm = 12.0
+    # Both front tyres sliding about the king-pins: the paper's equation (2) at the unladen car's front wheel
+    # loads (about 2.8 kN a wheel, 125 N m each), the size at which the model's own tyre moment slides.
+    saturation_Nm = 250.0
+    # The steer over which the moment builds: a first stiffness M_s / delta_0 of 5 kN m/rad, stiffer than the
+    # paper's carcass (728 N m/rad a wheel) and with a rounder knee than its sliding patch: another shape.
     approach_rad = 0.05
 
     def dahl(self, steer_rad: np.ndarray) -> np.ndarray:
-        """Dahl's moment along the steer angle's path, from rest (0) at the start (explicit steps, exact
-        arithmetic: the same bits on every machine)."""
+        """Dahl's moment about the king-pins along the steer angle's path, from rest (0) at the start (explicit
+        steps, exact arithmetic: the same bits on every machine)."""
         slope = self.saturation_Nm / self.approach_rad
         out = np.empty(len(steer_rad))
         m, previous = 0.0, float(steer_rad[0])
@@ -141,7 +177,9 @@ class DahlTyre(Quirk):
         return out
 
     def added_torque(self, road, strength):
-        return strength * (self.dahl(road.steer_rad) - road.tyre_Nm)
+        """At the handwheel: the share `strength` of the model's tyre moment (``tyre_Nm``, already through the
+        linkage) replaced by Dahl's moment mapped by the linkage's ratio sample by sample."""
+        return strength * (self.dahl(road.steer_rad) * road.steer_per_column - road.tyre_Nm)
 
 
 class TieRodCompliance(Quirk):
