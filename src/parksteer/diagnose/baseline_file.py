@@ -68,7 +68,7 @@ def baseline_text(baseline) -> str:
         lines += _table("form.strengths", {k: dict(v) for k, v in form.strengths.items()})
     t = baseline.threshold
     lines += _table("threshold", {"over_floor": float(t.over_floor), "bic_per_sample": float(t.bic_per_sample),
-                                  "method": t.method})
+                                  "lead_per_sample": float(t.lead_per_sample), "method": t.method})
     for part in t.parts:
         lines += ["[[threshold.parts]]"] + [f"{_key(k)} = {_value(v)}" for k, v in part.items()
                                             if v is not None] + [""]
@@ -140,7 +140,9 @@ def parse_baseline(data: dict, where: str) -> dict:
     t = _get(data, "threshold", dict, where)
     threshold = Threshold(_get(t, "over_floor", float, where, "threshold."),
                           _get(t, "bic_per_sample", float, where, "threshold."),
-                          _get(t, "method", str, where, "threshold."), tuple(dict(p) for p in t.get("parts", ())))
+                          _get(t, "method", str, where, "threshold."), tuple(dict(p) for p in t.get("parts", ())),
+                          # a file written before the lead was learnt: the settings' band alone
+                          _get(t, "lead_per_sample", float, where, "threshold.") if "lead_per_sample" in t else 0.0)
     identified = data.get("identified", {}).get("vehicle")
     return {"vehicle": vehicle.get("file"), "fingerprint": _get(vehicle, "fingerprint", str, where, "vehicle."),
             "records": tuple(_get(records, "files", list, where, "records.")),

@@ -60,19 +60,26 @@ class HeldForm:
 
 @dataclass(frozen=True)
 class Threshold:
-    """What "as the baseline" allows: `over_floor`, the weighted RMS error in noise floors, and `bic_per_sample`, the
-    best candidate's BIC gain per sample, that one more healthy part stays under (95 % prediction bounds over the
-    healthy parts with the form held); `method` says how the parts were made; `parts` lists each."""
+    """What "as the baseline" allows: `over_floor`, the weighted RMS error in noise floors, `bic_per_sample`, the
+    best candidate's BIC gain per sample, and `lead_per_sample`, the best candidate's lead in BIC gain over the
+    second best per sample, that one more healthy part stays under (95 % prediction bounds over the healthy parts
+    with the form held); `method` says how the parts were made; `parts` lists each. A baseline file written before
+    the lead was learnt reads with a lead of 0: the settings' band alone."""
 
     over_floor: float
     bic_per_sample: float
     method: str
     parts: tuple[dict, ...] = ()
+    lead_per_sample: float = 0.0
 
     def settings_for(self, settings: DiagnosisSettings, samples: int) -> DiagnosisSettings:
         """`settings` with the thresholds of "as the baseline" for a later record of `samples` samples: the adequate
         factor at least the healthy spread, the ceiling on a named effect's error raised in proportion, and the BIC
-        gain a candidate needs at least what healthy parts reached at the same length; no candidate named whose
+        gain a candidate needs at least what healthy parts reached at the same length; the band within which two
+        candidates are indistinguishable (a name within it is not confident) at least the lead over the second best
+        that healthy parts reached at the same length: there the best candidate's gain is the car's own misfit taken
+        up, and a candidate's lead of that size is what the misfit makes of two candidates that fit alike, not a
+        change told apart from its rival; no candidate named whose
         95 % interval holds 0 (``headline_interval_clear_of_zero``): against a baseline the held strengths are
         uncertain, and a strength the data do not hold apart from 0 is within what the healthy car already does; and
         nothing calibrated again (the car's calibrated values are the baseline's, :meth:`Baseline.parameters`): a
@@ -82,11 +89,13 @@ class Threshold:
         ceiling = max(settings.missing_rms_ceiling, adequate * settings.missing_rms_ceiling
                       / settings.adequate_rms_factor)
         bic = max(settings.bic_missing_threshold, self.bic_per_sample * samples)
+        band = max(settings.bic_indistinguishable, self.lead_per_sample * samples)
         return dataclasses.replace(settings, adequate_rms_factor=adequate, missing_rms_ceiling=ceiling,
-                                   bic_missing_threshold=bic, headline_interval_clear_of_zero=True,
-                                   calibrated_parameters=(), calibrated_with_angle=(),
-                                   calibrated_with_angle_offsets=())
+                                   bic_missing_threshold=bic, bic_indistinguishable=band,
+                                   headline_interval_clear_of_zero=True, calibrated_parameters=(),
+                                   calibrated_with_angle=(), calibrated_with_angle_offsets=())
 
     def as_dict(self) -> dict:
-        return {"over_floor": self.over_floor, "bic_per_sample": self.bic_per_sample, "method": self.method,
+        return {"over_floor": self.over_floor, "bic_per_sample": self.bic_per_sample,
+                "lead_per_sample": self.lead_per_sample, "method": self.method,
                 "parts": [dict(p) for p in self.parts]}

@@ -106,24 +106,50 @@ def left_out(f: FileData, held_out: np.ndarray) -> FileData:
     return dataclasses.replace(f, replay_uncertainty_Nm=out)
 
 
+def _ranked(found):
+    """The best candidate and the second best (None where there is none: the calibration itself, gain 0), of those
+    refitted, by BIC gain."""
+    refitted = sorted((c for c in found.candidates if c.delta_bic is not None and c.refit is not None),
+                      key=lambda c: c.delta_bic, reverse=True)
+    return (refitted[0] if refitted else None), (refitted[1] if len(refitted) > 1 else None)
+
+
+def _lead(best, second) -> float:
+    """The best candidate's BIC gain over the second best's (a gain under 0 counts as the calibration's, 0), the
+    margin a later record's name is held against the band with."""
+    if best is None or best.delta_bic <= 0.0:
+        return 0.0
+    return best.delta_bic - max(second.delta_bic if second is not None else 0.0, 0.0)
+
+
+def _share(value: float, before: np.ndarray, after: np.ndarray, index: np.ndarray) -> float:
+    """`value` times the fraction of the fall of the weighted sum of squares from `before` to `after` that falls
+    on the samples `index` (clipped to 0-1): a fold's share of a gain over the whole record."""
+    fall_all = float(np.sum(before**2 - after**2))
+    fall_here = float(np.sum(before[index]**2 - after[index]**2))
+    return value * min(max(fall_here / fall_all, 0.0), 1.0) if fall_all > 0.0 else 0.0
+
+
 def fold_row(found, label: str, mask: np.ndarray) -> dict:
     """One fold's row: its weighted RMS error in noise floors under the whole record's calibration with the form
-    fitted without it held, and its share of the best candidate's BIC gain (the gain times the fraction of the
-    refit's fall of the weighted sum of squares that falls on the fold's samples)."""
+    fitted without it held, its share of the best candidate's BIC gain (the gain times the fraction of the
+    refit's fall of the weighted sum of squares that falls on the fold's samples), and its share of the best
+    candidate's lead over the second best, scaled the same way (the lead times the fraction of the fall from the
+    second best's refit to the best's that falls on the fold)."""
     f, prediction = found.problem.files[0], found.calibration.predictions[0]
     index = np.tile(mask, f.signals)
     weighted = (f.measured - prediction) / f.sigma
     samples = int(index.sum())
-    best = max((c for c in found.candidates if c.delta_bic is not None and c.refit is not None),
-               key=lambda c: c.delta_bic, default=None)
-    gain = 0.0
+    best, second = _ranked(found)
+    gain = lead = 0.0
     if best is not None and best.delta_bic > 0.0:
         after = (f.measured - best.refit.predictions[0]) / f.sigma
-        fall_all = float(np.sum(weighted**2 - after**2))
-        fall_here = float(np.sum(weighted[index]**2 - after[index]**2))
-        gain = best.delta_bic * min(max(fall_here / fall_all, 0.0), 1.0) if fall_all > 0.0 else 0.0
+        gain = _share(best.delta_bic, weighted, after, index)
+        runner = weighted if second is None or second.delta_bic <= 0.0 \
+            else (f.measured - second.refit.predictions[0]) / f.sigma
+        lead = _share(_lead(best, second), runner, after, index)
     return {"part": label, "samples": samples, "over_floor": float(np.sqrt(np.mean(weighted[index]**2))),
-            **_best_of(best), "delta_bic": gain, "verdict": found.verdict}
+            **_best_of(best), "delta_bic": gain, "lead": lead, "verdict": found.verdict}
 
 
 def _best_of(candidate) -> dict:
@@ -190,8 +216,10 @@ def prediction_bound(values) -> float:
 def _threshold(rows: list[dict], method: str) -> Threshold:
     over = prediction_bound([r["over_floor"] for r in rows])
     gain = prediction_bound([r["delta_bic"] / r["samples"] for r in rows])
+    lead = prediction_bound([r["lead"] / r["samples"] for r in rows])
     return Threshold(over, max(gain, 0.0), method + "; the threshold is the one-sided 95 % prediction bound for "
-                     "one more healthy part (Student's t over the parts)", tuple(rows))
+                     "one more healthy part (Student's t over the parts), of the error, the best candidate's gain and "
+                     "its lead over the second best", tuple(rows), max(lead, 0.0))
 
 
 def pooled_bound(values, per_record: int) -> float:
@@ -208,18 +236,25 @@ def pooled_bound(values, per_record: int) -> float:
 
 
 def _block_threshold(rows: list[dict], method: str) -> Threshold:
-    """The threshold of one record's blocks (:func:`_folds`): the bounds on a later record's mean square error and
-    mean BIC gain per sample over as many blocks as the healthy record has, pooled over its blocks."""
+    """The threshold of one record's blocks (:func:`_folds`): the bounds on a later record's mean square error,
+    mean BIC gain per sample and mean lead of the best candidate over the second best per sample, over as many
+    blocks as the healthy record has, pooled over its blocks."""
     k = len(rows)
     mean_square = pooled_bound([r["over_floor"] ** 2 for r in rows], k)
     gain = pooled_bound([r["delta_bic"] / r["samples"] for r in rows], k)
+    lead = pooled_bound([r["lead"] / r["samples"] for r in rows], k)
     return Threshold(math.sqrt(max(mean_square, 0.0)), max(gain, 0.0), method + "; the threshold is the one-sided "
-                     f"95 % prediction bound for a later record's mean over {k} blocks, the blocks' variance pooled "
-                     "(Student's t over the blocks)", tuple(rows))
+                     f"95 % prediction bound for a later record's mean over {k} blocks, of the error, the best "
+                     "candidate's gain and its lead over the second best, the blocks' variance pooled (Student's t "
+                     "over the blocks)", tuple(rows), max(lead, 0.0))
 
 
 def _best_gain(found) -> float:
     return max([0.0, *(c.delta_bic for c in found.candidates if c.delta_bic is not None)])
+
+
+def _record_lead(found) -> float:
+    return _lead(*_ranked(found))
 
 
 def blocks_of(f: FileData, block_s: float) -> int:
@@ -273,7 +308,7 @@ def spread(make, files, params: Parameters, base: list[Effect], registry, form: 
         found = _judged(make, [judged], params, base, registry, held, train, start, settings, workers)
         n = found.problem.n
         rows.append({"part": judged.label, "samples": int(n), "over_floor": math.sqrt(found.calibration.rss / n),
-                     **_best_of(found.best), "delta_bic": _best_gain(found),
+                     **_best_of(found.best), "delta_bic": _best_gain(found), "lead": _record_lead(found),
                      "verdict": found.verdict})
     return _threshold(rows, method)
 
@@ -308,8 +343,9 @@ def learn(make, files, params: Parameters, effects=None, settings: DiagnosisSett
                             + (f" with {form.effect}" if form is not None else ""))
     start = {k: v["value"] for k, v in calibrated.items()}
     threshold = spread(make, files, params, base, registry, form, start, settings, workers, say, share)
-    say(f"baseline: as the baseline up to {threshold.over_floor:.2f} noise floors and a BIC gain of "
-        f"{threshold.bic_per_sample:.4f} per sample ({threshold.method.split(':')[0]})")
+    say(f"baseline: as the baseline up to {threshold.over_floor:.2f} noise floors, a BIC gain of "
+        f"{threshold.bic_per_sample:.4f} and a lead of {threshold.lead_per_sample:.4f} per sample "
+        f"({threshold.method.split(':')[0]})")
     return make(None if vehicle is None else str(vehicle), fingerprint, tuple(f.label for f in files),
                     tuple(e.name for e in base), calibrated, absolute.verdict,
                     math.sqrt(absolute.calibration.rss / absolute.problem.n), form, threshold, identified)

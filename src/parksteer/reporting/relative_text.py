@@ -38,5 +38,6 @@ def relative_sentence(result: dict) -> str | None:
     else:
         said = "Changed, outside the library: see the residual's signature below."
     return (f"{name} (content hash {rel['content_hash']}; {held}). {said} \"As the baseline\" allows up to "
-            f"{num(t['over_floor'])} noise floors and a BIC gain of {num(t['bic_per_sample'])} per sample, from "
-            f"{t['method']}.")
+            f"{num(t['over_floor'])} noise floors and a BIC gain of {num(t['bic_per_sample'])} per sample, and a name "
+            f"is confident only beyond a lead of {num(t.get('lead_per_sample', 0.0))} per sample over the second "
+            f"best, from {t['method']}.")
