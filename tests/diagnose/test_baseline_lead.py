@@ -27,27 +27,23 @@ def _found(measured, calibration, candidates):
                            candidates=candidates, verdict="missing")
 
 
-def test_a_parts_lead_is_its_share_of_the_fall_from_the_second_best_to_the_best():
-    """The lead of the best candidate over the second best is apportioned to a part as its gain is: by the share,
-    on the part's samples, of the weighted sum of squares by which the best's refit falls below the second best's.
-    Where the two refits agree on a part, its lead is 0, whatever either gains there; the parts that hold the whole
-    difference hold the whole lead (here split 1 : 3)."""
-    n = 40
+def test_a_parts_lead_is_its_signed_share_of_the_fall_from_the_second_best_to_the_best():
+    """The lead of the best candidate over the second best is apportioned to a part by the share, on the part's
+    samples, of the weighted sum of squares by which the best's refit falls below the second best's. Where the two
+    refits agree on a part, its lead is 0, whatever either gains there; where the second best fits better, the
+    part's lead is below 0; the parts' leads add up to the whole lead (here in shares -1 : 0 : 2 of a fall of 1)."""
+    n = 30
     measured = np.zeros(n)
     calibration = np.full(n, 2.0)  # the calibration misses by 2 everywhere
-    second = calibration.copy()
-    second[:20] = 1.0  # the second best halves the miss on the first half only
+    second = np.full(n, 1.0)
     best = second.copy()
-    best[20:30] = 1.9  # the best does as well there, and a little better on the third quarter ...
-    best[30:40] = 1.7  # ... and three times as much better on the fourth
+    best[:10] = np.sqrt(1.1)  # worse than the second best on the first part by a sum of squares of 1 ...
+    best[20:] = np.sqrt(0.8)  # ... better on the third by 2; the second part alike
     found = _found(measured, calibration, [_candidate("a", 30.0, best), _candidate("b", 22.0, second),
                                           _candidate("c", -3.0, calibration)])
-    halves = [np.arange(n) < 20, (np.arange(n) >= 20) & (np.arange(n) < 30), np.arange(n) >= 30]
-    leads = [fold_row(found, f"part {k}", mask)["lead"] for k, mask in enumerate(halves)]
-    fall = [0.0, 10 * (2.0**2 - 1.9**2), 10 * (2.0**2 - 1.7**2)]
-    assert leads[0] == 0.0
-    assert leads[1] == pytest.approx(8.0 * fall[1] / sum(fall))
-    assert leads[2] == pytest.approx(8.0 * fall[2] / sum(fall))
+    parts = [np.arange(n) // 10 == k for k in range(3)]
+    leads = [fold_row(found, f"part {k}", mask)["lead"] for k, mask in enumerate(parts)]
+    assert leads == pytest.approx([-8.0, 0.0, 16.0])
     assert sum(leads) == pytest.approx(30.0 - 22.0)
 
 

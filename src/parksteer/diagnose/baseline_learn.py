@@ -122,12 +122,14 @@ def _lead(best, second) -> float:
     return best.delta_bic - max(second.delta_bic if second is not None else 0.0, 0.0)
 
 
-def _share(value: float, before: np.ndarray, after: np.ndarray, index: np.ndarray) -> float:
+def _share(value: float, before: np.ndarray, after: np.ndarray, index: np.ndarray, clipped: bool = True) -> float:
     """`value` times the fraction of the fall of the weighted sum of squares from `before` to `after` that falls
-    on the samples `index` (clipped to 0-1): a fold's share of a gain over the whole record."""
+    on the samples `index` (`clipped` to 0-1, or signed): a fold's share of a gain over the whole record."""
     fall_all = float(np.sum(before**2 - after**2))
     fall_here = float(np.sum(before[index]**2 - after[index]**2))
-    return value * min(max(fall_here / fall_all, 0.0), 1.0) if fall_all > 0.0 else 0.0
+    if fall_all <= 0.0:
+        return 0.0
+    return value * (min(max(fall_here / fall_all, 0.0), 1.0) if clipped else fall_here / fall_all)
 
 
 def fold_row(found, label: str, mask: np.ndarray) -> dict:
@@ -135,7 +137,10 @@ def fold_row(found, label: str, mask: np.ndarray) -> dict:
     fitted without it held, its share of the best candidate's BIC gain (the gain times the fraction of the
     refit's fall of the weighted sum of squares that falls on the fold's samples), and its share of the best
     candidate's lead over the second best, scaled the same way (the lead times the fraction of the fall from the
-    second best's refit to the best's that falls on the fold)."""
+    second best's refit to the best's that falls on the fold). The lead's share is signed: both candidates have one
+    strength, so the lead is the log ratio of their sums of squares, and to first order the sum over samples of
+    the difference of their squared residuals; where the second best fits a fold better, that fold counts against
+    the lead, as it would in a later record's sum, and the folds' shares of one diagnosis add up to its lead."""
     f, prediction = found.problem.files[0], found.calibration.predictions[0]
     index = np.tile(mask, f.signals)
     weighted = (f.measured - prediction) / f.sigma
@@ -147,7 +152,7 @@ def fold_row(found, label: str, mask: np.ndarray) -> dict:
         gain = _share(best.delta_bic, weighted, after, index)
         runner = weighted if second is None or second.delta_bic <= 0.0 \
             else (f.measured - second.refit.predictions[0]) / f.sigma
-        lead = _share(_lead(best, second), runner, after, index)
+        lead = _share(_lead(best, second), runner, after, index, clipped=False)
     return {"part": label, "samples": samples, "over_floor": float(np.sqrt(np.mean(weighted[index]**2))),
             **_best_of(best), "delta_bic": gain, "lead": lead, "verdict": found.verdict}
 
