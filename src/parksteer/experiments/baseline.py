@@ -98,7 +98,8 @@ def car_by_name(design: BaselineDesign, name: str) -> Car:
 
 def judged(truth: dict, result: dict) -> dict:
     """One diagnosis's answer and how it fares: named (a hidden effect, or in its group), adequate, confident (a
-    name beyond the BIC band) and confident wrong (a confident name that is not the hidden effect)."""
+    name beyond the BIC band, `band` the one it was judged with) and confident wrong (a confident name that is not
+    the hidden effect)."""
     missing = result["verdict"] == "missing"
     named = result["effect"] if missing else None
     group = [s["effect"] for s in result.get("indistinguishable", [])]
@@ -109,7 +110,7 @@ def judged(truth: dict, result: dict) -> dict:
     return {"verdict": result["verdict"], "effect": named or "", "indistinguishable": " ".join(group),
             "named": bool(right), "confident": confident, "confident_wrong": confident and not right,
             "changed_value": changed_key(named) is not None,
-            "bic_margin": margin,
+            "bic_margin": margin, "band": band,
             "over_floor": result["statistics"]["calibrated"]["weighted_rms_Nm"] / result["noise_floor_Nm"]}
 
 
@@ -172,6 +173,7 @@ def run_car(params: Parameters, car: Car, vehicle_path=None, progress=None) -> d
             named = named() if callable(named) else named
             out["learnt"] = {"verdict": named["verdict"], "form": named["form"],
                              "threshold_over_floor": named["threshold"]["over_floor"],
+                             "threshold_lead_per_sample": named["threshold"].get("lead_per_sample", 0.0),
                              "threshold_method": named["threshold"]["method"], "records": 1 + len(more)}
         for index, later in enumerate(car.later, start=1):
             truth, record = maker.later(later, index)
