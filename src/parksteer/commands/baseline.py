@@ -117,7 +117,7 @@ def baseline_lines(baseline) -> list[str]:
                      + (f": {form.signature}" if form.signature else ""))
     t = baseline.threshold
     lines.append(f"as the baseline: up to {t.over_floor:.2f} noise floors, a BIC gain up to {t.bic_per_sample:.4f} "
-                 f"per sample, a name confident only beyond a lead of {t.lead_per_sample:.4f} per sample over the "
-                 f"second best ({t.method})")
+                 f"per sample, a confident name leading the second best by more than {t.lead_per_sample:.4f} per "
+                 f"sample and the settings' band ({t.method})")
     lines.append(f"wrote {baseline.path} (content hash {baseline.content_hash})")
     return lines

@@ -12,6 +12,7 @@ def relative_sentence(result: dict) -> str | None:
         return None
     name = rel["baseline"] or "learnt from " + ", ".join(rel["records"])
     t = rel["threshold"]
+    band = result["selection"]["thresholds"]["bic_indistinguishable"]
     held = f"with {rel['form']} held at the baseline's strengths" if rel["form"] else "the healthy records were adequate"
     verdict = result["verdict"]
     if verdict == "adequate":
@@ -39,5 +40,6 @@ def relative_sentence(result: dict) -> str | None:
         said = "Changed, outside the library: see the residual's signature below."
     return (f"{name} (content hash {rel['content_hash']}; {held}). {said} \"As the baseline\" allows up to "
             f"{num(t['over_floor'])} noise floors and a BIC gain of {num(t['bic_per_sample'])} per sample, and a name "
-            f"is confident only beyond a lead of {num(t.get('lead_per_sample', 0.0))} per sample over the second "
-            f"best, from {t['method']}.")
+            f"is confident only where it leads the second best by more than {num(band)} (the settings' band, or "
+            f"{num(t.get('lead_per_sample', 0.0))} per sample times the record's samples where that is more), from "
+            f"{t['method']}.")
