@@ -8,10 +8,10 @@ them, :mod:`parksteer.diagnose.baseline_share`), and how far apart healthy data 
 out of sample: leave one record out, or with one record each of its 2 s blocks left out; the one-sided 95 %
 prediction bound, in noise floors, for one more healthy record). A later record is diagnosed
 (``diagnose(..., baseline=...)``) with the form's strengths and the car's calibrated values held at the baseline's
-(nothing calibrated again), and with that threshold where it is above the sensor's
-(:meth:`Threshold.settings_for`): ``adequate`` reads "as the baseline", ``missing`` "changed: X", ``unexplained``
-"changed, outside the library"; against a baseline no candidate whose 95 % interval holds 0 is named. The
-diagnosis's JSON names the baseline (``relative_to``).
+(nothing calibrated again), and with that threshold where it is above the sensor's, a name confident only beyond
+the lead over the second best that healthy parts reach (:meth:`Threshold.settings_for`): ``adequate`` reads "as the
+baseline", ``missing`` "changed: X", ``unexplained`` "changed, outside the library"; against a baseline no
+candidate whose 95 % interval holds 0 is named. The diagnosis's JSON names the baseline (``relative_to``).
 The file (:meth:`Baseline.write`, :mod:`parksteer.diagnose.baseline_file`) is TOML a person reads, every value with its
 interval and source. Why and how: docs/diagnosis.md, "Against a car's baseline".
 """
