@@ -16,6 +16,7 @@ docs/assist_diagnosis.md.
 
 from __future__ import annotations
 
+import functools
 import json
 import tempfile
 import time
@@ -32,7 +33,7 @@ from ..parameters import Parameters
 from ..synthetic.assisted import OUT_OF_CLASS, AssistedLogger, assisted_clean, assisted_record
 from ..synthetic.assisted_truth import HIDDEN_TRUTH
 from ..synthetic.datasets import BASE_PERTURBATION, perturbed_base
-from ..synthetic.size_search import SizeSearch, remembered, rms_difference, strength_for_rms
+from ..synthetic.size_search import SizeSearch, rms_difference, strength_for_rms
 from ..measure.converter import quantisation_step
 from ..synthetic.variations import variation_by_name
 from .benchmark import BENCHMARK_SETTINGS
@@ -181,10 +182,10 @@ def case_truth_and_record(params: Parameters, design: AssistedDesign, case: Assi
     if case.kind == "hidden":
         key = hidden[case.hidden][0]
         if case.hidden == "rack_friction":
-            of = remembered(lambda s: torque(assist, {**base, key: base[key] + s}))
+            of = functools.cache(lambda s: torque(assist, {**base, key: base[key] + s}))
         else:
             spec = f"{assist},+{case.hidden}"
-            of = remembered(lambda s: torque(spec, {**base, key: s}))
+            of = functools.cache(lambda s: torque(spec, {**base, key: s}))
         largest = largest_size(case.hidden, hidden)
         strength = strength_for_rms(of, case.steps * step, largest * 1e-2, largest, SEARCH)
         size = rms_difference(of(strength), reference()) / step

@@ -16,6 +16,7 @@ unless related. The truth and the results: docs/assist_diagnosis.md, "An indepen
 
 from __future__ import annotations
 
+import functools
 import json
 import math
 import tempfile
@@ -41,7 +42,7 @@ from ..synthetic.assisted_truth import (
 )
 from ..synthetic.column_eps_layer import truth_clean
 from ..synthetic.datasets import BASE_PERTURBATION, perturbed_base
-from ..synthetic.size_search import remembered, rms_difference, strength_for_rms
+from ..synthetic.size_search import rms_difference, strength_for_rms
 from ..synthetic.variations import variation_by_name
 from .benchmark import BENCHMARK_SETTINGS
 from .assisted_benchmark import RACK_FRICTION, judged
@@ -88,7 +89,7 @@ def case_truth_and_record(params: Parameters, design: TruthDesign, case: TruthCa
     hidden, strength, size = Hidden(), None, 0.0
     if case.kind != "null":
         reference = reading(Hidden())
-        of = remembered(lambda s: reading(with_hidden(Hidden(), case.hidden, s)))
+        of = functools.cache(lambda s: reading(with_hidden(Hidden(), case.hidden, s)))
         target = case.floors * floor_Nm(logger)
         largest = largest_size(case.hidden)
         strength = strength_for_rms(of, target, largest * 1e-2, largest, SEARCH)

@@ -173,7 +173,7 @@ def run_car(params: Parameters, car: Car, vehicle_path=None, progress=None) -> d
             named = named() if callable(named) else named
             out["learnt"] = {"verdict": named["verdict"], "form": named["form"],
                              "threshold_over_floor": named["threshold"]["over_floor"],
-                             "threshold_lead_per_sample": named["threshold"].get("lead_per_sample", 0.0),
+                             "threshold_lead_per_sample": named["threshold"]["lead_per_sample"],
                              "threshold_method": named["threshold"]["method"], "records": 1 + len(more)}
         for index, later in enumerate(car.later, start=1):
             truth, record = maker.later(later, index)

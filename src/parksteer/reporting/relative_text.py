@@ -41,5 +41,5 @@ def relative_sentence(result: dict) -> str | None:
     return (f"{name} (content hash {rel['content_hash']}; {held}). {said} \"As the baseline\" allows up to "
             f"{num(t['over_floor'])} noise floors and a BIC gain of {num(t['bic_per_sample'])} per sample, and a name "
             f"is confident only where it leads the second best by more than {num(band)} (the settings' band, or "
-            f"{num(t.get('lead_per_sample', 0.0))} per sample times the record's samples where that is more), from "
+            f"{num(t['lead_per_sample'])} per sample times the record's samples where that is more), from "
             f"{t['method']}.")

@@ -25,20 +25,6 @@ class SizeSearch:
     max_lag_s: float
 
 
-def remembered(torque_of):
-    """`torque_of`, each size run once: a caller that records the change at the size :func:`strength_for_rms`
-    returned reads the run the search made there (the same run, so the same numbers) instead of simulating again."""
-    runs: dict[float, np.ndarray] = {}
-
-    def run(size: float) -> np.ndarray:
-        size = float(size)
-        if size not in runs:
-            runs[size] = torque_of(size)
-        return runs[size]
-
-    return run
-
-
 def strength_for_rms(torque_of, target_Nm: float, start: float, upper: float, search: SizeSearch) -> float:
     """The size s (from 0 up) at which RMS(torque_of(s) - torque_of(0)) = target: secant steps in log-log.
 
