@@ -4,7 +4,8 @@ process and in worker processes, reports the same JSON, field by field, but its 
 
 The routes differ in what the workers are handed: several records (a prediction's files spread over the workers,
 two or three per pool), a torque lag searched (new problems on new files, at new instants, after the workers of
-the first were forked), the handwheel angle fitted beside the torque (two signals a file), a user's effect with
+the first were forked), the handwheel angle fitted beside the torque (two signals a file, on one record: the
+spreading of a prediction's files over the workers is the several records' route), a user's effect with
 free strengths (a model derived from a file outside the package, its class found by reference in the workers) and
 an assisted car (its torsion-bar torque and motor current).
 
@@ -80,7 +81,9 @@ def routes(folder: Path) -> dict[str, list[str]]:
         # 20 ms at 50 Hz: one sample; the whole records, on which the lag found is the record's (on their first
         # halves it comes out at 13 and 16 ms)
         "torque_lag": [*(str(lagged(p, folder, 1)) for p in CAR), "--torque-lag"],
-        "angle": [*car, "--angle"],
+        # one record, its two signals: the same verdict through the same stages as two records' (rack_lash among
+        # the candidates, its twist through the column's deflection law)
+        "angle": [car[0], "--angle"],
         "user_effect": [*car, f"--effects=+{ROOT / 'examples' / 'user_effect' / 'centre_friction.py'}"],
         "assisted": [*half(SAMPLES / "polo_baseline.csv", SAMPLES / "polo_drag.csv"), "--with-assist",
                      "--vehicle", str(ROOT / "data" / "vehicles" / "polo_vi.toml")],
