@@ -7,13 +7,18 @@ up to date (`snakemake --touch`), once for the module; then a module is edited a
 Snakemake would run. No job runs: the DAG alone shows which rules depend on which module. After each test the
 edited file gets back its bytes and its modification time, which is all a dry run's verdict depends on (a dry run
 writes no metadata), so the copy is up to date again for the next test without a second `--touch`.
+
+Snakemake runs in the test's process, through its command line's own entry point (`snakemake.cli.main`, the same
+arguments and the workflow's profile): what is checked is the DAG each command plans, not the process, and a
+process of its own for each command spent most of its time importing Snakemake again.
 """
 
 from __future__ import annotations
 
+import contextlib
+import io
 import os
 import re
-import subprocess
 import sys
 from pathlib import Path
 
@@ -22,14 +27,26 @@ import yaml
 
 pytestmark = pytest.mark.slow
 
-SNAKEMAKE = Path(sys.executable).with_name("snakemake")
-
 
 def _snakemake(workdir: Path, *args: str) -> str:
+    """`snakemake ARGS` run in `workdir` (module docstring: in this process); its stdout and stderr."""
     # The outputs here are empty placeholders; reading the workflow removes nothing (repair is `parksteer repair`).
-    done = subprocess.run([str(SNAKEMAKE), *args], cwd=workdir, capture_output=True, text=True, timeout=300)
-    assert done.returncode == 0, (done.stdout + done.stderr)[-3000:]
-    return done.stdout + done.stderr
+    from snakemake.cli import main
+
+    printed = io.StringIO()
+    status = None
+    before, path = Path.cwd(), list(sys.path)  # Snakemake puts the workflow's folders on the path: taken off after
+    os.chdir(workdir)
+    try:
+        with contextlib.redirect_stdout(printed), contextlib.redirect_stderr(printed):
+            main(list(args))
+    except SystemExit as done:  # the entry point always ends so, with the command's exit status
+        status = done.code
+    finally:
+        os.chdir(before)
+        sys.path[:] = path
+    assert status == 0, printed.getvalue()[-3000:]
+    return printed.getvalue()
 
 
 def _planned(workdir: Path, *options: str) -> dict[str, int]:
