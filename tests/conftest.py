@@ -3,9 +3,12 @@ per session, seeded) for the data-set and diagnosis tests."""
 
 from __future__ import annotations
 
+import contextlib
 import importlib.util
+import io
 import os
 import shutil
+import sys
 from pathlib import Path
 
 # One BLAS thread per test process, set before numpy loads here and inherited by the workers and every subprocess:
@@ -106,6 +109,37 @@ def copy_with_models(repo_root, copy_repository):
             shutil.copytree(entry, work / "results" / "model" / entry.name)
         return work
     return copy
+
+
+def _snakemake(workdir: Path, *args: str) -> tuple[str, str]:
+    """`snakemake ARGS` run in `workdir` in this process; (stdout, stderr). A status other than 0 fails the test
+    with the output's tail."""
+    # The tests' outputs are empty placeholders; reading the workflow removes nothing (repair is `parksteer repair`).
+    from snakemake.cli import main
+
+    out, err = io.StringIO(), io.StringIO()
+    status = None
+    before, path = Path.cwd(), list(sys.path)  # Snakemake puts the workflow's folders on the path: taken off after
+    os.chdir(workdir)
+    try:
+        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+            main(list(args))
+    except SystemExit as done:  # the entry point always ends so, with the command's exit status
+        status = done.code
+    finally:
+        os.chdir(before)
+        sys.path[:] = path
+    assert status == 0, (out.getvalue() + err.getvalue())[-3000:]
+    return out.getvalue(), err.getvalue()
+
+
+@pytest.fixture(scope="session")
+def snakemake():
+    """run(workdir, *args) -> (stdout, stderr): the command `snakemake ARGS` in `workdir`, through its command line's
+    own entry point (snakemake.cli.main: the same arguments, the workflow's profile) in the test's process, for the
+    tests that read what a command plans or writes without running a job: a process of its own for each command
+    spent most of its time importing Snakemake and its plugins again."""
+    return _snakemake
 
 
 def _placeholder_files(work: Path, outputs: list[str]) -> None:

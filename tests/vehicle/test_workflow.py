@@ -2,27 +2,22 @@
 
 from __future__ import annotations
 
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
 
-SNAKEMAKE = Path(sys.executable).with_name("snakemake")
 
-
-def _summary(repo_root: Path, *args: str) -> dict[str, str]:
-    """Output file -> rule of a target's DAG (snakemake --summary; no job runs)."""
-    done = subprocess.run([str(SNAKEMAKE), *args, "--summary"], cwd=repo_root, capture_output=True, text=True,
-                          timeout=300)
-    assert done.returncode == 0, done.stderr[-3000:]
-    rows = [line.split("\t") for line in done.stdout.splitlines()[1:] if "\t" in line]
+def _summary(snakemake, repo_root: Path, *args: str) -> dict[str, str]:
+    """Output file -> rule of a target's DAG (snakemake --summary, `snakemake` the conftest fixture; no job runs)."""
+    out, _ = snakemake(repo_root, *args, "--summary")
+    rows = [line.split("\t") for line in out.splitlines()[1:] if "\t" in line]
     return {row[0]: row[2] for row in rows}
 
 
 @pytest.fixture(scope="module")
-def dags(repo_root):
-    return (_summary(repo_root, "vehicle_study", "--config", "vehicle=polo_vi"), _summary(repo_root, "all"))
+def dags(repo_root, snakemake):
+    return (_summary(snakemake, repo_root, "vehicle_study", "--config", "vehicle=polo_vi"),
+            _summary(snakemake, repo_root, "all"))
 
 
 def test_vehicle_study_writes_under_its_own_name(dags, repo_root):

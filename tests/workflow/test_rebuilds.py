@@ -8,18 +8,14 @@ Snakemake would run. No job runs: the DAG alone shows which rules depend on whic
 edited file gets back its bytes and its modification time, which is all a dry run's verdict depends on (a dry run
 writes no metadata), so the copy is up to date again for the next test without a second `--touch`.
 
-Snakemake runs in the test's process, through its command line's own entry point (`snakemake.cli.main`, the same
-arguments and the workflow's profile): what is checked is the DAG each command plans, not the process, and a
-process of its own for each command spent most of its time importing Snakemake again.
+Snakemake runs in the test's process (the conftest fixture `snakemake`): what is checked is the DAG each command
+plans, not the process.
 """
 
 from __future__ import annotations
 
-import contextlib
-import io
 import os
 import re
-import sys
 from pathlib import Path
 
 import pytest
@@ -28,30 +24,9 @@ import yaml
 pytestmark = pytest.mark.slow
 
 
-def _snakemake(workdir: Path, *args: str) -> str:
-    """`snakemake ARGS` run in `workdir` (module docstring: in this process); its stdout and stderr."""
-    # The outputs here are empty placeholders; reading the workflow removes nothing (repair is `parksteer repair`).
-    from snakemake.cli import main
-
-    printed = io.StringIO()
-    status = None
-    before, path = Path.cwd(), list(sys.path)  # Snakemake puts the workflow's folders on the path: taken off after
-    os.chdir(workdir)
-    try:
-        with contextlib.redirect_stdout(printed), contextlib.redirect_stderr(printed):
-            main(list(args))
-    except SystemExit as done:  # the entry point always ends so, with the command's exit status
-        status = done.code
-    finally:
-        os.chdir(before)
-        sys.path[:] = path
-    assert status == 0, printed.getvalue()[-3000:]
-    return printed.getvalue()
-
-
-def _planned(workdir: Path, *options: str) -> dict[str, int]:
-    """Rule -> number of jobs a dry run of the default target plans."""
-    out = _snakemake(workdir, "all", "--dry-run", *options)  # the target first: --configfile takes several
+def _planned(snakemake, workdir: Path, *options: str) -> dict[str, int]:
+    """Rule -> number of jobs a dry run of the default target plans (`snakemake`: the conftest fixture)."""
+    out = "".join(snakemake(workdir, "all", "--dry-run", *options))  # the target first: --configfile takes several
     if "Nothing to be done" in out:
         return {}
     stats = out[out.index("Job stats:"):]
@@ -82,62 +57,62 @@ def edit():
 
 
 @pytest.fixture(scope="module")
-def repository_copy(copy_repository, placeholder_outputs, tmp_path_factory) -> Path:
+def repository_copy(copy_repository, placeholder_outputs, snakemake, tmp_path_factory) -> Path:
     """A copy of the repository whose every pipeline output exists and is up to date."""
     work = copy_repository(tmp_path_factory.mktemp("rebuilds"))
-    placeholder_outputs(work, _snakemake(work, "--summary", "all"))
+    placeholder_outputs(work, snakemake(work, "--summary", "all")[0])
     return work
 
 
 @pytest.fixture(scope="module")
-def up_to_date_copy(repository_copy) -> Path:
+def up_to_date_copy(repository_copy, snakemake) -> Path:
     """The copy, every output marked up to date (each newer than its inputs, in DAG order) and every job's metadata
     recorded as a run records it (its parameters, the code digest among them: --forceall makes --touch pass over
     every job); each test restores what it edits (fixture `edit`)."""
-    _snakemake(repository_copy, "--touch", "--forceall", "--cores", "1", "all")
-    assert _planned(repository_copy) == {}
+    snakemake(repository_copy, "--touch", "--forceall", "--cores", "1", "all")
+    assert _planned(snakemake, repository_copy) == {}
     return repository_copy
 
 
-def test_a_figure_module_edit_reruns_that_figure_and_the_paper_only(up_to_date_copy, edit):
+def test_a_figure_module_edit_reruns_that_figure_and_the_paper_only(up_to_date_copy, edit, snakemake):
     """figures/lifting.py draws Fig. A3 alone: editing it plans figA3 and the paper that shows it, nothing else."""
     edit(up_to_date_copy / "src" / "parksteer" / "figures" / "lifting.py")
-    assert _planned(up_to_date_copy) == {"figA3": 1, "paper": 1, "all": 1}
+    assert _planned(snakemake, up_to_date_copy) == {"figA3": 1, "paper": 1, "all": 1}
 
 
-def test_a_numeric_model_edit_derives_nothing_and_reruns_the_simulations(up_to_date_copy, edit):
+def test_a_numeric_model_edit_derives_nothing_and_reruns_the_simulations(up_to_date_copy, edit, snakemake):
     """model/numeric does not key the compiled model: editing simulate.py plans every simulation again (the model
     figures' runs, the sweep's batches, the synthetic data) but no derive job."""
     edit(up_to_date_copy / "src" / "parksteer" / "model" / "numeric" / "simulate.py")
-    planned = _planned(up_to_date_copy)
+    planned = _planned(snakemake, up_to_date_copy)
     assert "derive" not in planned
     assert planned["simulate_model"] > 0 and planned["sweep_batch"] > 0 and planned["diag_car_data"] == 1
 
 
-def test_a_diagnosis_setting_edit_reruns_the_diagnoses_not_the_model_figures(up_to_date_copy, edit):
+def test_a_diagnosis_setting_edit_reruns_the_diagnoses_not_the_model_figures(up_to_date_copy, edit, snakemake):
     """diagnose/settings.py holds the diagnosis thresholds: editing it reruns the benchmark's diagnoses and the
     case study, and leaves the compiled models, the simulations of the model figures and the sweep alone."""
     edit(up_to_date_copy / "src" / "parksteer" / "diagnose" / "settings.py")
-    planned = _planned(up_to_date_copy)
+    planned = _planned(snakemake, up_to_date_copy)
     assert planned["diag_bench_batch"] > 0 and planned["case_study"] == 1 and planned["diag_benchmark"] == 1
     assert not {"derive", "simulate_model", "model_figure", "sweep_batch", "fig3", "figA3"} & set(planned)
 
 
-def test_a_design_entry_reruns_what_it_affects(up_to_date_copy, tmp_path):
+def test_a_design_entry_reruns_what_it_affects(up_to_date_copy, tmp_path, snakemake):
     """A new seed of the synthetic car (config car.seed) plans its data set again and what reads it (comparison,
     case study, ladder, paper), not the benchmark; a new legend label of Fig. 14's ablation plans Fig. 14 alone."""
     seed = tmp_path / "seed.yaml"
     seed.write_text("car:\n  seed: 1984\n", encoding="utf-8")
-    planned = _planned(up_to_date_copy, "--configfile", str(seed))
+    planned = _planned(snakemake, up_to_date_copy, "--configfile", str(seed))
     assert planned == {"diag_car_data": 1, "diag_compare": 1, "case_study": 1, "diag_ladder": 1, "paper": 1,
                        "all": 1}
     label = tmp_path / "label.yaml"
     label.write_text("variants:\n  no_friction: {model: no_friction, surface: ground, label: lifting alone}\n",
                      encoding="utf-8")
-    assert _planned(up_to_date_copy, "--configfile", str(label)) == {"model_figure": 1, "paper": 1, "all": 1}
+    assert _planned(snakemake, up_to_date_copy, "--configfile", str(label)) == {"model_figure": 1, "paper": 1, "all": 1}
 
 
-def test_a_docstring_or_comment_edit_reruns_nothing(up_to_date_copy, edit):
+def test_a_docstring_or_comment_edit_reruns_nothing(up_to_date_copy, edit, snakemake):
     """A rule's code parameter is the digest of its modules without docstrings and comment lines: rewording the
     docstring of diagnose/settings.py (which every diagnosis runs) and adding a comment line to it plans no job,
     and neither does an edited test."""
@@ -145,5 +120,5 @@ def test_a_docstring_or_comment_edit_reruns_nothing(up_to_date_copy, edit):
     edit(settings, replace=('"""', '"""Reworded. '))
     edit(settings, code=False)
     edit(up_to_date_copy / "tests" / "diagnose" / "test_verdict.py")
-    assert _planned(up_to_date_copy) == {}
+    assert _planned(snakemake, up_to_date_copy) == {}
 
