@@ -224,18 +224,31 @@ def test_fir_low_pass_is_linear_phase_with_unit_dc_gain():
     assert np.allclose(h, h[::-1], rtol=0.0, atol=1e-15 * np.max(np.abs(h)))  # symmetric to rounding: linear phase
 
 
+@pytest.mark.parametrize("padtype", ["constant", "antireflect"])
 @pytest.mark.parametrize("factor", [2, 3, 5, 10])
-def test_fir_decimation_is_scipys_resample_poly_to_the_bit(factor):
+def test_fir_decimation_is_scipys_resample_poly_to_the_bit(factor, padtype):
     """The record importer's anti-alias decimation, written out so that a diagnosis need not import scipy.signal,
-    gives scipy.signal.resample_poly's bits (same taps, same zero-phase delay, same zero padding, same order of sums),
-    at lengths that are and are not multiples of the factor."""
+    gives scipy.signal.resample_poly's bits (same taps, same zero-phase delay, same padding beyond the ends: zeros,
+    or the record reflected through its end sample, same order of sums), at lengths that are and are not multiples
+    of the factor, on a walk away from 0 at both ends (where the two paddings differ)."""
     from scipy.signal import resample_poly
 
     rng = np.random.default_rng(factor)
     fir = pm.hamming_lowpass_fir(20 * factor + 1, 1.0 / factor)
     for n in (40 * factor, 40 * factor + 1, 4999):
-        x = np.cumsum(rng.normal(size=n)) * 1e-3
-        assert np.array_equal(pm.fir_decimate(x, fir, factor), resample_poly(x, 1, factor, window=fir))
+        x = 3.0 + np.cumsum(rng.normal(size=n)) * 1e-3
+        assert np.array_equal(pm.fir_decimate(x, fir, factor, padtype),
+                              resample_poly(x, 1, factor, window=fir, padtype=padtype))
+
+
+def test_fir_decimation_reflected_through_its_ends_passes_a_line_unchanged():
+    """A zero-phase filter of unit gain passes a straight line unchanged, and the record reflected through its end
+    sample continues the line beyond each end: every decimated sample of a ramp is the ramp's, the first and last
+    included (zeros beyond the ends would pull them toward 0)."""
+    x = 2.0 + 0.01 * np.arange(401)
+    fir = pm.hamming_lowpass_fir(41, 0.5)
+    assert np.allclose(pm.fir_decimate(x, fir, 2, "antireflect"), x[::2], rtol=0.0, atol=1e-12)
+    assert abs(pm.fir_decimate(x, fir, 2)[-1] - x[-1]) > 1.0
 
 
 def test_running_filters_are_scipy_ndimages_to_the_bit():

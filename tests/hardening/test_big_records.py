@@ -51,6 +51,34 @@ def test_fast_record_is_decimated_and_a_tone_above_the_new_nyquist_is_filtered_n
     assert np.max(np.abs(np.sin(2 * np.pi * 2430.0 * t[::step]))) > 0.5
 
 
+def test_a_record_cut_under_load_keeps_its_ends_through_the_decimation(tmp_path, params):
+    """A fast record cut where the torque and the rack are far from 0 (the example cycle at 200 Hz, cut at its
+    largest torque, 18.7 N m near the lock) ends where its logger left it: the zero-phase filter reads the record
+    reflected through its end sample beyond it, and a straight line passes such a filter unchanged, so the last
+    tenth of a second is within the example's 8-bit torque rounding (RMS 0.057 N m) and a tenth of a millimetre of
+    the logged values. Zeros read there instead (scipy.signal.decimate's padding) pull the last samples toward 0
+    and set them ringing, newton metres of torque and millimetres of rack off, which the last assertion shows."""
+    from parksteer import portable as pm
+
+    meta, header, data = base_record(1)
+    meta = [m for m in meta if not m.startswith(("# bits", "# full_scale", "# sample_rate"))]
+    t = np.arange(data[0, 0], data[-1, 0], 1.0 / 200.0)
+    cols = [t] + [np.interp(t, data[:, 0], data[:, j]) for j in range(1, data.shape[1])]
+    end = int(np.argmax(np.abs(cols[2][: len(t) // 2]))) + 1  # cut at the largest torque of the first stroke
+    body = "\n".join(",".join(f"{v:.9g}" for v in row) for row in zip(*(c[:end] for c in cols)))
+    path = tmp_path / "cut_under_load.csv"
+    path.write_text("\n".join(meta + [",".join(header)]) + "\n" + body + "\n", encoding="utf-8")
+    m = load_record(path, params=params)
+    assert "decimated" in m.metadata and abs(m.handwheel_torque_Nm[-1]) > 10.0 and abs(m.rack_m[-1]) > 0.05
+    last = slice(-10, None)  # half the filter's 41 taps at 200 Hz, in samples at 100 Hz
+    logged_torque = np.interp(m.time_s, t, cols[2])
+    logged_rack = np.interp(m.time_s, t, cols[1])
+    assert np.max(np.abs(m.handwheel_torque_Nm - logged_torque)[last]) < (2 * 25 / 255) / np.sqrt(12)
+    assert np.max(np.abs(m.rack_m - logged_rack)[last]) < 1e-4
+    zeros = pm.fir_decimate(cols[2][:end], pm.hamming_lowpass_fir(41, 0.5), 2)
+    assert np.max(np.abs(zeros - logged_torque)[last]) > 1.0
+
+
 def test_slow_record_is_kept_sample_for_sample(tmp_path, params):
     """The 50 Hz example needs no decimation: every sample is kept and nothing is noted."""
     m = load_record(Path(__file__).resolve().parents[2] / "data/measurements/example_unladen.csv", params=params)

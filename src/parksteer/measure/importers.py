@@ -62,6 +62,12 @@ ALIASES = {
 # least that rate on reading, so the work downstream grows with the record's duration, not its sample rate.
 # Beyond the caps a record is refused, not read for minutes.
 METHOD_RATE_HZ = 100.0
+# What the zero-phase filter reads beyond a record's ends: the record reflected through its end sample
+# (parksteer.portable.fir_decimate, "antireflect"; scipy.signal.filtfilt's odd padding). Zeros there (scipy's
+# default) pull the samples within half the filter of an end toward 0 wherever the record ends away from 0: a torque
+# held or a rack off centre at the end, a record cut mid-stroke (its last sample 4.3 N m under the 17.9 N m logged,
+# the samples before it ringing); the reflection passes a straight line through unchanged up to the ends.
+DECIMATION_PADDING = "antireflect"
 MAX_RECORD_BYTES = 256 * 2**20
 
 
@@ -315,8 +321,9 @@ def _unmapped(ignored: list[str]) -> str:
 
 def _decimate(path: Path, columns: dict[str, np.ndarray], metadata: dict[str, str], notes: list[str]
               ) -> dict[str, np.ndarray]:
-    """A record sampled faster than METHOD_RATE_HZ, filtered (FIR anti-alias, zero phase) and decimated by the
-    largest whole factor that keeps at least that rate; a record with uneven sampling is left as it is."""
+    """A record sampled faster than METHOD_RATE_HZ, filtered (FIR anti-alias, zero phase, its ends extended by
+    DECIMATION_PADDING) and decimated by the largest whole factor that keeps at least that rate; a record with uneven
+    sampling is left as it is."""
     time_s = columns[TIME]
     steps = np.diff(time_s)
     dt = float(np.median(steps))
@@ -324,11 +331,12 @@ def _decimate(path: Path, columns: dict[str, np.ndarray], metadata: dict[str, st
     if factor < 2 or float(steps.max() - steps.min()) > 0.01 * dt or len(time_s) < 40 * factor:
         return columns
     out = {TIME: time_s[::factor]}
-    # scipy.signal.decimate's filter (ftype="fir", zero_phase=True), designed without numpy's CPU-dispatched sin
+    # scipy.signal.decimate's filter (ftype="fir", zero_phase=True), designed without numpy's CPU-dispatched sin, its
+    # ends extended by reflection (resample_poly's padtype="antireflect") instead of zeros
     fir = pm.hamming_lowpass_fir(20 * factor + 1, 1.0 / factor)
     for name, values in columns.items():
         if name != TIME:
-            out[name] = pm.fir_decimate(values, fir, factor)[: len(out[TIME])]
+            out[name] = pm.fir_decimate(values, fir, factor, DECIMATION_PADDING)[: len(out[TIME])]
     # A converter's levels no longer describe filtered samples, but its rounding stays in them where the signal
     # moves by less than a step (the filter averages rounding errors only across the levels crossed): the step is
     # kept as the column's rounding (Measurement.rounding_step).

@@ -57,10 +57,15 @@ def hamming_lowpass_fir(taps: int, cutoff: float) -> np.ndarray:
     return h / float(np.sum(h))
 
 
-def fir_decimate(values: np.ndarray, fir: np.ndarray, factor: int) -> np.ndarray:
-    """``scipy.signal.resample_poly(values, 1, factor, window=fir)`` written out, with its zero-phase delay and its
-    zero padding, summed in upfirdn's order (oldest sample first, one rounding per product and per sum), so that it
-    gives the same bits without importing scipy.signal (more than a second per process)."""
+def fir_decimate(values: np.ndarray, fir: np.ndarray, factor: int, padtype: str = "constant") -> np.ndarray:
+    """``scipy.signal.resample_poly(values, 1, factor, window=fir, padtype=padtype)`` written out, with its zero-phase
+    delay, summed in upfirdn's order (oldest sample first, one rounding per product and per sum), so that it gives
+    the same bits without importing scipy.signal (more than a second per process). `padtype` is what the filter
+    reads beyond the ends: ``constant`` zeros (scipy's default), or ``antireflect`` the record reflected through
+    its end sample, 2 x[0] - x[k] before it and 2 x[-1] - x[-1-k] after it (upfirdn's mode of that name,
+    scipy.signal.filtfilt's odd padding): a straight line passes the filter unchanged up to the ends."""
+    if padtype not in ("constant", "antireflect"):
+        raise ValueError(f"fir_decimate: padtype {padtype!r} is not constant or antireflect")
     values = np.asarray(values, dtype=float)
     n_in = len(values)
     n_out = n_in // factor + bool(n_in % factor)
@@ -68,6 +73,8 @@ def fir_decimate(values: np.ndarray, fir: np.ndarray, factor: int) -> np.ndarray
     n_pre_pad = factor - half_len % factor
     n_pre_remove = (half_len + n_pre_pad) // factor
     h = np.concatenate([np.zeros(n_pre_pad), np.asarray(fir, dtype=float)])
+    if padtype == "antireflect" and n_in <= len(h):
+        raise ValueError(f"fir_decimate: {n_in} samples reflect no filter of {len(h)} taps")
     # output m of the full convolution taken every `factor` samples: sum over taps j of h[j] * values[m factor - j]
     outputs = np.arange(n_pre_remove, n_pre_remove + n_out) * factor
     out = np.zeros(n_out)
@@ -75,8 +82,14 @@ def fir_decimate(values: np.ndarray, fir: np.ndarray, factor: int) -> np.ndarray
         if h[j] == 0.0:
             continue
         index = outputs - j
-        inside = (index >= 0) & (index < n_in)
-        out[inside] = out[inside] + values[index[inside]] * h[j]
+        if padtype == "constant":
+            inside = (index >= 0) & (index < n_in)
+            out[inside] = out[inside] + values[index[inside]] * h[j]
+            continue
+        before, after = index < 0, index >= n_in
+        taken = values[np.where(before, -index, np.where(after, 2 * (n_in - 1) - index, index))]
+        taken = np.where(before, 2.0 * values[0] - taken, np.where(after, 2.0 * values[-1] - taken, taken))
+        out = out + taken * h[j]
     return out
 
 
