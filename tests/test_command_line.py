@@ -98,3 +98,16 @@ def test_the_command_whose_reader_is_gone_ends_quietly(tmp_path):
         os.close(write_end)
     assert "Traceback" not in done.stderr and "BrokenPipeError" not in done.stderr, done.stderr
     assert done.returncode == 1, done.stderr
+
+
+def test_the_command_under_a_profiler_exits_as_usual_so_the_profile_is_written(tmp_path):
+    """Under `python -m cProfile -o FILE -m parksteer.cli ...` the command leaves the interpreter's exit to it (the
+    profiler writes its file after the program returns; cli.run_as_main's os._exit would lose it): the file is
+    written and the status is the command's."""
+    import subprocess
+    import sys
+
+    done = subprocess.run([sys.executable, "-m", "cProfile", "-o", str(tmp_path / "profile"), "-m", "parksteer.cli",
+                           "effects"], capture_output=True, text=True, cwd=tmp_path, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert (tmp_path / "profile").stat().st_size > 0

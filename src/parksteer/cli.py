@@ -213,13 +213,15 @@ def run_as_main() -> None:
     The teardown frees, module by module, what the process's end frees at once (some 0.05 s after a diagnosis, which
     imports over 400 modules); every file a command writes is closed where it is written, and the exit functions
     (the worker pools' finalizers, logging's) run here as they would at a normal exit. While a thread other than
-    the main one is alive the interpreter exits as usual (it waits for such threads). CPython also marks a
-    KeyboardInterrupt that passed through an extension's ``PyRun`` call (as one may while the subcommands' modules
-    load) as unhandled even once caught, and then ends a ``-m`` run by SIGINT whatever its status: through
+    the main one is alive the interpreter exits as usual (it waits for such threads), and so it does under a profiler
+    or a tracer (``python -m cProfile``, ``trace``), which writes what it found once the program returns. CPython also
+    marks a KeyboardInterrupt that passed through an extension's ``PyRun`` call (as one may while the subcommands'
+    modules load) as unhandled even once caught, and then ends a ``-m`` run by SIGINT whatever its status: through
     ``os._exit`` an interrupted command ends with its status."""
     status = main()
     interrupted = status in {128 + int(number) for number in STOPPING_SIGNALS}
-    if interrupted or threading.active_count() == 1:
+    watched = sys.getprofile() is not None or sys.gettrace() is not None
+    if interrupted or (threading.active_count() == 1 and not watched):
         atexit._run_exitfuncs()
         os._exit(_flushed(status))
     sys.exit(status)
