@@ -81,3 +81,16 @@ def test_a_diagnosis_of_a_decimated_record_never_imports_scipy_signal_stats_or_s
                             f"    main(['diagnose', {str(record)!r}, '--json', '--quiet', '--jobs', '1'])")
     assert "parksteer.diagnose.select" in modules
     assert _heavy(modules, NEVER_IN_A_DIAGNOSIS) == []
+
+
+@pytest.mark.slow
+def test_a_diagnosis_written_as_json_alone_imports_no_page_renderer():
+    """The README's example diagnosed with `--json` alone (no report, no page) imports neither the pages' renderer
+    (parksteer.reporting.pages) nor the standard library's html (with its table of entities): they are imported
+    where a report or a page is written."""
+    record = ROOT / "data" / "measurements" / "example_unladen.csv"
+    modules = _loaded_after("import contextlib, io\nfrom parksteer.cli import main\n"
+                            "with contextlib.redirect_stdout(io.StringIO()):\n"
+                            f"    main(['diagnose', {str(record)!r}, '--json', '--quiet', '--jobs', '1'])")
+    assert "parksteer.reporting.report" in modules  # the JSON was made
+    assert _heavy(modules, ("parksteer.reporting.pages", "html")) == []

@@ -14,7 +14,6 @@ def write_diagnosis(diagnosis, taken, plot: str | None = None, report: str | Non
     """Write the outputs asked for of `diagnosis` (made from the intake `taken`,
     :class:`parksteer.diagnose.intake.Intake`) and give its JSON (:func:`parksteer.reporting.report.diagnosis_dict`,
     with the suggested effect where one was written)."""
-    from ..reporting.pages import markdown_report, write_markdown
     from ..reporting.report import diagnosis_dict
 
     result = _with_suggestion(suggest_effect, diagnosis_dict(diagnosis), diagnosis, taken.settings)
@@ -42,6 +41,8 @@ def write_diagnosis(diagnosis, taken, plot: str | None = None, report: str | Non
         ladder = error_ladder(taken.files, taken.params, list(diagnosis.base_effects), first=diagnosis,
                               workers=taken.workers)
     if report:
+        from ..reporting.pages import markdown_report, write_markdown  # a page renderer: not for the JSON alone
+
         figure = _linked(plot, report) if plot else None
         write_markdown(report, markdown_report(result, figure, _linked(user_plot, report) if user_plot else None,
                                                phases, ladder.as_dict() if ladder is not None else None))

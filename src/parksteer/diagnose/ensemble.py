@@ -54,8 +54,9 @@ def with_replay_uncertainty(engine: ReplayEngine, problem: Problem, effects: lis
         # pauses free, so the samples there carry that doubt.
         released = any(f.rack.held_at_rest) or bool(f.rack.rest_intervals_s)
         for spacing, hold in ensemble_plan(f, draws, released):
-            source = _source(sources, f, i, spacing, hold)  # made here, once, before the workers fork
-            perturbed = None if logger is not None else source.perturbed(rng)
+            # without a logger the draw's coefficients come from this stream, so its source is smoothed here; with
+            # one, the job smooths it where it runs (a worker, side by side with the others), once per process
+            perturbed = None if logger is not None else _source(sources, f, i, spacing, hold).perturbed(rng)
             drawn = []
             if logger is not None and logger[2] > 0.0:  # the analog noise add_noise draws (none at 0 RMS)
                 drawn.append(("normal", (0.0, logger[2], f.time_s.shape), rng.normal(0.0, logger[2], f.time_s.shape)))
@@ -135,8 +136,10 @@ def _source(smoothed: dict, f: FileData, index: int, spacing: float, hold: bool)
     if hold and spacing == f.rack.knot_spacing_s:
         return f.rack
     if (index, spacing, hold) not in smoothed:
-        smoothed[index, spacing, hold] = smooth_rack(f.time_s, f.rack_m, spacing, hold_rest=hold,
-                                                     rest_resolution_m=f.rack.rest_resolution_m)
+        # the search for the file's spacing fitted each passing spacing, holding rests, already
+        smoothed[index, spacing, hold] = ((hold and f.rack.held_at(f.time_s, f.rack_m, spacing))
+                                          or smooth_rack(f.time_s, f.rack_m, spacing, hold_rest=hold,
+                                                         rest_resolution_m=f.rack.rest_resolution_m))
     return smoothed[index, spacing, hold]
 
 

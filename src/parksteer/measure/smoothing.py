@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -59,16 +59,33 @@ class SmoothedRack(RackSpline):
     # when the spacing was given (smooth_rack)
     passing_spacings_s: tuple[float, ...] = ()
     rest_resolution_m: float = 0.0  # the rounding the rests were tested with (smooth_rack's rest_resolution_m)
+    # what a search for the spacing (smooth_rack without one) fitted, holding rests: its time, rack and noise, and the
+    # fit of every passing spacing (held_at gives them); None for a rack smoothed otherwise
+    search_fits: tuple | None = field(default=None, repr=False)
 
     @classmethod
     def from_bspline(cls, knots, bspline, covariance, knot_spacing_s, fit_rms_m, noise_rms_m,
                      held_at_rest=(False, False), turning_times_s=(), rest_intervals_s=(),
-                     passing_spacings_s=(), rest_resolution_m=0.0) -> SmoothedRack:
+                     passing_spacings_s=(), rest_resolution_m=0.0, search_fits=None) -> SmoothedRack:
         piecewise = RackSpline(*piecewise_cubic(knots, bspline))
         return cls(piecewise.breaks, piecewise.coefficients, knots, bspline, covariance, float(knot_spacing_s),
                    float(fit_rms_m), float(noise_rms_m), tuple(held_at_rest), tuple(turning_times_s),
                    tuple(rest_intervals_s), tuple(float(x) for x in passing_spacings_s) or (float(knot_spacing_s),),
-                   float(rest_resolution_m))
+                   float(rest_resolution_m), search_fits)
+
+    def held_at(self, time_s, rack_m, spacing: float) -> SmoothedRack | None:
+        """``smooth_rack(time_s, rack_m, spacing, rest_resolution_m=self.rest_resolution_m)`` made from the fit the
+        search for this rack's spacing made at `spacing` (the same fit of the same data: the same spline), where that
+        search fitted these very `time_s` and `rack_m` and `spacing` passed; otherwise None."""
+        if self.search_fits is None:
+            return None
+        searched_time_s, searched_rack_m, noise, fits = self.search_fits
+        fit = fits.get(spacing)
+        if fit is None or not (np.array_equal(searched_time_s, time_s) and np.array_equal(searched_rack_m, rack_m)):
+            return None
+        knots, coefficients, inverse, rms, at_rest = fit
+        return SmoothedRack.from_bspline(knots, coefficients, noise**2 * inverse, spacing, rms, noise, at_rest,
+                                         self.turning_times_s, self.rest_intervals_s, (), self.rest_resolution_m)
 
     def perturbed(self, rng: np.random.Generator) -> SmoothedRack:
         """A rack the data allow as well: coefficients drawn from their least-squares distribution."""
@@ -173,10 +190,10 @@ def smooth_rack(time_s, rack_m, knot_spacing_s: float | None = None, hold_rest: 
     turns = turning_times(t, x)
     rests = rest_intervals(t, x, max(noise, rest_resolution_m)) if hold_rest else ()
 
-    def build(fit, spacing, passing=()):
+    def build(fit, spacing, passing=(), search_fits=None):
         knots, coefficients, inverse, rms, at_rest = fit
         return SmoothedRack.from_bspline(knots, coefficients, noise**2 * inverse, spacing, rms, noise, at_rest, turns,
-                                         rests, passing, rest_resolution_m)
+                                         rests, passing, rest_resolution_m, search_fits)
 
     if knot_spacing_s is not None:
         if not knot_spacing_s > 0:
@@ -185,7 +202,7 @@ def smooth_rack(time_s, rack_m, knot_spacing_s: float | None = None, hold_rest: 
         if fit is None:
             raise UsageError(f"rack smoothing: knot spacing {knot_spacing_s:g} s leaves intervals without samples")
         return build(fit, knot_spacing_s)
-    best, passing = None, []
+    best, passing = None, {}
     for spacing in knot_spacings(t):
         fit = lsq_fit(t, x, spacing, turns, rests, hold_rest)
         if fit is None:
@@ -193,10 +210,12 @@ def smooth_rack(time_s, rack_m, knot_spacing_s: float | None = None, hold_rest: 
         # the residual of a least-squares fit with p coefficients has n - p degrees of freedom
         unbiased = fit[3] * math.sqrt(len(t) / max(len(t) - len(fit[1]), 1))
         if unbiased <= RACK_DISCREPANCY_FACTOR * noise:
-            passing.append(spacing)
+            passing[float(spacing)] = fit
         if best is None or unbiased <= RACK_DISCREPANCY_FACTOR * noise:
             best = (fit, spacing)
     if best is None:
         raise UsageError("rack smoothing: no knot spacing gives a well-posed spline (samples too uneven)")
     # the spacings run from fine to coarse, so the kept one is the coarsest that passed (or, none passing, the finest)
-    return build(*best, passing=sorted(passing, reverse=True))
+    # (the replay ensemble smooths the rack again at the passing spacings, holding rests: held_at)
+    return build(*best, passing=sorted(passing, reverse=True),
+                 search_fits=(t, x, noise, passing) if hold_rest and passing else None)

@@ -3,8 +3,6 @@ read from it; the pages (markdown and HTML) are :mod:`parksteer.reporting.pages`
 
 from __future__ import annotations
 
-import html
-
 import math
 
 import numpy as np
@@ -392,6 +390,8 @@ def num(x, digits: int = 3) -> str:
 
 def html_table(head: list[str], rows: list[list]) -> list[str]:
     """An HTML table of `head` and `rows`, every cell escaped."""
+    import html  # only a page needs it (it loads html.entities), not the JSON
+
     out = ["<table>", "<tr>" + "".join(f"<th>{html.escape(h)}</th>" for h in head) + "</tr>"]
     out += ["<tr>" + "".join(f"<td>{html.escape(str(c))}</td>" for c in row) + "</tr>" for row in rows]
     return out + ["</table>"]

@@ -1,0 +1,63 @@
+"""The rack smoothing's search for its knot spacing keeps the fit of every spacing that passed
+(parksteer.measure.smoothing.SmoothedRack.held_at): the replay ensemble smooths the rack again at those spacings,
+holding rests, and takes the search's fits instead, on the promise that they are the same splines to the bit."""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from parksteer.measure.importers import load_record
+from parksteer.measure.smoothing import smooth_rack
+
+ROOT = Path(__file__).resolve().parents[2]
+RECORDS = ("data/measurements/example_unladen.csv", "data/samples/car/unladen__ground.csv")
+
+
+def _rack(name: str) -> tuple[np.ndarray, np.ndarray]:
+    record = load_record(ROOT / name)
+    return np.asarray(record.time_s, dtype=float), np.asarray(record.rack_m, dtype=float)
+
+
+def _same(a, b) -> bool:
+    """Equal in value and type, arrays bit for bit."""
+    if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
+        return (isinstance(a, np.ndarray) and isinstance(b, np.ndarray) and a.dtype == b.dtype
+                and a.shape == b.shape and a.tobytes() == b.tobytes())
+    if isinstance(a, tuple) and isinstance(b, tuple):
+        return len(a) == len(b) and all(_same(x, y) for x, y in zip(a, b))
+    return type(a) is type(b) and a == b
+
+
+@pytest.mark.parametrize("name", RECORDS)
+@pytest.mark.parametrize("rest_resolution_m", [0.0, 1e-4])
+def test_the_searchs_fit_at_each_passing_spacing_is_the_spline_smoothed_at_it(name, rest_resolution_m):
+    """For every spacing the search passed, held_at gives the rack smooth_rack makes at that spacing holding rests
+    (the same least-squares fit of the same samples, turns and pauses): every field equal, arrays to the bit."""
+    t, x = _rack(name)
+    searched = smooth_rack(t, x, rest_resolution_m=rest_resolution_m)
+    assert len(searched.passing_spacings_s) > 1  # the ensemble's spacings are more than the chosen one
+    for spacing in searched.passing_spacings_s:
+        kept = searched.held_at(t, x, spacing)
+        made = smooth_rack(t, x, spacing, hold_rest=True, rest_resolution_m=rest_resolution_m)
+        for field in dataclasses.fields(made):
+            if field.name != "search_fits":
+                assert _same(getattr(kept, field.name), getattr(made, field.name)), (spacing, field.name)
+
+
+def test_no_fit_is_given_for_other_samples_another_spacing_or_a_smoothing_without_a_search():
+    """held_at answers only for the samples the search fitted and a spacing that passed; a rack smoothed at a given
+    spacing, or with its ends and pauses free, keeps no fits."""
+    t, x = _rack(RECORDS[0])
+    searched = smooth_rack(t, x)
+    spacing = searched.passing_spacings_s[-1]
+    moved = x.copy()
+    moved[len(x) // 2] += 1e-6
+    assert searched.held_at(t, moved, spacing) is None
+    assert searched.held_at(t + 1e-3, x, spacing) is None
+    assert searched.held_at(t, x, spacing * 1.01) is None
+    assert smooth_rack(t, x, spacing).search_fits is None
+    assert smooth_rack(t, x, hold_rest=False).held_at(t, x, spacing) is None
