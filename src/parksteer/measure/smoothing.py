@@ -73,6 +73,15 @@ class SmoothedRack(RackSpline):
                    tuple(rest_intervals_s), tuple(float(x) for x in passing_spacings_s) or (float(knot_spacing_s),),
                    float(rest_resolution_m), search_fits)
 
+    @classmethod
+    def from_fit(cls, fit, spacing, noise, turning_times_s, rest_intervals_s, rest_resolution_m, passing=(),
+                 search_fits=None) -> SmoothedRack:
+        """The rack of one least-squares fit (``lsq_fit``'s knots, coefficients, inverse normal matrix, RMS and
+        held ends) at knot `spacing`, its covariance scaled by the rack's `noise` RMS."""
+        knots, coefficients, inverse, rms, at_rest = fit
+        return cls.from_bspline(knots, coefficients, noise**2 * inverse, spacing, rms, noise, at_rest, turning_times_s,
+                                rest_intervals_s, passing, rest_resolution_m, search_fits)
+
     def held_at(self, time_s, rack_m, spacing: float) -> SmoothedRack | None:
         """``smooth_rack(time_s, rack_m, spacing, rest_resolution_m=self.rest_resolution_m)`` made from the fit the
         search for this rack's spacing made at `spacing` (the same fit of the same data: the same spline), where that
@@ -83,9 +92,8 @@ class SmoothedRack(RackSpline):
         fit = fits.get(spacing)
         if fit is None or not (np.array_equal(searched_time_s, time_s) and np.array_equal(searched_rack_m, rack_m)):
             return None
-        knots, coefficients, inverse, rms, at_rest = fit
-        return SmoothedRack.from_bspline(knots, coefficients, noise**2 * inverse, spacing, rms, noise, at_rest,
-                                         self.turning_times_s, self.rest_intervals_s, (), self.rest_resolution_m)
+        return SmoothedRack.from_fit(fit, spacing, noise, self.turning_times_s, self.rest_intervals_s,
+                                     self.rest_resolution_m)
 
     def perturbed(self, rng: np.random.Generator) -> SmoothedRack:
         """A rack the data allow as well: coefficients drawn from their least-squares distribution."""
@@ -191,9 +199,7 @@ def smooth_rack(time_s, rack_m, knot_spacing_s: float | None = None, hold_rest: 
     rests = rest_intervals(t, x, max(noise, rest_resolution_m)) if hold_rest else ()
 
     def build(fit, spacing, passing=(), search_fits=None):
-        knots, coefficients, inverse, rms, at_rest = fit
-        return SmoothedRack.from_bspline(knots, coefficients, noise**2 * inverse, spacing, rms, noise, at_rest, turns,
-                                         rests, passing, rest_resolution_m, search_fits)
+        return SmoothedRack.from_fit(fit, spacing, noise, turns, rests, rest_resolution_m, passing, search_fits)
 
     if knot_spacing_s is not None:
         if not knot_spacing_s > 0:
