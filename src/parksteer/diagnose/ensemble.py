@@ -22,7 +22,7 @@ import numpy as np
 
 from .. import portable as pm
 from ..measure.converter import add_noise, quantise
-from ..measure.smoothing import SmoothedRack, rounding_draw, rounding_draw_size, smooth_rack
+from ..measure.smoothing import SmoothedRack, rounding_draw, rounding_draw_size
 from ..model.symbolic.components import Effect
 from .engine import ReplayEngine
 from ..measure.column import rack_logger
@@ -44,7 +44,7 @@ def with_replay_uncertainty(engine: ReplayEngine, problem: Problem, effects: lis
     rng = np.random.default_rng(seed)
     # The random numbers are drawn here, in order (one random stream); each draw's rack is logged, smoothed and
     # replayed side by side on the workers from its numbers (DrawnInAdvance).
-    jobs, sources = [], {}
+    jobs = []
     for i, f in enumerate(problem.files):
         base = engine.replay(problem, effects, i)
         base.parameter_vector(overrides)  # any run the overrides need is prepared once, here
@@ -56,7 +56,7 @@ def with_replay_uncertainty(engine: ReplayEngine, problem: Problem, effects: lis
         for spacing, hold in ensemble_plan(f, draws, released):
             # without a logger the draw's coefficients come from this stream, so its source is smoothed here; with
             # one, the job smooths it where it runs (a worker, side by side with the others), once per process
-            perturbed = None if logger is not None else _source(sources, f, i, spacing, hold).perturbed(rng)
+            perturbed = None if logger is not None else _source(f, spacing, hold).perturbed(rng)
             drawn = []
             if logger is not None and logger[2] > 0.0:  # the analog noise add_noise draws (none at 0 RMS)
                 drawn.append(("normal", (0.0, logger[2], f.time_s.shape), rng.normal(0.0, logger[2], f.time_s.shape)))
@@ -70,7 +70,7 @@ def with_replay_uncertainty(engine: ReplayEngine, problem: Problem, effects: lis
         f, numbers = problem.files[i], DrawnInAdvance(drawn)
         logger = rack_logger(f.measurement, problem.params)
         if rack is None:
-            rack = relogged_rack(_source(sources, f, i, spacing, hold), f.time_s, *logger, numbers, hold_rest=hold)
+            rack = relogged_rack(_source(f, spacing, hold), f.time_s, *logger, numbers, hold_rest=hold)
         if f.rack.rest_resolution_m > 0.0:  # a rounding coarser than the noise: the rack within its levels
             rack = rounding_draw(rack, f.time_s, f.rack.rest_resolution_m, numbers,
                                  held=rack.rest_intervals_s if hold else ())
@@ -131,16 +131,13 @@ def ensemble_plan(f: FileData, draws: int, released: bool) -> list[tuple[float, 
     return out
 
 
-def _source(smoothed: dict, f: FileData, index: int, spacing: float, hold: bool) -> SmoothedRack:
-    """File `index`'s rack smoothed at `spacing` (holding rests or not), made once per `smoothed` (a process's)."""
+def _source(f: FileData, spacing: float, hold: bool) -> SmoothedRack:
+    """The file's rack smoothed at `spacing` (holding rests or not): the rack itself at its own spacing, held; else
+    made once per process for the file's rack (:meth:`parksteer.measure.smoothing.SmoothedRack.smoothed_at`, which
+    takes the search's fit where it has one), and so its draws logged again are smoothed once too."""
     if hold and spacing == f.rack.knot_spacing_s:
         return f.rack
-    if (index, spacing, hold) not in smoothed:
-        # the search for the file's spacing fitted each passing spacing, holding rests, already
-        smoothed[index, spacing, hold] = ((hold and f.rack.held_at(f.time_s, f.rack_m, spacing))
-                                          or smooth_rack(f.time_s, f.rack_m, spacing, hold_rest=hold,
-                                                         rest_resolution_m=f.rack.rest_resolution_m))
-    return smoothed[index, spacing, hold]
+    return f.rack.smoothed_at(f.time_s, f.rack_m, spacing, hold)
 
 
 class DrawnInAdvance:

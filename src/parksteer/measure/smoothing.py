@@ -62,6 +62,10 @@ class SmoothedRack(RackSpline):
     # what a search for the spacing (smooth_rack without one) fitted, holding rests: its time, rack and noise, and the
     # fit of every passing spacing (held_at gives them); None for a rack smoothed otherwise
     search_fits: tuple | None = field(default=None, repr=False)
+    # the racks smoothed again from this one's record (smoothed_at, resmoothed), each made once, keyed on the exact
+    # bytes of its inputs: a diagnosis estimates the replay's uncertainty again for each model a stage settles on,
+    # from the same racks and the same drawn numbers
+    _smoothed_again: dict = field(default_factory=dict, init=False, repr=False)
 
     @classmethod
     def from_bspline(cls, knots, bspline, covariance, knot_spacing_s, fit_rms_m, noise_rms_m,
@@ -86,14 +90,30 @@ class SmoothedRack(RackSpline):
         """``smooth_rack(time_s, rack_m, spacing, rest_resolution_m=self.rest_resolution_m)`` made from the fit the
         search for this rack's spacing made at `spacing` (the same fit of the same data: the same spline), where that
         search fitted these very `time_s` and `rack_m` and `spacing` passed; otherwise None."""
-        if self.search_fits is None:
+        fit = self.search_fits[3].get(spacing) if self._searched(time_s, rack_m) else None
+        if fit is None:
             return None
-        searched_time_s, searched_rack_m, noise, fits = self.search_fits
-        fit = fits.get(spacing)
-        if fit is None or not (np.array_equal(searched_time_s, time_s) and np.array_equal(searched_rack_m, rack_m)):
-            return None
-        return SmoothedRack.from_fit(fit, spacing, noise, self.turning_times_s, self.rest_intervals_s,
+        return SmoothedRack.from_fit(fit, spacing, self.search_fits[2], self.turning_times_s, self.rest_intervals_s,
                                      self.rest_resolution_m)
+
+    def _searched(self, time_s, rack_m) -> bool:
+        """Whether a search for this rack's spacing, holding rests, fitted these very `time_s` and `rack_m` (so its
+        noise, turning times and pauses are theirs)."""
+        return self.search_fits is not None and (np.array_equal(self.search_fits[0], time_s)
+                                                 and np.array_equal(self.search_fits[1], rack_m))
+
+    def smoothed_at(self, time_s, rack_m, spacing: float, hold_rest: bool) -> SmoothedRack:
+        """``smooth_rack(time_s, rack_m, spacing, hold_rest, rest_resolution_m=self.rest_resolution_m)``, taken from
+        the search's fit where :meth:`held_at` has it, and made once for the same arguments."""
+        t, x = np.asarray(time_s, dtype=float), np.asarray(rack_m, dtype=float)
+        key = ("smoothed", t.tobytes(), x.tobytes(), float(spacing), bool(hold_rest))
+        if key not in self._smoothed_again:
+            rack = hold_rest and self.held_at(t, x, spacing)
+            if not rack and self._searched(t, x):  # its own record: its noise, turns and pauses are known
+                rack = _smoothed_at_spacing(t, x, spacing, bool(hold_rest), self.rest_resolution_m, self.noise_rms_m,
+                                            self.turning_times_s, self.rest_intervals_s if hold_rest else ())
+            self._smoothed_again[key] = rack or smooth_rack(t, x, spacing, bool(hold_rest), self.rest_resolution_m)
+        return self._smoothed_again[key]
 
     def perturbed(self, rng: np.random.Generator) -> SmoothedRack:
         """A rack the data allow as well: coefficients drawn from their least-squares distribution."""
@@ -115,7 +135,12 @@ class SmoothedRack(RackSpline):
         sample to sample rather than independent, and the turning time the data fix is
         correspondingly less certain.
         """
-        return smooth_rack(time_s, log(self.evaluate(time_s)[0]), self.knot_spacing_s, hold_rest)
+        t = np.asarray(time_s, dtype=float)
+        logged = np.asarray(log(self.evaluate(t)[0]), dtype=float)
+        key = ("resmoothed", t.tobytes(), logged.tobytes(), bool(hold_rest))
+        if key not in self._smoothed_again:  # the same logged rack again (the same drawn numbers): the same spline
+            self._smoothed_again[key] = smooth_rack(t, logged, self.knot_spacing_s, bool(hold_rest))
+        return self._smoothed_again[key]
 
     def summary(self) -> dict:
         """The smoothing's settings and fit (for JSON)."""
@@ -198,16 +223,8 @@ def smooth_rack(time_s, rack_m, knot_spacing_s: float | None = None, hold_rest: 
     turns = turning_times(t, x)
     rests = rest_intervals(t, x, max(noise, rest_resolution_m)) if hold_rest else ()
 
-    def build(fit, spacing, passing=(), search_fits=None):
-        return SmoothedRack.from_fit(fit, spacing, noise, turns, rests, rest_resolution_m, passing, search_fits)
-
     if knot_spacing_s is not None:
-        if not knot_spacing_s > 0:
-            raise UsageError(f"knot spacing must be positive, got {knot_spacing_s:g} s")
-        fit = lsq_fit(t, x, knot_spacing_s, turns, rests, hold_rest)
-        if fit is None:
-            raise UsageError(f"rack smoothing: knot spacing {knot_spacing_s:g} s leaves intervals without samples")
-        return build(fit, knot_spacing_s)
+        return _smoothed_at_spacing(t, x, knot_spacing_s, hold_rest, rest_resolution_m, noise, turns, rests)
     best, passing = None, {}
     for spacing in knot_spacings(t):
         fit = lsq_fit(t, x, spacing, turns, rests, hold_rest)
@@ -223,5 +240,18 @@ def smooth_rack(time_s, rack_m, knot_spacing_s: float | None = None, hold_rest: 
         raise UsageError("rack smoothing: no knot spacing gives a well-posed spline (samples too uneven)")
     # the spacings run from fine to coarse, so the kept one is the coarsest that passed (or, none passing, the finest)
     # (the replay ensemble smooths the rack again at the passing spacings, holding rests: held_at)
-    return build(*best, passing=sorted(passing, reverse=True),
-                 search_fits=(t, x, noise, passing) if hold_rest and passing else None)
+    return SmoothedRack.from_fit(*best, noise, turns, rests, rest_resolution_m, sorted(passing, reverse=True),
+                                 (t, x, noise, passing) if hold_rest and passing else None)
+
+
+def _smoothed_at_spacing(t: np.ndarray, x: np.ndarray, knot_spacing_s: float, hold_rest: bool, rest_resolution_m: float,
+                         noise: float, turns: tuple[float, ...], rests: tuple[tuple[float, float], ...]
+                         ) -> SmoothedRack:
+    """:func:`smooth_rack` at a given knot spacing, from the rack's noise RMS, turning times and pauses (those
+    smooth_rack finds in `t` and `x`)."""
+    if not knot_spacing_s > 0:
+        raise UsageError(f"knot spacing must be positive, got {knot_spacing_s:g} s")
+    fit = lsq_fit(t, x, knot_spacing_s, turns, rests, hold_rest)
+    if fit is None:
+        raise UsageError(f"rack smoothing: knot spacing {knot_spacing_s:g} s leaves intervals without samples")
+    return SmoothedRack.from_fit(fit, knot_spacing_s, noise, turns, rests, rest_resolution_m)
