@@ -5,11 +5,13 @@ from __future__ import annotations
 
 import hashlib
 import json
+import math
 import platform
 import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from parksteer.checksums import CHANGED, IDENTICAL, WITHIN, failures, read_sums, refresh, verify
@@ -130,6 +132,29 @@ def test_number_formatting_absorbs_last_bit_noise(value, text):
     from parksteer.tables import format_number
 
     assert format_number(value) == text
+
+
+def test_a_number_reads_as_zero_only_when_it_is_zero_and_a_column_is_written_as_each_number_is():
+    """format_number writes Python's `digits` significant digits and "0" for either zero, and only for a zero (no
+    nonzero float, subnormals among them, rounds to a text that reads as zero); format_numbers writes a column
+    exactly as format_number writes each of its numbers (random bit patterns of both signs, zeros, subnormals,
+    infinities and nan)."""
+    from parksteer.tables import format_number, format_numbers
+
+    rng = np.random.default_rng(11)
+    patterns = rng.integers(0, 2**64, 20000, dtype=np.uint64, endpoint=False)
+    values = np.concatenate([patterns.view(np.float64), [0.0, -0.0, 5e-324, -5e-324, 2.2e-308, np.inf, -np.inf,
+                                                          np.nan, -np.nan, 0.1 + 0.2, 123456789.5]])
+    for digits in (1, 7, 9, 10):
+        texts = format_numbers(values, digits)
+        assert texts == [format_number(v, digits) for v in values]
+        for value, text in zip(values.tolist(), texts):
+            if value == 0.0:
+                assert text == "0"
+            elif math.isfinite(value):
+                assert float(text) != 0.0 and text == f"{value:.{digits}g}"
+            else:
+                assert text == ("nan" if math.isnan(value) else "inf" if value > 0 else "-inf")
 
 
 @pytest.mark.parametrize("victim", ["svg", "csv"])

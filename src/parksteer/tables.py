@@ -28,12 +28,18 @@ SIGNIFICANT_DIGITS = 7
 
 
 def format_number(x: float, digits: int = SIGNIFICANT_DIGITS) -> str:
-    """Format a float with `digits` significant digits; -0 becomes 0."""
-    x = float(x)
-    if not math.isfinite(x):
-        return "nan" if math.isnan(x) else ("inf" if x > 0 else "-inf")
-    s = f"{x:.{digits}g}"
-    return "0" if s in ("-0", "0") or float(s) == 0.0 else s
+    """Format a float with `digits` significant digits; -0 becomes 0 (nan, inf and -inf as Python writes them).
+
+    Only a zero is written as zero: a nonzero float rounded to one or more significant digits keeps a nonzero
+    leading digit, so "-0" is the one text to mend."""
+    s = format(float(x), f".{digits}g")
+    return "0" if s == "-0" else s
+
+
+def format_numbers(values: np.ndarray, digits: int = SIGNIFICANT_DIGITS) -> list[str]:
+    """:func:`format_number` of each of the floats `values` (a table's column, written in one pass)."""
+    spec = f".{digits}g"
+    return ["0" if s == "-0" else s for s in [format(v, spec) for v in np.asarray(values, dtype=float).tolist()]]
 
 
 # A temporary file is named ".<target name>.<host>.<pid>.<random>.tmp" so that one left by a killed writer can be

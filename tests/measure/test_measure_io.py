@@ -229,3 +229,29 @@ def test_a_channel_with_its_own_converter_has_its_own_step(tmp_path, params):
     m = read_measurement(path, params)
     assert m.quantisation_step("rack_m") == pytest.approx(0.2 / 4095)
     assert m.quantisation_step("handwheel_torque_Nm") == pytest.approx(50.0 / 255)
+
+
+def test_of_several_bad_cells_the_first_by_row_is_named(tmp_path, params):
+    """A column with an infinite number above a cell that is no number is refused at the infinite one, the first
+    defect a reader going down the file meets."""
+    cols = with_cell("rack_m", 9, "-inf")
+    cols["rack_m"][30] = "1.2.3"
+    message = refused(tmp_path, render(cols), params)
+    assert f"column 'rack_m', row 9 (line {9 + HEADER_LINE})" in message and "not a finite number" in message
+
+
+def test_a_column_holds_each_cells_number_to_the_bit():
+    """Table.column gives, for every cell, the float parse_number reads from it (shortest and long decimal forms,
+    exponents, signs, surrounding spaces, decimal commas): the same bits."""
+    from parksteer.measure.text_table import parse_number, read_table
+
+    rng = np.random.default_rng(5)
+    values = (rng.standard_normal(3000) * 10.0 ** rng.integers(-300, 300, 3000)).tolist()
+    texts = [f" {v!r}" if i % 3 == 0 else f"{v:.17g} " if i % 3 == 1 else f"{v:+.6e}" for i, v in enumerate(values)]
+    for delimiter, decimal in ((",", "."), (";", ",")):
+        cells = [t.replace(".", ",") for t in texts] if decimal == "," else texts
+        table = read_table("a" + delimiter + "b\n" + "\n".join(f"{i}{delimiter}{c}" for i, c in enumerate(cells)),
+                           "t.csv")
+        assert table.decimal == decimal
+        expected = np.array([parse_number(c.replace(",", "."), "t.csv") for c in cells])
+        assert table.column(1).tobytes() == expected.tobytes()

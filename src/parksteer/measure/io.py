@@ -39,7 +39,7 @@ from ..errors import UsageError, cannot_read
 from .converter import quantisation_step
 from ..names import SURFACES, TORQUE
 from ..parameters import Parameters, load_parameters
-from ..tables import atomic_path, format_number
+from ..tables import atomic_path, format_number, format_numbers
 from .text_table import parse_number, read_table
 
 REQUIRED_COLUMNS = ("time_s", "rack_m", TORQUE)
@@ -356,8 +356,7 @@ def format_measurement(measurement: Measurement) -> str:
     lengths = {len(c) for c in data}
     if len(lengths) != 1:
         raise UsageError(f"columns have different lengths {sorted(lengths)}")
-    for row in zip(*data):
-        lines.append(",".join(format_number(v, 9) for v in row))
+    lines.extend(map(",".join, zip(*(format_numbers(column, 9) for column in data))))
     return "\n".join(lines) + "\n"
 
 

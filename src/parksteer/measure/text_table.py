@@ -58,6 +58,15 @@ class Table:
     def column(self, j: int, name: str | None = None) -> np.ndarray:
         """Column `j` as floats; a cell that is not a finite number is refused naming column, row and line."""
         name = self.header[j] if name is None else name
+        texts = [cells[j] for _, cells in self.rows]
+        if self.decimal == ",":
+            texts = [text.replace(",", ".") for text in texts]
+        try:  # float() strips a cell as parse_number does; the loop below names the first cell that is no number
+            values = np.fromiter(map(float, texts), dtype=float, count=len(texts))
+        except (ValueError, TypeError):
+            values = None
+        if values is not None and np.isfinite(values).all():
+            return values
         values = np.empty(len(self.rows))
         for row, (line_no, cells) in enumerate(self.rows, start=1):
             cell = cells[j]
@@ -71,7 +80,7 @@ def _split(line: str, delimiter: str) -> list[str]:
     """The cells of a line; a cell in double quotes (as spreadsheets write "0.01" or "time_s") loses its quotes,
     and a delimiter inside quotes is part of the cell."""
     if '"' not in line:
-        return [cell.strip() for cell in line.split(delimiter)]
+        return list(map(str.strip, line.split(delimiter)))
     cells = next(csv.reader([line], delimiter=delimiter, skipinitialspace=True))
     return [_unquote(cell.strip()) for cell in cells]
 
