@@ -27,9 +27,19 @@ def basis(knots: np.ndarray, x: np.ndarray, intervals: np.ndarray, degree: int, 
 
     De Boor's recurrence: degree - derivative steps raising the degree of the values, then `derivative` steps of
     differences that turn them into the derivative's values (a zero-length knot span contributes zero)."""
+    return _de_boor(knots, x, intervals, degree, derivative)
+
+
+def _de_boor(knots: np.ndarray, x: np.ndarray, intervals: np.ndarray, degree: int, derivative: int = 0,
+             steps: list | None = None) -> np.ndarray:
+    """:func:`basis`; into `steps`, if given, the values after each step of the recurrence, from none to `degree`:
+    without a derivative, step j's are the B-splines of degree j (step j reads only the j columns the steps before
+    it wrote, and writes j + 1)."""
     x = np.asarray(x, dtype=float)
     h = np.zeros((len(x), degree + 1))
     h[:, 0] = 1.0
+    if steps is not None:
+        steps.append(h[:, :1].copy())
     for j in range(1, degree + 1):
         previous = h[:, :j].copy()
         h[:, 0] = 0.0
@@ -46,6 +56,8 @@ def basis(knots: np.ndarray, x: np.ndarray, intervals: np.ndarray, degree: int, 
                 w = float(j) * previous[:, n - 1] / span
                 h[:, n - 1] = np.where(same, h[:, n - 1], h[:, n - 1] - w)
                 h[:, n] = np.where(same, 0.0, w)
+        if steps is not None:
+            steps.append(h[:, : j + 1].copy())
     return h
 
 
@@ -105,39 +117,49 @@ def derivative_rows(knots: np.ndarray, x: np.ndarray, degree: int = 3, derivativ
     return out
 
 
-def _spline_derivative_at_breaks(knots: np.ndarray, coefficients: np.ndarray, degree: int, order: int,
-                                 intervals: np.ndarray) -> np.ndarray:
-    """The `order`-th derivative of the spline at the left end of each of `intervals` (FITPACK's splev/splder: the
-    derivative's B-spline coefficients by repeated differences, then its basis at the point)."""
+def _derivative_coefficients(knots: np.ndarray, coefficients: np.ndarray, degree: int) -> list[np.ndarray]:
+    """The B-spline coefficients of the spline's derivatives of order 0 ... `degree` (FITPACK's splder: repeated
+    differences), each the array the one before it becomes after one more difference (only its leading entries,
+    which the derivative's fewer B-splines read, are new)."""
     work = np.array(coefficients, dtype=float)
+    out = [work.copy()]
     count = len(knots) - degree - 1
-    for j in range(1, order + 1):
+    for j in range(1, degree + 1):
         kk = degree - j + 1
         count -= 1
         i = np.arange(count)
         span = knots[j + i + kk] - knots[j + i]
         step = float(kk) * (work[1 : count + 1] - work[:count]) / np.where(span > 0.0, span, 1.0)
         work[:count] = np.where(span > 0.0, step, work[:count])
-    if order == degree:
-        return work[intervals - degree]
-    x = knots[intervals]
-    h = basis(knots, x, intervals, degree - order)
-    total = np.zeros(len(intervals))
-    for a in range(degree - order + 1):
-        total = total + work[intervals - degree + a] * h[:, a]
-    return total
+        out.append(work.copy())
+    return out
 
 
 def piecewise_cubic(knots: np.ndarray, coefficients: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The cubic spline with these clamped `knots` and B-spline `coefficients` as a piecewise polynomial: (breaks,
     coefficients with the highest power first, one column per piece), pieces of zero length left out (the form
-    of :class:`parksteer.measure.rack_spline.RackSpline`, with PPoly.from_spline's bits)."""
+    of :class:`parksteer.measure.rack_spline.RackSpline`, with PPoly.from_spline's bits).
+
+    Each derivative at the left end of each piece as FITPACK's splev/splder take it: the derivative's B-spline
+    coefficients by repeated differences, then the B-splines of its degree at the point (the differences and the
+    recurrence of the lower degrees are the first steps of the higher ones, so each is made once)."""
     knots = np.asarray(knots, dtype=float)
     degree = 3
     pieces = np.flatnonzero(np.diff(knots) > 0.0)
+    derivatives = _derivative_coefficients(knots, coefficients, degree)
+    values: list[np.ndarray] = []  # the B-splines of degree 0 ... 3 at the breaks
+    _de_boor(knots, knots[pieces], pieces, degree, steps=values)
     out = np.empty((degree + 1, len(pieces)))
     factorial = 1.0
     for order in range(degree + 1):
-        out[degree - order] = _spline_derivative_at_breaks(knots, coefficients, degree, order, pieces) / factorial
+        work = derivatives[order]
+        if order == degree:
+            at_breaks = work[pieces - degree]
+        else:
+            h = values[degree - order]
+            at_breaks = np.zeros(len(pieces))
+            for a in range(degree - order + 1):
+                at_breaks = at_breaks + work[pieces - degree + a] * h[:, a]
+        out[degree - order] = at_breaks / factorial
         factorial *= order + 1
     return np.concatenate([knots[pieces], [knots[-1]]]), out
