@@ -100,10 +100,11 @@ def test_predictions_follow_the_problem_they_are_asked_on(params):
 
 @pytest.mark.parametrize("workers", [1, 2])
 def test_the_engine_counts_every_solve_once_wherever_it_runs(params, monkeypatch, workers):
-    """ReplayEngine.evaluations (the report's replay count) is the number of model solves run: one on a replay
+    """ReplayEngine.evaluations (the report's replay count) is the number of replays asked for: one on a replay
     the engine made and did not keep, one on a replay made from it on another rack, one at other instants, and
-    three mapped over the workers (counted there by an independent tally of the solver's calls, returned with each
-    result), each once, in line or in two worker processes."""
+    three mapped over the workers, each once, in line or in two worker processes (counted there by an independent
+    tally of the solver's calls and of the solves the memo answered, returned with each result); the three mapped
+    repeat solves made before, so the memo answers them, in line and in the workers alike (forked with it)."""
     import parksteer.diagnose.replay as replay_module
 
     real, calls = replay_module.solve, []
@@ -119,16 +120,18 @@ def test_the_engine_counts_every_solve_once_wherever_it_runs(params, monkeypatch
         one_off.at_times(f.time_s[1:]).torque()
 
         def job(overrides):
-            before = len(calls)
+            before, found = len(calls), engine.solutions.found
             one_off.torque(overrides)
-            return os.getpid(), len(calls) - before
+            return os.getpid(), len(calls) - before, engine.solutions.found - found
 
         mapped = engine.map(job, [{}, moved, {}])
     finally:
         engine.close()
-    in_workers = [solves for pid, solves in mapped if pid != os.getpid()]
+    in_workers = [(solves, found) for pid, solves, found in mapped if pid != os.getpid()]
     assert len(in_workers) == (3 if workers == 2 else 0)
-    assert len(calls) + sum(in_workers) == 6
+    assert len(calls) == 3 and [found for _, _, found in mapped] == [1, 1, 1]
+    assert len(calls) + sum(solves + found for solves, found in in_workers) + (engine.solutions.found
+                                                                              if workers == 1 else 0) == 6
     assert engine.evaluations == 6
 
 

@@ -196,3 +196,41 @@ def test_a_replay_on_another_rack_shares_the_preparation_not_the_result(params):
     for overrides in ({}, moved):
         assert np.array_equal(shared.torque(overrides), fresh.torque(overrides))
     assert not np.array_equal(shared.torque(), replay.torque())
+
+
+def test_a_repeated_replay_is_answered_from_the_memo_bit_for_bit_and_counted(params):
+    """SolutionMemo (ReplayEngine.solutions): a solve is a function of its inputs alone, so a replay asked again
+    with the same compiled model, vector, rack and times (another effect set on the same host model at the same
+    values, as each candidate's signature replays the calibrated model at strength 0) is not solved again, yet is
+    counted as a replay, and gives bit for bit what a replay without the memo solves, its outputs too; what it hands
+    out is a copy, so a caller changing it changes no later answer; another vector or rack is solved anew."""
+    t, logged, _ = _logged_rack(17, True)
+    _, other_logged, _ = _logged_rack(18, True)
+    rack, other_rack = smooth_rack(t, logged), smooth_rack(t, other_logged)
+    base = resolve_effects(None)
+    host = resolve_effects([*base, discover_effects()["column_friction"]])
+    engine = ReplayEngine(hosts={effect_key(base): host, effect_key(host): host})
+    first = engine.new_replay(base, "unladen", "ground", params, rack, t)
+    second = engine.new_replay(host, "unladen", "ground", params, rack, t)
+    alone = Replay(base, "unladen", "ground", params, rack, t, model_effects=host)
+    run, p = alone.parameter_vector()
+    solved = solve(run, p, rack, t)
+
+    torque = first.torque()
+    assert engine.solutions.found == 0 and np.array_equal(torque, solved.torque_Nm)
+    torque[:] = 0.0  # a caller's own copy
+    again = second.torque()
+    assert engine.solutions.found == 1 and engine.evaluations == 2
+    assert np.array_equal(again, solved.torque_Nm) and again.tobytes() == solved.torque_Nm.tobytes()
+
+    with_outputs = [first.solve(outputs=True), second.solve(outputs=True)]
+    fresh = solve(run, p, rack, t, outputs=True)
+    assert engine.solutions.found == 2
+    for found in with_outputs:
+        assert np.array_equal(found.states, fresh.states) and np.array_equal(found.handwheel, fresh.handwheel)
+        assert all(np.array_equal(found.outputs[k], fresh.outputs[k]) for k in fresh.outputs)
+
+    moved = {"steering.rack_friction_force": params["steering.rack_friction_force"] + 80.0}
+    assert np.array_equal(second.torque(moved), alone.torque(moved))
+    assert np.array_equal(first.on_rack(other_rack).torque(), alone.on_rack(other_rack).torque())
+    assert engine.solutions.found == 2 and engine.evaluations == 6

@@ -13,6 +13,8 @@ itself as scipy's ``OdeSolver`` keeps ``nfev``. It owns:
 - `replays`: one :class:`parksteer.diagnose.replay.Replay` per effect set, file and torque lag (the kept ones);
 - `solves`: the count every replay it makes adds its solves to, kept or not (a replay on another rack or at
   other instants made from one of them too: :class:`parksteer.diagnose.replay.SolveCount`);
+- `solutions`: the latest solves of those replays by their exact inputs, a repeat answered from them
+  (:class:`parksteer.diagnose.replay.SolutionMemo`);
 - `pool`, `workers`: the worker processes a prediction spreads its files over (:mod:`parksteer.diagnose.parallel`),
   forked for the problem they serve and again for another problem, so that none answers for an earlier one, and
   holding the diagnosis's effects and their classes, which a prediction's tasks name by place;
@@ -32,7 +34,7 @@ from ..model.numeric.compiled import CompiledModel, CompiledModels
 from ..model.symbolic.components import Effect
 from .parallel import ServingPool, fork_map, forks
 from .problem import Problem
-from .replay import Replay, SolveCount
+from .replay import Replay, SolutionMemo, SolveCount
 
 
 class LoadedModels(CompiledModels):
@@ -87,6 +89,7 @@ class ReplayEngine:
         self.prepared: dict[tuple, tuple[object, dict]] = {}
         self.replays: dict[tuple, Replay] = {}
         self.solves = SolveCount()
+        self.solutions = SolutionMemo()
         self.other_replays = 0
         self.pool = ServingPool(self.workers, inherited_effects([*effects, *(e for host in self.hosts.values()
                                                                           for e in host)]))
@@ -108,7 +111,8 @@ class ReplayEngine:
         if key not in self.prepared:
             self.prepared[key] = (params, {})
         return Replay(list(effects), case, surface, params, rack, time_s, model_effects=model_effects,
-                      direct=self.direct, models=self.models, shared_runs=self.prepared[key][1], counter=self.solves)
+                      direct=self.direct, models=self.models, shared_runs=self.prepared[key][1], counter=self.solves,
+                      solutions=self.solutions)
 
     def replay(self, problem: Problem, effects: list[Effect], index: int) -> Replay:
         """The kept replay of `effects` on file `index` of `problem`, at the file's instants (made when first asked

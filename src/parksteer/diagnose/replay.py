@@ -7,6 +7,9 @@ the compiled model, the parameter vector and the static balance are made once pe
 per override of a quantity that shapes them (a case value, the geometry), while an override of a
 quantity that only enters the equations is written into a copy of the vector.
 
+A solve asked for again with the same inputs (the model, its vector, the rack, the times) is answered from the
+latest solves (:class:`SolutionMemo`), bit for bit the solve it would make, and counted as a replay all the same.
+
 A diagnosis replays most candidates in one compiled model, the diagnosis model
 (:func:`parksteer.diagnose.candidates.diagnosis_model`): the replay engine
 (:class:`parksteer.diagnose.engine.ReplayEngine`) makes a replay of an effect set it maps on the compiled model of
@@ -15,7 +18,7 @@ its host set (`model_effects`), the other candidates there at their values, stre
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 
 import numpy as np
 
@@ -23,13 +26,74 @@ from ..measure.rack_spline import RackSpline
 from ..errors import UsageError
 from ..model.numeric.assisted import solve_assisted
 from ..model.numeric.compiled import CompiledModels
-from ..model.numeric.prescribed import PrescribedSolution, solve, twist_spread
+from ..model.numeric.prescribed import PrescribedSolution, rack_table, solve, twist_spread
 from ..model.numeric.simulate import PreparedRun, prepare
 from ..model.symbolic.components import Effect, power_assist_of
 from ..parameters import Parameters
 
 # Prepared runs kept per replay: the base run and the latest others.
 KEPT_RUNS = 8
+# Solves kept per memo (SolutionMemo), at most this many and this many bytes: a diagnosis asks for the same replay
+# again some replays later (each candidate's signature replays the calibrated model at strength 0 on the diagnosis
+# model: the same vector each time, a few files by a few probes apart).
+KEPT_SOLUTIONS = 64
+KEPT_SOLUTION_BYTES = 64 * 2**20
+
+
+def _arrays(solution: PrescribedSolution) -> list[np.ndarray]:
+    """The arrays `solution` holds (an assisted solve's motor channels among them)."""
+    out = []
+    for f in fields(solution):
+        value = getattr(solution, f.name)
+        out += [v for v in (value.values() if isinstance(value, dict) else [value]) if isinstance(v, np.ndarray)]
+    return out
+
+
+def copied(solution: PrescribedSolution) -> PrescribedSolution:
+    """`solution` (an assisted solve's too) with every array its own copy, the same bits, so that a caller changing
+    one changes no other."""
+    def own(value):
+        if isinstance(value, np.ndarray):
+            return value.copy()
+        if isinstance(value, dict):
+            return {key: own(item) for key, item in value.items()}
+        return value
+
+    return type(solution)(**{f.name: own(getattr(solution, f.name)) for f in fields(solution)})
+
+
+class SolutionMemo:
+    """The latest solves of a family of replays by their exact inputs (:meth:`Replay.solve`): the compiled model, its
+    effects, the parameter vector's bytes, the rack's table and ends, the output times' bytes and whether the outputs
+    were asked for. A solve is a deterministic function of these, so a solve found here is the one it would compute,
+    bit for bit; it is handed out as a copy (:func:`copied`). A replay engine's replays share one
+    (:attr:`parksteer.diagnose.engine.ReplayEngine.solutions`); a worker process's copy is its own."""
+
+    __slots__ = ("kept", "kept_bytes", "found")
+
+    def __init__(self) -> None:
+        self.kept: dict[tuple, tuple[PrescribedSolution, int]] = {}
+        self.kept_bytes = 0
+        self.found = 0  # solves answered from the memo
+
+    def get(self, key: tuple) -> PrescribedSolution | None:
+        """A copy of the solve kept under `key`, or None."""
+        kept = self.kept.get(key)
+        if kept is None:
+            return None
+        self.found += 1
+        return copied(kept[0])
+
+    def keep(self, key: tuple, solution: PrescribedSolution) -> None:
+        """Keep a copy of `solution` under `key`, the oldest dropped beyond KEPT_SOLUTIONS or KEPT_SOLUTION_BYTES."""
+        solution = copied(solution)
+        size = sum(a.nbytes for a in _arrays(solution))
+        if size > KEPT_SOLUTION_BYTES:
+            return
+        while self.kept and (len(self.kept) >= KEPT_SOLUTIONS or self.kept_bytes + size > KEPT_SOLUTION_BYTES):
+            self.kept_bytes -= self.kept.pop(next(iter(self.kept)))[1]
+        self.kept[key] = (solution, size)
+        self.kept_bytes += size
 
 
 class SolveCount:
@@ -79,6 +143,9 @@ class Replay:
     models: CompiledModels | None = field(default=None, repr=False, compare=False)
     # the count its solves add to besides its own `evaluations`, shared with the replays made from it
     counter: SolveCount | None = field(default=None, repr=False, compare=False)
+    # the latest solves by their exact inputs, shared by the replays of one engine (ReplayEngine.solutions) and those
+    # made from them; by default this replay's own
+    solutions: SolutionMemo | None = field(default=None, repr=False, compare=False)
 
     def __post_init__(self):
         self.time_s = np.asarray(self.time_s, dtype=float)
@@ -93,6 +160,9 @@ class Replay:
             self.direct = {}
         if self.models is None:
             self.models = CompiledModels()
+        if self.solutions is None:
+            self.solutions = SolutionMemo()
+        self._drive_key: tuple[bytes, ...] | None = None  # made at the first solve (_solve_key)
         self._base = self._prepared(self.base_overrides)
 
     def on_rack(self, rack: RackSpline) -> Replay:
@@ -108,7 +178,7 @@ class Replay:
     def _sharing(self, rack: RackSpline, time_s: np.ndarray) -> Replay:
         return Replay(self.effects, self.case, self.surface, self.params, rack, time_s, dict(self.base_overrides),
                       runs=self._runs, model_effects=self.model_effects, direct=self.direct,
-                      models=self.models, counter=self.counter)
+                      models=self.models, counter=self.counter, solutions=self.solutions)
 
     def _prepared(self, overrides: dict[str, float]) -> PreparedRun:
         key = tuple(sorted(overrides.items()))
@@ -177,13 +247,29 @@ class Replay:
         assisted car, the assisted solve (torsion-bar torque, motor torque and current; no outputs)."""
         run, p = self.parameter_vector(overrides)
         self.count_solve()
+        if self.assisted and outputs:
+            raise UsageError("the handwheel angle of an assisted car is not replayed (its twist passes the "
+                             "torsion-bar torque through the torsion bar in series); fit the torque and the motor "
+                             "channel instead of --angle")
+        # a repeat is counted as a solve all the same: the count is the replays asked for, at any number of workers
+        key = self._solve_key(run, p, outputs)
+        found = self.solutions.get(key)
+        if found is not None:
+            return found
         if self.assisted:
-            if outputs:
-                raise UsageError("the handwheel angle of an assisted car is not replayed (its twist passes the "
-                                 "torsion-bar torque through the torsion bar in series); fit the torque and the motor "
-                                 "channel instead of --angle")
-            return solve_assisted(run, p, self.rack, self.time_s)
-        return solve(run, p, self.rack, self.time_s, outputs=outputs)
+            solution = solve_assisted(run, p, self.rack, self.time_s)
+        else:
+            solution = solve(run, p, self.rack, self.time_s, outputs=outputs)
+        self.solutions.keep(key, solution)
+        return solution
+
+    def _solve_key(self, run: PreparedRun, p: np.ndarray, outputs: bool) -> tuple:
+        """A solve's inputs exactly (:class:`SolutionMemo`): the compiled model and its effects, the vector's bytes,
+        whether the outputs are made, the rack's table and ends and the times' bytes (the last three made once)."""
+        if self._drive_key is None:
+            ends = np.array([self.rack.start_s, self.rack.end_s], dtype=float)
+            self._drive_key = (rack_table(self.rack).tobytes(), ends.tobytes(), self.time_s.tobytes())
+        return (run.model.directory.name, tuple(e.name for e in run.effects), outputs, p.tobytes(), *self._drive_key)
 
     def twist_spread(self, torque_error: np.ndarray, overrides: dict[str, float] | None = None) -> np.ndarray:
         """How far the replayed twist moves for a torque off by `torque_error` at each sample

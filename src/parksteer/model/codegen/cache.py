@@ -61,8 +61,10 @@ PREBUILT_DIR = MODEL_DIR / "prebuilt"
 STALE_SCRATCH_S = 6 * 3600.0
 
 
+@lru_cache(maxsize=1)
 def checkout_root() -> Path | None:
-    """The repository the package runs from (editable install, or src/ on the path); None when installed."""
+    """The repository the package runs from (editable install, or src/ on the path); None when installed. Found once
+    a process (reading the installed distributions' metadata costs a millisecond, and every model is found by it)."""
     package = MODEL_DIR.parent
     try:
         dist = metadata.distribution("parksteer")
@@ -89,10 +91,17 @@ def cache_root() -> Path:
     return Path(base) / "parksteer" / "model"
 
 
+@lru_cache(maxsize=None)
+def _in_symbolic_half(path: str) -> bool:
+    """Whether the module file `path` lies in the symbolic half (found once a path: resolving it is a system call a
+    directory)."""
+    return any(Path(path).resolve().is_relative_to(d) for d in SYMBOLIC_DIRS)
+
+
 def _effect_source(effect: Effect) -> str:
     module = sys.modules.get(type(effect).__module__)
     path = getattr(module, "__file__", None)
-    if path and any(Path(path).resolve().is_relative_to(d) for d in SYMBOLIC_DIRS):
+    if path and _in_symbolic_half(path):
         return ""  # hashed with the symbolic half
     try:
         return inspect.getsource(module)
@@ -383,11 +392,12 @@ def cache_write_error(root: Path, exc: OSError) -> UsageError:
                       f"XDG_CACHE_HOME {os.environ.get('XDG_CACHE_HOME') or 'unset: ~/.cache'})")
 
 
-def ensure_entry(effects: list[Effect]) -> Path:
+def ensure_entry(effects: list[Effect], final: Path | None = None) -> Path:
     """The cache entry of `effects`, built if missing or unsound (atomically: built aside, then renamed into
     place; a scratch directory left by a killed build is removed here; one build at a time per entry). A cache
-    that cannot be written is one line (:func:`cache_write_error`), with nothing half-written left in it."""
-    final = entry_path(effects)
+    that cannot be written is one line (:func:`cache_write_error`), with nothing half-written left in it. `final`:
+    the entry's path (:func:`entry_path`) when the caller has it already."""
+    final = entry_path(effects) if final is None else final
     if entry_is_sound(final):
         return final
     try:

@@ -162,8 +162,9 @@ class CompiledModels:
 
     def of(self, effects: list[Effect]) -> CompiledModel:
         """The compiled model of `effects`, from the cache (derived and compiled once if missing)."""
-        loaded = self.loaded.get(entry_path(effects).resolve())
-        return loaded if loaded is not None else self.entry(ensure_entry(effects))
+        path = entry_path(effects)  # the key hashes the model's source: once
+        loaded = self.loaded.get(path.resolve())
+        return loaded if loaded is not None else self.entry(ensure_entry(effects, path))
 
 
 def load_entry(directory: Path) -> CompiledModel:
