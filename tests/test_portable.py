@@ -28,7 +28,7 @@ import pytest
 from parksteer import portable as pm
 from parksteer.measure.bspline import DesignMatrix
 from parksteer.model.codegen import generate
-from parksteer.portable import elimination
+from parksteer.portable import elimination, linalg
 
 C_SOURCE = Path(generate.__file__).with_name("portable_math.c")
 UNARY = ("sin", "cos", "atan", "exp", "expm1", "tanh", "log")
@@ -205,6 +205,46 @@ def test_banded_elimination_is_the_dense_one_to_the_bit():
     n = gram.shape[0]
     assert same_bits(pm.inv(gram), dense_solve(gram, np.eye(n), identity=True))
     assert same_bits(pm.cholesky(gram), elimination._cholesky(gram, n - 1))
+
+
+def test_sums_in_python_floats_are_numpys_to_the_bit():
+    """The small least squares in Python floats sums in numpy's orders: a vector's pairwise sum (one by one below 8
+    terms, eight interleaved partial sums from 8 on) and a column's sum over the first axis (one row after another
+    for several columns), signed zeros included, for every length up to 128."""
+    rng = np.random.default_rng(12)
+    for count in range(0, 129):
+        for _ in range(20):
+            terms = rng.normal(size=count) * 10.0 ** rng.integers(-12, 13, size=count)
+            terms[rng.random(count) < 0.2] = rng.choice([0.0, -0.0])
+            if rng.random() < 0.2:
+                terms[:] = -0.0
+            expected = np.add.reduce(terms)
+            assert np.float64(linalg._pairwise_sum(terms.tolist())).view(np.int64) == expected.view(np.int64)
+            down = np.add.reduce(np.stack([terms, terms[::-1]], axis=1), axis=0)[0]
+            assert np.float64(linalg._sum_down(terms.tolist(), 2)).view(np.int64) == down.view(np.int64)
+            single = np.add.reduce(terms[:, None], axis=0)[0]
+            assert np.float64(linalg._sum_down(terms.tolist(), 1)).view(np.int64) == single.view(np.int64)
+
+
+def test_least_squares_in_python_floats_is_the_numpy_one_to_the_bit(monkeypatch):
+    """lstsq of a small system in Python floats gives the bits of the same algorithm in numpy calls (rank-deficient
+    and -0.0 columns, one and several right-hand sides, up to 14 rows and 12 columns)."""
+    rng = np.random.default_rng(13)
+    cases = []
+    for _ in range(300):
+        m, n = int(rng.integers(1, 15)), int(rng.integers(1, 13))
+        a = rng.normal(size=(m, n)) * 10.0 ** rng.integers(-6, 7, size=(m, n))
+        a[rng.random((m, n)) < 0.15] = rng.choice([0.0, -0.0])
+        if rng.random() < 0.2:
+            a[:, rng.integers(n)] = 0.0
+        b = rng.normal(size=m) if rng.random() < 0.5 else rng.normal(size=(m, int(rng.integers(1, 3))))
+        cases.append((a, b))
+    monkeypatch.setattr(linalg, "_FLOATS_AT_MOST", 10**6)
+    in_floats = [pm.lstsq(a, b) for a, b in cases]
+    monkeypatch.setattr(linalg, "_FLOATS_AT_MOST", 0)
+    for (a, b), fast in zip(cases, in_floats):
+        slow = pm.lstsq(a, b)
+        assert fast.shape == slow.shape and np.array_equal(fast.view(np.int64), slow.view(np.int64))
 
 
 def test_generalised_inverse_and_semidefinite_factor():

@@ -5,6 +5,8 @@ norms, Householder QR with column pivoting (the algorithm LAPACK uses, written o
 from __future__ import annotations
 
 import math
+from functools import reduce
+from operator import add, mul, sub
 
 import numpy as np
 
@@ -14,6 +16,7 @@ LinAlgError = np.linalg.LinAlgError
 _sum = np.add.reduce
 
 _CHUNK_ELEMENTS = 1 << 21  # temporaries of matmul stay under 16 MB
+_FLOATS_AT_MOST = 40  # least squares in Python floats up to this many entries of a and b (numpy's calls cost more)
 
 
 def _f64(a) -> np.ndarray:
@@ -75,6 +78,85 @@ def _householder(r: np.ndarray, k: int, b: np.ndarray | None) -> np.ndarray | No
     return v
 
 
+def _pairwise_sum(terms: list[float]) -> float:
+    """numpy's sum of a float64 vector of up to 128 terms, to the bit: one by one below 8 terms, else eight
+    interleaved partial sums added as a tree, then the rest one by one (its pairwise_sum), after the identity +0."""
+    count = len(terms)
+    if count < 8:
+        return 0.0 + reduce(add, terms, -0.0)
+    partial = terms[:8]
+    whole = count - count % 8
+    for start in range(8, whole, 8):
+        partial = list(map(add, partial, terms[start:start + 8]))
+    p0, p1, p2, p3, p4, p5, p6, p7 = partial
+    total = ((p0 + p1) + (p2 + p3)) + ((p4 + p5) + (p6 + p7))
+    return 0.0 + reduce(add, terms[whole:], total)
+
+
+def _sum_down(terms: list[float], columns: int) -> float:
+    """numpy's sum of one column of a (len(terms) x columns) array over its first axis: one row after another from
+    +0 for more than one column, else the column's pairwise sum."""
+    return reduce(add, terms, 0.0) if columns > 1 else _pairwise_sum(terms)
+
+
+def _lstsq_in_floats(a: np.ndarray, rhs: np.ndarray, rcond: float) -> np.ndarray:
+    """:func:`lstsq`'s operations, each the same IEEE operation on Python floats and each sum in numpy's order
+    (:func:`_sum_down`, :func:`_pairwise_sum`): the same bits without numpy's cost per call, for small systems.
+    Raises ZeroDivisionError where numpy would divide by zero (its caller then runs the numpy version)."""
+    m, n = a.shape
+    p = rhs.shape[1]
+    columns = np.concatenate([a, rhs], axis=1).T.tolist()  # column-major: a swap moves two references
+    order = list(range(n))
+    rank = 0
+    largest = 0.0
+    for k in range(min(m, n)):
+        lengths = [_sum_down(list(map(mul, column[k:], column[k:])), n - k) for column in columns[k:n]]
+        j = k + _first_max(lengths)
+        length = math.sqrt(lengths[j - k])
+        if k == 0:
+            largest = length
+        if not length > rcond * largest:
+            break
+        if j != k:
+            columns[k], columns[j] = columns[j], columns[k]
+            order[k], order[j] = order[j], order[k]
+        rank = k + 1
+        x = columns[k][k:]
+        if m - k >= 8:
+            length = math.sqrt(_pairwise_sum(list(map(mul, x, x))))
+        if length == 0.0:
+            continue
+        alpha = -length if x[0] >= 0.0 else length
+        v = list(x)
+        v[0] = v[0] - alpha
+        scale = 2.0 / _pairwise_sum(list(map(mul, v, v)))
+        for c in range(k, n + p):
+            column = columns[c]
+            w = _sum_down(list(map(mul, v, column[k:])), n - k if c < n else p) * scale
+            column[k:] = map(sub, column[k:], [vi * w for vi in v])
+    z = [[0.0] * n for _ in range(p)]  # column-major too
+    for c in range(p):
+        solution, right = z[c], columns[n + c]
+        for k in range(rank - 1, -1, -1):
+            row = [columns[i][k] for i in range(k + 1, rank)]
+            tail = _sum_down(list(map(mul, row, solution[k + 1:rank])), p) if k + 1 < rank else 0.0
+            solution[k] = (right[k] - tail) / columns[k][k]
+    x = np.zeros((n, p))
+    x[order] = np.array(z).T
+    return x
+
+
+def _first_max(values: list[float]) -> int:
+    """np.argmax: the first largest value, or the first NaN if there is one."""
+    best, largest = 0, -math.inf
+    for i, value in enumerate(values):
+        if value != value:
+            return i
+        if value > largest:
+            best, largest = i, value
+    return best
+
+
 def _sums_down_in_order(rows: int, columns: int) -> bool:
     """Whether numpy sums a (rows x columns) array over its first axis one row after another from +0.0: it does
     for more than one column, and for one column of fewer than 8 rows (its pairwise sum starts with eight
@@ -98,6 +180,12 @@ def lstsq(a, b, rcond: float | None = None) -> np.ndarray:
     if rcond is None:
         rcond = np.finfo(float).eps * max(m, n)
     p = rhs.shape[1]
+    if m <= 128 and m * (n + p) <= _FLOATS_AT_MOST:
+        try:
+            x = _lstsq_in_floats(r, rhs, rcond)
+            return x[:, 0] if vector else x
+        except ZeroDivisionError:
+            pass
     # a and b side by side: one reflection, one reduction and one update for both where the columns' sums are
     # the same sequential ones as each block's on its own
     work = np.concatenate([r, rhs], axis=1)
