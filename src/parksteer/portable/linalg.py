@@ -110,7 +110,11 @@ def _lstsq_in_floats(a: np.ndarray, rhs: np.ndarray, rcond: float) -> np.ndarray
     rank = 0
     largest = 0.0
     for k in range(min(m, n)):
-        lengths = [_sum_down(list(map(mul, column[k:], column[k:])), n - k) for column in columns[k:n]]
+        tails = [column[k:] for column in columns[k:n]]
+        if n - k > 1:
+            lengths = [reduce(add, map(mul, tail, tail), 0.0) for tail in tails]
+        else:
+            lengths = [_pairwise_sum(list(map(mul, tails[0], tails[0])))]
         j = k + _first_max(lengths)
         length = math.sqrt(lengths[j - k])
         if k == 0:
@@ -132,8 +136,9 @@ def _lstsq_in_floats(a: np.ndarray, rhs: np.ndarray, rcond: float) -> np.ndarray
         scale = 2.0 / _pairwise_sum(list(map(mul, v, v)))
         for c in range(k, n + p):
             column = columns[c]
-            w = _sum_down(list(map(mul, v, column[k:])), n - k if c < n else p) * scale
-            column[k:] = map(sub, column[k:], [vi * w for vi in v])
+            tail = column[k:]
+            w = _sum_down(list(map(mul, v, tail)), n - k if c < n else p) * scale
+            column[k:] = [t - vi * w for t, vi in zip(tail, v)]
     z = [[0.0] * n for _ in range(p)]  # column-major too
     for c in range(p):
         solution, right = z[c], columns[n + c]
