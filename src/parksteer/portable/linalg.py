@@ -6,7 +6,8 @@ from __future__ import annotations
 
 import math
 from functools import reduce
-from operator import add, mul, sub
+from itertools import repeat
+from operator import add, itemgetter, mul, sub
 
 import numpy as np
 
@@ -93,10 +94,10 @@ def _pairwise_sum(terms: list[float]) -> float:
     return 0.0 + reduce(add, terms[whole:], total)
 
 
-def _sum_down(terms: list[float], columns: int) -> float:
-    """numpy's sum of one column of a (len(terms) x columns) array over its first axis: one row after another from
-    +0 for more than one column, else the column's pairwise sum."""
-    return reduce(add, terms, 0.0) if columns > 1 else _pairwise_sum(terms)
+def _sum_down(terms, columns: int) -> float:
+    """numpy's sum of one column (an iterable of its terms) of an array of `columns` columns over its first axis:
+    one row after another from +0 for more than one column, else the column's pairwise sum."""
+    return reduce(add, terms, 0.0) if columns > 1 else _pairwise_sum(list(terms))
 
 
 def _lstsq_in_floats(a: np.ndarray, rhs: np.ndarray, rcond: float) -> np.ndarray:
@@ -137,14 +138,14 @@ def _lstsq_in_floats(a: np.ndarray, rhs: np.ndarray, rcond: float) -> np.ndarray
         for c in range(k, n + p):
             column = columns[c]
             tail = column[k:]
-            w = _sum_down(list(map(mul, v, tail)), n - k if c < n else p) * scale
-            column[k:] = [t - vi * w for t, vi in zip(tail, v)]
+            w = _sum_down(map(mul, v, tail), n - k if c < n else p) * scale
+            column[k:] = map(sub, tail, map(mul, v, repeat(w)))  # t - v_i w, as numpy's outer product and update
     z = [[0.0] * n for _ in range(p)]  # column-major too
     for c in range(p):
         solution, right = z[c], columns[n + c]
         for k in range(rank - 1, -1, -1):
-            row = [columns[i][k] for i in range(k + 1, rank)]
-            tail = _sum_down(list(map(mul, row, solution[k + 1:rank])), p) if k + 1 < rank else 0.0
+            row = map(itemgetter(k), columns[k + 1:rank])
+            tail = _sum_down(map(mul, row, solution[k + 1:rank]), p) if k + 1 < rank else 0.0
             solution[k] = (right[k] - tail) / columns[k][k]
     x = np.zeros((n, p))
     x[order] = np.array(z).T
