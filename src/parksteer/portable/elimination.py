@@ -56,11 +56,12 @@ def _first_largest(column: list[float]) -> int:
     return best
 
 
-def _eliminate(lu: np.ndarray, x: np.ndarray, lower: int, upper: int, identity: bool) -> np.ndarray:
-    """x with lu x = b for b = `x` (two-dimensional): Gaussian elimination with partial pivoting, touching only the
-    band of `lower` diagonals below and `upper` above the main one (which a row swap widens to lower + upper
-    above). With `identity` (b is the identity) a row of b is zero beyond the band too. Returns x; the factors are
-    left in the first n columns of the (n, n + columns of b) working array, which is returned second."""
+def _eliminate(lu: np.ndarray, x: np.ndarray, lower: int, upper: int, identity: bool
+               ) -> tuple[np.ndarray, np.ndarray]:
+    """Solve lu y = x (x two-dimensional; neither overwritten) by Gaussian elimination with partial pivoting,
+    touching only the band of `lower` diagonals below and `upper` above the main one (which a row swap widens to
+    lower + upper above). With `identity` (x is the identity) a row of x is zero beyond the band too. Returns y and
+    the working array (the factors in its first n columns, y in the rest)."""
     n = lu.shape[0]
     work = np.concatenate([lu, x], axis=1)  # a row of the matrix and of b, swapped and reduced as one
     stop = work.shape[1]
