@@ -78,14 +78,16 @@ def _eliminate(lu: np.ndarray, x: np.ndarray, lower: int, upper: int, identity: 
             end = n + bottom if identity else stop
             factor = work[k + 1:bottom, k] / work[k, k]
             work[k + 1:bottom, k:end] -= np.multiply.outer(factor, work[k, k:end])
+    solution = work[:, n:]
     for k in range(n - 1, -1, -1):
+        row = solution[k]
         if k + 1 < n:
             end = min(n, k + lower + upper + 1) if sequential else n
-            tail = _sum(work[k, k + 1:end, None] * work[k + 1:end, n:], axis=0)
+            np.subtract(row, _sum(work[k, k + 1:end, None] * solution[k + 1:end], axis=0), out=row)
         else:
-            tail = 0.0
-        work[k, n:] = (work[k, n:] - tail) / work[k, k]
-    return work[:, n:], work
+            np.subtract(row, 0.0, out=row)
+        np.divide(row, work[k, k], out=row)
+    return solution, work
 
 
 def _solve(a, b, identity: bool) -> np.ndarray:
