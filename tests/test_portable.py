@@ -26,7 +26,9 @@ import numpy as np
 import pytest
 
 from parksteer import portable as pm
+from parksteer.measure.bspline import DesignMatrix
 from parksteer.model.codegen import generate
+from parksteer.portable import elimination, linalg
 
 C_SOURCE = Path(generate.__file__).with_name("portable_math.c")
 UNARY = ("sin", "cos", "atan", "exp", "expm1", "tanh", "log")
@@ -150,6 +152,99 @@ def test_linear_algebra_solves_what_it_claims():
     assert np.allclose(q.T @ q, np.eye(3), atol=1e-14) and np.allclose(q @ r, tall[:, [0, 1, 3]], atol=1e-13)
     assert pm.dot([3.0, 4.0], [3.0, 4.0]) == 25.0 and pm.norm([3.0, 4.0]) == 5.0
     assert np.array_equal(pm.matmul(np.eye(3), [1.0, 2.0, 3.0]), [1.0, 2.0, 3.0])
+
+
+def _banded_matrix(rng, n: int, below: int, above: int) -> np.ndarray:
+    """Random entries (signs mixed, so partial pivoting swaps rows; a few exact zeros) within the band only."""
+    a = rng.normal(size=(n, n)) * 10.0 ** rng.integers(-2, 3, size=(n, n))
+    rows, columns = np.indices((n, n))
+    a[(columns - rows > above) | (rows - columns > below)] = 0.0
+    a[rng.random((n, n)) < 0.05] = 0.0
+    return a
+
+
+def test_banded_elimination_is_the_dense_one_to_the_bit():
+    """Solving, inverting and factoring a banded matrix touch only the band, and give the dense algorithms' bits
+    (the skipped operations subtract exact zeros from entries that are not -0.0): checked against the same
+    elimination run over the whole matrix, on matrices whose pivoting swaps rows and widens the band, on the
+    Gram matrices of cubic B-splines (three diagonals either side), and on an input with a -0.0 (dense only)."""
+    def same_bits(a, b):
+        return a.shape == b.shape and np.array_equal(a.view(np.int64), b.view(np.int64))
+
+    def dense_solve(a, b, identity=False):
+        n = a.shape[0]
+        return elimination._eliminate(a, b, n - 1, n - 1, identity)[0]
+
+    rng = np.random.default_rng(11)
+    swaps = 0
+    for trial in range(60):
+        n = int(rng.integers(5, 80))
+        below, above = int(rng.integers(0, 4)), int(rng.integers(0, 4))
+        a = _banded_matrix(rng, n, below, above)
+        if trial % 10 == 0:
+            a[rng.integers(n), rng.integers(n)] = -0.0
+        swaps += int(np.argmax(np.abs(a[:below + 1, 0])) != 0)
+        try:
+            expected = dense_solve(a, np.eye(n), identity=True)
+        except pm.LinAlgError:
+            with pytest.raises(pm.LinAlgError):
+                pm.inv(a)
+            continue
+        assert same_bits(pm.inv(a), expected)
+        b = rng.normal(size=(n, 3))
+        assert same_bits(pm.solve(a, b), dense_solve(a, b))
+        assert same_bits(pm.solve(a, b[:, 0]), dense_solve(a, b[:, :1])[:, 0])
+        low = np.tril(_banded_matrix(rng, n, below, 0))
+        spd = pm.matmul(low, low.T) + np.diag(rng.uniform(0.1, 1.0, n))
+        assert same_bits(pm.cholesky(spd), elimination._cholesky(spd, n - 1))
+    assert swaps > 5  # the pivoting did swap rows
+
+    t = np.sort(rng.uniform(0.0, 10.0, 2000))
+    gram = DesignMatrix(t, np.concatenate([[0.0] * 4, np.linspace(0.2, 9.8, 60), [10.0] * 4])).gram()
+    assert elimination._bandwidths(gram) == (3, 3)
+    n = gram.shape[0]
+    assert same_bits(pm.inv(gram), dense_solve(gram, np.eye(n), identity=True))
+    assert same_bits(pm.cholesky(gram), elimination._cholesky(gram, n - 1))
+
+
+def test_sums_in_python_floats_are_numpys_to_the_bit():
+    """The small least squares in Python floats sums in numpy's orders: a vector's pairwise sum (one by one below 8
+    terms, eight interleaved partial sums from 8 on) and a column's sum over the first axis (one row after another
+    for several columns), signed zeros included, for every length up to 128."""
+    rng = np.random.default_rng(12)
+    for count in range(0, 129):
+        for _ in range(20):
+            terms = rng.normal(size=count) * 10.0 ** rng.integers(-12, 13, size=count)
+            terms[rng.random(count) < 0.2] = rng.choice([0.0, -0.0])
+            if rng.random() < 0.2:
+                terms[:] = -0.0
+            expected = np.add.reduce(terms)
+            assert np.float64(linalg._pairwise_sum(terms.tolist())).view(np.int64) == expected.view(np.int64)
+            down = np.add.reduce(np.stack([terms, terms[::-1]], axis=1), axis=0)[0]
+            assert np.float64(linalg._sum_down(terms.tolist(), 2)).view(np.int64) == down.view(np.int64)
+            single = np.add.reduce(terms[:, None], axis=0)[0]
+            assert np.float64(linalg._sum_down(terms.tolist(), 1)).view(np.int64) == single.view(np.int64)
+
+
+def test_least_squares_in_python_floats_is_the_numpy_one_to_the_bit(monkeypatch):
+    """lstsq of a small system in Python floats gives the bits of the same algorithm in numpy calls (rank-deficient
+    and -0.0 columns, one and several right-hand sides, up to 14 rows and 12 columns)."""
+    rng = np.random.default_rng(13)
+    cases = []
+    for _ in range(300):
+        m, n = int(rng.integers(1, 15)), int(rng.integers(1, 13))
+        a = rng.normal(size=(m, n)) * 10.0 ** rng.integers(-6, 7, size=(m, n))
+        a[rng.random((m, n)) < 0.15] = rng.choice([0.0, -0.0])
+        if rng.random() < 0.2:
+            a[:, rng.integers(n)] = 0.0
+        b = rng.normal(size=m) if rng.random() < 0.5 else rng.normal(size=(m, int(rng.integers(1, 3))))
+        cases.append((a, b))
+    monkeypatch.setattr(linalg, "_FLOATS_AT_MOST", 10**6)
+    in_floats = [pm.lstsq(a, b) for a, b in cases]
+    monkeypatch.setattr(linalg, "_FLOATS_AT_MOST", 0)
+    for (a, b), fast in zip(cases, in_floats):
+        slow = pm.lstsq(a, b)
+        assert fast.shape == slow.shape and np.array_equal(fast.view(np.int64), slow.view(np.int64))
 
 
 def test_generalised_inverse_and_semidefinite_factor():

@@ -141,28 +141,43 @@ def turning_times(time_s: np.ndarray, rack_m: np.ndarray) -> tuple[float, ...]:
     level = 0.2 * float(np.percentile(np.abs(speed), 90))
     moving = np.flatnonzero(np.abs(speed) > level)
     turns = []
-    for a, b in zip(moving[:-1], moving[1:]):
-        if level > 0 and np.sign(speed[a]) != np.sign(speed[b]):
-            segment = speed[a : b + 1]
-            k = a + int(np.flatnonzero(np.sign(segment[:-1]) != np.sign(segment[1:]))[0])
-            v0, v1 = speed[k], speed[k + 1]
-            turns.append(float(time_s[k] + (time_s[k + 1] - time_s[k]) * v0 / (v0 - v1)))
+    signs = np.sign(speed[moving])
+    reversals = np.flatnonzero(signs[:-1] != signs[1:]) if level > 0 else np.array([], dtype=int)
+    for a, b in zip(moving[reversals], moving[reversals + 1]):  # steady motions of opposite sign
+        segment = speed[a : b + 1]
+        k = a + int(np.flatnonzero(np.sign(segment[:-1]) != np.sign(segment[1:]))[0])
+        v0, v1 = speed[k], speed[k + 1]
+        turns.append(float(time_s[k] + (time_s[k + 1] - time_s[k]) * v0 / (v0 - v1)))
     return tuple(turns)
 
 
-def _constrained_solve(inverse: np.ndarray, rhs: np.ndarray, constraints: np.ndarray):
-    """Least squares with linear equality constraints C c = 0, from the inverse of the normal equations' matrix:
-    (coefficients, their covariance per unit variance)."""
-    coefficients = pm.matmul(inverse, rhs)
-    covariance = inverse
-    if len(constraints):
-        gc = pm.matmul(inverse, constraints.T)
-        # A generalised inverse (a rest reaching an end already fixes its speed, so C may repeat a constraint):
-        # any G with M G M = M gives the same coefficients and covariance.
-        correction = pm.matmul(gc, pm.generalized_inverse(pm.matmul(constraints, gc)))
-        coefficients = coefficients - pm.matmul(correction, pm.matmul(constraints, coefficients))
-        covariance = inverse - pm.matmul(correction, gc.T)
-    return coefficients, 0.5 * (covariance + covariance.T)
+class _ConstrainedFits:
+    """Least squares with linear equality constraints C c = 0 for subsets C of one set of constraint rows, from the
+    inverse of the normal equations' matrix: (coefficients, their covariance per unit variance).
+
+    The products of the inverse with every row are formed once: each entry of a product is a sum of its own, so a
+    subset's products are the same bits as products formed with that subset alone."""
+
+    def __init__(self, inverse: np.ndarray, rhs: np.ndarray, rows: np.ndarray):
+        self.inverse = inverse
+        self.unconstrained = pm.matmul(inverse, rhs)
+        if len(rows):
+            self.inverse_rows = pm.matmul(inverse, rows.T)
+            self.row_products = pm.matmul(rows, self.inverse_rows)
+            self.row_values = pm.matmul(rows, self.unconstrained)
+
+    def solve(self, chosen: list[int], covariance: bool = True):
+        """The fit held to the rows `chosen` (the covariance, the costlier part, only if asked for)."""
+        coefficients, full = self.unconstrained, self.inverse
+        if chosen:
+            gc = self.inverse_rows[:, chosen]
+            # A generalised inverse (a rest reaching an end already fixes its speed, so C may repeat a constraint):
+            # any G with M G M = M gives the same coefficients and covariance.
+            correction = pm.matmul(gc, pm.generalized_inverse(self.row_products[np.ix_(chosen, chosen)]))
+            coefficients = coefficients - pm.matmul(correction, self.row_values[chosen])
+            if covariance:
+                full = self.inverse - pm.matmul(correction, gc.T)
+        return coefficients, (0.5 * (full + full.T) if covariance else None)
 
 
 def lsq_fit(t: np.ndarray, x: np.ndarray, spacing_s: float, turns: tuple[float, ...] = (),
@@ -198,18 +213,20 @@ def lsq_fit(t: np.ndarray, x: np.ndarray, spacing_s: float, turns: tuple[float, 
             row = np.zeros(len(rhs))
             row[j], row[k] = 1.0, -1.0
             still.append(row)
-    free, _ = _constrained_solve(inverse, rhs, np.array(still).reshape(len(still), len(rhs)))
+    speed_rows = derivative_rows(knots, np.array([t[0], t[-1]]))
+    fits = _ConstrainedFits(inverse, rhs, np.array(still + list(speed_rows)).reshape(-1, len(rhs)))
+    held = list(range(len(still)))
+    free, _ = fits.solve(held, covariance=False)
     rss_free = float(np.sum((design.times(free) - x) ** 2))
     noise_var = max(rss_free / max(len(t) - len(rhs), 1), 1e-30)
-    speed_rows = derivative_rows(knots, np.array([t[0], t[-1]]))
-    held, at_rest = list(still), []
-    for row in speed_rows:
-        trial, _ = _constrained_solve(inverse, rhs, np.array(held + [row]))
+    at_rest = []
+    for end in range(len(speed_rows)):
+        trial, _ = fits.solve(held + [len(still) + end], covariance=False)
         rss = float(np.sum((design.times(trial) - x) ** 2))
         at_rest.append(hold_rest and rss - rss_free < RACK_REST_TEST_CHI2 * noise_var)
         if at_rest[-1]:
-            held.append(row)
-    coefficients, covariance = _constrained_solve(inverse, rhs, np.array(held).reshape(len(held), len(rhs)))
+            held.append(len(still) + end)
+    coefficients, covariance = fits.solve(held)
     rms = float(np.sqrt(np.mean((design.times(coefficients) - x) ** 2)))
     return knots, coefficients, covariance, rms, tuple(at_rest)
 

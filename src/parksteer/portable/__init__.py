@@ -32,19 +32,17 @@ from .filters import (
     running_median,
     sos_steady_state,
 )
+from .elimination import cholesky, inv, solve
 from .linalg import (
     LinAlgError,
-    cholesky,
     dot,
     generalized_inverse,
-    inv,
     inv_spd_batched,
     lstsq,
     matmul,
     norm,
     psd_factor,
     qr,
-    solve,
     solve_tridiagonal,
     symmetric_eigen,
 )

@@ -1,14 +1,23 @@
-"""Linear algebra for the small systems of the model and the diagnosis, with sums in a fixed order: Gaussian
-elimination with partial pivoting and Householder QR with column pivoting, the algorithms LAPACK uses, written
-out (:mod:`parksteer.portable` says why)."""
+"""Linear algebra for the small systems of the model and the diagnosis, with sums in a fixed order: products,
+norms, Householder QR with column pivoting (the algorithm LAPACK uses, written out) and what is built on them
+(:mod:`parksteer.portable` says why; Gaussian elimination and Cholesky are in :mod:`.elimination`)."""
 
 from __future__ import annotations
+
+import math
+from functools import reduce
+from itertools import repeat
+from operator import add, itemgetter, mul, sub
 
 import numpy as np
 
 LinAlgError = np.linalg.LinAlgError
 
+# np.sum without its Python wrapper (np.sum(x, axis=a) calls exactly this)
+_sum = np.add.reduce
+
 _CHUNK_ELEMENTS = 1 << 21  # temporaries of matmul stay under 16 MB
+_FLOATS_AT_MOST = 40  # least squares in Python floats up to this many entries of a and b (numpy's calls cost more)
 
 
 def _f64(a) -> np.ndarray:
@@ -17,7 +26,7 @@ def _f64(a) -> np.ndarray:
 
 def dot(a, b) -> float:
     """sum(a * b) of two vectors, pairwise in a fixed order."""
-    return float(np.sum(np.multiply(_f64(a), _f64(b))))
+    return float(_sum(np.multiply(_f64(a), _f64(b)), axis=None))
 
 
 def matmul(a, b) -> np.ndarray:
@@ -37,7 +46,7 @@ def matmul(a, b) -> np.ndarray:
     for start in range(0, m, rows):
         block = np.ascontiguousarray(a2[start:start + rows])
         # (rows, p, n), reduced over its last, contiguous axis: one pairwise sum per entry
-        out[start:start + rows] = np.sum(block[:, None, :] * bt[None, :, :], axis=-1)
+        _sum(block[:, None, :] * bt[None, :, :], axis=-1, out=out[start:start + rows])
     if a.ndim == 1:
         out = out[0]
     if b.ndim == 1:
@@ -49,57 +58,9 @@ def norm(a, axis: int | None = None):
     """Euclidean norm of a vector (or of a matrix's columns with ``axis=0``, rows with ``axis=1``)."""
     a = _f64(a)
     if axis is None:
-        return float(np.sqrt(np.sum(np.square(a.ravel()))))
+        return math.sqrt(_sum(np.square(a.ravel()), axis=None))
     lines = np.ascontiguousarray(np.moveaxis(a, axis, -1))
-    return np.sqrt(np.sum(np.square(lines), axis=-1))
-
-
-def solve(a, b) -> np.ndarray:
-    """x with a x = b (a square); Gaussian elimination with partial pivoting. Raises LinAlgError if singular."""
-    lu = np.array(a, dtype=float)
-    x = np.array(b, dtype=float)
-    n = lu.shape[0]
-    if lu.shape != (n, n) or x.shape[0] != n:
-        raise ValueError(f"solve: shapes {lu.shape} and {x.shape} do not align")
-    vector = x.ndim == 1
-    if vector:
-        x = x[:, None]
-    for k in range(n):
-        p = k + int(np.argmax(np.abs(lu[k:, k])))
-        if lu[p, k] == 0.0:
-            raise LinAlgError("Singular matrix")
-        if p != k:
-            lu[[k, p]] = lu[[p, k]]
-            x[[k, p]] = x[[p, k]]
-        if k + 1 < n:
-            factor = lu[k + 1:, k] / lu[k, k]
-            lu[k + 1:, k:] -= np.multiply.outer(factor, lu[k, k:])
-            x[k + 1:] -= np.multiply.outer(factor, x[k])
-    for k in range(n - 1, -1, -1):
-        tail = np.sum(lu[k, k + 1:, None] * x[k + 1:], axis=0) if k + 1 < n else 0.0
-        x[k] = (x[k] - tail) / lu[k, k]
-    return x[:, 0] if vector else x
-
-
-def inv(a) -> np.ndarray:
-    """The inverse of a square matrix (:func:`solve` against the identity)."""
-    a = _f64(a)
-    return solve(a, np.eye(a.shape[0]))
-
-
-def cholesky(a) -> np.ndarray:
-    """Lower-triangular L with L L^T = a; raises LinAlgError unless a is positive definite."""
-    a = _f64(a)
-    n = a.shape[0]
-    low = np.zeros((n, n))
-    for j in range(n):
-        d = a[j, j] - float(np.sum(np.square(low[j, :j])))
-        if not d > 0.0:
-            raise LinAlgError("Matrix is not positive definite")
-        low[j, j] = np.sqrt(d)
-        if j + 1 < n:
-            low[j + 1:, j] = (a[j + 1:, j] - np.sum(low[j + 1:, :j] * low[j, :j], axis=1)) / low[j, j]
-    return low
+    return np.sqrt(_sum(np.square(lines), axis=-1))
 
 
 def _householder(r: np.ndarray, k: int, b: np.ndarray | None) -> np.ndarray | None:
@@ -111,11 +72,102 @@ def _householder(r: np.ndarray, k: int, b: np.ndarray | None) -> np.ndarray | No
     alpha = -length if x[0] >= 0.0 else length
     v = x.copy()
     v[0] -= alpha
-    scale = 2.0 / float(np.sum(np.square(v)))
-    r[k:, k:] -= np.multiply.outer(v, np.sum(v[:, None] * r[k:, k:], axis=0) * scale)
+    scale = 2.0 / float(_sum(np.square(v)))
+    r[k:, k:] -= np.multiply.outer(v, _sum(v[:, None] * r[k:, k:], axis=0) * scale)
     if b is not None:
-        b[k:] -= np.multiply.outer(v, np.sum(v[:, None] * b[k:], axis=0) * scale)
+        b[k:] -= np.multiply.outer(v, _sum(v[:, None] * b[k:], axis=0) * scale)
     return v
+
+
+def _pairwise_sum(terms: list[float]) -> float:
+    """numpy's sum of a float64 vector of up to 128 terms, to the bit: one by one below 8 terms, else eight
+    interleaved partial sums added as a tree, then the rest one by one (its pairwise_sum), after the identity +0."""
+    count = len(terms)
+    if count < 8:
+        return 0.0 + reduce(add, terms, -0.0)
+    partial = terms[:8]
+    whole = count - count % 8
+    for start in range(8, whole, 8):
+        partial = list(map(add, partial, terms[start:start + 8]))
+    p0, p1, p2, p3, p4, p5, p6, p7 = partial
+    total = ((p0 + p1) + (p2 + p3)) + ((p4 + p5) + (p6 + p7))
+    return 0.0 + reduce(add, terms[whole:], total)
+
+
+def _sum_down(terms, columns: int) -> float:
+    """numpy's sum of one column (an iterable of its terms) of an array of `columns` columns over its first axis:
+    one row after another from +0 for more than one column, else the column's pairwise sum."""
+    return reduce(add, terms, 0.0) if columns > 1 else _pairwise_sum(list(terms))
+
+
+def _lstsq_in_floats(a: np.ndarray, rhs: np.ndarray, rcond: float) -> np.ndarray:
+    """:func:`lstsq`'s operations, each the same IEEE operation on Python floats and each sum in numpy's order
+    (:func:`_sum_down`, :func:`_pairwise_sum`): the same bits without numpy's cost per call, for small systems.
+    Raises ZeroDivisionError where numpy would divide by zero (its caller then runs the numpy version)."""
+    m, n = a.shape
+    p = rhs.shape[1]
+    columns = np.concatenate([a, rhs], axis=1).T.tolist()  # column-major: a swap moves two references
+    order = list(range(n))
+    rank = 0
+    largest = 0.0
+    for k in range(min(m, n)):
+        tails = [column[k:] for column in columns[k:n]]
+        if n - k > 1:
+            lengths = [reduce(add, map(mul, tail, tail), 0.0) for tail in tails]
+        else:
+            lengths = [_pairwise_sum(list(map(mul, tails[0], tails[0])))]
+        j = k + _first_max(lengths)
+        length = math.sqrt(lengths[j - k])
+        if k == 0:
+            largest = length
+        if not length > rcond * largest:
+            break
+        if j != k:
+            columns[k], columns[j] = columns[j], columns[k]
+            order[k], order[j] = order[j], order[k]
+        rank = k + 1
+        x = columns[k][k:]
+        if m - k >= 8:
+            length = math.sqrt(_pairwise_sum(list(map(mul, x, x))))
+        if length == 0.0:
+            continue
+        alpha = -length if x[0] >= 0.0 else length
+        v = list(x)
+        v[0] = v[0] - alpha
+        scale = 2.0 / _pairwise_sum(list(map(mul, v, v)))
+        for c in range(k, n + p):
+            column = columns[c]
+            tail = column[k:]
+            w = _sum_down(map(mul, v, tail), n - k if c < n else p) * scale
+            column[k:] = map(sub, tail, map(mul, v, repeat(w)))  # t - v_i w, as numpy's outer product and update
+    z = [[0.0] * n for _ in range(p)]  # column-major too
+    for c in range(p):
+        solution, right = z[c], columns[n + c]
+        for k in range(rank - 1, -1, -1):
+            row = map(itemgetter(k), columns[k + 1:rank])
+            tail = _sum_down(map(mul, row, solution[k + 1:rank]), p) if k + 1 < rank else 0.0
+            solution[k] = (right[k] - tail) / columns[k][k]
+    x = np.zeros((n, p))
+    x[order] = np.array(z).T
+    return x
+
+
+def _first_max(values: list[float]) -> int:
+    """np.argmax: the first largest value, or the first NaN if there is one."""
+    best, largest = 0, -math.inf
+    for i, value in enumerate(values):
+        if value != value:
+            return i
+        if value > largest:
+            best, largest = i, value
+    return best
+
+
+def _sums_down_in_order(rows: int, columns: int) -> bool:
+    """Whether numpy sums a (rows x columns) array over its first axis one row after another from +0.0: it does
+    for more than one column, and for one column of fewer than 8 rows (its pairwise sum starts with eight
+    partial sums)."""
+    return columns > 1 or rows < 8
 
 
 def lstsq(a, b, rcond: float | None = None) -> np.ndarray:
@@ -133,25 +185,50 @@ def lstsq(a, b, rcond: float | None = None) -> np.ndarray:
         rhs = rhs[:, None]
     if rcond is None:
         rcond = np.finfo(float).eps * max(m, n)
-    order = np.arange(n)
+    p = rhs.shape[1]
+    if m <= 128 and m * (n + p) <= _FLOATS_AT_MOST:
+        try:
+            x = _lstsq_in_floats(r, rhs, rcond)
+            return x[:, 0] if vector else x
+        except ZeroDivisionError:
+            pass
+    # a and b side by side: one reflection, one reduction and one update for both where the columns' sums are
+    # the same sequential ones as each block's on its own
+    work = np.concatenate([r, rhs], axis=1)
+    order = list(range(n))
     rank = 0
     largest = 0.0
     for k in range(min(m, n)):
-        lengths = np.sum(np.square(r[k:, k:]), axis=0)
-        j = k + int(np.argmax(lengths))
+        lengths = _sum(np.square(work[k:, k:n]), axis=0)
+        j = k + int(lengths.argmax())
+        length = math.sqrt(lengths[j - k])
         if k == 0:
-            largest = float(np.sqrt(lengths[j - k]))
-        if not np.sqrt(lengths[j - k]) > rcond * largest:
+            largest = length
+        if not length > rcond * largest:
             break
         if j != k:
-            r[:, [k, j]] = r[:, [j, k]]
-            order[[k, j]] = order[[j, k]]
-        _householder(r, k, rhs)
+            work[:, [k, j]] = work[:, [j, k]]
+            order[k], order[j] = order[j], order[k]
         rank = k + 1
-    z = np.zeros((n, rhs.shape[1]))
+        x = work[k:, k]
+        if m - k >= 8:  # else the sum of squares of x is the one of lengths to the bit: both sum one by one
+            length = math.sqrt(_sum(np.square(x)))
+        if length == 0.0:
+            continue
+        alpha = -length if x[0] >= 0.0 else length
+        v = x.copy()
+        v[0] -= alpha
+        scale = 2.0 / float(_sum(np.square(v)))
+        if _sums_down_in_order(m - k, n - k) and _sums_down_in_order(m - k, p):
+            block = work[k:, k:]
+            block -= np.multiply.outer(v, _sum(v[:, None] * block, axis=0) * scale)
+        else:
+            for block in (work[k:, k:n], work[k:, n:]):
+                block -= np.multiply.outer(v, _sum(v[:, None] * block, axis=0) * scale)
+    z = np.zeros((n, p))
     for k in range(rank - 1, -1, -1):
-        tail = np.sum(r[k, k + 1:rank, None] * z[k + 1:rank], axis=0) if k + 1 < rank else 0.0
-        z[k] = (rhs[k] - tail) / r[k, k]
+        tail = _sum(work[k, k + 1:rank, None] * z[k + 1:rank], axis=0) if k + 1 < rank else 0.0
+        z[k] = (work[k, n:] - tail) / work[k, k]
     x = np.zeros_like(z)
     x[order] = z
     return x[:, 0] if vector else x
@@ -286,5 +363,5 @@ def qr(a) -> tuple[np.ndarray, np.ndarray]:
     for k in range(min(m, n) - 1, -1, -1):
         v = reflectors[k]
         if v is not None:
-            q[k:] -= np.multiply.outer(v, np.sum(v[:, None] * q[k:], axis=0) * (2.0 / float(np.sum(np.square(v)))))
+            q[k:] -= np.multiply.outer(v, _sum(v[:, None] * q[k:], axis=0) * (2.0 / float(_sum(np.square(v)))))
     return q, np.triu(r[:n])

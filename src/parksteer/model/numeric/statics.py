@@ -18,16 +18,17 @@ def static_state(run, fixed: dict[str, float] | None = None, t_s: float = 0.0, p
     p = run.p if p is None else p
     n = model.n_q
     fixed = fixed or {}
-    free = [i for i, name in enumerate(model.coordinates) if name not in fixed]
+    free = np.array([i for i, name in enumerate(model.coordinates) if name not in fixed], dtype=int)
+    free_block = np.ix_(free, free)
     y = np.zeros(2 * n)
     for name, value in fixed.items():
         y[model.index(name)] = value
     for _ in range(50):
         residual = model.forcing(t_s, y, p)[free]
-        jac = model.forcing_dq(t_s, y, p)[np.ix_(free, free)]
+        jac = model.forcing_dq(t_s, y, p)[free_block]
         # least squares: a coordinate with neither stiffness nor load (an effect at strength 0) stays put
         step = pm.lstsq(jac, -residual)
         y[free] += step
-        if np.max(np.abs(step)) < 1e-14:
+        if np.abs(step).max() < 1e-14:
             break
     return y
