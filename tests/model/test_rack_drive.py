@@ -299,28 +299,3 @@ def test_a_rack_whose_acceleration_jumps_is_integrated_across_its_corner(params)
     t = np.linspace(0.0, t_end, 201)
     reference = _lsoda_torque(run, run.p, rack, t, 1e-10, 0.01)
     assert np.max(np.abs(solve(run, run.p, rack, t).torque_Nm - reference)) < 0.004
-
-
-def test_the_corners_kept_are_those_of_the_exact_rack_and_interval():
-    """rack_corners keeps its answers by the rack's table, its ends and the interval, to the bit: asked again, it
-    gives the corners computed afresh (a new array, so a caller's change reaches no later answer); a rack on the
-    same breaks differing in one coefficient (its acceleration jumping at one join), or an interval that leaves that
-    join out, gets its own corners."""
-    from parksteer.model.numeric.prescribed import _found_corners, rack_corners
-
-    rng = np.random.default_rng(3)
-    breaks = np.cumsum(rng.uniform(0.1, 0.5, 12))
-    spline = RackSpline.from_ppoly(CubicSpline(breaks, rng.normal(0.0, 0.02, 12)))
-    coefficients = np.array(spline.coefficients, dtype=float)
-    coefficients[0, 5] += 0.3  # the third derivative jumps: no corner; the acceleration at the next break: a corner
-    jumping = RackSpline(breaks, coefficients)
-    for rack in (spline, jumping):
-        for interval in ((breaks[0], breaks[-1]), (breaks[0], 0.5 * (breaks[0] + breaks[-1])), (-1.0, 100.0)):
-            first, again = rack_corners(rack, *interval), rack_corners(rack, *interval)
-            fresh = _found_corners(rack, *interval)
-            assert first.tobytes() == again.tobytes() == fresh.tobytes() and first is not again
-            first[:] = -1.0
-            assert rack_corners(rack, *interval).tobytes() == fresh.tobytes()
-    assert rack_corners(spline, breaks[0], breaks[-1]).size == 0
-    assert rack_corners(jumping, breaks[0], breaks[-1]).tolist() == [breaks[6]]
-    assert rack_corners(jumping, breaks[0], breaks[5]).size == 0

@@ -46,9 +46,8 @@ KEYED_FILES = (MODEL_DIR.parent / "names.py",)
 # This module stores entries and generates nothing, so its source is not part of the key.
 KEYLESS_SOURCE = Path(__file__).resolve()
 # How the generated C is compiled; part of the model key. -O1: integrates these models about as fast as -O2 and
-# compiles in less time. -ffp-contract=off: no fused
-# multiply-add, which GCC otherwise forms wherever the target has one (aarch64, or x86 with -march=native), so
-# every product is rounded on its own and the bits do not depend on the target.
+# compiles in less time. -ffp-contract=off: no fused multiply-add, which GCC otherwise forms wherever the target has
+# one (aarch64, or x86 with -march=native), so every product is rounded on its own and the bits do not depend on it.
 COMPILE_FLAGS = ("-O1", "-ffp-contract=off", "-shared", "-fPIC")
 # Built files whose SHA-256 model.json records: an entry is used only if both exist and match.
 BUILT_FILES = ("model.c", "model.so")
@@ -63,16 +62,12 @@ STALE_SCRATCH_S = 6 * 3600.0
 
 @lru_cache(maxsize=1)
 def checkout_root() -> Path | None:
-    """The repository the package runs from (editable install, or src/ on the path); None when installed. Found once
-    a process (reading the installed distributions' metadata costs a millisecond, and every model is found by it)."""
+    """The repository the package runs from (editable install, or src/ on the path); None when installed (once)."""
     package = MODEL_DIR.parent
-    try:
-        dist = metadata.distribution("parksteer")
-    except metadata.PackageNotFoundError:
-        dist = None
-    # An installed wheel's files sit where its metadata says: never a checkout, wherever the environment is.
-    if dist is not None and Path(str(dist.locate_file("parksteer"))).resolve() == package:
-        return None
+    with suppress(metadata.PackageNotFoundError):
+        # An installed wheel's files sit where its metadata says: never a checkout, wherever the environment is.
+        if Path(str(metadata.distribution("parksteer").locate_file("parksteer"))).resolve() == package:
+            return None
     root = package.parents[1]
     if package.parent.name == "src" and (root / "workflow" / "Snakefile").is_file():
         return root
@@ -91,11 +86,8 @@ def cache_root() -> Path:
     return Path(base) / "parksteer" / "model"
 
 
-@lru_cache(maxsize=None)
-def _in_symbolic_half(path: str) -> bool:
-    """Whether the module file `path` lies in the symbolic half (found once a path: resolving it is a system call a
-    directory)."""
-    return any(Path(path).resolve().is_relative_to(d) for d in SYMBOLIC_DIRS)
+_in_symbolic_half = lru_cache(maxsize=None)(  # resolving a path is a system call a directory: once a path
+    lambda path: any(Path(path).resolve().is_relative_to(d) for d in SYMBOLIC_DIRS))
 
 
 def _effect_source(effect: Effect) -> str:
@@ -111,17 +103,14 @@ def _effect_source(effect: Effect) -> str:
 
 @lru_cache(maxsize=1)
 def _symbolic_half_source() -> bytes:
-    """The symbolic half's files (symbolic/ and codegen/, Python and C) and :data:`KEYED_FILES`, each with its path:
-    read once per process (a simulation loads its model by key, and re-reading some thirty files each time was a
-    fifth of a cycle)."""
+    """The symbolic half's files (symbolic/ and codegen/, Python and C) and :data:`KEYED_FILES`, each with its path,
+    read once per process (a simulation loads its model by key)."""
     sources = [p for d in SYMBOLIC_DIRS for pattern in ("*.py", "*.c") for p in d.rglob(pattern)]
     return b"".join(str(path.relative_to(MODEL_DIR.parent)).encode() + b"\0" + path.read_bytes() + b"\0"
                     for path in sorted(p for p in [*sources, *KEYED_FILES] if p != KEYLESS_SOURCE))
 
 
-@lru_cache(maxsize=None)
-def _sympy_version() -> str:
-    return metadata.version("sympy")
+_sympy_version = lru_cache(maxsize=None)(lambda: metadata.version("sympy"))
 
 
 def model_key(effects: list[Effect]) -> str:
@@ -395,8 +384,8 @@ def cache_write_error(root: Path, exc: OSError) -> UsageError:
 def ensure_entry(effects: list[Effect], final: Path | None = None) -> Path:
     """The cache entry of `effects`, built if missing or unsound (atomically: built aside, then renamed into
     place; a scratch directory left by a killed build is removed here; one build at a time per entry). A cache
-    that cannot be written is one line (:func:`cache_write_error`), with nothing half-written left in it. `final`:
-    the entry's path (:func:`entry_path`) when the caller has it already."""
+    that cannot be written is one line (:func:`cache_write_error`), with nothing half-written left in it (`final`:
+    its path, if the caller has it)."""
     final = entry_path(effects) if final is None else final
     if entry_is_sound(final):
         return final

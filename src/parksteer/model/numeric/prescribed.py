@@ -68,29 +68,10 @@ def rack_table(rack: RackMotion) -> np.ndarray:
     return np.concatenate([[len(breaks) - 1, len(coefficients)], breaks, coefficients.ravel()])
 
 
-# Corners found by rack_corners, by the exact inputs (its rack's table and ends, the interval): a diagnosis replays
-# one rack over the same times hundreds of times. At most this many kept, the oldest dropped first.
-KEPT_CORNERS = 64
-_corners_found: dict[tuple[bytes, bytes], np.ndarray] = {}
-
-
 def rack_corners(rack: RackMotion, t_start: float, t_end: float) -> np.ndarray:
     """The corners of `rack` strictly between `t_start` and `t_end` (s): its start and end, where it is held, and
     every break where its position, speed or acceleration jumps (by more than ``CORNER_TOLERANCE`` of the largest
-    value of each over the pieces; a cubic spline's pieces join with none). Found once per rack table, ends and
-    interval (by their bytes: the same corners to the bit), a new array each call."""
-    key = (rack_table(rack).tobytes(), np.array([rack.start_s, rack.end_s, t_start, t_end], dtype=float).tobytes())
-    found = _corners_found.get(key)
-    if found is None:
-        found = _found_corners(rack, t_start, t_end)
-        if len(_corners_found) >= KEPT_CORNERS:
-            del _corners_found[next(iter(_corners_found))]
-        _corners_found[key] = found
-    return found.copy()
-
-
-def _found_corners(rack: RackMotion, t_start: float, t_end: float) -> np.ndarray:
-    """rack_corners, computed."""
+    value of each over the pieces; a cubic spline's pieces join with none)."""
     breaks = np.asarray(rack.breaks, dtype=float)
     c = np.asarray(rack.coefficients, dtype=float)
     order = len(c)

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from functools import lru_cache
 
 import numpy as np
 
@@ -20,7 +21,7 @@ from ...errors import UsageError
 from ...geometry import steer_axis
 from ...names import SIDES, SURFACES
 from ...parameters import CASE_SCHEMA, SCHEMA, DeclaredQuantities, Parameters
-from ..symbolic.components import Effect, known_quantities, shipped_quantities
+from ..symbolic.components import Effect, known_quantities
 from ..symbolic.system import CORE_PARAMETERS, DERIVED
 
 
@@ -70,25 +71,13 @@ _GEOMETRY_KEYS = tuple(f"geometry.{k}" for k in SCHEMA["geometry"]) + (
 _INPUT_KEYS = tuple(f"input.{k}" for k in SCHEMA["input"])
 
 
-# The quantities known with a list of effects (known_quantities), by the effects' identities and the shipped
-# quantities': a run knows those of every installed effect, some fifty effects' quantities gathered and checked at
-# every preparation, and a diagnosis prepares hundreds. The effects are kept with their answer, so that their ids
-# stay theirs; at most this many answers are kept, the oldest dropped first.
-KEPT_KNOWN = 32
-_known: dict[tuple[int, ...], tuple[tuple, DeclaredQuantities]] = {}
-
-
-def _known_quantities(effects: list[Effect]) -> DeclaredQuantities:
-    """:func:`parksteer.model.symbolic.components.known_quantities` of `effects`, gathered once per list of the same
-    effects (an effect's quantities are fixed when it is made)."""
-    shipped = shipped_quantities()
-    key = (id(shipped), *map(id, effects))
-    found = _known.get(key)
-    if found is None:
-        if len(_known) >= KEPT_KNOWN:
-            del _known[next(iter(_known))]
-        found = _known[key] = ((shipped, *effects), known_quantities(effects))
-    return found[1]
+@lru_cache(maxsize=32)
+def _known_quantities(effects: tuple[Effect, ...]) -> DeclaredQuantities:
+    """:func:`parksteer.model.symbolic.components.known_quantities` of `effects`, gathered once per tuple of the same
+    effect objects (an effect's quantities are fixed when it is made; the installed effects' are read once a
+    process): some fifty effects' quantities are gathered and checked for each, and a diagnosis prepares hundreds of
+    runs."""
+    return known_quantities(effects)
 
 
 def resolve_values(params: Parameters, case: str, effects: list[Effect], overrides: dict[str, float] | None,
@@ -107,7 +96,7 @@ def resolve_values(params: Parameters, case: str, effects: list[Effect], overrid
         section = key.partition(".")[0]
         if all_effects is not None and section in all_effects and section not in in_model:
             raise UsageError(f"--set {key}: effect {section} is not in the model")
-    params = params.knowing(_known_quantities([*effects, *(all_effects or {}).values()]))
+    params = params.knowing(_known_quantities((*effects, *(all_effects or {}).values())))
     try:
         params = params.with_overrides(overrides, case=case)
     except UsageError as exc:
