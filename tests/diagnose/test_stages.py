@@ -64,34 +64,45 @@ def lagged_stiction(tmp_path_factory):
     return path
 
 
-def test_a_diagnosis_leaves_the_files_and_arguments_it_is_given_as_they_were(lagged_stiction):
-    """After a diagnosis that moved the torque lag twice and diagnosed again with the lags held, every field of
-    the caller's files (the lag, the replay uncertainty, the angle flag, the measured arrays) and the registry,
-    start values and strengths passed in are exactly as before; the lag found is in the result's own files (the
-    channel's 10 ms within 3.5 ms, as tests/diagnose/test_torque_lag.py finds it)."""
+@pytest.fixture(scope="module")
+def first(lagged_stiction):
+    """The record's files diagnosed once (the lag searched), with the parameter file's rack friction as the start
+    value and the effects found as the registry passed in: (files, registry, start, their copies made before the
+    diagnosis, their copies made after it, the diagnosis)."""
     files = load_files([lagged_stiction], PARAMS)
     registry = dict(discover_effects())
     start = {"steering.rack_friction_force": PARAMS["steering.rack_friction_force"]}  # the parameter file's
     before = [_snapshot(f) for f in files], dict(registry), dict(start)
     result = diagnose(files, PARAMS, registry=registry, start=start, settings=SEARCH)
+    after = [_snapshot(f) for f in files], dict(registry), list(registry), dict(start)
+    return files, registry, start, before, after, result
+
+
+def test_a_diagnosis_leaves_the_files_and_arguments_it_is_given_as_they_were(first):
+    """After a diagnosis that moved the torque lag twice and diagnosed again with the lags held, every field of
+    the caller's files (the lag, the replay uncertainty, the angle flag, the measured arrays) and the registry,
+    start values and strengths passed in are exactly as before; the lag found is in the result's own files (the
+    channel's 10 ms within 3.5 ms, as tests/diagnose/test_torque_lag.py finds it)."""
+    _, _, _, before, (files_after, registry, registry_order, start), result = first
     assert result.verdict == "missing" and result.effect == "rack_stiction"
-    assert all(_same(a, _snapshot(f)) for a, f in zip(before[0], files))
-    assert registry == before[1] and list(registry) == list(before[1]) and start == before[2]
-    assert [f.torque_lag_s for f in files] == [0.0] and files[0].replay_uncertainty_Nm is None
+    assert all(_same(a, b) for a, b in zip(before[0], files_after)) and len(files_after) == len(before[0])
+    assert registry == before[1] and registry_order == list(before[1]) and start == before[2]
+    assert [f["torque_lag_s"] for f in files_after] == [0.0] and files_after[0]["replay_uncertainty_Nm"] is None
     (lag,) = [f.torque_lag_s for f in result.problem.files]
     assert lag == pytest.approx(0.010, abs=0.0035)
     with pytest.raises(dataclasses.FrozenInstanceError):
         result.verdict = "adequate"
 
 
-def test_the_same_files_diagnosed_twice_give_the_same_diagnosis(lagged_stiction):
+def test_the_same_files_diagnosed_twice_give_the_same_diagnosis(first):
     """A diagnosis depends on the record, not on what was asked of the same file objects before: diagnosed twice,
     the same files give the same JSON, number for number (timings apart). Once, the first diagnosis's lag stayed
-    in the files and the second searched from there."""
-    files = load_files([lagged_stiction], PARAMS)
+    in the files and the second searched from there. The first diagnosis is the module's (the files, registry and
+    start values passed in again as they were)."""
+    files, registry, start, _, _, result = first
     runs = []
-    for _ in range(2):
-        out = diagnosis_dict(diagnose(files, PARAMS, settings=SEARCH))
+    for diagnosis in (result, diagnose(files, PARAMS, registry=registry, start=start, settings=SEARCH)):
+        out = diagnosis_dict(diagnosis)
         out["cost"].pop("timings_s")
         runs.append(json.dumps(out))
     assert runs[0] == runs[1]

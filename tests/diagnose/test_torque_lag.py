@@ -9,6 +9,8 @@ logger's lag before sampling (a physical delay of the channel, not a shift of th
 
 from __future__ import annotations
 
+import contextlib
+import io
 from dataclasses import replace
 
 import pytest
@@ -44,17 +46,30 @@ def _over_floor(result: dict) -> float:
     return result["statistics"]["calibrated"]["weighted_rms_Nm"] / result["noise_floor_Nm"]
 
 
-def test_a_torque_channel_10_ms_behind_the_rack_is_found_and_the_record_is_adequate(tmp_path, seed=3):
+@pytest.fixture(scope="module")
+def lagged_10ms(tmp_path_factory):
+    """(path, JSON) of the 10 ms lagged record (seed 3) with nothing hidden, diagnosed with the lag searched by
+    `parksteer diagnose --torque-lag --json` in this process: the command's diagnosis is the method's, the same
+    JSON byte for byte but the machine's times (tests/diagnose/test_intake.py), so the tests of what the search
+    finds and of what the command reports read this one diagnosis."""
+    path = _record(tmp_path_factory.mktemp("lagged"), "lag_10ms_50Hz", 3)
+    printed = io.StringIO()
+    with contextlib.redirect_stdout(printed):
+        assert main(["diagnose", str(path), "--json", "--quiet", "--jobs", "1", "--torque-lag"]) == 0
+    return path, json.loads(printed.getvalue())
+
+
+def test_a_torque_channel_10_ms_behind_the_rack_is_found_and_the_record_is_adequate(lagged_10ms):
     """At 50 Hz a 10 ms lag moves each friction reversal of the torque by half a sample. With nothing hidden, the
     lag found is 10 ms within 3 ms (the benchmark's lagged records gave 7.6-10.3 ms), the calibrated base then
     sits within the adequate band, and the verdict is adequate; without the search (the default) the same record's
     base stays further from its floor."""
-    found = _diagnosed(tmp_path, "lag_10ms_50Hz", seed)
+    path, found = lagged_10ms
     (lag,) = [f["torque_lag_s"] for f in found["files"]]
     assert lag == pytest.approx(0.010, abs=0.003)
     assert found["verdict"] == "adequate"
     assert _over_floor(found) < DEFAULT_SETTINGS.adequate_rms_factor
-    blind = _diagnosed(tmp_path, "lag_10ms_50Hz", seed, DEFAULT_SETTINGS)
+    blind = diagnosis_dict(diagnose(load_files([path], PARAMS), PARAMS, settings=DEFAULT_SETTINGS))
     assert [f["torque_lag_s"] for f in blind["files"]] == [0.0]
     assert _over_floor(blind) > _over_floor(found) + 0.02
 
@@ -80,10 +95,9 @@ def test_a_record_whose_channels_are_in_step_keeps_no_lag(tmp_path):
     assert found["verdict"] == "adequate"
 
 
-def test_the_command_reports_the_lag_it_found(tmp_path, capsys):
+def test_the_command_reports_the_lag_it_found(lagged_10ms):
     """`parksteer diagnose --torque-lag` reports the lag it found for each file (without the option none is searched
     for: the default settings' diagnosis above keeps 0)."""
-    path = _record(tmp_path, "lag_10ms_50Hz", 3)
-    assert main(["diagnose", str(path), "--json", "--quiet", "--jobs", "1", "--torque-lag"]) == 0
-    (lag,) = [f["torque_lag_s"] for f in json.loads(capsys.readouterr().out)["files"]]
+    _, printed = lagged_10ms
+    (lag,) = [f["torque_lag_s"] for f in printed["files"]]
     assert lag == pytest.approx(0.010, abs=0.003)
