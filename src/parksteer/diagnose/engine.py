@@ -15,6 +15,9 @@ itself as scipy's ``OdeSolver`` keeps ``nfev``. It owns:
   other instants made from one of them too: :class:`parksteer.diagnose.replay.SolveCount`);
 - `solutions`: the latest solves of those replays by their exact inputs, a repeat answered from them
   (:class:`parksteer.diagnose.replay.SolutionMemo`);
+- `smoothed_racks`: the files' racks smoothed again for the replay ensemble, by their exact inputs (each stage that
+  estimates the replay's uncertainty again smooths the same racks from the same drawn numbers;
+  :meth:`parksteer.measure.smoothing.SmoothedRack.smoothed_at`), so that the files themselves are left as they were;
 - `pool`, `workers`: the worker processes a prediction spreads its files over (:mod:`parksteer.diagnose.parallel`),
   forked for the problem they serve and again for another problem, so that none answers for an earlier one, and
   holding the diagnosis's effects and their classes, which a prediction's tasks name by place;
@@ -90,6 +93,7 @@ class ReplayEngine:
         self.replays: dict[tuple, Replay] = {}
         self.solves = SolveCount()
         self.solutions = SolutionMemo()
+        self.smoothed_racks: dict[tuple, tuple] = {}
         self.other_replays = 0
         self.pool = ServingPool(self.workers, inherited_effects([*effects, *(e for host in self.hosts.values()
                                                                           for e in host)]))

@@ -56,7 +56,7 @@ def with_replay_uncertainty(engine: ReplayEngine, problem: Problem, effects: lis
         for spacing, hold in ensemble_plan(f, draws, released):
             # without a logger the draw's coefficients come from this stream, so its source is smoothed here; with
             # one, the job smooths it where it runs (a worker, side by side with the others), once per process
-            perturbed = None if logger is not None else _source(f, spacing, hold).perturbed(rng)
+            perturbed = None if logger is not None else _source(f, spacing, hold, engine.smoothed_racks).perturbed(rng)
             drawn = []
             if logger is not None and logger[2] > 0.0:  # the analog noise add_noise draws (none at 0 RMS)
                 drawn.append(("normal", (0.0, logger[2], f.time_s.shape), rng.normal(0.0, logger[2], f.time_s.shape)))
@@ -70,7 +70,8 @@ def with_replay_uncertainty(engine: ReplayEngine, problem: Problem, effects: lis
         f, numbers = problem.files[i], DrawnInAdvance(drawn)
         logger = rack_logger(f.measurement, problem.params)
         if rack is None:
-            rack = relogged_rack(_source(f, spacing, hold), f.time_s, *logger, numbers, hold_rest=hold)
+            rack = relogged_rack(_source(f, spacing, hold, engine.smoothed_racks), f.time_s, *logger, numbers,
+                                 hold_rest=hold, memo=engine.smoothed_racks)
         if f.rack.rest_resolution_m > 0.0:  # a rounding coarser than the noise: the rack within its levels
             rack = rounding_draw(rack, f.time_s, f.rack.rest_resolution_m, numbers,
                                  held=rack.rest_intervals_s if hold else ())
@@ -131,13 +132,14 @@ def ensemble_plan(f: FileData, draws: int, released: bool) -> list[tuple[float, 
     return out
 
 
-def _source(f: FileData, spacing: float, hold: bool) -> SmoothedRack:
+def _source(f: FileData, spacing: float, hold: bool, memo: dict) -> SmoothedRack:
     """The file's rack smoothed at `spacing` (holding rests or not): the rack itself at its own spacing, held; else
-    made once per process for the file's rack (:meth:`parksteer.measure.smoothing.SmoothedRack.smoothed_at`, which
-    takes the search's fit where it has one), and so its draws logged again are smoothed once too."""
+    made once per `memo` (the engine's, in each process: :meth:`parksteer.measure.smoothing.SmoothedRack.
+    smoothed_at`, which takes the search's fit where it has one), and so its draws logged again are smoothed once
+    too."""
     if hold and spacing == f.rack.knot_spacing_s:
         return f.rack
-    return f.rack.smoothed_at(f.time_s, f.rack_m, spacing, hold)
+    return f.rack.smoothed_at(f.time_s, f.rack_m, spacing, hold, memo)
 
 
 class DrawnInAdvance:
@@ -168,9 +170,9 @@ class DrawnInAdvance:
 
 
 def relogged_rack(rack: SmoothedRack, time_s: np.ndarray, full_scale: float, bits: int, analog_rms: float,
-                  rng: np.random.Generator, hold_rest: bool = True) -> SmoothedRack:
+                  rng: np.random.Generator, hold_rest: bool = True, memo: dict | None = None) -> SmoothedRack:
     """A rack the logger could equally have recorded: `rack` at `time_s` with analog noise of `analog_rms`,
     rounded to the levels of a `bits` converter over +-`full_scale`, and smoothed again
-    (:meth:`parksteer.measure.smoothing.SmoothedRack.resmoothed`)."""
+    (:meth:`parksteer.measure.smoothing.SmoothedRack.resmoothed`, once per `memo`)."""
     return rack.resmoothed(time_s, lambda clean: quantise(add_noise(clean, analog_rms, rng), full_scale, bits),
-                           hold_rest)
+                           hold_rest, memo)

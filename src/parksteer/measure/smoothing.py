@@ -62,10 +62,6 @@ class SmoothedRack(RackSpline):
     # what a search for the spacing (smooth_rack without one) fitted, holding rests: its time, rack and noise, and the
     # fit of every passing spacing (held_at gives them); None for a rack smoothed otherwise
     search_fits: tuple | None = field(default=None, repr=False)
-    # the racks smoothed again from this one's record (smoothed_at, resmoothed), each made once, keyed on the exact
-    # bytes of its inputs: a diagnosis estimates the replay's uncertainty again for each model a stage settles on,
-    # from the same racks and the same drawn numbers
-    _smoothed_again: dict = field(default_factory=dict, init=False, repr=False)
 
     @classmethod
     def from_bspline(cls, knots, bspline, covariance, knot_spacing_s, fit_rms_m, noise_rms_m,
@@ -102,18 +98,19 @@ class SmoothedRack(RackSpline):
         return self.search_fits is not None and (np.array_equal(self.search_fits[0], time_s)
                                                  and np.array_equal(self.search_fits[1], rack_m))
 
-    def smoothed_at(self, time_s, rack_m, spacing: float, hold_rest: bool) -> SmoothedRack:
+    def smoothed_at(self, time_s, rack_m, spacing: float, hold_rest: bool, memo: dict | None = None) -> SmoothedRack:
         """``smooth_rack(time_s, rack_m, spacing, hold_rest, rest_resolution_m=self.rest_resolution_m)``, taken from
-        the search's fit where :meth:`held_at` has it, and made once for the same arguments."""
+        the search's fit where :meth:`held_at` has it; made once per `memo` (its owner's: :func:`_remembered`)."""
         t, x = np.asarray(time_s, dtype=float), np.asarray(rack_m, dtype=float)
-        key = ("smoothed", t.tobytes(), x.tobytes(), float(spacing), bool(hold_rest))
-        if key not in self._smoothed_again:
+
+        def made() -> SmoothedRack:
             rack = hold_rest and self.held_at(t, x, spacing)
             if not rack and self._searched(t, x):  # its own record: its noise, turns and pauses are known
                 rack = _smoothed_at_spacing(t, x, spacing, bool(hold_rest), self.rest_resolution_m, self.noise_rms_m,
                                             self.turning_times_s, self.rest_intervals_s if hold_rest else ())
-            self._smoothed_again[key] = rack or smooth_rack(t, x, spacing, bool(hold_rest), self.rest_resolution_m)
-        return self._smoothed_again[key]
+            return rack or smooth_rack(t, x, spacing, bool(hold_rest), self.rest_resolution_m)
+
+        return _remembered(memo, self, ("smoothed", t.tobytes(), x.tobytes(), float(spacing), bool(hold_rest)), made)
 
     def perturbed(self, rng: np.random.Generator) -> SmoothedRack:
         """A rack the data allow as well: coefficients drawn from their least-squares distribution."""
@@ -124,7 +121,7 @@ class SmoothedRack(RackSpline):
                                          self.rest_intervals_s, self.passing_spacings_s, self.rest_resolution_m)
 
     def resmoothed(self, time_s: np.ndarray, log: Callable[[np.ndarray], np.ndarray],
-                   hold_rest: bool = True) -> SmoothedRack:
+                   hold_rest: bool = True, memo: dict | None = None) -> SmoothedRack:
         """A rack the logger could equally have recorded: this spline at `time_s`, logged by `log`, smoothed again.
 
         `log` maps a clean rack (m) to a logged one (noise and rounding to the logger's levels;
@@ -133,14 +130,13 @@ class SmoothedRack(RackSpline):
         what makes an 8-bit rack hard near a turning point: there the rack stays within one
         converter step for a tenth of a second or more, its rounding errors are the same from
         sample to sample rather than independent, and the turning time the data fix is
-        correspondingly less certain.
+        correspondingly less certain. The same logged rack again (the same drawn numbers) is smoothed once per
+        `memo` (:func:`_remembered`).
         """
         t = np.asarray(time_s, dtype=float)
         logged = np.asarray(log(self.evaluate(t)[0]), dtype=float)
-        key = ("resmoothed", t.tobytes(), logged.tobytes(), bool(hold_rest))
-        if key not in self._smoothed_again:  # the same logged rack again (the same drawn numbers): the same spline
-            self._smoothed_again[key] = smooth_rack(t, logged, self.knot_spacing_s, bool(hold_rest))
-        return self._smoothed_again[key]
+        return _remembered(memo, self, ("resmoothed", t.tobytes(), logged.tobytes(), bool(hold_rest)),
+                           lambda: smooth_rack(t, logged, self.knot_spacing_s, bool(hold_rest)))
 
     def summary(self) -> dict:
         """The smoothing's settings and fit (for JSON)."""
@@ -242,6 +238,19 @@ def smooth_rack(time_s, rack_m, knot_spacing_s: float | None = None, hold_rest: 
     # (the replay ensemble smooths the rack again at the passing spacings, holding rests: held_at)
     return SmoothedRack.from_fit(*best, noise, turns, rests, rest_resolution_m, sorted(passing, reverse=True),
                                  (t, x, noise, passing) if hold_rest and passing else None)
+
+
+def _remembered(memo: dict | None, rack: SmoothedRack, key: tuple, made: Callable[[], SmoothedRack]) -> SmoothedRack:
+    """``made()``, kept in `memo` (a dict its owner keeps, e.g. a diagnosis's replay engine; None: not kept) under
+    `rack` and `key` (the exact bytes of the other inputs): a rack smoothed from the same inputs is the same spline.
+    `memo` holds `rack` beside the answer, so the identity in its key stays that rack's; the rack itself is left as
+    it was."""
+    if memo is None:
+        return made()
+    full_key = (id(rack), *key)
+    if full_key not in memo:
+        memo[full_key] = (rack, made())
+    return memo[full_key][1]
 
 
 def _smoothed_at_spacing(t: np.ndarray, x: np.ndarray, knot_spacing_s: float, hold_rest: bool, rest_resolution_m: float,
