@@ -13,14 +13,11 @@ itself as scipy's ``OdeSolver`` keeps ``nfev``. It owns:
 - `replays`: one :class:`parksteer.diagnose.replay.Replay` per effect set, file and torque lag (the kept ones);
 - `solves`: the count every replay it makes adds its solves to, kept or not (a replay on another rack or at
   other instants made from one of them too: :class:`parksteer.diagnose.replay.SolveCount`);
-- `solutions`: the latest solves of those replays by their exact inputs, a repeat answered from them
-  (:class:`parksteer.diagnose.replay.SolutionMemo`);
-- `smoothed_racks`: the files' racks smoothed again for the replay ensemble, by their exact inputs (each stage that
-  estimates the replay's uncertainty again smooths the same racks from the same drawn numbers;
-  :meth:`parksteer.measure.smoothing.SmoothedRack.smoothed_at`), so that the files themselves are left as they were;
+- `solutions`, `smoothed_racks`: the latest solves by their exact inputs
+  (:class:`parksteer.diagnose.replay.SolutionMemo`), and the racks the replay ensemble smooths again
+  (:meth:`parksteer.measure.smoothing.SmoothedRack.smoothed_at`), each asked again by a later stage;
 - `pool`, `workers`: the worker processes a prediction spreads its files over (:mod:`parksteer.diagnose.parallel`),
-  forked for the problem they serve and again for another problem, so that none answers for an earlier one, and
-  holding the diagnosis's effects and their classes, which a prediction's tasks name by place;
+  forked for each problem they serve, holding the diagnosis's effects and their classes;
 - `other_replays`: the solves run in worker processes, which each worker's copy of `solves` counted, so that
   :attr:`evaluations` counts every solve, wherever it ran.
 
