@@ -116,12 +116,10 @@ def _lstsq_in_floats(a: np.ndarray, rhs: np.ndarray, rcond: float) -> np.ndarray
             lengths = [reduce(add, map(mul, tail, tail), 0.0) for tail in tails]
         else:
             lengths = [_pairwise_sum(list(map(mul, tails[0], tails[0])))]
-        j = k + _first_max(lengths)
-        length = math.sqrt(lengths[j - k])
-        if k == 0:
-            largest = length
-        if not length > rcond * largest:
+        pivot = _pivot(lengths, k, largest, rcond)
+        if pivot is None:
             break
+        j, length, largest = pivot
         if j != k:
             columns[k], columns[j] = columns[j], columns[k]
             order[k], order[j] = order[j], order[k]
@@ -150,6 +148,15 @@ def _lstsq_in_floats(a: np.ndarray, rhs: np.ndarray, rcond: float) -> np.ndarray
     x = np.zeros((n, p))
     x[order] = np.array(z).T
     return x
+
+
+def _pivot(lengths: list[float], k: int, largest: float, rcond: float) -> tuple[int, float, float] | None:
+    """Step `k`'s pivot column from the remaining columns' sums of squares `lengths`: (its index, its norm, the
+    largest norm, which is the first step's), or None where it falls below `rcond` times the largest (rank k)."""
+    j = k + _first_max(lengths)
+    length = math.sqrt(lengths[j - k])
+    largest = length if k == 0 else largest
+    return (j, length, largest) if length > rcond * largest else None
 
 
 def _first_max(values: list[float]) -> int:
@@ -200,12 +207,10 @@ def lstsq(a, b, rcond: float | None = None) -> np.ndarray:
     largest = 0.0
     for k in range(min(m, n)):
         lengths = _sum(np.square(work[k:, k:n]), axis=0)
-        j = k + int(lengths.argmax())
-        length = math.sqrt(lengths[j - k])
-        if k == 0:
-            largest = length
-        if not length > rcond * largest:
+        pivot = _pivot(lengths.tolist(), k, largest, rcond)
+        if pivot is None:
             break
+        j, length, largest = pivot
         if j != k:
             work[:, [k, j]] = work[:, [j, k]]
             order[k], order[j] = order[j], order[k]

@@ -86,8 +86,9 @@ def cache_root() -> Path:
     return Path(base) / "parksteer" / "model"
 
 
-_in_symbolic_half = lru_cache(maxsize=None)(  # resolving a path is a system call a directory: once a path
-    lambda path: any(Path(path).resolve().is_relative_to(d) for d in SYMBOLIC_DIRS))
+@lru_cache(maxsize=None)
+def _in_symbolic_half(path: str) -> bool:  # resolving a path is a system call a directory: once a path
+    return any(Path(path).resolve().is_relative_to(d) for d in SYMBOLIC_DIRS)
 
 
 def _effect_source(effect: Effect) -> str:
@@ -110,7 +111,9 @@ def _symbolic_half_source() -> bytes:
                     for path in sorted(p for p in [*sources, *KEYED_FILES] if p != KEYLESS_SOURCE))
 
 
-_sympy_version = lru_cache(maxsize=None)(lambda: metadata.version("sympy"))
+@lru_cache(maxsize=None)
+def _sympy_version() -> str:
+    return metadata.version("sympy")
 
 
 def model_key(effects: list[Effect]) -> str:
@@ -382,10 +385,9 @@ def cache_write_error(root: Path, exc: OSError) -> UsageError:
 
 
 def ensure_entry(effects: list[Effect], final: Path | None = None) -> Path:
-    """The cache entry of `effects`, built if missing or unsound (atomically: built aside, then renamed into
-    place; a scratch directory left by a killed build is removed here; one build at a time per entry). A cache
-    that cannot be written is one line (:func:`cache_write_error`), with nothing half-written left in it (`final`:
-    its path, if the caller has it)."""
+    """The cache entry of `effects` (at `final`, if the caller has its path), built if missing or unsound (built
+    aside, then renamed into place; a killed build's scratch directory removed; one build at a time per entry). A
+    cache that cannot be written is one line (:func:`cache_write_error`), with nothing half-written left in it."""
     final = entry_path(effects) if final is None else final
     if entry_is_sound(final):
         return final
