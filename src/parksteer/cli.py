@@ -116,7 +116,8 @@ class Interrupt:
 
     In this process it raises KeyboardInterrupt where the work is, so that every ``finally`` on the way up ends what
     it started, and again at each signal until the command has said it was interrupted (the interpreter ignores an
-    exception raised in some places, a destructor or a fork hook, so one may be lost; what must not be cut short,
+    exception raised in some places, a destructor, a weakref callback or a fork hook, so one may be lost: the command
+    then ends as interrupted once its modules have loaded, or when it is done; what must not be cut short,
     ending worker processes, holds the signals back: :func:`parksteer.diagnose.parallel.signals_held`). A process
     forked from this one that does not ignore the signal (a background model build:
     :func:`parksteer.model.codegen.cache.start_builds`) ends quietly through SystemExit, which removes its scratch
@@ -134,6 +135,19 @@ class Interrupt:
             self.received = signum
         if not self.reported:
             raise KeyboardInterrupt
+
+    @property
+    def lost(self) -> bool:
+        """Whether a signal came and its KeyboardInterrupt has not reached the command (the interpreter ignored it)."""
+        return self.received is not None and not self.reported
+
+    def unraisable(self, hook):
+        """`hook` (sys.unraisablehook), silent on this handler's own KeyboardInterrupt, which the interpreter reports
+        as ignored when it is raised in a weakref callback or a destructor (:attr:`lost` then says so)."""
+        def report(unraisable) -> None:
+            if not (isinstance(unraisable.exc_value, KeyboardInterrupt) and self.received is not None):
+                hook(unraisable)
+        return report
 
     @property
     def status(self) -> int:
@@ -154,9 +168,12 @@ def stopped_by_signals() -> Iterator[Interrupt]:
         yield interrupt
         return
     before = {number: signal.signal(number, interrupt) for number in STOPPING_SIGNALS}
+    hook = sys.unraisablehook
+    sys.unraisablehook = interrupt.unraisable(hook)
     try:
         yield interrupt
     finally:
+        sys.unraisablehook = hook
         for number, handler in before.items():
             signal.signal(number, handler)
 
@@ -166,6 +183,8 @@ def main(argv: list[str] | None = None) -> int:
         try:  # the subcommands' modules are imported here: a Ctrl-C may come while they load
             args = build_parser().parse_args(_join_dash_values(sys.argv[1:] if argv is None else list(argv)))
         except KeyboardInterrupt:
+            return _interrupted(None, interrupt)
+        if interrupt.lost:  # raised where the interpreter ignores it, while the modules loaded
             return _interrupted(None, interrupt)
         try:
             return _run(args, interrupt)
@@ -187,6 +206,8 @@ def _run(args, interrupt: Interrupt) -> int:
                                       {"--suggest-effect": getattr(args, "suggest_effect", None)}):
                 status = int(args.func(args) or 0)
         sys.stdout.flush()  # a closed pipe shows here, inside the handler, not at interpreter exit
+        if interrupt.lost:  # the command ran on past a signal the interpreter ignored: it still ends as stopped
+            return _interrupted(args, interrupt)
         return status
     except KeyboardInterrupt:
         return _interrupted(args, interrupt)

@@ -211,3 +211,44 @@ def test_an_interrupt_seen_inside_an_extensions_pyrun_call_still_exits_130(tmp_p
                           capture_output=True, text=True, timeout=120)
     assert done.stderr.splitlines() == ["parksteer: interrupted"]
     assert done.returncode == 130, done.returncode
+
+
+@pytest.mark.parametrize("where", ["parser", "command"])
+def test_an_interrupt_the_interpreter_ignores_in_a_weakref_callback_still_ends_the_command_with_130(where,
+                                                                                                     tmp_path):
+    """A signal whose KeyboardInterrupt is raised inside a weakref callback (as the import system's module locks
+    run one while the subcommands' modules load) is ignored by the interpreter: the command must still end with
+    status 130 and its one line, and the interpreter's 'Exception ignored' report of it must not reach stderr.
+    Here the handler in place is called from such a callback, in the parser or in the command itself."""
+    (tmp_path / "lost_interrupt.py").write_text(
+        "import argparse, signal, sys, weakref\n"
+        "from parksteer import cli\n"
+        "class Thing: pass\n"
+        "def lose_an_interrupt():\n"
+        "    handler = signal.getsignal(signal.SIGINT)\n"
+        "    thing = Thing()\n"
+        "    watch = weakref.ref(thing, lambda _: handler(signal.SIGINT, None))\n"
+        "    del thing\n"
+        "    return watch\n"
+        "def command(args):\n"
+        "    if args.where == 'command':\n"
+        "        lose_an_interrupt()\n"
+        "    print('done')\n"
+        "    return 0\n"
+        "def parser():\n"
+        "    made = argparse.ArgumentParser(prog='parksteer')\n"
+        "    sub = made.add_subparsers(dest='command', required=True)\n"
+        "    one = sub.add_parser('one')\n"
+        "    one.add_argument('where')\n"
+        "    one.set_defaults(func=command)\n"
+        "    if sys.argv[-1] == 'parser':\n"
+        "        lose_an_interrupt()\n"
+        "    return made\n"
+        "cli.build_parser = parser\n"
+        "cli.run_as_main()\n")
+    done = subprocess.run([sys.executable, "-m", "lost_interrupt", "one", where], cwd=tmp_path,
+                          env={**os.environ, "PYTHONPATH": f"{ROOT / 'src'}{os.pathsep}{tmp_path}"},
+                          capture_output=True, text=True, timeout=120)
+    assert done.stderr.splitlines() == ["parksteer: interrupted" if where == "parser" else "parksteer one: interrupted"]
+    assert done.returncode == 130, done.returncode
+    assert done.stdout == ("" if where == "parser" else "done\n")
