@@ -8,6 +8,7 @@ import importlib.util
 import io
 import os
 import shutil
+import signal
 import sys
 from pathlib import Path
 
@@ -120,6 +121,10 @@ def _snakemake(workdir: Path, *args: str) -> tuple[str, str]:
     out, err = io.StringIO(), io.StringIO()
     status = None
     before, path = Path.cwd(), list(sys.path)  # Snakemake puts the workflow's folders on the path: taken off after
+    # Snakemake's job scheduler answers SIGTERM with a handler that only sets a flag, and leaves it in place: a
+    # process forked later by this test process (a multiprocessing pool) would inherit it and outlive the
+    # SIGTERM that Pool.terminate sends, which then waits for it for good.
+    handlers = {number: signal.getsignal(number) for number in (signal.SIGTERM, signal.SIGINT)}
     os.chdir(workdir)
     try:
         with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
@@ -129,6 +134,8 @@ def _snakemake(workdir: Path, *args: str) -> tuple[str, str]:
     finally:
         os.chdir(before)
         sys.path[:] = path
+        for number, handler in handlers.items():
+            signal.signal(number, handler)
     assert status == 0, (out.getvalue() + err.getvalue())[-3000:]
     return out.getvalue(), err.getvalue()
 

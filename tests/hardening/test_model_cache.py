@@ -122,3 +122,25 @@ def test_a_model_building_in_the_background_is_waited_for_not_built_again(cache_
     assert cache.entry_is_sound(path)
     assert capfd.readouterr().err.count("deriving the model") == 1
     assert [p for p in cache_dir.iterdir() if p.name.startswith(".")] == []
+
+
+def test_a_background_build_ends_on_sigterm_whatever_handler_the_process_had(cache_dir):
+    """A diagnosis ends its background builds with SIGTERM on an interrupt or an error (select.py), then waits for
+    them. Forked from a process whose SIGTERM handler only sets a flag (as Snakemake's job scheduler leaves one in
+    the process that ran it), a builder must still end, with status 143, and leave neither scratch directory nor
+    entry nor build lock behind: it answers SIGTERM itself."""
+    flagged = []
+    before = signal.signal(signal.SIGTERM, lambda signum, frame: flagged.append(signum))
+    try:
+        builders = cache.start_builds([resolve_effects(SMALL)], jobs=2)
+        deadline = time.monotonic() + 60
+        while not (cache_dir.is_dir() and _scratch(cache_dir)):  # building: its scratch directory made
+            assert time.monotonic() < deadline and builders[0].is_alive(), "the build never started"
+            time.sleep(0.02)
+        builders[0].terminate()
+        builders[0].join(timeout=30)
+    finally:
+        signal.signal(signal.SIGTERM, before)
+    assert builders[0].exitcode == 128 + signal.SIGTERM, builders[0].exitcode
+    assert flagged == []
+    assert list(cache_dir.iterdir()) == []

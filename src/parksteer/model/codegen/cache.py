@@ -18,6 +18,7 @@ import inspect
 import json
 import os
 import shutil
+import signal
 import socket
 import subprocess
 import sys
@@ -255,12 +256,9 @@ def build_entry(effects: list[Effect], directory: Path, key: str | None = None) 
         raise UsageError(f"C compiler failed on the generated model: {first}")
     t_compile = time.perf_counter() - start - t_derive - t_codegen
     note(f"compiled with {Path(compiler).name} {COMPILE_FLAGS[0]}: {t_compile:.1f} s")
-    info.update({
-        "sha256": {name: _sha256(directory / name) for name in BUILT_FILES},
-        "sympy_version": _sympy_version(),
-        "prebuilt": prebuilt is not None,
-        "timings_s": {**timings, "compile": t_compile, "total": time.perf_counter() - start},
-    })
+    info.update({"sha256": {name: _sha256(directory / name) for name in BUILT_FILES}, "sympy_version": _sympy_version(),
+                 "prebuilt": prebuilt is not None,
+                 "timings_s": {**timings, "compile": t_compile, "total": time.perf_counter() - start}})
     (directory / "model.json").write_text(json.dumps(info, indent=1, sort_keys=True) + "\n", encoding="utf-8")
     return info
 
@@ -425,6 +423,8 @@ def _build_entry_into(effects: list[Effect], final: Path) -> Path:
 
 
 def _build_in_child(effect_sets: list[list[Effect]]) -> None:
+    # terminate() ends the build through SystemExit (its scratch removed), whatever SIGTERM handler it inherited
+    signal.signal(signal.SIGTERM, lambda signum, frame: sys.exit(128 + signum))
     for effects in effect_sets:
         ensure_entry(effects)
 
