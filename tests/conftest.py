@@ -124,7 +124,7 @@ def _snakemake(workdir: Path, *args: str) -> tuple[str, str]:
     # Snakemake's job scheduler answers SIGTERM with a handler that only sets a flag, and leaves it in place: a
     # process forked later by this test process (a multiprocessing pool) would inherit it and outlive the
     # SIGTERM that Pool.terminate sends, which then waits for it for good.
-    handlers = {number: signal.getsignal(number) for number in (signal.SIGTERM, signal.SIGINT)}
+    handlers = {number: signal.getsignal(number) for number in _parallel.STOPPING_SIGNALS}
     os.chdir(workdir)
     try:
         with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):

@@ -22,6 +22,8 @@ from pathlib import Path
 import pytest
 import yaml
 
+from parksteer.diagnose.parallel import STOPPING_SIGNALS
+
 pytestmark = pytest.mark.slow
 
 
@@ -70,11 +72,11 @@ def up_to_date_copy(repository_copy, snakemake) -> Path:
     """The copy, every output marked up to date (each newer than its inputs, in DAG order) and every job's metadata
     recorded as a run records it (its parameters, the code digest among them: --forceall makes --touch pass over
     every job); each test restores what it edits (fixture `edit`)."""
-    handlers = signal.getsignal(signal.SIGTERM), signal.getsignal(signal.SIGINT)
+    handlers = [signal.getsignal(number) for number in STOPPING_SIGNALS]
     snakemake(repository_copy, "--touch", "--forceall", "--cores", "1", "all")
     # Snakemake's scheduler sets a SIGTERM handler that does not end the process; the in-process run (conftest)
     # puts the test process's own back, or a pool forked later in this worker could never be terminated
-    assert (signal.getsignal(signal.SIGTERM), signal.getsignal(signal.SIGINT)) == handlers
+    assert [signal.getsignal(number) for number in STOPPING_SIGNALS] == handlers
     assert _planned(snakemake, repository_copy) == {}
     return repository_copy
 
