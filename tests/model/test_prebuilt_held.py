@@ -1,12 +1,13 @@
 """The models a diagnosis against a car's baseline builds: the baseline holds the form it learnt on the car's
-model, and every later diagnosis replays the diagnosis models over it. `parksteer derive --prebuilt` given the
-baseline benchmark's car results pre-derives them, so that a cold pipeline's baseline job compiles them instead of
-deriving them."""
+model, and every later diagnosis replays the diagnosis models over it. `parksteer derive --prebuilt` pre-derives
+them for every form a baseline can hold, so that the first diagnosis against a manual car's baseline (and a cold
+pipeline's baseline job) compiles them instead of deriving them."""
 
 from __future__ import annotations
 
 import json
 
+from parksteer.cli import main
 from parksteer.commands.model import _held_form_sets
 from parksteer.diagnose.candidates import default_diagnosis_models
 from parksteer.diagnose.suggest import shape_forms
@@ -14,32 +15,32 @@ from parksteer.model.codegen import cache
 from parksteer.model.symbolic.components import resolve_effects
 
 
-def _car(tmp_path, kind, form):
-    path = tmp_path / "car.json"
-    path.write_text(json.dumps({"car": "bore", "kind": kind, "learnt": {"verdict": "unexplained", "form": form}}))
-    return str(path)
-
-
-def test_a_manual_cars_held_form_gives_the_default_diagnosis_models_with_it(tmp_path):
-    """Each default diagnosis model (base, every candidate at once, brush_patch) with the learnt form added, once
-    each; each spec resolves back to its model's key (as the shipped models' staleness check resolves it), and the
-    base model with the form is the suggestion's form the package already ships."""
-    form = next(f for f in shape_forms() if f.name == "shape_elastic_9")
-    sets = _held_form_sets(_car(tmp_path, "manual", form.name))
-    wanted = [sorted([e.name for e in model] + [form.name]) for model in default_diagnosis_models()]
-    assert [sorted(e.name for e in effects) for _, effects in sets] == wanted
+def test_every_form_a_baseline_can_hold_ships_the_default_diagnosis_models_with_it():
+    """For each form a suggestion can take (what a manual car's baseline holds), the default diagnosis models (base,
+    every candidate at once, brush_patch) with the form added, once each; each spec resolves back to its model's
+    key (as the shipped models' staleness check resolves it), and the package ships the C of every one of them."""
+    sets = _held_form_sets()
+    shipped = cache.prebuilt_specs()
+    forms = shape_forms()
+    assert len(sets) == len(forms) * len(default_diagnosis_models())
+    for form in forms:
+        held = [effects for spec, effects in sets if spec["shape"] == form.name]
+        wanted = [sorted([e.name for e in model] + [form.name]) for model in default_diagnosis_models()]
+        assert [sorted(e.name for e in effects) for effects in held] == wanted, form.name
     for spec, effects in sets:
+        form = next(f for f in forms if f.name == spec["shape"])
         again = sorted([*resolve_effects(spec.get("effects")), form], key=lambda e: e.name)
-        assert spec["shape"] == form.name and cache.model_key(again) == cache.model_key(effects)
-    base_key = cache.model_key(sets[0][1])
-    assert cache.prebuilt_specs().get(base_key) == {"shape": form.name}
+        key = cache.model_key(effects)
+        assert cache.model_key(again) == key
+        assert key in shipped, f"{spec}: not pre-derived (run `parksteer derive --prebuilt results/model/*.json`)"
 
 
-def test_what_is_not_a_manual_cars_result_gives_no_held_sets(tmp_path, capsys):
-    """A pipeline model manifest is not a baseline result (None: it is read as a manifest); an assisted car's form
-    is on the car's own assisted model, which this does not pre-derive, and is said on stderr (no sets)."""
-    manifest = tmp_path / "full.json"
-    manifest.write_text(json.dumps({"effects": ["rack_friction"], "key": "0" * 20, "spec": None}))
-    assert _held_form_sets(str(manifest)) is None
-    assert _held_form_sets(_car(tmp_path, "assisted", "shape_elastic_9")) == []
-    assert "not pre-derived" in capsys.readouterr().err
+def test_a_baseline_result_is_not_a_model_manifest(tmp_path, capsys):
+    """The baseline benchmark's car results are no longer needed to pre-derive the held forms' models: given as a
+    manifest, one is refused in one line naming the file, before anything is derived."""
+    path = tmp_path / "bore.json"
+    path.write_text(json.dumps({"car": "bore", "kind": "manual", "learnt": {"verdict": "unexplained",
+                                                                            "form": "shape_elastic_9"}}))
+    assert main(["derive", "--prebuilt", str(path)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "bore.json" in err[0] and "not a model manifest" in err[0]

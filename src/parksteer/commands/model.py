@@ -57,15 +57,14 @@ def register(sub) -> None:
     p.add_argument("--effects", default=None, help="effects spec (default: all five)")
     p.add_argument("--out", default=None, help="also write a JSON manifest of the cache entry here")
     p.add_argument("--prebuilt", action="store_true",
-                   help="instead: derive the models of a diagnosis with the default effects, and those of the "
-                        "pipeline's model manifests given, and keep their C in the package "
-                        "(src/parksteer/model/prebuilt), where a cold cache compiles it without deriving; run after "
-                        "any change to the symbolic half (the tests say when) as "
-                        "`parksteer derive --prebuilt results/model/*.json results/diagnose/baseline/*.json`")
+                   help="instead: derive the models of a diagnosis with the default effects (against any manual "
+                        "car's baseline too), and those of the pipeline's model manifests given, and keep their C in "
+                        "the package (src/parksteer/model/prebuilt), where a cold cache compiles it without deriving; "
+                        "run after any change to the symbolic half (the tests say when) as "
+                        "`parksteer derive --prebuilt results/model/*.json`")
     p.add_argument("manifests", nargs="*", metavar="MANIFEST",
                    help="with --prebuilt: model manifests the pipeline wrote (results/model/<name>.json), whose "
-                        "effect sets are pre-derived too, and the baseline benchmark's cars "
-                        "(results/diagnose/baseline/<car>.json), whose held form's diagnosis models are")
+                        "effect sets are pre-derived too")
     add_quiet_option(p)
     p.set_defaults(func=_derive)
 
@@ -124,31 +123,23 @@ def _signature_truth_sets() -> list:
     return [({"truth_form": form.effect.name}, truth_effects(form)) for form in ALL_FORMS]
 
 
-def _held_form_sets(path: str) -> list | None:
-    """(spec, effects) of the models a diagnosis against the baseline of the benchmark's car `path` builds
-    (results/diagnose/baseline/<car>.json; None for a file that is not one): a manual car's learnt form held on the
-    default set, with the diagnosis models over it (:func:`parksteer.diagnose.candidates.models_to_build`), spec
-    ``{"shape": name, "effects": [the other effects]}``. An assisted car's or a form a suggestion cannot take is
-    said and left out (its job derives it)."""
-    try:
-        result = json.loads(Path(path).read_text(encoding="utf-8"))
-    except (OSError, ValueError):
-        return None
-    if not isinstance(result, dict) or not isinstance(result.get("learnt"), dict) or "spec" in result:
-        return None
+def _held_form_sets() -> list:
+    """(spec, effects) of the models a diagnosis against a manual car's baseline builds, whatever form the baseline
+    learnt: each form a suggestion can take (parksteer.diagnose.suggest.shape_forms) held on the default set, with
+    the diagnosis models over it (:func:`parksteer.diagnose.candidates.models_to_build`), spec ``{"shape": name,
+    "effects": [the other effects]}``. A manual car's model is the default set whatever its vehicle file, so a later
+    record of any manual car compiles these instead of deriving them. An assisted car's form is held on the car's
+    own assisted model, which is not pre-derived (its job derives it)."""
     from ..diagnose.candidates import candidate_effects, models_to_build
     from ..diagnose.suggest import shape_forms
     from ..model.symbolic.components import resolve_effects
-    from ..progress import note
 
-    name = result["learnt"].get("form")
-    form = next((f for f in shape_forms() if f.name == name), None)
-    if result.get("kind") != "manual" or form is None:
-        note(f"{path}: held form {name!r} of a {result.get('kind')} car not pre-derived (its job derives its models)")
-        return []
-    base = sorted([*resolve_effects(None), form], key=lambda e: e.name)
-    return [({"shape": form.name, "effects": [e.name for e in model if e.name != form.name]}, model)
-            for model in models_to_build(base, candidate_effects(base)[0])]
+    sets = []
+    for form in shape_forms():
+        base = sorted([*resolve_effects(None), form], key=lambda e: e.name)
+        sets += [({"shape": form.name, "effects": [e.name for e in model if e.name != form.name]}, model)
+                 for model in models_to_build(base, candidate_effects(base)[0])]
+    return sets
 
 
 def _manifest_spec(path: str):
@@ -276,12 +267,8 @@ def _derive(args) -> int:
                              "--effects or --out")
         sets = [([e.name for e in effects], effects) for effects in default_diagnosis_models()]
         sets += (_assisted_vehicle_sets() + _signature_truth_sets() + _suggestion_shape_sets()
-                 + _example_effect_sets())
+                 + _held_form_sets() + _example_effect_sets())
         for path in args.manifests:
-            held = _held_form_sets(path)
-            if held is not None:
-                sets += held
-                continue
             spec = _manifest_spec(path)
             sets.append((spec, resolve_effects(spec)))
         written = write_prebuilt(sets)
