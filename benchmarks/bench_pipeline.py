@@ -2,7 +2,9 @@
 
 The repository's tracked and new files (git ls-files) are copied to a scratch directory, so that nothing is built
 there yet: no results/, no compiled model (the copy's package is the one its jobs import, through PYTHONPATH, and
-its model cache is the copy's results/model). Then `snakemake --cores N TARGET...` runs once, timed, and every
+its model cache is the copy's results/model), and the copy's package bytecode is compiled (`python -m compileall`,
+as the README's quick start does; `--no-bytecode` leaves it out, so that every job compiles the modules it imports
+where PYTHONDONTWRITEBYTECODE is set). Then `snakemake --cores N TARGET...` runs once, timed, and every
 rule's benchmark file (results/benchmarks/<rule>/*.tsv: wall seconds `s` and `cpu_time` of each job) is read.
 It reports the run's wall time, and per rule the number of jobs and the sum of their wall and CPU seconds; the
 top five rules by summed wall time are printed. The sum over jobs exceeds the run's wall time when jobs ran in
@@ -10,7 +12,7 @@ parallel. It also reports the critical path: the chain of jobs through the DAG (
 times add up to the most, which no number of cores shortens, and the lower bound of the run's wall time on N
 cores, the larger of that path and the jobs' summed wall time over N.
 
-    python benchmarks/bench_pipeline.py results/bench_pipeline.json [--cores 2] [--keep DIR] [TARGET ...]
+    python benchmarks/bench_pipeline.py results/bench_pipeline.json [--cores 2] [--keep DIR] [--no-bytecode] [TARGET ...]
 
 With no target, the default target (every figure and the paper). A rule without a `benchmark:` directive does not
 appear; the report names the rules of the run that wrote no benchmark file (the aggregate rule `all` has none).
@@ -119,19 +121,25 @@ def main(argv=None) -> int:
     parser.add_argument("targets", nargs="*", help="Snakemake targets (default: the default target)")
     parser.add_argument("--cores", type=int, default=2)
     parser.add_argument("--keep", help="run in this (new) directory and keep it, instead of a temporary one")
+    parser.add_argument("--no-bytecode", action="store_true",
+                        help="leave the copy's package without its bytecode (the README's quick start compiles it)")
     args = parser.parse_args(argv)
     load_start = os.getloadavg()
     with tempfile.TemporaryDirectory(prefix="bench_pipeline_") as tmp:
         work = Path(args.keep) if args.keep else Path(tmp) / "work"
         work.mkdir(parents=True, exist_ok=False)
         scratch_copy(work)
+        if not args.no_bytecode:
+            subprocess.run([sys.executable, "-m", "compileall", "-q", str(work / "src")], check=True,
+                           stdout=subprocess.DEVNULL)
         wall, ran = run(work, args.cores, args.targets)
         rules = read_benchmarks(work)
         env = dict(os.environ, PYTHONPATH=str(work / "src"), PARKSTEER_MODEL_CACHE=str(work / "results" / "model"))
         path_s, path_jobs = critical_path(work, args.targets, env)
     top = sorted(rules.items(), key=lambda item: -item[1]["wall_s"])[:TOP]
     result = {
-        "targets": args.targets or ["(default)"], "cores": args.cores, "wall_s": wall,
+        "targets": args.targets or ["(default)"], "cores": args.cores, "bytecode": not args.no_bytecode,
+        "wall_s": wall,
         "jobs_wall_s": sum(r["wall_s"] for r in rules.values()), "jobs_cpu_s": sum(r["cpu_s"] for r in rules.values()),
         "rules": rules, "top": [name for name, _ in top],
         "rules_without_benchmark": sorted(set(ran) - set(rules)),

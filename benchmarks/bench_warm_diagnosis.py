@@ -17,8 +17,8 @@ interpreters with that ``src`` first on the path, on the model cache the first (
 
 Warm means the bytecode too: each interpreter compiles a module's source only once, into a cache of this run's
 own (``PYTHONPYCACHEPREFIX``, a temporary folder, so that no tree is written into), whatever
-``PYTHONDONTWRITEBYTECODE`` says; an installed package has its bytecode, and without it every process compiles
-some 140 modules again (0.3 s a process here).
+``PYTHONDONTWRITEBYTECODE`` says; an installed package has its bytecode, and so has the README's editable install
+(its quick start runs ``compileall``); without it every process compiles some 140 modules again.
 
 Each is repeated ``--repeats`` times in turn (tree by tree within a repeat, so a machine's drift touches every tree
 alike) and reported as its median, and as the ratio of this tree's median to each reference's. Time per replay is
