@@ -96,8 +96,9 @@ def _point_the_profile_at_the_test_cluster(work: Path, cpus: int, memory_mb: int
     limits["mem_mb"] = min(int(limits.get("mem_mb", memory_mb)), memory_mb)
     # slurm.conf.in keeps a finished job in squeue for MinJobAge = 600 s, well above the plugin's threshold
     # (3 x the first check's delay). The plugin checks first after this delay, then 10 s later than the time before
-    # until a job has finished: each of the run's two jobs (4-8 s) is seen done at the second check, 1 + 11 s
-    # after its submission with a first check after 1 s (2 + 12 s after 2 s, 40 + 50 s after the default 40 s).
+    # until a job has finished: each of the run's two jobs (7-9 s, a Snakemake started inside the job) is seen done
+    # at the second check, 1 + 11 s after its submission with a first check after 1 s (2 + 12 s after 2 s, 40 + 50 s
+    # after the default 40 s).
     profile["slurm-status-command"] = "squeue"
     profile["slurm-init-seconds-before-status-checks"] = 1
     path.write_text(yaml.safe_dump(profile, sort_keys=False), encoding="utf-8")
@@ -142,12 +143,12 @@ def test_slurm_run_of_a_sweep_matches_the_local_run_byte_for_byte(repo_root, tmp
     local = _work_copy(repo_root, tmp_path / "local")
 
     # The local run goes on beside the SLURM run, which mostly waits for the plugin's status checks: the first
-    # comes 40 s after a submission by default (a real cluster's queue), 3 s here (a one-node cluster on this
-    # machine answers at once); what the checks find is the same.
+    # comes 40 s after a submission by default (a real cluster's queue), 1 s here (the profile as
+    # _point_the_profile_at_the_test_cluster sets it: a one-node cluster on this machine answers at once); what the
+    # checks find is the same.
     with concurrent.futures.ThreadPoolExecutor(max_workers=1) as pool:
         beside = pool.submit(_snakemake, local, "--cores", "2")
-        slurm_s, slurm_log = _snakemake(on_slurm, "--profile", "workflow/profiles/slurm",
-                                        "--slurm-init-seconds-before-status-checks", "3")
+        slurm_s, slurm_log = _snakemake(on_slurm, "--profile", "workflow/profiles/slurm")
         local_s, _ = beside.result()
 
     submitted = re.findall(r"has been submitted with SLURM jobid (\d+)", slurm_log)
