@@ -129,15 +129,13 @@ def _held_form_sets() -> list:
     the diagnosis models over it (:func:`parksteer.diagnose.candidates.models_to_build`), spec ``{"shape": name,
     "effects": [the other effects]}``. A manual car's model is the default set whatever its vehicle file, so a later
     record of any manual car compiles these instead of deriving them. An assisted car's form is held on the car's
-    own assisted model, which is not pre-derived (its job derives it)."""
+    own assisted model, which is not pre-derived (its job derives it). The first model of each form is its
+    suggestion's (:func:`_suggestion_shape_sets`), which the package ships under that spec."""
     from ..diagnose.candidates import candidate_effects, models_to_build
-    from ..diagnose.suggest import shape_forms
-    from ..model.symbolic.components import resolve_effects
 
     sets = []
-    for form in shape_forms():
-        base = sorted([*resolve_effects(None), form], key=lambda e: e.name)
-        sets += [({"shape": form.name, "effects": [e.name for e in model if e.name != form.name]}, model)
+    for spec, base in _suggestion_shape_sets():
+        sets += [({"shape": spec["shape"], "effects": [e.name for e in model if e.name != spec["shape"]]}, model)
                  for model in models_to_build(base, candidate_effects(base)[0])]
     return sets
 
