@@ -18,7 +18,8 @@ read or written) and reports its stages; the table gives the median of the runs 
   and printing);
 * print: the C printer (_Printer.doprint), every line;
 * rest: generate's remainder (the source assembled, the portability check);
-* cc: the compiler on model.c, as parksteer.model.codegen.cache.build_entry runs it.
+* cc: the compiler on model.c alone (the runtime it links, compiled once per cache, is not timed; on trees before
+  the runtime was compiled apart, model.c holds it).
 
 Each stage is timed in wall time and in CPU time (the CPU time of generate's set-up and remainder together, as
 expressions_rest; the Kane and forces stages split at the first group's generalized forces; cc's from the

@@ -20,7 +20,6 @@ import os
 import shutil
 import signal
 import socket
-import subprocess
 import sys
 import tempfile
 import time
@@ -33,6 +32,7 @@ from typing import TYPE_CHECKING
 
 from ...errors import UsageError
 from ...progress import note
+from .compiler import COMPILE_FLAGS, compile_model, find_compiler
 
 if TYPE_CHECKING:  # the workflow checks cache entries on every run: sympy is imported only to derive or key a model
     from ..symbolic.components import Effect
@@ -44,12 +44,9 @@ MODEL_DIR = Path(__file__).resolve().parents[1]
 SYMBOLIC_DIRS = (MODEL_DIR / "symbolic", MODEL_DIR / "codegen")
 # Files outside the two halves whose names the symbolic model builds on (the sides a coordinate is made for).
 KEYED_FILES = (MODEL_DIR.parent / "names.py",)
-# This module stores entries and generates nothing, so its source is not part of the key.
-KEYLESS_SOURCE = Path(__file__).resolve()
-# How the generated C is compiled; part of the model key. -O1: integrates these models about as fast as -O2 and
-# compiles in less time. -ffp-contract=off: no fused multiply-add, which GCC otherwise forms wherever the target has
-# one (aarch64, or x86 with -march=native), so every product is rounded on its own and the bits do not depend on it.
-COMPILE_FLAGS = ("-O1", "-ffp-contract=off", "-shared", "-fPIC")
+# These modules store and compile entries and generate nothing, so their source is not part of the key (the flags
+# are).
+KEYLESS_SOURCES = (Path(__file__).resolve(), Path(__file__).resolve().with_name("compiler.py"))
 # Built files whose SHA-256 model.json records: an entry is used only if both exist and match.
 BUILT_FILES = ("model.c", "model.so")
 # The package's pre-derived models: the generated C (gzip) and description of the effect sets a first diagnosis of
@@ -109,7 +106,7 @@ def _symbolic_half_source() -> bytes:
     read once per process (a simulation loads its model by key)."""
     sources = [p for d in SYMBOLIC_DIRS for pattern in ("*.py", "*.c") for p in d.rglob(pattern)]
     return b"".join(str(path.relative_to(MODEL_DIR.parent)).encode() + b"\0" + path.read_bytes() + b"\0"
-                    for path in sorted(p for p in [*sources, *KEYED_FILES] if p != KEYLESS_SOURCE))
+                    for path in sorted(p for p in [*sources, *KEYED_FILES] if p not in KEYLESS_SOURCES))
 
 
 @lru_cache(maxsize=None)
@@ -128,14 +125,6 @@ def model_key(effects: list[Effect]) -> str:
     for effect in effects:
         digest.update(_effect_source(effect).encode())
     return digest.hexdigest()[:20]
-
-
-def find_compiler() -> str:
-    for name in filter(None, (os.environ.get("CC"), "cc", "gcc", "clang")):
-        found = shutil.which(name)
-        if found:
-            return found
-    raise UsageError("no C compiler found (tried $CC, cc, gcc, clang): install one, e.g. apt-get install gcc")
 
 
 def derive_source(effects: list[Effect]) -> tuple[str, dict, dict]:
@@ -247,13 +236,7 @@ def build_entry(effects: list[Effect], directory: Path, key: str | None = None) 
     t_derive, t_codegen = timings["derive"], timings["codegen"]
     directory.mkdir(parents=True, exist_ok=True)
     (directory / "model.c").write_text(source, encoding="utf-8")
-    cmd = [compiler, *COMPILE_FLAGS, "-o", str(directory / "model.so"), str(directory / "model.c"), "-lm"]
-    done = subprocess.run(cmd, capture_output=True, text=True)
-    if done.returncode != 0:
-        if "No space left on device" in done.stderr:  # the library could not be written: the cache's disk is full
-            raise OSError(errno.ENOSPC, "No space left on device")
-        first = (done.stderr.strip().splitlines() or ["unknown error"])[0]
-        raise UsageError(f"C compiler failed on the generated model: {first}")
+    compile_model(compiler, directory / "model.c", directory / "model.so", directory.parent)
     t_compile = time.perf_counter() - start - t_derive - t_codegen
     note(f"compiled with {Path(compiler).name} {COMPILE_FLAGS[0]}: {t_compile:.1f} s")
     info.update({"sha256": {name: _sha256(directory / name) for name in BUILT_FILES}, "sympy_version": _sympy_version(),

@@ -1,9 +1,9 @@
 /* Stiff integration of the model in C: one call runs a whole cycle, handwheel-driven (ps_integrate: y' = ps_rhs)
    or with the rack prescribed (ps_integrate_prescribed: the reduced system of ps_prescribed_rhs).
 
-   Appended as text after the generated model code and its runtime (one translation unit), which define NY, NQ, NO,
-   INPUT_OFFSET, ps_rhs, ps_jac, ps_prescribed_rhs, ps_prescribed_jac and, for the sensitivities,
-   PS_SENSITIVITIES and prescribed_tangent (sensitivities.c), and include <math.h> and <string.h>. Every name here
+   The last part of the runtime's translation unit (runtime.py), after runtime.c and sensitivities.c, which define
+   NY, NQ, NO, INPUT_OFFSET, ps_rhs, ps_jac, ps_prescribed_rhs, ps_prescribed_jac and, for the sensitivities,
+   PS_SENSITIVITIES and prescribed_tangent, and include <math.h> and <string.h>. Every name here
    starts with bdf_ (or is ps_integrate...), so as not to clash with the model code's own static helpers; all state
    lives on the call's stack (reentrant).
 
@@ -210,11 +210,12 @@ static void bdf_rescale(int width, double *D, int stride, int order, double fact
     }
 }
 
-/* Differences of the sensitivities: BDF_MAX_ORDER + 3 rows of n_sens x n (direction k's at k * n). */
-typedef double bdf_sens_differences[BDF_MAX_ORDER + 3][BDF_MAX_SENS * NY];
+/* Differences of the sensitivities: BDF_MAX_ORDER + 3 rows of n_sens x n (direction k's at k * n). A row's length,
+   not a typedef: NY may be the run-time dimension of a runtime compiled once for every model (runtime.py). */
+#define BDF_SENS_ROW (BDF_MAX_SENS * NY)
 
 /* Rescale the state's differences and the sensitivities' alike. */
-static void bdf_change_D(const bdf_system *s, double D[][NY], bdf_sens_differences DS, int order, double factor)
+static void bdf_change_D(const bdf_system *s, double D[][NY], double DS[][BDF_SENS_ROW], int order, double factor)
 {
     bdf_rescale(s->n, &D[0][0], NY, order, factor);
     if (s->n_sens) bdf_rescale(s->n * s->n_sens, &DS[0][0], BDF_MAX_SENS * NY, order, factor);
@@ -306,7 +307,7 @@ static int bdf_sens_rhs(const bdf_system *s, double t, const double *z, const do
    the linear corrector solved with the LU of I - c J at (t_new, y_new), then the differences updated as the
    state's. 0, or 1 when the sensitivities' right-hand side fails or I - c J is singular. */
 static int bdf_sens_step(const bdf_system *s, const bdf_coefficients *co, double t_new, const double *y_new,
-                         double h, int order, bdf_sens_differences DS)
+                         double h, int order, double DS[][BDF_SENS_ROW])
 {
     const int n = s->n, w = s->n * s->n_sens;
     double S_pred[BDF_MAX_SENS * NY], psi[BDF_MAX_SENS * NY], f[BDF_MAX_SENS * NY], d[BDF_MAX_SENS * NY];
@@ -365,14 +366,14 @@ static int bdf_solve(const bdf_system *s, const double *y0, int n_out, const dou
     double jac[NY * NY], lu[NY * NY], f[NY];
     double y_pred[NY], y_new[NY], d[NY], psi[NY], scale[NY], error[NY];
     int pivot[NY];
-    bdf_sens_differences DS; /* the sensitivities' differences, as D (s->n_sens of them) */
+    double DS[BDF_MAX_ORDER + 3][BDF_SENS_ROW]; /* the sensitivities' differences, as D (s->n_sens of them) */
     double h = 0.0, c_factored = 0.0; /* c of the current LU; 0 = no valid LU */
     int order = 1, n_equal_steps = 0, jac_is_current = 0, restart = 1, failed_evaluations = 0;
     int next_out = 1;
     long attempts_since_output = 0;
     memcpy(D[0], y0, n * sizeof(double));
     if (w) {
-        memset(DS, 0, sizeof(bdf_sens_differences));
+        memset(DS, 0, sizeof DS);
         memcpy(DS[0], s0, w * sizeof(double));
         if (n_out > 0) memcpy(s_out, s0, w * sizeof(double));
     }

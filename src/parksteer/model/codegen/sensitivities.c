@@ -1,6 +1,5 @@
-/* The forward sensitivities' runtime of a generated model (parksteer.model.codegen.tangent): appended after the
-   generated functions (eval_tangent among them) and generate.py's RUNTIME, before integrator.c, which calls
-   prescribed_tangent. */
+/* The forward sensitivities' runtime of a generated model (parksteer.model.codegen.tangent): after runtime.c and
+   before integrator.c, which calls prescribed_tangent; the model's eval_tangent is linked in (runtime.py). */
 
 /* ---- forward sensitivities of the prescribed-rack solve ---------------------------------
    Along a direction (dz, dp) of the reduced state and the parameters, the Kane equations M a = F + b T, with the
@@ -8,8 +7,6 @@
    dG = G_y dy + G_p dp the directional derivative of G = F + b T - M a with a and T held (eval_tangent). So one
    call gives J dz + f_p dp, the reduced right-hand side's derivative (dz' = (du_o, da_o)), and the column torque's,
    h_z dz + h_p dp. Directions: m rows of dz (2 NO each); dps[k] the k-th direction's parameters (INPUT_OFFSET). */
-#define NPAR (INPUT_OFFSET > 0 ? INPUT_OFFSET : 1)
-static const double ps_no_parameters[NPAR];
 
 int ps_sensitivities_available(void) { return PS_SENSITIVITIES; }
 
@@ -53,10 +50,12 @@ int ps_prescribed_tangent(double t, const double *z, const double *p, const doub
                           const double *dp, double *dzdot, double *dtorque)
 {
     double dy[MAX_TANGENTS * NY], dG[MAX_TANGENTS * NQ], dH[MAX_TANGENTS * NQ];
+    double no_parameters[INPUT_OFFSET > 0 ? INPUT_OFFSET : 1];
     const double *dps[MAX_TANGENTS];
+    if (!dp) memset(no_parameters, 0, sizeof no_parameters);
     for (int start = 0; start < m; start += MAX_TANGENTS) {
         int count = m - start < MAX_TANGENTS ? m - start : MAX_TANGENTS;
-        for (int k = 0; k < count; k++) dps[k] = dp ? dp + (long)(start + k) * INPUT_OFFSET : ps_no_parameters;
+        for (int k = 0; k < count; k++) dps[k] = dp ? dp + (long)(start + k) * INPUT_OFFSET : no_parameters;
         if (prescribed_tangent(t, z, p, rack, count, dz + (long)start * 2 * NO, dps, dzdot + (long)start * 2 * NO,
                                dtorque ? dtorque + start : NULL, dy, dG, dH)) return -1;
     }

@@ -8,24 +8,16 @@ grow with the number of parameters. Used by :mod:`.generate`; the integration of
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import sympy as sp
 
 from ..symbolic.derive import Derivation, memoised_diff
-
-SENSITIVITY_RUNTIME = "\n" + (Path(__file__).with_name("sensitivities.c")).read_text(encoding="utf-8")
+from .runtime import model_function
 
 
 # eval_tangent compiled without optimisation: optimised, its some 600 lines of chain rule cost about 1.2 s of the
 # compiler's time a model (half again what the rest costs), paid by every model built, while only a fit that asks for
 # exact Jacobians runs it. The arithmetic is the same (no fused multiply-add at any level: -ffp-contract=off).
 UNOPTIMISED = '__attribute__((optimize("O0"))) '
-
-
-def _function(name: str, args: str, lines: list[str]) -> str:
-    body = "\n".join(lines)
-    return f"{UNOPTIMISED}static void {name}({args})\n{{\n{body}\n}}\n"
 
 
 def _directional_block(expressions: list[sp.Expr], directions: dict[sp.Symbol, sp.Symbol], targets: list[str],
@@ -67,14 +59,12 @@ def tangent_function(derivation: Derivation, plain: dict, F_drive, F_full, M, bc
     """eval_tangent: along m directions (dq, du, dp: the coordinates', speeds' and parameters'), the derivatives of
     the prescribed-rack residual G = F_drive + b T - M a (the column torque T and the accelerations a held) and of
     the full forcing F (the statics' residual, at the handwheel input th, thd), the directions' values computed
-    once. The forward sensitivities of the prescribed-rack solve are made of them (RUNTIME's ps_prescribed_tangent,
-    ps_forcing_tangent)."""
-    args = ("const double *q, const double *u, const double *a, const double *p, double T, double th, double thd, "
-            "int m, const double *dy, const double *const *dps, double *dG, double *dH")
+    once. The forward sensitivities of the prescribed-rack solve are made of them (sensitivities.c's
+    ps_prescribed_tangent, ps_forcing_tangent)."""
     if drive_hand:  # an assist's drive, written at zero handwheel input, has no sensitivities
-        return "#define PS_SENSITIVITIES 0\n" + _function(
-            "eval_tangent", args, ["    (void)q; (void)u; (void)a; (void)p; (void)T; (void)th; (void)thd; (void)m; "
-                                   "(void)dy; (void)dps; (void)dG; (void)dH;"])
+        return "#define PS_SENSITIVITIES 0\n" + model_function(
+            "eval_tangent", ["    (void)q; (void)u; (void)a; (void)p; (void)T; (void)th; (void)thd; (void)m; "
+                             "(void)dy; (void)dps; (void)dG; (void)dH;"], UNOPTIMISED)
     space = derivation.space
     n = len(space.coordinates)
     torque = sp.Symbol("T", real=True)
@@ -87,4 +77,4 @@ def tangent_function(derivation: Derivation, plain: dict, F_drive, F_full, M, bc
     loop = ("for (int k = 0; k < m; k++) {\n        const double *dq = dy + k * NY, *du = dq + NQ, *dp = dps[k];"
             "\n        (void)dq; (void)du; (void)dp;")  # the loop's head and the direction's arrays
     lines = _directional_block(residual + list(F_full), directions, targets, printer, loop)
-    return "#define PS_SENSITIVITIES 1\n" + _function("eval_tangent", args, lines)
+    return "#define PS_SENSITIVITIES 1\n" + model_function("eval_tangent", lines, UNOPTIMISED)

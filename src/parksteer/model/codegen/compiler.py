@@ -1,0 +1,93 @@
+"""How a model's generated C becomes its shared library: the compiler, its flags, and the runtime every model links.
+
+The runtime (:mod:`.runtime`: the mass-matrix solves, the outputs, the stiff integrator and its sensitivities) is the
+same text for every model and about a third of what the compiler spent on each; it is compiled once per cache and
+compiler, into ``runtime/<key>.o`` beside the cache's entries, and linked with each model's own file. The object is
+compiled in the building entry's scratch directory and renamed into place whole, so a killed build leaves no half of
+one; two builders that compile it at once rename the same bytes.
+"""
+
+from __future__ import annotations
+
+import errno
+import hashlib
+import os
+import platform
+import shutil
+import subprocess
+from contextlib import suppress
+from functools import lru_cache
+from pathlib import Path
+
+from ...errors import UsageError
+from .runtime import runtime_source
+
+# How the C is compiled; part of the model key. -O1: integrates these models about as fast as -O2 and compiles in
+# less time. -ffp-contract=off: no fused multiply-add, which GCC otherwise forms wherever the target has one
+# (aarch64, or x86 with -march=native), so every product is rounded on its own and the bits do not depend on it.
+OPTIMISE_FLAGS = ("-O1", "-ffp-contract=off")
+COMPILE_FLAGS = (*OPTIMISE_FLAGS, "-shared", "-fPIC")
+RUNTIME_FOLDER = "runtime"
+
+
+def find_compiler() -> str:
+    for name in filter(None, (os.environ.get("CC"), "cc", "gcc", "clang")):
+        found = shutil.which(name)
+        if found:
+            return found
+    raise UsageError("no C compiler found (tried $CC, cc, gcc, clang): install one, e.g. apt-get install gcc")
+
+
+@lru_cache(maxsize=None)
+def _compiler_identity(compiler: str) -> str:
+    """The compiler's real path, its version line and the machine: what the runtime object's bytes depend on."""
+    done = subprocess.run([compiler, "--version"], capture_output=True, text=True)
+    version = (done.stdout.strip().splitlines() or [""])[0]
+    return f"{os.path.realpath(compiler)}\n{version}\n{platform.machine()}\n"
+
+
+def runtime_key(compiler: str) -> str:
+    """Hash of the runtime's source, the flags and the compiler."""
+    digest = hashlib.sha256(_compiler_identity(compiler).encode())
+    digest.update(" ".join(OPTIMISE_FLAGS).encode() + b"\0" + runtime_source().encode())
+    return digest.hexdigest()[:20]
+
+
+def runtime_object(compiler: str, root: Path, scratch: Path) -> Path:
+    """The runtime compiled by `compiler` for the cache `root`: root/runtime/<key>.o, compiled in `scratch` and
+    renamed into place if it is not there yet."""
+    final = root / RUNTIME_FOLDER / f"{runtime_key(compiler)}.o"
+    if final.is_file():
+        return final
+    source, built = scratch / "runtime.c", scratch / "runtime.o"
+    source.write_text(runtime_source(), encoding="utf-8")
+    _run([compiler, *OPTIMISE_FLAGS, "-fPIC", "-c", "-o", str(built), str(source)], "the models' runtime")
+    final.parent.mkdir(parents=True, exist_ok=True)
+    os.replace(built, final)
+    source.unlink()
+    return final
+
+
+def compile_model(compiler: str, c_path: Path, so_path: Path, root: Path) -> None:
+    """Compile the generated `c_path` and link it with the runtime into `so_path` (the cache `root` holds the
+    runtime's object; `c_path`'s folder is the build's scratch)."""
+    runtime = runtime_object(compiler, root, c_path.parent)
+    cmd = [compiler, *COMPILE_FLAGS, "-o", str(so_path), str(c_path), str(runtime), "-lm"]
+    try:
+        _run(cmd, "the generated model")
+    except UsageError:
+        # Perhaps a damaged runtime object: compiled again once and linked again (a fault of the model's own C fails
+        # again, with its first line).
+        with suppress(FileNotFoundError):
+            runtime.unlink()
+        cmd[-2] = str(runtime_object(compiler, root, c_path.parent))
+        _run(cmd, "the generated model")
+
+
+def _run(cmd: list[str], what: str) -> None:
+    done = subprocess.run(cmd, capture_output=True, text=True)
+    if done.returncode != 0:
+        if "No space left on device" in done.stderr:  # the library could not be written: the cache's disk is full
+            raise OSError(errno.ENOSPC, "No space left on device")
+        first = (done.stderr.strip().splitlines() or ["unknown error"])[0]
+        raise UsageError(f"C compiler failed on {what}: {first}")

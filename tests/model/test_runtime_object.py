@@ -1,0 +1,81 @@
+"""The models' runtime is compiled once per cache and linked with each model (parksteer.model.codegen.compiler): the
+numbers are those of the runtime compiled in one translation unit with the model, whose dimensions the compiler then
+knows; one object serves every model; a damaged object is compiled again."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import shutil
+
+import numpy as np
+import pytest
+
+from parksteer.measure.rack_spline import interpolate_rack
+from parksteer.model.codegen import cache, compiler
+from parksteer.model.codegen.runtime import HERE, RUNTIME_FILES
+from parksteer.model.numeric.compiled import load_entry
+from parksteer.model.numeric.sensitivities import parameter_directions, solve_sensitivities
+from parksteer.model.numeric.simulate import integrate, prepare
+from parksteer.model.symbolic.components import resolve_effects
+
+pytestmark = pytest.mark.slow
+
+
+@pytest.fixture
+def cache_dir(tmp_path, monkeypatch):
+    monkeypatch.setenv(cache.CACHE_ENV, str(tmp_path / "model"))
+    return tmp_path / "model"
+
+
+def _one_translation_unit(entry, folder):
+    """The entry's model compiled with the runtime's text after it in one file, as every model was built before the
+    runtime was compiled apart: NQ, NOUT, ... are the model's constants there."""
+    folder.mkdir()
+    text = (entry / "model.c").read_text(encoding="utf-8")
+    text += "".join("\n" + (HERE / name).read_text(encoding="utf-8") for name in RUNTIME_FILES)
+    (folder / "model.c").write_text(text, encoding="utf-8")
+    shutil.copy(entry / "model.json", folder / "model.json")
+    cmd = [compiler.find_compiler(), *compiler.COMPILE_FLAGS, "-o", str(folder / "model.so"), str(folder / "model.c"),
+           "-lm"]
+    compiler._run(cmd, "the model in one translation unit")
+    return load_entry(folder)
+
+
+def test_the_runtime_compiled_apart_gives_the_bits_of_one_translation_unit(cache_dir, tmp_path):
+    """The paper's cycle integrated handwheel-driven (mass matrix, Cholesky solves, the analytic Jacobian, the
+    integrator), its outputs, and a prescribed-rack solve with its forward sensitivities (the drive, the LU solves,
+    the tangent) are the same bits whether the runtime knows the model's dimensions at compile time or reads them
+    at run time: IEEE arithmetic in the same order, no fused multiply-add at any level."""
+    run = prepare("unladen")
+    alone = dataclasses.replace(run, model=_one_translation_unit(run.model.directory, tmp_path / "one"))
+    t = np.round(np.arange(0.0, run.profile.end_time_s + 0.005, 0.01), 12)
+    states = integrate(run, t)
+    assert states.tobytes() == integrate(alone, t).tobytes()
+    assert np.ptp(states[:, run.model.index("rack")]) > 0.05  # the rack swept the cycle's stroke
+    outputs, again = run.model.evaluate_outputs(t, states, run.p), alone.model.evaluate_outputs(t, states, alone.p)
+    assert outputs.keys() == again.keys() and all(outputs[k].tobytes() == again[k].tobytes() for k in outputs)
+    t_rack = np.linspace(0.0, 4.0, 401)
+    rack = interpolate_rack(t_rack, 0.03 * np.sin(np.pi * t_rack / 2.0))
+    times = np.linspace(0.5, 1.5, 51)
+    keys = ["steering.rack_friction_force", "tyre.carcass_torsional_stiffness"]
+    apart = solve_sensitivities(run, run.p, rack, times, parameter_directions(run, keys))
+    one = solve_sensitivities(alone, alone.p, rack, times, parameter_directions(alone, keys))
+    assert apart.torque_sensitivities.tobytes() == one.torque_sensitivities.tobytes()
+    assert np.all(np.abs(apart.torque_sensitivities).max(axis=0) > 0.0)
+
+
+def test_one_runtime_object_serves_every_model_and_a_damaged_one_is_compiled_again(cache_dir):
+    """Two models built into an empty cache link one runtime object; an object damaged afterwards (here: its bytes
+    replaced) fails the next link, is compiled again and the model built and run."""
+    first = cache.ensure(resolve_effects(None))
+    second = cache.ensure(resolve_effects("+rack_lash"))
+    objects = list((cache_dir / compiler.RUNTIME_FOLDER).iterdir())
+    assert [p.name for p in objects] == [f"{compiler.runtime_key(compiler.find_compiler())}.o"]
+    assert first["built_now"] and second["built_now"]
+    objects[0].write_bytes(b"not an object file")
+    third = cache.ensure(resolve_effects("+ackermann"))
+    assert third["built_now"] and objects[0].read_bytes()[:4] == b"\x7fELF"
+    run = prepare("unladen", effects="+ackermann")
+    assert json.loads((cache_dir / third["key"] / "model.json").read_text())["prebuilt"] is True
+    assert np.all(np.isfinite(integrate(run, np.linspace(0.0, 1.0, 11))))
