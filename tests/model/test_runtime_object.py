@@ -45,9 +45,8 @@ def _one_translation_unit(entry, folder):
 def test_the_runtime_compiled_apart_gives_the_bits_of_one_translation_unit(cache_dir, tmp_path):
     """The paper's cycle integrated handwheel-driven (mass matrix, Cholesky solves, the analytic Jacobian, the
     integrator), its outputs, and a prescribed-rack solve with its forward sensitivities (the drive, the LU solves,
-    the tangent) are the same bits whether the runtime knows the model's dimensions at compile time (at the model's
-    -O1) or reads them at run time (its own object, at -O2): IEEE arithmetic in the same order, no fused
-    multiply-add at any level."""
+    the tangent) are the same bits whether the runtime knows the model's dimensions at compile time or reads them
+    at run time: IEEE arithmetic in the same order, no fused multiply-add at any level."""
     run = prepare("unladen")
     alone = dataclasses.replace(run, model=_one_translation_unit(run.model.directory, tmp_path / "one"))
     t = np.round(np.arange(0.0, run.profile.end_time_s + 0.005, 0.01), 12)

@@ -25,10 +25,8 @@ from .runtime import runtime_source
 # How the C is compiled; part of the model key. -O1: integrates these models about as fast as -O2 and compiles in
 # less time. -ffp-contract=off: no fused multiply-add, which GCC otherwise forms wherever the target has one
 # (aarch64, or x86 with -march=native), so every product is rounded on its own and the bits do not depend on it.
-COMPILE_FLAGS = ("-O1", "-ffp-contract=off", "-shared", "-fPIC")
-# The runtime at -O2: compiled once per cache, so the longer compile is paid once, and the integrator's loops run
-# about 5 % faster (a diagnosis benchmark's job, the same bits). Not part of the model key (the object's key has it).
-RUNTIME_FLAGS = ("-O2", "-ffp-contract=off", "-fPIC")
+OPTIMISE_FLAGS = ("-O1", "-ffp-contract=off")
+COMPILE_FLAGS = (*OPTIMISE_FLAGS, "-shared", "-fPIC")
 RUNTIME_FOLDER = "runtime"
 
 
@@ -51,7 +49,7 @@ def _compiler_identity(compiler: str) -> str:
 def runtime_key(compiler: str) -> str:
     """Hash of the runtime's source, the flags and the compiler."""
     digest = hashlib.sha256(_compiler_identity(compiler).encode())
-    digest.update(" ".join(RUNTIME_FLAGS).encode() + b"\0" + runtime_source().encode())
+    digest.update(" ".join(OPTIMISE_FLAGS).encode() + b"\0" + runtime_source().encode())
     return digest.hexdigest()[:20]
 
 
@@ -63,7 +61,7 @@ def runtime_object(compiler: str, root: Path, scratch: Path) -> Path:
         return final
     source, built = scratch / "runtime.c", scratch / "runtime.o"
     source.write_text(runtime_source(), encoding="utf-8")
-    _run([compiler, *RUNTIME_FLAGS, "-c", "-o", str(built), str(source)], "the models' runtime")
+    _run([compiler, *OPTIMISE_FLAGS, "-fPIC", "-c", "-o", str(built), str(source)], "the models' runtime")
     final.parent.mkdir(parents=True, exist_ok=True)
     os.replace(built, final)
     source.unlink()
