@@ -70,7 +70,7 @@ def test_one_runtime_object_serves_every_model_and_a_damaged_one_is_compiled_aga
     replaced) fails the next link, is compiled again and the model built and run."""
     first = cache.ensure(resolve_effects(None))
     second = cache.ensure(resolve_effects("+rack_lash"))
-    objects = list((cache_dir / compiler.RUNTIME_FOLDER).iterdir())
+    objects = list((cache_dir / compiler.RUNTIME_FOLDER).glob("*.o"))
     assert [p.name for p in objects] == [f"{compiler.runtime_key(compiler.find_compiler())}.o"]
     assert first["built_now"] and second["built_now"]
     objects[0].write_bytes(b"not an object file")
@@ -79,3 +79,15 @@ def test_one_runtime_object_serves_every_model_and_a_damaged_one_is_compiled_aga
     run = prepare("unladen", effects="+ackermann")
     assert json.loads((cache_dir / third["key"] / "model.json").read_text())["prebuilt"] is True
     assert np.all(np.isfinite(integrate(run, np.linspace(0.0, 1.0, 11))))
+
+
+def test_models_built_side_by_side_on_an_empty_cache_compile_the_runtime_once(cache_dir, capfd):
+    """A first diagnosis builds its three models in background processes side by side (start_builds); each needs
+    the runtime: the first compiles it under its lock, the others wait and link the same object."""
+    sets = [resolve_effects(None), resolve_effects("+rack_lash"), resolve_effects("+ackermann")]
+    builders = cache.start_builds(sets, jobs=3)
+    assert len(builders) == 3
+    cache.finish_builds(builders)
+    assert [b.exitcode for b in builders] == [0, 0, 0]
+    assert all(cache.entry_is_sound(cache.entry_path(effects)) for effects in sets)
+    assert capfd.readouterr().err.count("compiling the models' runtime") == 1

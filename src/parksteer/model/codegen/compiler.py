@@ -3,13 +3,14 @@
 The runtime (:mod:`.runtime`: the mass-matrix solves, the outputs, the stiff integrator and its sensitivities) is the
 same text for every model and about a third of what the compiler spent on each; it is compiled once per cache and
 compiler, into ``runtime/<key>.o`` beside the cache's entries, and linked with each model's own file. The object is
-compiled in the building entry's scratch directory and renamed into place whole, so a killed build leaves no half of
-one; two builders that compile it at once rename the same bytes.
+compiled in the building entry's scratch directory, under a lock, and renamed into place whole, so a killed build
+leaves no half of one and builders side by side compile it once.
 """
 
 from __future__ import annotations
 
 import errno
+import fcntl
 import hashlib
 import os
 import platform
@@ -20,6 +21,7 @@ from functools import lru_cache
 from pathlib import Path
 
 from ...errors import UsageError
+from ...progress import note
 from .runtime import runtime_source
 
 # How the C is compiled; part of the model key. -O1: integrates these models about as fast as -O2 and compiles in
@@ -55,16 +57,22 @@ def runtime_key(compiler: str) -> str:
 
 def runtime_object(compiler: str, root: Path, scratch: Path) -> Path:
     """The runtime compiled by `compiler` for the cache `root`: root/runtime/<key>.o, compiled in `scratch` and
-    renamed into place if it is not there yet."""
+    renamed into place if it is not there yet. Builders that need it at once (a first diagnosis builds its models
+    side by side) wait for the one compiling it, under a lock the kernel releases when its holder ends."""
     final = root / RUNTIME_FOLDER / f"{runtime_key(compiler)}.o"
     if final.is_file():
         return final
-    source, built = scratch / "runtime.c", scratch / "runtime.o"
-    source.write_text(runtime_source(), encoding="utf-8")
-    _run([compiler, *OPTIMISE_FLAGS, "-fPIC", "-c", "-o", str(built), str(source)], "the models' runtime")
     final.parent.mkdir(parents=True, exist_ok=True)
-    os.replace(built, final)
-    source.unlink()
+    with open(final.with_suffix(".lock"), "a", encoding="utf-8") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        if final.is_file():
+            return final
+        note(f"compiling the models' runtime, once for this cache and compiler ({final})")
+        source, built = scratch / "runtime.c", scratch / "runtime.o"
+        source.write_text(runtime_source(), encoding="utf-8")
+        _run([compiler, *OPTIMISE_FLAGS, "-fPIC", "-c", "-o", str(built), str(source)], "the models' runtime")
+        os.replace(built, final)
+        source.unlink()
     return final
 
 
