@@ -93,7 +93,7 @@ def test_every_rule_script_logs_through_rule_log(repo_root):
 
 def test_derive_reports_each_stage_and_quiet_silences_it(tmp_path, monkeypatch, capsys):
     """A cold `parksteer derive` names each stage on stderr (derivation with its coordinates, generated C, the
-    compilation) with the numbers the cache entry records; a second call finds it in the cache; --quiet prints
+    runtime's one compile on an empty cache, the compilation) with the numbers the cache entry records; a second call finds it in the cache; --quiet prints
     nothing on stderr and still answers on stdout. The smallest effect set (rack friction alone) keeps it short."""
     monkeypatch.setenv("PARKSTEER_MODEL_CACHE", str(tmp_path / "cache"))
     effects = "--effects=-carcass_compliance,-hooke_joint,-lifting,-tyre_friction"
@@ -105,7 +105,9 @@ def test_derive_reports_each_stage_and_quiet_silences_it(tmp_path, monkeypatch, 
         stages = [line.split(":")[0] for line in err.splitlines()]
         assert stages[:3] == ["deriving the model of rack_friction (sympy Kane's method) ...", "derived",
                               "generated C"], err
-        assert stages[3].startswith("compiled with ") and stages[4:] == ["model of rack_friction"], err
+        # an empty cache compiles the models' runtime once, before the model's own C
+        assert stages[3].startswith("compiling the models' runtime, once for this cache and compiler"), err
+        assert stages[4].startswith("compiled with ") and stages[5:] == ["model of rack_friction"], err
         assert f"derived: {len(manifest['coordinates'])} coordinates ({', '.join(manifest['coordinates'])}), " \
                f"{manifest['n_parameters']} parameters" in err
         assert f"generated C: {source.count(chr(10))} lines" in err
