@@ -30,7 +30,8 @@ def cache_dir(tmp_path, monkeypatch):
 
 def _one_translation_unit(entry, folder):
     """The entry's model compiled with the runtime's text after it in one file, as every model was built before the
-    runtime was compiled apart: NQ, NOUT, ... are the model's constants there."""
+    runtime was compiled apart: NQ, NOUT, ... are the model's constants there. Assembled here from the C files, not
+    through runtime.runtime_source, so that the reference does not share the code it checks."""
     folder.mkdir()
     text = (entry / "model.c").read_text(encoding="utf-8")
     text += "".join("\n" + (HERE / name).read_text(encoding="utf-8") for name in RUNTIME_FILES)
@@ -38,7 +39,7 @@ def _one_translation_unit(entry, folder):
     shutil.copy(entry / "model.json", folder / "model.json")
     cmd = [compiler.find_compiler(), *compiler.COMPILE_FLAGS, "-o", str(folder / "model.so"), str(folder / "model.c"),
            "-lm"]
-    compiler._run(cmd, "the model in one translation unit")
+    compiler.run_compiler(cmd, "the model in one translation unit")
     return load_entry(folder)
 
 

@@ -70,7 +70,8 @@ def runtime_object(compiler: str, root: Path, scratch: Path) -> Path:
         note(f"compiling the models' runtime, once for this cache and compiler ({final})")
         source, built = scratch / "runtime.c", scratch / "runtime.o"
         source.write_text(runtime_source(), encoding="utf-8")
-        _run([compiler, *OPTIMISE_FLAGS, "-fPIC", "-c", "-o", str(built), str(source)], "the models' runtime")
+        run_compiler([compiler, *OPTIMISE_FLAGS, "-fPIC", "-c", "-o", str(built), str(source)],
+                     "the models' runtime")
         os.replace(built, final)
         source.unlink()
     return final
@@ -82,17 +83,18 @@ def compile_model(compiler: str, c_path: Path, so_path: Path, root: Path) -> Non
     runtime = runtime_object(compiler, root, c_path.parent)
     cmd = [compiler, *COMPILE_FLAGS, "-o", str(so_path), str(c_path), str(runtime), "-lm"]
     try:
-        _run(cmd, "the generated model")
+        run_compiler(cmd, "the generated model")
     except UsageError:
         # Perhaps a damaged runtime object: compiled again once and linked again (a fault of the model's own C fails
         # again, with its first line).
         with suppress(FileNotFoundError):
             runtime.unlink()
         cmd[-2] = str(runtime_object(compiler, root, c_path.parent))
-        _run(cmd, "the generated model")
+        run_compiler(cmd, "the generated model")
 
 
-def _run(cmd: list[str], what: str) -> None:
+def run_compiler(cmd: list[str], what: str) -> None:
+    """Run the compiler command `cmd` on `what`; a failure is one line (its first), a full disk an OSError."""
     done = subprocess.run(cmd, capture_output=True, text=True)
     if done.returncode != 0:
         if "No space left on device" in done.stderr:  # the library could not be written: the cache's disk is full
