@@ -79,18 +79,22 @@ def runtime_object(compiler: str, root: Path, scratch: Path) -> Path:
 
 def compile_model(compiler: str, c_path: Path, so_path: Path, root: Path) -> None:
     """Compile the generated `c_path` and link it with the runtime into `so_path` (the cache `root` holds the
-    runtime's object; `c_path`'s folder is the build's scratch)."""
+    runtime's object; `c_path`'s folder is the build's scratch). The model's own object is compiled first, so that
+    builders side by side compile their models while one of them compiles a missing runtime."""
+    model_object = c_path.with_suffix(".o")
+    run_compiler([compiler, *OPTIMISE_FLAGS, "-fPIC", "-c", "-o", str(model_object), str(c_path)],
+                 "the generated model")
     runtime = runtime_object(compiler, root, c_path.parent)
-    cmd = [compiler, *COMPILE_FLAGS, "-o", str(so_path), str(c_path), str(runtime), "-lm"]
+    cmd = [compiler, "-shared", "-o", str(so_path), str(model_object), str(runtime), "-lm"]
     try:
-        run_compiler(cmd, "the generated model")
+        run_compiler(cmd, "the model's library")
     except UsageError:
-        # Perhaps a damaged runtime object: compiled again once and linked again (a fault of the model's own C fails
-        # again, with its first line).
+        # a damaged runtime object: compiled again once and linked again
         with suppress(FileNotFoundError):
             runtime.unlink()
         cmd[-2] = str(runtime_object(compiler, root, c_path.parent))
-        run_compiler(cmd, "the generated model")
+        run_compiler(cmd, "the model's library")
+    model_object.unlink()
 
 
 def run_compiler(cmd: list[str], what: str) -> None:

@@ -30,6 +30,13 @@ MODEL_FUNCTIONS = {
     "eval_tangent": "const double *q, const double *u, const double *a, const double *p, double T, double th, "
                     "double thd, int m, const double *dy, const double *const *dps, double *dG, double *dH",
 }
+# The model functions compiled without optimisation: their long straight-line bodies (eval_tangent's chain rule,
+# eval_jac's derivatives) are most of the compiler's time a model, which every first use of a model waits for, while
+# a replay's time goes to eval_drive, the stiff integrator and the portable math, which stay optimised. The arithmetic
+# is the same at any level: no fused multiply-add is formed (-ffp-contract=off), and nothing is reordered or carried
+# in another precision without -ffast-math.
+UNOPTIMISED = '__attribute__((optimize("O0"))) '
+COMPILED_UNOPTIMISED = frozenset({"eval_mf", "eval_jac", "eval_outputs", "eval_tangent"})
 # The dimensions a model's header defines and the runtime reads from it.
 DIMENSIONS = ("NQ", "NY", "NOUT", "INPUT_OFFSET", "MAX_PIECES", "RACK", "OUT_COLUMN_ANGLE", "OUT_COLUMN_TORQUE",
               "PS_SENSITIVITIES")
@@ -45,9 +52,10 @@ def check_portable(source: str) -> None:
         raise RuntimeError(f"generated C calls {', '.join(bad)} from the C library; route it through portable_math.c")
 
 
-def model_function(name: str, lines: list[str], prefix: str = "") -> str:
+def model_function(name: str, lines: list[str]) -> str:
     """The C definition of the model function `name` (one of MODEL_FUNCTIONS) with the body `lines`."""
     body = "\n".join(lines)
+    prefix = UNOPTIMISED if name in COMPILED_UNOPTIMISED else ""
     return f"{prefix}{LOCAL}void {name}({MODEL_FUNCTIONS[name]})\n{{\n{body}\n}}\n"
 
 

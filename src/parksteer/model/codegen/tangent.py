@@ -14,11 +14,6 @@ from ..symbolic.derive import Derivation, memoised_diff
 from .runtime import model_function
 
 
-# eval_tangent compiled without optimisation: optimised, its some 600 lines of chain rule cost about 1.2 s of the
-# compiler's time a model (half again what the rest costs), paid by every model built, while only a fit that asks for
-# exact Jacobians runs it. The arithmetic is the same (no fused multiply-add at any level: -ffp-contract=off).
-UNOPTIMISED = '__attribute__((optimize("O0"))) '
-
 
 def _directional_block(expressions: list[sp.Expr], directions: dict[sp.Symbol, sp.Symbol], targets: list[str],
                        printer, loop: str) -> list[str]:
@@ -64,7 +59,7 @@ def tangent_function(derivation: Derivation, plain: dict, F_drive, F_full, M, bc
     if drive_hand:  # an assist's drive, written at zero handwheel input, has no sensitivities
         return "#define PS_SENSITIVITIES 0\n" + model_function(
             "eval_tangent", ["    (void)q; (void)u; (void)a; (void)p; (void)T; (void)th; (void)thd; (void)m; "
-                             "(void)dy; (void)dps; (void)dG; (void)dH;"], UNOPTIMISED)
+                             "(void)dy; (void)dps; (void)dG; (void)dH;"])
     space = derivation.space
     n = len(space.coordinates)
     torque = sp.Symbol("T", real=True)
@@ -77,4 +72,4 @@ def tangent_function(derivation: Derivation, plain: dict, F_drive, F_full, M, bc
     loop = ("for (int k = 0; k < m; k++) {\n        const double *dq = dy + k * NY, *du = dq + NQ, *dp = dps[k];"
             "\n        (void)dq; (void)du; (void)dp;")  # the loop's head and the direction's arrays
     lines = _directional_block(residual + list(F_full), directions, targets, printer, loop)
-    return "#define PS_SENSITIVITIES 1\n" + model_function("eval_tangent", lines, UNOPTIMISED)
+    return "#define PS_SENSITIVITIES 1\n" + model_function("eval_tangent", lines)
