@@ -72,7 +72,7 @@ def test_one_runtime_object_serves_every_model_and_a_damaged_one_is_compiled_aga
     first = cache.ensure(resolve_effects(None))
     second = cache.ensure(resolve_effects("+rack_lash"))
     objects = list((cache_dir / compiler.RUNTIME_FOLDER).glob("*.o"))
-    assert [p.name for p in objects] == [f"{compiler.runtime_key(compiler.find_compiler())}.o"]
+    assert [p.name for p in objects] == [f"{compiler.shared_key(compiler.find_compiler(), 'runtime')}.o"]
     assert first["built_now"] and second["built_now"]
     objects[0].write_bytes(b"not an object file")
     third = cache.ensure(resolve_effects("+ackermann"))
@@ -92,3 +92,27 @@ def test_models_built_side_by_side_on_an_empty_cache_compile_the_runtime_once(ca
     assert [b.exitcode for b in builders] == [0, 0, 0]
     assert all(cache.entry_is_sound(cache.entry_path(effects)) for effects in sets)
     assert capfd.readouterr().err.count("compiling the models' runtime") == 1
+
+
+def test_the_shipped_boost_table_is_the_law_as_printed():
+    """boost_table.c, which every model with a boost table links, is the C that generate prints from the law in
+    sympy (assist_common.table_law): a model derived here and one compiled from shipped C call the same law."""
+    from parksteer.model.codegen.generate import table_functions_source
+    from parksteer.model.codegen.runtime import boost_table_source
+
+    assert boost_table_source() == table_functions_source()
+
+
+def test_models_with_a_boost_table_link_one_compiled_law(cache_dir):
+    """Two assisted models built into an empty cache compile the boost table's law once, beside the runtime, and
+    each links it: the law's functions are hidden symbols, so a library without the object would not link (the
+    assisted replays' tests run the law through these libraries against its Python evaluation)."""
+    sets = [resolve_effects("+electric_assist_column"), resolve_effects("+electric_assist_column,+assist_motor_friction")]
+    manifests = [cache.ensure(effects) for effects in sets]
+    compiled = compiler.find_compiler()
+    names = sorted(p.name for p in (cache_dir / compiler.RUNTIME_FOLDER).glob("*.o"))
+    assert names == sorted(f"{compiler.shared_key(compiled, name)}.o" for name in ("runtime", "boost_table"))
+    for manifest in manifests:
+        info = json.loads((cache_dir / manifest["key"] / "model.json").read_text())
+        assert info["shared_objects"] == ["boost_table"] and info["prebuilt"] is True
+        assert load_entry(cache_dir / manifest["key"]) is not None

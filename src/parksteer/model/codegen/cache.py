@@ -46,7 +46,9 @@ SYMBOLIC_DIRS = (MODEL_DIR / "symbolic", MODEL_DIR / "codegen")
 KEYED_FILES = (MODEL_DIR.parent / "names.py",)
 # These modules store and compile entries and generate nothing, so their source is not part of the key (the flags
 # are).
-KEYLESS_SOURCES = (Path(__file__).resolve(), Path(__file__).resolve().with_name("compiler.py"))
+KEYLESS_SOURCES = (Path(__file__).resolve(), Path(__file__).resolve().with_name("compiler.py"),
+                   # printed from the keyed symbolic half and checked against it where a model is derived
+                   Path(__file__).resolve().with_name("boost_table.c"))
 # Built files whose SHA-256 model.json records: an entry is used only if both exist and match.
 BUILT_FILES = ("model.c", "model.so")
 # The package's pre-derived models: the generated C (gzip) and description of the effect sets a first diagnosis of
@@ -189,7 +191,7 @@ def prebuilt_specs() -> dict[str, str | list | dict | None]:
 
 def write_prebuilt(effect_sets: list[tuple[str | list | None, list[Effect]]]) -> list[Path]:
     """Derive each (spec, effects) of `effect_sets` and keep its C and description, with its spec, as the package's
-    pre-derived models, replacing all others; return the files written. The gzip stream carries no time stamp, so
+    pre-derived models, replacing all others (after writing boost_table.c again); return the models' files written. The gzip stream carries no time stamp, so
     the same C gives the same file."""
     import gzip
 
@@ -198,6 +200,11 @@ def write_prebuilt(effect_sets: list[tuple[str | list | None, list[Effect]]]) ->
     if checkout_root() is None:
         raise UsageError("--prebuilt writes into the package's source: run it in a checkout of the repository "
                          "(an editable install), not an installed package")
+    from .generate import table_functions_source
+    from .runtime import BOOST_TABLE_FILE
+
+    with atomic_path(BOOST_TABLE_FILE) as tmp:  # the shared C the assisted models link (runtime.SHARED_OBJECTS)
+        tmp.write_text(table_functions_source(), encoding="utf-8")
     PREBUILT_DIR.mkdir(parents=True, exist_ok=True)
     written = []
     for number, (spec, effects) in enumerate(effect_sets, 1):
@@ -236,7 +243,8 @@ def build_entry(effects: list[Effect], directory: Path, key: str | None = None) 
     t_derive, t_codegen = timings["derive"], timings["codegen"]
     directory.mkdir(parents=True, exist_ok=True)
     (directory / "model.c").write_text(source, encoding="utf-8")
-    compile_model(compiler, directory / "model.c", directory / "model.so", directory.parent)
+    compile_model(compiler, directory / "model.c", directory / "model.so", directory.parent,
+                  tuple(info.get("shared_objects", ())))
     t_compile = time.perf_counter() - start - t_derive - t_codegen
     note(f"compiled with {Path(compiler).name} {COMPILE_FLAGS[0]}: {t_compile:.1f} s")
     info.update({"sha256": {name: _sha256(directory / name) for name in BUILT_FILES}, "sympy_version": _sympy_version(),

@@ -1,10 +1,11 @@
-"""How a model's generated C becomes its shared library: the compiler, its flags, and the runtime every model links.
+"""How a model's generated C becomes its shared library: the compiler, its flags, and the shared objects it links.
 
 The runtime (:mod:`.runtime`: the mass-matrix solves, the outputs, the stiff integrator and its sensitivities) is the
-same text for every model and about a third of what the compiler spent on each; it is compiled once per cache and
-compiler, into ``runtime/<key>.o`` beside the cache's entries, and linked with each model's own file. The object is
-compiled in the building entry's scratch directory, under a lock, and renamed into place whole, so a killed build
-leaves no half of one and builders side by side compile it once.
+same text for every model, and the boost table's law the same for every model with a boost table; each is compiled
+once per cache and compiler, into ``runtime/<key>.o`` beside the cache's entries, and linked with each model's own
+file (:data:`.runtime.SHARED_OBJECTS`). An object is compiled in the building entry's scratch directory, under a
+lock, and renamed into place whole, so a killed build leaves no half of one and builders side by side compile it
+once.
 """
 
 from __future__ import annotations
@@ -22,7 +23,7 @@ from pathlib import Path
 
 from ...errors import UsageError
 from ...progress import note
-from .runtime import runtime_source
+from .runtime import SHARED_OBJECTS
 
 # How the C is compiled; part of the model key. -O1: integrates these models about as fast as -O2 and compiles in
 # less time. -ffp-contract=off: no fused multiply-add, which GCC otherwise forms wherever the target has one
@@ -48,18 +49,20 @@ def _compiler_identity(compiler: str) -> str:
     return f"{os.path.realpath(compiler)}\n{version}\n{platform.machine()}\n"
 
 
-def runtime_key(compiler: str) -> str:
-    """Hash of the runtime's source, the flags and the compiler."""
+def shared_key(compiler: str, name: str = "runtime") -> str:
+    """Hash of the shared object `name`'s source (:data:`.runtime.SHARED_OBJECTS`), the flags and the compiler."""
     digest = hashlib.sha256(_compiler_identity(compiler).encode())
-    digest.update(" ".join(OPTIMISE_FLAGS).encode() + b"\0" + runtime_source().encode())
+    digest.update(" ".join(OPTIMISE_FLAGS).encode() + b"\0" + SHARED_OBJECTS[name][1]().encode())
     return digest.hexdigest()[:20]
 
 
-def runtime_object(compiler: str, root: Path, scratch: Path) -> Path:
-    """The runtime compiled by `compiler` for the cache `root`: root/runtime/<key>.o, compiled in `scratch` and
-    renamed into place if it is not there yet. Builders that need it at once (a first diagnosis builds its models
-    side by side) wait for the one compiling it, under a lock the kernel releases when its holder ends."""
-    final = root / RUNTIME_FOLDER / f"{runtime_key(compiler)}.o"
+def shared_object(compiler: str, name: str, root: Path, scratch: Path) -> Path:
+    """The shared object `name` (:data:`.runtime.SHARED_OBJECTS`) compiled by `compiler` for the cache `root`:
+    root/runtime/<key>.o, compiled in `scratch` and renamed into place if it is not there yet. Builders that need it
+    at once (a first diagnosis builds its models side by side) wait for the one compiling it, under a lock the
+    kernel releases when its holder ends."""
+    what, source_of = SHARED_OBJECTS[name]
+    final = root / RUNTIME_FOLDER / f"{shared_key(compiler, name)}.o"
     if final.is_file():
         return final
     final.parent.mkdir(parents=True, exist_ok=True)
@@ -67,33 +70,36 @@ def runtime_object(compiler: str, root: Path, scratch: Path) -> Path:
         fcntl.flock(lock, fcntl.LOCK_EX)
         if final.is_file():
             return final
-        note(f"compiling the models' runtime, once for this cache and compiler ({final})")
-        source, built = scratch / "runtime.c", scratch / "runtime.o"
-        source.write_text(runtime_source(), encoding="utf-8")
-        run_compiler([compiler, *OPTIMISE_FLAGS, "-fPIC", "-c", "-o", str(built), str(source)],
-                     "the models' runtime")
+        note(f"compiling {what}, once for this cache and compiler ({final})")
+        source, built = scratch / f"{name}.c", scratch / f"{name}.o"
+        source.write_text(source_of(), encoding="utf-8")
+        run_compiler([compiler, *OPTIMISE_FLAGS, "-fPIC", "-c", "-o", str(built), str(source)], what)
         os.replace(built, final)
         source.unlink()
     return final
 
 
-def compile_model(compiler: str, c_path: Path, so_path: Path, root: Path) -> None:
-    """Compile the generated `c_path` and link it with the runtime into `so_path` (the cache `root` holds the
-    runtime's object; `c_path`'s folder is the build's scratch). The model's own object is compiled first, so that
-    builders side by side compile their models while one of them compiles a missing runtime."""
+def compile_model(compiler: str, c_path: Path, so_path: Path, root: Path, shared: tuple[str, ...] = ()) -> None:
+    """Compile the generated `c_path` and link it with the runtime and the `shared` objects it names into `so_path`
+    (the cache `root` holds the shared objects; `c_path`'s folder is the build's scratch). The model's own object is
+    compiled first, so that builders side by side compile their models while one of them compiles a missing shared
+    object."""
     model_object = c_path.with_suffix(".o")
     run_compiler([compiler, *OPTIMISE_FLAGS, "-fPIC", "-c", "-o", str(model_object), str(c_path)],
                  "the generated model")
-    runtime = runtime_object(compiler, root, c_path.parent)
-    cmd = [compiler, "-shared", "-o", str(so_path), str(model_object), str(runtime), "-lm"]
+    names = ("runtime", *shared)
+    objects = [shared_object(compiler, name, root, c_path.parent) for name in names]
     try:
-        run_compiler(cmd, "the model's library")
+        run_compiler([compiler, "-shared", "-o", str(so_path), str(model_object), *map(str, objects), "-lm"],
+                     "the model's library")
     except UsageError:
-        # a damaged runtime object: compiled again once and linked again
-        with suppress(FileNotFoundError):
-            runtime.unlink()
-        cmd[-2] = str(runtime_object(compiler, root, c_path.parent))
-        run_compiler(cmd, "the model's library")
+        # a damaged shared object: each compiled again once and linked again
+        for path in objects:
+            with suppress(FileNotFoundError):
+                path.unlink()
+        objects = [shared_object(compiler, name, root, c_path.parent) for name in names]
+        run_compiler([compiler, "-shared", "-o", str(so_path), str(model_object), *map(str, objects), "-lm"],
+                     "the model's library")
     model_object.unlink()
 
 

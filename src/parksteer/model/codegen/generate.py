@@ -21,7 +21,9 @@ import sympy as sp
 from sympy.printing.c import C99CodePrinter
 
 from ..symbolic.derive import Derivation, Replacer, free_symbols, memoised_diff
-from .runtime import PORTABLE_MATH, check_portable, dimension_exports, model_function
+from ...errors import UsageError
+from .runtime import (BOOST_TABLE_FILE, LOCAL, PORTABLE_MATH, boost_table_source, check_portable, dimension_exports,
+                      model_function)
 from .tangent import tangent_function
 
 # The handwheel input is a piecewise-quadratic table in p: count, then (t0, angle0, rate0, accel) per piece.
@@ -69,7 +71,7 @@ class _Printer(C99CodePrinter):
         return self._table_call(TABLE_SLOPE, expr)
 
     def _table_call(self, function: str, expr) -> str:
-        """A boost table's law as a call of its printed function (:func:`_table_functions`): the table's scalars
+        """A boost table's law as a call of its printed function (:func:`table_functions_source`): the table's scalars
         are consecutive in p (an effect's quantities in the order of boost_table.table_keys), so the call passes
         their start."""
         torque, speed, *table = expr.args
@@ -81,26 +83,43 @@ class _Printer(C99CodePrinter):
 
 
 # The boost table's law and its torque derivative as C functions of (torque, speed, table), printed once from
-# parksteer.model.symbolic.effects.assist_common.table_law (the formula the replay evaluates on numbers).
+# parksteer.model.symbolic.effects.assist_common.table_law (the formula the replay evaluates on numbers). The text is
+# the same for every model with a boost table, so it is a translation unit of its own, boost_table.c, compiled once
+# per cache like the runtime (runtime.SHARED_OBJECTS); a model declares the two functions and calls them.
 TABLE_LAW = "ps_boost_law"
 TABLE_SLOPE = "ps_boost_slope"
+TABLE_ARGUMENTS = "double x, double v, const double *t"
 
 
-def _table_functions(printer: _Printer) -> str:
-    """The C of the boost table's law and slope: table_law and table_slope (its derivative in the torque) on symbols
-    x (torque), v (speed) and t[j] (the table's scalars in boost_table.table_keys order), each after
-    common-subexpression elimination."""
+def table_functions_source() -> str:
+    """boost_table.c: the C of the boost table's law and slope, table_law and table_slope (its derivative in the
+    torque) on symbols x (torque), v (speed) and t[j] (the table's scalars in boost_table.table_keys order), each
+    after common-subexpression elimination. `parksteer derive --prebuilt` writes it beside the runtime's C, and a
+    model derived here checks it is what the shipped file holds (:func:`generate`)."""
     from ...boost_table import table_keys
     from ..symbolic.effects.assist_common import table_law, table_points, table_slope
 
+    printer = _Printer()
     x, v = sp.Symbol("x", real=True), sp.Symbol("v", real=True)
     table = {key: sp.Symbol(f"t[{j}]", real=True) for j, key in enumerate(table_keys())}
     points = table_points(table.__getitem__, v)
-    out = []
+    out = ["/* The boost table's law and slope (parksteer.model.codegen.generate.table_functions_source, from the law of\n"
+           "   parksteer.model.symbolic.effects.assist_common); do not edit: `parksteer derive --prebuilt` writes it. */\n"]
     for name, expr in ((TABLE_LAW, table_law(x, None, v, points)), (TABLE_SLOPE, table_slope(x, None, v, points))):
         body = ["    double value;", *_c_block([("value", expr)], printer), "    return value;"]
-        out.append(f"static double {name}(double x, double v, const double *t)\n{{\n" + "\n".join(body) + "\n}\n")
-    return "\n".join(out)
+        out.append(f"{LOCAL}double {name}({TABLE_ARGUMENTS})\n{{\n" + "\n".join(body) + "\n}\n")
+    source = "\n".join(out)
+    check_portable(source)
+    return source
+
+
+def _table_declarations() -> str:
+    """The boost table's functions as a model declares them (boost_table.c defines them), once the shipped file is
+    found to be what this package prints."""
+    if table_functions_source() != boost_table_source():
+        raise UsageError(f"{BOOST_TABLE_FILE} is not the boost table's law as this package prints it: write it again "
+                         "with `parksteer derive --prebuilt` in the checkout")
+    return "".join(f"{LOCAL}double {name}({TABLE_ARGUMENTS});\n" for name in (TABLE_LAW, TABLE_SLOPE))
 
 
 def _c_block(assignments: list[tuple[str, sp.Expr]], printer: _Printer) -> list[str]:
@@ -159,6 +178,56 @@ def _derivative_block(expressions: list[sp.Expr], variables: list[sp.Symbol], ta
     return lines
 
 
+def _outputs(derivation: Derivation, c: Replacer, M, a: list, rack: int) -> tuple[list, list]:
+    """The outputs eval_outputs writes, (name, expression in C symbols), and those of them the effects declare."""
+    space = derivation.space
+    n = len(space.coordinates)
+    dcol = c(space.kinematics.column_angle_per_rack)
+    outputs: list[tuple[str, sp.Expr]] = [
+        ("column_angle_rad", c(space.kinematics.column_angle)),
+        ("column_angle_per_rack_rad_per_m", dcol),
+        ("column_torque_Nm", c(space.kinematics.column_torque)),
+        ("load_left_N", c(space.kinematics.wheel_load["left"])),
+        ("load_right_N", c(space.kinematics.wheel_load["right"])),
+        ("steer_left_rad", c(space.kinematics.steer_angle["left"])),
+        ("steer_right_rad", c(space.kinematics.steer_angle["right"])),
+        ("ring_yaw_rate_left_rad_s", c(space.kinematics.ring_frame["left"].ang_vel_in(space.N).dot(space.N.z))),
+        ("ring_yaw_rate_right_rad_s", c(space.kinematics.ring_frame["right"].ang_vel_in(space.N).dot(space.N.z))),
+    ]
+    for name in derivation.effects:
+        outputs.append((f"contrib_{name}_Nm", -c(derivation.generalized_forces[name][rack]) / dcol))
+    inertia_row = sum(M[rack, j] * a[j] for j in range(n))
+    outputs.append((
+        "contrib_inertia_Nm",
+        (inertia_row - c(derivation.forcing_inertia[rack]) - c(derivation.generalized_forces["core"][rack])) / dcol,
+    ))
+    outputs += [
+        ("kinetic_energy_J", c(space.kinetic_energy())),
+        ("potential_energy_J", c(derivation.potential_energy)),
+        ("column_energy_J", c(space.column_potential_energy())),
+    ]
+    effect_outputs = [(name, c(expr)) for effect in space.effects for name, expr in effect.outputs(space)]
+    taken = {name for name, _ in outputs}
+    for name, _ in effect_outputs:
+        if name in taken:
+            raise ValueError(f"output {name} is given twice (an effect's outputs must have names of their own)")
+        taken.add(name)
+    outputs += effect_outputs
+    return outputs, effect_outputs
+
+
+def _header(info: dict, n: int) -> str:
+    """The generated file's head: the portable math and the model's dimensions, from its description `info`."""
+    return (
+        "/* Generated by parksteer.model.codegen.generate from the sympy derivation; do not edit. */\n"
+        "#include <math.h>\n#include <string.h>\n\n" + PORTABLE_MATH + "\n"
+        f"#define NQ {n}\n#define NY {2 * n}\n#define NOUT {len(info['outputs'])}\n"
+        f"#define INPUT_OFFSET {info['input_offset']}\n#define MAX_PIECES {MAX_INPUT_PIECES}\n"
+        f"#define RACK {info['rack_index']}\n#define OUT_COLUMN_ANGLE {info['outputs'].index('column_angle_rad')}\n"
+        f"#define OUT_COLUMN_TORQUE {info['outputs'].index('column_torque_Nm')}\n\n"
+    )
+
+
 def generate(derivation: Derivation) -> tuple[str, dict]:
     """C source of the model and its description (state names, parameter order, output names)."""
     timings = {}
@@ -200,38 +269,8 @@ def generate(derivation: Derivation) -> tuple[str, dict]:
     drive += [(f"F[{i}]", F_nocol[i]) for i in range(n)] + [(f"b[{i}]", bcol[i]) for i in range(n)]
     timings["expressions_s"] = time.perf_counter() - start
 
-    dcol = c(space.kinematics.column_angle_per_rack)
     rack = space.coordinates.index(next(cc for cc in space.coordinates if cc.name == "rack"))
-    outputs: list[tuple[str, sp.Expr]] = [
-        ("column_angle_rad", c(space.kinematics.column_angle)),
-        ("column_angle_per_rack_rad_per_m", dcol),
-        ("column_torque_Nm", c(space.kinematics.column_torque)),
-        ("load_left_N", c(space.kinematics.wheel_load["left"])),
-        ("load_right_N", c(space.kinematics.wheel_load["right"])),
-        ("steer_left_rad", c(space.kinematics.steer_angle["left"])),
-        ("steer_right_rad", c(space.kinematics.steer_angle["right"])),
-        ("ring_yaw_rate_left_rad_s", c(space.kinematics.ring_frame["left"].ang_vel_in(space.N).dot(space.N.z))),
-        ("ring_yaw_rate_right_rad_s", c(space.kinematics.ring_frame["right"].ang_vel_in(space.N).dot(space.N.z))),
-    ]
-    for name in derivation.effects:
-        outputs.append((f"contrib_{name}_Nm", -c(derivation.generalized_forces[name][rack]) / dcol))
-    inertia_row = sum(M[rack, j] * a[j] for j in range(n))
-    outputs.append((
-        "contrib_inertia_Nm",
-        (inertia_row - c(derivation.forcing_inertia[rack]) - c(derivation.generalized_forces["core"][rack])) / dcol,
-    ))
-    outputs += [
-        ("kinetic_energy_J", c(space.kinetic_energy())),
-        ("potential_energy_J", c(derivation.potential_energy)),
-        ("column_energy_J", c(space.column_potential_energy())),
-    ]
-    effect_outputs = [(name, c(expr)) for effect in space.effects for name, expr in effect.outputs(space)]
-    taken = {name for name, _ in outputs}
-    for name, _ in effect_outputs:
-        if name in taken:
-            raise ValueError(f"output {name} is given twice (an effect's outputs must have names of their own)")
-        taken.add(name)
-    outputs += effect_outputs
+    outputs, effect_outputs = _outputs(derivation, c, M, a, rack)
     out_assign = [(f"out[{i}]", e) for i, (_, e) in enumerate(outputs)]
 
     start = time.perf_counter()
@@ -242,8 +281,9 @@ def generate(derivation: Derivation) -> tuple[str, dict]:
         model_function("eval_outputs", _c_block(out_assign, printer)),
     ]
     parts.append(tangent_function(derivation, plain, F_nocol, F, M, bcol, a, printer, drive_hand))  # tangent.py
-    if any(f"{TABLE_LAW}(" in part or f"{TABLE_SLOPE}(" in part for part in parts):
-        parts.insert(0, _table_functions(printer))
+    boost_table = any(f"{TABLE_LAW}(" in part or f"{TABLE_SLOPE}(" in part for part in parts)
+    if boost_table:
+        parts.insert(0, _table_declarations())
     timings["cse_derivatives_print_s"] = time.perf_counter() - start
     n_params = len(derivation.parameter_names)
     info = {
@@ -260,14 +300,8 @@ def generate(derivation: Derivation) -> tuple[str, dict]:
         "rack_drive": not drive_hand,
         "rack_index": rack,
     }
-    header = (
-        "/* Generated by parksteer.model.codegen.generate from the sympy derivation; do not edit. */\n"
-        "#include <math.h>\n#include <string.h>\n\n" + PORTABLE_MATH + "\n"
-        f"#define NQ {n}\n#define NY {2 * n}\n#define NOUT {len(outputs)}\n"
-        f"#define INPUT_OFFSET {n_params}\n#define MAX_PIECES {MAX_INPUT_PIECES}\n"
-        f"#define RACK {rack}\n#define OUT_COLUMN_ANGLE {info['outputs'].index('column_angle_rad')}\n"
-        f"#define OUT_COLUMN_TORQUE {info['outputs'].index('column_torque_Nm')}\n\n"
-    )
-    source = header + "\n".join(parts) + dimension_exports()
+    if boost_table:
+        info["shared_objects"] = ["boost_table"]
+    source = _header(info, n) + "\n".join(parts) + dimension_exports()
     check_portable(source)
     return source, {**info, "codegen_timings_s": timings}

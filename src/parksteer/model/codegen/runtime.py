@@ -1,8 +1,8 @@
 """The fixed runtime of the generated models, as one translation unit of its own: ``runtime.c`` (handwheel input,
 mass-matrix solves, right-hand side, Jacobian, outputs, the prescribed-rack drive), ``sensitivities.c`` (the forward
 sensitivities) and ``integrator.c`` (the stiff integrator), after a prelude that reads the model's dimensions from the
-model at run time. It is the same text for every model, so it is compiled once (``compiler.runtime_object``) and
-linked with each model's generated functions, which :mod:`.generate` writes with :func:`dimension_exports` after
+model at run time. It is the same text for every model, so it is compiled once (``compiler.shared_object``) and
+linked with each model's generated functions (as is ``boost_table.c`` with each model that has a boost table), which :mod:`.generate` writes with :func:`dimension_exports` after
 them. The arithmetic is the same as in one translation unit: no operation depends on whether a dimension is known to
 the compiler, and no fused multiply-add is formed at any level (``-ffp-contract=off``). No sympy here: a pre-derived
 model compiles without it."""
@@ -76,3 +76,18 @@ def runtime_source() -> str:
     source = "\n".join(prelude) + "\n" + "".join("\n" + (HERE / f).read_text(encoding="utf-8") for f in RUNTIME_FILES)
     check_portable(source)
     return source
+
+
+# boost_table.c: the boost table's law and slope, the same text for every model with a boost table (an assist's), so
+# compiled once like the runtime; generate.table_functions_source prints it from the law in sympy.
+BOOST_TABLE_FILE = HERE / "boost_table.c"
+
+
+def boost_table_source() -> str:
+    return BOOST_TABLE_FILE.read_text(encoding="utf-8")
+
+
+# The C compiled once per cache and compiler and linked with the models that name it: what it is, and its text.
+# Every model links the runtime; a model's description lists the others it needs ("shared_objects").
+SHARED_OBJECTS = {"runtime": ("the models' runtime", runtime_source),
+                  "boost_table": ("the boost table's law", boost_table_source)}
