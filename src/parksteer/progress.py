@@ -31,9 +31,11 @@ def quiet_while(quiet: bool) -> Iterator[None]:
 
 
 def note(message: str) -> None:
-    """One progress line on the current stderr (looked up at each call: a rule redirects it to its log)."""
+    """One progress line on the current stderr (looked up at each call: a rule redirects it to its log), written
+    whole in one call, so that processes sharing the stream (a diagnosis's builders and workers) never split a line."""
     if not QUIET.get():
-        print(message, file=sys.stderr, flush=True)
+        sys.stderr.write(message + "\n")
+        sys.stderr.flush()
 
 
 @contextmanager
