@@ -31,12 +31,13 @@ MODEL_FUNCTIONS = {
                     "double thd, int m, const double *dy, const double *const *dps, double *dG, double *dH",
 }
 # The model functions compiled without optimisation: their long straight-line bodies (eval_tangent's chain rule,
-# eval_jac's derivatives) are most of the compiler's time a model, which every first use of a model waits for, while
-# a replay's time goes to eval_drive, the stiff integrator and the portable math, which stay optimised. The arithmetic
-# is the same at any level: no fused multiply-add is formed (-ffp-contract=off), and nothing is reordered or carried
-# in another precision without -ffast-math.
+# eval_jac's derivatives) are most of the compiler's time a model, which every first use of a model waits for, and
+# little of a replay's, which goes to eval_drive, eval_mf, eval_outputs, the stiff integrator and the portable math
+# (optimised: eval_mf or eval_outputs unoptimised would cost a benchmark job 2-3 % each for 0.03-0.07 s of compile).
+# The arithmetic is the same at any level: no fused multiply-add is formed (-ffp-contract=off), and nothing is
+# reordered or carried in another precision without -ffast-math.
 UNOPTIMISED = '__attribute__((optimize("O0"))) '
-COMPILED_UNOPTIMISED = frozenset({"eval_mf", "eval_jac", "eval_outputs", "eval_tangent"})
+COMPILED_UNOPTIMISED = frozenset({"eval_jac", "eval_tangent"})
 # The dimensions a model's header defines and the runtime reads from it.
 DIMENSIONS = ("NQ", "NY", "NOUT", "INPUT_OFFSET", "MAX_PIECES", "RACK", "OUT_COLUMN_ANGLE", "OUT_COLUMN_TORQUE",
               "PS_SENSITIVITIES")
