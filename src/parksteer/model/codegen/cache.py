@@ -191,8 +191,8 @@ def prebuilt_specs() -> dict[str, str | list | dict | None]:
 
 def write_prebuilt(effect_sets: list[tuple[str | list | None, list[Effect]]]) -> list[Path]:
     """Derive each (spec, effects) of `effect_sets` and keep its C and description, with its spec, as the package's
-    pre-derived models, replacing all others (after writing boost_table.c again); return the models' files written. The gzip stream carries no time stamp, so
-    the same C gives the same file."""
+    pre-derived models, replacing all others (after writing boost_table.c again); return the models' files written.
+    The gzip stream carries no time stamp, so the same C gives the same file."""
     import gzip
 
     from ...tables import atomic_path

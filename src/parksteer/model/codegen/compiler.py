@@ -49,7 +49,7 @@ def _compiler_identity(compiler: str) -> str:
     return f"{os.path.realpath(compiler)}\n{version}\n{platform.machine()}\n"
 
 
-def shared_key(compiler: str, name: str = "runtime") -> str:
+def shared_key(compiler: str, name: str) -> str:
     """Hash of the shared object `name`'s source (:data:`.runtime.SHARED_OBJECTS`), the flags and the compiler."""
     digest = hashlib.sha256(_compiler_identity(compiler).encode())
     digest.update(" ".join(OPTIMISE_FLAGS).encode() + b"\0" + SHARED_OBJECTS[name][1]().encode())
@@ -73,7 +73,7 @@ def shared_object(compiler: str, name: str, root: Path, scratch: Path) -> Path:
         note(f"compiling {what}, once for this cache and compiler ({final})")
         source, built = scratch / f"{name}.c", scratch / f"{name}.o"
         source.write_text(source_of(), encoding="utf-8")
-        run_compiler([compiler, *OPTIMISE_FLAGS, "-fPIC", "-c", "-o", str(built), str(source)], what)
+        compile_object(compiler, source, built, what)
         os.replace(built, final)
         source.unlink()
     return final
@@ -85,22 +85,27 @@ def compile_model(compiler: str, c_path: Path, so_path: Path, root: Path, shared
     compiled first, so that builders side by side compile their models while one of them compiles a missing shared
     object."""
     model_object = c_path.with_suffix(".o")
-    run_compiler([compiler, *OPTIMISE_FLAGS, "-fPIC", "-c", "-o", str(model_object), str(c_path)],
-                 "the generated model")
+    compile_object(compiler, c_path, model_object, "the generated model")
     names = ("runtime", *shared)
-    objects = [shared_object(compiler, name, root, c_path.parent) for name in names]
-    try:
-        run_compiler([compiler, "-shared", "-o", str(so_path), str(model_object), *map(str, objects), "-lm"],
-                     "the model's library")
-    except UsageError:
-        # a damaged shared object: each compiled again once and linked again
-        for path in objects:
-            with suppress(FileNotFoundError):
-                path.unlink()
+    for attempt in (1, 2):
         objects = [shared_object(compiler, name, root, c_path.parent) for name in names]
-        run_compiler([compiler, "-shared", "-o", str(so_path), str(model_object), *map(str, objects), "-lm"],
-                     "the model's library")
+        try:
+            run_compiler([compiler, "-shared", "-o", str(so_path), str(model_object), *map(str, objects), "-lm"],
+                         "the model's library")
+            break
+        except UsageError:
+            if attempt == 2:
+                raise
+            # a damaged shared object: each compiled again once and linked again
+            for path in objects:
+                with suppress(FileNotFoundError):
+                    path.unlink()
     model_object.unlink()
+
+
+def compile_object(compiler: str, source: Path, built: Path, what: str) -> None:
+    """Compile the C file `source` (`what` it is, for an error) into the position-independent object `built`."""
+    run_compiler([compiler, *OPTIMISE_FLAGS, "-fPIC", "-c", "-o", str(built), str(source)], what)
 
 
 def run_compiler(cmd: list[str], what: str) -> None:
