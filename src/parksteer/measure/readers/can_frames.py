@@ -88,7 +88,8 @@ def read_frames(raw: bytes, where: Path, fmt: str):
     finally:
         reader = None
     try:
-        gc.collect()  # the exception and its traceback are gone: a half-built reader is collected now, quietly
+        if problem is not None:  # the exception and its traceback are gone: a half-built reader is collected now,
+            gc.collect()         # quietly (a whole collection: a test process's heap makes it half a second)
     finally:
         quiet[0].disabled, sys.unraisablehook = False, quiet[1]
     if problem is not None:
