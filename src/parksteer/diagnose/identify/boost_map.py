@@ -14,7 +14,7 @@ import numpy as np
 
 from ... import portable as pm
 from ...boost_table import entries
-from ...model.symbolic.effects.assist_common import table_law
+from ...model.numeric.boost_numeric import table_law_numeric, table_points_numeric
 from ..fitting import Z95
 from ..problem import FileData
 from ...names import TORQUE
@@ -50,11 +50,13 @@ def _t95(dof: int) -> float:
 
 
 def _map_law(torques: list[float], values: list[float]):
-    """The boost table's law (:func:`parksteer.model.symbolic.effects.assist_common.table_law`) of one row."""
+    """The boost table's law (:func:`parksteer.model.symbolic.effects.assist_common.table_law`) of one row, on
+    numbers (:mod:`parksteer.model.numeric.boost_numeric`: the same operations, its points read once)."""
     scalars = entries([float(t) for t in torques], None, [[float(a) for a in values]])
+    points = table_points_numeric(scalars.__getitem__, 0.0)
 
     def law(x):
-        return table_law(np.asarray(x, dtype=float), scalars.__getitem__, 0.0)
+        return table_law_numeric(np.asarray(x, dtype=float), points)
 
     return law
 
