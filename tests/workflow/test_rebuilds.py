@@ -72,8 +72,18 @@ def up_to_date_copy(repository_copy, snakemake) -> Path:
     """The copy, every output marked up to date (each newer than its inputs, in DAG order) and every job's metadata
     recorded as a run records it (its parameters, the code digest among them: --forceall makes --touch pass over
     every job); each test restores what it edits (fixture `edit`)."""
+    from snakemake.executors.touch import Executor as TouchExecutor
+
     handlers = [signal.getsignal(number) for number in STOPPING_SIGNALS]
-    snakemake(repository_copy, "--touch", "--forceall", "--cores", "1", "all")
+    # The touch executor waits SLEEPING_TIME (0.1 s) before each job's touch, so that its outputs come out newer
+    # than its inputs: 9 s over the DAG's jobs. 20 ms is still two ticks of the coarsest kernel clock a file's
+    # time is taken from (HZ = 100), and the dry run below shows every output up to date.
+    sleeping = TouchExecutor.SLEEPING_TIME
+    TouchExecutor.SLEEPING_TIME = 0.02
+    try:
+        snakemake(repository_copy, "--touch", "--forceall", "--cores", "1", "all")
+    finally:
+        TouchExecutor.SLEEPING_TIME = sleeping
     # Snakemake's scheduler sets a SIGTERM handler that does not end the process; the in-process run (conftest)
     # puts the test process's own back, or a pool forked later in this worker could never be terminated
     assert [signal.getsignal(number) for number in STOPPING_SIGNALS] == handlers
