@@ -58,11 +58,11 @@ PACKAGE_DIR = CHECKOUT / "src" / "parksteer"
 
 def code(script):
     """The digest of the package code the rule script workflow/scripts/<script>.py runs (or the notebook whose
-    path is `script`)."""
+    path is `script`), as an input function: taken for the jobs a run plans, not for every rule at parse time."""
     from parksteer.code_inputs import code_digest
 
     path = script if script.endswith(".py") else f"workflow/scripts/{script}.py"
-    return code_digest(CHECKOUT, path)
+    return lambda wildcards: code_digest(CHECKOUT, path)
 
 
 def plan(function, *args):
