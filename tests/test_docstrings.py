@@ -15,6 +15,8 @@ import re
 import tokenize
 from pathlib import Path
 
+import syntax_trees
+
 REPO_ROOT = Path(__file__).resolve().parents[1]
 SRC = REPO_ROOT / "src"
 PACKAGE = SRC / "parksteer"
@@ -55,7 +57,7 @@ def docstring_words(source: str) -> dict[str, int]:
             else:
                 visit(child, name)
 
-    visit(ast.parse(source), "")
+    visit(syntax_trees.tree(source), "")
     return words
 
 
@@ -75,7 +77,7 @@ def counts() -> dict[str, int]:
 
 def prose(source: str) -> list[str]:
     """The docstrings and the comments of a module, each with its whitespace made single spaces."""
-    texts = [node.body[0].value.value for node in ast.walk(ast.parse(source))
+    texts = [node.body[0].value.value for node in syntax_trees.nodes(source)
              if isinstance(node, (ast.Module, ast.ClassDef, ast.FunctionDef, ast.AsyncFunctionDef))
              and ast.get_docstring(node, clean=False) is not None]
     texts += [tok.string for tok in tokenize.generate_tokens(io.StringIO(source).readline)

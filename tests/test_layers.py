@@ -16,6 +16,8 @@ from pathlib import Path
 
 import pytest
 
+import syntax_trees
+
 REPO_ROOT = Path(__file__).resolve().parents[1]
 SRC = REPO_ROOT / "src"
 
@@ -44,7 +46,7 @@ def import_graph(src: Path, package: str = "parksteer") -> dict[str, set[str]]:
 
     for importer, path in modules.items():
         is_package = path.name == "__init__.py"
-        for node in ast.walk(ast.parse(path.read_text(), str(path))):
+        for node in syntax_trees.nodes(path.read_text()):
             targets: list[str] = []
             if isinstance(node, ast.Import):
                 targets = [alias.name for alias in node.names]

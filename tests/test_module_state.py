@@ -22,6 +22,8 @@ from pathlib import Path
 
 import pytest
 
+import syntax_trees
+
 PACKAGE = Path(__file__).resolve().parents[1] / "src" / "parksteer"
 
 # (module path under src/parksteer, name) -> why the module keeps that state.
@@ -168,22 +170,23 @@ def findings() -> list[tuple[str, int, str, str]]:
     out = []
     for path in modules():
         where = path.relative_to(PACKAGE).as_posix()
-        tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
-        for node in ast.walk(tree):
+        source = path.read_text(encoding="utf-8")
+        module = syntax_trees.tree(source)
+        for node in syntax_trees.nodes(source):
             if isinstance(node, ast.Global):
                 out.extend((where, node.lineno, name, "global statement") for name in node.names)
-        module_level = _module_names(tree)
-        for function in (n for n in ast.walk(tree) if isinstance(n, (ast.FunctionDef, ast.AsyncFunctionDef,
-                                                                        ast.Lambda))):
+        module_level = _module_names(module)
+        functions = (ast.FunctionDef, ast.AsyncFunctionDef, ast.Lambda)
+        for function in (n for n in syntax_trees.nodes(source) if isinstance(n, functions)):
             out.extend((where, line, name, what) for line, name, what in _writes_in(function, module_level))
-        stateful = _self_writing_classes(tree)
-        for node in tree.body:
+        stateful = _self_writing_classes(module)
+        for node in module.body:
             if isinstance(node, ast.Assign) and isinstance(node.value, ast.Call) \
                     and getattr(node.value.func, "id", None) in stateful:
                 for target in node.targets:
                     out.append((where, node.lineno, ast.unparse(target),
                                 f"an instance of {node.value.func.id}, whose methods write its attributes"))
-        for function in _cached_functions(tree):
+        for function in _cached_functions(module):
             mutable = [n for n in _annotation_names(function.returns) if n not in IMMUTABLE_TYPES]
             if mutable:
                 out.append((where, function.lineno, function.name,

@@ -20,7 +20,10 @@ from importlib import metadata
 from pathlib import Path
 
 import pytest
+
 from packaging.requirements import Requirement
+
+import syntax_trees
 
 REPO_ROOT = Path(__file__).resolve().parents[1]
 PIPELINE_LOCK = REPO_ROOT / "requirements" / "pipeline.lock"
@@ -50,16 +53,15 @@ def lock_pins(path: Path) -> dict[str, str]:
 def imports_in(source: str, where: str) -> dict[str, list[tuple[str, int, bool]]]:
     """Top-level module name -> [(file, line, guarded)] for every absolute import in `source`, in functions too.
     `guarded` is true where the import sits in a `try` whose handlers catch ImportError."""
-    tree = ast.parse(source, where)
     guarded_lines: set[int] = set()
-    for node in ast.walk(tree):
+    for node in syntax_trees.nodes(source):
         if isinstance(node, ast.Try) and any(
             handler.type is not None and "ImportError" in ast.unparse(handler.type) for handler in node.handlers
         ):
             for inner in node.body:
                 guarded_lines.update(range(inner.lineno, (inner.end_lineno or inner.lineno) + 1))
     found: dict[str, list[tuple[str, int, bool]]] = {}
-    for node in ast.walk(tree):
+    for node in syntax_trees.nodes(source):
         if isinstance(node, ast.Import):
             names = [alias.name for alias in node.names]
         elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:

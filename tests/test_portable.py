@@ -25,6 +25,8 @@ import mpmath
 import numpy as np
 import pytest
 
+import syntax_trees
+
 from parksteer import portable as pm
 from parksteer.measure.bspline import DesignMatrix
 from parksteer.model.codegen import generate
@@ -409,7 +411,7 @@ def test_no_module_outside_portable_calls_blas_or_lapack():
     for path in sorted(root.rglob("*.py")):
         if "portable" in path.relative_to(root).parts:
             continue
-        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        for node in syntax_trees.nodes(path.read_text(encoding="utf-8")):
             if isinstance(node, ast.BinOp) and isinstance(node.op, ast.MatMult):
                 found.append(f"{path.relative_to(root)}:{node.lineno}: @")
             elif (isinstance(node, ast.Attribute) and isinstance(node.value, ast.Attribute)

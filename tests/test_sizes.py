@@ -11,6 +11,8 @@ from __future__ import annotations
 import ast
 from pathlib import Path
 
+import syntax_trees
+
 REPO_ROOT = Path(__file__).resolve().parents[1]
 SRC = REPO_ROOT / "src"
 MODULE_LINES = 400
@@ -53,7 +55,7 @@ def function_lines(path: Path) -> dict[str, int]:
             else:
                 visit(child, prefix)
 
-    visit(ast.parse(path.read_text(encoding="utf-8"), str(path)), "")
+    visit(syntax_trees.tree(path.read_text(encoding="utf-8")), "")
     return sizes
 
 

@@ -9,6 +9,8 @@ from pathlib import Path
 
 import pytest
 
+import syntax_trees
+
 from parksteer.code_inputs import code_digest, script_files
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -85,7 +87,7 @@ def test_imports_are_found_wherever_a_statement_can_hold_them():
     files = [*(ROOT / "src/parksteer").rglob("*.py"), *(ROOT / p for p in _scripts(ROOT))]
     for path in files:
         every = []
-        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        for node in syntax_trees.nodes(path.read_text(encoding="utf-8")):
             if isinstance(node, ast.Import):
                 every += [alias.name for alias in node.names]
             elif isinstance(node, ast.ImportFrom):

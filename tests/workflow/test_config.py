@@ -10,6 +10,8 @@ import yaml
 from snakemake.exceptions import WorkflowError
 from snakemake.utils import validate
 
+import syntax_trees
+
 from parksteer.errors import UsageError
 from parksteer.figures.model import FigureDesign
 
@@ -116,7 +118,7 @@ def test_the_base_perturbation_has_one_definition(config, schema, repo_root):
         for path in sorted((repo_root / folder).rglob("*")):
             if path.suffix == ".py":
                 found = any(isinstance(n, ast.Dict) and {getattr(k, "value", None) for k in n.keys} == keys
-                            for n in ast.walk(ast.parse(path.read_text(encoding="utf-8"))))
+                            for n in syntax_trees.nodes(path.read_text(encoding="utf-8")))
             elif path.suffix == ".yaml":
                 found = any(set(m) == keys for m in mappings(yaml.safe_load(path.read_text(encoding="utf-8"))))
             elif path.suffix == ".smk":
