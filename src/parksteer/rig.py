@@ -82,8 +82,9 @@ def disc_distance_integral_m3(radius_m, offset_m):
     Both give 32 R^3 / 9 at e = R and 2 pi R^3 / 3 at e = 0. For R/e < 0.02 the series
     pi R^2 e (1 + k^2/8 + k^4/192 + k^6/1024) replaces the second form.
     """
-    from scipy.special import ellipe, ellipk  # here: the many modules that import this one for its tables need
-    # no elliptic integral, and scipy.special takes 0.15 s to import
+    # Imported here: the many modules that import this one for its tables take no elliptic integral, and
+    # scipy.special takes 0.15 s to import.
+    from scipy.special import ellipe, ellipk
 
     radius_m, offset_m = np.broadcast_arrays(
         np.asarray(radius_m, dtype=float), np.abs(np.asarray(offset_m, dtype=float))

@@ -88,8 +88,10 @@ def read_frames(raw: bytes, where: Path, fmt: str):
     finally:
         reader = None
     try:
-        if problem is not None:  # the exception and its traceback are gone: a half-built reader is collected now,
-            gc.collect()         # quietly (a whole collection: a test process's heap makes it half a second)
+        # A reader that failed half-built, its exception and traceback gone, is collected now, quietly; only then,
+        # since a whole collection takes half a second in a process with a large heap.
+        if problem is not None:
+            gc.collect()
     finally:
         quiet[0].disabled, sys.unraisablehook = False, quiet[1]
     if problem is not None:
