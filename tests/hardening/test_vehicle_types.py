@@ -12,7 +12,6 @@ import pytest
 import parksteer.model  # noqa: F401 (an effect's own quantities in a vehicle file are known once the model is)
 from parksteer.errors import UsageError
 from parksteer.model.numeric.assist import check_assist
-from parksteer.parameters import load_parameters
 from parksteer.vehicle import vehicle_from_text
 
 from .corpus import REPO
@@ -21,8 +20,6 @@ CARS = sorted((REPO / "data" / "vehicles").glob("*.toml"))
 ENTRY = re.compile(r"^(\w+) = \{")
 WRONG_VALUES = ("true", '"0.5"', "{ a = 1 }", "[]")
 WRONG_TEXT = ("1", "true", '["x"]')
-# The base file, read once: every variant is a vehicle file over it, and its parse would be most of each check's time.
-BASE = load_parameters()
 
 
 def _variants(text: str):
@@ -41,16 +38,17 @@ def _variants(text: str):
 
 
 @pytest.mark.parametrize("car", CARS, ids=[c.stem for c in CARS])
-def test_every_entry_of_a_wrong_type_is_refused_naming_its_key(car):
+def test_every_entry_of_a_wrong_type_is_refused_naming_its_key(car, params):
     """Each shipped car loads; each of its entries with a value, unit or source of the wrong type is refused with
-    a one-line error naming the file and the entry's key."""
+    a one-line error naming the file and the entry's key. Each variant is read over the base file loaded once (the
+    session's `params`), whose parse would otherwise be most of each check's time."""
     text = car.read_text(encoding="utf-8")
-    check_assist(vehicle_from_text(text, car, BASE))
+    check_assist(vehicle_from_text(text, car, params))
     count = 0
     for key, changed in _variants(text):
         count += 1
         with pytest.raises(UsageError) as refused:
-            check_assist(vehicle_from_text(changed, car, BASE))
+            check_assist(vehicle_from_text(changed, car, params))
         message = str(refused.value)
         assert "\n" not in message and message.startswith(f"{car}: ") and key in message, (key, message)
     assert count > 300
