@@ -59,6 +59,7 @@ def test_zero_gain_assist_is_the_manual_steering(params, manual_series):
     assert np.array_equal(assisted.columns["torsion_bar_torque_Nm"], torque)
 
 
+@pytest.mark.slow  # builds a model of its own: started early, so that the workers end together
 @pytest.mark.parametrize("name", ELECTRIC)
 def test_linear_boost_divides_the_driver_torque_by_one_plus_gain(params, name):
     """Quasi-statically the gear carries the road load as torsion-bar torque plus assist, T_s (1 + G) = T_road,
@@ -161,6 +162,7 @@ def test_closed_valve_is_the_manual_steering(params):
     assert np.max(np.abs(assisted.columns["handwheel_torque_Nm"] - reference)) < 1e-4 * np.max(np.abs(reference))
 
 
+@pytest.mark.slow  # builds a model of its own: started early, so that the workers end together
 def test_valve_slope_divides_the_driver_torque_by_one_plus_its_gain(params):
     """In the valve's linear range the piston adds A k_v T_s on the rack, a pinion torque A k_v T_s / G_hr: the
     driver's torque is the manual one divided by 1 + A k_v / G_hr (without the Hooke joint)."""

@@ -41,6 +41,7 @@ def exact_rack(result) -> RackSpline:
     return RackSpline.from_ppoly(PPoly.from_bernstein_basis(bernstein))
 
 
+@pytest.mark.slow  # builds a model of its own: started early, so that the workers end together
 @pytest.mark.parametrize(("name", "overrides"), CASES, ids=["column", "pinion", "rack", "saturated", "hydraulic", "hydraulic_table", "speed_gain"])
 def test_replayed_rack_gives_back_the_torsion_bar_torque_and_motor_current(params, name, overrides):
     """Independent paths: the free (handwheel-driven) integration of the assisted model, whose boost feeds the
@@ -124,6 +125,7 @@ def _sweep(params, effects: str, overrides: dict):
     return solve_assisted(run, run.p, rack, t[::5], rtol=1e-8, atol_factor=1.0)
 
 
+@pytest.mark.slow  # builds a model of its own: started early, so that the workers end together
 def test_motor_friction_at_a_column_assist_is_a_column_friction_of_n_times_it(params):
     """Independent effects, one load: extra friction T_e on the rotor of a column assist turning at N times the
     column is a torque N T_e on the column above the intermediate shaft, smoothed over the same rack-equivalent

@@ -123,6 +123,7 @@ NEW_EFFECT = rack_effect_text(
     docstring="Viscous damping of the rack (an effect added as one file).")
 
 
+@pytest.mark.slow  # builds a model of its own: started early, so that the workers end together
 def test_a_new_effect_is_one_file(tmp_path, params, nominal):
     """A mechanism added as one file (given by path in the spec) joins the model without editing the core; at
     strength 0 (its default) the torque is the nominal one, and at damping c its share of the handwheel torque is

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 import sympy as sp
 import sympy.physics.mechanics as me
 
@@ -11,6 +12,7 @@ from parksteer.model.symbolic.derive import build_space
 from parksteer.model.numeric.simulate import prepare
 
 
+@pytest.mark.slow  # builds a model of its own: started early, so that the workers end together
 def test_kane_agrees_with_lagrange_at_random_states(params):
     """The compiled Kane equations (mass matrix and accelerations) equal those of sympy's LagrangesMethod applied
     to the same bodies and loads (kinetic energy differentiated, generalized forces from partial velocities with

@@ -91,6 +91,7 @@ def test_every_rule_script_logs_through_rule_log(repo_root):
     assert bare == []
 
 
+@pytest.mark.slow  # builds a model of its own: started early, so that the workers end together
 def test_derive_reports_each_stage_and_quiet_silences_it(tmp_path, monkeypatch, capsys):
     """A cold `parksteer derive` names each stage on stderr (derivation with its coordinates, generated C, the
     runtime's one compile on an empty cache, the compilation) with the numbers the cache entry records; a second call finds it in the cache; --quiet prints
