@@ -68,6 +68,24 @@ def test_the_package_cars_first_diagnosis_needs_only_shipped_models(repo_root):
         assert keys <= shipped
 
 
+def test_the_example_effect_files_first_diagnosis_needs_only_shipped_models(repo_root):
+    """The documents' worked examples add an effect file to the model (`parksteer diagnose --effects=+FILE`:
+    docs/signature.md's examples/user_effect, docs/measurement.md's src/parksteer/examples): every model such a
+    diagnosis builds (the base with the file's effect, the diagnosis models over it) is shipped, so a reader's first
+    run of those commands compiles and never derives."""
+    from parksteer.commands.model import EXAMPLE_EFFECT_FOLDERS
+    from parksteer.diagnose.candidates import candidate_effects, models_to_build
+
+    shipped = {p.name.removesuffix(".c.gz") for p in cache.PREBUILT_DIR.glob("*.c.gz")}
+    files = [path for folder in EXAMPLE_EFFECT_FOLDERS for path in sorted((repo_root / folder).glob("[!_]*.py"))]
+    assert {path.name for path in files} >= {"centre_friction.py", "column_imbalance.py"}
+    for path in files:
+        base = resolve_effects(f"+{path}")
+        missing = [[e.name for e in effects] for effects in models_to_build(base, candidate_effects(base)[0])
+                   if cache.model_key(effects) not in shipped]
+        assert not missing, f"{path.name}: models not shipped {missing}: {REFRESH}"
+
+
 def test_a_damaged_prebuilt_model_is_said_and_derived(tmp_path, monkeypatch, capsys):
     """A truncated shipped file is not trusted: the build says so and derives (here: reading gives None)."""
     key = cache.model_key(resolve_effects(None))

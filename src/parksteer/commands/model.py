@@ -95,17 +95,23 @@ def _suggestion_shape_sets() -> list:
     return [({"shape": form.name}, sorted([*base, form], key=lambda e: e.name)) for form in shape_forms()]
 
 
+# The folders of example effect files, relative to the checkout: the user's worked example (docs/signature.md) and
+# the package's own (docs/measurement.md, docs/diagnosis.md).
+EXAMPLE_EFFECT_FOLDERS = ("examples/user_effect", "src/parksteer/examples")
+
+
 def _example_effect_sets() -> list:
-    """(spec, effects) of the models a diagnosis with each effect file of the checkout's examples/user_effect
+    """(spec, effects) of the models a diagnosis with each effect file of :data:`EXAMPLE_EFFECT_FOLDERS`
     (`--effects=+FILE`) builds, spec ``{"example": the file relative to the checkout, "effects": the other
-    effects}``: the worked examples of docs/signature.md compile them instead of deriving them."""
+    effects}``: the documents' worked examples compile them instead of deriving them."""
     from ..diagnose.candidates import candidate_effects, models_to_build
     from ..model.codegen.cache import checkout_root
     from ..model.symbolic.components import resolve_effects
 
     root = checkout_root()
     sets = []
-    for path in sorted((root / "examples" / "user_effect").glob("*.py")) if root is not None else []:
+    files = [p for folder in EXAMPLE_EFFECT_FOLDERS for p in sorted((root / folder).glob("[!_]*.py"))] if root else []
+    for path in files:
         base = resolve_effects(f"+{path}")
         example = next(e for e in base if e.name == path.stem)
         sets += [({"example": path.relative_to(root).as_posix(), "effects": [e.name for e in effects if e is not example]},
