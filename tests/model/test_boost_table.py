@@ -114,16 +114,17 @@ def test_tables_that_are_not_boost_curves_are_refused():
 def test_quasi_static_driver_torque_solves_t_plus_a_of_t_equals_the_road_torque(params):
     """Quasi-statically the column carries the road torque as torsion-bar torque plus assist: T + A(T) = T_road. For
     the progressive table, a lossless gear (eta_f = eta_b = 1: the motor's torque through N is the table's assist
-    either way), an ideal motor and no Hooke joint, the driver's torque on the slow steer to the right is the root of
-    that equation, solved here by hand (Brent's method on SciPy's PCHIP through the mirrored points) from the manual
-    car's torque at the same rack position, within 1 %."""
-    from test_assist import series_column
+    either way), an ideal motor and the Hooke joint straight, the driver's torque on the slow steer to the right is
+    the root of that equation, solved here by hand (Brent's method on SciPy's PCHIP through the mirrored points)
+    from the manual car's torque at the same rack position, within 1 %."""
+    from test_assist import STRAIGHT, series_column
 
-    manual = simulate("unladen", effects="-hooke_joint", overrides=series_column(params, NAME), params=params)
+    manual = simulate("unladen", overrides={**series_column(params, NAME), **STRAIGHT}, params=params)
     gear = {f"{NAME}.motor_inertia": 0.0, f"{NAME}.motor_friction_torque": 0.0, f"{NAME}.efficiency": 1.0,
             f"{NAME}.back_efficiency": 1.0, f"{NAME}.motor_torque_limit": 30.0}
-    assisted = simulate("unladen", effects=f"-hooke_joint,+{NAME}",
-                        overrides={**gear, **as_overrides(entries(TORQUES, None, [ASSIST]))}, params=params)
+    assisted = simulate("unladen", effects=f"+{NAME}",
+                        overrides={**gear, **as_overrides(entries(TORQUES, None, [ASSIST])), **STRAIGHT},
+                        params=params)
     ramp, at = first_ramp(manual), first_ramp(assisted)
     road = np.interp(assisted.columns["rack_m"][at], manual.columns["rack_m"][ramp],
                      manual.columns["handwheel_torque_Nm"][ramp])
@@ -220,15 +221,16 @@ def test_valve_table_from_bar_takes_its_points_and_is_monotone_odd_and_zero_in_t
 
 def test_quasi_static_driver_torque_with_a_progressive_valve_solves_t_plus_a_of_t(golf):
     """Quasi-statically the pinion carries the road torque as torsion-bar torque plus the piston's push through the
-    gear: T + a_p p(T) / G_hr = T_road (a_p the piston area, G_hr the handwheel-to-rack ratio). On the hydraulic Golf
-    with its progressive valve table, seals without friction, the relief out of reach and no Hooke joint, the
-    driver's torque on the slow steer to the right is the root of that equation, solved by hand (Brent's method on
-    SciPy's PCHIP through the table's points) from the manual car's torque at the same rack position, within 1 %."""
-    from test_assist import series_column
+    gear: T + a_p p(T) / G_hr = T_road (a_p the piston area, G_hr the handwheel-to-rack ratio). On the hydraulic
+    Golf with its progressive valve table, seals without friction, the relief out of reach and the Hooke joint
+    straight, the driver's torque on the slow steer to the right is the root of that equation, solved by hand
+    (Brent's method on SciPy's PCHIP through the table's points) from the manual car's torque at the same rack
+    position, within 1 %."""
+    from test_assist import STRAIGHT, series_column
 
-    manual = simulate("kerb", effects="-hooke_joint", overrides=series_column(golf, HYDRAULIC), params=golf)
-    ideal = {f"{HYDRAULIC}.seal_friction_force": 0.0, f"{HYDRAULIC}.relief_pressure": 3.0e7}
-    assisted = simulate("kerb", effects=f"-hooke_joint,+{HYDRAULIC}", overrides=ideal, params=golf)
+    manual = simulate("kerb", overrides={**series_column(golf, HYDRAULIC), **STRAIGHT}, params=golf)
+    ideal = {f"{HYDRAULIC}.seal_friction_force": 0.0, f"{HYDRAULIC}.relief_pressure": 3.0e7, **STRAIGHT}
+    assisted = simulate("kerb", effects=f"+{HYDRAULIC}", overrides=ideal, params=golf)
     ramp, at = first_ramp(manual), first_ramp(assisted)
     road = np.interp(assisted.columns["rack_m"][at], manual.columns["rack_m"][ramp],
                      manual.columns["handwheel_torque_Nm"][ramp])
