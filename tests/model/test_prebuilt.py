@@ -86,6 +86,17 @@ def test_the_example_effect_files_first_diagnosis_needs_only_shipped_models(repo
         assert not missing, f"{path.name}: models not shipped {missing}: {REFRESH}"
 
 
+def test_the_paper_car_with_each_power_assist_is_shipped():
+    """`--effects=+NAME` for each power assist the library has (a vehicle file's `[assist] type`): the paper's car
+    with it is shipped, so the first run of any assist type compiles and never derives."""
+    from parksteer.model.numeric.assist import ASSIST_EFFECTS
+
+    shipped = {p.name.removesuffix(".c.gz") for p in cache.PREBUILT_DIR.glob("*.c.gz")}
+    assert len(ASSIST_EFFECTS) == 4
+    missing = [name for name in ASSIST_EFFECTS.values() if cache.model_key(resolve_effects(f"+{name}")) not in shipped]
+    assert not missing, f"not shipped: {missing}: {REFRESH}"
+
+
 def test_a_damaged_prebuilt_model_is_said_and_derived(tmp_path, monkeypatch, capsys):
     """A truncated shipped file is not trusted: the build says so and derives (here: reading gives None)."""
     key = cache.model_key(resolve_effects(None))

@@ -85,6 +85,16 @@ def _assisted_vehicle_sets() -> list:
     return sets
 
 
+def _assist_type_sets() -> list:
+    """(spec, effects) of the paper's car with each power assist of the library (`--effects=+NAME`,
+    model.numeric.assist.ASSIST_EFFECTS), spec ``"+NAME"``: the first run of any assist type on the default car
+    compiles instead of deriving (docs/assist.md)."""
+    from ..model.numeric.assist import ASSIST_EFFECTS
+    from ..model.symbolic.components import resolve_effects
+
+    return [(f"+{name}", resolve_effects(f"+{name}")) for name in ASSIST_EFFECTS.values()]
+
+
 def _suggestion_shape_sets() -> list:
     """(spec, effects) of the models a suggestion on the default car is fitted with: the default set and each form
     of a suggested effect (parksteer.diagnose.suggest.shape_forms), spec ``{"shape": name}``."""
@@ -270,7 +280,7 @@ def _derive(args) -> int:
             raise UsageError("--prebuilt derives the default diagnosis' models and the manifests' sets: give it no "
                              "--effects or --out")
         sets = [([e.name for e in effects], effects) for effects in default_diagnosis_models()]
-        sets += (_assisted_vehicle_sets() + _signature_truth_sets() + _suggestion_shape_sets()
+        sets += (_assisted_vehicle_sets() + _assist_type_sets() + _signature_truth_sets() + _suggestion_shape_sets()
                  + _held_form_sets() + _example_effect_sets())
         for path in args.manifests:
             spec = _manifest_spec(path)
