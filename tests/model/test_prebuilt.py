@@ -36,12 +36,17 @@ def _effects(spec):
     return resolve_effects(spec)
 
 
+def _shipped() -> set[str]:
+    """The keys of the shipped models' C."""
+    return {p.name.removesuffix(".c.gz") for p in cache.PREBUILT_DIR.glob("*.c.gz")}
+
+
 def test_prebuilt_models_are_current_and_cover_the_default_diagnosis():
     """Every shipped model is the model of its spec in today's source (its key is the key of what the spec
     resolves to: no stale entry that nothing asks for any more), C and description in pairs, and the base,
     diagnosis and brush_patch models of a diagnosis with the default effects are among them. That they cover every
     set the pipeline derives is checked where the pipeline runs cold (.ci/run: every manifest says `prebuilt`)."""
-    shipped = {p.name.removesuffix(".c.gz") for p in cache.PREBUILT_DIR.glob("*.c.gz")}
+    shipped = _shipped()
     specs = cache.prebuilt_specs()
     assert shipped == set(specs), f"pre-derived C and descriptions do not pair up: {REFRESH}"
     stale = sorted(key for key, spec in specs.items() if cache.model_key(_effects(spec)) != key)
@@ -58,7 +63,7 @@ def test_the_package_cars_first_diagnosis_needs_only_shipped_models(repo_root):
     from parksteer.parameters import load_parameters
     from parksteer.vehicle import load_vehicle
 
-    shipped = {p.name.removesuffix(".c.gz") for p in cache.PREBUILT_DIR.glob("*.c.gz")}
+    shipped = _shipped()
     base = resolve_effects(None)
     candidates = candidate_effects(base)[0]
     cars = sorted((repo_root / "data" / "vehicles").glob("*.toml"))
@@ -73,11 +78,11 @@ def test_the_example_effect_files_first_diagnosis_needs_only_shipped_models(repo
     docs/signature.md's examples/user_effect, docs/measurement.md's src/parksteer/examples): every model such a
     diagnosis builds (the base with the file's effect, the diagnosis models over it) is shipped, so a reader's first
     run of those commands compiles and never derives."""
-    from parksteer.commands.model import EXAMPLE_EFFECT_FOLDERS
+    from parksteer.commands.model import example_effect_files
     from parksteer.diagnose.candidates import candidate_effects, models_to_build
 
-    shipped = {p.name.removesuffix(".c.gz") for p in cache.PREBUILT_DIR.glob("*.c.gz")}
-    files = [path for folder in EXAMPLE_EFFECT_FOLDERS for path in sorted((repo_root / folder).glob("[!_]*.py"))]
+    shipped = _shipped()
+    files = example_effect_files(repo_root)
     assert {path.name for path in files} >= {"centre_friction.py", "column_imbalance.py"}
     for path in files:
         base = resolve_effects(f"+{path}")
@@ -91,7 +96,7 @@ def test_the_paper_car_with_each_power_assist_is_shipped():
     with it is shipped, so the first run of any assist type compiles and never derives."""
     from parksteer.model.numeric.assist import ASSIST_EFFECTS
 
-    shipped = {p.name.removesuffix(".c.gz") for p in cache.PREBUILT_DIR.glob("*.c.gz")}
+    shipped = _shipped()
     assert len(ASSIST_EFFECTS) == 4
     missing = [name for name in ASSIST_EFFECTS.values() if cache.model_key(resolve_effects(f"+{name}")) not in shipped]
     assert not missing, f"not shipped: {missing}: {REFRESH}"

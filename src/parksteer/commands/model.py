@@ -110,18 +110,22 @@ def _suggestion_shape_sets() -> list:
 EXAMPLE_EFFECT_FOLDERS = ("examples/user_effect", "src/parksteer/examples")
 
 
+def example_effect_files(root: Path) -> list[Path]:
+    """The example effect files of the checkout `root` (:data:`EXAMPLE_EFFECT_FOLDERS`), folder by folder."""
+    return [path for folder in EXAMPLE_EFFECT_FOLDERS for path in sorted((root / folder).glob("[!_]*.py"))]
+
+
 def _example_effect_sets() -> list:
-    """(spec, effects) of the models a diagnosis with each effect file of :data:`EXAMPLE_EFFECT_FOLDERS`
-    (`--effects=+FILE`) builds, spec ``{"example": the file relative to the checkout, "effects": the other
-    effects}``: the documents' worked examples compile them instead of deriving them."""
+    """(spec, effects) of the models a diagnosis with each of :func:`example_effect_files` (`--effects=+FILE`)
+    builds, spec ``{"example": the file relative to the checkout, "effects": the other effects}``: the documents'
+    worked examples compile them instead of deriving them."""
     from ..diagnose.candidates import candidate_effects, models_to_build
     from ..model.codegen.cache import checkout_root
     from ..model.symbolic.components import resolve_effects
 
     root = checkout_root()
     sets = []
-    files = [p for folder in EXAMPLE_EFFECT_FOLDERS for p in sorted((root / folder).glob("[!_]*.py"))] if root else []
-    for path in files:
+    for path in example_effect_files(root) if root is not None else []:
         base = resolve_effects(f"+{path}")
         example = next(e for e in base if e.name == path.stem)
         sets += [({"example": path.relative_to(root).as_posix(), "effects": [e.name for e in effects if e is not example]},
