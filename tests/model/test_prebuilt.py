@@ -5,6 +5,7 @@ builds. A change to the symbolic half without `parksteer derive --prebuilt` fail
 from __future__ import annotations
 
 import json
+import re
 
 import pytest
 
@@ -100,6 +101,42 @@ def test_the_paper_car_with_each_power_assist_is_shipped():
     assert len(ASSIST_EFFECTS) == 4
     missing = [name for name in ASSIST_EFFECTS.values() if cache.model_key(resolve_effects(f"+{name}")) not in shipped]
     assert not missing, f"not shipped: {missing}: {REFRESH}"
+
+
+def test_the_paper_model_without_each_of_its_effects_is_shipped():
+    """`--effects=-NAME` for each of the paper's effects (the ablation a reader runs first, and the reference the
+    physical checks switch lifting or the Hooke joint off for) is shipped: it compiles and never derives."""
+    shipped = _shipped()
+    names = [e.name for e in resolve_effects(None)]
+    assert len(names) == 5
+    missing = [name for name in names if cache.model_key(resolve_effects(f"-{name}")) not in shipped]
+    assert not missing, f"not shipped: {missing}: {REFRESH}"
+
+
+# An effects option in a document's command: `--effects SPEC` or `--effects=SPEC`, up to a space or a backquote.
+_EFFECTS_OPTION = re.compile(r"--effects[ =]([^\s`]+)")
+
+
+def _documented_plain_specs(repo_root) -> set[str]:
+    """The effects specs the documents' shell blocks run that name library effects only (no effect file, no
+    placeholder such as EFFECTS or +NAME)."""
+    specs = set()
+    for page in [repo_root / "README.md", *sorted((repo_root / "docs").glob("*.md"))]:
+        for block in re.findall(r"```sh\n(.*?)```", page.read_text(encoding="utf-8"), flags=re.S):
+            specs |= {spec for spec in _EFFECTS_OPTION.findall(block)
+                      if not any(mark in spec for mark in ("/", ".py", "$")) and spec == spec.lower()}
+    return specs
+
+
+def test_every_plain_effects_spec_the_documents_run_is_shipped(repo_root):
+    """A reader running a document's `--effects` example on the paper's car compiles its model and never derives
+    it: every spec of library effects in the documents' commands resolves to a shipped model
+    (parksteer.commands.model.DOCUMENTED_SPECS ships those no other category does)."""
+    specs = _documented_plain_specs(repo_root)
+    assert "-rack_friction,+kingpin_friction" in specs  # docs/model.md's example is found
+    shipped = _shipped()
+    missing = sorted(spec for spec in specs if cache.model_key(resolve_effects(spec)) not in shipped)
+    assert not missing, f"not shipped: {missing} (add to DOCUMENTED_SPECS): {REFRESH}"
 
 
 def test_a_damaged_prebuilt_model_is_said_and_derived(tmp_path, monkeypatch, capsys):
