@@ -95,3 +95,16 @@ def test_effects_simulate_and_compare_run_from_the_wheel(installed):
     shutil.copy2(REPO_ROOT / "data" / "measurements" / "example_unladen.csv", measured)
     report = run([parksteer, "compare", str(measured)], cwd=work, env=env)
     assert "RMS" in report.stdout or "rms" in report.stdout.lower(), report.stdout[-2000:]
+
+
+def test_an_assisted_replays_inversion_compiles_from_the_wheel(installed):
+    """The assisted replay's torsion-bar inversion is C shipped beside the package's Python
+    (model/numeric/torsion_bar.c, package data): installed from the wheel, the first inversion compiles it into the
+    model cache and solves T + A(T) = y (here a valve of gain 4e5 Pa per N m on 8 cm^2 at G_hr 150: T well below y)."""
+    venv, env, work = installed
+    probe = ("import numpy as np; from parksteer.model.numeric.assisted import BoostLaw; "
+             "law = BoostLaw('hydraulic_assist', 'rack', 4e5, 0.3, 0.05, 7e6, 1e5, 150.0, area=8e-4); "
+             "print(law.torsion_bar(np.array([5.0]))[0])")
+    torque = float(run([str(venv / "bin" / "python"), "-c", probe], cwd=work, env=env).stdout)
+    assert 0.3 < torque < 5.0
+    assert list((Path(env["PARKSTEER_MODEL_CACHE"]) / "runtime").glob("torsion_bar-*.so"))

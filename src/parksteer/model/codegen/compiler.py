@@ -5,7 +5,8 @@ same text for every model, and the boost table's law the same for every model wi
 once per cache and compiler, into ``runtime/<key>.o`` beside the cache's entries, and linked with each model's own
 file (:data:`.runtime.SHARED_OBJECTS`). An object is compiled in the building entry's scratch directory, under a
 lock, and renamed into place whole, so a killed build leaves no half of one and builders side by side compile it
-once.
+once. C that no model links (the assisted replay's torsion-bar inversion, ``model/numeric/torsion_bar.c``) is
+compiled alike into a library of its own, ``runtime/<name>-<key>.so`` (:func:`standalone_library`).
 """
 
 from __future__ import annotations
@@ -16,14 +17,16 @@ import hashlib
 import os
 import platform
 import shutil
+import socket
 import subprocess
+import tempfile
 from contextlib import suppress
 from functools import lru_cache
 from pathlib import Path
 
 from ...errors import UsageError
 from ...progress import note
-from .runtime import SHARED_OBJECTS
+from .runtime import SHARED_OBJECTS, check_portable
 
 # How the C is compiled; part of the model key. -O1: integrates these models about as fast as -O2 and compiles in
 # less time. -ffp-contract=off: no fused multiply-add, which GCC otherwise forms wherever the target has one
@@ -77,6 +80,55 @@ def shared_object(compiler: str, name: str, root: Path, scratch: Path) -> Path:
         os.replace(built, final)
         source.unlink()
     return final
+
+
+def library_key(compiler: str, source: str) -> str:
+    """Hash of a standalone library's C `source`, the flags and the compiler (:func:`standalone_library`)."""
+    digest = hashlib.sha256(_compiler_identity(compiler).encode())
+    digest.update(" ".join(COMPILE_FLAGS).encode() + b"\0" + source.encode())
+    return digest.hexdigest()[:20]
+
+
+def standalone_library(compiler: str, name: str, source: str, what: str, root: Path) -> Path:
+    """The C `source` (`what` it is) compiled on its own by `compiler` into a shared library for the cache `root`:
+    root/runtime/<name>-<key>.so (:func:`library_key`), with the SHA-256 of its bytes beside it (.sha256), compiled
+    if it is not there yet or its bytes are not the ones recorded (a damaged or truncated file). It is compiled in a
+    scratch folder of `root` named as the cache's builds name theirs (``cache.clean_stale_scratch`` removes a
+    killed build's), under a lock the kernel releases when its holder ends (builders side by side compile it once),
+    and renamed into place whole, its digest first: a killed build leaves no half of it, nor a library without its
+    digest."""
+    check_portable(source)
+    stem = f"{name}-{library_key(compiler, source)}"
+    final = root / RUNTIME_FOLDER / f"{stem}.so"
+    digest = final.with_suffix(".sha256")
+    if _library_is_sound(final, digest):
+        return final
+    final.parent.mkdir(parents=True, exist_ok=True)
+    with open(final.with_suffix(".lock"), "a", encoding="utf-8") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        if _library_is_sound(final, digest):
+            return final
+        note(f"compiling {what}, once for this cache and compiler ({final})")
+        host = socket.gethostname().replace(".", "-")
+        scratch = Path(tempfile.mkdtemp(prefix=f".{stem}.{host}.{os.getpid()}.", dir=root))
+        try:
+            c_path, built = scratch / f"{name}.c", scratch / f"{name}.so"
+            c_path.write_text(source, encoding="utf-8")
+            run_compiler([compiler, *COMPILE_FLAGS, "-o", str(built), str(c_path), "-lm"], what)
+            (scratch / "sha256").write_text(hashlib.sha256(built.read_bytes()).hexdigest(), encoding="utf-8")
+            os.replace(scratch / "sha256", digest)
+            os.replace(built, final)
+        finally:
+            shutil.rmtree(scratch, ignore_errors=True)
+    return final
+
+
+def _library_is_sound(library: Path, digest: Path) -> bool:
+    """Whether `library` is there with the SHA-256 its `digest` file records."""
+    try:
+        return hashlib.sha256(library.read_bytes()).hexdigest() == digest.read_text(encoding="utf-8").strip()
+    except OSError:
+        return False
 
 
 def compile_model(compiler: str, c_path: Path, so_path: Path, root: Path, shared: tuple[str, ...] = ()) -> None:

@@ -6,9 +6,10 @@ which gives the road torque T_road (N m); the torsion-bar torque T_s (N m) is th
 ``T_s + A(T_s) = y``, y the road torque referred to the bar, A the boost law of
 :mod:`parksteer.model.symbolic.effects.electric_assist` or ``hydraulic_assist`` with the same smoothed corners
 (:mod:`parksteer.model.symbolic.effects.assist_common`) and the gear's efficiency in the direction the power flows,
-found pointwise by bisection; the motor torque (N m) and current (A), or the pressure (Pa), follow from the law. A is
-increasing, so the root is unique, for a back-driven efficiency above :func:`least_back_efficiency` (0.147 at
-eta_f 0.85); below it the law is refused. The derivation: docs/assist.md, "Replaying an assisted car's rack".
+found pointwise by regula falsi in compiled C (:mod:`.torsion_bar`); the motor torque (N m) and current (A), or the
+pressure (Pa), follow from the law. A is increasing, so the root is unique, for a back-driven efficiency above
+:func:`least_back_efficiency` (0.147 at eta_f 0.85); below it the law is refused. The derivation: docs/assist.md,
+"Replaying an assisted car's rack".
 """
 
 from __future__ import annotations
@@ -24,12 +25,14 @@ from ...parameters import VEHICLE_SPEED
 from ...reduction_efficiency import min_monotone_back_efficiency
 from ..symbolic.components import power_assist_of
 from ..symbolic.effects.assist_common import speed_gain
-from .boost_numeric import (clamp, deadband, directional_efficiency, points_at_speed, table_law_numeric,
-                            table_law_segments, table_segments)
+from .boost_numeric import clamp, deadband, directional_efficiency, points_at_speed, table_law_numeric
 from .prescribed import PRESCRIBED_ATOL_FACTOR, PRESCRIBED_RTOL, PrescribedSolution, RackMotion, solve
+from .torsion_bar import LAW_FIELDS, invert
 
 # The inversion stops when the bracket is this narrow (N m of torsion-bar torque), far below a sensor's resolution.
 INVERSION_TOLERANCE_NM = 1e-12
+# ... or after this many steps (beyond 8192 N m two neighbouring doubles are further apart than that tolerance).
+INVERSION_STEPS = 200
 HYDRAULIC = "hydraulic_assist"
 
 
@@ -91,11 +94,6 @@ class BoostLaw:
         points = points_at_speed(np.asarray(self.table, dtype=float).tobytes(), np.float64(self.speed).tobytes())
         return tuple(np.asarray(v, dtype=float) for v in points)
 
-    @cached_property
-    def _segments(self):
-        """The table's segments at this law's speed (:func:`.boost_numeric.table_segments`), read once per law."""
-        return table_segments(self._table_points)
-
     def with_wider_dead_band(self, size_Nm: float) -> BoostLaw:
         """This law with its dead band wider by `size_Nm`: the line's band, and every point of a table but the
         origin moved out by it (the curve beyond the band unchanged in shape)."""
@@ -134,94 +132,53 @@ class BoostLaw:
         increasing, and factor >= 0: a motor whose delivered torque departs from the law by `factor`), so the root
         is bracketed and kept bracketed: regula falsi with the Illinois rule (the end that stays has its value
         halved), falling back to the bracket's midpoint where the secant leaves it, until the bracket is
-        INVERSION_TOLERANCE_NM wide. Only comparisons and the four operations: the same bits on any machine.
+        INVERSION_TOLERANCE_NM wide (at most INVERSION_STEPS steps). Only comparisons, the four operations and
+        square roots: the same bits on any machine.
 
-        Each sample's steps are its own; the samples still open are stepped together, and the law's parts that do
-        not change from step to step (the gear's direction at each sample's rotor speed, the table's segments) are
-        read once (:class:`_Excess`)."""
+        Each sample is solved on its own in compiled C (:mod:`.torsion_bar`, ``torsion_bar.c``, which writes the
+        law once); the gear's direction tanh(omega / w) at each sample's rotor speed is read here, once a call."""
         y = np.asarray(y, dtype=float)
-        excess = _Excess(self, y, factor, rotor_speed)
+        samples = np.ascontiguousarray(y.reshape(-1))
+        gains = np.asarray(factor, dtype=float)
+        # a factor of 1 everywhere multiplies by 1: the same bits without the product
+        gains = (None if gains.ndim == 0 and float(gains) == 1.0
+                 else np.ascontiguousarray(np.broadcast_to(gains, y.shape).reshape(-1)))
+        direction = None
+        if not self.hydraulic:
+            if self.back_efficiency == 0.0:
+                raise ZeroDivisionError("back_efficiency 0: a back-driven gear delivering 1 / 0 of the motor torque")
+            speed = np.array(np.broadcast_to(np.asarray(rotor_speed, dtype=float), y.shape))
+            direction = np.ascontiguousarray(np.tanh((1.0 / self.friction_speed) * speed).reshape(-1))
         # A has the sign of its argument, so the root lies between 0 and y; where rounding says otherwise, a
         # bracket as wide as the assist can be
-        low, high = np.minimum(y, 0.0), np.maximum(y, 0.0)
-        f_low, f_high = excess(low, slice(None)), excess(high, slice(None))
-        wide = np.flatnonzero((f_low > 0.0) | (f_high < 0.0))
-        if wide.size:
-            width = self.bound() * float(np.max(factor)) + 1.0
-            low[wide], high[wide] = y[wide] - width, y[wide] + width
-            f_low[wide], f_high[wide] = excess(low[wide], wide), excess(high[wide], wide)
-        low = np.where(f_high == 0.0, high, low)  # an end that is the root
-        high = np.where(f_low == 0.0, low, high)
-        # the open samples' brackets, packed: their indices, ends, values there and the end the last step moved
-        # (-1 low, +1 high)
-        rows = np.flatnonzero(high - low > INVERSION_TOLERANCE_NM)
-        lo, hi, flo, fhi = low[rows], high[rows], f_low[rows], f_high[rows]
-        side = np.zeros(rows.shape, dtype=np.int8)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            for _ in range(200):
-                if rows.size == 0:
-                    break
-                x = lo - flo * (hi - lo) / (fhi - flo)
-                x = np.where((x > lo) & (x < hi), x, 0.5 * (lo + hi))
-                fx = excess(x, rows)
-                above = fx > 0.0
-                # Illinois: the end that did not move twice in a row has its value halved
-                flo = np.where(above & (side == 1), 0.5 * flo, flo)
-                fhi = np.where(~above & (side == -1), 0.5 * fhi, fhi)
-                lo, flo, hi, fhi = (np.where(above, lo, x), np.where(above, flo, fx), np.where(above, x, hi),
-                                    np.where(above, fx, fhi))
-                side = np.where(above, 1, -1).astype(np.int8)
-                exact = fx == 0.0
-                if exact.any():
-                    lo[exact] = hi[exact] = x[exact]
-                still = hi - lo > INVERSION_TOLERANCE_NM
-                if not still.all():
-                    done = ~still
-                    low[rows[done]], high[rows[done]] = lo[done], hi[done]
-                    rows, lo, hi, flo, fhi, side = (a[still] for a in (rows, lo, hi, flo, fhi, side))
-        low[rows], high[rows] = lo, hi
-        return 0.5 * (low + high)
+        try:
+            width = self.bound() * float(np.max(factor)) + 1.0 if samples.size else 0.0
+        except ZeroDivisionError:
+            width = None  # a law whose bound is not a number: said below if a sample needs it
+        points = self._inversion_points if any(self.table) else None
+        root = invert(self._inversion_values, self.hydraulic, points, samples, gains, direction, width,
+                      INVERSION_TOLERANCE_NM, INVERSION_STEPS)
+        if root is None:
+            self.bound()  # raises what it raised
+        return root.reshape(y.shape)
 
+    @cached_property
+    def _inversion_values(self) -> np.ndarray:
+        """The law's values as the compiled inversion reads them (:data:`.torsion_bar.LAW_FIELDS`): a rack motor's
+        demand times G_hr (``line_scale``) and its assist over G_hr (``assist_scale``)."""
+        rack = self.location == "rack"
+        scales = {"line_scale": self.ratio if rack and not self.hydraulic else 1.0,
+                  "assist_scale": self.ratio if rack else 1.0}
+        return np.array([scales[key] if key in scales else getattr(self, key) for key in LAW_FIELDS], dtype=float)
 
-class _Excess:
-    """x + factor A(x) - y of :meth:`BoostLaw.torsion_bar` at the samples `rows` (an index array, or every sample),
-    with the operations of :meth:`BoostLaw.assist`, one by one and in their order (so with its bits), and what does
-    not change with x read once: the gear's direction tanh(omega / w) at each sample's rotor speed, the table's
-    segments (each one's width and width times its end slopes, as :func:`.boost_numeric.hermite_at` takes them)."""
-
-    def __init__(self, law: BoostLaw, y: np.ndarray, factor, rotor_speed) -> None:
-        self.law, self.y = law, y
-        factor = np.asarray(factor, dtype=float)
-        # a factor of 1 everywhere multiplies by 1: the same bits without the product
-        self.factor = None if factor.ndim == 0 and float(factor) == 1.0 else np.broadcast_to(factor, y.shape)
-        self.table = law._segments if any(law.table) else None
-        self.direction = None
-        if not law.hydraulic:
-            speed = np.array(np.broadcast_to(np.asarray(rotor_speed, dtype=float), y.shape))
-            self.direction = np.tanh((1.0 / law.friction_speed) * speed)
-        self.line_scale = law.ratio if law.location == "rack" and not law.hydraulic else 1.0
-        self.assist_scale = law.ratio if law.location == "rack" else 1.0
-
-    def __call__(self, x: np.ndarray, rows) -> np.ndarray:
-        law = self.law
-        demand = law.gain * deadband(x, law.dead_band, law.band_width)
-        if self.line_scale != 1.0:
-            demand = demand * self.line_scale
-        if self.table is not None:
-            table = table_law_segments(x, self.table)
-            demand = demand + (table if law.table_scale == 1.0 else law.table_scale * table)
-        if law.hydraulic:
-            assist = law.area * clamp(demand, law.limit, law.limit_width) / law.ratio
-        else:
-            motor = clamp(demand / (law.efficiency * law.reduction), law.limit, law.limit_width)
-            delivered = directional_efficiency(motor, self.direction[rows], law.efficiency, law.back_efficiency,
-                                                law.direction_width)
-            assist = delivered * law.reduction * motor
-            if self.assist_scale != 1.0:
-                assist = assist / self.assist_scale
-        if self.factor is not None:
-            assist = self.factor[rows] * assist
-        return x + assist - self.y[rows]
+    @cached_property
+    def _inversion_points(self) -> np.ndarray:
+        """The table's points at this law's speed (torques, assists, slopes) as one 3 x n array, read once per law.
+        The torques past the first must rise (as the table's file has them), for a sample's segment to be one."""
+        points = np.ascontiguousarray(np.array(self._table_points, dtype=float))
+        if not np.all(points[0, 2:] >= points[0, 1:-1]):
+            raise UsageError(f"{self.name}: the boost table's torques do not rise ({points[0].tolist()})")
+        return points
 
 
 @lru_cache(maxsize=64)

@@ -1,4 +1,5 @@
-"""The boost law's arithmetic on plain numbers, for the assisted replay's inversion (:mod:`.assisted`).
+"""The boost law's arithmetic on plain numbers, for the assisted replay's motor torque and assist (:mod:`.assisted`;
+its inversion is compiled C, :mod:`.torsion_bar`) and the assist's identification of a boost map.
 
 Each function is its namesake of :mod:`parksteer.model.symbolic.effects.assist_common` with the same operations
 in the same order, so every bit is the same (tests/model/test_assisted_replay.py checks it), but without the
@@ -74,37 +75,3 @@ def directional_efficiency(motor, direction, forward, back, width):
     tanh(sharpness speed) given (`direction`): the same operations."""
     s = direction * motor / np.sqrt(motor * motor + width * width)
     return 1 + s * ((forward - 1) * (1 + s) / 2 + (1 - 1 / back) * (1 - s) / 2)
-
-
-def table_segments(points):
-    """The table's Hermite segments read once (`points`: :func:`points_at_speed`): the inner knots (the first k
-    with x < knots[k + 1] is the segment), each segment's start t0, width h = t1 - t0, end values a0, a1 and h m0,
-    h m1 (the products :func:`hermite_at` takes, as _hermite forms them), and the line beyond the last point."""
-    knots, assist, slope = (np.asarray(v, dtype=float) for v in points)
-    width = knots[1:] - knots[:-1]
-    return (knots[1:], knots[:-1], width, assist[:-1], assist[1:], width * slope[:-1], width * slope[1:],
-            knots[-1], assist[-1], slope[-1])
-
-
-def hermite_at(x, t0, h, a0, a1, h_m0, h_m1):
-    """:func:`~parksteer.model.symbolic.effects.assist_common._hermite` with h = t1 - t0, h m0 and h m1 formed
-    beforehand: the same operations in the same order (2 s and s s each formed once, as the same products)."""
-    s = (x - t0) / h
-    r = 1 - s
-    two_s = 2 * s
-    ss = s * s
-    return a0 * ((1 + two_s) * r * r) + h_m0 * (s * r * r) + a1 * (ss * (3 - two_s)) + h_m1 * (ss * (s - 1))
-
-
-def table_law_segments(torque: np.ndarray, segments) -> np.ndarray:
-    """:func:`table_law_numeric` on the table's segments read once (:func:`table_segments`): the same
-    operations (:func:`~parksteer.model.symbolic.effects.assist_common._half_numeric`'s)."""
-    upper, t0, h, a0, a1, h_m0, h_m1, last_knot, last_assist, last_slope = segments
-    x = np.abs(torque)
-    k = np.searchsorted(upper, x, side="right")  # len(upper) beyond the last point
-    beyond = k == len(upper)
-    inner = np.minimum(k, len(upper) - 1)
-    magnitude = hermite_at(x, t0[inner], h[inner], a0[inner], a1[inner], h_m0[inner], h_m1[inner])
-    if beyond.any():
-        magnitude = np.where(beyond, last_assist + last_slope * (x - last_knot), magnitude)
-    return np.where(torque >= 0, magnitude, -magnitude)
