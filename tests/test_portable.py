@@ -421,3 +421,39 @@ def test_no_module_outside_portable_calls_blas_or_lapack():
                   and node.attr in ("dot", "matmul", "einsum", "tensordot", "inner", "vdot")):
                 found.append(f"{path.relative_to(root)}:{node.lineno}: np.{node.attr}")
     assert not found, "BLAS/LAPACK outside parksteer.portable: " + "; ".join(found)
+
+
+# numpy's and the math module's elementary functions: numpy's dispatch on the CPU's SIMD level, and the C library's
+# (behind math, and numpy's where it has no SIMD loop) pick FMA or SSE2 variants by processor; either differs from
+# the other in the last bit.
+ELEMENTARY = {"sin", "cos", "tan", "arcsin", "arccos", "arctan", "arctan2", "asin", "acos", "atan", "atan2", "sinh",
+              "cosh", "tanh", "arcsinh", "arccosh", "arctanh", "exp", "exp2", "expm1", "log", "log2", "log10", "log1p",
+              "power", "float_power", "pow", "cbrt", "erf", "erfc", "gamma", "lgamma"}
+# The calls whose last bit reaches no number the package writes, each with its reason.
+ELEMENTARY_ALLOWED = {
+    # a logarithmic axis's positions in a figure (its data are written as computed)
+    ("figures/assisted.py", "log10"),
+    # a converter's bit count, rounded to a whole number
+    ("synthetic/quirk_eps.py", "log2"), ("synthetic/column_eps_layer.py", "log2"),
+}
+
+
+def test_no_module_outside_portable_calls_numpys_or_the_c_librarys_elementary_functions():
+    """Every number the package computes through sin, exp, tanh, log, ... takes them from parksteer.portable (fdlibm's
+    algorithms, the model's C's own): outside ``portable/``, no ``np.<f>`` or ``math.<f>`` of :data:`ELEMENTARY`
+    but the listed few, so that a figure's bytes do not depend on the processor's SIMD level or FMA (CI's
+    .ci/other_kernels runs figures again under both held back)."""
+    import ast
+
+    root = Path(pm.__file__).parents[1]
+    found = []
+    for path in sorted(root.rglob("*.py")):
+        where = path.relative_to(root).as_posix()
+        if where.startswith("portable/"):
+            continue
+        for node in syntax_trees.nodes(path.read_text(encoding="utf-8")):
+            if (isinstance(node, ast.Attribute) and isinstance(node.value, ast.Name)
+                    and node.value.id in ("np", "numpy", "math") and node.attr in ELEMENTARY
+                    and (where, node.attr) not in ELEMENTARY_ALLOWED):
+                found.append(f"{where}:{node.lineno}: {node.value.id}.{node.attr}")
+    assert not found, "elementary functions outside parksteer.portable: " + "; ".join(found)

@@ -294,7 +294,7 @@ def _describe_dissipative_column(best: Basis, c: np.ndarray) -> tuple[str, dict]
     amplitudes = {m: float(pm.hypot(c[2 * i], c[2 * i + 1])) for i, m in enumerate(best.orders)}
     # the angle where sum_m a_m sin(m theta) + b_m cos(m theta) peaks, on a grid of one turn
     grid = np.linspace(0.0, 2.0 * np.pi, 361)[:-1]
-    shape = sum(c[2 * i] * np.sin(m * grid) + c[2 * i + 1] * np.cos(m * grid) for i, m in enumerate(best.orders))
+    shape = sum(c[2 * i] * pm.sin(m * grid) + c[2 * i + 1] * pm.cos(m * grid) for i, m in enumerate(best.orders))
     peak = float(grid[int(np.argmax(shape))])
     top = max(amplitudes, key=amplitudes.get)
     orders = " and ".join(f"{m} per column turn ({amplitudes[m]:.3g} N m)" for m in best.orders)

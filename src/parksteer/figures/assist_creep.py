@@ -24,6 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .. import portable as pm
 from ..model.numeric.simulate import SimulationResult, simulate
 from ..parameters import Parameters, load_parameters
 from ..sweep.assist_sizing import published_loads
@@ -43,9 +44,11 @@ def spin_band() -> dict:
 
 
 def q_grid() -> list[float]:
-    """GRID_POINTS values of q_Dz8 evenly spaced in log over Q_RANGE."""
-    low, high = (math.log(q) for q in Q_RANGE)
-    return [math.exp(low + (high - low) * i / (GRID_POINTS - 1)) for i in range(GRID_POINTS)]
+    """GRID_POINTS values of q_Dz8 evenly spaced in log over Q_RANGE (the portable log and exp: the C library's
+    differ in the last bit between processors, and the values are the simulations' inputs)."""
+    low, high = (pm.log(float(q)) for q in Q_RANGE)
+    inner = [pm.exp(low + (high - low) * i / (GRID_POINTS - 1)) for i in range(1, GRID_POINTS - 1)]
+    return [float(Q_RANGE[0]), *inner, float(Q_RANGE[1])]  # the range's ends as written
 
 
 def plateau_terms(result: SimulationResult, params: Parameters) -> dict:
@@ -201,7 +204,8 @@ def plot_creep(out: dict):
                    linestyle="--", label=f"rack friction, {speed:g} km/h")
         cross = out["crossover_q_dz8"][key]
         if cross is not None:
-            at = float(np.interp(math.log(cross), np.log(q), np.asarray(out["tyre_share"][key])))
+            at = float(np.interp(pm.log(float(cross)), pm.log(np.asarray(q, dtype=float)),
+                                 np.asarray(out["tyre_share"][key])))
             right.plot([cross], [100.0 * at], marker="o", markerfacecolor="none", color=colour, linestyle="none")
     left.set_ylabel("tyre moment kept on the plateau (% of standstill)")
     left.set_ylim(0.0, 100.0)

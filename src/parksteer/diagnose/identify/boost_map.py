@@ -120,7 +120,7 @@ def _fit_table(S: np.ndarray, i: np.ndarray, top: float, d0: float, span: int):
     for k in _knots(d0, top, span)[2:]:
         near = active & (np.abs(magnitude - k) <= (top - d0) / span)
         level = float(np.median(np.abs(i[near]))) if near.any() else previous + 1.0
-        start.append(math.log(max(level - previous, 0.05)))
+        start.append(float(pm.log(max(level - previous, 0.05))))  # the portable log, as _currents' exp
         previous = max(level, previous + 0.05)
     x0 = np.array([d0, 0.0, *start])
 

@@ -19,6 +19,7 @@ from functools import cached_property, lru_cache
 
 import numpy as np
 
+from ... import portable as pm
 from ...boost_table import MAX_POINTS, off_keys, table_keys
 from ...errors import UsageError
 from ...parameters import VEHICLE_SPEED
@@ -107,7 +108,7 @@ class BoostLaw:
         """What the gear delivers per motor torque, in the direction the power flows (eta_f driving, 1 / eta_b
         back-driven; :func:`~parksteer.model.symbolic.effects.assist_common.directional_efficiency`), the rotor
         turning at `rotor_speed` (rad/s)."""
-        direction = np.tanh((1.0 / self.friction_speed) * np.asarray(rotor_speed, dtype=float))
+        direction = pm.tanh((1.0 / self.friction_speed) * np.asarray(rotor_speed, dtype=float))
         return directional_efficiency(motor, direction, self.efficiency, self.back_efficiency, self.direction_width)
 
     def assist(self, torsion_bar_Nm, rotor_speed=0.0):
@@ -136,7 +137,8 @@ class BoostLaw:
         square roots: the same bits on any machine.
 
         Each sample is solved on its own in compiled C (:mod:`.torsion_bar`, ``torsion_bar.c``, which writes the
-        law once); the gear's direction tanh(omega / w) at each sample's rotor speed is read here, once a call."""
+        law once); the gear's direction tanh(omega / w) at each sample's rotor speed is read here, once a call, with the
+        portable tanh (:mod:`parksteer.portable`: the compiled model's own, not the C library's)."""
         y = np.asarray(y, dtype=float)
         samples = np.ascontiguousarray(y.reshape(-1))
         gains = np.asarray(factor, dtype=float)
@@ -148,7 +150,7 @@ class BoostLaw:
             if self.back_efficiency == 0.0:
                 raise ZeroDivisionError("back_efficiency 0: a back-driven gear delivering 1 / 0 of the motor torque")
             speed = np.array(np.broadcast_to(np.asarray(rotor_speed, dtype=float), y.shape))
-            direction = np.ascontiguousarray(np.tanh((1.0 / self.friction_speed) * speed).reshape(-1))
+            direction = np.ascontiguousarray(pm.tanh((1.0 / self.friction_speed) * speed).reshape(-1))
         # A has the sign of its argument, so the root lies between 0 and y; where rounding says otherwise, a
         # bracket as wide as the assist can be
         try:

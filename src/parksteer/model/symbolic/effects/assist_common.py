@@ -14,6 +14,7 @@ from ..lazy_sympy import sp
 
 from functools import cache
 
+from .... import portable
 from ....boost_table import MAX_POINTS, MAX_SPEEDS, PAD_STEP_MPS, PAD_STEP_NM, table_keys
 from ....parameters import Quantity
 
@@ -40,7 +41,9 @@ def clamp(y, limit, width):
 
 
 def _tanh(x):
-    return sp.tanh(x) if isinstance(x, sp.Basic) else np.tanh(x)
+    # on numbers the portable tanh, the compiled model's own (portable_math.c): the C library's differs in the last
+    # bit from one machine to another
+    return sp.tanh(x) if isinstance(x, sp.Basic) else portable.tanh(x)
 
 
 def directional_efficiency(motor, speed, forward, back, width, sharpness):
