@@ -14,7 +14,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-import sympy as sp
+from ..model.symbolic.lazy_sympy import sp  # sympy on first use: the workflow reads the forms' names
 
 from ..model.symbolic.components import Effect
 from ..model.symbolic.system import action_reaction, torque_between
