@@ -406,21 +406,28 @@ def test_no_module_outside_portable_calls_blas_or_lapack():
     (which go through the BLAS for floats), so that a figure's bytes do not depend on the machine's kernel."""
     import ast
 
-    root = Path(pm.__file__).parents[1]
     found = []
+    for where, node in _nodes_outside_portable():
+        if isinstance(node, ast.BinOp) and isinstance(node.op, ast.MatMult):
+            found.append(f"{where}:{node.lineno}: @")
+        elif (isinstance(node, ast.Attribute) and isinstance(node.value, ast.Attribute)
+              and node.value.attr == "linalg" and node.attr != "LinAlgError"):
+            found.append(f"{where}:{node.lineno}: linalg.{node.attr}")
+        elif (isinstance(node, ast.Attribute) and isinstance(node.value, ast.Name) and node.value.id == "np"
+              and node.attr in ("dot", "matmul", "einsum", "tensordot", "inner", "vdot")):
+            found.append(f"{where}:{node.lineno}: np.{node.attr}")
+    assert not found, "BLAS/LAPACK outside parksteer.portable: " + "; ".join(found)
+
+
+def _nodes_outside_portable():
+    """(the module's path in the package, node) for every syntax node of every module outside ``portable/``."""
+    root = Path(pm.__file__).parents[1]
     for path in sorted(root.rglob("*.py")):
-        if "portable" in path.relative_to(root).parts:
+        where = path.relative_to(root).as_posix()
+        if where.startswith("portable/"):
             continue
         for node in syntax_trees.nodes(path.read_text(encoding="utf-8")):
-            if isinstance(node, ast.BinOp) and isinstance(node.op, ast.MatMult):
-                found.append(f"{path.relative_to(root)}:{node.lineno}: @")
-            elif (isinstance(node, ast.Attribute) and isinstance(node.value, ast.Attribute)
-                  and node.value.attr == "linalg" and node.attr != "LinAlgError"):
-                found.append(f"{path.relative_to(root)}:{node.lineno}: linalg.{node.attr}")
-            elif (isinstance(node, ast.Attribute) and isinstance(node.value, ast.Name) and node.value.id == "np"
-                  and node.attr in ("dot", "matmul", "einsum", "tensordot", "inner", "vdot")):
-                found.append(f"{path.relative_to(root)}:{node.lineno}: np.{node.attr}")
-    assert not found, "BLAS/LAPACK outside parksteer.portable: " + "; ".join(found)
+            yield where, node
 
 
 # numpy's and the math module's elementary functions: numpy's dispatch on the CPU's SIMD level, and the C library's
@@ -445,15 +452,8 @@ def test_no_module_outside_portable_calls_numpys_or_the_c_librarys_elementary_fu
     .ci/other_kernels runs figures again under both held back)."""
     import ast
 
-    root = Path(pm.__file__).parents[1]
-    found = []
-    for path in sorted(root.rglob("*.py")):
-        where = path.relative_to(root).as_posix()
-        if where.startswith("portable/"):
-            continue
-        for node in syntax_trees.nodes(path.read_text(encoding="utf-8")):
-            if (isinstance(node, ast.Attribute) and isinstance(node.value, ast.Name)
-                    and node.value.id in ("np", "numpy", "math") and node.attr in ELEMENTARY
-                    and (where, node.attr) not in ELEMENTARY_ALLOWED):
-                found.append(f"{where}:{node.lineno}: {node.value.id}.{node.attr}")
+    found = [f"{where}:{node.lineno}: {node.value.id}.{node.attr}" for where, node in _nodes_outside_portable()
+             if isinstance(node, ast.Attribute) and isinstance(node.value, ast.Name)
+             and node.value.id in ("np", "numpy", "math") and node.attr in ELEMENTARY
+             and (where, node.attr) not in ELEMENTARY_ALLOWED]
     assert not found, "elementary functions outside parksteer.portable: " + "; ".join(found)

@@ -62,7 +62,7 @@ def test_zero_gain_assist_is_the_manual_steering(params, manual_series):
     assert np.array_equal(assisted.columns["torsion_bar_torque_Nm"], torque)
 
 
-@pytest.mark.slow  # builds the pinion and rack assists' models (not shipped): started early
+@pytest.mark.slow  # six cycles, one model per assist location: started early
 @pytest.mark.parametrize("name", ELECTRIC)
 def test_linear_boost_divides_the_driver_torque_by_one_plus_gain(params, name):
     """Quasi-statically the gear carries the road load as torsion-bar torque plus assist, T_s (1 + G) = T_road,

@@ -95,7 +95,7 @@ def test_tyre_carcass_winds_up_over_about_20_mm_of_rack(nominal, params):
     assert 0.010 <= c["rack_m"][reached] <= 0.030
 
 
-@pytest.mark.slow  # builds a model of its own: started early, so that the workers end together
+@pytest.mark.slow  # eight cycles on two surfaces: started early, so that the workers end together
 def test_offset_changes_torque_little_and_only_through_lifting(params):
     """Figs. 15 and 16: the 68.5 mm spacer (d from 59.5 to 126.4 mm) raises the plateau torque on the ground only a
     little (under 10 % of the total); the change is the lifting share's, which is proportional to d (Appendix A),

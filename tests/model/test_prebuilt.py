@@ -117,22 +117,24 @@ def test_the_paper_model_without_each_of_its_effects_is_shipped():
 _EFFECTS_OPTION = re.compile(r"--effects[ =]([^\s`]+)")
 
 
-def _documented_plain_specs(repo_root) -> set[str]:
-    """The effects specs the documents' shell blocks run that name library effects only (no effect file, no
-    placeholder such as EFFECTS or +NAME)."""
+def _documented_plain_specs() -> set[str]:
+    """The effects specs the documents' shell blocks run (as tests/test_docs.py reads them) that name library
+    effects only (no effect file, no placeholder such as EFFECTS or +NAME)."""
+    from test_docs import documents, parse
+
     specs = set()
-    for page in [repo_root / "README.md", *sorted((repo_root / "docs").glob("*.md"))]:
-        for block in re.findall(r"```sh\n(.*?)```", page.read_text(encoding="utf-8"), flags=re.S):
-            specs |= {spec for spec in _EFFECTS_OPTION.findall(block)
+    for name, text in documents().items():
+        for block in parse(name, text):
+            specs |= {spec for spec in _EFFECTS_OPTION.findall(block.text)
                       if not any(mark in spec for mark in ("/", ".py", "$")) and spec == spec.lower()}
     return specs
 
 
-def test_every_plain_effects_spec_the_documents_run_is_shipped(repo_root):
+def test_every_plain_effects_spec_the_documents_run_is_shipped():
     """A reader running a document's `--effects` example on the paper's car compiles its model and never derives
     it: every spec of library effects in the documents' commands resolves to a shipped model
     (parksteer.commands.model.DOCUMENTED_SPECS ships those no other category does)."""
-    specs = _documented_plain_specs(repo_root)
+    specs = _documented_plain_specs()
     assert "-rack_friction,+kingpin_friction" in specs  # docs/model.md's example is found
     shipped = _shipped()
     missing = sorted(spec for spec in specs if cache.model_key(resolve_effects(spec)) not in shipped)

@@ -19,9 +19,7 @@ import json
 import os
 import shutil
 import signal
-import socket
 import sys
-import tempfile
 import time
 from collections.abc import Iterator
 from contextlib import contextmanager, suppress
@@ -32,7 +30,7 @@ from typing import TYPE_CHECKING
 
 from ...errors import UsageError
 from ...progress import note
-from .compiler import COMPILE_FLAGS, compile_model, find_compiler
+from .compiler import COMPILE_FLAGS, compile_model, find_compiler, scratch_directory, scratch_host
 
 if TYPE_CHECKING:  # the workflow checks cache entries on every run: sympy is imported only to derive or key a model
     from ..symbolic.components import Effect
@@ -302,7 +300,7 @@ def clean_stale_scratch(root: Path) -> list[Path]:
     """Remove scratch directories and build locks of builds that were killed (their process is gone); return what
     was removed."""
     removed = []
-    host = socket.gethostname().replace(".", "-")  # as the scratch name writes it
+    host = scratch_host()  # as the scratch name writes it
     if not root.is_dir():
         return removed
     for path in root.iterdir():
@@ -394,12 +392,11 @@ def _build_entry_into(effects: list[Effect], final: Path) -> Path:
         if entry_is_sound(final):  # built by the process this one waited for
             return final
         clean_stale_scratch(final.parent)
-        host = socket.gethostname().replace(".", "-")
-        scratch = Path(tempfile.mkdtemp(prefix=f".{final.name}.{host}.{os.getpid()}.", dir=final.parent))
+        scratch = scratch_directory(final.parent, final.name)
         try:
             build_entry(effects, scratch, final.name)
             if final.exists() and not entry_is_sound(final):  # damaged or incomplete: replaced by the new build
-                broken = Path(tempfile.mkdtemp(prefix=f".{final.name}.{host}.{os.getpid()}.", dir=final.parent))
+                broken = scratch_directory(final.parent, final.name)
                 os.rename(final, broken / "old")
                 shutil.rmtree(broken, ignore_errors=True)
             try:

@@ -52,11 +52,27 @@ def _compiler_identity(compiler: str) -> str:
     return f"{os.path.realpath(compiler)}\n{version}\n{platform.machine()}\n"
 
 
+def _built_key(compiler: str, flags: tuple[str, ...], source: str) -> str:
+    """Hash of what a file compiled on its own is made of: the compiler, the flags and the C `source`."""
+    digest = hashlib.sha256(_compiler_identity(compiler).encode())
+    digest.update(" ".join(flags).encode() + b"\0" + source.encode())
+    return digest.hexdigest()[:20]
+
+
 def shared_key(compiler: str, name: str) -> str:
     """Hash of the shared object `name`'s source (:data:`.runtime.SHARED_OBJECTS`), the flags and the compiler."""
-    digest = hashlib.sha256(_compiler_identity(compiler).encode())
-    digest.update(" ".join(OPTIMISE_FLAGS).encode() + b"\0" + SHARED_OBJECTS[name][1]().encode())
-    return digest.hexdigest()[:20]
+    return _built_key(compiler, OPTIMISE_FLAGS, SHARED_OBJECTS[name][1]())
+
+
+def scratch_host() -> str:
+    """This machine's name as a build's scratch directory carries it (``cache.clean_stale_scratch`` reads it back)."""
+    return socket.gethostname().replace(".", "-")
+
+
+def scratch_directory(parent: Path, name: str) -> Path:
+    """A new scratch directory in `parent` for building `name`: ``.<name>.<host>.<pid>.<random>``, the name by which
+    ``cache.clean_stale_scratch`` finds a killed build's."""
+    return Path(tempfile.mkdtemp(prefix=f".{name}.{scratch_host()}.{os.getpid()}.", dir=parent))
 
 
 def shared_object(compiler: str, name: str, root: Path, scratch: Path) -> Path:
@@ -84,9 +100,7 @@ def shared_object(compiler: str, name: str, root: Path, scratch: Path) -> Path:
 
 def library_key(compiler: str, source: str) -> str:
     """Hash of a standalone library's C `source`, the flags and the compiler (:func:`standalone_library`)."""
-    digest = hashlib.sha256(_compiler_identity(compiler).encode())
-    digest.update(" ".join(COMPILE_FLAGS).encode() + b"\0" + source.encode())
-    return digest.hexdigest()[:20]
+    return _built_key(compiler, COMPILE_FLAGS, source)
 
 
 def standalone_library(compiler: str, name: str, source: str, what: str, root: Path) -> Path:
@@ -109,8 +123,7 @@ def standalone_library(compiler: str, name: str, source: str, what: str, root: P
         if _library_is_sound(final, digest):
             return final
         note(f"compiling {what}, once for this cache and compiler ({final})")
-        host = socket.gethostname().replace(".", "-")
-        scratch = Path(tempfile.mkdtemp(prefix=f".{stem}.{host}.{os.getpid()}.", dir=root))
+        scratch = scratch_directory(root, stem)
         try:
             c_path, built = scratch / f"{name}.c", scratch / f"{name}.so"
             c_path.write_text(source, encoding="utf-8")

@@ -108,8 +108,13 @@ class BoostLaw:
         """What the gear delivers per motor torque, in the direction the power flows (eta_f driving, 1 / eta_b
         back-driven; :func:`~parksteer.model.symbolic.effects.assist_common.directional_efficiency`), the rotor
         turning at `rotor_speed` (rad/s)."""
-        direction = pm.tanh((1.0 / self.friction_speed) * np.asarray(rotor_speed, dtype=float))
-        return directional_efficiency(motor, direction, self.efficiency, self.back_efficiency, self.direction_width)
+        return directional_efficiency(motor, self._direction(rotor_speed), self.efficiency, self.back_efficiency,
+                                      self.direction_width)
+
+    def _direction(self, rotor_speed):
+        """The gear's direction of power flow tanh(omega / w) at `rotor_speed` (rad/s), with the portable tanh
+        (:mod:`parksteer.portable`: the compiled model's own, not the C library's)."""
+        return pm.tanh((1.0 / self.friction_speed) * np.asarray(rotor_speed, dtype=float))
 
     def assist(self, torsion_bar_Nm, rotor_speed=0.0):
         """A(T_s): the assist in torsion-bar torque units (what it adds to the torsion bar's torque in y), with the
@@ -137,8 +142,7 @@ class BoostLaw:
         square roots: the same bits on any machine.
 
         Each sample is solved on its own in compiled C (:mod:`.torsion_bar`, ``torsion_bar.c``, which writes the
-        law once); the gear's direction tanh(omega / w) at each sample's rotor speed is read here, once a call, with the
-        portable tanh (:mod:`parksteer.portable`: the compiled model's own, not the C library's)."""
+        law once); the gear's direction at each sample's rotor speed is read here, once a call (:meth:`_direction`)."""
         y = np.asarray(y, dtype=float)
         samples = np.ascontiguousarray(y.reshape(-1))
         gains = np.asarray(factor, dtype=float)
@@ -150,7 +154,7 @@ class BoostLaw:
             if self.back_efficiency == 0.0:
                 raise ZeroDivisionError("back_efficiency 0: a back-driven gear delivering 1 / 0 of the motor torque")
             speed = np.array(np.broadcast_to(np.asarray(rotor_speed, dtype=float), y.shape))
-            direction = np.ascontiguousarray(pm.tanh((1.0 / self.friction_speed) * speed).reshape(-1))
+            direction = np.ascontiguousarray(self._direction(speed).reshape(-1))
         # A has the sign of its argument, so the root lies between 0 and y; where rounding says otherwise, a
         # bracket as wide as the assist can be
         try:
