@@ -23,8 +23,6 @@ STALES_PRE_DERIVED = "splitting stales the pre-derived models; next regeneration
 NOT_YET_SPLIT = "not yet split by job"
 NOT_YET_CUT = "not yet cut into named steps"
 EXCEPTIONS: dict[str, tuple[int, str]] = {
-    "parksteer/model/codegen/cache.py": (480, "the cache and the pre-derived models; not yet split (keyless: splitting "
-                                             "it stales nothing)"),
     "parksteer/model/symbolic/system.py": (464, STALES_PRE_DERIVED),
     "parksteer/diagnose/identify/assist_identify.py:identify_boost": (194, f"the assist's identification; {NOT_YET_CUT}"),
     "parksteer/diagnose/suggest.py:effect_source": (113, f"the suggested effect's source text; {NOT_YET_CUT}"),

@@ -9,7 +9,7 @@ Snakemake compares timestamps only, so a truncated output newer than its inputs 
   the sympy in use), or whose cache entry is missing or fails its SHA-256 check: a manifest is trusted only if
   what it points at is sound and current;
 - temporary files of writers that were killed (:func:`parksteer.tables.remove_stale_temporaries`) and scratch
-  directories of killed model builds (:func:`parksteer.model.codegen.cache.clean_stale_scratch`);
+  directories of killed model builds (:func:`parksteer.model.codegen.scratch.clean_stale_scratch`);
 - Snakemake's lock (.snakemake/locks) when no Snakemake process runs in the folder any more. A run started from
   another host on a shared file system cannot be seen from here: do not run one folder from two hosts at once.
 The next Snakemake run treats what was removed as any missing file: a missing target is built, a missing
@@ -26,7 +26,8 @@ from collections.abc import Iterator
 from pathlib import Path
 
 from .checksums import integrity_problem
-from .model.codegen.cache import cache_root, clean_stale_scratch, entry_is_sound
+from .model.codegen.cache import cache_root, entry_is_sound
+from .model.codegen.scratch import clean_stale_scratch
 from .tables import ROWS_KEY, remove_stale_temporaries
 
 CHECKED_SUFFIXES = (".csv", ".svg", ".json", ".ipynb", ".pdf")

@@ -13,7 +13,7 @@ import pytest
 
 from parksteer.measure.rack_spline import interpolate_rack
 from parksteer.model.codegen import cache, compiler
-from parksteer.model.codegen.runtime import HERE, RUNTIME_FILES
+from parksteer.model.codegen.runtime import HERE, RUNTIME_FILES, WITH_TANGENT
 from parksteer.model.numeric.compiled import load_entry
 from parksteer.model.numeric.sensitivities import parameter_directions, solve_sensitivities
 from parksteer.model.numeric.simulate import integrate, prepare
@@ -30,15 +30,16 @@ def cache_dir(tmp_path, monkeypatch):
 
 def _one_translation_unit(entry, folder):
     """The entry's model compiled with the runtime's text after it in one file, as every model was built before the
-    runtime was compiled apart: NQ, NOUT, ... are the model's constants there. Assembled here from the C files, not
-    through runtime.runtime_source, so that the reference does not share the code it checks."""
+    runtime was compiled apart: NQ, NOUT, ... are the model's constants there, and the tangent is compiled in.
+    Assembled here from the C files, not through runtime.runtime_source, so that the reference does not share the
+    code it checks."""
     folder.mkdir()
     text = (entry / "model.c").read_text(encoding="utf-8")
     text += "".join("\n" + (HERE / name).read_text(encoding="utf-8") for name in RUNTIME_FILES)
     (folder / "model.c").write_text(text, encoding="utf-8")
     shutil.copy(entry / "model.json", folder / "model.json")
-    cmd = [compiler.find_compiler(), *compiler.COMPILE_FLAGS, "-o", str(folder / "model.so"), str(folder / "model.c"),
-           "-lm"]
+    cmd = [compiler.find_compiler(), *compiler.COMPILE_FLAGS, f"-D{WITH_TANGENT}", "-o", str(folder / "model.so"),
+           str(folder / "model.c"), "-lm"]
     compiler.run_compiler(cmd, "the model in one translation unit")
     return load_entry(folder)
 
@@ -46,8 +47,9 @@ def _one_translation_unit(entry, folder):
 def test_the_runtime_compiled_apart_gives_the_bits_of_one_translation_unit(cache_dir, tmp_path):
     """The paper's cycle integrated handwheel-driven (mass matrix, Cholesky solves, the analytic Jacobian, the
     integrator), its outputs, and a prescribed-rack solve with its forward sensitivities (the drive, the LU solves,
-    the tangent) are the same bits whether the runtime knows the model's dimensions at compile time or reads them
-    at run time: IEEE arithmetic in the same order, no fused multiply-add at any level."""
+    the tangent, from the model's second library) are the same bits whether the runtime knows the model's
+    dimensions at compile time or reads them at run time: IEEE arithmetic in the same order, no fused multiply-add
+    at any level."""
     run = prepare("unladen")
     alone = dataclasses.replace(run, model=_one_translation_unit(run.model.directory, tmp_path / "one"))
     t = np.round(np.arange(0.0, run.profile.end_time_s + 0.005, 0.01), 12)
@@ -92,6 +94,29 @@ def test_models_built_side_by_side_on_an_empty_cache_compile_the_runtime_once(ca
     assert [b.exitcode for b in builders] == [0, 0, 0]
     assert all(cache.entry_is_sound(cache.entry_path(effects)) for effects in sets)
     assert capfd.readouterr().err.count("compiling the models' runtime") == 1
+
+
+def test_the_runtime_compiles_beside_the_first_models_object_not_after_it(cache_dir, tmp_path, monkeypatch):
+    """On an empty cache a model's build starts its own object's compile and meanwhile compiles the missing runtime:
+    the two run side by side. The compiler here is a wrapper that logs each compile and holds the model's until the
+    runtime's has ended (giving up after 30 s): built one after the other, the log would read model, then runtime."""
+    log, wrapper = tmp_path / "compiles.log", tmp_path / "cc"
+    wrapper.write_text(f"""#!/bin/sh
+case "$*" in
+*" -c "*model.c*)
+  echo start model >> {log}
+  i=0; while ! grep -q "end runtime" {log} && [ $i -lt 300 ]; do sleep 0.1; i=$((i + 1)); done
+  "{compiler.find_compiler()}" "$@"; status=$?; echo end model >> {log}; exit $status;;
+*" -c "*runtime.c*)
+  echo start runtime >> {log}; "{compiler.find_compiler()}" "$@"; status=$?; echo end runtime >> {log}; exit $status;;
+esac
+exec "{compiler.find_compiler()}" "$@"
+""", encoding="utf-8")
+    wrapper.chmod(0o755)
+    monkeypatch.setenv("CC", str(wrapper))
+    assert cache.ensure(resolve_effects(None))["built_now"]
+    assert log.read_text(encoding="utf-8").split("\n") == ["start model", "start runtime", "end runtime", "end model",
+                                                            ""]
 
 
 def test_the_shipped_boost_table_is_the_law_as_printed():

@@ -12,7 +12,6 @@ user's cache directory. :func:`ensure` is the one way to get a model built and d
 from __future__ import annotations
 
 import errno
-import fcntl
 import hashlib
 import inspect
 import json
@@ -21,8 +20,7 @@ import shutil
 import signal
 import sys
 import time
-from collections.abc import Iterator
-from contextlib import contextmanager, suppress
+from contextlib import suppress
 from functools import lru_cache
 from importlib import metadata
 from pathlib import Path
@@ -30,7 +28,8 @@ from typing import TYPE_CHECKING
 
 from ...errors import UsageError
 from ...progress import note
-from .compiler import COMPILE_FLAGS, compile_model, find_compiler, scratch_directory, scratch_host
+from .compiler import COMPILE_FLAGS, compile_model, find_compiler, tangent_library
+from .scratch import build_lock, clean_stale_scratch, scratch_directory
 
 if TYPE_CHECKING:  # the workflow checks cache entries on every run: sympy is imported only to derive or key a model
     from ..symbolic.components import Effect
@@ -45,6 +44,7 @@ KEYED_FILES = (MODEL_DIR.parent / "names.py",)
 # These modules store and compile entries and generate nothing, so their source is not part of the key (the flags
 # are).
 KEYLESS_SOURCES = (Path(__file__).resolve(), Path(__file__).resolve().with_name("compiler.py"),
+                   Path(__file__).resolve().with_name("scratch.py"),
                    # printed from the keyed symbolic half and checked against it where a model is derived
                    Path(__file__).resolve().with_name("boost_table.c"))
 # Built files whose SHA-256 model.json records: an entry is used only if both exist and match.
@@ -53,9 +53,6 @@ BUILT_FILES = ("model.c", "model.so")
 # a car with the default effects builds, named by their cache keys (`parksteer derive --prebuilt` writes them; the
 # tests derive each again and compare the bytes). Outside the symbolic half, so they are not part of any key.
 PREBUILT_DIR = MODEL_DIR / "prebuilt"
-# A scratch directory (".<key>.<host>.<pid>.<random>") whose builder is gone is removed by the next build; one
-# from another host (a shared cache on a cluster) only once it is older than any build could take.
-STALE_SCRATCH_S = 6 * 3600.0
 
 
 @lru_cache(maxsize=1)
@@ -271,90 +268,6 @@ def entry_is_sound(directory: Path) -> bool:
         return False
 
 
-def _alive(pid: int) -> bool:
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except PermissionError:
-        return True
-    return True
-
-
-def _unheld(lock: Path) -> bool:
-    """Whether no process holds the build lock `lock` now."""
-    try:
-        fd = os.open(lock, os.O_RDWR)
-    except OSError:
-        return False
-    try:
-        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        return True
-    except BlockingIOError:
-        return False
-    finally:
-        os.close(fd)
-
-
-def clean_stale_scratch(root: Path) -> list[Path]:
-    """Remove scratch directories and build locks of builds that were killed (their process is gone); return what
-    was removed."""
-    removed = []
-    host = scratch_host()  # as the scratch name writes it
-    if not root.is_dir():
-        return removed
-    for path in root.iterdir():
-        parts = path.name.split(".")
-        if path.name.startswith(".") and path.name.endswith(".lock") and _unheld(path):
-            with suppress(FileNotFoundError):
-                path.unlink()  # the build lock of a killed build
-            removed.append(path)
-            continue
-        if not (path.name.startswith(".") and len(parts) >= 5 and path.is_dir()):
-            continue
-        _, _key, owner_host, pid, *_ = parts
-        try:
-            age = time.time() - path.stat().st_mtime
-        except OSError:
-            continue
-        if not pid.isdigit():
-            continue
-        stale = (owner_host == host and not _alive(int(pid))) or age > STALE_SCRATCH_S
-        if stale:
-            shutil.rmtree(path, ignore_errors=True)
-            removed.append(path)
-    return removed
-
-
-@contextmanager
-def _build_lock(final: Path) -> Iterator[None]:
-    """Hold the build of one cache entry: processes that need the same model at the same time build it once, the
-    others wait here and then find it built. The lock file goes when its holder is done (a waiter that wakes on a
-    removed file takes the lock again on the new one)."""
-    path = final.parent / f".{final.name}.lock"
-    while True:
-        fd = os.open(path, os.O_CREAT | os.O_RDWR, 0o644)
-        try:
-            try:
-                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-            except BlockingIOError:
-                note(f"another process is building the model {final.name}: waiting for it")
-                fcntl.flock(fd, fcntl.LOCK_EX)
-            try:
-                current = os.stat(path).st_ino == os.fstat(fd).st_ino
-            except FileNotFoundError:
-                current = False
-            if current:
-                try:
-                    yield
-                finally:
-                    with suppress(FileNotFoundError):
-                        os.unlink(path)
-                return
-        finally:
-            os.close(fd)
-
-
 # What a cache folder that cannot be written raises: read-only, no permission, no space or quota, a file in the path.
 CACHE_WRITE_ERRNOS = {errno.EROFS, errno.EACCES, errno.EPERM, errno.ENOSPC, errno.EDQUOT, errno.ENOTDIR, errno.EEXIST}
 
@@ -386,9 +299,21 @@ def ensure_entry(effects: list[Effect], final: Path | None = None) -> Path:
         raise cache_write_error(final.parent, exc) from None
 
 
+def ensure_tangent_library(directory: Path, info: dict) -> Path:
+    """The library of the cache entry `directory` (its description `info`) with the model's tangent compiled in,
+    which only the forward sensitivities call (:func:`.compiler.tangent_library`), compiled on first use; a cache
+    that cannot be written is one line (:func:`cache_write_error`)."""
+    try:
+        return tangent_library(find_compiler(), directory, tuple(info.get("shared_objects", ())))
+    except OSError as exc:
+        if exc.errno not in CACHE_WRITE_ERRNOS:
+            raise
+        raise cache_write_error(directory.parent, exc) from None
+
+
 def _build_entry_into(effects: list[Effect], final: Path) -> Path:
     final.parent.mkdir(parents=True, exist_ok=True)
-    with _build_lock(final):
+    with build_lock(final):
         if entry_is_sound(final):  # built by the process this one waited for
             return final
         clean_stale_scratch(final.parent)

@@ -6,7 +6,9 @@ once per cache and compiler, into ``runtime/<key>.o`` beside the cache's entries
 file (:data:`.runtime.SHARED_OBJECTS`). An object is compiled in the building entry's scratch directory, under a
 lock, and renamed into place whole, so a killed build leaves no half of one and builders side by side compile it
 once. C that no model links (the assisted replay's torsion-bar inversion, ``model/numeric/torsion_bar.c``) is
-compiled alike into a library of its own, ``runtime/<name>-<key>.so`` (:func:`standalone_library`).
+compiled alike into a library of its own, ``runtime/<name>-<key>.so`` (:func:`standalone_library`), and a model's
+tangent, which only the forward sensitivities call, into a second library of the model's entry on first use
+(:func:`tangent_library`).
 """
 
 from __future__ import annotations
@@ -17,16 +19,15 @@ import hashlib
 import os
 import platform
 import shutil
-import socket
 import subprocess
-import tempfile
 from contextlib import suppress
 from functools import lru_cache
 from pathlib import Path
 
 from ...errors import UsageError
 from ...progress import note
-from .runtime import SHARED_OBJECTS, check_portable
+from .runtime import SHARED_OBJECTS, WITH_TANGENT, check_portable
+from .scratch import scratch_directory
 
 # How the C is compiled; part of the model key. -O1: integrates these models about as fast as -O2 and compiles in
 # less time. -ffp-contract=off: no fused multiply-add, which GCC otherwise forms wherever the target has one
@@ -64,17 +65,6 @@ def shared_key(compiler: str, name: str) -> str:
     return _built_key(compiler, OPTIMISE_FLAGS, SHARED_OBJECTS[name][1]())
 
 
-def scratch_host() -> str:
-    """This machine's name as a build's scratch directory carries it (``cache.clean_stale_scratch`` reads it back)."""
-    return socket.gethostname().replace(".", "-")
-
-
-def scratch_directory(parent: Path, name: str) -> Path:
-    """A new scratch directory in `parent` for building `name`: ``.<name>.<host>.<pid>.<random>``, the name by which
-    ``cache.clean_stale_scratch`` finds a killed build's."""
-    return Path(tempfile.mkdtemp(prefix=f".{name}.{scratch_host()}.{os.getpid()}.", dir=parent))
-
-
 def shared_object(compiler: str, name: str, root: Path, scratch: Path) -> Path:
     """The shared object `name` (:data:`.runtime.SHARED_OBJECTS`) compiled by `compiler` for the cache `root`:
     root/runtime/<key>.o, compiled in `scratch` and renamed into place if it is not there yet. Builders that need it
@@ -105,15 +95,42 @@ def library_key(compiler: str, source: str) -> str:
 
 def standalone_library(compiler: str, name: str, source: str, what: str, root: Path) -> Path:
     """The C `source` (`what` it is) compiled on its own by `compiler` into a shared library for the cache `root`:
-    root/runtime/<name>-<key>.so (:func:`library_key`), with the SHA-256 of its bytes beside it (.sha256), compiled
-    if it is not there yet or its bytes are not the ones recorded (a damaged or truncated file). It is compiled in a
-    scratch folder of `root` named as the cache's builds name theirs (``cache.clean_stale_scratch`` removes a
-    killed build's), under a lock the kernel releases when its holder ends (builders side by side compile it once),
-    and renamed into place whole, its digest first: a killed build leaves no half of it, nor a library without its
-    digest."""
+    root/runtime/<name>-<key>.so (:func:`library_key`), built once (:func:`_library_once`)."""
     check_portable(source)
     stem = f"{name}-{library_key(compiler, source)}"
-    final = root / RUNTIME_FOLDER / f"{stem}.so"
+
+    def build(scratch: Path) -> Path:
+        c_path, built = scratch / f"{name}.c", scratch / f"{name}.so"
+        c_path.write_text(source, encoding="utf-8")
+        run_compiler([compiler, *COMPILE_FLAGS, "-o", str(built), str(c_path), "-lm"], what)
+        return built
+
+    return _library_once(root / RUNTIME_FOLDER / f"{stem}.so", what, root, stem, build)
+
+
+def tangent_library(compiler: str, entry: Path, shared: tuple[str, ...] = ()) -> Path:
+    """The library of the model in the cache entry `entry` with its tangent compiled in (its model.c compiled with
+    :data:`.runtime.WITH_TANGENT` defined, linked as :func:`compile_model` links the model's own library), which
+    the forward sensitivities call: entry/model_tangent.so, built once (:func:`_library_once`). The model's C is
+    read from the entry, whose digests the caller has checked."""
+
+    def build(scratch: Path) -> Path:
+        c_path, built = scratch / "model.c", scratch / "model_tangent.so"
+        shutil.copyfile(entry / "model.c", c_path)
+        compile_model(compiler, c_path, built, entry.parent, shared, (f"-D{WITH_TANGENT}",))
+        return built
+
+    return _library_once(entry / "model_tangent.so", "the model's tangent (its forward sensitivities)", entry.parent,
+                         f"{entry.name}-tangent", build)
+
+
+def _library_once(final: Path, what: str, root: Path, stem: str, build) -> Path:
+    """The library `final` (`what` it is), with the SHA-256 of its bytes beside it (.sha256): as it is, or built
+    by `build` (given a new scratch folder of the cache `root`, named from `stem` as the cache's builds name theirs,
+    so that ``scratch.clean_stale_scratch`` removes a killed build's; it returns the library it built there) if it is
+    not there yet or its bytes are not the ones recorded (a damaged or truncated file). The build runs under a lock
+    the kernel releases when its holder ends (builders side by side build it once), and its library is renamed into
+    place whole, its digest first: a killed build leaves no half of it, nor a library without its digest."""
     digest = final.with_suffix(".sha256")
     if _library_is_sound(final, digest):
         return final
@@ -125,9 +142,7 @@ def standalone_library(compiler: str, name: str, source: str, what: str, root: P
         note(f"compiling {what}, once for this cache and compiler ({final})")
         scratch = scratch_directory(root, stem)
         try:
-            c_path, built = scratch / f"{name}.c", scratch / f"{name}.so"
-            c_path.write_text(source, encoding="utf-8")
-            run_compiler([compiler, *COMPILE_FLAGS, "-o", str(built), str(c_path), "-lm"], what)
+            built = build(scratch)
             (scratch / "sha256").write_text(hashlib.sha256(built.read_bytes()).hexdigest(), encoding="utf-8")
             os.replace(scratch / "sha256", digest)
             os.replace(built, final)
@@ -144,16 +159,24 @@ def _library_is_sound(library: Path, digest: Path) -> bool:
         return False
 
 
-def compile_model(compiler: str, c_path: Path, so_path: Path, root: Path, shared: tuple[str, ...] = ()) -> None:
-    """Compile the generated `c_path` and link it with the runtime and the `shared` objects it names into `so_path`
-    (the cache `root` holds the shared objects; `c_path`'s folder is the build's scratch). The model's own object is
-    compiled first, so that builders side by side compile their models while one of them compiles a missing shared
-    object."""
+def compile_model(compiler: str, c_path: Path, so_path: Path, root: Path, shared: tuple[str, ...] = (),
+                  defines: tuple[str, ...] = ()) -> None:
+    """Compile the generated `c_path` (with the macro `defines`, e.g. ``-DPS_WITH_TANGENT``) and link it with the
+    runtime and the `shared` objects it names into `so_path` (the cache `root` holds the shared objects; `c_path`'s
+    folder is the build's scratch). The model's own object compiles while this builder finds the shared objects or
+    compiles a missing one (:func:`shared_object`), so that on an empty cache the runtime's compile runs beside the
+    models' rather than after the first of them."""
     model_object = c_path.with_suffix(".o")
-    compile_object(compiler, c_path, model_object, "the generated model")
+    compiling = start_compiler(object_command(compiler, c_path, model_object, defines))
     names = ("runtime", *shared)
-    for attempt in (1, 2):
+    try:
         objects = [shared_object(compiler, name, root, c_path.parent) for name in names]
+    except BaseException:
+        compiling.kill()
+        compiling.communicate()
+        raise
+    finish_compiler(compiling, "the generated model")
+    for attempt in (1, 2):
         try:
             run_compiler([compiler, "-shared", "-o", str(so_path), str(model_object), *map(str, objects), "-lm"],
                          "the model's library")
@@ -165,19 +188,36 @@ def compile_model(compiler: str, c_path: Path, so_path: Path, root: Path, shared
             for path in objects:
                 with suppress(FileNotFoundError):
                     path.unlink()
+            objects = [shared_object(compiler, name, root, c_path.parent) for name in names]
     model_object.unlink()
+
+
+def object_command(compiler: str, source: Path, built: Path, defines: tuple[str, ...] = ()) -> list[str]:
+    """The command that compiles the C file `source` (with the macro `defines`) into the position-independent
+    object `built`."""
+    return [compiler, *OPTIMISE_FLAGS, *defines, "-fPIC", "-c", "-o", str(built), str(source)]
 
 
 def compile_object(compiler: str, source: Path, built: Path, what: str) -> None:
     """Compile the C file `source` (`what` it is, for an error) into the position-independent object `built`."""
-    run_compiler([compiler, *OPTIMISE_FLAGS, "-fPIC", "-c", "-o", str(built), str(source)], what)
+    run_compiler(object_command(compiler, source, built), what)
 
 
 def run_compiler(cmd: list[str], what: str) -> None:
     """Run the compiler command `cmd` on `what`; a failure is one line (its first), a full disk an OSError."""
-    done = subprocess.run(cmd, capture_output=True, text=True)
-    if done.returncode != 0:
-        if "No space left on device" in done.stderr:  # the library could not be written: the cache's disk is full
+    finish_compiler(start_compiler(cmd), what)
+
+
+def start_compiler(cmd: list[str]) -> subprocess.Popen:
+    """The compiler command `cmd`, started (:func:`finish_compiler` waits for it)."""
+    return subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+
+
+def finish_compiler(process: subprocess.Popen, what: str) -> None:
+    """Wait for the compiler `process` (on `what`); a failure is one line (its first), a full disk an OSError."""
+    _, stderr = process.communicate()
+    if process.returncode != 0:
+        if "No space left on device" in stderr:  # the library could not be written: the cache's disk is full
             raise OSError(errno.ENOSPC, "No space left on device")
-        first = (done.stderr.strip().splitlines() or ["unknown error"])[0]
+        first = (stderr.strip().splitlines() or ["unknown error"])[0]
         raise UsageError(f"C compiler failed on {what}: {first}")

@@ -38,6 +38,10 @@ MODEL_FUNCTIONS = {
 # reordered or carried in another precision without -ffast-math.
 UNOPTIMISED = '__attribute__((optimize("O0"))) '
 COMPILED_UNOPTIMISED = frozenset({"eval_jac", "eval_tangent"})
+# The macro under which a model's eval_tangent is compiled. Only the optional exact Jacobians integrate sensitivities,
+# so a model's library is compiled without it (a stub, PS_SENSITIVITIES 0: a third less of the compiler's time a
+# model) and a second library with it on first use (compiler.tangent_library).
+WITH_TANGENT = "PS_WITH_TANGENT"
 # The dimensions a model's header defines and the runtime reads from it.
 DIMENSIONS = ("NQ", "NY", "NOUT", "INPUT_OFFSET", "MAX_PIECES", "RACK", "OUT_COLUMN_ANGLE", "OUT_COLUMN_TORQUE",
               "PS_SENSITIVITIES")

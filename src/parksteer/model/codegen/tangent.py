@@ -11,9 +11,12 @@ from __future__ import annotations
 import sympy as sp
 
 from ..symbolic.derive import Derivation, memoised_diff
-from .runtime import model_function
+from .runtime import WITH_TANGENT, model_function
 
-
+# A model without the tangent: the runtime's sensitivities return -1 (PS_SENSITIVITIES 0) and never call the stub.
+NO_TANGENT = "#define PS_SENSITIVITIES 0\n" + model_function(
+    "eval_tangent", ["    (void)q; (void)u; (void)a; (void)p; (void)T; (void)th; (void)thd; (void)m; (void)dy; "
+                     "(void)dps; (void)dG; (void)dH;"])
 
 def _directional_block(expressions: list[sp.Expr], directions: dict[sp.Symbol, sp.Symbol], targets: list[str],
                        printer, loop: str) -> list[str]:
@@ -55,11 +58,10 @@ def tangent_function(derivation: Derivation, plain: dict, F_drive, F_full, M, bc
     the prescribed-rack residual G = F_drive + b T - M a (the column torque T and the accelerations a held) and of
     the full forcing F (the statics' residual, at the handwheel input th, thd), the directions' values computed
     once. The forward sensitivities of the prescribed-rack solve are made of them (sensitivities.c's
-    ps_prescribed_tangent, ps_forcing_tangent)."""
+    ps_prescribed_tangent, ps_forcing_tangent). It is compiled only where the macro WITH_TANGENT is defined
+    (:func:`.compiler.tangent_library`): the model's own library, which every replay loads, has the stub instead."""
     if drive_hand:  # an assist's drive, written at zero handwheel input, has no sensitivities
-        return "#define PS_SENSITIVITIES 0\n" + model_function(
-            "eval_tangent", ["    (void)q; (void)u; (void)a; (void)p; (void)T; (void)th; (void)thd; (void)m; "
-                             "(void)dy; (void)dps; (void)dG; (void)dH;"])
+        return NO_TANGENT
     space = derivation.space
     n = len(space.coordinates)
     torque = sp.Symbol("T", real=True)
@@ -72,4 +74,5 @@ def tangent_function(derivation: Derivation, plain: dict, F_drive, F_full, M, bc
     loop = ("for (int k = 0; k < m; k++) {\n        const double *dq = dy + k * NY, *du = dq + NQ, *dp = dps[k];"
             "\n        (void)dq; (void)du; (void)dp;")  # the loop's head and the direction's arrays
     lines = _directional_block(residual + list(F_full), directions, targets, printer, loop)
-    return "#define PS_SENSITIVITIES 1\n" + model_function("eval_tangent", lines)
+    return (f"#ifdef {WITH_TANGENT}\n#define PS_SENSITIVITIES 1\n" + model_function("eval_tangent", lines)
+            + f"#else\n{NO_TANGENT}#endif\n")

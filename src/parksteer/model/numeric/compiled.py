@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..codegen.cache import ensure_entry, entry_path
+from ..codegen.cache import ensure_entry, ensure_tangent_library, entry_path
 from ..symbolic.components import Effect
 
 
@@ -42,6 +42,16 @@ class CompiledModel:
 
     def index(self, coordinate: str) -> int:
         return self.coordinates.index(coordinate)
+
+    @cached_property
+    def with_tangent(self) -> CompiledModel:
+        """This model from its library with the tangent compiled in (eval_tangent, which the forward sensitivities
+        call; the model's own library has a stub), compiled into the entry on first use. A model whose library has
+        the tangent already, or whose generated C has none (an assist's drive: ``rack_drive`` false), is itself."""
+        if self.lib.ps_sensitivities_available() or not self.info.get("rack_drive", True):
+            return self
+        library = ensure_tangent_library(self.directory, self.info)
+        return CompiledModel(self.directory, self.info, bind(ctypes.CDLL(str(library))))
 
     @cached_property
     def parameter_positions(self) -> dict[str, int]:
@@ -117,6 +127,36 @@ class CompiledModel:
         return {name: out[:, i] for i, name in enumerate(self.outputs)}
 
 
+def bind(lib: ctypes.CDLL) -> ctypes.CDLL:
+    """`lib`, a model's library (its own or its tangent's), with the C signatures of the runtime's functions."""
+    vp, dbl, i32 = ctypes.c_void_p, ctypes.c_double, ctypes.c_int
+    for name, restype, args in (
+        ("ps_rhs", i32, [dbl, vp, vp, vp]),
+        ("ps_jac", i32, [dbl, vp, vp, vp]),
+        ("ps_forcing", None, [dbl, vp, vp, vp]),
+        ("ps_forcing_dq", None, [dbl, vp, vp, vp]),
+        ("ps_drive", None, [vp, vp, vp, vp, vp]),
+        ("ps_handwheel", None, [dbl, vp, vp, vp]),
+        ("ps_outputs", i32, [i32, vp, vp, vp, vp, vp, vp]),
+        ("ps_rack", None, [dbl, vp, vp]),
+        ("ps_prescribed_rhs", i32, [dbl, vp, vp, vp, vp]),
+        ("ps_prescribed_jac", i32, [dbl, vp, vp, vp, vp, vp]),
+        ("ps_prescribed_samples", i32, [i32, vp, vp, vp, vp, vp, vp, vp]),
+        ("ps_integrate", i32, [vp, vp, i32, vp, i32, vp, dbl, vp, ctypes.c_long, vp, vp]),
+        ("ps_integrate_prescribed", i32, [vp, vp, vp, vp, i32, vp, i32, vp, dbl, vp, ctypes.c_long, vp, vp]),
+        ("ps_sensitivities_available", i32, []),
+        ("ps_prescribed_tangent", i32, [dbl, vp, vp, vp, i32, vp, vp, vp, vp]),
+        ("ps_forcing_tangent", i32, [dbl, vp, vp, i32, vp, vp]),
+        ("ps_integrate_prescribed_sens", i32, [vp, vp, vp, vp, i32, vp, i32, vp, dbl, vp, ctypes.c_long, vp, vp,
+                                               i32, vp, vp, vp]),
+        ("ps_prescribed_torque_sens", i32, [i32, vp, vp, vp, vp, vp, i32, vp, vp]),
+    ):
+        function = getattr(lib, name)
+        function.restype = restype
+        function.argtypes = args
+    return lib
+
+
 class CompiledModels:
     """The compiled models one owner has loaded (a diagnosis's replay engine, or one call of :func:`load_model`), by
     cache entry: each entry's library is loaded once, and an entry loaded is used again without re-checking its
@@ -131,32 +171,7 @@ class CompiledModels:
         if directory in self.loaded:
             return self.loaded[directory]
         info = json.loads((directory / "model.json").read_text(encoding="utf-8"))
-        lib = ctypes.CDLL(str(directory / "model.so"))
-        vp, dbl, i32 = ctypes.c_void_p, ctypes.c_double, ctypes.c_int
-        for name, restype, args in (
-            ("ps_rhs", i32, [dbl, vp, vp, vp]),
-            ("ps_jac", i32, [dbl, vp, vp, vp]),
-            ("ps_forcing", None, [dbl, vp, vp, vp]),
-            ("ps_forcing_dq", None, [dbl, vp, vp, vp]),
-            ("ps_drive", None, [vp, vp, vp, vp, vp]),
-            ("ps_handwheel", None, [dbl, vp, vp, vp]),
-            ("ps_outputs", i32, [i32, vp, vp, vp, vp, vp, vp]),
-            ("ps_rack", None, [dbl, vp, vp]),
-            ("ps_prescribed_rhs", i32, [dbl, vp, vp, vp, vp]),
-            ("ps_prescribed_jac", i32, [dbl, vp, vp, vp, vp, vp]),
-            ("ps_prescribed_samples", i32, [i32, vp, vp, vp, vp, vp, vp, vp]),
-            ("ps_integrate", i32, [vp, vp, i32, vp, i32, vp, dbl, vp, ctypes.c_long, vp, vp]),
-            ("ps_integrate_prescribed", i32, [vp, vp, vp, vp, i32, vp, i32, vp, dbl, vp, ctypes.c_long, vp, vp]),
-            ("ps_sensitivities_available", i32, []),
-            ("ps_prescribed_tangent", i32, [dbl, vp, vp, vp, i32, vp, vp, vp, vp]),
-            ("ps_forcing_tangent", i32, [dbl, vp, vp, i32, vp, vp]),
-            ("ps_integrate_prescribed_sens", i32, [vp, vp, vp, vp, i32, vp, i32, vp, dbl, vp, ctypes.c_long, vp, vp,
-                                                   i32, vp, vp, vp]),
-            ("ps_prescribed_torque_sens", i32, [i32, vp, vp, vp, vp, vp, i32, vp, vp]),
-        ):
-            function = getattr(lib, name)
-            function.restype = restype
-            function.argtypes = args
+        lib = bind(ctypes.CDLL(str(directory / "model.so")))
         self.loaded[directory] = CompiledModel(directory, info, lib)
         return self.loaded[directory]
 

@@ -4,9 +4,10 @@ chosen parameters, from one integration.
 Beside the reduced state z (the coordinates other than the rack, and their speeds), the compiled integrator carries
 S = dz/dp . v for each parameter direction v (``ps_integrate_prescribed_sens``: the staggered direct method on the
 same steps, the sensitivity equations S' = J S + f_p v derived by sympy from the same expressions as the model,
-``eval_tangent``); the torque's derivative is h_z S + h_p v at each output (``ps_prescribed_torque_sens``). The
-state starts from the static equilibrium with the rack held, so S starts from that equilibrium's derivative,
-dq_o/dp = -(df/dq_o)^-1 df/dp (the implicit function theorem on the statics' equations). The steps, and so every
+``eval_tangent``, which the model's second library holds: :attr:`.compiled.CompiledModel.with_tangent`); the
+torque's derivative is h_z S + h_p v at each output (``ps_prescribed_torque_sens``). The state starts from the
+static equilibrium with the rack held, so S starts from that equilibrium's derivative, dq_o/dp = -(df/dq_o)^-1 df/dp
+(the implicit function theorem on the statics' equations). The steps, and so every
 byte of the torque, are those of :func:`parksteer.model.numeric.prescribed.solve`. The method: docs/model.md,
 "Forward sensitivities".
 
@@ -57,8 +58,8 @@ def initial_sensitivities(run, p: np.ndarray, y_static: np.ndarray, directions: 
     others = [i for i in range(n) if i != model.index("rack")]
     m = len(directions)
     dF = np.empty((m, n))
-    if model.lib.ps_forcing_tangent(0.0, y_static.ctypes.data, p.ctypes.data, m, directions.ctypes.data,
-                                    dF.ctypes.data):
+    if model.with_tangent.lib.ps_forcing_tangent(0.0, y_static.ctypes.data, p.ctypes.data, m,
+                                                 directions.ctypes.data, dF.ctypes.data):
         raise UsageError(f"the model of {', '.join(model.effects)} has no sensitivities")
     dFdq = model.forcing_dq(0.0, y_static, p)[np.ix_(others, others)]
     dq = pm.lstsq(dFdq, -dF[:, others].T)  # (others x m)
@@ -81,7 +82,7 @@ def solve_sensitivities(run, p: np.ndarray, rack: RackMotion, t_out, directions:
         raise ValueError(f"sensitivity directions: need rows of {n_par} parameters")
     begin = prescribed_start(run, p, rack, t_out, atol_factor)  # solve's start, so solve's steps
     t_out, p, table, p_jac, atol = begin.t_out, begin.p, begin.table, begin.p_jac, begin.atol
-    lib, n_z, z0, y_static = model.lib, 2 * len(begin.others), begin.z0, begin.y_static
+    lib, n_z, z0, y_static = model.with_tangent.lib, 2 * len(begin.others), begin.z0, begin.y_static
     corners = np.ascontiguousarray(rack_corners(rack, t_out[0], t_out[-1]))
     m = len(t_out)
     torque = np.empty(m)
