@@ -21,6 +21,7 @@ for _variable in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
 import pytest  # noqa: E402
 
 import parksteer.diagnose.parallel as _parallel  # noqa: E402
+from parksteer.model.codegen.cache import CACHE_ENV  # noqa: E402
 from parksteer.parameters import DEFAULT_PATH, Parameters, load_parameters  # noqa: E402
 
 # For the same reason, a diagnosis or baseline run in a test process without --jobs (the command line, or a
@@ -77,6 +78,13 @@ def pytest_collection_modifyitems(config, items):
         return (3, 0)
 
     items.sort(key=rank)  # stable: the order within each rank is the collection order
+
+
+@pytest.fixture
+def cache_dir(tmp_path, monkeypatch):
+    """An empty model cache of the test's own (PARKSTEER_MODEL_CACHE), for the tests of how entries are built."""
+    monkeypatch.setenv(CACHE_ENV, str(tmp_path / "model"))
+    return tmp_path / "model"
 
 
 @pytest.fixture(scope="session")

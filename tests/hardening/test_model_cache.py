@@ -24,12 +24,6 @@ pytestmark = pytest.mark.slow
 SMALL = "-carcass_compliance,-hooke_joint,-lifting,-tyre_friction"
 
 
-@pytest.fixture
-def cache_dir(tmp_path, monkeypatch):
-    monkeypatch.setenv(cache.CACHE_ENV, str(tmp_path / "model"))
-    return tmp_path / "model"
-
-
 def _dead_pid() -> int:
     done = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True, text=True)
     return int(done.stdout)

@@ -22,12 +22,6 @@ from parksteer.model.symbolic.components import resolve_effects
 pytestmark = pytest.mark.slow
 
 
-@pytest.fixture
-def cache_dir(tmp_path, monkeypatch):
-    monkeypatch.setenv(cache.CACHE_ENV, str(tmp_path / "model"))
-    return tmp_path / "model"
-
-
 def _one_translation_unit(entry, folder):
     """The entry's model compiled with the runtime's text after it in one file, as every model was built before the
     runtime was compiled apart: NQ, NOUT, ... are the model's constants there, and the tangent is compiled in.

@@ -6,10 +6,10 @@ once, under a lock, and again when damaged; a replay builds none."""
 from __future__ import annotations
 
 import dataclasses
-import multiprocessing
 
 import numpy as np
 import pytest
+import side_by_side
 
 from parksteer.measure.rack_spline import interpolate_rack
 from parksteer.model.codegen import cache
@@ -22,12 +22,6 @@ from parksteer.model.symbolic.components import resolve_effects
 pytestmark = pytest.mark.slow
 
 TANGENT = "compiling the model's tangent"
-
-
-@pytest.fixture
-def cache_dir(tmp_path, monkeypatch):
-    monkeypatch.setenv(cache.CACHE_ENV, str(tmp_path / "model"))
-    return tmp_path / "model"
 
 
 def _rack():
@@ -82,18 +76,12 @@ def _tangent(entry: str) -> None:
     assert load_entry(entry).with_tangent.lib.ps_sensitivities_available() == 1
 
 
-@pytest.mark.skipif("fork" not in multiprocessing.get_all_start_methods(), reason="forks its builders")
+@pytest.mark.skipif(not side_by_side.FORKS, reason="forks its workers")
 def test_processes_side_by_side_compile_the_tangent_once(cache_dir, capfd):
     """Three processes that need the tangent at once (a diagnosis's workers taking exact Jacobians): one compiles
     it under its lock, the others wait and load the same library."""
     entry = cache.ensure_entry(resolve_effects(None))
-    context = multiprocessing.get_context("fork")
-    workers = [context.Process(target=_tangent, args=(str(entry),)) for _ in range(3)]
-    for worker in workers:
-        worker.start()
-    for worker in workers:
-        worker.join()
-    assert [w.exitcode for w in workers] == [0, 0, 0]
+    assert side_by_side.exit_codes(_tangent, str(entry)) == [0, 0, 0]
     assert capfd.readouterr().err.count(TANGENT) == 1
 
 

@@ -4,7 +4,6 @@ the bits of the numpy inversion it replaced, the balance it solves, and the libr
 from __future__ import annotations
 
 import dataclasses
-import multiprocessing
 import os
 import subprocess
 import sys
@@ -12,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import side_by_side
 
 from parksteer.boost_table import entries, table_keys
 from parksteer.model.codegen import compiler
@@ -289,17 +289,11 @@ def _build(root: str) -> None:
                                 Path(root))
 
 
-@pytest.mark.skipif("fork" not in multiprocessing.get_all_start_methods(), reason="forks its builders")
+@pytest.mark.skipif(not side_by_side.FORKS, reason="forks its builders")
 def test_builders_side_by_side_compile_the_inversion_once(tmp_path, capfd):
     """Three processes that need the library at once on an empty cache (a first diagnosis's workers): one
     compiles it under its lock, the others wait and find it built."""
-    context = multiprocessing.get_context("fork")
-    builders = [context.Process(target=_build, args=(str(tmp_path),)) for _ in range(3)]
-    for builder in builders:
-        builder.start()
-    for builder in builders:
-        builder.join()
-    assert [b.exitcode for b in builders] == [0, 0, 0]
+    assert side_by_side.exit_codes(_build, str(tmp_path)) == [0, 0, 0]
     assert capfd.readouterr().err.count(f"compiling {INVERSION}") == 1
     assert len(list((tmp_path / compiler.RUNTIME_FOLDER).glob("*.so"))) == 1
 
