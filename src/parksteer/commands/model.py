@@ -105,25 +105,25 @@ def _suggestion_shape_sets() -> list:
     return [({"shape": form.name}, sorted([*base, form], key=lambda e: e.name)) for form in shape_forms()]
 
 
+def _spec_sets(specs) -> list:
+    """(spec, effects) of each effects spec of `specs`, the spec as written."""
+    from ..model.symbolic.components import resolve_effects
+
+    return [(spec, resolve_effects(spec)) for spec in specs]
+
+
 def _ablation_sets() -> list:
     """(spec, effects) of the paper's model without each of its effects, spec ``"-NAME"``: the first question a
     reader asks of a share (docs/model.md's `--effects`), and a physical check's reference (lifting or the Hooke
     joint switched off, as tests/model/test_cycle.py and test_hooke.py switch them), compiled instead of derived."""
     from ..model.symbolic.components import resolve_effects
 
-    return [(f"-{effect.name}", resolve_effects(f"-{effect.name}")) for effect in resolve_effects(None)]
+    return _spec_sets(f"-{effect.name}" for effect in resolve_effects(None))
 
 
 # The effects specs the documents' commands run that no other category ships (a test finds every plain spec the
 # documents run among the shipped models): docs/model.md's king-pin friction in place of the rack's.
 DOCUMENTED_SPECS = ("-rack_friction,+kingpin_friction",)
-
-
-def _documented_sets() -> list:
-    """(spec, effects) of :data:`DOCUMENTED_SPECS`, spec the spec as the documents write it."""
-    from ..model.symbolic.components import resolve_effects
-
-    return [(spec, resolve_effects(spec)) for spec in DOCUMENTED_SPECS]
 
 
 # The folders of example effect files, relative to the checkout: the user's worked example (docs/signature.md) and
@@ -310,7 +310,8 @@ def _derive(args) -> int:
         for path in args.manifests:
             spec = _manifest_spec(path)
             sets.append((spec, resolve_effects(spec)))
-        sets += _ablation_sets() + _documented_sets()  # after the manifests: a set both ship keeps the manifest's spec
+        # after the manifests: a set both ship keeps the manifest's spec
+        sets += _ablation_sets() + _spec_sets(DOCUMENTED_SPECS)
         written = write_prebuilt(sets)
         print(f"pre-derived {len(written) // 2} models -> {written[0].parent} ({time.perf_counter() - start:.1f} s)")
         return 0

@@ -20,7 +20,8 @@ import shutil
 import signal
 import sys
 import time
-from contextlib import suppress
+from collections.abc import Iterator
+from contextlib import contextmanager, suppress
 from functools import lru_cache
 from importlib import metadata
 from pathlib import Path
@@ -272,43 +273,39 @@ def entry_is_sound(directory: Path) -> bool:
 CACHE_WRITE_ERRNOS = {errno.EROFS, errno.EACCES, errno.EPERM, errno.ENOSPC, errno.EDQUOT, errno.ENOTDIR, errno.EEXIST}
 
 
-def cache_write_error(root: Path, exc: OSError) -> UsageError:
-    """The one line for a model cache that cannot be written (a read-only checkout, a full disk, a path through a
-    file): the folder, why, and where else the cache can go."""
-    if exc.errno == errno.ENOSPC:
-        why = "no space left on its disk"
-    else:
-        why = exc.strerror or type(exc).__name__
-    return UsageError(f"cannot write the model cache {root} ({why}): set {CACHE_ENV} to a folder with room that you "
-                      "can write (the cache is results/model of a checkout, else $XDG_CACHE_HOME/parksteer/model, "
-                      f"XDG_CACHE_HOME {os.environ.get('XDG_CACHE_HOME') or 'unset: ~/.cache'})")
+@contextmanager
+def writing_cache(root: Path) -> Iterator[None]:
+    """Writing into the model cache `root`: an error that says it cannot be written (a read-only checkout, a full
+    disk, a path through a file) becomes one line, with the folder, why, and where else the cache can go."""
+    try:
+        yield
+    except OSError as exc:
+        if exc.errno not in CACHE_WRITE_ERRNOS:
+            raise
+        why = "no space left on its disk" if exc.errno == errno.ENOSPC else exc.strerror or type(exc).__name__
+        raise UsageError(f"cannot write the model cache {root} ({why}): set {CACHE_ENV} to a folder with room that "
+                         "you can write (the cache is results/model of a checkout, else "
+                         "$XDG_CACHE_HOME/parksteer/model, XDG_CACHE_HOME "
+                         f"{os.environ.get('XDG_CACHE_HOME') or 'unset: ~/.cache'})") from None
 
 
 def ensure_entry(effects: list[Effect], final: Path | None = None) -> Path:
     """The cache entry of `effects` (at `final`, if the caller has its path), built if missing or unsound (built
     aside, then renamed into place; a killed build's scratch directory removed; one build at a time per entry). A
-    cache that cannot be written is one line (:func:`cache_write_error`), with nothing half-written left in it."""
+    cache that cannot be written is one line (:func:`writing_cache`), with nothing half-written left in it."""
     final = entry_path(effects) if final is None else final
     if entry_is_sound(final):
         return final
-    try:
+    with writing_cache(final.parent):
         return _build_entry_into(effects, final)
-    except OSError as exc:
-        if exc.errno not in CACHE_WRITE_ERRNOS:
-            raise
-        raise cache_write_error(final.parent, exc) from None
 
 
 def ensure_tangent_library(directory: Path, info: dict) -> Path:
     """The library of the cache entry `directory` (its description `info`) with the model's tangent compiled in,
     which only the forward sensitivities call (:func:`.compiler.tangent_library`), compiled on first use; a cache
-    that cannot be written is one line (:func:`cache_write_error`)."""
-    try:
+    that cannot be written is one line (:func:`writing_cache`)."""
+    with writing_cache(directory.parent):
         return tangent_library(find_compiler(), directory, tuple(info.get("shared_objects", ())))
-    except OSError as exc:
-        if exc.errno not in CACHE_WRITE_ERRNOS:
-            raise
-        raise cache_write_error(directory.parent, exc) from None
 
 
 def _build_entry_into(effects: list[Effect], final: Path) -> Path:

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..codegen.cache import CACHE_WRITE_ERRNOS, cache_root, cache_write_error
+from ..codegen.cache import cache_root, writing_cache
 from ..codegen.compiler import find_compiler, standalone_library
 
 SOURCE = Path(__file__).resolve().with_name("torsion_bar.c")
@@ -34,16 +34,12 @@ _SIGNATURE = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_long, *[ctypes.c_void_p] * 
 @lru_cache(maxsize=1)
 def entry_point() -> int:
     """The address of the compiled inversion's ps_torsion_bar: its library built into the model cache if it is not
-    there yet (a cache that cannot be written is one line, :func:`~parksteer.model.codegen.cache.cache_write_error`)
+    there yet (a cache that cannot be written is one line, :func:`~parksteer.model.codegen.cache.writing_cache`)
     and loaded once a process (ctypes never unloads a library)."""
     compiler, root = find_compiler(), cache_root()
-    try:
+    with writing_cache(root):
         path = standalone_library(compiler, "torsion_bar", SOURCE.read_text(encoding="utf-8"),
                                   "the assisted replay's torsion-bar inversion", root)
-    except OSError as exc:
-        if exc.errno not in CACHE_WRITE_ERRNOS:
-            raise
-        raise cache_write_error(root, exc) from None
     lib = ctypes.CDLL(str(path))
     names = ctypes.cast(ctypes.addressof(ctypes.c_char.in_dll(lib, "ps_torsion_bar_fields")), ctypes.c_char_p).value
     if tuple(names.decode().split(",")) != LAW_FIELDS:
