@@ -15,7 +15,8 @@ NAME or ``reference``) and this tree in turn:
 
 and times the process: wall, and the CPU (user + system) of it and every process it waited for (its workers and
 background builds), which on a machine other work shares is the steadier number (wall >= CPU / cores). It prints
-every time, the medians, and whether each tree gave the same verdict and
+every time, the medians, the cold run's CPU over the cores as a multiple of the warm wall (the least cold / warm
+ratio its work allows, however its compiles are ordered), and whether each tree gave the same verdict and
 ranking in every run; the cold runs' model builds (derive, codegen, compile: their model.json timings) are summed
 per tree, to show where the cold time goes (their wall times, so only as steady as the machine is quiet). The package's
 pre-derived models (src/parksteer/model/prebuilt) make a cold run compile without deriving; to time the cold run
@@ -130,6 +131,7 @@ def main() -> None:
                     print(f"{name} {kind} {elapsed:.2f} s wall, {cpu:.2f} s CPU  ({result['verdict']}, "
                           f"{result['cost']['replays']} replays; load {os.getloadavg()[0]:.1f})", flush=True)
                 builds[name].append(build_times(cache))
+    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
     print(f"\nparksteer diagnose, one record of {VEHICLE.name}, whole process, {args.repeats} repeats "
           f"(median s, wall / CPU; cold = empty model cache)")
     for name in trees:
@@ -139,6 +141,11 @@ def main() -> None:
               f"   models built {b['models']}, summed over them: "
               f"derive {b['derive']:.1f} s, codegen {b['codegen']:.1f} s, compile {b['compile']:.1f} s   "
               f"same answer in every run: {len(answers[name]) == 1}")
+        cold, warm = statistics.median(times[name]["cold"]), statistics.median(times[name]["warm"])
+        # a cold run's CPU spread over every core is the least wall it can take, however its compiles are ordered
+        floor = statistics.median(cpus[name]["cold"]) / cores
+        print(f"  {'':9s} cold / warm {cold / warm:.2f}; the cold run's CPU over {cores} cores {floor:.2f} s, "
+              f"{floor / warm:.2f} x warm")
     if len(trees) > 1:
         same = all(answers[name] == answers["this"] for name in trees)
         print(f"  verdict, named effect and ranking order the same in every tree: {same}")
