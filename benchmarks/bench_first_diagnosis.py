@@ -131,7 +131,9 @@ def main() -> None:
                     print(f"{name} {kind} {elapsed:.2f} s wall, {cpu:.2f} s CPU  ({result['verdict']}, "
                           f"{result['cost']['replays']} replays; load {os.getloadavg()[0]:.1f})", flush=True)
                 builds[name].append(build_times(cache))
-    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
+    from parksteer.diagnose.parallel import available_workers
+
+    cores = available_workers()
     print(f"\nparksteer diagnose, one record of {VEHICLE.name}, whole process, {args.repeats} repeats "
           f"(median s, wall / CPU; cold = empty model cache)")
     for name in trees:
