@@ -29,11 +29,17 @@ from ...progress import note
 from .runtime import SHARED_OBJECTS, WITH_TANGENT, check_portable
 from .scratch import scratch_directory
 
-# How the C is compiled; part of the model key. -O1: integrates these models about as fast as -O2 and compiles in
-# less time. -ffp-contract=off: no fused multiply-add, which GCC otherwise forms wherever the target has one
-# (aarch64, or x86 with -march=native), so every product is rounded on its own and the bits do not depend on it.
+# How the C is compiled; part of the model key. A model's own C at -O1: its straight-line functions run about as
+# fast as at -O2 and compile in less time, and every first use of a model waits for them. The C compiled once per
+# cache (the runtime, the boost table's law, the torsion-bar inversion) at -O2: a replay spends most of its time in
+# the runtime's loops (the integrator's solves, the prescribed rack's elimination), about 6 % less at -O2.
+# -ffp-contract=off: no fused multiply-add, which GCC otherwise forms wherever the target has one (aarch64, or x86
+# with -march=native), so every product is rounded on its own and the bits do not depend on it; without
+# -ffast-math nothing is reordered at any level, so the level changes no bit.
 OPTIMISE_FLAGS = ("-O1", "-ffp-contract=off")
+SHARED_OPTIMISE_FLAGS = ("-O2", "-ffp-contract=off")
 COMPILE_FLAGS = (*OPTIMISE_FLAGS, "-shared", "-fPIC")
+SHARED_COMPILE_FLAGS = (*SHARED_OPTIMISE_FLAGS, "-shared", "-fPIC")
 RUNTIME_FOLDER = "runtime"
 
 
@@ -62,7 +68,7 @@ def _built_key(compiler: str, flags: tuple[str, ...], source: str) -> str:
 
 def shared_key(compiler: str, name: str) -> str:
     """Hash of the shared object `name`'s source (:data:`.runtime.SHARED_OBJECTS`), the flags and the compiler."""
-    return _built_key(compiler, OPTIMISE_FLAGS, SHARED_OBJECTS[name][1]())
+    return _built_key(compiler, SHARED_OPTIMISE_FLAGS, SHARED_OBJECTS[name][1]())
 
 
 def shared_object(compiler: str, name: str, root: Path, scratch: Path) -> Path:
@@ -90,7 +96,7 @@ def shared_object(compiler: str, name: str, root: Path, scratch: Path) -> Path:
 
 def library_key(compiler: str, source: str) -> str:
     """Hash of a standalone library's C `source`, the flags and the compiler (:func:`standalone_library`)."""
-    return _built_key(compiler, COMPILE_FLAGS, source)
+    return _built_key(compiler, SHARED_COMPILE_FLAGS, source)
 
 
 def standalone_library(compiler: str, name: str, source: str, what: str, root: Path) -> Path:
@@ -102,7 +108,7 @@ def standalone_library(compiler: str, name: str, source: str, what: str, root: P
     def build(scratch: Path) -> Path:
         c_path, built = scratch / f"{name}.c", scratch / f"{name}.so"
         c_path.write_text(source, encoding="utf-8")
-        run_compiler([compiler, *COMPILE_FLAGS, "-o", str(built), str(c_path), "-lm"], what)
+        run_compiler([compiler, *SHARED_COMPILE_FLAGS, "-o", str(built), str(c_path), "-lm"], what)
         return built
 
     return _library_once(root / RUNTIME_FOLDER / f"{stem}.so", what, root, stem, build)
@@ -192,15 +198,17 @@ def compile_model(compiler: str, c_path: Path, so_path: Path, root: Path, shared
     model_object.unlink()
 
 
-def object_command(compiler: str, source: Path, built: Path, defines: tuple[str, ...] = ()) -> list[str]:
-    """The command that compiles the C file `source` (with the macro `defines`) into the position-independent
-    object `built`."""
-    return [compiler, *OPTIMISE_FLAGS, *defines, "-fPIC", "-c", "-o", str(built), str(source)]
+def object_command(compiler: str, source: Path, built: Path, defines: tuple[str, ...] = (),
+                   flags: tuple[str, ...] = OPTIMISE_FLAGS) -> list[str]:
+    """The command that compiles the C file `source` (with the macro `defines`, at the optimisation `flags`) into the
+    position-independent object `built`."""
+    return [compiler, *flags, *defines, "-fPIC", "-c", "-o", str(built), str(source)]
 
 
 def compile_object(compiler: str, source: Path, built: Path, what: str) -> None:
-    """Compile the C file `source` (`what` it is, for an error) into the position-independent object `built`."""
-    run_compiler(object_command(compiler, source, built), what)
+    """Compile the C file `source` of a shared object (`what` it is, for an error) into the position-independent
+    object `built`."""
+    run_compiler(object_command(compiler, source, built, flags=SHARED_OPTIMISE_FLAGS), what)
 
 
 def run_compiler(cmd: list[str], what: str) -> None:
