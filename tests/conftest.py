@@ -18,6 +18,9 @@ from pathlib import Path
 for _variable in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_variable, "1")
 
+import atexit  # noqa: E402
+import tempfile  # noqa: E402
+
 import pytest  # noqa: E402
 
 import parksteer.diagnose.parallel as _parallel  # noqa: E402
@@ -36,6 +39,24 @@ if _TEST_WORKERS > 1:
     _parallel.available_workers = lambda: max(_cpus // _TEST_WORKERS, 1)
 
 REPO_ROOT = Path(__file__).resolve().parents[1]
+
+# SLURM's executor plugin, installed here for tests/cluster, asks the controller for its configuration (`scontrol
+# show config`, 10 s timeout) at every start of Snakemake; where SLURM's tools are installed but no controller
+# answers (the test cluster not started yet, or gone), each of the suite's many `snakemake` runs would wait about
+# 9 s for it. The test run's processes get an `scontrol` that gives that query 1 s (a controller answers in
+# milliseconds) and hands every other use to SLURM's own unchanged. Made once, by the process the workers are
+# started from, and inherited with PATH.
+_SCONTROL = shutil.which("scontrol")
+if _SCONTROL and "PARKSTEER_TESTS_SCONTROL" not in os.environ:
+    _folder = tempfile.mkdtemp(prefix="parksteer-tests-scontrol-")
+    atexit.register(shutil.rmtree, _folder, True)
+    _shim = Path(_folder) / "scontrol"
+    _shim.write_text('#!/bin/sh\n'
+                     f'if [ "$1" = show ] && [ "$2" = config ]; then exec timeout 1 {_SCONTROL} "$@"; fi\n'
+                     f'exec {_SCONTROL} "$@"\n', encoding="utf-8")
+    _shim.chmod(0o755)
+    os.environ["PARKSTEER_TESTS_SCONTROL"] = _folder
+    os.environ["PATH"] = _folder + os.pathsep + os.environ.get("PATH", "")
 
 
 # Modules whose tests share no module fixture and are each long (the document chains, the diagnosis routes at several
