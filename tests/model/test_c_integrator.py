@@ -81,7 +81,7 @@ def compile_problem(tmp_path_factory):
 
     def build(name: str, n_y: int, body: str, prescribed: str = PRESCRIBED_STUBS) -> Problem:
         preamble = (f"#include <math.h>\n#include <string.h>\n{PORTABLE_MATH_C.read_text(encoding='utf-8')}\n"
-                    f"#define NY {n_y}\n#define NQ (NY / 2)\n{body}\n" + prescribed)
+                    f"#define NY {n_y}\n#define NQ (NY / 2)\n#define PS_HOT\n{body}\n" + prescribed)
         source = directory / f"{name}.c"
         source.write_text(preamble + INTEGRATOR_C.read_text(encoding="utf-8"), encoding="utf-8")
         library = directory / f"{name}.so"

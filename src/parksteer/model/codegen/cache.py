@@ -29,7 +29,8 @@ from typing import TYPE_CHECKING
 
 from ...errors import UsageError
 from ...progress import note
-from .compiler import COMPILE_FLAGS, SHARED_COMPILE_FLAGS, compile_model, find_compiler, tangent_library
+from .compiler import COMPILE_FLAGS, compile_model, find_compiler, shared_flags, tangent_library
+from .runtime import SHARED_OBJECTS
 from .scratch import build_lock, clean_stale_scratch, scratch_directory
 
 if TYPE_CHECKING:  # the workflow checks cache entries on every run: sympy is imported only to derive or key a model
@@ -116,9 +117,10 @@ def model_key(effects: list[Effect]) -> str:
     """Hash of the effect set, the symbolic half's source (symbolic/ and codegen/, Python and C), external effects'
     source, the sympy version (its distribution's: a replay keys its model without importing sympy) and the compiler
     flags."""
+    shared = ", ".join(f"{name} {' '.join(shared_flags(name))}" for name in SHARED_OBJECTS)
     digest = hashlib.sha256()
     digest.update(f"format {FORMAT_VERSION}\nsympy {_sympy_version()}\ncc {' '.join(COMPILE_FLAGS)}\n"
-                  f"shared {' '.join(SHARED_COMPILE_FLAGS)}\n".encode())
+                  f"shared {shared}\n".encode())
     digest.update(("effects " + ",".join(e.name for e in effects) + "\n").encode())
     digest.update(_symbolic_half_source())
     for effect in effects:

@@ -29,17 +29,18 @@ from ...progress import note
 from .runtime import SHARED_OBJECTS, WITH_TANGENT, check_portable
 from .scratch import scratch_directory
 
-# How the C is compiled; part of the model key. A model's own C at -O1: its straight-line functions run about as
-# fast as at -O2 and compile in less time, and every first use of a model waits for them. The C compiled once per
-# cache (the runtime, the boost table's law, the torsion-bar inversion) at -O2: a replay spends most of its time in
-# the runtime's loops (the integrator's solves, the prescribed rack's elimination), about 6 % less at -O2.
+# How the C is compiled; part of the model key. -O1 for a model's own C and the runtime: their straight-line
+# functions run about as fast as at -O2 and compile in less time, and every first use of a model waits for them;
+# the runtime's loops a replay spends most of its time in are compiled at -O2 all the same (PS_HOT, runtime.c). -O2 for
+# the boost table's law and the torsion-bar inversion, which compile as fast or faster at -O2 (0.7 s instead of
+# 1.1 s, 0.12 s instead of 0.08 s) and run faster.
 # -ffp-contract=off: no fused multiply-add, which GCC otherwise forms wherever the target has one (aarch64, or x86
 # with -march=native), so every product is rounded on its own and the bits do not depend on it; without
 # -ffast-math nothing is reordered at any level, so the level changes no bit.
-OPTIMISE_FLAGS = ("-O1", "-ffp-contract=off")
-SHARED_OPTIMISE_FLAGS = ("-O2", "-ffp-contract=off")
+FP_FLAGS = ("-ffp-contract=off",)
+OPTIMISE_FLAGS = ("-O1", *FP_FLAGS)
 COMPILE_FLAGS = (*OPTIMISE_FLAGS, "-shared", "-fPIC")
-SHARED_COMPILE_FLAGS = (*SHARED_OPTIMISE_FLAGS, "-shared", "-fPIC")
+STANDALONE_COMPILE_FLAGS = ("-O2", *FP_FLAGS, "-shared", "-fPIC")
 RUNTIME_FOLDER = "runtime"
 
 
@@ -68,7 +69,13 @@ def _built_key(compiler: str, flags: tuple[str, ...], source: str) -> str:
 
 def shared_key(compiler: str, name: str) -> str:
     """Hash of the shared object `name`'s source (:data:`.runtime.SHARED_OBJECTS`), the flags and the compiler."""
-    return _built_key(compiler, SHARED_OPTIMISE_FLAGS, SHARED_OBJECTS[name][1]())
+    return _built_key(compiler, shared_flags(name), SHARED_OBJECTS[name][1]())
+
+
+def shared_flags(name: str) -> tuple[str, ...]:
+    """The optimisation flags of the shared object `name`: its level (:data:`.runtime.SHARED_OBJECTS`) and
+    :data:`FP_FLAGS`."""
+    return (SHARED_OBJECTS[name][2], *FP_FLAGS)
 
 
 def shared_object(compiler: str, name: str, root: Path, scratch: Path) -> Path:
@@ -76,7 +83,7 @@ def shared_object(compiler: str, name: str, root: Path, scratch: Path) -> Path:
     root/runtime/<key>.o, compiled in `scratch` and renamed into place if it is not there yet. Builders that need it
     at once (a first diagnosis builds its models side by side) wait for the one compiling it, under a lock the
     kernel releases when its holder ends."""
-    what, source_of = SHARED_OBJECTS[name]
+    what, source_of, _ = SHARED_OBJECTS[name]
     final = root / RUNTIME_FOLDER / f"{shared_key(compiler, name)}.o"
     if final.is_file():
         return final
@@ -88,7 +95,7 @@ def shared_object(compiler: str, name: str, root: Path, scratch: Path) -> Path:
         note(f"compiling {what}, once for this cache and compiler ({final})")
         source, built = scratch / f"{name}.c", scratch / f"{name}.o"
         source.write_text(source_of(), encoding="utf-8")
-        compile_object(compiler, source, built, what)
+        compile_object(compiler, source, built, what, shared_flags(name))
         os.replace(built, final)
         source.unlink()
     return final
@@ -96,7 +103,7 @@ def shared_object(compiler: str, name: str, root: Path, scratch: Path) -> Path:
 
 def library_key(compiler: str, source: str) -> str:
     """Hash of a standalone library's C `source`, the flags and the compiler (:func:`standalone_library`)."""
-    return _built_key(compiler, SHARED_COMPILE_FLAGS, source)
+    return _built_key(compiler, STANDALONE_COMPILE_FLAGS, source)
 
 
 def standalone_library(compiler: str, name: str, source: str, what: str, root: Path) -> Path:
@@ -108,7 +115,7 @@ def standalone_library(compiler: str, name: str, source: str, what: str, root: P
     def build(scratch: Path) -> Path:
         c_path, built = scratch / f"{name}.c", scratch / f"{name}.so"
         c_path.write_text(source, encoding="utf-8")
-        run_compiler([compiler, *SHARED_COMPILE_FLAGS, "-o", str(built), str(c_path), "-lm"], what)
+        run_compiler([compiler, *STANDALONE_COMPILE_FLAGS, "-o", str(built), str(c_path), "-lm"], what)
         return built
 
     return _library_once(root / RUNTIME_FOLDER / f"{stem}.so", what, root, stem, build)
@@ -205,10 +212,10 @@ def object_command(compiler: str, source: Path, built: Path, defines: tuple[str,
     return [compiler, *flags, *defines, "-fPIC", "-c", "-o", str(built), str(source)]
 
 
-def compile_object(compiler: str, source: Path, built: Path, what: str) -> None:
-    """Compile the C file `source` of a shared object (`what` it is, for an error) into the position-independent
-    object `built`."""
-    run_compiler(object_command(compiler, source, built, flags=SHARED_OPTIMISE_FLAGS), what)
+def compile_object(compiler: str, source: Path, built: Path, what: str, flags: tuple[str, ...]) -> None:
+    """Compile the C file `source` of a shared object (`what` it is, for an error) at the optimisation `flags` into
+    the position-independent object `built`."""
+    run_compiler(object_command(compiler, source, built, flags=flags), what)
 
 
 def run_compiler(cmd: list[str], what: str) -> None:

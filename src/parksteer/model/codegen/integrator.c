@@ -2,8 +2,9 @@
    or with the rack prescribed (ps_integrate_prescribed: the reduced system of ps_prescribed_rhs).
 
    The last part of the runtime's translation unit (runtime.py), after runtime.c and sensitivities.c, which define
-   NY, NQ, NO, INPUT_OFFSET, ps_rhs, ps_jac, ps_prescribed_rhs, ps_prescribed_jac and, for the sensitivities,
-   PS_SENSITIVITIES and prescribed_tangent, and include <math.h> and <string.h>. Every name here
+   NY, NQ, NO, INPUT_OFFSET, ps_rhs, ps_jac, ps_prescribed_rhs, ps_prescribed_jac, PS_HOT (the mark of the loops
+   compiled at -O2) and, for the sensitivities, PS_SENSITIVITIES and prescribed_tangent, and include <math.h> and
+   <string.h>. Every name here
    starts with bdf_ (or is ps_integrate...), so as not to clash with the model code's own static helpers; all state
    lives on the call's stack (reentrant).
 
@@ -86,7 +87,7 @@ static void bdf_make_coefficients(bdf_coefficients *co)
     }
 }
 
-static int bdf_all_finite(const double *v, int n)
+PS_HOT static int bdf_all_finite(const double *v, int n)
 {
     for (int i = 0; i < n; i++)
         if (!isfinite(v[i])) return 0;
@@ -106,7 +107,7 @@ typedef struct {
 } bdf_system;
 
 /* The right-hand side, with non-finite results reported as failure too; counts the call. */
-static int bdf_rhs(const bdf_system *s, double t, const double *y, double *ydot, long *n_rhs)
+PS_HOT static int bdf_rhs(const bdf_system *s, double t, const double *y, double *ydot, long *n_rhs)
 {
     ++*n_rhs;
     int failed = s->rack ? ps_prescribed_rhs(t, y, s->p, s->rack, ydot) : ps_rhs(t, y, s->p, ydot);
@@ -122,7 +123,7 @@ static int bdf_jac(const bdf_system *s, double t, const double *y, double *jac, 
 }
 
 /* RMS norm of v / scale (the weighted norm of the error test and of the Newton corrections). */
-static double bdf_norm(int n, const double *v, const double *scale)
+PS_HOT static double bdf_norm(int n, const double *v, const double *scale)
 {
     double sum = 0.0;
     for (int i = 0; i < n; i++) {
@@ -133,7 +134,7 @@ static double bdf_norm(int n, const double *v, const double *scale)
 }
 
 /* In-place LU factorisation with partial pivoting of the row-major n x n matrix A; 0, or -1 if singular. */
-static int bdf_lu_factor(int n, double *A, int *pivot)
+PS_HOT static int bdf_lu_factor(int n, double *A, int *pivot)
 {
     for (int k = 0; k < n; k++) {
         int best = k;
@@ -161,7 +162,7 @@ static int bdf_lu_factor(int n, double *A, int *pivot)
 
 /* Solve (LU) x = b in place. The factorisation swaps whole rows (multipliers too), so all swaps are applied
    to b before the forward substitution, not interleaved with it. */
-static void bdf_lu_solve(int n, const double *LU, const int *pivot, double *b)
+PS_HOT static void bdf_lu_solve(int n, const double *LU, const int *pivot, double *b)
 {
     for (int k = 0; k < n; k++)
         if (pivot[k] != k) { double swap = b[k]; b[k] = b[pivot[k]]; b[pivot[k]] = swap; }
@@ -188,7 +189,7 @@ static void bdf_compute_R(int order, double factor, double R[BDF_MAX_ORDER + 1][
 
 /* Rescale the differences D[0..order] (rows `stride` apart, `width` values each) from step h to step factor * h
    (the same interpolating polynomial). */
-static void bdf_rescale(int width, double *D, int stride, int order, double factor)
+PS_HOT static void bdf_rescale(int width, double *D, int stride, int order, double factor)
 {
     double R[BDF_MAX_ORDER + 1][BDF_MAX_ORDER + 1], U[BDF_MAX_ORDER + 1][BDF_MAX_ORDER + 1];
     double RU[BDF_MAX_ORDER + 1][BDF_MAX_ORDER + 1], old[BDF_MAX_ORDER + 1];
@@ -255,7 +256,7 @@ static double bdf_initial_step(const bdf_system *s, double t, const double *y, c
 /* Simplified Newton iteration for the NDF step (scipy's solve_bdf_system): on success, y_new and
    d = y_new - y_pred. Stops early when the observed contraction rate says tol cannot be reached within the
    iteration limit. *evaluation_failed tells a failed right-hand side from slow convergence. */
-static int bdf_newton(const bdf_system *s, double t_new, const double *y_pred, double c, const double *psi, const double *lu,
+PS_HOT static int bdf_newton(const bdf_system *s, double t_new, const double *y_pred, double c, const double *psi, const double *lu,
                       const int *pivot, const double *scale, double tol, double *y_new, double *d,
                       int *n_iter, int *evaluation_failed, long *n_rhs)
 {
@@ -281,7 +282,7 @@ static int bdf_newton(const bdf_system *s, double t_new, const double *y_pred, d
 
 /* The interpolating polynomial of the differences (rows `stride` apart, `width` values each) at time t (scipy's
    BdfDenseOutput): y at t_now, and prod_{m<j} (t - t_now + m h) / ((m + 1) h) times D[j]. */
-static void bdf_interpolate(int width, double t, double t_now, double h, int order, const double *D, int stride,
+PS_HOT static void bdf_interpolate(int width, double t, double t_now, double h, int order, const double *D, int stride,
                             double *y)
 {
     double product = 1.0;
