@@ -31,15 +31,15 @@ from .scratch import scratch_directory
 
 # How the C is compiled; part of the model key. -O1 for a model's own C and the runtime: their straight-line
 # functions run about as fast as at -O2 and compile in less time, and every first use of a model waits for them;
-# the runtime's loops a replay spends most of its time in are compiled at -O2 all the same (PS_HOT, runtime.c). -O2 for
-# the boost table's law and the torsion-bar inversion, which compile as fast or faster at -O2 (0.7 s instead of
-# 1.1 s, 0.12 s instead of 0.08 s) and run faster.
+# the runtime's loops a replay spends most of its time in are compiled at -O2 all the same (PS_HOT, runtime.c). -O2
+# for the boost table's law, which compiles faster there, and the torsion-bar inversion, a loop a few lines long.
 # -ffp-contract=off: no fused multiply-add, which GCC otherwise forms wherever the target has one (aarch64, or x86
 # with -march=native), so every product is rounded on its own and the bits do not depend on it; without
 # -ffast-math nothing is reordered at any level, so the level changes no bit.
 FP_FLAGS = ("-ffp-contract=off",)
 OPTIMISE_FLAGS = ("-O1", *FP_FLAGS)
 COMPILE_FLAGS = (*OPTIMISE_FLAGS, "-shared", "-fPIC")
+SHARED_LEVELS = {"runtime": "-O1", "boost_table": "-O2"}  # of each of runtime.SHARED_OBJECTS
 STANDALONE_COMPILE_FLAGS = ("-O2", *FP_FLAGS, "-shared", "-fPIC")
 RUNTIME_FOLDER = "runtime"
 
@@ -73,9 +73,9 @@ def shared_key(compiler: str, name: str) -> str:
 
 
 def shared_flags(name: str) -> tuple[str, ...]:
-    """The optimisation flags of the shared object `name`: its level (:data:`.runtime.SHARED_OBJECTS`) and
-    :data:`FP_FLAGS`."""
-    return (SHARED_OBJECTS[name][2], *FP_FLAGS)
+    """The optimisation flags of the shared object `name` (:data:`.runtime.SHARED_OBJECTS`): its level
+    (:data:`SHARED_LEVELS`) and :data:`FP_FLAGS`."""
+    return (SHARED_LEVELS[name], *FP_FLAGS)
 
 
 def shared_object(compiler: str, name: str, root: Path, scratch: Path) -> Path:
@@ -83,7 +83,7 @@ def shared_object(compiler: str, name: str, root: Path, scratch: Path) -> Path:
     root/runtime/<key>.o, compiled in `scratch` and renamed into place if it is not there yet. Builders that need it
     at once (a first diagnosis builds its models side by side) wait for the one compiling it, under a lock the
     kernel releases when its holder ends."""
-    what, source_of, _ = SHARED_OBJECTS[name]
+    what, source_of = SHARED_OBJECTS[name]
     final = root / RUNTIME_FOLDER / f"{shared_key(compiler, name)}.o"
     if final.is_file():
         return final

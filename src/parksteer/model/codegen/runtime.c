@@ -4,9 +4,9 @@
    functions; the model's dimensions (NQ, NOUT, ...) are read from the model at run time there. */
 
 /* The loops a replay spends most of its time in (the solves below, the integrator's solves, norms and Newton
-   iteration), compiled at -O2 inside a runtime compiled at -O1 (compiler.shared_flags): a replay takes about 6 %
-   less than with them at -O1, as much as with the whole runtime at -O2, whose compile takes 0.2 s longer (these
-   alone 0.04 s). The same bits: no fused multiply-add at any level, nothing reordered. */
+   iteration), compiled at -O2 inside a runtime compiled at -O1 (compiler.SHARED_LEVELS): they gain what the whole
+   runtime at -O2 would, for a small part of its longer compile, which a first diagnosis waits for
+   (docs/scaling.md). The same bits: no fused multiply-add at any level, nothing reordered. */
 #define PS_HOT __attribute__((optimize("O2")))
 
 /* ---- fixed runtime ---------------------------------------------------------------- */

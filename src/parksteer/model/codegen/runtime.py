@@ -94,7 +94,5 @@ def boost_table_source() -> str:
 
 # The C compiled once per cache and compiler and linked with the models that name it: what it is, and its text.
 # Every model links the runtime; a model's description lists the others it needs ("shared_objects").
-# And the optimisation level each is compiled at (compiler.shared_flags; the runtime's hot loops at -O2: PS_HOT in
-# runtime.c).
-SHARED_OBJECTS = {"runtime": ("the models' runtime", runtime_source, "-O1"),
-                  "boost_table": ("the boost table's law", boost_table_source, "-O2")}
+SHARED_OBJECTS = {"runtime": ("the models' runtime", runtime_source),
+                  "boost_table": ("the boost table's law", boost_table_source)}
