@@ -94,3 +94,20 @@ def test_a_diagnosis_written_as_json_alone_imports_no_page_renderer():
                             f"    main(['diagnose', {str(record)!r}, '--json', '--quiet', '--jobs', '1'])")
     assert "parksteer.reporting.report" in modules  # the JSON was made
     assert _heavy(modules, ("parksteer.reporting.pages", "html")) == []
+
+
+def test_planning_the_workflow_and_loading_the_example_effect_imports_no_sympy_or_scipy():
+    """What Snakemake computes from the package while it reads the workflow (parksteer.plan.diagnosis: the candidate
+    models, the example user effect among them, and the benchmarks' cases) imports neither sympy nor scipy, and
+    neither does a replaying process that loads the example effect (src/parksteer/examples/column_imbalance.py takes
+    sympy lazily, as the package's own effects do): the example is a candidate in every benchmark job."""
+    example = "src/parksteer/examples/column_imbalance.py"
+    modules = _loaded_after(
+        "import yaml\nfrom parksteer import plan\n"
+        "config = yaml.safe_load(open('config/config.yaml', encoding='utf-8'))\n"
+        "sections = {k: config[k] for k in ('car', 'benchmark', 'outclass', 'variations', 'signature')}\n"
+        f"planned = plan.diagnosis(sections, config['parameters'], {example!r})\n"
+        "assert 'with_column_imbalance' in planned['candidates'], planned['candidates']\n"
+        "from parksteer.model.symbolic.components import load_effect_module\n"
+        f"assert load_effect_module({example!r}).quantities")
+    assert _heavy(modules, ("sympy", "scipy")) == []

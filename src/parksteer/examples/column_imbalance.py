@@ -11,8 +11,8 @@ N m, is 0 when the column is balanced.
 The file is one module defining ``EFFECT``; nothing in the package refers to it. Join it to
 the model with an effects spec, or name it in the environment::
 
-    parksteer compare run.csv --effects=+examples/user_effect/column_imbalance.py
-    PARKSTEER_EFFECT_MODULES=examples/user_effect/column_imbalance.py parksteer diagnose run.csv --json
+    parksteer compare run.csv --effects=+src/parksteer/examples/column_imbalance.py
+    PARKSTEER_EFFECT_MODULES=src/parksteer/examples/column_imbalance.py parksteer diagnose run.csv --json
 
 or, from an installed package, with an entry point in its pyproject.toml::
 
@@ -24,7 +24,10 @@ from __future__ import annotations
 
 import math
 
-import sympy as sp
+# sympy as the package's own effects take it, imported at its first use: only a derivation builds the torque's
+# expression, so a process that replays the compiled model (every diagnosis that has this effect among its
+# candidates) never imports sympy. A file of your own may import sympy as it stands.
+from parksteer.model.symbolic.lazy_sympy import sp
 
 from parksteer.model.symbolic.components import Effect
 from parksteer.model.symbolic.system import torque_between
