@@ -21,6 +21,7 @@ appear; the report names the rules of the run that wrote no benchmark file (the 
 from __future__ import annotations
 
 import argparse
+import compileall
 import csv
 import json
 import os
@@ -37,8 +38,9 @@ SNAKEMAKE = Path(sys.executable).with_name("snakemake")
 TOP = 5
 
 
-def scratch_copy(dest: Path) -> Path:
-    """The repository's tracked and untracked, not ignored, files copied to dest (no results, no model cache)."""
+def scratch_copy(dest: Path, bytecode: bool = False) -> Path:
+    """The repository's tracked and untracked, not ignored, files copied to dest (no results, no model cache); with
+    `bytecode`, the copy's package compiled (compileall), as the README's quick start compiles a checkout's."""
     listed = subprocess.run(["git", "ls-files", "-z", "--cached", "--others", "--exclude-standard"], cwd=REPO,
                             capture_output=True, text=True, check=True).stdout.split("\0")
     for name in filter(None, listed):
@@ -46,6 +48,8 @@ def scratch_copy(dest: Path) -> Path:
         if source.is_file():
             (dest / name).parent.mkdir(parents=True, exist_ok=True)
             shutil.copy2(source, dest / name)
+    if bytecode and not compileall.compile_dir(dest / "src", quiet=1):
+        raise RuntimeError(f"compileall failed on {dest / 'src'}")
     return dest
 
 
@@ -128,10 +132,7 @@ def main(argv=None) -> int:
     with tempfile.TemporaryDirectory(prefix="bench_pipeline_") as tmp:
         work = Path(args.keep) if args.keep else Path(tmp) / "work"
         work.mkdir(parents=True, exist_ok=False)
-        scratch_copy(work)
-        if not args.no_bytecode:
-            subprocess.run([sys.executable, "-m", "compileall", "-q", str(work / "src")], check=True,
-                           stdout=subprocess.DEVNULL)
+        scratch_copy(work, bytecode=not args.no_bytecode)
         wall, ran = run(work, args.cores, args.targets)
         rules = read_benchmarks(work)
         env = dict(os.environ, PYTHONPATH=str(work / "src"), PARKSTEER_MODEL_CACHE=str(work / "results" / "model"))

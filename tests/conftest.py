@@ -3,14 +3,16 @@ per session, seeded) for the data-set and diagnosis tests."""
 
 from __future__ import annotations
 
-import compileall
+import atexit
 import contextlib
+import functools
 import importlib.util
 import io
 import os
 import shutil
 import signal
 import sys
+import tempfile
 from pathlib import Path
 
 # One BLAS thread per test process, set before numpy loads here and inherited by the workers and every subprocess:
@@ -18,9 +20,6 @@ from pathlib import Path
 # CPUs (OpenBLAS's idle threads spin). Snakemake does the same for its jobs (its `threads`).
 for _variable in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_variable, "1")
-
-import atexit  # noqa: E402
-import tempfile  # noqa: E402
 
 import pytest  # noqa: E402
 
@@ -124,12 +123,8 @@ def copy_repository(repo_root):
     spec = importlib.util.spec_from_file_location("bench_pipeline", repo_root / "benchmarks" / "bench_pipeline.py")
     bench_pipeline = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(bench_pipeline)
-
-    def copy(dest: Path) -> Path:
-        bench_pipeline.scratch_copy(dest)  # the benchmarks' scratch copy: the same files the cold-DAG timing builds
-        compileall.compile_dir(dest / "src", quiet=1)
-        return dest
-    return copy
+    # the benchmarks' scratch copy: the same files, and bytecode, the cold-DAG timing builds from
+    return functools.partial(bench_pipeline.scratch_copy, bytecode=True)
 
 
 @pytest.fixture(scope="session")
