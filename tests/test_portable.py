@@ -374,9 +374,17 @@ parts = [pm.sin(x), pm.cos(x), pm.atan(x), pm.exp(x), pm.tanh(x), pm.log(np.abs(
          pm.fir_decimate(x, pm.hamming_lowpass_fir(101, 0.2), 5), pm.running_median(x, 21), pm.running_max3(x)]
 print(hashlib.sha256(b"".join(np.ascontiguousarray(p).tobytes() for p in parts)).hexdigest())
 """
-# OpenBLAS kernels of three generations, numpy without AVX-512 and without AVX2, and two threads.
+# OpenBLAS kernels of three generations, numpy without AVX-512 and without AVX2, and two threads. The widest
+# kernel is SkylakeX (AVX-512) where the CPU has AVX-512, else Nehalem (SSE4.2): SkylakeX's code would die of SIGILL.
+def _has_avx512() -> bool:
+    try:
+        return "avx512f" in Path("/proc/cpuinfo").read_text().split()
+    except OSError:
+        return False
+
+
 SETTINGS = [
-    {"OPENBLAS_CORETYPE": "SkylakeX"},
+    {"OPENBLAS_CORETYPE": "SkylakeX" if _has_avx512() else "Nehalem"},
     {"OPENBLAS_CORETYPE": "Haswell", "NPY_DISABLE_CPU_FEATURES": "AVX512_ICL X86_V4"},
     {"OPENBLAS_CORETYPE": "Sandybridge", "NPY_DISABLE_CPU_FEATURES": "AVX512_ICL X86_V4 X86_V3"},
     {"OPENBLAS_CORETYPE": "Zen", "OPENBLAS_NUM_THREADS": "2", "OMP_NUM_THREADS": "2"},
