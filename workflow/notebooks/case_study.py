@@ -51,14 +51,15 @@ OUT_RESIDUALS = Path(os.environ.get("PARKSTEER_CASE_RESIDUALS", "results/case_st
 PARAMETERS = Path(os.environ.get("PARKSTEER_PARAMETERS", str(DEFAULT_PATH)))
 ASSISTED_RECORD = Path(os.environ.get("PARKSTEER_ASSISTED_RECORD", "data/measurements/example_polo_assisted.csv"))
 ASSISTED_VEHICLE = Path(os.environ.get("PARKSTEER_ASSISTED_VEHICLE", "data/vehicles/polo_vi.toml"))
-SCRATCH = Path(tempfile.mkdtemp(prefix="case_study_"))
 
 
 def show(draw, *args, **kwargs):
-    """Draw a figure with a parksteer figure function into a scratch SVG and display it."""
-    path = SCRATCH / f"figure_{len(list(SCRATCH.iterdir()))}.svg"
-    draw(*args, path, **kwargs)
-    display(SVG(filename=str(path)))
+    """Draw a figure with a parksteer figure function into a scratch SVG and display it; the scratch folder goes
+    once displayed (SVG reads the file when made)."""
+    with tempfile.TemporaryDirectory(prefix="case_study_") as scratch:
+        path = Path(scratch) / "figure.svg"
+        draw(*args, path, **kwargs)
+        display(SVG(filename=str(path)))
 
 
 def table(header, rows):
