@@ -446,6 +446,17 @@ def test_platform_facts_are_quick_and_complete():
     assert facts["machine"] == platform.machine()
 
 
+@pytest.mark.skipif(not (platform.system() == "Linux" and platform.machine() == "x86_64"), reason="x86-64 Linux only")
+def test_cpu_flags_hold_the_x86_64_baseline_and_agree_with_the_fma_fact():
+    """Every x86-64 CPU has SSE2 (the architecture's baseline), so /proc/cpuinfo's flags, as cpu_flags reads them, name
+    it; and the recorded fact of FMA is the flags' (what picks glibc's FMA variants, and which OpenBLAS kernels run)."""
+    from parksteer.checksums.platform_facts import cpu_flags, gather
+
+    flags = cpu_flags()
+    assert {"sse2", "fpu"} <= flags
+    assert gather()["cpu_fma"] == ("yes" if "fma" in flags else "no")
+
+
 def test_every_stored_figure_has_a_tolerance_family():
     """Every figure in figures/SHA256SUMS belongs to a declared family, so none is judged without a tolerance."""
     from parksteer.checksums.tolerances import family_of

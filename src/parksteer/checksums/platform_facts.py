@@ -61,16 +61,30 @@ def _blas() -> tuple[str, str]:
     return name, core
 
 
-def _cpu() -> tuple[str, str]:
-    """The CPU's model name and whether it has FMA (glibc's libm picks FMA variants of exp, log, sin, pow by it)."""
+def _first_cpu() -> dict[str, str] | None:
+    """The fields of the first processor in /proc/cpuinfo, or None where there is none (not Linux)."""
     try:
         text = Path("/proc/cpuinfo").read_text(encoding="utf-8", errors="replace")
-    except OSError:  # not Linux
-        return platform.processor() or "unknown", "unknown"
+    except OSError:
+        return None
     first = text.split("\n\n", 1)[0]
-    fields = {k.strip(): v.strip() for k, _, v in (line.partition(":") for line in first.splitlines())}
+    return {k.strip(): v.strip() for k, _, v in (line.partition(":") for line in first.splitlines())}
+
+
+def cpu_flags() -> frozenset[str]:
+    """The CPU's feature flags as /proc/cpuinfo names them (x86's "flags", aarch64's "Features"); empty where it
+    cannot be read. An OpenBLAS kernel the CPU lacks the instructions of (SkylakeX without avx512f) dies of SIGILL."""
+    fields = _first_cpu() or {}
+    return frozenset((fields.get("flags") or fields.get("Features") or "").split())
+
+
+def _cpu() -> tuple[str, str]:
+    """The CPU's model name and whether it has FMA (glibc's libm picks FMA variants of exp, log, sin, pow by it)."""
+    fields = _first_cpu()
+    if fields is None:
+        return platform.processor() or "unknown", "unknown"
     name = fields.get("model name") or fields.get("CPU part") or platform.processor() or "unknown"
-    flags = (fields.get("flags") or fields.get("Features") or "").split()
+    flags = cpu_flags()
     fma = "yes" if ("fma" in flags or "asimd" in flags) else "no"  # aarch64's Advanced SIMD always fuses
     return name, fma
 
