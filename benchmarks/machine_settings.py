@@ -31,7 +31,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from bench_pipeline import REPO, SNAKEMAKE, scratch_copy  # noqa: E402
 
-from parksteer.checksums.platform_facts import cpu_flags  # noqa: E402
+from parksteer.checksums.platform_facts import kernel_runs_here  # noqa: E402
 
 # The machine's own setting first: the others' key numbers and PDF are compared with its.
 SETTINGS = {
@@ -47,10 +47,6 @@ SETTINGS = {
                                 "NPY_DISABLE_CPU_FEATURES": "AVX512_ICL X86_V4 X86_V3", "OPENBLAS_NUM_THREADS": "1"},
     "zen_2threads": {"OPENBLAS_CORETYPE": "Zen", "OPENBLAS_NUM_THREADS": "2", "OMP_NUM_THREADS": "2"},
 }
-# OpenBLAS's kernels of AVX-512 code, which die of SIGILL on a CPU without it (an AMD EPYC of the Zen 3 generation).
-AVX512_KERNELS = {"SkylakeX", "Cooperlake"}
-
-
 # The variables a setting sets: cleared from the calling environment first, so that each setting is only itself.
 VARIABLES = ("OPENBLAS_CORETYPE", "NPY_DISABLE_CPU_FEATURES", "OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS",
              "PARKSTEER_MODEL_CACHE")
@@ -89,11 +85,10 @@ def main() -> int:
     parser.add_argument("--only", nargs="+", choices=list(SETTINGS), help="these settings only (default first)")
     args = parser.parse_args()
     names = ["default", *[n for n in (args.only or SETTINGS) if n != "default"]]
-    if "avx512f" not in cpu_flags():
-        skipped = [n for n in names if SETTINGS[n].get("OPENBLAS_CORETYPE") in AVX512_KERNELS]
-        if skipped:
-            print(f"skipped, this CPU has no AVX-512: {', '.join(skipped)}", flush=True)
-        names = [n for n in names if n not in skipped]
+    skipped = [n for n in names if not kernel_runs_here(SETTINGS[n].get("OPENBLAS_CORETYPE", ""))]
+    if skipped:
+        print(f"skipped, this CPU has no AVX-512: {', '.join(skipped)}", flush=True)
+    names = [n for n in names if n not in skipped]
     results = {}
     with tempfile.TemporaryDirectory(prefix="parksteer-settings-") as scratch:
         for name in names:

@@ -71,11 +71,24 @@ def _first_cpu() -> dict[str, str] | None:
     return {k.strip(): v.strip() for k, _, v in (line.partition(":") for line in first.splitlines())}
 
 
+def _flags(fields: dict[str, str]) -> frozenset[str]:
+    return frozenset((fields.get("flags") or fields.get("Features") or "").split())
+
+
 def cpu_flags() -> frozenset[str]:
     """The CPU's feature flags as /proc/cpuinfo names them (x86's "flags", aarch64's "Features"); empty where it
-    cannot be read. An OpenBLAS kernel the CPU lacks the instructions of (SkylakeX without avx512f) dies of SIGILL."""
-    fields = _first_cpu() or {}
-    return frozenset((fields.get("flags") or fields.get("Features") or "").split())
+    cannot be read."""
+    return _flags(_first_cpu() or {})
+
+
+# OpenBLAS's kernels of AVX-512 code (OPENBLAS_CORETYPE values): on a CPU without avx512f, such as an AMD EPYC of the
+# Zen 3 generation, they die of SIGILL.
+AVX512_KERNELS = frozenset({"SkylakeX", "Cooperlake"})
+
+
+def kernel_runs_here(core: str) -> bool:
+    """Whether OpenBLAS's kernel `core` (an OPENBLAS_CORETYPE value) can run on this CPU."""
+    return core not in AVX512_KERNELS or "avx512f" in cpu_flags()
 
 
 def _cpu() -> tuple[str, str]:
@@ -84,7 +97,7 @@ def _cpu() -> tuple[str, str]:
     if fields is None:
         return platform.processor() or "unknown", "unknown"
     name = fields.get("model name") or fields.get("CPU part") or platform.processor() or "unknown"
-    flags = cpu_flags()
+    flags = _flags(fields)
     fma = "yes" if ("fma" in flags or "asimd" in flags) else "no"  # aarch64's Advanced SIMD always fuses
     return name, fma
 
